@@ -1,0 +1,103 @@
+//! The library's error type: every failure a user or a device can cause is one of these.
+
+use std::path::PathBuf;
+
+/// Result alias used throughout shadowgraph.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// Everything that can go wrong in shadowgraph, each variant naming what is wrong.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// No GPU adapter was found (not even a software one).
+    #[error(
+        "no GPU adapter found{detail}: on a machine without a GPU install Mesa's software Vulkan \
+         driver (Debian/Ubuntu: `apt-get install mesa-vulkan-drivers`)"
+    )]
+    NoAdapter {
+        /// Extra context (e.g. the `WGPU_ADAPTER_NAME` that matched nothing).
+        detail: String,
+    },
+    /// The adapter refused to create a device.
+    #[error("could not create a device on adapter `{adapter}`: {message}")]
+    RequestDevice {
+        /// Adapter name.
+        adapter: String,
+        /// wgpu's message.
+        message: String,
+    },
+    /// A WGSL kernel failed to parse, validate or import.
+    #[error("kernel `{kernel}`: {message}")]
+    Kernel {
+        /// Kernel name (`kernels/<name>.wgsl`).
+        kernel: String,
+        /// What went wrong, with source location where naga gives one.
+        message: String,
+    },
+    /// Pipeline creation failed on the device.
+    #[error("pipeline `shadowgraph.{kernel}`: {message}")]
+    Pipeline {
+        /// Kernel name.
+        kernel: String,
+        /// wgpu's validation message.
+        message: String,
+    },
+    /// Executing recorded GPU work failed.
+    #[error("GPU error during {stage}: {message}")]
+    Gpu {
+        /// What was running (e.g. `render`, `shade`).
+        stage: String,
+        /// wgpu's message.
+        message: String,
+    },
+    /// The kernel graph is malformed.
+    #[error("graph: {0}")]
+    Graph(#[from] crate::graph::GraphError),
+    /// A scene file could not be read or is invalid.
+    #[error("{path}{location}: {message}")]
+    Scene {
+        /// The scene file.
+        path: PathBuf,
+        /// `:line:column` when known, else empty.
+        location: String,
+        /// What is wrong, naming the key.
+        message: String,
+    },
+    /// A mesh referenced by a scene could not be loaded.
+    #[error("mesh `{path}`: {message}")]
+    Mesh {
+        /// The mesh file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+    /// A requested size exceeds what the device allows.
+    #[error("{what} is {requested}, but this device allows at most {limit}")]
+    Limit {
+        /// What was too large (e.g. `light[0].shadow_map`).
+        what: String,
+        /// The size asked for.
+        requested: u64,
+        /// The device limit.
+        limit: u64,
+    },
+    /// An argument is invalid (zero size, mismatched lengths, ...).
+    #[error("invalid argument: {0}")]
+    Invalid(String),
+    /// Reading or writing a file failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// Encoding an output image failed.
+    #[error("writing image `{path}`: {message}")]
+    Image {
+        /// The output path.
+        path: PathBuf,
+        /// Encoder message.
+        message: String,
+    },
+}

@@ -1,0 +1,283 @@
+//! GPU context: adapter selection, device creation with the adapter's own limits, readback.
+
+use std::sync::Arc;
+
+use crate::error::{Error, Result};
+
+/// A device and queue chosen by shadowgraph (the CLI's way in). Library entry points that run
+/// work take `&wgpu::Device`/`&wgpu::Queue` instead, so a host renderer can pass its own.
+pub struct Gpu {
+    /// The adapter the device came from.
+    pub adapter: wgpu::Adapter,
+    /// The logical device.
+    pub device: wgpu::Device,
+    /// Its queue.
+    pub queue: wgpu::Queue,
+}
+
+/// Features shadowgraph uses when offered; none is required.
+const WANTED_FEATURES: wgpu::Features = wgpu::Features::TIMESTAMP_QUERY
+    .union(wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES)
+    .union(wgpu::Features::FLOAT32_FILTERABLE)
+    .union(wgpu::Features::SHADER_F64)
+    .union(wgpu::Features::SHADER_INT64);
+
+impl Gpu {
+    /// Picks an adapter and creates a device with the adapter's own limits.
+    ///
+    /// Honours wgpu's environment overrides: `WGPU_BACKEND`, `WGPU_ADAPTER_NAME` (a substring of
+    /// the adapter name), `WGPU_POWER_PREF`.
+    pub fn new() -> Result<Self> {
+        pollster::block_on(Self::new_async())
+    }
+
+    async fn new_async() -> Result<Self> {
+        let instance = wgpu::Instance::new(
+            wgpu::InstanceDescriptor::new_without_display_handle_from_env(),
+        );
+        let adapter = pick_adapter(&instance).await?;
+        let info = adapter.get_info();
+        let features = adapter.features() & WANTED_FEATURES;
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("shadowgraph"),
+                required_features: features,
+                required_limits: adapter.limits(),
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| Error::RequestDevice {
+                adapter: info.name.clone(),
+                message: e.to_string(),
+            })?;
+        // Errors are caught with error scopes where they can happen; anything that escapes is
+        // logged rather than aborting the process from inside wgpu.
+        device.on_uncaptured_error(Arc::new(|e| log::error!("uncaptured wgpu error: {e}")));
+        Ok(Self {
+            adapter,
+            device,
+            queue,
+        })
+    }
+
+    /// One-line description of the adapter: name, backend, device type, driver.
+    pub fn describe(&self) -> String {
+        let i = self.adapter.get_info();
+        format!(
+            "{} ({:?}, {:?}, driver {} {})",
+            i.name, i.backend, i.device_type, i.driver, i.driver_info
+        )
+    }
+
+    /// Whether GPU timestamps can be written around compute passes.
+    pub fn can_time(&self) -> bool {
+        self.device.features().contains(wgpu::Features::TIMESTAMP_QUERY)
+    }
+
+    /// The facts `shadowgraph info` prints: adapter, backend, features and limits that matter.
+    pub fn info_report(&self) -> String {
+        let i = self.adapter.get_info();
+        let f = self.device.features();
+        let l = self.device.limits();
+        let mut s = String::new();
+        let mut line = |k: &str, v: String| s.push_str(&format!("{k:<40} {v}\n"));
+        line("adapter", i.name.clone());
+        line("backend", format!("{:?}", i.backend));
+        line("device type", format!("{:?}", i.device_type));
+        line("driver", format!("{} {}", i.driver, i.driver_info));
+        for (name, feat) in [
+            ("TIMESTAMP_QUERY", wgpu::Features::TIMESTAMP_QUERY),
+            ("TIMESTAMP_QUERY_INSIDE_PASSES", wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES),
+            ("FLOAT32_FILTERABLE", wgpu::Features::FLOAT32_FILTERABLE),
+            ("SHADER_F64", wgpu::Features::SHADER_F64),
+            ("SHADER_INT64", wgpu::Features::SHADER_INT64),
+        ] {
+            line(&format!("feature {name}"), yes_no(f.contains(feat)));
+        }
+        line("max_texture_dimension_2d", l.max_texture_dimension_2d.to_string());
+        line("max_storage_textures_per_shader_stage", l.max_storage_textures_per_shader_stage.to_string());
+        line("max_sampled_textures_per_shader_stage", l.max_sampled_textures_per_shader_stage.to_string());
+        line("max_storage_buffer_binding_size", l.max_storage_buffer_binding_size.to_string());
+        line("max_buffer_size", l.max_buffer_size.to_string());
+        line("max_compute_workgroup_storage_size", l.max_compute_workgroup_storage_size.to_string());
+        line("max_compute_invocations_per_workgroup", l.max_compute_invocations_per_workgroup.to_string());
+        line("max_compute_workgroups_per_dimension", l.max_compute_workgroups_per_dimension.to_string());
+        line("max_bind_groups", l.max_bind_groups.to_string());
+        line("timestamp period (ns/tick)", format!("{}", self.queue.get_timestamp_period()));
+        s
+    }
+}
+
+fn yes_no(b: bool) -> String {
+    if b { "yes" } else { "no" }.to_string()
+}
+
+async fn pick_adapter(instance: &wgpu::Instance) -> Result<wgpu::Adapter> {
+    if let Ok(wanted) = std::env::var("WGPU_ADAPTER_NAME") {
+        let wanted = wanted.to_lowercase();
+        let adapters = instance.enumerate_adapters(wgpu::Backends::all()).await;
+        let names: Vec<String> = adapters.iter().map(|a| a.get_info().name).collect();
+        return adapters
+            .into_iter()
+            .find(|a| a.get_info().name.to_lowercase().contains(&wanted))
+            .ok_or_else(|| Error::NoAdapter {
+                detail: format!(
+                    " matching WGPU_ADAPTER_NAME={wanted:?} (adapters present: {names:?})"
+                ),
+            });
+    }
+    instance
+        .request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::from_env().unwrap_or_default(),
+            ..Default::default()
+        })
+        .await
+        .map_err(|e| Error::NoAdapter {
+            detail: format!(" ({e})"),
+        })
+}
+
+/// Runs `f` inside a validation error scope and turns a captured error into `make_err`.
+pub fn scoped<T>(
+    device: &wgpu::Device,
+    f: impl FnOnce() -> T,
+    make_err: impl FnOnce(String) -> Error,
+) -> Result<T> {
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let out = f();
+    match pollster::block_on(scope.pop()) {
+        None => Ok(out),
+        Some(e) => Err(make_err(e.to_string())),
+    }
+}
+
+/// Submits `encoder`, waits for completion, and reports any validation error as `stage`.
+pub fn submit_and_wait(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    encoder: wgpu::CommandEncoder,
+    stage: &str,
+) -> Result<()> {
+    let gpu_err = |m: String| Error::Gpu {
+        stage: stage.to_string(),
+        message: m,
+    };
+    scoped(device, || queue.submit([encoder.finish()]), gpu_err)?;
+    device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| gpu_err(e.to_string()))?;
+    Ok(())
+}
+
+/// Reads a whole buffer back (it must have `MAP_READ`); waits for the device.
+pub fn read_buffer(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
+    let (tx, rx) = std::sync::mpsc::channel();
+    buffer.map_async(wgpu::MapMode::Read, .., move |r| {
+        let _ = tx.send(r);
+    });
+    device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| Error::Gpu {
+            stage: "readback".into(),
+            message: e.to_string(),
+        })?;
+    let mapped = rx.recv().map_err(|e| Error::Gpu {
+        stage: "readback".into(),
+        message: e.to_string(),
+    })?;
+    mapped.map_err(|e| Error::Gpu {
+        stage: "readback".into(),
+        message: e.to_string(),
+    })?;
+    let data = buffer
+        .get_mapped_range(..)
+        .map_err(|e| Error::Gpu {
+            stage: "readback".into(),
+            message: e.to_string(),
+        })?
+        .to_vec();
+    buffer.unmap();
+    Ok(data)
+}
+
+/// Copies mip level `mip` of a 2-D texture to the CPU, tightly packed (rows without padding).
+pub fn read_texture(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+    mip: u32,
+) -> Result<Vec<u8>> {
+    let format = texture.format();
+    let bpp = format
+        .block_copy_size(Some(wgpu::TextureAspect::All))
+        .or_else(|| format.block_copy_size(Some(wgpu::TextureAspect::DepthOnly)))
+        .ok_or_else(|| Error::Invalid(format!("cannot read back {format:?}")))?;
+    let w = (texture.width() >> mip).max(1);
+    let h = (texture.height() >> mip).max(1);
+    let row = w * bpp;
+    let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("shadowgraph.readback"),
+        size: u64::from(padded) * u64::from(h),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut enc = device.create_command_encoder(&Default::default());
+    let aspect = if format.is_depth_stencil_format() {
+        wgpu::TextureAspect::DepthOnly
+    } else {
+        wgpu::TextureAspect::All
+    };
+    enc.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: mip,
+            origin: wgpu::Origin3d::ZERO,
+            aspect,
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded),
+                rows_per_image: Some(h),
+            },
+        },
+        wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        },
+    );
+    submit_and_wait(device, queue, enc, "readback")?;
+    let raw = read_buffer(device, &buffer)?;
+    let mut out = Vec::with_capacity((row * h) as usize);
+    for y in 0..h as usize {
+        let start = y * padded as usize;
+        out.extend_from_slice(&raw[start..start + row as usize]);
+    }
+    Ok(out)
+}
+
+/// Uploads tightly packed texel data into mip 0 of a 2-D texture.
+pub fn write_texture(queue: &wgpu::Queue, texture: &wgpu::Texture, data: &[u8]) {
+    let bpp = texture
+        .format()
+        .block_copy_size(Some(wgpu::TextureAspect::All))
+        .unwrap_or(4);
+    queue.write_texture(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        data,
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(texture.width() * bpp),
+            rows_per_image: Some(texture.height()),
+        },
+        texture.size(),
+    );
+}

@@ -1,0 +1,204 @@
+//! The kernel graph as data: nodes name a kernel, their named input and output resources
+//! (format and size rule) and their parameters. [`plan()`] turns a graph and the outputs a
+//! scene asks for into an ordered, pruned [`Plan`] with resource lifetimes and texture reuse.
+
+mod plan;
+pub mod print;
+
+pub use plan::{Plan, PlannedResource, Slot, Step, plan};
+
+/// How big a resource is.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum SizeRule {
+    /// An explicit extent in texels.
+    Fixed {
+        /// Width.
+        width: u32,
+        /// Height.
+        height: u32,
+    },
+    /// The size of another resource divided by `2^shift` (rounded up, at least 1).
+    Reduced {
+        /// The resource whose size this follows.
+        of: String,
+        /// Halvings.
+        shift: u32,
+    },
+}
+
+/// A named, typed texture in the graph.
+#[derive(Clone, Debug)]
+pub struct Resource {
+    /// Unique name, `light<i>.<what>` by convention (e.g. `light0.linear`).
+    pub name: String,
+    /// Texel format.
+    pub format: wgpu::TextureFormat,
+    /// Size rule.
+    pub size: SizeRule,
+    /// Mip levels (1 for a plain map).
+    pub mips: u32,
+    /// Provided from outside the graph (the rasterized shadow map); never allocated by it.
+    pub imported: bool,
+    /// The light this resource belongs to, if any.
+    pub light: Option<usize>,
+}
+
+/// How many workgroups a node dispatches.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Dispatch {
+    /// One invocation per texel of this resource (workgroup size from the kernel).
+    Texels(String),
+    /// An explicit workgroup count.
+    Groups([u32; 3]),
+}
+
+/// One kernel invocation in the graph.
+#[derive(Clone, Debug)]
+pub struct Node {
+    /// Unique label, e.g. `light0.linearize`; pipelines and passes are labelled with it.
+    pub name: String,
+    /// Kernel name: `kernels/<kernel>.wgsl`.
+    pub kernel: String,
+    /// `(binding name in the WGSL, resource name)` read by the kernel.
+    pub inputs: Vec<(String, String)>,
+    /// `(binding name in the WGSL, resource name)` written by the kernel.
+    pub outputs: Vec<(String, String)>,
+    /// Bytes of the kernel's `params` uniform (a `#[repr(C)]` mirror of its WGSL struct).
+    pub params: Vec<u8>,
+    /// Dispatch size.
+    pub dispatch: Dispatch,
+    /// The light this node works for, if any.
+    pub light: Option<usize>,
+}
+
+/// A set of resources and the nodes that produce and consume them.
+#[derive(Clone, Debug, Default)]
+pub struct Graph {
+    /// Resources in declaration order.
+    pub resources: Vec<Resource>,
+    /// Nodes in declaration order (the tie-break of the planner's ordering).
+    pub nodes: Vec<Node>,
+}
+
+impl Graph {
+    /// Declares a resource produced inside the graph; returns its name.
+    pub fn resource(
+        &mut self,
+        name: impl Into<String>,
+        format: wgpu::TextureFormat,
+        size: SizeRule,
+        light: Option<usize>,
+    ) -> String {
+        let name = name.into();
+        self.resources.push(Resource {
+            name: name.clone(),
+            format,
+            size,
+            mips: 1,
+            imported: false,
+            light,
+        });
+        name
+    }
+
+    /// Declares a resource provided from outside (e.g. a rasterized depth map).
+    pub fn import(
+        &mut self,
+        name: impl Into<String>,
+        format: wgpu::TextureFormat,
+        width: u32,
+        height: u32,
+        light: Option<usize>,
+    ) -> String {
+        let name = name.into();
+        self.resources.push(Resource {
+            name: name.clone(),
+            format,
+            size: SizeRule::Fixed { width, height },
+            mips: 1,
+            imported: true,
+            light,
+        });
+        name
+    }
+
+    /// Adds a node.
+    pub fn node(&mut self, node: Node) {
+        self.nodes.push(node);
+    }
+
+    /// The resource named `name`.
+    pub fn find(&self, name: &str) -> Option<&Resource> {
+        self.resources.iter().find(|r| r.name == name)
+    }
+}
+
+/// A wiring mistake in a graph, found by the planner.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum GraphError {
+    /// A node reads or writes a resource that was never declared.
+    #[error("node `{node}` uses undeclared resource `{resource}`")]
+    UnknownResource {
+        /// The node.
+        node: String,
+        /// The resource name.
+        resource: String,
+    },
+    /// An output was asked for that was never declared.
+    #[error("output `{0}` is not a declared resource")]
+    UnknownOutput(String),
+    /// A needed resource has no node producing it and is not imported.
+    #[error("resource `{resource}` (needed by {needed_by}) has no producer and is not imported")]
+    MissingProducer {
+        /// The resource.
+        resource: String,
+        /// Who needs it: a node name or `the outputs`.
+        needed_by: String,
+    },
+    /// Two nodes write the same resource.
+    #[error("resource `{resource}` is written by both `{first}` and `{second}`")]
+    DuplicateProducer {
+        /// The resource.
+        resource: String,
+        /// The first writer.
+        first: String,
+        /// The second writer.
+        second: String,
+    },
+    /// A node writes an imported resource.
+    #[error("node `{node}` writes imported resource `{resource}`")]
+    WritesImport {
+        /// The node.
+        node: String,
+        /// The resource.
+        resource: String,
+    },
+    /// Two nodes or two resources share a name.
+    #[error("name `{0}` is declared twice")]
+    DuplicateName(String),
+    /// The needed part of the graph has a cycle.
+    #[error("cycle through nodes {}", .0.join(" → "))]
+    Cycle(Vec<String>),
+    /// A size rule refers to a missing resource or to itself.
+    #[error("size of `{resource}`: {message}")]
+    BadSize {
+        /// The resource.
+        resource: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// Bytes of one texel of `format` (0 where the format has no fixed size).
+pub fn texel_bytes(format: wgpu::TextureFormat) -> u64 {
+    u64::from(
+        format
+            .block_copy_size(None)
+            .or_else(|| format.block_copy_size(Some(wgpu::TextureAspect::DepthOnly)))
+            .unwrap_or(0),
+    )
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,118 @@
+//! Human-readable and Graphviz views of a plan.
+
+use std::fmt::Write;
+
+use super::Plan;
+
+/// `1.5 MiB`-style byte counts.
+pub fn human_bytes(b: u64) -> String {
+    const UNITS: [&str; 4] = ["B", "KiB", "MiB", "GiB"];
+    let mut v = b as f64;
+    let mut u = 0;
+    while v >= 1024.0 && u < UNITS.len() - 1 {
+        v /= 1024.0;
+        u += 1;
+    }
+    if u == 0 {
+        format!("{b} B")
+    } else {
+        format!("{v:.1} {}", UNITS[u])
+    }
+}
+
+impl Plan {
+    /// The text `shadowgraph plan` prints: per light, the ordered nodes and the resources they
+    /// touch (format, size, bytes), then memory totals.
+    pub fn to_text(&self, light_labels: &[String]) -> String {
+        let mut s = String::new();
+        for (li, label) in light_labels.iter().enumerate() {
+            let _ = writeln!(s, "light {li}: {label}");
+            let steps: Vec<_> = self
+                .steps
+                .iter()
+                .enumerate()
+                .filter(|(_, st)| st.node.light == Some(li))
+                .collect();
+            if steps.is_empty() {
+                let _ = writeln!(s, "  (no kernels: the shading pass reads the rasterized map)");
+            }
+            for (i, st) in steps {
+                let n = &st.node;
+                let ins: Vec<&str> = n.inputs.iter().map(|(_, r)| r.as_str()).collect();
+                let outs: Vec<&str> = n.outputs.iter().map(|(_, r)| r.as_str()).collect();
+                let _ = writeln!(
+                    s,
+                    "  {i:>2}. {:<24} kernel {:<12} {} -> {}",
+                    n.name,
+                    n.kernel,
+                    ins.join(", "),
+                    outs.join(", ")
+                );
+            }
+            for r in self.resources.iter().filter(|r| r.resource.light == Some(li)) {
+                let role = if r.resource.imported {
+                    "imported".to_string()
+                } else {
+                    format!("slot {}", r.slot.map_or("-".into(), |s| s.to_string()))
+                };
+                let out = if self.outputs.contains(&r.resource.name) {
+                    ", read by shading"
+                } else {
+                    ""
+                };
+                let _ = writeln!(
+                    s,
+                    "      {:<24} {:<14} {:>5}x{:<5} {:>10}  ({role}{out})",
+                    r.resource.name,
+                    format!("{:?}", r.resource.format),
+                    r.width,
+                    r.height,
+                    human_bytes(r.bytes)
+                );
+            }
+        }
+        let imported: u64 = self
+            .resources
+            .iter()
+            .filter(|r| r.resource.imported)
+            .map(|r| r.bytes)
+            .sum();
+        let _ = writeln!(
+            s,
+            "memory: {} in {} pooled texture(s), peak live {}, plus {} imported",
+            human_bytes(self.slot_bytes()),
+            self.slots.len(),
+            human_bytes(self.peak_live_bytes()),
+            human_bytes(imported)
+        );
+        s
+    }
+
+    /// Graphviz: resources as boxes, nodes as ellipses, one cluster per light.
+    pub fn to_dot(&self) -> String {
+        let mut s = String::from("digraph shadowgraph {\n  rankdir=LR;\n");
+        for r in &self.resources {
+            let _ = writeln!(
+                s,
+                "  \"{0}\" [shape=box, label=\"{0}\\n{1:?} {2}x{3}\"];",
+                r.resource.name, r.resource.format, r.width, r.height
+            );
+        }
+        for st in &self.steps {
+            let n = &st.node;
+            let _ = writeln!(s, "  \"{0}\" [shape=ellipse, label=\"{0}\\n{1}\"];", n.name, n.kernel);
+            for (_, r) in &n.inputs {
+                let _ = writeln!(s, "  \"{r}\" -> \"{}\";", n.name);
+            }
+            for (_, r) in &n.outputs {
+                let _ = writeln!(s, "  \"{}\" -> \"{r}\";", n.name);
+            }
+        }
+        let _ = writeln!(s, "  \"shade\" [shape=doubleoctagon];");
+        for o in &self.outputs {
+            let _ = writeln!(s, "  \"{o}\" -> \"shade\";");
+        }
+        s.push_str("}\n");
+        s
+    }
+}

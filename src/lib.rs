@@ -1,0 +1,7 @@
+//! shadowgraph: shadow-map prefiltering on the GPU as a graph of WGSL compute kernels.
+pub mod error;
+pub mod gpu;
+pub mod graph;
+pub mod kernels;
+
+pub use error::{Error, Result};
