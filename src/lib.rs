@@ -3,5 +3,6 @@ pub mod error;
 pub mod gpu;
 pub mod graph;
 pub mod kernels;
+pub mod scene;
 
 pub use error::{Error, Result};

@@ -1,0 +1,139 @@
+//! The scene file as written: TOML with every value spanned, so each error names its line.
+
+use serde::Deserialize;
+use toml::Spanned;
+
+/// A scalar or a list of numbers (`size = 2` or `size = [2, 1, 3]`).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(untagged)]
+pub enum Num {
+    /// One number.
+    One(f64),
+    /// Several.
+    Many(Vec<f64>),
+}
+
+/// A spanned 3-vector.
+pub type V3 = Spanned<[f64; 3]>;
+
+/// The whole file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// Ambient light colour.
+    pub ambient: Option<V3>,
+    /// `[output]`.
+    pub output: OutputFile,
+    /// `[camera]`.
+    pub camera: CameraFile,
+    /// `[[light]]`.
+    #[serde(default, rename = "light")]
+    pub lights: Vec<LightFile>,
+    /// `[[object]]`.
+    #[serde(default, rename = "object")]
+    pub objects: Vec<ObjectFile>,
+}
+
+/// `[output]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputFile {
+    /// Image width in pixels.
+    pub width: Spanned<i64>,
+    /// Image height in pixels.
+    pub height: Spanned<i64>,
+    /// Background colour.
+    pub background: Option<V3>,
+}
+
+/// `[camera]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraFile {
+    /// Eye position.
+    pub position: V3,
+    /// Look-at point.
+    pub target: V3,
+    /// Up vector (default +Y).
+    pub up: Option<V3>,
+    /// Vertical field of view.
+    pub fov_y_degrees: Spanned<f64>,
+}
+
+/// `[[light]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightFile {
+    /// `directional` or `spot`.
+    pub kind: Spanned<String>,
+    /// Light position (directional: where its orthographic frustum starts).
+    pub position: V3,
+    /// Point the light aims at.
+    pub target: V3,
+    /// Spot cone angle (full), degrees.
+    pub fov_degrees: Option<Spanned<f64>>,
+    /// Directional: half-width of the orthographic frustum.
+    pub extent: Option<Spanned<f64>>,
+    /// Near plane distance.
+    pub near: Option<Spanned<f64>>,
+    /// Far plane distance.
+    pub far: Option<Spanned<f64>>,
+    /// Area-light width in world units (soft shadows).
+    pub size: Option<Spanned<f64>>,
+    /// Colour.
+    pub color: Option<V3>,
+    /// Intensity multiplier.
+    pub intensity: Option<Spanned<f64>>,
+    /// Shadow-map resolution (square).
+    pub shadow_map: Option<Spanned<i64>>,
+    /// `[light.shadow]`.
+    pub shadow: Option<ShadowFile>,
+}
+
+/// `[light.shadow]`: the technique and its parameters.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShadowFile {
+    /// Technique name.
+    pub technique: Spanned<String>,
+    /// Constant depth bias (linear depth units).
+    pub bias: Option<Spanned<f64>>,
+    /// Slope-scaled bias at rasterization.
+    pub slope_bias: Option<Spanned<f64>>,
+    /// Normal offset in shadow-map texels.
+    pub normal_bias: Option<Spanned<f64>>,
+    /// PCF radius in texels.
+    pub radius: Option<Spanned<i64>>,
+    /// PCF weights: `box`, `tent` or `hardware`.
+    pub kernel: Option<Spanned<String>>,
+    /// PCSS blocker-search taps.
+    pub blocker_samples: Option<Spanned<i64>>,
+    /// PCSS filter taps.
+    pub filter_samples: Option<Spanned<i64>>,
+    /// PCSS cap on the blocker-search radius, in shadow-map UV.
+    pub max_search: Option<Spanned<f64>>,
+}
+
+/// `[[object]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectFile {
+    /// `plane`, `box`, `sphere`, `cylinder` or `mesh`.
+    pub shape: Spanned<String>,
+    /// Plane: `[x, z]` or one number; box: `[x, y, z]` or one number.
+    pub size: Option<Spanned<Num>>,
+    /// Sphere and cylinder radius.
+    pub radius: Option<Spanned<f64>>,
+    /// Cylinder height.
+    pub height: Option<Spanned<f64>>,
+    /// Mesh file, relative to the scene file.
+    pub path: Option<Spanned<String>>,
+    /// Translation.
+    pub translate: Option<V3>,
+    /// Rotation about X, then Y, then Z, degrees.
+    pub rotate_degrees: Option<V3>,
+    /// Scale: one number or `[x, y, z]`.
+    pub scale: Option<Spanned<Num>>,
+    /// Albedo.
+    pub color: Option<V3>,
+}

@@ -1,0 +1,234 @@
+//! Scenes: the validated model, loaded from TOML (see `format`) with errors that name the file,
+//! the key and the line.
+
+pub mod format;
+pub mod mesh;
+mod validate;
+
+use std::path::{Path, PathBuf};
+
+use glam::{Mat4, Vec3};
+
+use crate::error::{Error, Result};
+pub use mesh::{Mesh, Vertex};
+
+/// A loaded, validated scene.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// The file it came from.
+    pub path: PathBuf,
+    /// Output image size.
+    pub width: u32,
+    /// Output image height.
+    pub height: u32,
+    /// Background colour (linear RGB).
+    pub background: Vec3,
+    /// Ambient light (linear RGB).
+    pub ambient: Vec3,
+    /// The camera.
+    pub camera: Camera,
+    /// Lights, each with its own shadow technique.
+    pub lights: Vec<Light>,
+    /// Objects, already turned into world-space triangle meshes.
+    pub objects: Vec<Object>,
+}
+
+/// A perspective camera.
+#[derive(Clone, Debug)]
+pub struct Camera {
+    /// Eye position.
+    pub position: Vec3,
+    /// Look-at point.
+    pub target: Vec3,
+    /// Up vector.
+    pub up: Vec3,
+    /// Vertical field of view, degrees.
+    pub fov_y_degrees: f32,
+}
+
+impl Camera {
+    /// World → clip for an image of `aspect` = width / height.
+    pub fn view_proj(&self, aspect: f32) -> Mat4 {
+        let proj = Mat4::perspective_rh(self.fov_y_degrees.to_radians(), aspect, 0.05, 500.0);
+        proj * Mat4::look_at_rh(self.position, self.target, self.up)
+    }
+}
+
+/// The projection a light's shadow map uses.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightKind {
+    /// Orthographic, half-width `extent`.
+    Directional {
+        /// Half-width of the frustum in world units.
+        extent: f32,
+    },
+    /// Perspective with a square frustum of full angle `fov_degrees`.
+    Spot {
+        /// Full cone angle, degrees.
+        fov_degrees: f32,
+    },
+}
+
+/// Weights of an N×N PCF window.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PcfKernel {
+    /// Equal weights.
+    Box,
+    /// Bilinear tent weights `(r + 1 − |dx|)(r + 1 − |dy|)`.
+    Tent,
+    /// The hardware 2×2 comparison sampler (`textureSampleCompareLevel`).
+    Hardware,
+}
+
+/// A light's shadow technique and its parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Technique {
+    /// One comparison at the nearest texel.
+    Hard,
+    /// Percentage-closer filtering.
+    Pcf {
+        /// Window radius in texels (window is `2r + 1` wide).
+        radius: u32,
+        /// Weights.
+        kernel: PcfKernel,
+    },
+    /// Percentage-closer soft shadows (Fernando 2005).
+    Pcss {
+        /// Blocker-search taps.
+        blocker_samples: u32,
+        /// Filter taps.
+        filter_samples: u32,
+        /// Cap on the blocker-search radius in shadow-map UV.
+        max_search: f32,
+    },
+}
+
+impl Technique {
+    /// The name used in scene files.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Technique::Hard => "hard",
+            Technique::Pcf { .. } => "pcf",
+            Technique::Pcss { .. } => "pcss",
+        }
+    }
+}
+
+/// How a light's shadow map is made and read.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shadow {
+    /// Technique.
+    pub technique: Technique,
+    /// Constant bias at the comparison, in linear depth units.
+    pub bias: f32,
+    /// Slope-scaled bias at rasterization (wgpu `DepthBiasState::slope_scale`).
+    pub slope_bias: f32,
+    /// Normal offset in shadow-map texels, scaled by `1 − N·L`.
+    pub normal_bias: f32,
+}
+
+/// A light.
+#[derive(Clone, Debug)]
+pub struct Light {
+    /// Projection.
+    pub kind: LightKind,
+    /// Position.
+    pub position: Vec3,
+    /// Aim point.
+    pub target: Vec3,
+    /// Near plane.
+    pub near: f32,
+    /// Far plane.
+    pub far: f32,
+    /// Area-light width, world units (0 = point/sharp).
+    pub size: f32,
+    /// Colour × intensity.
+    pub radiance: Vec3,
+    /// Shadow-map resolution.
+    pub shadow_map: u32,
+    /// Shadow settings.
+    pub shadow: Shadow,
+}
+
+impl Light {
+    /// Unit vector from the light toward its target.
+    pub fn direction(&self) -> Vec3 {
+        (self.target - self.position).normalize()
+    }
+
+    /// World → light view space.
+    pub fn view(&self) -> Mat4 {
+        let dir = self.direction();
+        let up = if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
+        Mat4::look_at_rh(self.position, self.target, up)
+    }
+
+    /// Light view → clip (depth in [0, 1]).
+    pub fn projection(&self) -> Mat4 {
+        match self.kind {
+            LightKind::Directional { extent } => {
+                Mat4::orthographic_rh(-extent, extent, -extent, extent, self.near, self.far)
+            }
+            LightKind::Spot { fov_degrees } => {
+                Mat4::perspective_rh(fov_degrees.to_radians(), 1.0, self.near, self.far)
+            }
+        }
+    }
+
+    /// World width covered by the shadow map at view distance 1 (spot) or at any distance
+    /// (directional): the map spans `width_at_unit * distance` (spot) world units.
+    pub fn width_at_unit(&self) -> f32 {
+        match self.kind {
+            LightKind::Directional { extent } => 2.0 * extent,
+            LightKind::Spot { fov_degrees } => 2.0 * (0.5 * fov_degrees.to_radians()).tan(),
+        }
+    }
+
+    /// One-line description for plans and reports.
+    pub fn label(&self) -> String {
+        let kind = match self.kind {
+            LightKind::Directional { .. } => "directional",
+            LightKind::Spot { .. } => "spot",
+        };
+        format!(
+            "{kind}, {} shadows, {}² map",
+            self.shadow.technique.name(),
+            self.shadow_map
+        )
+    }
+}
+
+/// A scene object: its world-space mesh and colour.
+#[derive(Clone, Debug)]
+pub struct Object {
+    /// World-space triangles.
+    pub mesh: Mesh,
+    /// Albedo (linear RGB).
+    pub color: Vec3,
+}
+
+impl Scene {
+    /// Reads and validates a scene file; meshes are loaded relative to it.
+    pub fn load(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::parse(path, &text)
+    }
+
+    /// Parses scene text; `path` names the file in errors and anchors relative mesh paths.
+    pub fn parse(path: &Path, text: &str) -> Result<Self> {
+        validate::parse(path, text)
+    }
+
+    /// All objects' triangles as one vertex list (material = object index).
+    pub fn vertices(&self) -> Vec<Vertex> {
+        self.objects
+            .iter()
+            .enumerate()
+            .flat_map(|(i, o)| o.mesh.vertices(i as u32))
+            .collect()
+    }
+}

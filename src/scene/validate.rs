@@ -1,0 +1,345 @@
+//! Turns the spanned TOML (`format`) into the validated model, naming key and line on errors.
+
+use std::ops::Range;
+use std::path::Path;
+
+use glam::{EulerRot, Mat4, Quat, Vec3};
+use toml::Spanned;
+
+use super::format::{LightFile, Num, ObjectFile, SceneFile, ShadowFile, V3};
+use super::{
+    Camera, Light, LightKind, Mesh, Object, PcfKernel, Scene, Shadow, Technique, mesh,
+};
+use crate::error::{Error, Result};
+
+/// Largest output or shadow-map side accepted before the device is even asked.
+const MAX_SIDE: i64 = 1 << 16;
+
+struct Ctx<'a> {
+    path: &'a Path,
+    text: &'a str,
+}
+
+impl Ctx<'_> {
+    fn location(&self, span: Option<Range<usize>>) -> String {
+        let Some(span) = span else { return String::new() };
+        let before = &self.text[..span.start.min(self.text.len())];
+        let line = before.matches('\n').count() + 1;
+        let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+        format!(":{line}:{col}")
+    }
+
+    fn err(&self, span: Option<Range<usize>>, message: impl Into<String>) -> Error {
+        Error::Scene {
+            path: self.path.to_path_buf(),
+            location: self.location(span),
+            message: message.into(),
+        }
+    }
+
+    fn vec3(&self, key: &str, v: &V3) -> Result<Vec3> {
+        let [x, y, z] = *v.get_ref();
+        if ![x, y, z].iter().all(|c| c.is_finite()) {
+            return Err(self.err(Some(v.span()), format!("`{key}` must be finite, got {:?}", [x, y, z])));
+        }
+        Ok(Vec3::new(x as f32, y as f32, z as f32))
+    }
+
+    fn vec3_or(&self, key: &str, v: &Option<V3>, default: Vec3) -> Result<Vec3> {
+        v.as_ref().map_or(Ok(default), |v| self.vec3(key, v))
+    }
+
+    /// A finite number inside `[lo, hi]` (use infinities for open ends).
+    fn num(&self, key: &str, v: &Spanned<f64>, lo: f64, hi: f64) -> Result<f32> {
+        let x = *v.get_ref();
+        if !x.is_finite() || x < lo || x > hi {
+            return Err(self.err(Some(v.span()), format!("`{key}` = {x} is outside [{lo}, {hi}]")));
+        }
+        Ok(x as f32)
+    }
+
+    fn num_or(&self, key: &str, v: &Option<Spanned<f64>>, lo: f64, hi: f64, d: f32) -> Result<f32> {
+        v.as_ref().map_or(Ok(d), |v| self.num(key, v, lo, hi))
+    }
+
+    fn int(&self, key: &str, v: &Spanned<i64>, lo: i64, hi: i64) -> Result<u32> {
+        let x = *v.get_ref();
+        if x < lo || x > hi {
+            return Err(self.err(Some(v.span()), format!("`{key}` = {x} is outside [{lo}, {hi}]")));
+        }
+        Ok(x as u32)
+    }
+
+    fn int_or(&self, key: &str, v: &Option<Spanned<i64>>, lo: i64, hi: i64, d: u32) -> Result<u32> {
+        v.as_ref().map_or(Ok(d), |v| self.int(key, v, lo, hi))
+    }
+
+    fn required<'v, T>(&self, key: &str, v: &'v Option<T>, at: Range<usize>) -> Result<&'v T> {
+        v.as_ref()
+            .ok_or_else(|| self.err(Some(at), format!("missing key `{key}`")))
+    }
+
+    fn reject<T>(&self, key: &str, v: &Option<Spanned<T>>, why: &str) -> Result<()> {
+        match v {
+            Some(v) => Err(self.err(Some(v.span()), format!("`{key}` {why}"))),
+            None => Ok(()),
+        }
+    }
+}
+
+pub(super) fn parse(path: &Path, text: &str) -> Result<Scene> {
+    let ctx = Ctx { path, text };
+    let file: SceneFile = toml::from_str(text).map_err(|e| ctx.err(e.span(), e.message().trim()))?;
+    let width = ctx.int("output.width", &file.output.width, 1, MAX_SIDE)?;
+    let height = ctx.int("output.height", &file.output.height, 1, MAX_SIDE)?;
+    let background =
+        ctx.vec3_or("output.background", &file.output.background, Vec3::new(0.55, 0.62, 0.72))?;
+    let ambient = ctx.vec3_or("ambient", &file.ambient, Vec3::splat(0.12))?;
+    let camera = camera(&ctx, &file)?;
+    if file.lights.is_empty() {
+        return Err(ctx.err(None, "the scene has no `[[light]]`"));
+    }
+    let lights = file
+        .lights
+        .iter()
+        .enumerate()
+        .map(|(i, l)| light(&ctx, i, l))
+        .collect::<Result<Vec<_>>>()?;
+    let objects = file
+        .objects
+        .iter()
+        .enumerate()
+        .map(|(i, o)| object(&ctx, i, o))
+        .collect::<Result<Vec<_>>>()?;
+    if objects.is_empty() {
+        return Err(ctx.err(None, "the scene has no `[[object]]`"));
+    }
+    Ok(Scene {
+        path: path.to_path_buf(),
+        width,
+        height,
+        background,
+        ambient,
+        camera,
+        lights,
+        objects,
+    })
+}
+
+fn camera(ctx: &Ctx, file: &SceneFile) -> Result<Camera> {
+    let c = &file.camera;
+    let position = ctx.vec3("camera.position", &c.position)?;
+    let target = ctx.vec3("camera.target", &c.target)?;
+    let up = ctx.vec3_or("camera.up", &c.up, Vec3::Y)?;
+    let fov_y_degrees = ctx.num("camera.fov_y_degrees", &c.fov_y_degrees, 1.0, 170.0)?;
+    let forward = target - position;
+    if forward.length() < 1e-6 {
+        return Err(ctx.err(Some(c.target.span()), "`camera.target` equals `camera.position`"));
+    }
+    if forward.normalize().cross(up).length() < 1e-4 {
+        return Err(ctx.err(c.up.as_ref().map(|u| u.span()), "`camera.up` is parallel to the view direction"));
+    }
+    Ok(Camera {
+        position,
+        target,
+        up,
+        fov_y_degrees,
+    })
+}
+
+fn light(ctx: &Ctx, i: usize, l: &LightFile) -> Result<Light> {
+    let key = |k: &str| format!("light[{i}].{k}");
+    let kind = match l.kind.get_ref().as_str() {
+        "directional" => {
+            ctx.reject(&key("fov_degrees"), &l.fov_degrees, "applies to spot lights only")?;
+            let e = ctx.required(&key("extent"), &l.extent, l.kind.span())?;
+            LightKind::Directional {
+                extent: ctx.num(&key("extent"), e, 1e-3, 1e6)?,
+            }
+        }
+        "spot" => {
+            ctx.reject(&key("extent"), &l.extent, "applies to directional lights only")?;
+            let f = ctx.required(&key("fov_degrees"), &l.fov_degrees, l.kind.span())?;
+            LightKind::Spot {
+                fov_degrees: ctx.num(&key("fov_degrees"), f, 1.0, 170.0)?,
+            }
+        }
+        other => {
+            return Err(ctx.err(
+                Some(l.kind.span()),
+                format!("`{}` = \"{other}\": unknown light kind (expected \"directional\" or \"spot\")", key("kind")),
+            ));
+        }
+    };
+    let position = ctx.vec3(&key("position"), &l.position)?;
+    let target = ctx.vec3(&key("target"), &l.target)?;
+    if (target - position).length() < 1e-6 {
+        return Err(ctx.err(Some(l.target.span()), format!("`{}` equals its position", key("target"))));
+    }
+    let near = ctx.num_or(&key("near"), &l.near, 1e-6, 1e7, 0.1)?;
+    let far = ctx.num_or(&key("far"), &l.far, 1e-6, 1e7, 50.0)?;
+    if far <= near {
+        let span = l.far.as_ref().or(l.near.as_ref()).map(|s| s.span());
+        return Err(ctx.err(span, format!("`{}` ({far}) must exceed `{}` ({near})", key("far"), key("near"))));
+    }
+    let size = ctx.num_or(&key("size"), &l.size, 0.0, 1e6, 0.0)?;
+    let color = ctx.vec3_or(&key("color"), &l.color, Vec3::ONE)?;
+    let intensity = ctx.num_or(&key("intensity"), &l.intensity, 0.0, 1e6, 1.0)?;
+    let shadow_map = ctx.int_or(&key("shadow_map"), &l.shadow_map, 1, MAX_SIDE, 1024)?;
+    let shadow = match &l.shadow {
+        Some(s) => shadow(ctx, i, s)?,
+        None => Shadow {
+            technique: Technique::Hard,
+            bias: 0.002,
+            slope_bias: 1.0,
+            normal_bias: 1.0,
+        },
+    };
+    if let Technique::Pcss { .. } = shadow.technique {
+        if size <= 0.0 {
+            let span = l.size.as_ref().map(|s| s.span()).or(Some(l.kind.span()));
+            return Err(ctx.err(span, format!("technique \"pcss\" needs `{}` > 0 (the area light's width)", key("size"))));
+        }
+    }
+    Ok(Light {
+        kind,
+        position,
+        target,
+        near,
+        far,
+        size,
+        radiance: color * intensity,
+        shadow_map,
+        shadow,
+    })
+}
+
+fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
+    let key = |k: &str| format!("light[{i}].shadow.{k}");
+    let name = s.technique.get_ref().as_str();
+    let not_for = format!("does not apply to technique \"{name}\"");
+    let technique = match name {
+        "hard" | "pcf" | "pcss" => {
+            if name != "pcf" {
+                ctx.reject(&key("radius"), &s.radius, &not_for)?;
+                ctx.reject(&key("kernel"), &s.kernel, &not_for)?;
+            }
+            if name != "pcss" {
+                ctx.reject(&key("blocker_samples"), &s.blocker_samples, &not_for)?;
+                ctx.reject(&key("filter_samples"), &s.filter_samples, &not_for)?;
+                ctx.reject(&key("max_search"), &s.max_search, &not_for)?;
+            }
+            match name {
+                "hard" => Technique::Hard,
+                "pcf" => Technique::Pcf {
+                    radius: ctx.int_or(&key("radius"), &s.radius, 0, 32, 1)?,
+                    kernel: match s.kernel.as_ref().map(|k| (k.get_ref().as_str(), k.span())) {
+                        None | Some(("box", _)) => PcfKernel::Box,
+                        Some(("tent", _)) => PcfKernel::Tent,
+                        Some(("hardware", _)) => PcfKernel::Hardware,
+                        Some((other, span)) => {
+                            return Err(ctx.err(Some(span), format!(
+                                "`{}` = \"{other}\": unknown PCF kernel (expected \"box\", \"tent\" or \"hardware\")",
+                                key("kernel")
+                            )));
+                        }
+                    },
+                },
+                _ => Technique::Pcss {
+                    blocker_samples: ctx.int_or(&key("blocker_samples"), &s.blocker_samples, 1, 256, 16)?,
+                    filter_samples: ctx.int_or(&key("filter_samples"), &s.filter_samples, 1, 1024, 32)?,
+                    max_search: ctx.num_or(&key("max_search"), &s.max_search, 1e-4, 1.0, 0.1)?,
+                },
+            }
+        }
+        other => {
+            return Err(ctx.err(
+                Some(s.technique.span()),
+                format!(
+                    "`{}` = \"{other}\": unknown technique (this build knows \"hard\", \"pcf\", \"pcss\")",
+                    key("technique")
+                ),
+            ));
+        }
+    };
+    if matches!(technique, Technique::Pcf { kernel: PcfKernel::Hardware, .. }) {
+        ctx.reject(&key("radius"), &s.radius, "does not apply to the hardware 2×2 kernel")?;
+    }
+    Ok(Shadow {
+        technique,
+        bias: ctx.num_or(&key("bias"), &s.bias, -1.0, 1.0, 0.002)?,
+        slope_bias: ctx.num_or(&key("slope_bias"), &s.slope_bias, 0.0, 100.0, 1.0)?,
+        normal_bias: ctx.num_or(&key("normal_bias"), &s.normal_bias, 0.0, 100.0, 1.0)?,
+    })
+}
+
+fn num3(ctx: &Ctx, key: &str, v: &Spanned<Num>, len2_ok: bool) -> Result<Vec<f32>> {
+    let vals = match v.get_ref() {
+        Num::One(x) => vec![*x],
+        Num::Many(xs) => xs.clone(),
+    };
+    let ok_len = matches!(vals.len(), 1 | 3) || (len2_ok && vals.len() == 2);
+    if !ok_len || vals.iter().any(|x| !x.is_finite() || *x <= 0.0) {
+        return Err(ctx.err(Some(v.span()), format!("`{key}` must be one positive number or a list of positive numbers, got {vals:?}")));
+    }
+    Ok(vals.iter().map(|&x| x as f32).collect())
+}
+
+fn object(ctx: &Ctx, i: usize, o: &ObjectFile) -> Result<Object> {
+    let key = |k: &str| format!("object[{i}].{k}");
+    let at = o.shape.span();
+    let positive = |k: &str, v: &Option<Spanned<f64>>| -> Result<f32> {
+        ctx.num(&key(k), ctx.required(&key(k), v, at.clone())?, 1e-6, 1e7)
+    };
+    let local: Mesh = match o.shape.get_ref().as_str() {
+        "plane" => {
+            let s = num3(ctx, &key("size"), ctx.required(&key("size"), &o.size, at.clone())?, true)?;
+            let (sx, sz) = match s.as_slice() {
+                [a] => (*a, *a),
+                [a, b] => (*a, *b),
+                _ => return Err(ctx.err(o.size.as_ref().map(|s| s.span()), format!("`{}` of a plane is `[x, z]` or one number", key("size")))),
+            };
+            mesh::plane(sx, sz)
+        }
+        "box" => {
+            let s = num3(ctx, &key("size"), ctx.required(&key("size"), &o.size, at.clone())?, false)?;
+            let v = if s.len() == 1 { Vec3::splat(s[0]) } else { Vec3::new(s[0], s[1], s[2]) };
+            mesh::cuboid(v)
+        }
+        "sphere" => mesh::sphere(positive("radius", &o.radius)?, 48, 24),
+        "cylinder" => mesh::cylinder(positive("radius", &o.radius)?, positive("height", &o.height)?, 48),
+        "mesh" => {
+            let p = ctx.required(&key("path"), &o.path, at.clone())?;
+            let dir = ctx.path.parent().unwrap_or(Path::new("."));
+            let file = dir.join(p.get_ref());
+            mesh::load_obj(&file).map_err(|e| ctx.err(Some(p.span()), format!("`{}`: {e}", key("path"))))?
+        }
+        other => {
+            return Err(ctx.err(Some(at), format!(
+                "`{}` = \"{other}\": unknown shape (expected \"plane\", \"box\", \"sphere\", \"cylinder\" or \"mesh\")",
+                key("shape")
+            )));
+        }
+    };
+    let translate = ctx.vec3_or(&key("translate"), &o.translate, Vec3::ZERO)?;
+    let rot = ctx.vec3_or(&key("rotate_degrees"), &o.rotate_degrees, Vec3::ZERO)?;
+    let scale = match &o.scale {
+        None => Vec3::ONE,
+        Some(s) => {
+            let v = num3(ctx, &key("scale"), s, false)?;
+            if v.len() == 1 { Vec3::splat(v[0]) } else { Vec3::new(v[0], v[1], v[2]) }
+        }
+    };
+    let rotation = Quat::from_euler(
+        EulerRot::ZYX,
+        rot.z.to_radians(),
+        rot.y.to_radians(),
+        rot.x.to_radians(),
+    );
+    let transform = Mat4::from_scale_rotation_translation(scale, rotation, translate);
+    let color = ctx.vec3_or(&key("color"), &o.color, Vec3::splat(0.8))?;
+    Ok(Object {
+        mesh: local.transformed(transform),
+        color,
+    })
+}
