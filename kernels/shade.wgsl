@@ -1,0 +1,70 @@
+// The thin shading pass: Lambert + ambient over the G-buffer, one visibility function per
+// light's technique. The `// #generated` block binds each light's maps (group 1) and defines
+// `light_visibility(i, p, n)`, calling only the techniques the scene uses.
+// #import shared/light
+
+// Keep in sync with `FrameGpu` in src/render.rs.
+struct Frame {
+    size: vec2<u32>,
+    light_count: u32,
+    _pad0: u32,
+    ambient: vec3<f32>,
+    _pad1: f32,
+    background: vec3<f32>,
+    _pad2: f32,
+}
+
+@group(0) @binding(0) var g_position: texture_2d<f32>;
+@group(0) @binding(1) var g_normal: texture_2d<f32>;
+@group(0) @binding(2) var<storage, read> materials: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read> lights: array<Light>;
+@group(0) @binding(4) var<uniform> frame: Frame;
+@group(0) @binding(5) var out_color: texture_storage_2d<rgba8unorm, write>;
+@group(0) @binding(6) var<storage, read_write> out_visibility: array<f32>;
+@group(0) @binding(7) var cmp_sampler: sampler_comparison;
+
+// #generated
+
+const WG_SIZE: u32 = 8u;
+
+fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
+    let x = clamp(c, vec3<f32>(0.0), vec3<f32>(1.0));
+    return select(1.055 * pow(x, vec3<f32>(1.0 / 2.4)) - 0.055, 12.92 * x, x <= vec3<f32>(0.0031308));
+}
+
+// Spot lights light only their cone (soft edge over the outer 10% of the angle).
+fn cone(l: Light, p: vec3<f32>) -> f32 {
+    if l.kind == 0u {
+        return 1.0;
+    }
+    let c = dot(normalize(p - l.position), l.direction);
+    return smoothstep(l.cos_outer, mix(l.cos_outer, 1.0, 0.1), c);
+}
+
+@compute @workgroup_size(WG_SIZE, WG_SIZE)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if any(id.xy >= frame.size) {
+        return;
+    }
+    let base = (id.y * frame.size.x + id.x) * frame.light_count;
+    let gp = textureLoad(g_position, id.xy, 0);
+    if gp.w == 0.0 {
+        for (var i = 0u; i < frame.light_count; i++) {
+            out_visibility[base + i] = 1.0;
+        }
+        textureStore(out_color, id.xy, vec4<f32>(linear_to_srgb(frame.background), 1.0));
+        return;
+    }
+    let gn = textureLoad(g_normal, id.xy, 0);
+    let n = normalize(gn.xyz);
+    let albedo = materials[u32(gn.w)].rgb;
+    var radiance = frame.ambient * albedo;
+    for (var i = 0u; i < frame.light_count; i++) {
+        let l = lights[i];
+        let v = light_visibility(i, gp.xyz, n);
+        out_visibility[base + i] = v;
+        let ndl = max(dot(n, light_to_light(l, gp.xyz)), 0.0);
+        radiance += albedo * l.radiance * (ndl * v * cone(l, gp.xyz));
+    }
+    textureStore(out_color, id.xy, vec4<f32>(linear_to_srgb(radiance), 1.0));
+}

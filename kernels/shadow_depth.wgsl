@@ -1,0 +1,19 @@
+// Depth-only rasterization from a light (no fragment stage): the shadow map.
+
+struct LightView {
+    view_proj: mat4x4<f32>,
+}
+
+@group(0) @binding(0) var<uniform> light: LightView;
+
+// Keep in sync with `Vertex` in src/scene/mesh.rs.
+struct VsIn {
+    @location(0) position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) material: u32,
+}
+
+@vertex
+fn vs_main(v: VsIn) -> @builtin(position) vec4<f32> {
+    return light.view_proj * vec4<f32>(v.position, 1.0);
+}

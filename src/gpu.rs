@@ -32,9 +32,8 @@ impl Gpu {
     }
 
     async fn new_async() -> Result<Self> {
-        let instance = wgpu::Instance::new(
-            wgpu::InstanceDescriptor::new_without_display_handle_from_env(),
-        );
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let adapter = pick_adapter(&instance).await?;
         let info = adapter.get_info();
         let features = adapter.features() & WANTED_FEATURES;
@@ -71,7 +70,9 @@ impl Gpu {
 
     /// Whether GPU timestamps can be written around compute passes.
     pub fn can_time(&self) -> bool {
-        self.device.features().contains(wgpu::Features::TIMESTAMP_QUERY)
+        self.device
+            .features()
+            .contains(wgpu::Features::TIMESTAMP_QUERY)
     }
 
     /// The facts `shadowgraph info` prints: adapter, backend, features and limits that matter.
@@ -87,23 +88,50 @@ impl Gpu {
         line("driver", format!("{} {}", i.driver, i.driver_info));
         for (name, feat) in [
             ("TIMESTAMP_QUERY", wgpu::Features::TIMESTAMP_QUERY),
-            ("TIMESTAMP_QUERY_INSIDE_PASSES", wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES),
+            (
+                "TIMESTAMP_QUERY_INSIDE_PASSES",
+                wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES,
+            ),
             ("FLOAT32_FILTERABLE", wgpu::Features::FLOAT32_FILTERABLE),
             ("SHADER_F64", wgpu::Features::SHADER_F64),
             ("SHADER_INT64", wgpu::Features::SHADER_INT64),
         ] {
             line(&format!("feature {name}"), yes_no(f.contains(feat)));
         }
-        line("max_texture_dimension_2d", l.max_texture_dimension_2d.to_string());
-        line("max_storage_textures_per_shader_stage", l.max_storage_textures_per_shader_stage.to_string());
-        line("max_sampled_textures_per_shader_stage", l.max_sampled_textures_per_shader_stage.to_string());
-        line("max_storage_buffer_binding_size", l.max_storage_buffer_binding_size.to_string());
+        line(
+            "max_texture_dimension_2d",
+            l.max_texture_dimension_2d.to_string(),
+        );
+        line(
+            "max_storage_textures_per_shader_stage",
+            l.max_storage_textures_per_shader_stage.to_string(),
+        );
+        line(
+            "max_sampled_textures_per_shader_stage",
+            l.max_sampled_textures_per_shader_stage.to_string(),
+        );
+        line(
+            "max_storage_buffer_binding_size",
+            l.max_storage_buffer_binding_size.to_string(),
+        );
         line("max_buffer_size", l.max_buffer_size.to_string());
-        line("max_compute_workgroup_storage_size", l.max_compute_workgroup_storage_size.to_string());
-        line("max_compute_invocations_per_workgroup", l.max_compute_invocations_per_workgroup.to_string());
-        line("max_compute_workgroups_per_dimension", l.max_compute_workgroups_per_dimension.to_string());
+        line(
+            "max_compute_workgroup_storage_size",
+            l.max_compute_workgroup_storage_size.to_string(),
+        );
+        line(
+            "max_compute_invocations_per_workgroup",
+            l.max_compute_invocations_per_workgroup.to_string(),
+        );
+        line(
+            "max_compute_workgroups_per_dimension",
+            l.max_compute_workgroups_per_dimension.to_string(),
+        );
         line("max_bind_groups", l.max_bind_groups.to_string());
-        line("timestamp period (ns/tick)", format!("{}", self.queue.get_timestamp_period()));
+        line(
+            "timestamp period (ns/tick)",
+            format!("{}", self.queue.get_timestamp_period()),
+        );
         s
     }
 }
@@ -215,7 +243,8 @@ pub fn read_texture(
     let w = (texture.width() >> mip).max(1);
     let h = (texture.height() >> mip).max(1);
     let row = w * bpp;
-    let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let padded =
+        row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     let buffer = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("shadowgraph.readback"),
         size: u64::from(padded) * u64::from(h),

@@ -51,37 +51,39 @@ pub fn source(name: &str) -> Result<&'static str> {
         })
 }
 
-/// Resolves `// #import` lines (and `// #generated`, replaced by `generated`) of `name`.
+/// Resolves `// #import` lines (and `// #generated`, replaced by `generated`, whose own
+/// imports are resolved too) of kernel `name`.
 pub fn resolve(name: &str, generated: Option<&str>) -> Result<String> {
-    let mut seen = HashSet::new();
+    let mut seen = HashSet::from([name.to_string()]);
     let mut out = String::new();
-    resolve_into(name, generated, &mut seen, &mut out)?;
+    resolve_text(name, source(name)?, generated, &mut seen, &mut out)?;
     Ok(out)
 }
 
-fn resolve_into(
+fn resolve_text(
     name: &str,
+    text: &str,
     generated: Option<&str>,
     seen: &mut HashSet<String>,
     out: &mut String,
 ) -> Result<()> {
-    if !seen.insert(name.to_string()) {
-        return Ok(());
-    }
-    for line in source(name)?.lines() {
+    for line in text.lines() {
         let t = line.trim();
         if let Some(module) = t.strip_prefix("// #import ") {
-            resolve_into(module.trim(), generated, seen, out).map_err(|e| Error::Kernel {
-                kernel: name.to_string(),
-                message: format!("import `{}`: {e}", module.trim()),
-            })?;
+            let module = module.trim();
+            if seen.insert(module.to_string()) {
+                let imported = source(module).map_err(|e| Error::Kernel {
+                    kernel: name.to_string(),
+                    message: format!("import `{module}`: {e}"),
+                })?;
+                resolve_text(module, imported, None, seen, out)?;
+            }
         } else if t == "// #generated" {
             let block = generated.ok_or_else(|| Error::Kernel {
                 kernel: name.to_string(),
                 message: "has a `// #generated` block but none was supplied".into(),
             })?;
-            out.push_str(block);
-            out.push('\n');
+            resolve_text(name, block, None, seen, out)?;
         } else {
             out.push_str(line);
             out.push('\n');
@@ -275,7 +277,9 @@ fn binding_type(
                     multisampled: *multi,
                 },
                 ImageClass::Storage { format, access } => wgpu::BindingType::StorageTexture {
-                    access: if access.contains(naga::StorageAccess::LOAD | naga::StorageAccess::STORE) {
+                    access: if access
+                        .contains(naga::StorageAccess::LOAD | naga::StorageAccess::STORE)
+                    {
                         wgpu::StorageTextureAccess::ReadWrite
                     } else if access.contains(naga::StorageAccess::STORE) {
                         wgpu::StorageTextureAccess::WriteOnly

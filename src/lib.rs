@@ -1,8 +1,14 @@
 //! shadowgraph: shadow-map prefiltering on the GPU as a graph of WGSL compute kernels.
+pub mod bench;
+pub mod cli;
 pub mod error;
+pub mod exec;
 pub mod gpu;
 pub mod graph;
+pub mod io;
 pub mod kernels;
+pub mod render;
 pub mod scene;
+pub mod technique;
 
 pub use error::{Error, Result};

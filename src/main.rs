@@ -1,1 +1,91 @@
-fn main() {}
+//! `shadowgraph`: the command-line tool. Each subcommand calls one library function.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand};
+
+use shadowgraph::{cli, gpu::Gpu};
+
+#[derive(Parser)]
+#[command(
+    name = "shadowgraph",
+    version,
+    about = "Shadow-map prefiltering on the GPU"
+)]
+struct Args {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene to PNG.
+    Render {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// Output PNG.
+        #[arg(short, long, default_value = "out.png")]
+        output: PathBuf,
+        /// Also write position, normal and per-light visibility as 32-bit float OpenEXR here.
+        #[arg(long)]
+        aux: Option<PathBuf>,
+        /// Print GPU time per node and for the shading pass.
+        #[arg(long)]
+        timings: bool,
+        /// Frames to render (timings are medians over them).
+        #[arg(long, default_value_t = 1)]
+        repeat: u32,
+    },
+    /// Print the kernels a scene will run (per light), its resources and peak memory.
+    Plan {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// Print Graphviz instead of text.
+        #[arg(long)]
+        dot: bool,
+    },
+    /// Print the adapter, its backend, and the features and limits that matter.
+    Info,
+    /// Time kernels by GPU timestamps against a copy kernel over the same bytes.
+    Bench {
+        /// Square map sizes.
+        #[arg(long, value_delimiter = ',', default_value = "512,1024,2048,4096")]
+        sizes: Vec<u32>,
+        /// Timed repetitions per kernel and size (the median is reported).
+        #[arg(long, default_value_t = 10)]
+        repeat: u32,
+    },
+}
+
+fn main() {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    if let Err(e) = run(Args::parse()) {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn run(args: Args) -> Result<()> {
+    match args.command {
+        Command::Render {
+            scene,
+            output,
+            aux,
+            timings,
+            repeat,
+        } => {
+            let gpu = Gpu::new()?;
+            let report = cli::render(&gpu, &scene, &output, aux.as_deref(), timings, repeat)
+                .with_context(|| format!("rendering {}", scene.display()))?;
+            print!("{report}");
+        }
+        Command::Plan { scene, dot } => print!("{}", cli::plan(&scene, dot)?),
+        Command::Info => print!("{}", Gpu::new()?.info_report()),
+        Command::Bench { sizes, repeat } => {
+            let gpu = Gpu::new()?;
+            print!("{}", shadowgraph::bench::run(&gpu, &sizes, repeat)?);
+        }
+    }
+    Ok(())
+}

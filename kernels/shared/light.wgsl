@@ -1,0 +1,87 @@
+// Shared light description and light-space helpers (import-only module).
+//
+// Linear light-space depth, the quantity every technique compares, is
+//   d = (Z − near) / (far − near),  Z = distance along the light's view axis,
+// for both the orthographic (directional) and the perspective (spot) light.
+
+// Keep in sync with `LightGpu` in src/technique.rs.
+struct Light {
+    view_proj: mat4x4<f32>,  // world → light clip
+    view: mat4x4<f32>,       // world → light view
+    radiance: vec3<f32>,     // colour × intensity
+    kind: u32,               // 0 directional (orthographic), 1 spot (perspective)
+    position: vec3<f32>,
+    near: f32,
+    direction: vec3<f32>,    // unit, light → target
+    far: f32,
+    map_size: vec2<f32>,     // shadow-map texels
+    width_at_unit: f32,      // map width in world units: directional 2·extent; spot 2·tan(fov/2) per unit distance
+    size: f32,               // area-light width, world units
+    bias: f32,               // constant bias, linear depth units
+    normal_bias: f32,        // normal offset, texels, scaled by (1 − N·L)
+    cos_outer: f32,          // spot cone: cos(fov/2); directional: −1
+    technique: u32,          // 0 hard, 1 pcf, 2 pcss
+    radius: u32,             // pcf: window radius in texels
+    kernel: u32,             // pcf: 0 box, 1 tent, 2 hardware 2×2
+    blocker_samples: u32,    // pcss
+    filter_samples: u32,     // pcss
+    max_search: f32,         // pcss: cap on the blocker-search radius, UV
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
+}
+
+// Where a receiver lands in a light's shadow map.
+struct LightSample {
+    uv: vec2<f32>,   // shadow-map UV, y down
+    depth: f32,      // receiver's linear depth d
+    view_z: f32,     // receiver's distance Z along the light axis
+    inside: bool,    // inside the map and the depth range
+}
+
+// World width of the whole map at view distance z.
+fn light_map_width(l: Light, z: f32) -> f32 {
+    if l.kind == 0u {
+        return l.width_at_unit;
+    }
+    return l.width_at_unit * z;
+}
+
+// Unit vector from p toward the light.
+fn light_to_light(l: Light, p: vec3<f32>) -> vec3<f32> {
+    if l.kind == 0u {
+        return -l.direction;
+    }
+    return normalize(l.position - p);
+}
+
+// Projects p, first moved along n by normal_bias texels scaled by (1 − N·L).
+fn light_sample(l: Light, p: vec3<f32>, n: vec3<f32>) -> LightSample {
+    let z0 = -(l.view * vec4<f32>(p, 1.0)).z;
+    let texel = light_map_width(l, max(z0, l.near)) / l.map_size.x;
+    let ndl = clamp(dot(n, light_to_light(l, p)), 0.0, 1.0);
+    let q = p + n * (l.normal_bias * texel * (1.0 - ndl));
+    let clip = l.view_proj * vec4<f32>(q, 1.0);
+    let ndc = clip.xy / clip.w;
+    var s: LightSample;
+    s.uv = vec2<f32>(0.5 + 0.5 * ndc.x, 0.5 - 0.5 * ndc.y);
+    s.view_z = -(l.view * vec4<f32>(q, 1.0)).z;
+    s.depth = (s.view_z - l.near) / (l.far - l.near);
+    s.inside = clip.w > 0.0 && all(s.uv >= vec2<f32>(0.0)) && all(s.uv <= vec2<f32>(1.0))
+        && s.depth >= 0.0 && s.depth <= 1.0;
+    return s;
+}
+
+// Linear depth → the depth buffer's value (for the hardware comparison sampler).
+fn light_linear_to_ndc(l: Light, d: f32) -> f32 {
+    if l.kind == 0u {
+        return d;
+    }
+    let z = l.near + d * (l.far - l.near);
+    return l.far * (z - l.near) / ((l.far - l.near) * z);
+}
+
+// Linear depth → view distance.
+fn light_linear_to_z(l: Light, d: f32) -> f32 {
+    return l.near + d * (l.far - l.near);
+}

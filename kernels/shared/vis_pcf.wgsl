@@ -1,0 +1,29 @@
+// Percentage-closer filtering (Reeves et al. 1987): the weighted mean of comparison results
+// over a (2r + 1)² window around the receiver's texel — never a filter of depths.
+// #import shared/light
+// #import shared/sampling
+
+fn vis_pcf(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
+    let c = texel_of(s.uv, l.map_size);
+    let r = i32(l.radius);
+    var lit = 0.0;
+    var total = 0.0;
+    for (var dy = -r; dy <= r; dy++) {
+        for (var dx = -r; dx <= r; dx++) {
+            var w = 1.0;
+            if l.kernel == 1u {
+                w = f32(r + 1 - abs(dx)) * f32(r + 1 - abs(dy));
+            }
+            let z = load_depth(map, c + vec2<i32>(dx, dy));
+            lit += w * select(0.0, 1.0, s.depth <= z + l.bias);
+            total += w;
+        }
+    }
+    return lit / total;
+}
+
+// The hardware 2×2 comparison: bilinear weights of four comparisons against the raw depth map.
+fn vis_pcf_hardware(map: texture_depth_2d, cmp: sampler_comparison, l: Light, s: LightSample) -> f32 {
+    let reference = light_linear_to_ndc(l, clamp(s.depth - l.bias, 0.0, 1.0));
+    return textureSampleCompareLevel(map, cmp, s.uv, reference);
+}

@@ -1,0 +1,37 @@
+// Percentage-closer soft shadows (Fernando 2005), the brute-force peer of the prefiltered soft
+// shadows: 1) blocker search over the region the light cone cuts from the map, 2) penumbra
+// width w = size · (Z_r − Z_b) / Z_b, 3) PCF over that width. Taps lie on a Vogel disc.
+// #import shared/light
+// #import shared/sampling
+
+// Radius (UV) of the blocker search: the cone from the receiver to the light's width, at the
+// near plane where it is widest, capped by max_search.
+fn pcss_search_radius(l: Light, s: LightSample) -> f32 {
+    let world = 0.5 * l.size * (s.view_z - l.near) / s.view_z;
+    return min(world / light_map_width(l, l.near), l.max_search);
+}
+
+fn vis_pcss(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
+    let search = pcss_search_radius(l, s);
+    var sum = 0.0;
+    var count = 0u;
+    for (var i = 0u; i < l.blocker_samples; i++) {
+        let z = load_depth(map, texel_of(s.uv + search * vogel_disc(i, l.blocker_samples), l.map_size));
+        if z + l.bias < s.depth {
+            sum += z;
+            count += 1u;
+        }
+    }
+    if count == 0u {
+        return 1.0;
+    }
+    let z_blocker = light_linear_to_z(l, sum / f32(count));
+    let penumbra_world = l.size * (s.view_z - z_blocker) / z_blocker;
+    let radius = max(0.5 * penumbra_world / light_map_width(l, s.view_z), 0.5 / l.map_size.x);
+    var lit = 0.0;
+    for (var i = 0u; i < l.filter_samples; i++) {
+        let z = load_depth(map, texel_of(s.uv + radius * vogel_disc(i, l.filter_samples), l.map_size));
+        lit += select(0.0, 1.0, s.depth <= z + l.bias);
+    }
+    return lit / f32(l.filter_samples);
+}

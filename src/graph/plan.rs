@@ -201,8 +201,10 @@ fn needed_nodes(
             Some(Mark::Done) => return Ok(()),
             Some(Mark::Active) => {
                 let start = stack.iter().position(|&n| n == node).unwrap_or(0);
-                let mut cycle: Vec<String> =
-                    stack[start..].iter().map(|&n| graph.nodes[n].name.clone()).collect();
+                let mut cycle: Vec<String> = stack[start..]
+                    .iter()
+                    .map(|&n| graph.nodes[n].name.clone())
+                    .collect();
                 cycle.push(graph.nodes[node].name.clone());
                 return Err(GraphError::Cycle(cycle));
             }
@@ -223,7 +225,15 @@ fn needed_nodes(
         if !index.contains_key(out) {
             return Err(GraphError::UnknownOutput(out.to_string()));
         }
-        need(graph, out, "the outputs", index, producers, &mut marks, &mut stack)?;
+        need(
+            graph,
+            out,
+            "the outputs",
+            index,
+            producers,
+            &mut marks,
+            &mut stack,
+        )?;
     }
     Ok(marks.keys().copied().collect())
 }
@@ -253,7 +263,10 @@ fn order(
             .min();
         let Some(next) = ready else {
             // Unreachable after needed_nodes' cycle check, kept as a typed error, not a panic.
-            let names = remaining.keys().map(|&n| graph.nodes[n].name.clone()).collect();
+            let names = remaining
+                .keys()
+                .map(|&n| graph.nodes[n].name.clone())
+                .collect();
             return Err(GraphError::Cycle(names));
         };
         remaining.remove(&next);
@@ -285,7 +298,10 @@ fn resolve_size(
                 .get(of.as_str())
                 .ok_or_else(|| bad(&format!("follows undeclared resource `{of}`")))?;
             let (w, h) = resolve_size(graph, index, &graph.resources[*base], depth + 1)?;
-            let reduce = |v: u32| v.div_ceil(1u32.checked_shl(*shift).unwrap_or(u32::MAX)).max(1);
+            let reduce = |v: u32| {
+                v.div_ceil(1u32.checked_shl(*shift).unwrap_or(u32::MAX))
+                    .max(1)
+            };
             Ok((reduce(w), reduce(h)))
         }
     }

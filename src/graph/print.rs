@@ -34,7 +34,10 @@ impl Plan {
                 .filter(|(_, st)| st.node.light == Some(li))
                 .collect();
             if steps.is_empty() {
-                let _ = writeln!(s, "  (no kernels: the shading pass reads the rasterized map)");
+                let _ = writeln!(
+                    s,
+                    "  (no kernels: the shading pass reads the rasterized map)"
+                );
             }
             for (i, st) in steps {
                 let n = &st.node;
@@ -49,7 +52,11 @@ impl Plan {
                     outs.join(", ")
                 );
             }
-            for r in self.resources.iter().filter(|r| r.resource.light == Some(li)) {
+            for r in self
+                .resources
+                .iter()
+                .filter(|r| r.resource.light == Some(li))
+            {
                 let role = if r.resource.imported {
                     "imported".to_string()
                 } else {
@@ -100,7 +107,11 @@ impl Plan {
         }
         for st in &self.steps {
             let n = &st.node;
-            let _ = writeln!(s, "  \"{0}\" [shape=ellipse, label=\"{0}\\n{1}\"];", n.name, n.kernel);
+            let _ = writeln!(
+                s,
+                "  \"{0}\" [shape=ellipse, label=\"{0}\\n{1}\"];",
+                n.name, n.kernel
+            );
             for (_, r) in &n.inputs {
                 let _ = writeln!(s, "  \"{r}\" -> \"{}\";", n.name);
             }

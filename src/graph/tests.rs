@@ -8,8 +8,14 @@ fn node(name: &str, ins: &[&str], outs: &[&str]) -> Node {
     Node {
         name: name.into(),
         kernel: name.into(),
-        inputs: ins.iter().map(|r| ("src".to_string(), r.to_string())).collect(),
-        outputs: outs.iter().map(|r| ("dst".to_string(), r.to_string())).collect(),
+        inputs: ins
+            .iter()
+            .map(|r| ("src".to_string(), r.to_string()))
+            .collect(),
+        outputs: outs
+            .iter()
+            .map(|r| ("dst".to_string(), r.to_string()))
+            .collect(),
         params: vec![],
         dispatch: Dispatch::Groups([1, 1, 1]),
         light: Some(0),
@@ -17,7 +23,10 @@ fn node(name: &str, ins: &[&str], outs: &[&str]) -> Node {
 }
 
 fn fixed(w: u32) -> SizeRule {
-    SizeRule::Fixed { width: w, height: w }
+    SizeRule::Fixed {
+        width: w,
+        height: w,
+    }
 }
 
 /// depth → a → b → c, plus a side branch a → x that no output needs.
@@ -89,7 +98,10 @@ fn cycle_is_reported_with_its_nodes() {
     g.node(node("n2", &["p"], &["q"]));
     match plan(&g, &["p"]).unwrap_err() {
         GraphError::Cycle(c) => {
-            assert!(c.contains(&"n1".to_string()) && c.contains(&"n2".to_string()), "{c:?}")
+            assert!(
+                c.contains(&"n1".to_string()) && c.contains(&"n2".to_string()),
+                "{c:?}"
+            )
         }
         e => panic!("expected a cycle, got {e}"),
     }
@@ -99,17 +111,29 @@ fn cycle_is_reported_with_its_nodes() {
 fn wiring_mistakes_are_typed_errors() {
     let mut g = chain();
     g.node(node("bad", &["nope"], &["c2"]));
-    assert!(matches!(plan(&g, &["c"]), Err(GraphError::UnknownResource { .. })));
+    assert!(matches!(
+        plan(&g, &["c"]),
+        Err(GraphError::UnknownResource { .. })
+    ));
 
     let mut g = chain();
     g.node(node("again", &["a"], &["b"]));
-    assert!(matches!(plan(&g, &["c"]), Err(GraphError::DuplicateProducer { .. })));
+    assert!(matches!(
+        plan(&g, &["c"]),
+        Err(GraphError::DuplicateProducer { .. })
+    ));
 
     let mut g = chain();
     g.node(node("clobber", &["a"], &["depth"]));
-    assert!(matches!(plan(&g, &["c"]), Err(GraphError::WritesImport { .. })));
+    assert!(matches!(
+        plan(&g, &["c"]),
+        Err(GraphError::WritesImport { .. })
+    ));
 
-    assert!(matches!(plan(&chain(), &["zzz"]), Err(GraphError::UnknownOutput(_))));
+    assert!(matches!(
+        plan(&chain(), &["zzz"]),
+        Err(GraphError::UnknownOutput(_))
+    ));
 }
 
 #[test]
@@ -117,7 +141,11 @@ fn textures_are_reused_after_last_use() {
     // a → b → c: a dies after make_b, so c (same shape) reuses a's slot.
     let p = plan(&chain(), &["c"]).unwrap();
     let slot = |r: &str| p.resource(r).unwrap().slot.unwrap();
-    assert_ne!(slot("a"), slot("b"), "a step never reads and writes one texture");
+    assert_ne!(
+        slot("a"),
+        slot("b"),
+        "a step never reads and writes one texture"
+    );
     assert_eq!(slot("a"), slot("c"));
     assert_eq!(p.slots.len(), 2);
     assert_eq!(p.slot_bytes(), 2 * 64 * 64 * 4);
@@ -132,7 +160,15 @@ fn different_shapes_are_not_aliased() {
     g.import("depth", wgpu::TextureFormat::Depth32Float, 64, 64, None);
     g.resource("a", F, fixed(64), None);
     g.resource("b", F, fixed(64), None);
-    g.resource("c", F, SizeRule::Reduced { of: "a".into(), shift: 1 }, None);
+    g.resource(
+        "c",
+        F,
+        SizeRule::Reduced {
+            of: "a".into(),
+            shift: 1,
+        },
+        None,
+    );
     g.node(node("make_a", &["depth"], &["a"]));
     g.node(node("make_b", &["a"], &["b"]));
     g.node(node("make_c", &["b"], &["c"]));
@@ -146,9 +182,33 @@ fn different_shapes_are_not_aliased() {
 fn reduced_sizes_round_up_and_reject_bad_rules() {
     let mut g = Graph::default();
     g.import("depth", wgpu::TextureFormat::Depth32Float, 1000, 37, None);
-    g.resource("half", F, SizeRule::Reduced { of: "depth".into(), shift: 1 }, None);
-    g.resource("tiny", F, SizeRule::Reduced { of: "depth".into(), shift: 9 }, None);
-    g.resource("bad", F, SizeRule::Reduced { of: "ghost".into(), shift: 1 }, None);
+    g.resource(
+        "half",
+        F,
+        SizeRule::Reduced {
+            of: "depth".into(),
+            shift: 1,
+        },
+        None,
+    );
+    g.resource(
+        "tiny",
+        F,
+        SizeRule::Reduced {
+            of: "depth".into(),
+            shift: 9,
+        },
+        None,
+    );
+    g.resource(
+        "bad",
+        F,
+        SizeRule::Reduced {
+            of: "ghost".into(),
+            shift: 1,
+        },
+        None,
+    );
     g.node(node("h", &["depth"], &["half"]));
     g.node(node("t", &["depth"], &["tiny"]));
     g.node(node("b", &["depth"], &["bad"]));
@@ -159,7 +219,10 @@ fn reduced_sizes_round_up_and_reject_bad_rules() {
     };
     assert_eq!(r("half"), (500, 19));
     assert_eq!(r("tiny"), (2, 1));
-    assert!(matches!(plan(&g, &["bad"]), Err(GraphError::BadSize { .. })));
+    assert!(matches!(
+        plan(&g, &["bad"]),
+        Err(GraphError::BadSize { .. })
+    ));
 }
 
 #[test]
@@ -170,5 +233,8 @@ fn text_and_dot_name_every_step() {
         assert!(t.contains(n), "{n} missing from\n{t}");
     }
     let d = p.to_dot();
-    assert!(d.starts_with("digraph") && d.contains("\"make_b\" -> \"b\""), "{d}");
+    assert!(
+        d.starts_with("digraph") && d.contains("\"make_b\" -> \"b\""),
+        "{d}"
+    );
 }

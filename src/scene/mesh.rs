@@ -33,7 +33,11 @@ impl Mesh {
     pub fn transformed(&self, m: Mat4) -> Mesh {
         let nm = Mat3::from_mat4(m).inverse().transpose();
         Mesh {
-            positions: self.positions.iter().map(|&p| m.transform_point3(p)).collect(),
+            positions: self
+                .positions
+                .iter()
+                .map(|&p| m.transform_point3(p))
+                .collect(),
             normals: self
                 .normals
                 .iter()
@@ -95,9 +99,19 @@ pub fn cuboid(s: Vec3) -> Mesh {
                 p
             };
             let c = if sign > 0.0 {
-                [corner(-1.0, -1.0), corner(1.0, -1.0), corner(1.0, 1.0), corner(-1.0, 1.0)]
+                [
+                    corner(-1.0, -1.0),
+                    corner(1.0, -1.0),
+                    corner(1.0, 1.0),
+                    corner(-1.0, 1.0),
+                ]
             } else {
-                [corner(-1.0, -1.0), corner(-1.0, 1.0), corner(1.0, 1.0), corner(1.0, -1.0)]
+                [
+                    corner(-1.0, -1.0),
+                    corner(-1.0, 1.0),
+                    corner(1.0, 1.0),
+                    corner(1.0, -1.0),
+                ]
             };
             m.quad(c, n);
         }
@@ -112,7 +126,11 @@ pub fn sphere(radius: f32, segments: u32, rings: u32) -> Mesh {
         let theta = std::f32::consts::PI * r as f32 / rings as f32;
         for s in 0..=segments {
             let phi = std::f32::consts::TAU * s as f32 / segments as f32;
-            let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+            let n = Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            );
             m.positions.push(n * radius);
             m.normals.push(n);
         }
@@ -173,8 +191,8 @@ pub fn load_obj(path: &Path) -> Result<Mesh, String> {
         single_index: true,
         ..Default::default()
     };
-    let (models, _) =
-        tobj::load_obj(path, &opts).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
+    let (models, _) = tobj::load_obj(path, &opts)
+        .map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
     let mut mesh = Mesh::default();
     for model in models {
         let mm = &model.mesh;

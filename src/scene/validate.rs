@@ -7,9 +7,7 @@ use glam::{EulerRot, Mat4, Quat, Vec3};
 use toml::Spanned;
 
 use super::format::{LightFile, Num, ObjectFile, SceneFile, ShadowFile, V3};
-use super::{
-    Camera, Light, LightKind, Mesh, Object, PcfKernel, Scene, Shadow, Technique, mesh,
-};
+use super::{Camera, Light, LightKind, Mesh, Object, PcfKernel, Scene, Shadow, Technique, mesh};
 use crate::error::{Error, Result};
 
 /// Largest output or shadow-map side accepted before the device is even asked.
@@ -22,7 +20,9 @@ struct Ctx<'a> {
 
 impl Ctx<'_> {
     fn location(&self, span: Option<Range<usize>>) -> String {
-        let Some(span) = span else { return String::new() };
+        let Some(span) = span else {
+            return String::new();
+        };
         let before = &self.text[..span.start.min(self.text.len())];
         let line = before.matches('\n').count() + 1;
         let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
@@ -40,7 +40,10 @@ impl Ctx<'_> {
     fn vec3(&self, key: &str, v: &V3) -> Result<Vec3> {
         let [x, y, z] = *v.get_ref();
         if ![x, y, z].iter().all(|c| c.is_finite()) {
-            return Err(self.err(Some(v.span()), format!("`{key}` must be finite, got {:?}", [x, y, z])));
+            return Err(self.err(
+                Some(v.span()),
+                format!("`{key}` must be finite, got {:?}", [x, y, z]),
+            ));
         }
         Ok(Vec3::new(x as f32, y as f32, z as f32))
     }
@@ -53,7 +56,10 @@ impl Ctx<'_> {
     fn num(&self, key: &str, v: &Spanned<f64>, lo: f64, hi: f64) -> Result<f32> {
         let x = *v.get_ref();
         if !x.is_finite() || x < lo || x > hi {
-            return Err(self.err(Some(v.span()), format!("`{key}` = {x} is outside [{lo}, {hi}]")));
+            return Err(self.err(
+                Some(v.span()),
+                format!("`{key}` = {x} is outside [{lo}, {hi}]"),
+            ));
         }
         Ok(x as f32)
     }
@@ -65,7 +71,10 @@ impl Ctx<'_> {
     fn int(&self, key: &str, v: &Spanned<i64>, lo: i64, hi: i64) -> Result<u32> {
         let x = *v.get_ref();
         if x < lo || x > hi {
-            return Err(self.err(Some(v.span()), format!("`{key}` = {x} is outside [{lo}, {hi}]")));
+            return Err(self.err(
+                Some(v.span()),
+                format!("`{key}` = {x} is outside [{lo}, {hi}]"),
+            ));
         }
         Ok(x as u32)
     }
@@ -89,11 +98,15 @@ impl Ctx<'_> {
 
 pub(super) fn parse(path: &Path, text: &str) -> Result<Scene> {
     let ctx = Ctx { path, text };
-    let file: SceneFile = toml::from_str(text).map_err(|e| ctx.err(e.span(), e.message().trim()))?;
+    let file: SceneFile =
+        toml::from_str(text).map_err(|e| ctx.err(e.span(), e.message().trim()))?;
     let width = ctx.int("output.width", &file.output.width, 1, MAX_SIDE)?;
     let height = ctx.int("output.height", &file.output.height, 1, MAX_SIDE)?;
-    let background =
-        ctx.vec3_or("output.background", &file.output.background, Vec3::new(0.55, 0.62, 0.72))?;
+    let background = ctx.vec3_or(
+        "output.background",
+        &file.output.background,
+        Vec3::new(0.55, 0.62, 0.72),
+    )?;
     let ambient = ctx.vec3_or("ambient", &file.ambient, Vec3::splat(0.12))?;
     let camera = camera(&ctx, &file)?;
     if file.lights.is_empty() {
@@ -134,10 +147,16 @@ fn camera(ctx: &Ctx, file: &SceneFile) -> Result<Camera> {
     let fov_y_degrees = ctx.num("camera.fov_y_degrees", &c.fov_y_degrees, 1.0, 170.0)?;
     let forward = target - position;
     if forward.length() < 1e-6 {
-        return Err(ctx.err(Some(c.target.span()), "`camera.target` equals `camera.position`"));
+        return Err(ctx.err(
+            Some(c.target.span()),
+            "`camera.target` equals `camera.position`",
+        ));
     }
     if forward.normalize().cross(up).length() < 1e-4 {
-        return Err(ctx.err(c.up.as_ref().map(|u| u.span()), "`camera.up` is parallel to the view direction"));
+        return Err(ctx.err(
+            c.up.as_ref().map(|u| u.span()),
+            "`camera.up` is parallel to the view direction",
+        ));
     }
     Ok(Camera {
         position,
@@ -151,14 +170,22 @@ fn light(ctx: &Ctx, i: usize, l: &LightFile) -> Result<Light> {
     let key = |k: &str| format!("light[{i}].{k}");
     let kind = match l.kind.get_ref().as_str() {
         "directional" => {
-            ctx.reject(&key("fov_degrees"), &l.fov_degrees, "applies to spot lights only")?;
+            ctx.reject(
+                &key("fov_degrees"),
+                &l.fov_degrees,
+                "applies to spot lights only",
+            )?;
             let e = ctx.required(&key("extent"), &l.extent, l.kind.span())?;
             LightKind::Directional {
                 extent: ctx.num(&key("extent"), e, 1e-3, 1e6)?,
             }
         }
         "spot" => {
-            ctx.reject(&key("extent"), &l.extent, "applies to directional lights only")?;
+            ctx.reject(
+                &key("extent"),
+                &l.extent,
+                "applies to directional lights only",
+            )?;
             let f = ctx.required(&key("fov_degrees"), &l.fov_degrees, l.kind.span())?;
             LightKind::Spot {
                 fov_degrees: ctx.num(&key("fov_degrees"), f, 1.0, 170.0)?,
@@ -167,20 +194,33 @@ fn light(ctx: &Ctx, i: usize, l: &LightFile) -> Result<Light> {
         other => {
             return Err(ctx.err(
                 Some(l.kind.span()),
-                format!("`{}` = \"{other}\": unknown light kind (expected \"directional\" or \"spot\")", key("kind")),
+                format!(
+                    "`{}` = \"{other}\": unknown light kind (expected \"directional\" or \"spot\")",
+                    key("kind")
+                ),
             ));
         }
     };
     let position = ctx.vec3(&key("position"), &l.position)?;
     let target = ctx.vec3(&key("target"), &l.target)?;
     if (target - position).length() < 1e-6 {
-        return Err(ctx.err(Some(l.target.span()), format!("`{}` equals its position", key("target"))));
+        return Err(ctx.err(
+            Some(l.target.span()),
+            format!("`{}` equals its position", key("target")),
+        ));
     }
     let near = ctx.num_or(&key("near"), &l.near, 1e-6, 1e7, 0.1)?;
     let far = ctx.num_or(&key("far"), &l.far, 1e-6, 1e7, 50.0)?;
     if far <= near {
         let span = l.far.as_ref().or(l.near.as_ref()).map(|s| s.span());
-        return Err(ctx.err(span, format!("`{}` ({far}) must exceed `{}` ({near})", key("far"), key("near"))));
+        return Err(ctx.err(
+            span,
+            format!(
+                "`{}` ({far}) must exceed `{}` ({near})",
+                key("far"),
+                key("near")
+            ),
+        ));
     }
     let size = ctx.num_or(&key("size"), &l.size, 0.0, 1e6, 0.0)?;
     let color = ctx.vec3_or(&key("color"), &l.color, Vec3::ONE)?;
@@ -198,7 +238,13 @@ fn light(ctx: &Ctx, i: usize, l: &LightFile) -> Result<Light> {
     if let Technique::Pcss { .. } = shadow.technique {
         if size <= 0.0 {
             let span = l.size.as_ref().map(|s| s.span()).or(Some(l.kind.span()));
-            return Err(ctx.err(span, format!("technique \"pcss\" needs `{}` > 0 (the area light's width)", key("size"))));
+            return Err(ctx.err(
+                span,
+                format!(
+                    "technique \"pcss\" needs `{}` > 0 (the area light's width)",
+                    key("size")
+                ),
+            ));
         }
     }
     Ok(Light {
@@ -246,8 +292,20 @@ fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
                     },
                 },
                 _ => Technique::Pcss {
-                    blocker_samples: ctx.int_or(&key("blocker_samples"), &s.blocker_samples, 1, 256, 16)?,
-                    filter_samples: ctx.int_or(&key("filter_samples"), &s.filter_samples, 1, 1024, 32)?,
+                    blocker_samples: ctx.int_or(
+                        &key("blocker_samples"),
+                        &s.blocker_samples,
+                        1,
+                        256,
+                        16,
+                    )?,
+                    filter_samples: ctx.int_or(
+                        &key("filter_samples"),
+                        &s.filter_samples,
+                        1,
+                        1024,
+                        32,
+                    )?,
                     max_search: ctx.num_or(&key("max_search"), &s.max_search, 1e-4, 1.0, 0.1)?,
                 },
             }
@@ -262,8 +320,18 @@ fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
             ));
         }
     };
-    if matches!(technique, Technique::Pcf { kernel: PcfKernel::Hardware, .. }) {
-        ctx.reject(&key("radius"), &s.radius, "does not apply to the hardware 2×2 kernel")?;
+    if matches!(
+        technique,
+        Technique::Pcf {
+            kernel: PcfKernel::Hardware,
+            ..
+        }
+    ) {
+        ctx.reject(
+            &key("radius"),
+            &s.radius,
+            "does not apply to the hardware 2×2 kernel",
+        )?;
     }
     Ok(Shadow {
         technique,
@@ -280,7 +348,12 @@ fn num3(ctx: &Ctx, key: &str, v: &Spanned<Num>, len2_ok: bool) -> Result<Vec<f32
     };
     let ok_len = matches!(vals.len(), 1 | 3) || (len2_ok && vals.len() == 2);
     if !ok_len || vals.iter().any(|x| !x.is_finite() || *x <= 0.0) {
-        return Err(ctx.err(Some(v.span()), format!("`{key}` must be one positive number or a list of positive numbers, got {vals:?}")));
+        return Err(ctx.err(
+            Some(v.span()),
+            format!(
+                "`{key}` must be one positive number or a list of positive numbers, got {vals:?}"
+            ),
+        ));
     }
     Ok(vals.iter().map(|&x| x as f32).collect())
 }
@@ -293,26 +366,50 @@ fn object(ctx: &Ctx, i: usize, o: &ObjectFile) -> Result<Object> {
     };
     let local: Mesh = match o.shape.get_ref().as_str() {
         "plane" => {
-            let s = num3(ctx, &key("size"), ctx.required(&key("size"), &o.size, at.clone())?, true)?;
+            let s = num3(
+                ctx,
+                &key("size"),
+                ctx.required(&key("size"), &o.size, at.clone())?,
+                true,
+            )?;
             let (sx, sz) = match s.as_slice() {
                 [a] => (*a, *a),
                 [a, b] => (*a, *b),
-                _ => return Err(ctx.err(o.size.as_ref().map(|s| s.span()), format!("`{}` of a plane is `[x, z]` or one number", key("size")))),
+                _ => {
+                    return Err(ctx.err(
+                        o.size.as_ref().map(|s| s.span()),
+                        format!("`{}` of a plane is `[x, z]` or one number", key("size")),
+                    ));
+                }
             };
             mesh::plane(sx, sz)
         }
         "box" => {
-            let s = num3(ctx, &key("size"), ctx.required(&key("size"), &o.size, at.clone())?, false)?;
-            let v = if s.len() == 1 { Vec3::splat(s[0]) } else { Vec3::new(s[0], s[1], s[2]) };
+            let s = num3(
+                ctx,
+                &key("size"),
+                ctx.required(&key("size"), &o.size, at.clone())?,
+                false,
+            )?;
+            let v = if s.len() == 1 {
+                Vec3::splat(s[0])
+            } else {
+                Vec3::new(s[0], s[1], s[2])
+            };
             mesh::cuboid(v)
         }
         "sphere" => mesh::sphere(positive("radius", &o.radius)?, 48, 24),
-        "cylinder" => mesh::cylinder(positive("radius", &o.radius)?, positive("height", &o.height)?, 48),
+        "cylinder" => mesh::cylinder(
+            positive("radius", &o.radius)?,
+            positive("height", &o.height)?,
+            48,
+        ),
         "mesh" => {
             let p = ctx.required(&key("path"), &o.path, at.clone())?;
             let dir = ctx.path.parent().unwrap_or(Path::new("."));
             let file = dir.join(p.get_ref());
-            mesh::load_obj(&file).map_err(|e| ctx.err(Some(p.span()), format!("`{}`: {e}", key("path"))))?
+            mesh::load_obj(&file)
+                .map_err(|e| ctx.err(Some(p.span()), format!("`{}`: {e}", key("path"))))?
         }
         other => {
             return Err(ctx.err(Some(at), format!(
@@ -327,7 +424,11 @@ fn object(ctx: &Ctx, i: usize, o: &ObjectFile) -> Result<Object> {
         None => Vec3::ONE,
         Some(s) => {
             let v = num3(ctx, &key("scale"), s, false)?;
-            if v.len() == 1 { Vec3::splat(v[0]) } else { Vec3::new(v[0], v[1], v[2]) }
+            if v.len() == 1 {
+                Vec3::splat(v[0])
+            } else {
+                Vec3::new(v[0], v[1], v[2])
+            }
         }
     };
     let rotation = Quat::from_euler(

@@ -1,0 +1,138 @@
+//! The library functions behind the CLI's subcommands; each returns the text it prints.
+
+use std::fmt::Write;
+use std::path::Path;
+
+use crate::error::{Error, Result};
+use crate::gpu::Gpu;
+use crate::io::{deinterleave, write_exr, write_png};
+use crate::render::{Frame, RenderOptions, Renderer, plan_lights};
+use crate::scene::Scene;
+
+/// `shadowgraph plan`: the plan as text (or Graphviz with `dot`).
+pub fn plan(scene: &Path, dot: bool) -> Result<String> {
+    let scene = Scene::load(scene)?;
+    let sp = plan_lights(&scene.lights)?;
+    if dot {
+        return Ok(sp.plan.to_dot());
+    }
+    let labels: Vec<String> = scene.lights.iter().map(|l| l.label()).collect();
+    let mut s = sp.plan.to_text(&labels);
+    s.push_str("then: shade (one visibility function per light)\n");
+    Ok(s)
+}
+
+/// `shadowgraph render`: renders, writes the PNG (and EXRs with `aux`), returns a summary.
+pub fn render(
+    gpu: &Gpu,
+    scene_path: &Path,
+    output: &Path,
+    aux: Option<&Path>,
+    timings: bool,
+    repeat: u32,
+) -> Result<String> {
+    let scene = Scene::load(scene_path)?;
+    let mut renderer = Renderer::new(&gpu.device);
+    let frame = renderer.render(
+        &gpu.device,
+        &gpu.queue,
+        &scene,
+        RenderOptions {
+            aux: aux.is_some(),
+            repeat,
+        },
+    )?;
+    let bad = frame.visibility.iter().filter(|v| !v.is_finite()).count();
+    if bad > 0 {
+        return Err(Error::Gpu {
+            stage: "shade".into(),
+            message: format!("{bad} non-finite visibility values"),
+        });
+    }
+    write_png(output, frame.width, frame.height, &frame.rgba)?;
+    let mut s = format!(
+        "wrote {} ({}x{})\n",
+        output.display(),
+        frame.width,
+        frame.height
+    );
+    for (step, n) in &frame.sanitized {
+        let _ = writeln!(s, "warning: {step} replaced {n} non-finite depth texel(s)");
+    }
+    if let Some(dir) = aux {
+        write_aux(dir, &scene, &frame)?;
+        let _ = writeln!(
+            s,
+            "wrote position.exr, normal.exr, visibility.exr to {}",
+            dir.display()
+        );
+    }
+    if timings {
+        s.push_str(&timing_table(gpu, &frame));
+    }
+    Ok(s)
+}
+
+fn write_aux(dir: &Path, scene: &Scene, frame: &Frame) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let (w, h) = (frame.width, frame.height);
+    write_exr(
+        &dir.join("position.exr"),
+        w,
+        h,
+        deinterleave(&frame.position, 4, &["X", "Y", "Z", "coverage"]),
+    )?;
+    write_exr(
+        &dir.join("normal.exr"),
+        w,
+        h,
+        deinterleave(&frame.normal, 4, &["X", "Y", "Z", "material"]),
+    )?;
+    let names: Vec<String> = (0..scene.lights.len())
+        .map(|i| format!("light{i}"))
+        .collect();
+    let refs: Vec<&str> = names.iter().map(String::as_str).collect();
+    write_exr(
+        &dir.join("visibility.exr"),
+        w,
+        h,
+        deinterleave(&frame.visibility, scene.lights.len(), &refs),
+    )
+}
+
+/// Median of each pass's time over the frames, as a table.
+pub fn timing_table(gpu: &Gpu, frame: &Frame) -> String {
+    let mut s = String::new();
+    if !gpu.can_time() {
+        s.push_str(
+            "timings: this device has no TIMESTAMP_QUERY feature, so GPU passes cannot be timed\n",
+        );
+        return s;
+    }
+    let Some(first) = frame.timings.first() else {
+        return s;
+    };
+    let _ = writeln!(
+        s,
+        "GPU time per pass, median of {} frame(s), on {}:",
+        frame.timings.len(),
+        gpu.describe()
+    );
+    let mut total = 0.0;
+    for (i, (label, _)) in first.iter().enumerate() {
+        let mut v: Vec<f64> = frame
+            .timings
+            .iter()
+            .filter_map(|t| t.get(i).map(|x| x.1))
+            .collect();
+        v.sort_by(f64::total_cmp);
+        let med = v[v.len() / 2];
+        total += med;
+        let _ = writeln!(s, "  {label:<28} {med:>10.3} ms");
+    }
+    let _ = writeln!(s, "  {:<28} {total:>10.3} ms", "total");
+    s
+}

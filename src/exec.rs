@@ -1,0 +1,517 @@
+//! The executor: records a [`Plan`] into a caller's command encoder, one compute pass per node,
+//! with a timestamp pair around each when the device allows. It borrows the device and never
+//! submits, so it runs the same inside shadowgraph's renderer and inside a host's frame.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use wgpu::util::DeviceExt;
+
+use crate::error::{Error, Result};
+use crate::gpu::{read_buffer, scoped};
+use crate::graph::{Dispatch, Plan, Slot};
+use crate::kernels::{self, Reflection};
+
+/// A compute pipeline with the layouts reflected from its WGSL.
+pub struct ComputeKernel {
+    /// Kernel name (labels are `shadowgraph.<name>`).
+    pub name: String,
+    /// Bindings and workgroup size.
+    pub reflection: Reflection,
+    /// One layout per bind group.
+    pub layouts: Vec<wgpu::BindGroupLayout>,
+    /// The pipeline (entry point `main`).
+    pub pipeline: wgpu::ComputePipeline,
+}
+
+impl ComputeKernel {
+    /// Validates, reflects and compiles `wgsl`; errors name the kernel.
+    pub fn new(device: &wgpu::Device, name: &str, wgsl: &str) -> Result<Self> {
+        let (_, reflection) = kernels::reflect(name, wgsl)?;
+        let label = format!("shadowgraph.{name}");
+        let (layouts, pipeline) = scoped(
+            device,
+            || {
+                let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                    label: Some(&label),
+                    source: wgpu::ShaderSource::Wgsl(wgsl.into()),
+                });
+                let layouts: Vec<wgpu::BindGroupLayout> = (0..reflection.group_count())
+                    .map(|g| {
+                        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                            label: Some(&label),
+                            entries: &reflection.layout_entries(g),
+                        })
+                    })
+                    .collect();
+                let refs: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(Some).collect();
+                let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some(&label),
+                    bind_group_layouts: &refs,
+                    immediate_size: 0,
+                });
+                let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(&label),
+                    layout: Some(&layout),
+                    module: &module,
+                    entry_point: Some("main"),
+                    compilation_options: Default::default(),
+                    cache: None,
+                });
+                (layouts, pipeline)
+            },
+            |message| Error::Pipeline {
+                kernel: name.to_string(),
+                message,
+            },
+        )?;
+        Ok(Self {
+            name: name.to_string(),
+            reflection,
+            layouts,
+            pipeline,
+        })
+    }
+
+    /// Workgroups covering a `w × h` texel grid.
+    pub fn groups_for(&self, w: u32, h: u32) -> [u32; 3] {
+        let wg = self.reflection.workgroup_size.unwrap_or([1, 1, 1]);
+        [w.div_ceil(wg[0]), h.div_ceil(wg[1]), 1]
+    }
+}
+
+/// Pipelines created once per kernel (or generated variant) and reused.
+#[derive(Default)]
+pub struct KernelCache {
+    kernels: HashMap<String, Arc<ComputeKernel>>,
+}
+
+impl KernelCache {
+    /// The pipeline of `kernels/<name>.wgsl`, compiled on first use.
+    pub fn get(&mut self, device: &wgpu::Device, name: &str) -> Result<Arc<ComputeKernel>> {
+        self.get_generated(device, name, None)
+    }
+
+    /// The pipeline of `name` with a `// #generated` block, keyed by the block's text.
+    pub fn get_generated(
+        &mut self,
+        device: &wgpu::Device,
+        name: &str,
+        generated: Option<&str>,
+    ) -> Result<Arc<ComputeKernel>> {
+        let key = match generated {
+            Some(g) => format!("{name}\u{0}{g}"),
+            None => name.to_string(),
+        };
+        if let Some(k) = self.kernels.get(&key) {
+            return Ok(k.clone());
+        }
+        let wgsl = kernels::resolve(name, generated)?;
+        let k = Arc::new(ComputeKernel::new(device, name, &wgsl)?);
+        self.kernels.insert(key, k.clone());
+        Ok(k)
+    }
+
+    /// Number of pipelines created so far.
+    pub fn len(&self) -> usize {
+        self.kernels.len()
+    }
+
+    /// Whether no pipeline was created yet.
+    pub fn is_empty(&self) -> bool {
+        self.kernels.is_empty()
+    }
+}
+
+/// Textures kept across runs, keyed by shape; a plan takes the ones it needs in order.
+#[derive(Default)]
+pub struct TexturePool {
+    free: HashMap<Slot, Vec<wgpu::Texture>>,
+}
+
+impl TexturePool {
+    fn take(&mut self, device: &wgpu::Device, slot: &Slot) -> wgpu::Texture {
+        if let Some(t) = self.free.get_mut(slot).and_then(Vec::pop) {
+            return t;
+        }
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("shadowgraph.pool"),
+            size: wgpu::Extent3d {
+                width: slot.width,
+                height: slot.height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: slot.mips,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: slot.format,
+            usage: wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        })
+    }
+
+    /// Textures held (in use by the last run or free).
+    pub fn texture_count(&self) -> usize {
+        self.free.values().map(Vec::len).sum()
+    }
+}
+
+/// Timestamp queries around passes, resolved after the work is submitted.
+pub struct GpuTimer {
+    query_set: wgpu::QuerySet,
+    resolve: wgpu::Buffer,
+    readback: wgpu::Buffer,
+    capacity: u32,
+    labels: Vec<String>,
+    period_ns: f64,
+}
+
+impl GpuTimer {
+    /// A timer for up to `passes` passes, or `None` when the device has no TIMESTAMP_QUERY.
+    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, passes: u32) -> Option<Self> {
+        if !device.features().contains(wgpu::Features::TIMESTAMP_QUERY) || passes == 0 {
+            return None;
+        }
+        let count = 2 * passes;
+        let bytes = u64::from(count) * 8;
+        Some(Self {
+            query_set: device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("shadowgraph.timer"),
+                ty: wgpu::QueryType::Timestamp,
+                count,
+            }),
+            resolve: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("shadowgraph.timer.resolve"),
+                size: bytes,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
+            readback: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("shadowgraph.timer.readback"),
+                size: bytes,
+                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                mapped_at_creation: false,
+            }),
+            capacity: passes,
+            labels: Vec::new(),
+            period_ns: f64::from(queue.get_timestamp_period()),
+        })
+    }
+
+    /// Forgets the passes of the last frame.
+    pub fn reset(&mut self) {
+        self.labels.clear();
+    }
+
+    /// Query indices for the next pass named `label`, or `None` when the timer is full.
+    fn next(&mut self, label: &str) -> Option<(u32, u32)> {
+        let i = self.labels.len() as u32;
+        if i >= self.capacity {
+            log::warn!("timer full: pass `{label}` is not timed");
+            return None;
+        }
+        self.labels.push(label.to_string());
+        Some((2 * i, 2 * i + 1))
+    }
+
+    /// Timestamp writes for a compute pass named `label`.
+    pub fn compute_pass(&mut self, label: &str) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+        let (a, b) = self.next(label)?;
+        Some(wgpu::ComputePassTimestampWrites {
+            query_set: &self.query_set,
+            beginning_of_pass_write_index: Some(a),
+            end_of_pass_write_index: Some(b),
+        })
+    }
+
+    /// Timestamp writes for a render pass named `label`.
+    pub fn render_pass(&mut self, label: &str) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+        let (a, b) = self.next(label)?;
+        Some(wgpu::RenderPassTimestampWrites {
+            query_set: &self.query_set,
+            beginning_of_pass_write_index: Some(a),
+            end_of_pass_write_index: Some(b),
+        })
+    }
+
+    /// Records the query resolve; call after the last timed pass, before submitting.
+    pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
+        let n = self.labels.len() as u32 * 2;
+        if n == 0 {
+            return;
+        }
+        encoder.resolve_query_set(&self.query_set, 0..n, &self.resolve, 0);
+        encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.readback, 0, u64::from(n) * 8);
+    }
+
+    /// Milliseconds per timed pass, in recording order. Call after the submission completed.
+    pub fn read(&self, device: &wgpu::Device) -> Result<Vec<(String, f64)>> {
+        if self.labels.is_empty() {
+            return Ok(Vec::new());
+        }
+        let raw = read_buffer(device, &self.readback)?;
+        let ticks: &[u64] = bytemuck::cast_slice(&raw);
+        Ok(self
+            .labels
+            .iter()
+            .enumerate()
+            .map(|(i, l)| {
+                let dt = ticks[2 * i + 1].wrapping_sub(ticks[2 * i]);
+                (l.clone(), dt as f64 * self.period_ns * 1e-6)
+            })
+            .collect())
+    }
+}
+
+/// The textures a run produced, by resource name.
+pub struct Outputs {
+    /// Texture of every planned resource, imports included.
+    pub textures: HashMap<String, wgpu::Texture>,
+    /// One counter per step that a kernel may increment (e.g. non-finite texels replaced).
+    pub stats: wgpu::Buffer,
+    stats_readback: wgpu::Buffer,
+    /// Step names, in the order of the counters.
+    pub steps: Vec<String>,
+}
+
+/// Stride between per-step counters: storage binding offsets must be 256-byte aligned.
+const STATS_STRIDE: u64 = 256;
+
+impl Outputs {
+    /// A default view of resource `name`.
+    pub fn view(&self, name: &str) -> Result<wgpu::TextureView> {
+        self.textures
+            .get(name)
+            .map(|t| t.create_view(&Default::default()))
+            .ok_or_else(|| Error::Invalid(format!("the plan has no resource `{name}`")))
+    }
+
+    /// Records the copy of the counters for [`Outputs::read_stats`].
+    pub fn copy_stats(&self, encoder: &mut wgpu::CommandEncoder) {
+        encoder.copy_buffer_to_buffer(&self.stats, 0, &self.stats_readback, 0, self.stats.size());
+    }
+
+    /// `(step, count)` for every step whose counter is non-zero; after the submission completed.
+    pub fn read_stats(&self, device: &wgpu::Device) -> Result<Vec<(String, u32)>> {
+        let raw = read_buffer(device, &self.stats_readback)?;
+        Ok(self
+            .steps
+            .iter()
+            .enumerate()
+            .filter_map(|(i, s)| {
+                let at = i * STATS_STRIDE as usize;
+                let v = u32::from_le_bytes(raw[at..at + 4].try_into().ok()?);
+                (v > 0).then(|| (s.clone(), v))
+            })
+            .collect())
+    }
+}
+
+/// Runs plans: owns pipelines and pooled textures, borrows everything else.
+#[derive(Default)]
+pub struct Executor {
+    /// Compiled kernels.
+    pub kernels: KernelCache,
+    pool: TexturePool,
+    in_use: Vec<(Slot, wgpu::Texture)>,
+}
+
+impl Executor {
+    /// An executor with empty caches.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Compiles every kernel `plan` uses (also done lazily by [`Executor::record`]).
+    pub fn prepare(&mut self, device: &wgpu::Device, plan: &Plan) -> Result<()> {
+        for step in &plan.steps {
+            self.kernels.get(device, &step.node.kernel)?;
+        }
+        Ok(())
+    }
+
+    /// Textures held by the pool (constant across runs of the same plan).
+    pub fn texture_count(&self) -> usize {
+        self.pool.texture_count() + self.in_use.len()
+    }
+
+    /// Records `plan` into `encoder`. `imports` gives a texture for every imported resource.
+    pub fn record(
+        &mut self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        plan: &Plan,
+        imports: &HashMap<String, wgpu::Texture>,
+        mut timer: Option<&mut GpuTimer>,
+    ) -> Result<Outputs> {
+        // Textures of the previous run go back to the pool, then each slot takes one.
+        for (slot, t) in self.in_use.drain(..) {
+            self.pool.free.entry(slot).or_default().push(t);
+        }
+        let slot_textures: Vec<wgpu::Texture> = plan
+            .slots
+            .iter()
+            .map(|s| self.pool.take(device, s))
+            .collect();
+        self.in_use = plan
+            .slots
+            .iter()
+            .cloned()
+            .zip(slot_textures.iter().cloned())
+            .collect();
+
+        let mut textures = HashMap::new();
+        for r in &plan.resources {
+            let t = match r.slot {
+                Some(s) => slot_textures[s].clone(),
+                None => imports.get(&r.resource.name).cloned().ok_or_else(|| {
+                    Error::Invalid(format!(
+                        "imported resource `{}` was not provided",
+                        r.resource.name
+                    ))
+                })?,
+            };
+            if (t.width(), t.height()) != (r.width, r.height) {
+                return Err(Error::Invalid(format!(
+                    "`{}` is {}x{}, the plan expects {}x{}",
+                    r.resource.name,
+                    t.width(),
+                    t.height(),
+                    r.width,
+                    r.height
+                )));
+            }
+            textures.insert(r.resource.name.clone(), t);
+        }
+
+        let steps = plan.steps.len().max(1) as u64;
+        let stats = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("shadowgraph.stats"),
+            size: steps * STATS_STRIDE,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let stats_readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("shadowgraph.stats.readback"),
+            size: steps * STATS_STRIDE,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        encoder.clear_buffer(&stats, 0, None);
+
+        let align = u64::from(device.limits().min_uniform_buffer_offset_alignment).max(16);
+        let mut params_bytes = Vec::new();
+        let mut params_at = Vec::new();
+        for step in &plan.steps {
+            let at = (params_bytes.len() as u64).div_ceil(align) * align;
+            params_bytes.resize(at as usize, 0);
+            params_at.push((at, step.node.params.len().max(16) as u64));
+            params_bytes.extend_from_slice(&step.node.params);
+        }
+        params_bytes.resize(params_bytes.len().max(16).div_ceil(16) * 16 + 16, 0);
+        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("shadowgraph.params"),
+            contents: &params_bytes,
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+
+        for (si, step) in plan.steps.iter().enumerate() {
+            let node = &step.node;
+            let kernel = self.kernels.get(device, &node.kernel)?;
+            let mut views: Vec<(u32, wgpu::TextureView)> = Vec::new();
+            let mut entries: Vec<wgpu::BindGroupEntry> = Vec::new();
+            for b in kernel.reflection.bindings.iter().filter(|b| b.group == 0) {
+                let bound = node
+                    .inputs
+                    .iter()
+                    .chain(&node.outputs)
+                    .find(|(slot, _)| *slot == b.name);
+                if let Some((_, res)) = bound {
+                    let view = textures[res].create_view(&wgpu::TextureViewDescriptor {
+                        aspect: if textures[res].format().is_depth_stencil_format() {
+                            wgpu::TextureAspect::DepthOnly
+                        } else {
+                            wgpu::TextureAspect::All
+                        },
+                        ..Default::default()
+                    });
+                    views.push((b.binding, view));
+                } else if b.name != "params" && b.name != "stats" {
+                    return Err(Error::Pipeline {
+                        kernel: node.kernel.clone(),
+                        message: format!("node `{}` binds nothing to `{}`", node.name, b.name),
+                    });
+                }
+            }
+            for (binding, view) in &views {
+                entries.push(wgpu::BindGroupEntry {
+                    binding: *binding,
+                    resource: wgpu::BindingResource::TextureView(view),
+                });
+            }
+            if let Some(b) = kernel.reflection.binding("params") {
+                let (offset, size) = params_at[si];
+                entries.push(wgpu::BindGroupEntry {
+                    binding: b.binding,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &params,
+                        offset,
+                        size: wgpu::BufferSize::new(size.div_ceil(16) * 16),
+                    }),
+                });
+            }
+            if let Some(b) = kernel.reflection.binding("stats") {
+                entries.push(wgpu::BindGroupEntry {
+                    binding: b.binding,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &stats,
+                        offset: si as u64 * STATS_STRIDE,
+                        size: wgpu::BufferSize::new(4),
+                    }),
+                });
+            }
+            let bind_group = scoped(
+                device,
+                || {
+                    device.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some(&node.name),
+                        layout: &kernel.layouts[0],
+                        entries: &entries,
+                    })
+                },
+                |message| Error::Pipeline {
+                    kernel: node.kernel.clone(),
+                    message: format!("binding node `{}`: {message}", node.name),
+                },
+            )?;
+            let groups = match &node.dispatch {
+                Dispatch::Groups(g) => *g,
+                Dispatch::Texels(r) => {
+                    let t = &textures[r];
+                    kernel.groups_for(t.width(), t.height())
+                }
+            };
+            let timestamp_writes = timer
+                .as_deref_mut()
+                .and_then(|t| t.compute_pass(&node.name));
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(&node.name),
+                timestamp_writes,
+            });
+            pass.set_pipeline(&kernel.pipeline);
+            pass.set_bind_group(0, &bind_group, &[]);
+            pass.dispatch_workgroups(groups[0], groups[1], groups[2]);
+        }
+        Ok(Outputs {
+            textures,
+            stats,
+            stats_readback,
+            steps: plan.steps.iter().map(|s| s.node.name.clone()).collect(),
+        })
+    }
+}

@@ -1,0 +1,66 @@
+//! Writing images: PNG previews and 32-bit float OpenEXR with named channels.
+
+use std::path::Path;
+
+use crate::error::{Error, Result};
+
+/// Writes 8-bit RGBA pixels as PNG.
+pub fn write_png(path: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<()> {
+    image::save_buffer(path, rgba, width, height, image::ColorType::Rgba8).map_err(|e| {
+        Error::Image {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        }
+    })
+}
+
+/// Writes one 32-bit float OpenEXR layer with the given named channels (row-major, y down).
+pub fn write_exr(
+    path: &Path,
+    width: u32,
+    height: u32,
+    channels: Vec<(String, Vec<f32>)>,
+) -> Result<()> {
+    use exr::prelude::{
+        AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, SmallVec,
+        WritableImage,
+    };
+    let n = (width as usize) * (height as usize);
+    if let Some((name, c)) = channels.iter().find(|(_, c)| c.len() != n) {
+        return Err(Error::Invalid(format!(
+            "EXR channel `{name}` has {} samples, expected {n}",
+            c.len()
+        )));
+    }
+    let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = channels
+        .into_iter()
+        .map(|(name, data)| AnyChannel::new(name.as_str(), FlatSamples::F32(data)))
+        .collect();
+    let layer = Layer::new(
+        (width as usize, height as usize),
+        LayerAttributes::named("shadowgraph"),
+        Encoding::FAST_LOSSLESS,
+        AnyChannels::sort(list),
+    );
+    Image::from_layer(layer)
+        .write()
+        .to_file(path)
+        .map_err(|e| Error::Image {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })
+}
+
+/// Splits interleaved `stride`-channel data into one channel per name.
+pub fn deinterleave(data: &[f32], stride: usize, names: &[&str]) -> Vec<(String, Vec<f32>)> {
+    names
+        .iter()
+        .enumerate()
+        .map(|(c, n)| {
+            (
+                n.to_string(),
+                data.iter().skip(c).step_by(stride).copied().collect(),
+            )
+        })
+        .collect()
+}

@@ -1,0 +1,838 @@
+//! The frame: per light a depth-only raster pass, the planned kernels, the camera G-buffer and
+//! the generated shading kernel. Also [`probe`], which evaluates visibility at given points
+//! on given maps (how tests compare the GPU to the f64 references).
+
+use std::collections::HashMap;
+
+use glam::Vec3;
+use wgpu::util::DeviceExt;
+
+use crate::error::{Error, Result};
+use crate::exec::{Executor, GpuTimer};
+use crate::gpu::{read_buffer, read_texture, scoped, submit_and_wait, write_texture};
+use crate::graph::{Graph, Plan, plan};
+use crate::kernels;
+use crate::scene::{Light, Scene};
+use crate::technique::{self, LightGpu};
+
+/// Frame constants of `kernels/shade.wgsl` (mirrors its `Frame`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct FrameGpu {
+    /// Image size.
+    pub size: [u32; 2],
+    /// Number of lights.
+    pub light_count: u32,
+    /// Padding.
+    pub _pad0: u32,
+    /// Ambient colour.
+    pub ambient: [f32; 3],
+    /// Padding.
+    pub _pad1: f32,
+    /// Background colour.
+    pub background: [f32; 3],
+    /// Padding.
+    pub _pad2: f32,
+}
+
+/// The graph of a scene, its plan, and what the shading pass reads per light.
+pub struct ScenePlan {
+    /// Every node the scene's lights could use.
+    pub graph: Graph,
+    /// The pruned, ordered plan.
+    pub plan: Plan,
+    /// Per light, the resource the shading pass binds.
+    pub shade_inputs: Vec<technique::ShadeInput>,
+}
+
+/// Plans `lights` (no GPU needed): the kernels their techniques need and nothing else.
+pub fn plan_lights(lights: &[Light]) -> Result<ScenePlan> {
+    let mut graph = Graph::default();
+    let mut shade_inputs = Vec::new();
+    for (i, l) in lights.iter().enumerate() {
+        technique::add_light_nodes(&mut graph, i, l);
+        shade_inputs.push(technique::shade_input(i, l));
+    }
+    let outputs: Vec<&str> = shade_inputs.iter().map(|s| s.resource.as_str()).collect();
+    let plan = plan(&graph, &outputs)?;
+    Ok(ScenePlan {
+        graph,
+        plan,
+        shade_inputs,
+    })
+}
+
+/// Checks sizes against the device's limits, naming the offending key.
+pub fn check_limits(device: &wgpu::Device, scene: &Scene) -> Result<()> {
+    let max = device.limits().max_texture_dimension_2d;
+    let check = |what: String, v: u32| {
+        if v > max {
+            Err(Error::Limit {
+                what,
+                requested: u64::from(v),
+                limit: u64::from(max),
+            })
+        } else {
+            Ok(())
+        }
+    };
+    check("output.width".into(), scene.width)?;
+    check("output.height".into(), scene.height)?;
+    for (i, l) in scene.lights.iter().enumerate() {
+        check(format!("light[{i}].shadow_map"), l.shadow_map)?;
+    }
+    Ok(())
+}
+
+/// What `render` asks for besides the image.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RenderOptions {
+    /// Read back world position, normal and per-light visibility.
+    pub aux: bool,
+    /// Frames to render; timings are per frame (the caller takes medians).
+    pub repeat: u32,
+}
+
+/// A rendered frame read back to the CPU.
+pub struct Frame {
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+    /// sRGB RGBA8 pixels.
+    pub rgba: Vec<u8>,
+    /// Visibility per pixel per light: `vis[(y * width + x) * lights + l]`.
+    pub visibility: Vec<f32>,
+    /// World position + coverage per pixel (`aux` only).
+    pub position: Vec<f32>,
+    /// Normal + material per pixel (`aux` only).
+    pub normal: Vec<f32>,
+    /// Per frame, milliseconds per timed pass (empty when the device cannot time).
+    pub timings: Vec<Vec<(String, f64)>>,
+    /// Steps whose kernels reported replaced texels (non-finite depth), with the count.
+    pub sanitized: Vec<(String, u32)>,
+    /// The shadow maps' linear depth, per light (`aux` only; empty where the technique reads
+    /// the raw depth map).
+    pub linear_maps: Vec<Vec<f32>>,
+    /// The raw depth maps, per light (`aux` only).
+    pub depth_maps: Vec<Vec<f32>>,
+}
+
+/// Renders scenes; holds pipelines and pooled textures across frames.
+pub struct Renderer {
+    /// The graph executor (kernel pipelines, texture pool).
+    pub executor: Executor,
+    shadow: HashMap<u32, wgpu::RenderPipeline>,
+    gbuffer: Option<(wgpu::RenderPipeline, wgpu::BindGroupLayout)>,
+    cmp_sampler: wgpu::Sampler,
+}
+
+const VERTEX_ATTRS: [wgpu::VertexAttribute; 3] =
+    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Uint32];
+
+fn vertex_layout() -> wgpu::VertexBufferLayout<'static> {
+    wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<crate::scene::Vertex>() as u64,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &VERTEX_ATTRS,
+    }
+}
+
+fn uniform(device: &wgpu::Device, label: &str, bytes: &[u8]) -> wgpu::Buffer {
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: bytes,
+        usage: wgpu::BufferUsages::UNIFORM,
+    })
+}
+
+fn texture(
+    device: &wgpu::Device,
+    label: &str,
+    (w, h): (u32, u32),
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
+/// Usage of textures the renderer writes and later reads back or samples.
+const TARGET: wgpu::TextureUsages = wgpu::TextureUsages::RENDER_ATTACHMENT
+    .union(wgpu::TextureUsages::TEXTURE_BINDING)
+    .union(wgpu::TextureUsages::COPY_SRC)
+    .union(wgpu::TextureUsages::COPY_DST);
+
+impl Renderer {
+    /// A renderer for `device`.
+    pub fn new(device: &wgpu::Device) -> Self {
+        Self {
+            executor: Executor::new(),
+            shadow: HashMap::new(),
+            gbuffer: None,
+            cmp_sampler: device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("shadowgraph.cmp_sampler"),
+                mag_filter: wgpu::FilterMode::Linear,
+                min_filter: wgpu::FilterMode::Linear,
+                compare: Some(wgpu::CompareFunction::LessEqual),
+                ..Default::default()
+            }),
+        }
+    }
+
+    fn raster_pipeline(
+        device: &wgpu::Device,
+        name: &str,
+        fragment: Option<&[Option<wgpu::ColorTargetState>]>,
+        bias: wgpu::DepthBiasState,
+    ) -> Result<(wgpu::RenderPipeline, wgpu::BindGroupLayout)> {
+        let wgsl = kernels::resolve(name, None)?;
+        let (_, refl) = kernels::reflect(name, &wgsl)?;
+        let label = format!("shadowgraph.{name}");
+        scoped(
+            device,
+            || {
+                let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                    label: Some(&label),
+                    source: wgpu::ShaderSource::Wgsl(wgsl.as_str().into()),
+                });
+                let bgl = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some(&label),
+                    entries: &refl.layout_entries(0),
+                });
+                let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some(&label),
+                    bind_group_layouts: &[Some(&bgl)],
+                    immediate_size: 0,
+                });
+                let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                    label: Some(&label),
+                    layout: Some(&layout),
+                    vertex: wgpu::VertexState {
+                        module: &module,
+                        entry_point: Some("vs_main"),
+                        compilation_options: Default::default(),
+                        buffers: &[Some(vertex_layout())],
+                    },
+                    // Two-sided: planes and open meshes cast and receive from both sides.
+                    primitive: wgpu::PrimitiveState::default(),
+                    depth_stencil: Some(wgpu::DepthStencilState {
+                        format: wgpu::TextureFormat::Depth32Float,
+                        depth_write_enabled: Some(true),
+                        depth_compare: Some(wgpu::CompareFunction::Less),
+                        stencil: Default::default(),
+                        bias,
+                    }),
+                    multisample: Default::default(),
+                    fragment: fragment.map(|targets| wgpu::FragmentState {
+                        module: &module,
+                        entry_point: Some("fs_main"),
+                        compilation_options: Default::default(),
+                        targets,
+                    }),
+                    multiview_mask: None,
+                    cache: None,
+                });
+                (pipeline, bgl)
+            },
+            |message| Error::Pipeline {
+                kernel: name.to_string(),
+                message,
+            },
+        )
+    }
+
+    fn shadow_pipeline(
+        &mut self,
+        device: &wgpu::Device,
+        slope: f32,
+    ) -> Result<&wgpu::RenderPipeline> {
+        let key = slope.to_bits();
+        if !self.shadow.contains_key(&key) {
+            let bias = wgpu::DepthBiasState {
+                constant: 0,
+                slope_scale: slope,
+                clamp: 0.0,
+            };
+            let (p, _) = Self::raster_pipeline(device, "shadow_depth", None, bias)?;
+            self.shadow.insert(key, p);
+        }
+        Ok(&self.shadow[&key])
+    }
+
+    /// Renders `scene` on `device`/`queue` and reads the frame back.
+    pub fn render(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+        opts: RenderOptions,
+    ) -> Result<Frame> {
+        check_limits(device, scene)?;
+        let sp = plan_lights(&scene.lights)?;
+        let verts = scene.vertices();
+        let vbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("shadowgraph.vertices"),
+            contents: bytemuck::cast_slice(&verts),
+            usage: wgpu::BufferUsages::VERTEX,
+        });
+        let materials: Vec<[f32; 4]> = scene
+            .objects
+            .iter()
+            .map(|o| o.color.extend(1.0).to_array())
+            .collect();
+        let size = (scene.width, scene.height);
+        let gpos = texture(
+            device,
+            "shadowgraph.g_position",
+            size,
+            wgpu::TextureFormat::Rgba32Float,
+            TARGET,
+        );
+        let gnorm = texture(
+            device,
+            "shadowgraph.g_normal",
+            size,
+            wgpu::TextureFormat::Rgba32Float,
+            TARGET,
+        );
+        let cam_depth = texture(
+            device,
+            "shadowgraph.camera_depth",
+            size,
+            wgpu::TextureFormat::Depth32Float,
+            TARGET,
+        );
+        let depths: Vec<wgpu::Texture> = scene
+            .lights
+            .iter()
+            .map(|l| {
+                texture(
+                    device,
+                    "shadowgraph.shadow_map",
+                    (l.shadow_map, l.shadow_map),
+                    wgpu::TextureFormat::Depth32Float,
+                    TARGET,
+                )
+            })
+            .collect();
+        let imports: HashMap<String, wgpu::Texture> = depths
+            .iter()
+            .enumerate()
+            .map(|(i, t)| (technique::depth_name(i), t.clone()))
+            .collect();
+        let passes = 2 * scene.lights.len() as u32 + sp.plan.steps.len() as u32 + 2;
+        let mut timer = GpuTimer::new(device, queue, passes);
+        let repeat = opts.repeat.max(1);
+        let mut timings = Vec::new();
+        let mut last = None;
+        for _ in 0..repeat {
+            if let Some(t) = timer.as_mut() {
+                t.reset();
+            }
+            let mut enc = device.create_command_encoder(&Default::default());
+            for (i, (l, depth)) in scene.lights.iter().zip(&depths).enumerate() {
+                self.shadow_pass(
+                    device,
+                    &mut enc,
+                    i,
+                    l,
+                    &vbuf,
+                    verts.len() as u32,
+                    depth,
+                    timer.as_mut(),
+                )?;
+            }
+            let outputs =
+                self.executor
+                    .record(device, &mut enc, &sp.plan, &imports, timer.as_mut())?;
+            self.gbuffer_pass(
+                device,
+                &mut enc,
+                scene,
+                &vbuf,
+                verts.len() as u32,
+                &gpos,
+                &gnorm,
+                &cam_depth,
+                timer.as_mut(),
+            )?;
+            let maps: Vec<wgpu::TextureView> = sp
+                .shade_inputs
+                .iter()
+                .map(|s| depth_only_view(&outputs.textures[&s.resource]))
+                .collect();
+            let frame = FrameGpu {
+                size: [size.0, size.1],
+                light_count: scene.lights.len() as u32,
+                _pad0: 0,
+                ambient: scene.ambient.to_array(),
+                _pad1: 0.0,
+                background: scene.background.to_array(),
+                _pad2: 0.0,
+            };
+            let shaded = self.shade(
+                device,
+                &mut enc,
+                &scene.lights,
+                &frame,
+                &gpos,
+                &gnorm,
+                &materials,
+                &maps,
+                timer.as_mut(),
+            )?;
+            outputs.copy_stats(&mut enc);
+            if let Some(t) = timer.as_ref() {
+                t.resolve(&mut enc);
+            }
+            submit_and_wait(device, queue, enc, "render")?;
+            if let Some(t) = timer.as_ref() {
+                timings.push(t.read(device)?);
+            }
+            last = Some((outputs, shaded));
+        }
+        let Some((outputs, shaded)) = last else {
+            return Err(Error::Invalid("no frame rendered".into()));
+        };
+        let sanitized = outputs.read_stats(device)?;
+        for (step, n) in &sanitized {
+            log::warn!("{step}: replaced {n} non-finite depth texel(s) with 1.0 (no occluder)");
+        }
+        let rgba = read_texture(device, queue, &shaded.color, 0)?;
+        let visibility = shaded.read_visibility(device, queue)?;
+        let mut frame = Frame {
+            width: size.0,
+            height: size.1,
+            rgba,
+            visibility,
+            position: Vec::new(),
+            normal: Vec::new(),
+            timings,
+            sanitized,
+            linear_maps: Vec::new(),
+            depth_maps: Vec::new(),
+        };
+        if opts.aux {
+            frame.position = bytemuck::cast_slice(&read_texture(device, queue, &gpos, 0)?).to_vec();
+            frame.normal = bytemuck::cast_slice(&read_texture(device, queue, &gnorm, 0)?).to_vec();
+            for (i, d) in depths.iter().enumerate() {
+                frame
+                    .depth_maps
+                    .push(bytemuck::cast_slice(&read_texture(device, queue, d, 0)?).to_vec());
+                frame
+                    .linear_maps
+                    .push(match outputs.textures.get(&technique::linear_name(i)) {
+                        Some(t) => {
+                            bytemuck::cast_slice(&read_texture(device, queue, t, 0)?).to_vec()
+                        }
+                        None => Vec::new(),
+                    });
+            }
+        }
+        Ok(frame)
+    }
+
+    #[expect(clippy::too_many_arguments, reason = "one raster pass's inputs")]
+    fn shadow_pass(
+        &mut self,
+        device: &wgpu::Device,
+        enc: &mut wgpu::CommandEncoder,
+        i: usize,
+        light: &Light,
+        vbuf: &wgpu::Buffer,
+        count: u32,
+        depth: &wgpu::Texture,
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
+        let pipeline = self
+            .shadow_pipeline(device, light.shadow.slope_bias)?
+            .clone();
+        let vp = (light.projection() * light.view()).to_cols_array();
+        let ubuf = uniform(device, "shadowgraph.light_view", bytemuck::cast_slice(&vp));
+        let bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shadowgraph.shadow_depth"),
+            layout: &pipeline.get_bind_group_layout(0),
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: ubuf.as_entire_binding(),
+            }],
+        });
+        let view = depth.create_view(&Default::default());
+        let label = format!("light{i}.shadow_raster");
+        let timestamp_writes = timer.and_then(|t| t.render_pass(&label));
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(&label),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &bg, &[]);
+        pass.set_vertex_buffer(0, vbuf.slice(..));
+        pass.draw(0..count, 0..1);
+        Ok(())
+    }
+
+    #[expect(clippy::too_many_arguments, reason = "one raster pass's inputs")]
+    fn gbuffer_pass(
+        &mut self,
+        device: &wgpu::Device,
+        enc: &mut wgpu::CommandEncoder,
+        scene: &Scene,
+        vbuf: &wgpu::Buffer,
+        count: u32,
+        gpos: &wgpu::Texture,
+        gnorm: &wgpu::Texture,
+        cam_depth: &wgpu::Texture,
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
+        if self.gbuffer.is_none() {
+            let t = Some(wgpu::ColorTargetState {
+                format: wgpu::TextureFormat::Rgba32Float,
+                blend: None,
+                write_mask: wgpu::ColorWrites::ALL,
+            });
+            self.gbuffer = Some(Self::raster_pipeline(
+                device,
+                "gbuffer",
+                Some(&[t.clone(), t]),
+                Default::default(),
+            )?);
+        }
+        let Some((pipeline, bgl)) = &self.gbuffer else {
+            return Err(Error::Invalid("G-buffer pipeline missing".into()));
+        };
+        let vp = scene
+            .camera
+            .view_proj(scene.width as f32 / scene.height as f32)
+            .to_cols_array();
+        let ubuf = uniform(device, "shadowgraph.camera", bytemuck::cast_slice(&vp));
+        let bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shadowgraph.gbuffer"),
+            layout: bgl,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: ubuf.as_entire_binding(),
+            }],
+        });
+        let (pv, nv, dv) = (
+            gpos.create_view(&Default::default()),
+            gnorm.create_view(&Default::default()),
+            cam_depth.create_view(&Default::default()),
+        );
+        let clear = |view| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })
+        };
+        let timestamp_writes = timer.and_then(|t| t.render_pass("gbuffer"));
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("gbuffer"),
+            color_attachments: &[clear(&pv), clear(&nv)],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &dv,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &bg, &[]);
+        pass.set_vertex_buffer(0, vbuf.slice(..));
+        pass.draw(0..count, 0..1);
+        Ok(())
+    }
+
+    /// Records the shading kernel for `lights` over a G-buffer; `maps[i]` is light i's input.
+    #[expect(clippy::too_many_arguments, reason = "the shading pass's bindings")]
+    pub fn shade(
+        &mut self,
+        device: &wgpu::Device,
+        enc: &mut wgpu::CommandEncoder,
+        lights: &[Light],
+        frame: &FrameGpu,
+        gpos: &wgpu::Texture,
+        gnorm: &wgpu::Texture,
+        materials: &[[f32; 4]],
+        maps: &[wgpu::TextureView],
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<Shaded> {
+        let block = technique::shading_block(lights);
+        let kernel = self
+            .executor
+            .kernels
+            .get_generated(device, "shade", Some(&block))?;
+        let (w, h) = (frame.size[0], frame.size[1]);
+        let color = texture(
+            device,
+            "shadowgraph.color",
+            (w, h),
+            wgpu::TextureFormat::Rgba8Unorm,
+            wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        );
+        let vis_bytes = (u64::from(w) * u64::from(h) * lights.len().max(1) as u64 * 4).max(4);
+        let visibility = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("shadowgraph.visibility"),
+            size: vis_bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let gpu_lights: Vec<LightGpu> = lights.iter().map(LightGpu::new).collect();
+        let storage = |label, bytes: &[u8]| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: bytes,
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+        };
+        let mat_buf = storage("shadowgraph.materials", bytemuck::cast_slice(materials));
+        let light_buf = storage("shadowgraph.lights", bytemuck::cast_slice(&gpu_lights));
+        let frame_buf = uniform(device, "shadowgraph.frame", bytemuck::bytes_of(frame));
+        let views = [
+            gpos.create_view(&Default::default()),
+            gnorm.create_view(&Default::default()),
+            color.create_view(&Default::default()),
+        ];
+        let err = |message: String| Error::Pipeline {
+            kernel: "shade".into(),
+            message,
+        };
+        let bg0 = scoped(
+            device,
+            || {
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("shadowgraph.shade"),
+                    layout: &kernel.layouts[0],
+                    entries: &[
+                        wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: wgpu::BindingResource::TextureView(&views[0]),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 1,
+                            resource: wgpu::BindingResource::TextureView(&views[1]),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 2,
+                            resource: mat_buf.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 3,
+                            resource: light_buf.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 4,
+                            resource: frame_buf.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 5,
+                            resource: wgpu::BindingResource::TextureView(&views[2]),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 6,
+                            resource: visibility.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 7,
+                            resource: wgpu::BindingResource::Sampler(&self.cmp_sampler),
+                        },
+                    ],
+                })
+            },
+            err,
+        )?;
+        let entries: Vec<wgpu::BindGroupEntry> = maps
+            .iter()
+            .enumerate()
+            .map(|(i, v)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource: wgpu::BindingResource::TextureView(v),
+            })
+            .collect();
+        let bg1 = scoped(
+            device,
+            || {
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("shadowgraph.shade.maps"),
+                    layout: &kernel.layouts[1],
+                    entries: &entries,
+                })
+            },
+            err,
+        )?;
+        let groups = kernel.groups_for(w, h);
+        let timestamp_writes = timer.and_then(|t| t.compute_pass("shade"));
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("shade"),
+            timestamp_writes,
+        });
+        pass.set_pipeline(&kernel.pipeline);
+        pass.set_bind_group(0, &bg0, &[]);
+        pass.set_bind_group(1, &bg1, &[]);
+        pass.dispatch_workgroups(groups[0], groups[1], 1);
+        drop(pass);
+        Ok(Shaded { color, visibility })
+    }
+}
+
+/// The shading pass's outputs.
+pub struct Shaded {
+    /// RGBA8 image (sRGB-encoded values).
+    pub color: wgpu::Texture,
+    /// Visibility per pixel per light.
+    pub visibility: wgpu::Buffer,
+}
+
+impl Shaded {
+    /// Copies the visibility buffer back.
+    pub fn read_visibility(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Vec<f32>> {
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("shadowgraph.visibility.readback"),
+            size: self.visibility.size(),
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let mut enc = device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(&self.visibility, 0, &staging, 0, self.visibility.size());
+        submit_and_wait(device, queue, enc, "visibility readback")?;
+        Ok(bytemuck::cast_slice(&read_buffer(device, &staging)?).to_vec())
+    }
+}
+
+fn depth_only_view(t: &wgpu::Texture) -> wgpu::TextureView {
+    t.create_view(&wgpu::TextureViewDescriptor {
+        aspect: if t.format().is_depth_stencil_format() {
+            wgpu::TextureAspect::DepthOnly
+        } else {
+            wgpu::TextureAspect::All
+        },
+        ..Default::default()
+    })
+}
+
+/// A map handed to [`probe`]: linear depth (R32Float) for every technique but hardware PCF.
+pub struct ProbeMap<'a> {
+    /// Side length.
+    pub size: u32,
+    /// `size²` linear depths, row-major.
+    pub linear: &'a [f32],
+}
+
+/// Evaluates each light's visibility at `points` (position, unit normal) on the given linear
+/// depth maps with the real shading kernel. Returns `vis[point * lights + light]`.
+pub fn probe(
+    renderer: &mut Renderer,
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    lights: &[Light],
+    maps: &[ProbeMap],
+    points: &[(Vec3, Vec3)],
+) -> Result<Vec<f32>> {
+    if maps.len() != lights.len() || points.is_empty() {
+        return Err(Error::Invalid(
+            "probe needs one map per light and at least one point".into(),
+        ));
+    }
+    let w = (points.len() as u32).min(256);
+    let h = (points.len() as u32).div_ceil(w);
+    let mut pos = vec![[0.0f32; 4]; (w * h) as usize];
+    let mut nor = vec![[0.0f32; 4]; (w * h) as usize];
+    for (i, (p, n)) in points.iter().enumerate() {
+        pos[i] = p.extend(1.0).to_array();
+        nor[i] = n.extend(0.0).to_array();
+    }
+    let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
+    let gpos = texture(
+        device,
+        "shadowgraph.probe.position",
+        (w, h),
+        wgpu::TextureFormat::Rgba32Float,
+        usage,
+    );
+    let gnorm = texture(
+        device,
+        "shadowgraph.probe.normal",
+        (w, h),
+        wgpu::TextureFormat::Rgba32Float,
+        usage,
+    );
+    write_texture(queue, &gpos, bytemuck::cast_slice(&pos));
+    write_texture(queue, &gnorm, bytemuck::cast_slice(&nor));
+    let mut views = Vec::new();
+    for m in maps {
+        if m.linear.len() != (m.size * m.size) as usize {
+            return Err(Error::Invalid(format!(
+                "a {0}x{0} probe map needs {1} texels",
+                m.size,
+                m.size * m.size
+            )));
+        }
+        let t = texture(
+            device,
+            "shadowgraph.probe.map",
+            (m.size, m.size),
+            wgpu::TextureFormat::R32Float,
+            usage,
+        );
+        write_texture(queue, &t, bytemuck::cast_slice(m.linear));
+        views.push(t.create_view(&Default::default()));
+    }
+    let frame = FrameGpu {
+        size: [w, h],
+        light_count: lights.len() as u32,
+        _pad0: 0,
+        ambient: [0.0; 3],
+        _pad1: 0.0,
+        background: [0.0; 3],
+        _pad2: 0.0,
+    };
+    let mut enc = device.create_command_encoder(&Default::default());
+    let shaded = renderer.shade(
+        device,
+        &mut enc,
+        lights,
+        &frame,
+        &gpos,
+        &gnorm,
+        &[[1.0; 4]],
+        &views,
+        None,
+    )?;
+    submit_and_wait(device, queue, enc, "probe")?;
+    let mut vis = shaded.read_visibility(device, queue)?;
+    vis.truncate(points.len() * lights.len());
+    Ok(vis)
+}

@@ -1,0 +1,249 @@
+//! What each shadow technique needs: the graph nodes that build its maps, the maps the shading
+//! pass reads, the WGSL visibility call, and the GPU mirror of a light.
+
+use std::fmt::Write;
+
+use crate::graph::{Dispatch, Graph, Node, SizeRule};
+use crate::scene::{Light, LightKind, PcfKernel, Technique};
+
+/// A light as the shading kernel reads it. Mirrors `struct Light` in
+/// `kernels/shared/light.wgsl` (a test checks the size against naga's layout).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct LightGpu {
+    /// World → light clip.
+    pub view_proj: [[f32; 4]; 4],
+    /// World → light view.
+    pub view: [[f32; 4]; 4],
+    /// Colour × intensity.
+    pub radiance: [f32; 3],
+    /// 0 directional, 1 spot.
+    pub kind: u32,
+    /// Light position.
+    pub position: [f32; 3],
+    /// Near plane.
+    pub near: f32,
+    /// Unit direction light → target.
+    pub direction: [f32; 3],
+    /// Far plane.
+    pub far: f32,
+    /// Shadow-map size in texels.
+    pub map_size: [f32; 2],
+    /// Map width in world units (directional) or per unit distance (spot).
+    pub width_at_unit: f32,
+    /// Area-light width.
+    pub size: f32,
+    /// Constant bias, linear depth units.
+    pub bias: f32,
+    /// Normal offset, texels.
+    pub normal_bias: f32,
+    /// Spot: cos(fov/2); directional: −1.
+    pub cos_outer: f32,
+    /// 0 hard, 1 pcf, 2 pcss.
+    pub technique: u32,
+    /// PCF radius.
+    pub radius: u32,
+    /// PCF kernel: 0 box, 1 tent, 2 hardware.
+    pub kernel: u32,
+    /// PCSS blocker taps.
+    pub blocker_samples: u32,
+    /// PCSS filter taps.
+    pub filter_samples: u32,
+    /// PCSS search cap (UV).
+    pub max_search: f32,
+    /// Padding to the WGSL struct's 16-byte alignment.
+    pub _pad: [f32; 3],
+}
+
+impl LightGpu {
+    /// The GPU description of `light`.
+    pub fn new(light: &Light) -> Self {
+        let view = light.view();
+        let (technique, radius, kernel, blocker_samples, filter_samples, max_search) =
+            match light.shadow.technique {
+                Technique::Hard => (0, 0, 0, 0, 0, 0.0),
+                Technique::Pcf { radius, kernel } => {
+                    let k = match kernel {
+                        PcfKernel::Box => 0,
+                        PcfKernel::Tent => 1,
+                        PcfKernel::Hardware => 2,
+                    };
+                    (1, radius, k, 0, 0, 0.0)
+                }
+                Technique::Pcss {
+                    blocker_samples,
+                    filter_samples,
+                    max_search,
+                } => (2, 0, 0, blocker_samples, filter_samples, max_search),
+            };
+        let (kind, cos_outer) = match light.kind {
+            LightKind::Directional { .. } => (0, -1.0),
+            LightKind::Spot { fov_degrees } => (1, (0.5 * fov_degrees.to_radians()).cos()),
+        };
+        Self {
+            view_proj: (light.projection() * view).to_cols_array_2d(),
+            view: view.to_cols_array_2d(),
+            radiance: light.radiance.to_array(),
+            kind,
+            position: light.position.to_array(),
+            near: light.near,
+            direction: light.direction().to_array(),
+            far: light.far,
+            map_size: [light.shadow_map as f32; 2],
+            width_at_unit: light.width_at_unit(),
+            size: light.size,
+            bias: light.shadow.bias,
+            normal_bias: light.shadow.normal_bias,
+            cos_outer,
+            technique,
+            radius,
+            kernel,
+            blocker_samples,
+            filter_samples,
+            max_search,
+            _pad: [0.0; 3],
+        }
+    }
+}
+
+/// Parameters of `kernels/linearize.wgsl` (mirrors its `Params`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct LinearizeParams {
+    /// 1 for a perspective (spot) depth buffer.
+    pub perspective: u32,
+    /// Near plane.
+    pub near: f32,
+    /// Far plane.
+    pub far: f32,
+    /// Padding.
+    pub _pad: u32,
+}
+
+impl LinearizeParams {
+    /// Parameters for `light`'s depth buffer.
+    pub fn new(light: &Light) -> Self {
+        Self {
+            perspective: u32::from(matches!(light.kind, LightKind::Spot { .. })),
+            near: light.near,
+            far: light.far,
+            _pad: 0,
+        }
+    }
+}
+
+/// Name of light `i`'s rasterized depth map (imported into the graph).
+pub fn depth_name(i: usize) -> String {
+    format!("light{i}.depth")
+}
+
+/// Name of light `i`'s linear depth map.
+pub fn linear_name(i: usize) -> String {
+    format!("light{i}.linear")
+}
+
+/// Adds every node light `i` could use to `graph`; the planner keeps what its technique reads.
+pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) {
+    let depth = graph.import(
+        depth_name(i),
+        wgpu::TextureFormat::Depth32Float,
+        light.shadow_map,
+        light.shadow_map,
+        Some(i),
+    );
+    let linear = graph.resource(
+        linear_name(i),
+        wgpu::TextureFormat::R32Float,
+        SizeRule::Reduced {
+            of: depth.clone(),
+            shift: 0,
+        },
+        Some(i),
+    );
+    graph.node(Node {
+        name: format!("light{i}.linearize"),
+        kernel: "linearize".into(),
+        inputs: vec![("src".into(), depth)],
+        outputs: vec![("dst".into(), linear.clone())],
+        params: bytemuck::bytes_of(&LinearizeParams::new(light)).to_vec(),
+        dispatch: Dispatch::Texels(linear),
+        light: Some(i),
+    });
+}
+
+/// How the shading kernel reads a light's map.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ShadeInput {
+    /// Graph resource bound.
+    pub resource: String,
+    /// WGSL type of the binding.
+    pub wgsl_type: &'static str,
+}
+
+/// The map light `i`'s technique reads in the shading pass.
+pub fn shade_input(i: usize, light: &Light) -> ShadeInput {
+    match light.shadow.technique {
+        Technique::Pcf {
+            kernel: PcfKernel::Hardware,
+            ..
+        } => ShadeInput {
+            resource: depth_name(i),
+            wgsl_type: "texture_depth_2d",
+        },
+        Technique::Hard | Technique::Pcf { .. } | Technique::Pcss { .. } => ShadeInput {
+            resource: linear_name(i),
+            wgsl_type: "texture_2d<f32>",
+        },
+    }
+}
+
+fn visibility_call(light: &Light, map: &str) -> (&'static str, String) {
+    match light.shadow.technique {
+        Technique::Hard => ("shared/vis_hard", format!("vis_hard({map}, l, s)")),
+        Technique::Pcf {
+            kernel: PcfKernel::Hardware,
+            ..
+        } => (
+            "shared/vis_pcf",
+            format!("vis_pcf_hardware({map}, cmp_sampler, l, s)"),
+        ),
+        Technique::Pcf { .. } => ("shared/vis_pcf", format!("vis_pcf({map}, l, s)")),
+        Technique::Pcss { .. } => ("shared/vis_pcss", format!("vis_pcss({map}, l, s)")),
+    }
+}
+
+/// The `// #generated` block of `kernels/shade.wgsl` for these lights: imports of the
+/// techniques used, one group-1 binding per light (binding = light index) and
+/// `light_visibility`, which dispatches on the light index.
+pub fn shading_block(lights: &[Light]) -> String {
+    let mut imports: Vec<&str> = Vec::new();
+    let mut bindings = String::new();
+    let mut cases = String::new();
+    for (i, light) in lights.iter().enumerate() {
+        let input = shade_input(i, light);
+        let map = format!("light{i}_map");
+        let (module, call) = visibility_call(light, &map);
+        if !imports.contains(&module) {
+            imports.push(module);
+        }
+        let _ = writeln!(
+            bindings,
+            "@group(1) @binding({i}) var {map}: {};",
+            input.wgsl_type
+        );
+        let _ = writeln!(
+            cases,
+            "        case {i}u: {{\n            let l = lights[{i}];\n            let s = light_sample(l, p, n);\n            if !s.inside {{ return 1.0; }}\n            return {call};\n        }}"
+        );
+    }
+    let mut s = String::new();
+    for m in imports {
+        let _ = writeln!(s, "// #import {m}");
+    }
+    s.push_str(&bindings);
+    let _ = write!(
+        s,
+        "fn light_visibility(i: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {{\n    switch i {{\n{cases}        default: {{ return 1.0; }}\n    }}\n}}\n"
+    );
+    s
+}
