@@ -1,6 +1,7 @@
 //! shadowgraph: shadow-map prefiltering on the GPU as a graph of WGSL compute kernels.
 pub mod bench;
 pub mod cli;
+pub mod cpu;
 pub mod error;
 pub mod exec;
 pub mod gpu;

@@ -167,12 +167,13 @@ pub fn cylinder(radius: f32, height: f32, segments: u32) -> Mesh {
         m.normals.extend([d0, d0, d1, d1]);
         m.indices
             .extend([base, base + 1, base + 2, base, base + 2, base + 3]);
-        for (y, n) in [(h, Vec3::Y), (-h, -Vec3::Y)] {
+        // Counter-clockwise seen from outside: d1 before d0 on the top cap, d0 before d1 below.
+        for (y, n, (e0, e1)) in [(h, Vec3::Y, (d1, d0)), (-h, -Vec3::Y, (d0, d1))] {
             let base = m.positions.len() as u32;
             m.positions.extend([
                 Vec3::Y * y,
-                d0 * radius + Vec3::Y * y,
-                d1 * radius + Vec3::Y * y,
+                e0 * radius + Vec3::Y * y,
+                e1 * radius + Vec3::Y * y,
             ]);
             m.normals.extend([n; 3]);
             m.indices.extend([base, base + 1, base + 2]);

@@ -153,10 +153,9 @@ fn camera(ctx: &Ctx, file: &SceneFile) -> Result<Camera> {
         ));
     }
     if forward.normalize().cross(up).length() < 1e-4 {
-        return Err(ctx.err(
-            c.up.as_ref().map(|u| u.span()),
-            "`camera.up` is parallel to the view direction",
-        ));
+        // Without an `up` key (default +Y), the target sets the view direction: point there.
+        let span = c.up.as_ref().map_or(c.target.span(), |u| u.span());
+        return Err(ctx.err(Some(span), "`camera.up` is parallel to the view direction"));
     }
     Ok(Camera {
         position,

@@ -1,0 +1,80 @@
+//! Reference of `kernels/shared/light.wgsl`: where a receiver lands in a light's map.
+
+use glam::{DMat4, DVec3, DVec4};
+
+use crate::technique::LightGpu;
+
+/// Reference of `LightSample`.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    /// Map UV, y down.
+    pub uv: [f64; 2],
+    /// Linear depth.
+    pub depth: f64,
+    /// Distance along the light axis.
+    pub view_z: f64,
+    /// Inside the map and depth range.
+    pub inside: bool,
+}
+
+fn mat(m: &[[f32; 4]; 4]) -> DMat4 {
+    DMat4::from_cols_array_2d(&m.map(|c| c.map(f64::from)))
+}
+
+fn v3(v: [f32; 3]) -> DVec3 {
+    DVec3::new(v[0].into(), v[1].into(), v[2].into())
+}
+
+/// `light_map_width`.
+pub fn map_width(l: &LightGpu, z: f64) -> f64 {
+    let w = f64::from(l.width_at_unit);
+    if l.kind == 0 { w } else { w * z }
+}
+
+/// `light_to_light`.
+pub fn to_light(l: &LightGpu, p: DVec3) -> DVec3 {
+    if l.kind == 0 {
+        -v3(l.direction)
+    } else {
+        (v3(l.position) - p).normalize()
+    }
+}
+
+/// `light_sample`: project `p` after the normal offset along `n`.
+pub fn sample(l: &LightGpu, p: DVec3, n: DVec3) -> LightSample {
+    let view = mat(&l.view);
+    let (near, far) = (f64::from(l.near), f64::from(l.far));
+    let z0 = -(view * p.extend(1.0)).z;
+    let texel = map_width(l, z0.max(near)) / f64::from(l.map_size[0]);
+    let ndl = n.dot(to_light(l, p)).clamp(0.0, 1.0);
+    let q = p + n * (f64::from(l.normal_bias) * texel * (1.0 - ndl));
+    let clip: DVec4 = mat(&l.view_proj) * q.extend(1.0);
+    let ndc = [clip.x / clip.w, clip.y / clip.w];
+    let uv = [0.5 + 0.5 * ndc[0], 0.5 - 0.5 * ndc[1]];
+    let view_z = -(view * q.extend(1.0)).z;
+    let depth = (view_z - near) / (far - near);
+    let inside = clip.w > 0.0
+        && uv.iter().all(|&c| (0.0..=1.0).contains(&c))
+        && (0.0..=1.0).contains(&depth);
+    LightSample {
+        uv,
+        depth,
+        view_z,
+        inside,
+    }
+}
+
+/// `light_linear_to_ndc`.
+pub fn linear_to_ndc(l: &LightGpu, d: f64) -> f64 {
+    if l.kind == 0 {
+        return d;
+    }
+    let (near, far) = (f64::from(l.near), f64::from(l.far));
+    let z = near + d * (far - near);
+    far * (z - near) / ((far - near) * z)
+}
+
+/// `light_linear_to_z`.
+pub fn linear_to_z(l: &LightGpu, d: f64) -> f64 {
+    f64::from(l.near) + d * f64::from(l.far - l.near)
+}

@@ -1,0 +1,42 @@
+//! Reference of `kernels/shared/vis_pcss.wgsl`.
+
+use super::light::{LightSample, linear_to_z, map_width};
+use super::{Map, vogel_disc};
+use crate::technique::LightGpu;
+
+/// Blocker-search radius in UV (`pcss_search_radius`).
+pub fn search_radius(l: &LightGpu, s: &LightSample) -> f64 {
+    let world = 0.5 * f64::from(l.size) * (s.view_z - f64::from(l.near)) / s.view_z;
+    (world / map_width(l, f64::from(l.near))).min(f64::from(l.max_search))
+}
+
+/// Blocker search, penumbra estimate, PCF over the penumbra.
+pub fn vis_pcss(map: &Map, l: &LightGpu, s: &LightSample) -> f64 {
+    let bias = f64::from(l.bias);
+    let search = search_radius(l, s);
+    let (mut sum, mut count) = (0.0, 0u32);
+    for i in 0..l.blocker_samples {
+        let o = vogel_disc(i, l.blocker_samples);
+        let (x, y) = map.texel_of([s.uv[0] + search * o[0], s.uv[1] + search * o[1]]);
+        let z = map.load(x, y);
+        if z + bias < s.depth {
+            sum += z;
+            count += 1;
+        }
+    }
+    if count == 0 {
+        return 1.0;
+    }
+    let z_blocker = linear_to_z(l, sum / f64::from(count));
+    let penumbra = f64::from(l.size) * (s.view_z - z_blocker) / z_blocker;
+    let radius = (0.5 * penumbra / map_width(l, s.view_z)).max(0.5 / f64::from(l.map_size[0]));
+    let mut lit = 0.0;
+    for i in 0..l.filter_samples {
+        let o = vogel_disc(i, l.filter_samples);
+        let (x, y) = map.texel_of([s.uv[0] + radius * o[0], s.uv[1] + radius * o[1]]);
+        if s.depth <= map.load(x, y) + bias {
+            lit += 1.0;
+        }
+    }
+    lit / f64::from(l.filter_samples)
+}

@@ -1,0 +1,157 @@
+//! Every WGSL file parses and validates with naga (no GPU needed); Rust mirrors of WGSL
+//! structs match naga's layout.
+
+use std::collections::BTreeSet;
+
+use shadowgraph::kernels::{self, SOURCES, struct_size};
+use shadowgraph::scene::{Light, LightKind, PcfKernel, Shadow, Technique};
+use shadowgraph::technique::{LightGpu, LinearizeParams, shading_block};
+
+fn light(technique: Technique) -> Light {
+    Light {
+        kind: LightKind::Spot { fov_degrees: 60.0 },
+        position: glam::Vec3::new(0.0, 5.0, 0.0),
+        target: glam::Vec3::ZERO,
+        near: 0.5,
+        far: 20.0,
+        size: 0.5,
+        radiance: glam::Vec3::ONE,
+        shadow_map: 64,
+        shadow: Shadow {
+            technique,
+            bias: 0.002,
+            slope_bias: 1.0,
+            normal_bias: 1.0,
+        },
+    }
+}
+
+fn all_techniques() -> Vec<Technique> {
+    vec![
+        Technique::Hard,
+        Technique::Pcf {
+            radius: 2,
+            kernel: PcfKernel::Box,
+        },
+        Technique::Pcf {
+            radius: 1,
+            kernel: PcfKernel::Tent,
+        },
+        Technique::Pcf {
+            radius: 1,
+            kernel: PcfKernel::Hardware,
+        },
+        Technique::Pcss {
+            blocker_samples: 16,
+            filter_samples: 32,
+            max_search: 0.1,
+        },
+    ]
+}
+
+#[test]
+fn every_file_in_kernels_is_registered() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("kernels");
+    let mut on_disk = BTreeSet::new();
+    for sub in ["", "shared/"] {
+        for e in std::fs::read_dir(dir.join(sub)).expect("kernels/ readable") {
+            let p = e.expect("dir entry").path();
+            if p.extension().is_some_and(|x| x == "wgsl") {
+                let stem = p.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
+                on_disk.insert(format!("{sub}{stem}"));
+            }
+        }
+    }
+    let registered: BTreeSet<String> = SOURCES.iter().map(|s| s.name.to_string()).collect();
+    assert_eq!(
+        on_disk, registered,
+        "kernels/ and kernels::SOURCES disagree"
+    );
+}
+
+#[test]
+fn every_kernel_validates() {
+    let mut failures = Vec::new();
+    for s in SOURCES {
+        // The shading kernel needs its generated block: validate it once per technique, and
+        // with every technique at once.
+        let blocks: Vec<Option<String>> = if s.name == "shade" {
+            let mut b: Vec<Option<String>> = all_techniques()
+                .into_iter()
+                .map(|t| Some(shading_block(&[light(t)])))
+                .collect();
+            let lights: Vec<Light> = all_techniques().into_iter().map(light).collect();
+            b.push(Some(shading_block(&lights)));
+            b
+        } else {
+            vec![None]
+        };
+        for block in blocks {
+            let result = kernels::resolve(s.name, block.as_deref())
+                .and_then(|wgsl| kernels::reflect(s.name, &wgsl).map(|_| ()));
+            if let Err(e) = result {
+                failures.push(e.to_string());
+            }
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} kernel(s) failed:\n{}",
+        failures.len(),
+        failures.join("\n\n")
+    );
+}
+
+#[test]
+fn compute_kernels_reflect_bindings_and_workgroup_size() {
+    let wgsl = kernels::resolve("linearize", None).unwrap();
+    let (_, r) = kernels::reflect("linearize", &wgsl).unwrap();
+    let names: Vec<&str> = r.bindings.iter().map(|b| b.name.as_str()).collect();
+    assert_eq!(names, ["src", "dst", "params", "stats"]);
+    assert_eq!(r.workgroup_size, Some([16, 16, 1]));
+    assert!(matches!(
+        r.binding("src").unwrap().ty,
+        wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            ..
+        }
+    ));
+}
+
+#[test]
+fn missing_import_and_missing_block_are_named_errors() {
+    assert!(kernels::resolve("nonexistent", None).is_err());
+    let e = kernels::resolve("shade", None).unwrap_err().to_string();
+    assert!(e.contains("shade") && e.contains("generated"), "{e}");
+}
+
+#[test]
+fn rust_mirrors_match_naga_layouts() {
+    let shade = kernels::resolve("shade", Some(&shading_block(&[light(Technique::Hard)]))).unwrap();
+    let (m, _) = kernels::reflect("shade", &shade).unwrap();
+    assert_eq!(
+        struct_size(&m, "Light"),
+        Some(size_of::<LightGpu>() as u32),
+        "LightGpu vs struct Light"
+    );
+    assert_eq!(
+        struct_size(&m, "Frame"),
+        Some(size_of::<shadowgraph::render::FrameGpu>() as u32),
+        "FrameGpu vs struct Frame"
+    );
+    let lin = kernels::resolve("linearize", None).unwrap();
+    let (m, _) = kernels::reflect("linearize", &lin).unwrap();
+    assert_eq!(
+        struct_size(&m, "Params"),
+        Some(size_of::<LinearizeParams>() as u32)
+    );
+}
+
+#[test]
+fn shading_block_contains_only_the_techniques_used() {
+    let b = shading_block(&[light(Technique::Hard)]);
+    assert!(
+        b.contains("vis_hard") && !b.contains("vis_pcss") && !b.contains("vis_pcf"),
+        "{b}"
+    );
+}

@@ -1,0 +1,198 @@
+//! The shading kernel's visibility functions against the f64 references, on random blocky
+//! depth maps and random receivers (with random normals, so the normal offset is exercised).
+//!
+//! f32 and f64 may disagree where a receiver sits on a texel boundary or a comparison is a tie:
+//! a point is *robust* when the f64 reference gives the same answer with the receiver's UV and
+//! depth nudged by ±1e-4 texel / ±2e-6. At robust points the GPU must match to 1e-5 (the
+//! mean of at most a few hundred 0/1 terms in f32); robust points must be ≥ 90% of all.
+
+mod common;
+
+use glam::{DVec3, Vec3};
+use rand::Rng;
+use shadowgraph::cpu::{self, Map};
+use shadowgraph::render::{ProbeMap, Renderer, probe};
+use shadowgraph::scene::{Light, LightKind, PcfKernel, Shadow, Technique};
+use shadowgraph::technique::LightGpu;
+
+const MAP: usize = 61; // not a power of two
+
+fn light(kind: LightKind, technique: Technique) -> Light {
+    let (position, near, far) = match kind {
+        LightKind::Directional { .. } => (Vec3::new(-3.0, 10.0, 2.0), 2.0, 20.0),
+        LightKind::Spot { .. } => (Vec3::new(1.0, 8.0, -1.0), 0.5, 20.0),
+    };
+    Light {
+        kind,
+        position,
+        target: Vec3::ZERO,
+        near,
+        far,
+        size: 0.6,
+        radiance: Vec3::ONE,
+        shadow_map: MAP as u32,
+        shadow: Shadow {
+            technique,
+            bias: 0.002,
+            slope_bias: 0.0,
+            normal_bias: 1.0,
+        },
+    }
+}
+
+/// A world point whose light-space UV and linear depth are given, with a normal facing the light.
+fn point(l: &Light, rng: &mut impl Rng) -> (Vec3, Vec3) {
+    let g = LightGpu::new(l);
+    let uv = [rng.random_range(0.08..0.92), rng.random_range(0.08..0.92)];
+    let d: f64 = rng.random_range(0.05..0.98);
+    let ndc_z = cpu::light::linear_to_ndc(&g, d);
+    let inv = (l.projection() * l.view()).as_dmat4().inverse();
+    let p = inv.project_point3(DVec3::new(2.0 * uv[0] - 1.0, 1.0 - 2.0 * uv[1], ndc_z));
+    let to_light = cpu::light::to_light(&g, p);
+    let mut n = DVec3::new(
+        rng.random_range(-1.0..1.0),
+        rng.random_range(-1.0..1.0),
+        rng.random_range(-1.0..1.0),
+    );
+    n = (n.normalize_or_zero() + 1.5 * to_light).normalize();
+    (p.as_vec3(), n.as_vec3())
+}
+
+fn reference(l: &LightGpu, map: &Map, s: &cpu::light::LightSample) -> f64 {
+    if !s.inside {
+        return 1.0;
+    }
+    match l.technique {
+        0 => cpu::vis_hard::vis_hard(map, l, s),
+        1 => cpu::vis_pcf::vis_pcf(map, l, s),
+        _ => cpu::vis_pcss::vis_pcss(map, l, s),
+    }
+}
+
+fn robust_reference(l: &LightGpu, map: &Map, p: Vec3, n: Vec3) -> Option<f64> {
+    let s = cpu::light::sample(l, p.as_dvec3(), n.as_dvec3());
+    let v = reference(l, map, &s);
+    let du = 1e-4 / MAP as f64;
+    for (dx, dy, dz) in [
+        (du, 0.0, 0.0),
+        (-du, 0.0, 0.0),
+        (0.0, du, 0.0),
+        (0.0, -du, 0.0),
+        (0.0, 0.0, 2e-6),
+        (0.0, 0.0, -2e-6),
+    ] {
+        let mut t = s;
+        t.uv = [s.uv[0] + dx, s.uv[1] + dy];
+        t.depth += dz;
+        if (reference(l, map, &t) - v).abs() > 1e-9 {
+            return None;
+        }
+    }
+    Some(v)
+}
+
+fn check(kind: LightKind, technique: Technique, seed: u64) {
+    let g = common::gpu();
+    let mut rng = common::rng(seed);
+    let l = light(kind, technique);
+    let map = common::blocky_map(&mut rng, MAP);
+    let points: Vec<(Vec3, Vec3)> = (0..3000).map(|_| point(&l, &mut rng)).collect();
+    let mut renderer = Renderer::new(&g.device);
+    let vis = probe(
+        &mut renderer,
+        &g.device,
+        &g.queue,
+        std::slice::from_ref(&l),
+        &[ProbeMap {
+            size: MAP as u32,
+            linear: &map,
+        }],
+        &points,
+    )
+    .expect("probe");
+    let lg = LightGpu::new(&l);
+    let cmap = Map {
+        size: MAP,
+        texels: &map,
+    };
+    let (mut gpu_v, mut ref_v) = (Vec::new(), Vec::new());
+    let mut partial = 0;
+    for (i, (p, n)) in points.iter().enumerate() {
+        if let Some(r) = robust_reference(&lg, &cmap, *p, *n) {
+            gpu_v.push(vis[i]);
+            ref_v.push(r);
+            partial += usize::from(r > 0.0 && r < 1.0);
+        }
+    }
+    let what = format!("{kind:?} {technique:?}");
+    assert!(
+        gpu_v.len() * 10 >= points.len() * 9,
+        "{what}: only {} of {} points robust",
+        gpu_v.len(),
+        points.len()
+    );
+    assert!(
+        ref_v.iter().any(|&v| v < 0.5) && ref_v.iter().any(|&v| v > 0.5),
+        "{what}: inputs never shadow or never light"
+    );
+    if !matches!(technique, Technique::Hard) {
+        assert!(partial > 50, "{what}: only {partial} penumbra points");
+    }
+    common::assert_close(&what, &gpu_v, &ref_v, 1e-5, 0.0);
+}
+
+const DIR: LightKind = LightKind::Directional { extent: 5.0 };
+const SPOT: LightKind = LightKind::Spot { fov_degrees: 60.0 };
+
+#[test]
+fn hard_matches_reference() {
+    check(DIR, Technique::Hard, 10);
+    check(SPOT, Technique::Hard, 11);
+}
+
+#[test]
+fn pcf_box_and_tent_match_reference() {
+    check(
+        DIR,
+        Technique::Pcf {
+            radius: 1,
+            kernel: PcfKernel::Box,
+        },
+        20,
+    );
+    check(
+        SPOT,
+        Technique::Pcf {
+            radius: 2,
+            kernel: PcfKernel::Box,
+        },
+        21,
+    );
+    check(
+        DIR,
+        Technique::Pcf {
+            radius: 3,
+            kernel: PcfKernel::Tent,
+        },
+        22,
+    );
+    check(
+        SPOT,
+        Technique::Pcf {
+            radius: 2,
+            kernel: PcfKernel::Tent,
+        },
+        23,
+    );
+}
+
+#[test]
+fn pcss_matches_reference() {
+    let t = Technique::Pcss {
+        blocker_samples: 16,
+        filter_samples: 32,
+        max_search: 0.1,
+    };
+    check(DIR, t, 30);
+    check(SPOT, t, 31);
+}
