@@ -2,8 +2,8 @@
 //! depth maps and random receivers (with random normals, so the normal offset is exercised).
 //!
 //! f32 and f64 may disagree where a receiver sits on a texel boundary or a comparison is a tie:
-//! a point is *robust* when the f64 reference gives the same answer with the receiver's UV and
-//! depth nudged by ±1e-4 texel / ±2e-6. At robust points the GPU must match to 1e-5 (the
+//! a point is *robust* when the f64 reference does not jump when the receiver's UV and depth
+//! are nudged by ±1e-4 texel / ±2e-6 (`common::robust`). At robust points the GPU must match to 1e-5 (the
 //! mean of at most a few hundred 0/1 terms in f32); robust points must be ≥ 90% of all.
 
 mod common;
@@ -71,24 +71,7 @@ fn reference(l: &LightGpu, map: &Map, s: &cpu::light::LightSample) -> f64 {
 
 fn robust_reference(l: &LightGpu, map: &Map, p: Vec3, n: Vec3) -> Option<f64> {
     let s = cpu::light::sample(l, p.as_dvec3(), n.as_dvec3());
-    let v = reference(l, map, &s);
-    let du = 1e-4 / MAP as f64;
-    for (dx, dy, dz) in [
-        (du, 0.0, 0.0),
-        (-du, 0.0, 0.0),
-        (0.0, du, 0.0),
-        (0.0, -du, 0.0),
-        (0.0, 0.0, 2e-6),
-        (0.0, 0.0, -2e-6),
-    ] {
-        let mut t = s;
-        t.uv = [s.uv[0] + dx, s.uv[1] + dy];
-        t.depth += dz;
-        if (reference(l, map, &t) - v).abs() > 1e-9 {
-            return None;
-        }
-    }
-    Some(v)
+    common::robust(&s, MAP, |t| reference(l, map, t))
 }
 
 fn check(kind: LightKind, technique: Technique, seed: u64) {

@@ -62,3 +62,33 @@ pub fn blocky_map(rng: &mut SmallRng, size: usize) -> Vec<f32> {
     }
     m
 }
+
+/// The f64 reference `f` at sample `s`, or `None` where nudging the receiver by ±1e-4 texel in
+/// UV or ±2e-6 in depth makes it jump by more than 1e-3 (a texel boundary or a comparison tie,
+/// where f32 and f64 may legitimately disagree). Continuous changes (bilinear weights) stay
+/// below that threshold; a single tap flipping moves every tested kernel by more.
+pub fn robust(
+    s: &shadowgraph::cpu::light::LightSample,
+    map_size: usize,
+    f: impl Fn(&shadowgraph::cpu::light::LightSample) -> f64,
+) -> Option<f64> {
+    let v = f(s);
+    let du = 1e-4 / map_size as f64;
+    let nudges = [
+        (du, 0.0, 0.0),
+        (-du, 0.0, 0.0),
+        (0.0, du, 0.0),
+        (0.0, -du, 0.0),
+        (0.0, 0.0, 2e-6),
+        (0.0, 0.0, -2e-6),
+    ];
+    for (dx, dy, dz) in nudges {
+        let mut t = *s;
+        t.uv = [s.uv[0] + dx, s.uv[1] + dy];
+        t.depth += dz;
+        if (f(&t) - v).abs() > 1e-3 {
+            return None;
+        }
+    }
+    Some(v)
+}

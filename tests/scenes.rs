@@ -1,0 +1,225 @@
+//! Every bundled scene renders with no NaN, and every covered pixel's visibility matches the
+//! f64 references evaluated on the maps the GPU rasterized (read back with `aux`).
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use shadowgraph::Error;
+use shadowgraph::cpu::{self, Map};
+use shadowgraph::render::{RenderOptions, Renderer};
+use shadowgraph::scene::{PcfKernel, Scene, Technique};
+use shadowgraph::technique::LightGpu;
+
+fn scenes() -> Vec<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .expect("scenes/")
+        .map(|e| e.expect("entry").path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    v.sort();
+    assert!(v.len() >= 6, "bundled scenes missing: {v:?}");
+    v
+}
+
+/// Reference visibility of light `li` at pixel `px`, if robust.
+fn pixel_reference(
+    scene: &Scene,
+    frame: &shadowgraph::render::Frame,
+    li: usize,
+    px: usize,
+) -> Option<f64> {
+    let light = &scene.lights[li];
+    let lg = LightGpu::new(light);
+    let p = &frame.position[4 * px..4 * px + 3];
+    let n = &frame.normal[4 * px..4 * px + 3];
+    let s = cpu::light::sample(
+        &lg,
+        glam::DVec3::new(p[0].into(), p[1].into(), p[2].into()),
+        glam::DVec3::new(n[0].into(), n[1].into(), n[2].into()).normalize(),
+    );
+    let size = light.shadow_map as usize;
+    let hardware = matches!(
+        light.shadow.technique,
+        Technique::Pcf {
+            kernel: PcfKernel::Hardware,
+            ..
+        }
+    );
+    let texels = if hardware {
+        &frame.depth_maps[li]
+    } else {
+        &frame.linear_maps[li]
+    };
+    let map = Map { size, texels };
+    common::robust(&s, size, |t| {
+        if !t.inside {
+            return 1.0;
+        }
+        match light.shadow.technique {
+            Technique::Hard => cpu::vis_hard::vis_hard(&map, &lg, t),
+            Technique::Pcf {
+                kernel: PcfKernel::Hardware,
+                ..
+            } => cpu::vis_pcf::vis_pcf_hardware(&map, &lg, t),
+            Technique::Pcf { .. } => cpu::vis_pcf::vis_pcf(&map, &lg, t),
+            Technique::Pcss { .. } => cpu::vis_pcss::vis_pcss(&map, &lg, t),
+        }
+    })
+}
+
+#[test]
+fn every_scene_renders_and_matches_the_references() {
+    let g = common::gpu();
+    let mut renderer = Renderer::new(&g.device);
+    for path in scenes() {
+        let scene = Scene::load(&path).expect("scene loads");
+        let frame = renderer
+            .render(
+                &g.device,
+                &g.queue,
+                &scene,
+                RenderOptions {
+                    aux: true,
+                    repeat: 1,
+                },
+            )
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        let lights = scene.lights.len();
+        assert!(
+            frame
+                .visibility
+                .iter()
+                .all(|v| v.is_finite() && (0.0..=1.0).contains(v)),
+            "{name}: visibility not in [0, 1]"
+        );
+        assert!(
+            frame
+                .position
+                .iter()
+                .chain(&frame.normal)
+                .all(|v| v.is_finite()),
+            "{name}: NaN in G-buffer"
+        );
+        assert!(
+            frame.sanitized.is_empty(),
+            "{name}: rasterized non-finite depth"
+        );
+        for li in 0..lights {
+            let hardware = matches!(
+                scene.lights[li].shadow.technique,
+                Technique::Pcf {
+                    kernel: PcfKernel::Hardware,
+                    ..
+                }
+            );
+            // Hardware comparison sampling: Vulkan allows 8 bits of sub-texel precision, so each
+            // of the four bilinear weights may be off by 2⁻⁸: 2⁻⁶ in all. Otherwise as in
+            // tests/visibility.rs.
+            let atol = if hardware { 1.0 / 64.0 } else { 1e-5 };
+            let (mut gpu_v, mut ref_v, mut covered) = (Vec::new(), Vec::new(), 0);
+            for px in 0..(frame.width * frame.height) as usize {
+                if frame.position[4 * px + 3] == 0.0 {
+                    continue;
+                }
+                covered += 1;
+                if let Some(r) = pixel_reference(&scene, &frame, li, px) {
+                    gpu_v.push(frame.visibility[px * lights + li]);
+                    ref_v.push(r);
+                }
+            }
+            let what = format!("{name} light {li}");
+            assert!(
+                gpu_v.len() * 10 >= covered * 9,
+                "{what}: only {} of {covered} pixels robust",
+                gpu_v.len()
+            );
+            let shadowed = ref_v.iter().filter(|&&v| v < 0.5).count();
+            assert!(
+                shadowed * 200 > ref_v.len(),
+                "{what}: casts almost no shadow ({shadowed} pixels)"
+            );
+            common::assert_close(&what, &gpu_v, &ref_v, atol, 0.0);
+        }
+    }
+}
+
+#[test]
+fn repeated_renders_reuse_pipelines_and_textures() {
+    let g = common::gpu();
+    let mut renderer = Renderer::new(&g.device);
+    let scene =
+        Scene::load(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/two_lights.toml")).unwrap();
+    let mut counts = Vec::new();
+    for _ in 0..4 {
+        renderer
+            .render(&g.device, &g.queue, &scene, RenderOptions::default())
+            .unwrap();
+        counts.push((
+            renderer.executor.texture_count(),
+            renderer.executor.kernels.len(),
+        ));
+    }
+    assert!(
+        counts.windows(2).all(|w| w[0] == w[1]),
+        "pool or cache grew: {counts:?}"
+    );
+}
+
+#[test]
+fn shadow_map_past_the_device_limit_is_a_clear_error() {
+    let g = common::gpu();
+    let max = g.device.limits().max_texture_dimension_2d;
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/sphere_on_plane.toml"),
+    )
+    .unwrap();
+    let mut scene = Scene::parse(Path::new("limit.toml"), &text).unwrap();
+    scene.lights[0].shadow_map = max + 1;
+    let mut renderer = Renderer::new(&g.device);
+    match renderer.render(&g.device, &g.queue, &scene, RenderOptions::default()) {
+        Err(e @ Error::Limit { .. }) => {
+            let m = e.to_string();
+            assert!(
+                m.contains("light[0].shadow_map") && m.contains(&max.to_string()),
+                "{m}"
+            );
+        }
+        Err(e) => panic!("expected a limit error, got {e}"),
+        Ok(_) => panic!(
+            "a {}² shadow map rendered on a device limited to {max}",
+            max + 1
+        ),
+    }
+}
+
+#[test]
+fn plan_contains_only_what_techniques_need() {
+    let two =
+        Scene::load(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/two_lights.toml")).unwrap();
+    let sp = shadowgraph::render::plan_lights(&two.lights).unwrap();
+    for (i, l) in two.lights.iter().enumerate() {
+        let steps: Vec<&str> = sp
+            .plan
+            .steps
+            .iter()
+            .filter(|s| s.node.light == Some(i))
+            .map(|s| s.node.kernel.as_str())
+            .collect();
+        let hardware = matches!(
+            l.shadow.technique,
+            Technique::Pcf {
+                kernel: PcfKernel::Hardware,
+                ..
+            }
+        );
+        // The hardware comparison sampler reads the rasterized depth: no kernel at all.
+        assert_eq!(
+            steps,
+            if hardware { vec![] } else { vec!["linearize"] },
+            "light {i}"
+        );
+    }
+}
