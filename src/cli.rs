@@ -74,9 +74,9 @@ pub fn render(
 }
 
 fn write_aux(dir: &Path, scene: &Scene, frame: &Frame) -> Result<()> {
-    std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+    std::fs::create_dir_all(dir).map_err(|error| Error::Io {
         path: dir.to_path_buf(),
-        source,
+        error,
     })?;
     let (w, h) = (frame.width, frame.height);
     write_exr(

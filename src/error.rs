@@ -85,12 +85,12 @@ pub enum Error {
     #[error("invalid argument: {0}")]
     Invalid(String),
     /// Reading or writing a file failed.
-    #[error("{path}: {source}")]
+    #[error("{path}: {error}")]
     Io {
         /// The file.
         path: PathBuf,
         /// The OS error.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// Encoding an output image failed.
     #[error("writing image `{path}`: {message}")]

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::{Parser, Subcommand};
 
 use shadowgraph::{cli, gpu::Gpu};
@@ -76,8 +76,7 @@ fn run(args: Args) -> Result<()> {
             repeat,
         } => {
             let gpu = Gpu::new()?;
-            let report = cli::render(&gpu, &scene, &output, aux.as_deref(), timings, repeat)
-                .with_context(|| format!("rendering {}", scene.display()))?;
+            let report = cli::render(&gpu, &scene, &output, aux.as_deref(), timings, repeat)?;
             print!("{report}");
         }
         Command::Plan { scene, dot } => print!("{}", cli::plan(&scene, dot)?),

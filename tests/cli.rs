@@ -1,0 +1,86 @@
+//! The CLI's library functions: `render --aux` writes readable EXRs, `plan` prints the kernels.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+fn scene(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name)
+}
+
+fn temp_dir(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("shadowgraph-test-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).expect("temp dir");
+    d
+}
+
+#[test]
+fn render_writes_png_and_aux_exrs() {
+    let g = common::gpu();
+    let dir = temp_dir("aux");
+    let png = dir.join("out.png");
+    let report = shadowgraph::cli::render(&g, &scene("two_lights.toml"), &png, Some(&dir), true, 2)
+        .expect("render");
+    assert!(report.contains("wrote"), "{report}");
+    assert!(
+        report.contains("shade") && report.contains("light0.linearize"),
+        "timings missing:\n{report}"
+    );
+    let img = image::open(&png).expect("png readable").to_rgba8();
+    assert_eq!(img.dimensions(), (480, 360));
+    let vis = exr::prelude::read_all_flat_layers_from_file(dir.join("visibility.exr"))
+        .expect("visibility.exr");
+    let layer = &vis.layer_data[0];
+    let names: Vec<String> = layer
+        .channel_data
+        .list
+        .iter()
+        .map(|c| c.name.to_string())
+        .collect();
+    assert_eq!(names, ["light0", "light1"]);
+    for c in &layer.channel_data.list {
+        let v: Vec<f32> = c.sample_data.values_as_f32().collect();
+        assert_eq!(v.len(), 480 * 360);
+        assert!(
+            v.iter().all(|x| (0.0..=1.0).contains(x)),
+            "{}: out of [0, 1]",
+            c.name
+        );
+        assert!(
+            v.iter().any(|&x| x < 0.5),
+            "{}: no shadow in the EXR",
+            c.name
+        );
+    }
+    for f in ["position.exr", "normal.exr"] {
+        let img = exr::prelude::read_all_flat_layers_from_file(dir.join(f)).expect(f);
+        assert_eq!(img.layer_data[0].channel_data.list.len(), 4, "{f}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn plan_text_and_dot() {
+    let text = shadowgraph::cli::plan(&scene("bunny.toml"), false).expect("plan");
+    for needle in [
+        "light 0",
+        "light0.linearize",
+        "R32Float",
+        "1024x1024",
+        "peak live",
+    ] {
+        assert!(text.contains(needle), "`{needle}` missing:\n{text}");
+    }
+    let dot = shadowgraph::cli::plan(&scene("bunny.toml"), true).expect("dot");
+    assert!(dot.starts_with("digraph") && dot.contains("light0.linearize"));
+}
+
+#[test]
+fn bad_scene_path_is_an_error_naming_the_file() {
+    let e = shadowgraph::cli::plan(Path::new("no/such/scene.toml"), false)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("no/such/scene.toml"), "{e}");
+}
