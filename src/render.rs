@@ -259,17 +259,19 @@ impl Renderer {
         device: &wgpu::Device,
         slope: f32,
     ) -> Result<&wgpu::RenderPipeline> {
-        let key = slope.to_bits();
-        if !self.shadow.contains_key(&key) {
-            let bias = wgpu::DepthBiasState {
-                constant: 0,
-                slope_scale: slope,
-                clamp: 0.0,
-            };
-            let (p, _) = Self::raster_pipeline(device, "shadow_depth", None, bias)?;
-            self.shadow.insert(key, p);
+        // Slope-scaled bias is pipeline state: one pipeline per distinct value, made once.
+        match self.shadow.entry(slope.to_bits()) {
+            std::collections::hash_map::Entry::Occupied(e) => Ok(e.into_mut()),
+            std::collections::hash_map::Entry::Vacant(e) => {
+                let bias = wgpu::DepthBiasState {
+                    constant: 0,
+                    slope_scale: slope,
+                    clamp: 0.0,
+                };
+                let (p, _) = Self::raster_pipeline(device, "shadow_depth", None, bias)?;
+                Ok(e.insert(p))
+            }
         }
-        Ok(&self.shadow[&key])
     }
 
     /// Renders `scene` on `device`/`queue` and reads the frame back.
