@@ -1,1 +1,55 @@
-fn main(){}
+//! `cargo bench --bench kernels`: the kernel microbenchmark of `shadowgraph bench`.
+//!
+//! Sizes come from `SHADOWGRAPH_BENCH_SIZES` (comma list, default `512,1024,2048`), timed runs
+//! per kernel from `SHADOWGRAPH_BENCH_REPEAT` (default 10).
+
+use std::process::ExitCode;
+
+use shadowgraph::{bench, gpu::Gpu};
+
+const DEFAULT_SIZES: &[u32] = &[512, 1024, 2048];
+const DEFAULT_REPEAT: u32 = 10;
+
+fn sizes() -> Result<Vec<u32>, String> {
+    match std::env::var("SHADOWGRAPH_BENCH_SIZES") {
+        Ok(list) if !list.trim().is_empty() => list
+            .split(',')
+            .map(|s| {
+                s.trim()
+                    .parse::<u32>()
+                    .map_err(|e| format!("SHADOWGRAPH_BENCH_SIZES: `{s}`: {e}"))
+            })
+            .collect(),
+        _ => Ok(DEFAULT_SIZES.to_vec()),
+    }
+}
+
+fn repeat() -> Result<u32, String> {
+    match std::env::var("SHADOWGRAPH_BENCH_REPEAT") {
+        Ok(r) if !r.trim().is_empty() => r
+            .trim()
+            .parse()
+            .map_err(|e| format!("SHADOWGRAPH_BENCH_REPEAT: `{r}`: {e}")),
+        _ => Ok(DEFAULT_REPEAT),
+    }
+}
+
+fn run() -> Result<String, String> {
+    let (sizes, repeat) = (sizes()?, repeat()?);
+    let gpu = Gpu::new().map_err(|e| e.to_string())?;
+    bench::run(&gpu, &sizes, repeat).map_err(|e| e.to_string())
+}
+
+fn main() -> ExitCode {
+    // `cargo bench` passes `--bench` (and any filter); this harness takes no arguments.
+    match run() {
+        Ok(report) => {
+            print!("{report}");
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
