@@ -92,6 +92,51 @@ impl KernelCache {
         self.get_generated(device, name, None)
     }
 
+    /// The pipeline of `name` with the storage-texture bindings in `formats` re-declared with
+    /// those formats (a kernel declares a default; a graph may bind another, e.g. f16 moments).
+    pub fn get_specialized(
+        &mut self,
+        device: &wgpu::Device,
+        name: &str,
+        formats: &[(String, wgpu::TextureFormat)],
+    ) -> Result<Arc<ComputeKernel>> {
+        let base = self.get(device, name)?;
+        let mut changes = Vec::new();
+        for (binding, format) in formats {
+            if let Some(b) = base.reflection.binding(binding) {
+                if let wgpu::BindingType::StorageTexture {
+                    format: declared, ..
+                } = b.ty
+                {
+                    if declared != *format {
+                        changes.push((
+                            binding.as_str(),
+                            wgsl_storage_format(declared)?,
+                            wgsl_storage_format(*format)?,
+                        ));
+                    }
+                }
+            }
+        }
+        if changes.is_empty() {
+            return Ok(base);
+        }
+        let key = format!("{name}@{changes:?}");
+        if let Some(k) = self.kernels.get(&key) {
+            return Ok(k.clone());
+        }
+        let mut wgsl = kernels::resolve(name, None)?;
+        for (binding, from, to) in &changes {
+            wgsl = retype_storage(&wgsl, binding, from, to).ok_or_else(|| Error::Kernel {
+                kernel: name.to_string(),
+                message: format!("cannot find the declaration of storage texture `{binding}`"),
+            })?;
+        }
+        let k = Arc::new(ComputeKernel::new(device, name, &wgsl)?);
+        self.kernels.insert(key, k.clone());
+        Ok(k)
+    }
+
     /// The pipeline of `name` with a `// #generated` block, keyed by the block's text.
     pub fn get_generated(
         &mut self,
@@ -121,6 +166,35 @@ impl KernelCache {
     pub fn is_empty(&self) -> bool {
         self.kernels.is_empty()
     }
+}
+
+/// The WGSL name of a storage texel format.
+pub fn wgsl_storage_format(f: wgpu::TextureFormat) -> Result<&'static str> {
+    use wgpu::TextureFormat as T;
+    Ok(match f {
+        T::R32Float => "r32float",
+        T::Rg32Float => "rg32float",
+        T::Rgba32Float => "rgba32float",
+        T::Rgba16Float => "rgba16float",
+        T::Rgba16Unorm => "rgba16unorm",
+        T::Rgba8Unorm => "rgba8unorm",
+        T::R32Uint => "r32uint",
+        T::Rg32Uint => "rg32uint",
+        T::Rgba32Uint => "rgba32uint",
+        other => {
+            return Err(Error::Invalid(format!(
+                "{other:?} is not a storage format shadowgraph uses"
+            )));
+        }
+    })
+}
+
+/// `wgsl` with the storage texture `binding` declared as `to` instead of `from`.
+fn retype_storage(wgsl: &str, binding: &str, from: &str, to: &str) -> Option<String> {
+    let decl = format!("var {binding}: texture_storage_2d<{from},");
+    let at = wgsl.find(&decl)?;
+    let new = format!("var {binding}: texture_storage_2d<{to},");
+    Some(format!("{}{new}{}", &wgsl[..at], &wgsl[at + decl.len()..]))
 }
 
 /// Textures kept across runs, keyed by shape; a plan takes the ones it needs in order.
@@ -328,7 +402,14 @@ impl Executor {
     /// Compiles every kernel `plan` uses (also done lazily by [`Executor::record`]).
     pub fn prepare(&mut self, device: &wgpu::Device, plan: &Plan) -> Result<()> {
         for step in &plan.steps {
-            self.kernels.get(device, &step.node.kernel)?;
+            let formats: Vec<(String, wgpu::TextureFormat)> = step
+                .node
+                .outputs
+                .iter()
+                .filter_map(|(slot, r)| plan.resource(r).map(|p| (slot.clone(), p.resource.format)))
+                .collect();
+            self.kernels
+                .get_specialized(device, &step.node.kernel, &formats)?;
         }
         Ok(())
     }
@@ -422,7 +503,14 @@ impl Executor {
 
         for (si, step) in plan.steps.iter().enumerate() {
             let node = &step.node;
-            let kernel = self.kernels.get(device, &node.kernel)?;
+            let formats: Vec<(String, wgpu::TextureFormat)> = node
+                .outputs
+                .iter()
+                .map(|(slot, r)| (slot.clone(), textures[r].format()))
+                .collect();
+            let kernel = self
+                .kernels
+                .get_specialized(device, &node.kernel, &formats)?;
             let mut views: Vec<(u32, wgpu::TextureView)> = Vec::new();
             let mut entries: Vec<wgpu::BindGroupEntry> = Vec::new();
             for b in kernel.reflection.bindings.iter().filter(|b| b.group == 0) {
@@ -494,6 +582,15 @@ impl Executor {
                 Dispatch::Texels(r) => {
                     let t = &textures[r];
                     kernel.groups_for(t.width(), t.height())
+                }
+                Dispatch::Axis { of, axis } => {
+                    let t = &textures[of];
+                    let (along, across) = if *axis == 0 {
+                        (t.width(), t.height())
+                    } else {
+                        (t.height(), t.width())
+                    };
+                    [kernel.groups_for(along, 1)[0], across, 1]
                 }
             };
             let timestamp_writes = timer

@@ -310,3 +310,53 @@ pub fn write_texture(queue: &wgpu::Queue, texture: &wgpu::Texture, data: &[u8]) 
         texture.size(),
     );
 }
+
+/// Channels of a float texel format shadowgraph reads back, or `None` for other formats.
+pub fn float_channels(format: wgpu::TextureFormat) -> Option<usize> {
+    use wgpu::TextureFormat as T;
+    match format {
+        T::R32Float | T::Depth32Float => Some(1),
+        T::Rg32Float => Some(2),
+        T::Rgba32Float | T::Rgba16Float => Some(4),
+        _ => None,
+    }
+}
+
+/// IEEE half → single.
+pub fn f16_to_f32(h: u16) -> f32 {
+    let sign = u32::from(h >> 15) << 31;
+    let exp = u32::from((h >> 10) & 0x1f);
+    let mant = u32::from(h & 0x3ff);
+    let bits = match (exp, mant) {
+        (0, 0) => sign,
+        (0, m) => {
+            // Subnormal: renormalize.
+            let shift = m.leading_zeros() - 21;
+            sign | ((113 - shift) << 23) | ((m << (shift + 1)) & 0x3ff) << 13
+        }
+        (31, m) => sign | 0x7f80_0000 | (m << 13),
+        (e, m) => sign | ((e + 112) << 23) | (m << 13),
+    };
+    f32::from_bits(bits)
+}
+
+/// Reads mip `mip` of a float texture as f32 values (`channels` per texel, row-major).
+pub fn read_float_texture(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+    mip: u32,
+) -> Result<(usize, Vec<f32>)> {
+    let format = texture.format();
+    let channels = float_channels(format)
+        .ok_or_else(|| Error::Invalid(format!("cannot read {format:?} as float")))?;
+    let raw = read_texture(device, queue, texture, mip)?;
+    let values = if format == wgpu::TextureFormat::Rgba16Float {
+        raw.chunks_exact(2)
+            .map(|b| f16_to_f32(u16::from_le_bytes([b[0], b[1]])))
+            .collect()
+    } else {
+        bytemuck::cast_slice(&raw).to_vec()
+    };
+    Ok((channels, values))
+}

@@ -32,11 +32,14 @@ pub const SOURCES: &[Source] = sources![
     "shadow_depth",
     "gbuffer",
     "shade",
+    "vsm",
+    "blur",
     "shared/light",
     "shared/sampling",
     "shared/vis_hard",
     "shared/vis_pcf",
     "shared/vis_pcss",
+    "shared/vis_vsm",
 ];
 
 /// The embedded text of `kernels/<name>.wgsl`.

@@ -4,6 +4,7 @@ pub mod cli;
 pub mod cpu;
 pub mod error;
 pub mod exec;
+pub mod filter;
 pub mod gpu;
 pub mod graph;
 pub mod io;

@@ -50,8 +50,7 @@ pub fn plan_lights(lights: &[Light]) -> Result<ScenePlan> {
     let mut graph = Graph::default();
     let mut shade_inputs = Vec::new();
     for (i, l) in lights.iter().enumerate() {
-        technique::add_light_nodes(&mut graph, i, l);
-        shade_inputs.push(technique::shade_input(i, l));
+        shade_inputs.push(technique::add_light_nodes(&mut graph, i, l));
     }
     let outputs: Vec<&str> = shade_inputs.iter().map(|s| s.resource.as_str()).collect();
     let plan = plan(&graph, &outputs)?;
@@ -111,11 +110,45 @@ pub struct Frame {
     pub timings: Vec<Vec<(String, f64)>>,
     /// Steps whose kernels reported replaced texels (non-finite depth), with the count.
     pub sanitized: Vec<(String, u32)>,
-    /// The shadow maps' linear depth, per light (`aux` only; empty where the technique reads
-    /// the raw depth map).
-    pub linear_maps: Vec<Vec<f32>>,
-    /// The raw depth maps, per light (`aux` only).
-    pub depth_maps: Vec<Vec<f32>>,
+    /// Per light, the map its shading reads: raw depth, linear depth or a filtered
+    /// representation (`aux` only).
+    pub shade_maps: Vec<FloatMap>,
+    /// Per light, the linear depth map, when the plan made one (`aux` only).
+    pub linear_maps: Vec<Option<FloatMap>>,
+}
+
+/// A float texture read back: `channels` values per texel, row-major.
+#[derive(Clone, Debug)]
+pub struct FloatMap {
+    /// Graph resource name.
+    pub resource: String,
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+    /// Values per texel.
+    pub channels: usize,
+    /// The values.
+    pub data: Vec<f32>,
+}
+
+impl FloatMap {
+    /// Reads `texture` (mip 0) back.
+    pub fn read(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        resource: &str,
+        texture: &wgpu::Texture,
+    ) -> Result<Self> {
+        let (channels, data) = crate::gpu::read_float_texture(device, queue, texture, 0)?;
+        Ok(Self {
+            resource: resource.to_string(),
+            width: texture.width(),
+            height: texture.height(),
+            channels,
+            data,
+        })
+    }
 }
 
 /// Renders scenes; holds pipelines and pooled textures across frames.
@@ -424,24 +457,22 @@ impl Renderer {
             normal: Vec::new(),
             timings,
             sanitized,
+            shade_maps: Vec::new(),
             linear_maps: Vec::new(),
-            depth_maps: Vec::new(),
         };
         if opts.aux {
             frame.position = bytemuck::cast_slice(&read_texture(device, queue, &gpos, 0)?).to_vec();
             frame.normal = bytemuck::cast_slice(&read_texture(device, queue, &gnorm, 0)?).to_vec();
-            for (i, d) in depths.iter().enumerate() {
+            for (i, input) in sp.shade_inputs.iter().enumerate() {
+                let t = &outputs.textures[&input.resource];
                 frame
-                    .depth_maps
-                    .push(bytemuck::cast_slice(&read_texture(device, queue, d, 0)?).to_vec());
-                frame
-                    .linear_maps
-                    .push(match outputs.textures.get(&technique::linear_name(i)) {
-                        Some(t) => {
-                            bytemuck::cast_slice(&read_texture(device, queue, t, 0)?).to_vec()
-                        }
-                        None => Vec::new(),
-                    });
+                    .shade_maps
+                    .push(FloatMap::read(device, queue, &input.resource, t)?);
+                let linear = technique::linear_name(i);
+                frame.linear_maps.push(match outputs.textures.get(&linear) {
+                    Some(t) => Some(FloatMap::read(device, queue, &linear, t)?),
+                    None => None,
+                });
             }
         }
         Ok(frame)
@@ -745,12 +776,26 @@ fn depth_only_view(t: &wgpu::Texture) -> wgpu::TextureView {
     })
 }
 
-/// A map handed to [`probe`]: linear depth (R32Float) for every technique but hardware PCF.
+/// A map handed to [`probe`]: what the light's technique reads (linear depth as R32Float,
+/// moments as Rg32Float, …), never the raw depth of hardware PCF.
 pub struct ProbeMap<'a> {
     /// Side length.
     pub size: u32,
-    /// `size²` linear depths, row-major.
-    pub linear: &'a [f32],
+    /// Texel format of `data` (a 32-bit float format).
+    pub format: wgpu::TextureFormat,
+    /// `size²` texels, row-major.
+    pub data: &'a [f32],
+}
+
+impl<'a> ProbeMap<'a> {
+    /// A linear depth map.
+    pub fn linear(size: u32, data: &'a [f32]) -> Self {
+        Self {
+            size,
+            format: wgpu::TextureFormat::R32Float,
+            data,
+        }
+    }
 }
 
 /// Evaluates each light's visibility at `points` (position, unit normal) on the given linear
@@ -795,21 +840,27 @@ pub fn probe(
     write_texture(queue, &gnorm, bytemuck::cast_slice(&nor));
     let mut views = Vec::new();
     for m in maps {
-        if m.linear.len() != (m.size * m.size) as usize {
+        let channels = crate::gpu::float_channels(m.format).unwrap_or(0);
+        let texels = (m.size * m.size) as usize;
+        if m.format == wgpu::TextureFormat::Rgba16Float
+            || channels == 0
+            || m.data.len() != texels * channels
+        {
             return Err(Error::Invalid(format!(
-                "a {0}x{0} probe map needs {1} texels",
+                "a {0}x{0} {1:?} probe map needs {2} f32 values",
                 m.size,
-                m.size * m.size
+                m.format,
+                texels * channels.max(1)
             )));
         }
         let t = texture(
             device,
             "shadowgraph.probe.map",
             (m.size, m.size),
-            wgpu::TextureFormat::R32Float,
+            m.format,
             usage,
         );
-        write_texture(queue, &t, bytemuck::cast_slice(m.linear));
+        write_texture(queue, &t, bytemuck::cast_slice(m.data));
         views.push(t.create_view(&Default::default()));
     }
     let frame = FrameGpu {

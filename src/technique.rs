@@ -3,8 +3,9 @@
 
 use std::fmt::Write;
 
+use crate::filter::add_filter;
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
-use crate::scene::{Light, LightKind, PcfKernel, Technique};
+use crate::scene::{Light, LightKind, PcfKernel, Storage, Technique};
 
 /// A light as the shading kernel reads it. Mirrors `struct Light` in
 /// `kernels/shared/light.wgsl` (a test checks the size against naga's layout).
@@ -51,8 +52,12 @@ pub struct LightGpu {
     pub filter_samples: u32,
     /// PCSS search cap (UV).
     pub max_search: f32,
+    /// VSM light-bleeding reduction.
+    pub bleed: f32,
+    /// VSM minimum variance.
+    pub min_variance: f32,
     /// Padding to the WGSL struct's 16-byte alignment.
-    pub _pad: [f32; 3],
+    pub _pad: f32,
 }
 
 impl LightGpu {
@@ -75,7 +80,16 @@ impl LightGpu {
                     filter_samples,
                     max_search,
                 } => (2, 0, 0, blocker_samples, filter_samples, max_search),
+                Technique::Vsm { .. } => (3, 0, 0, 0, 0, 0.0),
             };
+        let (bleed, min_variance) = match light.shadow.technique {
+            Technique::Vsm {
+                bleed,
+                min_variance,
+                ..
+            } => (bleed, min_variance),
+            _ => (0.0, 0.0),
+        };
         let (kind, cos_outer) = match light.kind {
             LightKind::Directional { .. } => (0, -1.0),
             LightKind::Spot { fov_degrees } => (1, (0.5 * fov_degrees.to_radians()).cos()),
@@ -101,7 +115,9 @@ impl LightGpu {
             blocker_samples,
             filter_samples,
             max_search,
-            _pad: [0.0; 3],
+            bleed,
+            min_variance,
+            _pad: 0.0,
         }
     }
 }
@@ -142,8 +158,10 @@ pub fn linear_name(i: usize) -> String {
     format!("light{i}.linear")
 }
 
-/// Adds every node light `i` could use to `graph`; the planner keeps what its technique reads.
-pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) {
+/// Adds the nodes light `i`'s technique needs to `graph` and returns what the shading pass
+/// reads. The raw depth map and the linear map are always declared; the planner drops what the
+/// shading pass does not read (e.g. `linearize` for the hardware comparison sampler).
+pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput {
     let depth = graph.import(
         depth_name(i),
         wgpu::TextureFormat::Depth32Float,
@@ -163,12 +181,71 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) {
     graph.node(Node {
         name: format!("light{i}.linearize"),
         kernel: "linearize".into(),
-        inputs: vec![("src".into(), depth)],
+        inputs: vec![("src".into(), depth.clone())],
         outputs: vec![("dst".into(), linear.clone())],
         params: bytemuck::bytes_of(&LinearizeParams::new(light)).to_vec(),
-        dispatch: Dispatch::Texels(linear),
+        dispatch: Dispatch::Texels(linear.clone()),
         light: Some(i),
     });
+    let float = "texture_2d<f32>";
+    match light.shadow.technique {
+        Technique::Pcf {
+            kernel: PcfKernel::Hardware,
+            ..
+        } => ShadeInput {
+            resource: depth,
+            wgsl_type: "texture_depth_2d",
+        },
+        Technique::Hard | Technique::Pcf { .. } | Technique::Pcss { .. } => ShadeInput {
+            resource: linear,
+            wgsl_type: float,
+        },
+        Technique::Vsm { prefilter, .. } => {
+            let moments = encode(graph, i, "vsm", &linear, moments_format(prefilter.storage));
+            ShadeInput {
+                resource: add_filter(graph, i, &moments, &prefilter.filter),
+                wgsl_type: float,
+            }
+        }
+    }
+}
+
+/// The texel format of a two-moment representation stored at `storage` precision.
+pub fn moments_format(storage: Storage) -> wgpu::TextureFormat {
+    match storage {
+        Storage::F32 => wgpu::TextureFormat::Rg32Float,
+        // rg16float is no core storage format; rgba16float is.
+        Storage::F16 => wgpu::TextureFormat::Rgba16Float,
+    }
+}
+
+/// Adds the encoding node `kernel` (linear depth → representation) of light `i`.
+fn encode(
+    graph: &mut Graph,
+    i: usize,
+    kernel: &str,
+    linear: &str,
+    format: wgpu::TextureFormat,
+) -> String {
+    let out = graph.resource(
+        format!("light{i}.{kernel}"),
+        format,
+        SizeRule::Reduced {
+            of: linear.to_string(),
+            shift: 0,
+        },
+        Some(i),
+    );
+    graph.node(Node {
+        name: format!("light{i}.{kernel}"),
+        kernel: kernel.into(),
+        inputs: vec![("src".into(), linear.to_string())],
+        outputs: vec![("dst".into(), out.clone())],
+        params: Vec::new(),
+        dispatch: Dispatch::Texels(out.clone()),
+        light: Some(i),
+    });
+    out
 }
 
 /// How the shading kernel reads a light's map.
@@ -178,23 +255,6 @@ pub struct ShadeInput {
     pub resource: String,
     /// WGSL type of the binding.
     pub wgsl_type: &'static str,
-}
-
-/// The map light `i`'s technique reads in the shading pass.
-pub fn shade_input(i: usize, light: &Light) -> ShadeInput {
-    match light.shadow.technique {
-        Technique::Pcf {
-            kernel: PcfKernel::Hardware,
-            ..
-        } => ShadeInput {
-            resource: depth_name(i),
-            wgsl_type: "texture_depth_2d",
-        },
-        Technique::Hard | Technique::Pcf { .. } | Technique::Pcss { .. } => ShadeInput {
-            resource: linear_name(i),
-            wgsl_type: "texture_2d<f32>",
-        },
-    }
 }
 
 fn visibility_call(light: &Light, map: &str) -> (&'static str, String) {
@@ -209,6 +269,7 @@ fn visibility_call(light: &Light, map: &str) -> (&'static str, String) {
         ),
         Technique::Pcf { .. } => ("shared/vis_pcf", format!("vis_pcf({map}, l, s)")),
         Technique::Pcss { .. } => ("shared/vis_pcss", format!("vis_pcss({map}, l, s)")),
+        Technique::Vsm { .. } => ("shared/vis_vsm", format!("vis_vsm({map}, l, s)")),
     }
 }
 
@@ -220,7 +281,7 @@ pub fn shading_block(lights: &[Light]) -> String {
     let mut bindings = String::new();
     let mut cases = String::new();
     for (i, light) in lights.iter().enumerate() {
-        let input = shade_input(i, light);
+        let input = add_light_nodes(&mut Graph::default(), i, light);
         let map = format!("light{i}_map");
         let (module, call) = visibility_call(light, &map);
         if !imports.contains(&module) {

@@ -4,7 +4,9 @@
 use std::collections::BTreeSet;
 
 use shadowgraph::kernels::{self, SOURCES, struct_size};
-use shadowgraph::scene::{Light, LightKind, PcfKernel, Shadow, Technique};
+use shadowgraph::scene::{
+    BlurKernel, Filter, Light, LightKind, PcfKernel, Prefilter, Shadow, Storage, Technique,
+};
 use shadowgraph::technique::{LightGpu, LinearizeParams, shading_block};
 
 fn light(technique: Technique) -> Light {
@@ -45,6 +47,18 @@ fn all_techniques() -> Vec<Technique> {
             blocker_samples: 16,
             filter_samples: 32,
             max_search: 0.1,
+        },
+        Technique::Vsm {
+            prefilter: Prefilter {
+                storage: Storage::F16,
+                filter: Filter::Blur {
+                    radius: 2.0,
+                    sigma: 1.0,
+                    kernel: BlurKernel::Box,
+                },
+            },
+            bleed: 0.2,
+            min_variance: 1e-5,
         },
     ]
 }
@@ -154,4 +168,27 @@ fn shading_block_contains_only_the_techniques_used() {
         b.contains("vis_hard") && !b.contains("vis_pcss") && !b.contains("vis_pcf"),
         "{b}"
     );
+}
+
+#[test]
+fn storage_format_variants_validate() {
+    // The executor re-declares `dst` for the bound format; every format a technique can bind
+    // must give a valid kernel.
+    let mut failures = Vec::new();
+    for (kernel, formats) in [
+        ("vsm", ["rg32float", "rgba16float"]),
+        ("blur", ["rg32float", "rgba16float"]),
+    ] {
+        let base = kernels::resolve(kernel, None).unwrap();
+        for f in formats {
+            let wgsl = base.replace(
+                "var dst: texture_storage_2d<rg32float,",
+                &format!("var dst: texture_storage_2d<{f},"),
+            );
+            if let Err(e) = kernels::reflect(kernel, &wgsl) {
+                failures.push(format!("{kernel}@{f}: {e}"));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

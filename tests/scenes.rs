@@ -6,16 +6,20 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use shadowgraph::Error;
-use shadowgraph::cpu::{self, Map};
+use shadowgraph::cpu::{self, Map, Texels};
 use shadowgraph::render::{RenderOptions, Renderer};
 use shadowgraph::scene::{PcfKernel, Scene, Technique};
 use shadowgraph::technique::LightGpu;
 
 fn scenes() -> Vec<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
-    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
-        .expect("scenes/")
-        .map(|e| e.expect("entry").path())
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let mut v: Vec<PathBuf> = [root.clone(), root.join("techniques")]
+        .iter()
+        .flat_map(|d| {
+            std::fs::read_dir(d)
+                .expect("scenes/")
+                .map(|e| e.expect("entry").path())
+        })
         .filter(|p| p.extension().is_some_and(|x| x == "toml"))
         .collect();
     v.sort();
@@ -23,13 +27,14 @@ fn scenes() -> Vec<PathBuf> {
     v
 }
 
-/// Reference visibility of light `li` at pixel `px`, if robust.
+/// Reference visibility of light `li` at pixel `px` and its tolerance, if robust.
 fn pixel_reference(
     scene: &Scene,
     frame: &shadowgraph::render::Frame,
+    moments: &Texels,
     li: usize,
     px: usize,
-) -> Option<f64> {
+) -> Option<(f64, f64)> {
     let light = &scene.lights[li];
     let lg = LightGpu::new(light);
     let p = &frame.position[4 * px..4 * px + 3];
@@ -40,19 +45,10 @@ fn pixel_reference(
         glam::DVec3::new(n[0].into(), n[1].into(), n[2].into()).normalize(),
     );
     let size = light.shadow_map as usize;
-    let hardware = matches!(
-        light.shadow.technique,
-        Technique::Pcf {
-            kernel: PcfKernel::Hardware,
-            ..
-        }
-    );
-    let texels = if hardware {
-        &frame.depth_maps[li]
-    } else {
-        &frame.linear_maps[li]
+    let map = Map {
+        size,
+        texels: &frame.shade_maps[li].data,
     };
-    let map = Map { size, texels };
     common::robust(&s, size, |t| {
         if !t.inside {
             return 1.0;
@@ -65,7 +61,21 @@ fn pixel_reference(
             } => cpu::vis_pcf::vis_pcf_hardware(&map, &lg, t),
             Technique::Pcf { .. } => cpu::vis_pcf::vis_pcf(&map, &lg, t),
             Technique::Pcss { .. } => cpu::vis_pcss::vis_pcss(&map, &lg, t),
+            Technique::Vsm { .. } => cpu::vis_vsm::vis_vsm(moments, &lg, t),
         }
+    })
+    .map(|v| {
+        let tolerance = match light.shadow.technique {
+            // Vulkan allows 8-bit bilinear weights: each of four may be off by 2⁻⁸.
+            Technique::Pcf {
+                kernel: PcfKernel::Hardware,
+                ..
+            } => 1.0 / 64.0,
+            Technique::Vsm { .. } => common::vsm_tolerance(moments, &lg, &s),
+            // Means of 0/1 taps in f32.
+            _ => 1e-5,
+        };
+        (v, tolerance)
     })
 }
 
@@ -108,26 +118,21 @@ fn every_scene_renders_and_matches_the_references() {
             "{name}: rasterized non-finite depth"
         );
         for li in 0..lights {
-            let hardware = matches!(
-                scene.lights[li].shadow.technique,
-                Technique::Pcf {
-                    kernel: PcfKernel::Hardware,
-                    ..
-                }
-            );
-            // Hardware comparison sampling: Vulkan allows 8 bits of sub-texel precision, so each
-            // of the four bilinear weights may be off by 2⁻⁸: 2⁻⁶ in all. Otherwise as in
-            // tests/visibility.rs.
-            let atol = if hardware { 1.0 / 64.0 } else { 1e-5 };
-            let (mut gpu_v, mut ref_v, mut covered) = (Vec::new(), Vec::new(), 0);
+            check_prefilter_chain(&scene, &frame, li);
+            let sm = &frame.shade_maps[li];
+            let moments =
+                Texels::from_f32(sm.width as usize, sm.height as usize, sm.channels, &sm.data);
+            let (mut gpu_v, mut ref_v, mut tol, mut covered) =
+                (Vec::new(), Vec::new(), Vec::new(), 0);
             for px in 0..(frame.width * frame.height) as usize {
                 if frame.position[4 * px + 3] == 0.0 {
                     continue;
                 }
                 covered += 1;
-                if let Some(r) = pixel_reference(&scene, &frame, li, px) {
+                if let Some((r, t)) = pixel_reference(&scene, &frame, &moments, li, px) {
                     gpu_v.push(frame.visibility[px * lights + li]);
                     ref_v.push(r);
+                    tol.push(t);
                 }
             }
             let what = format!("{name} light {li}");
@@ -141,9 +146,47 @@ fn every_scene_renders_and_matches_the_references() {
                 shadowed * 200 > ref_v.len(),
                 "{what}: casts almost no shadow ({shadowed} pixels)"
             );
-            common::assert_close(&what, &gpu_v, &ref_v, atol, 0.0);
+            common::assert_within(&what, &gpu_v, &ref_v, &tol);
         }
     }
+}
+
+/// The filtered map the shading read equals the f64 encode and blur of the linear map the GPU
+/// produced (f32 storage: 1e-6, as in tests/prefilter.rs).
+fn check_prefilter_chain(scene: &Scene, frame: &shadowgraph::render::Frame, li: usize) {
+    let Technique::Vsm { prefilter, .. } = scene.lights[li].shadow.technique else {
+        return;
+    };
+    let Some(linear) = &frame.linear_maps[li] else {
+        panic!("light {li}: VSM without a linear map")
+    };
+    let (w, h) = (linear.width as usize, linear.height as usize);
+    let mut expected = cpu::vsm::vsm(&Texels::from_f32(w, h, 1, &linear.data));
+    if let shadowgraph::scene::Filter::Blur {
+        radius,
+        sigma,
+        kernel,
+    } = prefilter.filter
+    {
+        expected = cpu::blur::blur(&expected, radius.into(), sigma.into(), kernel);
+    }
+    let got = &frame.shade_maps[li];
+    let first_two: Vec<f32> = got
+        .data
+        .chunks(got.channels)
+        .flat_map(|c| [c[0], c[1]])
+        .collect();
+    let (atol, rtol) = match prefilter.storage {
+        shadowgraph::scene::Storage::F32 => (1e-6, 1e-6),
+        shadowgraph::scene::Storage::F16 => (1e-4, 3.0 * 2f64.powi(-10)),
+    };
+    common::assert_close(
+        &format!("light {li} filtered moments"),
+        &first_two,
+        &expected.data,
+        atol,
+        rtol,
+    );
 }
 
 #[test]

@@ -86,10 +86,7 @@ fn check(kind: LightKind, technique: Technique, seed: u64) {
         &g.device,
         &g.queue,
         std::slice::from_ref(&l),
-        &[ProbeMap {
-            size: MAP as u32,
-            linear: &map,
-        }],
+        &[ProbeMap::linear(MAP as u32, &map)],
         &points,
     )
     .expect("probe");
@@ -178,4 +175,66 @@ fn pcss_matches_reference() {
     };
     check(DIR, t, 30);
     check(SPOT, t, 31);
+}
+
+#[test]
+fn vsm_matches_reference_on_filtered_moments() {
+    use shadowgraph::scene::{BlurKernel, Filter, Prefilter, Storage};
+    let g = common::gpu();
+    let mut rng = common::rng(50);
+    for (kind, seed) in [(DIR, 51u64), (SPOT, 52)] {
+        let technique = Technique::Vsm {
+            prefilter: Prefilter {
+                storage: Storage::F32,
+                filter: Filter::Blur {
+                    radius: 2.0,
+                    sigma: 1.0,
+                    kernel: BlurKernel::Gaussian,
+                },
+            },
+            bleed: 0.2,
+            min_variance: 1e-5,
+        };
+        let l = light(kind, technique);
+        let linear = common::blocky_map(&mut common::rng(seed), MAP);
+        let moments = cpu::blur::blur(
+            &cpu::vsm::vsm(&cpu::Texels::from_f32(MAP, MAP, 1, &linear)),
+            2.0,
+            1.0,
+            BlurKernel::Gaussian,
+        );
+        let data: Vec<f32> = moments.data.iter().map(|&v| v as f32).collect();
+        let moments = cpu::Texels::from_f32(MAP, MAP, 2, &data);
+        let points: Vec<(Vec3, Vec3)> = (0..3000).map(|_| point(&l, &mut rng)).collect();
+        let mut renderer = Renderer::new(&g.device);
+        let map = ProbeMap {
+            size: MAP as u32,
+            format: wgpu::TextureFormat::Rg32Float,
+            data: &data,
+        };
+        let vis = probe(
+            &mut renderer,
+            &g.device,
+            &g.queue,
+            std::slice::from_ref(&l),
+            &[map],
+            &points,
+        )
+        .expect("probe");
+        let lg = LightGpu::new(&l);
+        let (mut reference, mut tolerance) = (Vec::new(), Vec::new());
+        for (p, n) in &points {
+            let s = cpu::light::sample(&lg, p.as_dvec3(), n.as_dvec3());
+            reference.push(if s.inside {
+                cpu::vis_vsm::vis_vsm(&moments, &lg, &s)
+            } else {
+                1.0
+            });
+            tolerance.push(common::vsm_tolerance(&moments, &lg, &s));
+        }
+        let partial = reference.iter().filter(|&&v| v > 0.01 && v < 0.99).count();
+        assert!(partial > 100, "{kind:?}: only {partial} penumbra points");
+        // VSM is continuous in the receiver (bilinear moments, no comparisons): every point counts.
+        common::assert_within(&format!("vsm {kind:?}"), &vis, &reference, &tolerance);
+    }
 }

@@ -26,9 +26,9 @@ struct Light {
     blocker_samples: u32,    // pcss
     filter_samples: u32,     // pcss
     max_search: f32,         // pcss: cap on the blocker-search radius, UV
+    bleed: f32,              // vsm: light-bleeding reduction amount
+    min_variance: f32,       // vsm
     _pad0: f32,
-    _pad1: f32,
-    _pad2: f32,
 }
 
 // Where a receiver lands in a light's shadow map.

@@ -20,3 +20,24 @@ fn load_depth(map: texture_2d<f32>, t: vec2<i32>) -> f32 {
     let size = vec2<i32>(textureDimensions(map));
     return textureLoad(map, clamp(t, vec2<i32>(0), size - 1), 0).r;
 }
+
+// Bilinear interpolation of all four channels at uv (texel centres at (i + ½) / size),
+// clamp-to-edge, from four loads: exact and filter-feature independent (f32 maps need not be
+// filterable).
+fn sample_bilinear(map: texture_2d<f32>, uv: vec2<f32>) -> vec4<f32> {
+    let size = vec2<f32>(textureDimensions(map));
+    let f = uv * size - 0.5;
+    let i = vec2<i32>(floor(f));
+    let a = f - floor(f);
+    let smax = vec2<i32>(size) - 1;
+    let t00 = textureLoad(map, clamp(i, vec2<i32>(0), smax), 0);
+    let t10 = textureLoad(map, clamp(i + vec2<i32>(1, 0), vec2<i32>(0), smax), 0);
+    let t01 = textureLoad(map, clamp(i + vec2<i32>(0, 1), vec2<i32>(0), smax), 0);
+    let t11 = textureLoad(map, clamp(i + vec2<i32>(1, 1), vec2<i32>(0), smax), 0);
+    return mix(mix(t00, t10, a.x), mix(t01, t11, a.x), a.y);
+}
+
+// linstep(lo, hi, x): the light-bleeding reduction of VSM-family techniques.
+fn linstep(lo: f32, hi: f32, x: f32) -> f32 {
+    return clamp((x - lo) / (hi - lo), 0.0, 1.0);
+}

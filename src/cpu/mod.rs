@@ -1,11 +1,14 @@
 //! f64 CPU references, one per kernel or WGSL module and named after it, written in the
 //! shader's shape so the two read side by side. Tests compare the GPU against these.
 
+pub mod blur;
 pub mod light;
 pub mod linearize;
 pub mod vis_hard;
 pub mod vis_pcf;
 pub mod vis_pcss;
+pub mod vis_vsm;
+pub mod vsm;
 
 /// A linear depth map on the CPU.
 #[derive(Clone, Debug)]
@@ -37,4 +40,52 @@ pub fn vogel_disc(i: u32, n: u32) -> [f64; 2] {
     let r = ((f64::from(i) + 0.5) / f64::from(n)).sqrt();
     let t = f64::from(i) * GOLDEN_ANGLE;
     [r * t.cos(), r * t.sin()]
+}
+
+/// A multi-channel image in f64 (row-major, `channels` values per texel).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Texels {
+    /// Width.
+    pub width: usize,
+    /// Height.
+    pub height: usize,
+    /// Values per texel.
+    pub channels: usize,
+    /// `width · height · channels` values.
+    pub data: Vec<f64>,
+}
+
+impl Texels {
+    /// From f32 data as read back from a texture.
+    pub fn from_f32(width: usize, height: usize, channels: usize, data: &[f32]) -> Self {
+        Self {
+            width,
+            height,
+            channels,
+            data: data.iter().map(|&v| f64::from(v)).collect(),
+        }
+    }
+
+    /// Texel (x, y), clamped to the edge.
+    pub fn at(&self, x: i64, y: i64) -> &[f64] {
+        let cx = x.clamp(0, self.width as i64 - 1) as usize;
+        let cy = y.clamp(0, self.height as i64 - 1) as usize;
+        let i = (cy * self.width + cx) * self.channels;
+        &self.data[i..i + self.channels]
+    }
+
+    /// Bilinear interpolation at `uv`, clamp-to-edge (`sample_bilinear` in `shared/sampling.wgsl`).
+    pub fn bilinear(&self, uv: [f64; 2]) -> Vec<f64> {
+        let fx = uv[0] * self.width as f64 - 0.5;
+        let fy = uv[1] * self.height as f64 - 0.5;
+        let (x0, y0) = (fx.floor() as i64, fy.floor() as i64);
+        let (ax, ay) = (fx - fx.floor(), fy - fy.floor());
+        (0..self.channels)
+            .map(|c| {
+                let t = |dx: i64, dy: i64| self.at(x0 + dx, y0 + dy)[c];
+                (1.0 - ay) * ((1.0 - ax) * t(0, 0) + ax * t(1, 0))
+                    + ay * ((1.0 - ax) * t(0, 1) + ax * t(1, 1))
+            })
+            .collect()
+    }
 }

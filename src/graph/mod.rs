@@ -50,6 +50,14 @@ pub enum Dispatch {
     Texels(String),
     /// An explicit workgroup count.
     Groups([u32; 3]),
+    /// One invocation per texel along `axis` (0 = x, 1 = y) of this resource, one workgroup
+    /// row per line across it: `[ceil(len / workgroup x), lines, 1]` (separable passes).
+    Axis {
+        /// The resource whose size counts.
+        of: String,
+        /// 0 for rows (horizontal), 1 for columns (vertical).
+        axis: u32,
+    },
 }
 
 /// One kernel invocation in the graph.

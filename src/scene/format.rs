@@ -112,6 +112,20 @@ pub struct ShadowFile {
     pub filter_samples: Option<Spanned<i64>>,
     /// PCSS cap on the blocker-search radius, in shadow-map UV.
     pub max_search: Option<Spanned<f64>>,
+    /// Storage of a prefiltered representation: `f32` or `f16`.
+    pub format: Option<Spanned<String>>,
+    /// Prefilter: `none` or `blur`.
+    pub filter: Option<Spanned<String>>,
+    /// Blur radius in texels (fractional for box edges).
+    pub filter_radius: Option<Spanned<f64>>,
+    /// Gaussian sigma in texels (default radius / 2).
+    pub filter_sigma: Option<Spanned<f64>>,
+    /// Blur weights: `gaussian` or `box`.
+    pub filter_kernel: Option<Spanned<String>>,
+    /// Light-bleeding reduction: `linstep(amount, 1, p)`.
+    pub bleed_reduction: Option<Spanned<f64>>,
+    /// Minimum variance (VSM).
+    pub min_variance: Option<Spanned<f64>>,
 }
 
 /// `[[object]]`.

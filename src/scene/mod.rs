@@ -80,6 +80,49 @@ pub enum PcfKernel {
     Hardware,
 }
 
+/// Storage precision of a prefiltered representation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Storage {
+    /// 32-bit float channels.
+    F32,
+    /// 16-bit float channels.
+    F16,
+}
+
+/// Weights of the separable blur.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BlurKernel {
+    /// `exp(−i² / 2σ²)` for `|i| ≤ ceil(radius)`.
+    Gaussian,
+    /// 1 for `|i| ≤ floor(radius)`, the fraction `radius − floor(radius)` one texel further.
+    Box,
+}
+
+/// How a prefiltered representation is filtered before shading.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Filter {
+    /// Not filtered (shading still interpolates bilinearly).
+    None,
+    /// Separable blur, one pass per axis, clamp-to-edge.
+    Blur {
+        /// Radius in texels.
+        radius: f32,
+        /// Gaussian sigma in texels.
+        sigma: f32,
+        /// Weights.
+        kernel: BlurKernel,
+    },
+}
+
+/// How a prefiltered technique stores and filters its representation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Prefilter {
+    /// Storage precision.
+    pub storage: Storage,
+    /// Filter.
+    pub filter: Filter,
+}
+
 /// A light's shadow technique and its parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Technique {
@@ -101,6 +144,15 @@ pub enum Technique {
         /// Cap on the blocker-search radius in shadow-map UV.
         max_search: f32,
     },
+    /// Variance shadow maps (Donnelly & Lauritzen 2006): moments (z, z²), filtered.
+    Vsm {
+        /// Storage and filter of the moments.
+        prefilter: Prefilter,
+        /// Light-bleeding reduction `linstep(bleed, 1, p_max)`.
+        bleed: f32,
+        /// Minimum variance.
+        min_variance: f32,
+    },
 }
 
 impl Technique {
@@ -110,6 +162,7 @@ impl Technique {
             Technique::Hard => "hard",
             Technique::Pcf { .. } => "pcf",
             Technique::Pcss { .. } => "pcss",
+            Technique::Vsm { .. } => "vsm",
         }
     }
 }

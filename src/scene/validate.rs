@@ -7,7 +7,10 @@ use glam::{EulerRot, Mat4, Quat, Vec3};
 use toml::Spanned;
 
 use super::format::{LightFile, Num, ObjectFile, SceneFile, ShadowFile, V3};
-use super::{Camera, Light, LightKind, Mesh, Object, PcfKernel, Scene, Shadow, Technique, mesh};
+use super::{
+    BlurKernel, Camera, Filter, Light, LightKind, Mesh, Object, PcfKernel, Prefilter, Scene,
+    Shadow, Storage, Technique, mesh,
+};
 use crate::error::{Error, Result};
 
 /// Largest output or shadow-map side accepted before the device is even asked.
@@ -259,85 +262,202 @@ fn light(ctx: &Ctx, i: usize, l: &LightFile) -> Result<Light> {
     })
 }
 
+/// The technique-specific keys each technique accepts (the common ones — technique, bias,
+/// slope_bias, normal_bias — are always allowed).
+const TECHNIQUE_KEYS: &[(&str, &[&str])] = &[
+    ("hard", &[]),
+    ("pcf", &["radius", "kernel"]),
+    ("pcss", &["blocker_samples", "filter_samples", "max_search"]),
+    (
+        "vsm",
+        &[
+            "format",
+            "filter",
+            "filter_radius",
+            "filter_sigma",
+            "filter_kernel",
+            "bleed_reduction",
+            "min_variance",
+        ],
+    ),
+];
+
+fn present(s: &ShadowFile) -> Vec<(&'static str, Range<usize>)> {
+    fn sp<T>(v: &Option<Spanned<T>>) -> Option<Range<usize>> {
+        v.as_ref().map(|v| v.span())
+    }
+    [
+        ("radius", sp(&s.radius)),
+        ("kernel", sp(&s.kernel)),
+        ("blocker_samples", sp(&s.blocker_samples)),
+        ("filter_samples", sp(&s.filter_samples)),
+        ("max_search", sp(&s.max_search)),
+        ("format", sp(&s.format)),
+        ("filter", sp(&s.filter)),
+        ("filter_radius", sp(&s.filter_radius)),
+        ("filter_sigma", sp(&s.filter_sigma)),
+        ("filter_kernel", sp(&s.filter_kernel)),
+        ("bleed_reduction", sp(&s.bleed_reduction)),
+        ("min_variance", sp(&s.min_variance)),
+    ]
+    .into_iter()
+    .filter_map(|(k, span)| span.map(|s| (k, s)))
+    .collect()
+}
+
+impl Ctx<'_> {
+    /// The option named by a string key, with `default` when absent.
+    fn choice<T: Copy>(
+        &self,
+        key: &str,
+        v: &Option<Spanned<String>>,
+        options: &[(&str, T)],
+        default: T,
+    ) -> Result<T> {
+        let Some(v) = v else { return Ok(default) };
+        options
+            .iter()
+            .find(|(name, _)| *name == v.get_ref())
+            .map(|(_, t)| *t)
+            .ok_or_else(|| {
+                let names: Vec<String> = options.iter().map(|(n, _)| format!("\"{n}\"")).collect();
+                self.err(
+                    Some(v.span()),
+                    format!(
+                        "`{key}` = \"{}\": expected one of {}",
+                        v.get_ref(),
+                        names.join(", ")
+                    ),
+                )
+            })
+    }
+}
+
 fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
     let key = |k: &str| format!("light[{i}].shadow.{k}");
     let name = s.technique.get_ref().as_str();
-    let not_for = format!("does not apply to technique \"{name}\"");
-    let technique = match name {
-        "hard" | "pcf" | "pcss" => {
-            if name != "pcf" {
-                ctx.reject(&key("radius"), &s.radius, &not_for)?;
-                ctx.reject(&key("kernel"), &s.kernel, &not_for)?;
-            }
-            if name != "pcss" {
-                ctx.reject(&key("blocker_samples"), &s.blocker_samples, &not_for)?;
-                ctx.reject(&key("filter_samples"), &s.filter_samples, &not_for)?;
-                ctx.reject(&key("max_search"), &s.max_search, &not_for)?;
-            }
-            match name {
-                "hard" => Technique::Hard,
-                "pcf" => Technique::Pcf {
-                    radius: ctx.int_or(&key("radius"), &s.radius, 0, 32, 1)?,
-                    kernel: match s.kernel.as_ref().map(|k| (k.get_ref().as_str(), k.span())) {
-                        None | Some(("box", _)) => PcfKernel::Box,
-                        Some(("tent", _)) => PcfKernel::Tent,
-                        Some(("hardware", _)) => PcfKernel::Hardware,
-                        Some((other, span)) => {
-                            return Err(ctx.err(Some(span), format!(
-                                "`{}` = \"{other}\": unknown PCF kernel (expected \"box\", \"tent\" or \"hardware\")",
-                                key("kernel")
-                            )));
-                        }
-                    },
-                },
-                _ => Technique::Pcss {
-                    blocker_samples: ctx.int_or(
-                        &key("blocker_samples"),
-                        &s.blocker_samples,
-                        1,
-                        256,
-                        16,
-                    )?,
-                    filter_samples: ctx.int_or(
-                        &key("filter_samples"),
-                        &s.filter_samples,
-                        1,
-                        1024,
-                        32,
-                    )?,
-                    max_search: ctx.num_or(&key("max_search"), &s.max_search, 1e-4, 1.0, 0.1)?,
-                },
-            }
-        }
-        other => {
-            return Err(ctx.err(
-                Some(s.technique.span()),
-                format!(
-                    "`{}` = \"{other}\": unknown technique (this build knows \"hard\", \"pcf\", \"pcss\")",
-                    key("technique")
-                ),
-            ));
-        }
+    let Some((_, allowed)) = TECHNIQUE_KEYS.iter().find(|(t, _)| *t == name) else {
+        let known: Vec<String> = TECHNIQUE_KEYS
+            .iter()
+            .map(|(t, _)| format!("\"{t}\""))
+            .collect();
+        return Err(ctx.err(
+            Some(s.technique.span()),
+            format!(
+                "`{}` = \"{name}\": unknown technique (this build knows {})",
+                key("technique"),
+                known.join(", ")
+            ),
+        ));
     };
-    if matches!(
-        technique,
-        Technique::Pcf {
-            kernel: PcfKernel::Hardware,
-            ..
-        }
-    ) {
-        ctx.reject(
-            &key("radius"),
-            &s.radius,
-            "does not apply to the hardware 2×2 kernel",
-        )?;
+    if let Some((k, span)) = present(s).into_iter().find(|(k, _)| !allowed.contains(k)) {
+        return Err(ctx.err(
+            Some(span),
+            format!("`{}` does not apply to technique \"{name}\"", key(k)),
+        ));
     }
+    let technique = match name {
+        "hard" => Technique::Hard,
+        "pcf" => {
+            let kernels = [
+                ("box", PcfKernel::Box),
+                ("tent", PcfKernel::Tent),
+                ("hardware", PcfKernel::Hardware),
+            ];
+            let kernel = ctx.choice(&key("kernel"), &s.kernel, &kernels, PcfKernel::Box)?;
+            if kernel == PcfKernel::Hardware {
+                ctx.reject(
+                    &key("radius"),
+                    &s.radius,
+                    "does not apply to the hardware 2×2 kernel",
+                )?;
+            }
+            Technique::Pcf {
+                radius: ctx.int_or(&key("radius"), &s.radius, 0, 32, 1)?,
+                kernel,
+            }
+        }
+        "pcss" => Technique::Pcss {
+            blocker_samples: ctx.int_or(&key("blocker_samples"), &s.blocker_samples, 1, 256, 16)?,
+            filter_samples: ctx.int_or(&key("filter_samples"), &s.filter_samples, 1, 1024, 32)?,
+            max_search: ctx.num_or(&key("max_search"), &s.max_search, 1e-4, 1.0, 0.1)?,
+        },
+        _ => Technique::Vsm {
+            prefilter: prefilter(ctx, i, s)?,
+            bleed: ctx.num_or(&key("bleed_reduction"), &s.bleed_reduction, 0.0, 0.99, 0.2)?,
+            min_variance: ctx.num_or(&key("min_variance"), &s.min_variance, 0.0, 1.0, 1e-5)?,
+        },
+    };
     Ok(Shadow {
         technique,
         bias: ctx.num_or(&key("bias"), &s.bias, -1.0, 1.0, 0.002)?,
         slope_bias: ctx.num_or(&key("slope_bias"), &s.slope_bias, 0.0, 100.0, 1.0)?,
         normal_bias: ctx.num_or(&key("normal_bias"), &s.normal_bias, 0.0, 100.0, 1.0)?,
     })
+}
+
+fn prefilter(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Prefilter> {
+    let key = |k: &str| format!("light[{i}].shadow.{k}");
+    let storage = ctx.choice(
+        &key("format"),
+        &s.format,
+        &[("f32", Storage::F32), ("f16", Storage::F16)],
+        Storage::F32,
+    )?;
+    let blur = ctx.choice(
+        &key("filter"),
+        &s.filter,
+        &[("none", false), ("blur", true)],
+        true,
+    )?;
+    let filter = if blur {
+        let radius = ctx.num_or(
+            &key("filter_radius"),
+            &s.filter_radius,
+            0.0,
+            f64::from(crate::filter::MAX_BLUR_RADIUS),
+            2.0,
+        )?;
+        let kernel = ctx.choice(
+            &key("filter_kernel"),
+            &s.filter_kernel,
+            &[("gaussian", BlurKernel::Gaussian), ("box", BlurKernel::Box)],
+            BlurKernel::Gaussian,
+        )?;
+        if kernel == BlurKernel::Box {
+            ctx.reject(
+                &key("filter_sigma"),
+                &s.filter_sigma,
+                "does not apply to the box kernel",
+            )?;
+        }
+        let sigma = ctx.num_or(
+            &key("filter_sigma"),
+            &s.filter_sigma,
+            0.1,
+            100.0,
+            (0.5 * radius).max(0.5),
+        )?;
+        Filter::Blur {
+            radius,
+            sigma,
+            kernel,
+        }
+    } else {
+        for (k, v) in [
+            ("filter_radius", &s.filter_radius),
+            ("filter_sigma", &s.filter_sigma),
+        ] {
+            ctx.reject(&key(k), v, "needs `filter = \"blur\"`")?;
+        }
+        ctx.reject(
+            &key("filter_kernel"),
+            &s.filter_kernel,
+            "needs `filter = \"blur\"`",
+        )?;
+        Filter::None
+    };
+    Ok(Prefilter { storage, filter })
 }
 
 fn num3(ctx: &Ctx, key: &str, v: &Spanned<Num>, len2_ok: bool) -> Result<Vec<f32>> {

@@ -1,0 +1,64 @@
+// One pass of a separable blur (Gaussian or box with fractional edge weights) over every
+// channel of any float representation. A workgroup filters WG_SIZE texels of one line: it loads
+// the line segment and its halo into workgroup memory once (one read per texel plus the halo),
+// then each invocation sums 2r + 1 taps from there. Edges clamp (replicate the border texel), so
+// the map edge keeps its shadow instead of fading toward zero.
+// Storage: rg32float by default; the executor re-declares `dst` for the bound format.
+
+// Keep in sync with `BlurParams` in src/filter.rs.
+struct Params {
+    axis: u32,                        // 0 horizontal, 1 vertical
+    radius: u32,                      // taps each side, ≤ MAX_RADIUS
+    _pad0: u32,
+    _pad1: u32,
+    weights: array<vec4<f32>, 9>,     // weight of offset i at weights[i / 4][i % 4], i = 0..=32
+}
+
+@group(0) @binding(0) var src: texture_2d<f32>;
+@group(0) @binding(1) var dst: texture_storage_2d<rg32float, write>;
+@group(0) @binding(2) var<uniform> params: Params;
+
+const WG_SIZE: u32 = 128u;
+const MAX_RADIUS: u32 = 32u;
+
+var<workgroup> sh_tile: array<vec4<f32>, 192>; // WG_SIZE + 2 · MAX_RADIUS
+
+fn weight(i: u32) -> f32 {
+    return params.weights[i / 4u][i % 4u];
+}
+
+// Texel `a` along the axis on line `b`, clamped to the map.
+fn load(a: i32, b: i32, size: vec2<i32>) -> vec4<f32> {
+    var p = vec2<i32>(a, b);
+    if params.axis == 1u {
+        p = vec2<i32>(b, a);
+    }
+    return textureLoad(src, clamp(p, vec2<i32>(0), size - 1), 0);
+}
+
+@compute @workgroup_size(WG_SIZE)
+fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    let size = vec2<i32>(textureDimensions(src));
+    let r = i32(min(params.radius, MAX_RADIUS));
+    let line = i32(wg.y);
+    let start = i32(wg.x * WG_SIZE) - r;
+    for (var t = i32(li); t < i32(WG_SIZE) + 2 * r; t += i32(WG_SIZE)) {
+        sh_tile[t] = load(start + t, line, size);
+    }
+    workgroupBarrier();
+    let a = i32(wg.x * WG_SIZE + li);
+    let along = select(size.x, size.y, params.axis == 1u);
+    if a >= along {
+        return;
+    }
+    let c = i32(li) + r;
+    var acc = weight(0u) * sh_tile[c];
+    for (var i = 1; i <= r; i++) {
+        acc += weight(u32(i)) * (sh_tile[c - i] + sh_tile[c + i]);
+    }
+    var p = vec2<i32>(a, line);
+    if params.axis == 1u {
+        p = vec2<i32>(line, a);
+    }
+    textureStore(dst, p, acc);
+}

@@ -1,0 +1,36 @@
+// Linear depth → variance-shadow-map moments (Donnelly & Lauritzen 2006):
+//   (z, z² + ¼ (∂z/∂x² + ∂z/∂y²))
+// The derivative term (GPU Gems 3, ch. 8) is the variance of a planar surface across one
+// texel, so a lit plane is not self-shadowed. In compute there is no rasterizer derivative:
+// each partial is the smaller in magnitude of the forward and backward difference, so a
+// silhouette (a jump on one side only) does not inflate the variance of the surface beside it.
+// Storage: rg32float by default; the executor re-declares `dst` for f16 (rgba16float).
+
+@group(0) @binding(0) var src: texture_2d<f32>;
+@group(0) @binding(1) var dst: texture_storage_2d<rg32float, write>;
+
+const WG_SIZE: u32 = 16u;
+
+fn depth_at(p: vec2<i32>, size: vec2<i32>) -> f32 {
+    return textureLoad(src, clamp(p, vec2<i32>(0), size - 1), 0).r;
+}
+
+// The one-sided difference of smaller magnitude.
+fn partial(z: f32, before: f32, after: f32) -> f32 {
+    let forward = after - z;
+    let backward = z - before;
+    return select(backward, forward, abs(forward) < abs(backward));
+}
+
+@compute @workgroup_size(WG_SIZE, WG_SIZE)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = vec2<i32>(textureDimensions(src));
+    let p = vec2<i32>(id.xy);
+    if any(p >= size) {
+        return;
+    }
+    let z = depth_at(p, size);
+    let dx = partial(z, depth_at(p - vec2<i32>(1, 0), size), depth_at(p + vec2<i32>(1, 0), size));
+    let dy = partial(z, depth_at(p - vec2<i32>(0, 1), size), depth_at(p + vec2<i32>(0, 1), size));
+    textureStore(dst, p, vec4<f32>(z, z * z + 0.25 * (dx * dx + dy * dy), 0.0, 0.0));
+}

@@ -1,0 +1,19 @@
+//! Reference of `kernels/shared/vis_vsm.wgsl`.
+
+use super::Texels;
+use super::light::LightSample;
+use crate::technique::LightGpu;
+
+/// Chebyshev upper bound from bilinearly filtered moments, with bleeding reduction.
+pub fn vis_vsm(moments: &Texels, l: &LightGpu, s: &LightSample) -> f64 {
+    let m = moments.bilinear(s.uv);
+    let d = s.depth - f64::from(l.bias);
+    if d <= m[0] {
+        return 1.0;
+    }
+    let variance = (m[1] - m[0] * m[0]).max(f64::from(l.min_variance));
+    let t = d - m[0];
+    let p = variance / (variance + t * t);
+    let bleed = f64::from(l.bleed);
+    ((p - bleed) / (1.0 - bleed)).clamp(0.0, 1.0)
+}
