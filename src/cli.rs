@@ -40,6 +40,7 @@ pub fn render(
         RenderOptions {
             aux: aux.is_some(),
             repeat,
+            dump: false,
         },
     )?;
     let bad = frame.visibility.iter().filter(|v| !v.is_finite()).count();

@@ -90,6 +90,21 @@ pub struct RenderOptions {
     pub aux: bool,
     /// Frames to render; timings are per frame (the caller takes medians).
     pub repeat: u32,
+    /// Read back every resource of the executed plan (for `shadowgraph dump`).
+    pub dump: bool,
+}
+
+/// A resource of the executed plan, read back for inspection.
+#[derive(Clone, Debug)]
+pub struct DumpedResource {
+    /// Its data (mip 0 in `levels[0]`, then each further mip level).
+    pub levels: Vec<FloatMap>,
+    /// The light it belongs to.
+    pub light: Option<usize>,
+    /// The kernel of the node that wrote it (`None` for imports: the rasterized map).
+    pub producer: Option<String>,
+    /// Texel format.
+    pub format: wgpu::TextureFormat,
 }
 
 /// A rendered frame read back to the CPU.
@@ -115,6 +130,8 @@ pub struct Frame {
     pub shade_maps: Vec<FloatMap>,
     /// Per light, the linear depth map, when the plan made one (`aux` only).
     pub linear_maps: Vec<Option<FloatMap>>,
+    /// Every resource of the plan in plan order (`dump` only).
+    pub resources: Vec<DumpedResource>,
 }
 
 /// A float texture read back: `channels` values per texel, row-major.
@@ -459,7 +476,11 @@ impl Renderer {
             sanitized,
             shade_maps: Vec::new(),
             linear_maps: Vec::new(),
+            resources: Vec::new(),
         };
+        if opts.dump {
+            frame.resources = dump_resources(device, queue, &sp.plan, &outputs)?;
+        }
         if opts.aux {
             frame.position = bytemuck::cast_slice(&read_texture(device, queue, &gpos, 0)?).to_vec();
             frame.normal = bytemuck::cast_slice(&read_texture(device, queue, &gnorm, 0)?).to_vec();
@@ -763,6 +784,40 @@ impl Shaded {
         submit_and_wait(device, queue, enc, "visibility readback")?;
         Ok(bytemuck::cast_slice(&read_buffer(device, &staging)?).to_vec())
     }
+}
+
+/// Reads back every resource of `plan` (all mip levels) with its provenance.
+fn dump_resources(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    plan: &Plan,
+    outputs: &crate::exec::Outputs,
+) -> Result<Vec<DumpedResource>> {
+    plan.resources
+        .iter()
+        .map(|r| {
+            let name = &r.resource.name;
+            let t = &outputs.textures[name];
+            let levels = (0..t.mip_level_count())
+                .map(|mip| {
+                    let (channels, data) = crate::gpu::read_float_texture(device, queue, t, mip)?;
+                    Ok(FloatMap {
+                        resource: name.clone(),
+                        width: (t.width() >> mip).max(1),
+                        height: (t.height() >> mip).max(1),
+                        channels,
+                        data,
+                    })
+                })
+                .collect::<Result<Vec<_>>>()?;
+            Ok(DumpedResource {
+                levels,
+                light: r.resource.light,
+                producer: r.producer.map(|s| plan.steps[s].node.kernel.clone()),
+                format: r.resource.format,
+            })
+        })
+        .collect()
 }
 
 fn depth_only_view(t: &wgpu::Texture) -> wgpu::TextureView {

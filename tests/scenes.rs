@@ -93,6 +93,7 @@ fn every_scene_renders_and_matches_the_references() {
                 RenderOptions {
                     aux: true,
                     repeat: 1,
+                    dump: false,
                 },
             )
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
