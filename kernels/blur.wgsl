@@ -1,5 +1,6 @@
 // One pass of a separable blur (Gaussian or box with fractional edge weights) over every
-// channel of any float representation. A workgroup filters WG_SIZE texels of one line: it loads
+// channel of any float representation, as a weighted sum or, for logarithmic representations
+// (ESM's c·z), as a log-sum-exp. A workgroup filters WG_SIZE texels of one line: it loads
 // the line segment and its halo into workgroup memory once (one read per texel plus the halo),
 // then each invocation sums 2r + 1 taps from there. Edges clamp (replicate the border texel), so
 // the map edge keeps its shadow instead of fading toward zero.
@@ -9,8 +10,8 @@
 struct Params {
     axis: u32,                        // 0 horizontal, 1 vertical
     radius: u32,                      // taps each side, ≤ MAX_RADIUS
-    _pad0: u32,
-    _pad1: u32,
+    mode: u32,                        // 0 weighted sum; 1 log Σ w exp(v) (texels hold logs)
+    _pad: u32,
     weights: array<vec4<f32>, 9>,     // weight of offset i at weights[i / 4][i % 4], i = 0..=32
 }
 
@@ -52,9 +53,23 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l
         return;
     }
     let c = i32(li) + r;
-    var acc = weight(0u) * sh_tile[c];
-    for (var i = 1; i <= r; i++) {
-        acc += weight(u32(i)) * (sh_tile[c - i] + sh_tile[c + i]);
+    var acc: vec4<f32>;
+    if params.mode == 1u {
+        // log-sum-exp around the largest tap: every exp ≤ 1, nothing overflows at any c.
+        var m = sh_tile[c];
+        for (var i = 1; i <= r; i++) {
+            m = max(m, max(sh_tile[c - i], sh_tile[c + i]));
+        }
+        var sum = weight(0u) * exp(sh_tile[c] - m);
+        for (var i = 1; i <= r; i++) {
+            sum += weight(u32(i)) * (exp(sh_tile[c - i] - m) + exp(sh_tile[c + i] - m));
+        }
+        acc = m + log(sum);
+    } else {
+        acc = weight(0u) * sh_tile[c];
+        for (var i = 1; i <= r; i++) {
+            acc += weight(u32(i)) * (sh_tile[c - i] + sh_tile[c + i]);
+        }
     }
     var p = vec2<i32>(a, line);
     if params.axis == 1u {

@@ -17,7 +17,8 @@ pub fn plan(scene: &Path, dot: bool) -> Result<String> {
         return Ok(sp.plan.to_dot());
     }
     let labels: Vec<String> = scene.lights.iter().map(|l| l.label()).collect();
-    let mut s = sp.plan.to_text(&labels);
+    let mut s = warnings(&scene);
+    s.push_str(&sp.plan.to_text(&labels));
     s.push_str("then: shade (one visibility function per light)\n");
     Ok(s)
 }
@@ -72,6 +73,15 @@ pub fn render(
         s.push_str(&timing_table(gpu, &frame));
     }
     Ok(s)
+}
+
+/// The scene's validation warnings, one `warning:` line each.
+fn warnings(scene: &Scene) -> String {
+    scene
+        .warnings
+        .iter()
+        .map(|w| format!("warning: {w}\n"))
+        .collect()
 }
 
 fn write_aux(dir: &Path, scene: &Scene, frame: &Frame) -> Result<()> {

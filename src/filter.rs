@@ -6,6 +6,15 @@ use crate::scene::{BlurKernel, Filter};
 /// Taps each side the blur kernel's workgroup tile can hold.
 pub const MAX_BLUR_RADIUS: u32 = 32;
 
+/// How the blur combines texels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BlurMode {
+    /// Weighted sum (moments, basis images).
+    Linear,
+    /// `log Σ wᵢ exp(vᵢ)`, stably (the texels hold logarithms, e.g. ESM's `c·z`).
+    LogSumExp,
+}
+
 /// Parameters of `kernels/blur.wgsl` (mirrors its `Params`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
@@ -14,8 +23,10 @@ pub struct BlurParams {
     pub axis: u32,
     /// Taps each side.
     pub radius: u32,
+    /// 0 linear, 1 log-sum-exp.
+    pub mode: u32,
     /// Padding.
-    pub _pad: [u32; 2],
+    pub _pad: u32,
     /// One-sided weights, offset `i` at `[i / 4][i % 4]`; `w0 + 2 Σ wi = 1`.
     pub weights: [[f32; 4]; 9],
 }
@@ -38,7 +49,7 @@ pub fn blur_weights(radius: f32, sigma: f32, kernel: BlurKernel) -> Vec<f32> {
 
 impl BlurParams {
     /// The pass along `axis` of `filter`'s blur.
-    pub fn new(axis: u32, radius: f32, sigma: f32, kernel: BlurKernel) -> Self {
+    pub fn new(axis: u32, radius: f32, sigma: f32, kernel: BlurKernel, mode: BlurMode) -> Self {
         let w = blur_weights(radius, sigma, kernel);
         let mut weights = [[0.0; 4]; 9];
         for (i, v) in w.iter().enumerate() {
@@ -47,7 +58,8 @@ impl BlurParams {
         Self {
             axis,
             radius: w.len() as u32 - 1,
-            _pad: [0; 2],
+            mode: u32::from(mode == BlurMode::LogSumExp),
+            _pad: 0,
             weights,
         }
     }
@@ -55,7 +67,13 @@ impl BlurParams {
 
 /// Adds the nodes of `filter` over `input` (a resource of `light`), named `<input>.<pass>`;
 /// returns the filtered resource (the input itself when there is nothing to do).
-pub fn add_filter(graph: &mut Graph, light: usize, input: &str, filter: &Filter) -> String {
+pub fn add_filter(
+    graph: &mut Graph,
+    light: usize,
+    input: &str,
+    filter: &Filter,
+    mode: BlurMode,
+) -> String {
     let Filter::Blur {
         radius,
         sigma,
@@ -83,7 +101,8 @@ pub fn add_filter(graph: &mut Graph, light: usize, input: &str, filter: &Filter)
             kernel: "blur".into(),
             inputs: vec![("src".into(), src)],
             outputs: vec![("dst".into(), out.clone())],
-            params: bytemuck::bytes_of(&BlurParams::new(axis, radius, sigma, kernel)).to_vec(),
+            params: bytemuck::bytes_of(&BlurParams::new(axis, radius, sigma, kernel, mode))
+                .to_vec(),
             dispatch: Dispatch::Axis {
                 of: out.clone(),
                 axis,

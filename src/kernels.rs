@@ -33,6 +33,8 @@ pub const SOURCES: &[Source] = sources![
     "gbuffer",
     "shade",
     "vsm",
+    "evsm",
+    "esm",
     "blur",
     "shared/light",
     "shared/sampling",
@@ -40,6 +42,8 @@ pub const SOURCES: &[Source] = sources![
     "shared/vis_pcf",
     "shared/vis_pcss",
     "shared/vis_vsm",
+    "shared/vis_evsm",
+    "shared/vis_esm",
 ];
 
 /// The embedded text of `kernels/<name>.wgsl`.

@@ -3,7 +3,7 @@
 
 use std::fmt::Write;
 
-use crate::filter::add_filter;
+use crate::filter::{BlurMode, add_filter};
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
 use crate::scene::{Light, LightKind, PcfKernel, Storage, Technique};
 
@@ -54,10 +54,16 @@ pub struct LightGpu {
     pub max_search: f32,
     /// VSM light-bleeding reduction.
     pub bleed: f32,
-    /// VSM minimum variance.
+    /// VSM/EVSM minimum variance (depth units²).
     pub min_variance: f32,
+    /// EVSM positive exponent; ESM exponent.
+    pub exp_pos: f32,
+    /// EVSM negative exponent.
+    pub exp_neg: f32,
+    /// EVSM: 2 or 4 stored moments.
+    pub moments: u32,
     /// Padding to the WGSL struct's 16-byte alignment.
-    pub _pad: f32,
+    pub _pad: [u32; 2],
 }
 
 impl LightGpu {
@@ -81,14 +87,31 @@ impl LightGpu {
                     max_search,
                 } => (2, 0, 0, blocker_samples, filter_samples, max_search),
                 Technique::Vsm { .. } => (3, 0, 0, 0, 0, 0.0),
+                Technique::Evsm { .. } => (4, 0, 0, 0, 0, 0.0),
+                Technique::Esm { .. } => (5, 0, 0, 0, 0, 0.0),
             };
-        let (bleed, min_variance) = match light.shadow.technique {
+        let (bleed, min_variance, exp_pos, exp_neg, moments) = match light.shadow.technique {
             Technique::Vsm {
                 bleed,
                 min_variance,
                 ..
-            } => (bleed, min_variance),
-            _ => (0.0, 0.0),
+            } => (bleed, min_variance, 0.0, 0.0, 2),
+            Technique::Evsm {
+                four,
+                exp_pos,
+                exp_neg,
+                bleed,
+                min_variance,
+                ..
+            } => (
+                bleed,
+                min_variance,
+                exp_pos,
+                exp_neg,
+                if four { 4 } else { 2 },
+            ),
+            Technique::Esm { exponent, .. } => (0.0, 0.0, exponent, 0.0, 1),
+            _ => (0.0, 0.0, 0.0, 0.0, 0),
         };
         let (kind, cos_outer) = match light.kind {
             LightKind::Directional { .. } => (0, -1.0),
@@ -117,7 +140,10 @@ impl LightGpu {
             max_search,
             bleed,
             min_variance,
-            _pad: 0.0,
+            exp_pos,
+            exp_neg,
+            moments,
+            _pad: [0; 2],
         }
     }
 }
@@ -201,31 +227,82 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
             wgsl_type: float,
         },
         Technique::Vsm { prefilter, .. } => {
-            let moments = encode(graph, i, "vsm", &linear, moments_format(prefilter.storage));
+            let format = moments_format(prefilter.storage, 2);
+            let moments = encode(graph, i, "vsm", &linear, format, Vec::new());
             ShadeInput {
-                resource: add_filter(graph, i, &moments, &prefilter.filter),
+                resource: add_filter(graph, i, &moments, &prefilter.filter, BlurMode::Linear),
+                wgsl_type: float,
+            }
+        }
+        Technique::Evsm {
+            prefilter,
+            four,
+            exp_pos,
+            exp_neg,
+            ..
+        } => {
+            let format = moments_format(prefilter.storage, if four { 4 } else { 2 });
+            let params = bytemuck::bytes_of(&ExpParams::new(exp_pos, exp_neg)).to_vec();
+            let moments = encode(graph, i, "evsm", &linear, format, params);
+            ShadeInput {
+                resource: add_filter(graph, i, &moments, &prefilter.filter, BlurMode::Linear),
+                wgsl_type: float,
+            }
+        }
+        Technique::Esm { filter, exponent } => {
+            let params = bytemuck::bytes_of(&ExpParams::new(exponent, 0.0)).to_vec();
+            let format = wgpu::TextureFormat::R32Float;
+            let log_moment = encode(graph, i, "esm", &linear, format, params);
+            ShadeInput {
+                resource: add_filter(graph, i, &log_moment, &filter, BlurMode::LogSumExp),
                 wgsl_type: float,
             }
         }
     }
 }
 
-/// The texel format of a two-moment representation stored at `storage` precision.
-pub fn moments_format(storage: Storage) -> wgpu::TextureFormat {
-    match storage {
-        Storage::F32 => wgpu::TextureFormat::Rg32Float,
-        // rg16float is no core storage format; rgba16float is.
-        Storage::F16 => wgpu::TextureFormat::Rgba16Float,
+/// Parameters of `kernels/evsm.wgsl` and `kernels/esm.wgsl` (mirror their `Params`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ExpParams {
+    /// c⁺ (EVSM) or c (ESM).
+    pub exp_pos: f32,
+    /// c⁻ (EVSM4).
+    pub exp_neg: f32,
+    /// Padding.
+    pub _pad: [f32; 2],
+}
+
+impl ExpParams {
+    /// Exponents `pos`, `neg`.
+    pub fn new(exp_pos: f32, exp_neg: f32) -> Self {
+        Self {
+            exp_pos,
+            exp_neg,
+            _pad: [0.0; 2],
+        }
     }
 }
 
-/// Adds the encoding node `kernel` (linear depth → representation) of light `i`.
+/// The texel format of a `channels`-moment representation (2 or 4) at `storage` precision.
+pub fn moments_format(storage: Storage, channels: u32) -> wgpu::TextureFormat {
+    match (storage, channels) {
+        (Storage::F32, 2) => wgpu::TextureFormat::Rg32Float,
+        (Storage::F32, _) => wgpu::TextureFormat::Rgba32Float,
+        // rg16float is no core storage format; rgba16float is.
+        (Storage::F16, _) => wgpu::TextureFormat::Rgba16Float,
+    }
+}
+
+/// Adds the encoding node `kernel` (linear depth → representation) of light `i`, writing
+/// `light{i}.{kernel}`; the output's format picks the kernel's storage variant.
 fn encode(
     graph: &mut Graph,
     i: usize,
     kernel: &str,
     linear: &str,
     format: wgpu::TextureFormat,
+    params: Vec<u8>,
 ) -> String {
     let out = graph.resource(
         format!("light{i}.{kernel}"),
@@ -241,7 +318,7 @@ fn encode(
         kernel: kernel.into(),
         inputs: vec![("src".into(), linear.to_string())],
         outputs: vec![("dst".into(), out.clone())],
-        params: Vec::new(),
+        params,
         dispatch: Dispatch::Texels(out.clone()),
         light: Some(i),
     });
@@ -270,6 +347,8 @@ fn visibility_call(light: &Light, map: &str) -> (&'static str, String) {
         Technique::Pcf { .. } => ("shared/vis_pcf", format!("vis_pcf({map}, l, s)")),
         Technique::Pcss { .. } => ("shared/vis_pcss", format!("vis_pcss({map}, l, s)")),
         Technique::Vsm { .. } => ("shared/vis_vsm", format!("vis_vsm({map}, l, s)")),
+        Technique::Evsm { .. } => ("shared/vis_evsm", format!("vis_evsm({map}, l, s)")),
+        Technique::Esm { .. } => ("shared/vis_esm", format!("vis_esm({map}, l, s)")),
     }
 }
 

@@ -60,6 +60,21 @@ fn all_techniques() -> Vec<Technique> {
             bleed: 0.2,
             min_variance: 1e-5,
         },
+        Technique::Evsm {
+            prefilter: Prefilter {
+                storage: Storage::F32,
+                filter: Filter::None,
+            },
+            four: true,
+            exp_pos: 40.0,
+            exp_neg: 5.0,
+            bleed: 0.0,
+            min_variance: 1e-4,
+        },
+        Technique::Esm {
+            filter: Filter::None,
+            exponent: 80.0,
+        },
     ]
 }
 

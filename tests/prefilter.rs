@@ -87,6 +87,27 @@ fn vsm_graph(
     format: wgpu::TextureFormat,
     filter: Option<Filter>,
 ) -> (Graph, String) {
+    encode_graph(
+        "vsm",
+        vec![],
+        w,
+        h,
+        format,
+        filter,
+        shadowgraph::filter::BlurMode::Linear,
+    )
+}
+
+/// `in` → encoding `kernel` (params) → optional blur in `mode`.
+fn encode_graph(
+    kernel: &str,
+    params: Vec<u8>,
+    w: u32,
+    h: u32,
+    format: wgpu::TextureFormat,
+    filter: Option<Filter>,
+    mode: shadowgraph::filter::BlurMode,
+) -> (Graph, String) {
     let mut g = Graph::default();
     g.import("in", wgpu::TextureFormat::R32Float, w, h, Some(0));
     // Reuse the technique's own node builders through a light-independent graph.
@@ -101,15 +122,15 @@ fn vsm_graph(
     );
     g.node(shadowgraph::graph::Node {
         name: "light0.vsm".into(),
-        kernel: "vsm".into(),
+        kernel: kernel.into(),
         inputs: vec![("src".into(), "in".into())],
         outputs: vec![("dst".into(), "light0.vsm".into())],
-        params: vec![],
+        params,
         dispatch: shadowgraph::graph::Dispatch::Texels("light0.vsm".into()),
         light: Some(0),
     });
     let out = match filter {
-        Some(f) => shadowgraph::filter::add_filter(&mut g, 0, "light0.vsm", &f),
+        Some(f) => shadowgraph::filter::add_filter(&mut g, 0, "light0.vsm", &f, mode),
         None => "light0.vsm".to_string(),
     };
     (g, out)
@@ -245,4 +266,102 @@ fn vsm_light_plans_encode_and_two_blur_passes_only() {
     // The encode's output is dead once blur_h has read it: blur_v (same shape) reuses it.
     let slot = |r: &str| sp.plan.resource(r).unwrap().slot;
     assert_eq!(slot("light0.vsm"), slot("light0.vsm.blur_v"));
+}
+
+#[test]
+fn evsm_and_esm_encodings_match_reference() {
+    use shadowgraph::filter::BlurMode;
+    use shadowgraph::technique::ExpParams;
+    let g = common::gpu();
+    let mut rng = common::rng(42);
+    let (w, h) = (333u32, 45u32);
+    let lin = random_linear(&mut rng, w as usize, h as usize);
+    let input = Texels::from_f32(w as usize, h as usize, 1, &lin);
+    let blur = Filter::Blur {
+        radius: 3.0,
+        sigma: 1.5,
+        kernel: BlurKernel::Gaussian,
+    };
+    // SPIR-V's exp is accurate to (3 + 2|x|) ULP; the square doubles it: for c = 42, |x| ≤ 42.
+    let exp_rtol = 2.0 * (3.0 + 2.0 * 42.0) * 2f64.powi(-23) + 1e-6;
+    let params = bytemuck::bytes_of(&ExpParams::new(42.0, 5.0)).to_vec();
+    for (format, channels, filter) in [
+        (wgpu::TextureFormat::Rgba32Float, 4, None),
+        (wgpu::TextureFormat::Rg32Float, 2, Some(blur)),
+        (wgpu::TextureFormat::Rgba32Float, 4, Some(blur)),
+    ] {
+        let (graph, out) = encode_graph(
+            "evsm",
+            params.clone(),
+            w,
+            h,
+            format,
+            filter,
+            BlurMode::Linear,
+        );
+        let gpu = run(
+            &g,
+            &graph,
+            &out,
+            upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin),
+        );
+        let mut expected = cpu::evsm::evsm(&input, 42.0, 5.0);
+        if filter.is_some() {
+            expected = cpu::blur::blur(&expected, 3.0, 1.5, BlurKernel::Gaussian);
+        }
+        let keep: Vec<f64> = expected
+            .data
+            .chunks(4)
+            .flat_map(|c| c[..channels].to_vec())
+            .collect();
+        // Moments span e^±42: the blur's own f32 roundings add ~65 ULP relative.
+        common::assert_close(
+            &format!("evsm {format:?} blur {}", filter.is_some()),
+            &channels_of(&gpu, channels),
+            &keep,
+            0.0,
+            exp_rtol + 65.0 * 2f64.powi(-24),
+        );
+        assert!(
+            gpu.data.iter().all(|v| v.is_finite()),
+            "evsm at the f32 limit overflowed"
+        );
+    }
+    // ESM at c = 200 (exp(200) overflows f32): log-space blur keeps everything finite.
+    let params = bytemuck::bytes_of(&ExpParams::new(200.0, 0.0)).to_vec();
+    let (graph, out) = encode_graph(
+        "esm",
+        params,
+        w,
+        h,
+        wgpu::TextureFormat::R32Float,
+        Some(blur),
+        BlurMode::LogSumExp,
+    );
+    let gpu = run(
+        &g,
+        &graph,
+        &out,
+        upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin),
+    );
+    let expected = cpu::blur::blur_mode(
+        &cpu::esm::esm(&input, 200.0),
+        3.0,
+        1.5,
+        BlurKernel::Gaussian,
+        true,
+    );
+    // Each log-sum-exp: exp of (v − max) ∈ [−200, 0] at (3 + 2|x|) ULP relative, then log: the
+    // absolute error in L is ≲ 2 · 403 ULP of 1 plus the rounding of |L| ≤ 200.
+    common::assert_close(
+        "esm c=200 log-space blur",
+        &channels_of(&gpu, 1),
+        &expected.data,
+        2.0 * 403.0 * 2f64.powi(-23),
+        4.0 * 2f64.powi(-24),
+    );
+}
+
+fn channels_of(t: &Texels, n: usize) -> Vec<f32> {
+    channels(t, n)
 }

@@ -62,6 +62,8 @@ fn pixel_reference(
             Technique::Pcf { .. } => cpu::vis_pcf::vis_pcf(&map, &lg, t),
             Technique::Pcss { .. } => cpu::vis_pcss::vis_pcss(&map, &lg, t),
             Technique::Vsm { .. } => cpu::vis_vsm::vis_vsm(moments, &lg, t),
+            Technique::Evsm { .. } => cpu::vis_evsm::vis_evsm(moments, &lg, t),
+            Technique::Esm { .. } => cpu::vis_esm::vis_esm(moments, &lg, t),
         }
     })
     .map(|v| {
@@ -72,6 +74,8 @@ fn pixel_reference(
                 ..
             } => 1.0 / 64.0,
             Technique::Vsm { .. } => common::vsm_tolerance(moments, &lg, &s),
+            Technique::Evsm { .. } => common::evsm_tolerance(moments, &lg, &s),
+            Technique::Esm { .. } => common::esm_tolerance(moments, &lg, &s, v),
             // Means of 0/1 taps in f32.
             _ => 1e-5,
         };
@@ -153,41 +157,81 @@ fn every_scene_renders_and_matches_the_references() {
 }
 
 /// The filtered map the shading read equals the f64 encode and blur of the linear map the GPU
-/// produced (f32 storage: 1e-6, as in tests/prefilter.rs).
+/// produced: f32 storage 1e-6 (as in tests/prefilter.rs), widened by SPIR-V's (3 + 2|x|)-ULP
+/// `exp` for the exponential encodings; f16 storage 3 · 2⁻¹⁰ relative.
 fn check_prefilter_chain(scene: &Scene, frame: &shadowgraph::render::Frame, li: usize) {
-    let Technique::Vsm { prefilter, .. } = scene.lights[li].shadow.technique else {
-        return;
-    };
+    use shadowgraph::scene::{Filter, Storage};
+    let (encoded, channels, filter, storage, log_space, rtol) =
+        match scene.lights[li].shadow.technique {
+            Technique::Vsm { prefilter, .. } => (
+                Box::new(|t: &Texels| cpu::vsm::vsm(t)) as Box<dyn Fn(&Texels) -> Texels>,
+                2,
+                prefilter.filter,
+                prefilter.storage,
+                false,
+                1e-6,
+            ),
+            Technique::Evsm {
+                prefilter,
+                four,
+                exp_pos,
+                exp_neg,
+                ..
+            } => {
+                let f = move |t: &Texels| cpu::evsm::evsm(t, exp_pos.into(), exp_neg.into());
+                let rtol = 4.0 * (3.0 + 4.0 * f64::from(exp_pos.max(exp_neg))) * 2f64.powi(-23);
+                (
+                    Box::new(f) as Box<dyn Fn(&Texels) -> Texels>,
+                    if four { 4 } else { 2 },
+                    prefilter.filter,
+                    prefilter.storage,
+                    false,
+                    rtol,
+                )
+            }
+            Technique::Esm { filter, exponent } => {
+                let f = move |t: &Texels| cpu::esm::esm(t, exponent.into());
+                // Log-space blur: exp and log of each tap, absolute error relative to |c·z|.
+                (
+                    Box::new(f) as Box<dyn Fn(&Texels) -> Texels>,
+                    1,
+                    filter,
+                    Storage::F32,
+                    true,
+                    1e-5,
+                )
+            }
+            _ => return,
+        };
     let Some(linear) = &frame.linear_maps[li] else {
-        panic!("light {li}: VSM without a linear map")
+        panic!("light {li}: no linear map")
     };
     let (w, h) = (linear.width as usize, linear.height as usize);
-    let mut expected = cpu::vsm::vsm(&Texels::from_f32(w, h, 1, &linear.data));
-    if let shadowgraph::scene::Filter::Blur {
+    let mut expected = encoded(&Texels::from_f32(w, h, 1, &linear.data));
+    if let Filter::Blur {
         radius,
         sigma,
         kernel,
-    } = prefilter.filter
+    } = filter
     {
-        expected = cpu::blur::blur(&expected, radius.into(), sigma.into(), kernel);
+        expected = cpu::blur::blur_mode(&expected, radius.into(), sigma.into(), kernel, log_space);
     }
+    let keep: Vec<f64> = expected
+        .data
+        .chunks(expected.channels)
+        .flat_map(|c| c[..channels].to_vec())
+        .collect();
     let got = &frame.shade_maps[li];
-    let first_two: Vec<f32> = got
+    let got: Vec<f32> = got
         .data
         .chunks(got.channels)
-        .flat_map(|c| [c[0], c[1]])
+        .flat_map(|c| c[..channels].to_vec())
         .collect();
-    let (atol, rtol) = match prefilter.storage {
-        shadowgraph::scene::Storage::F32 => (1e-6, 1e-6),
-        shadowgraph::scene::Storage::F16 => (1e-4, 3.0 * 2f64.powi(-10)),
+    let (atol, rtol) = match storage {
+        Storage::F32 => (1e-6, rtol),
+        Storage::F16 => (1e-4, 3.0 * 2f64.powi(-10)),
     };
-    common::assert_close(
-        &format!("light {li} filtered moments"),
-        &first_two,
-        &expected.data,
-        atol,
-        rtol,
-    );
+    common::assert_close(&format!("light {li} filtered map"), &got, &keep, atol, rtol);
 }
 
 #[test]

@@ -177,39 +177,30 @@ fn pcss_matches_reference() {
     check(SPOT, t, 31);
 }
 
-#[test]
-fn vsm_matches_reference_on_filtered_moments() {
-    use shadowgraph::scene::{BlurKernel, Filter, Prefilter, Storage};
+/// A prefiltered technique on a map the CPU encoded and blurred from a random blocky linear
+/// map, at 3000 receivers. These techniques are continuous in the receiver (bilinear moments,
+/// no comparisons), so every point counts, each with its propagated f32 tolerance.
+fn check_prefiltered(
+    technique: Technique,
+    format: wgpu::TextureFormat,
+    encode: impl Fn(&cpu::Texels) -> cpu::Texels,
+    visibility: impl Fn(&cpu::Texels, &LightGpu, &cpu::light::LightSample) -> f64,
+    tolerance: impl Fn(&cpu::Texels, &LightGpu, &cpu::light::LightSample, f64) -> f64,
+    seed: u64,
+) {
     let g = common::gpu();
-    let mut rng = common::rng(50);
-    for (kind, seed) in [(DIR, 51u64), (SPOT, 52)] {
-        let technique = Technique::Vsm {
-            prefilter: Prefilter {
-                storage: Storage::F32,
-                filter: Filter::Blur {
-                    radius: 2.0,
-                    sigma: 1.0,
-                    kernel: BlurKernel::Gaussian,
-                },
-            },
-            bleed: 0.2,
-            min_variance: 1e-5,
-        };
+    let mut rng = common::rng(seed);
+    for kind in [DIR, SPOT] {
         let l = light(kind, technique);
-        let linear = common::blocky_map(&mut common::rng(seed), MAP);
-        let moments = cpu::blur::blur(
-            &cpu::vsm::vsm(&cpu::Texels::from_f32(MAP, MAP, 1, &linear)),
-            2.0,
-            1.0,
-            BlurKernel::Gaussian,
-        );
-        let data: Vec<f32> = moments.data.iter().map(|&v| v as f32).collect();
-        let moments = cpu::Texels::from_f32(MAP, MAP, 2, &data);
+        let linear = common::blocky_map(&mut rng, MAP);
+        let encoded = encode(&cpu::Texels::from_f32(MAP, MAP, 1, &linear));
+        let data: Vec<f32> = encoded.data.iter().map(|&v| v as f32).collect();
+        let encoded = cpu::Texels::from_f32(MAP, MAP, encoded.channels, &data);
         let points: Vec<(Vec3, Vec3)> = (0..3000).map(|_| point(&l, &mut rng)).collect();
         let mut renderer = Renderer::new(&g.device);
         let map = ProbeMap {
             size: MAP as u32,
-            format: wgpu::TextureFormat::Rg32Float,
+            format,
             data: &data,
         };
         let vis = probe(
@@ -222,19 +213,124 @@ fn vsm_matches_reference_on_filtered_moments() {
         )
         .expect("probe");
         let lg = LightGpu::new(&l);
-        let (mut reference, mut tolerance) = (Vec::new(), Vec::new());
+        let (mut reference, mut tol) = (Vec::new(), Vec::new());
         for (p, n) in &points {
             let s = cpu::light::sample(&lg, p.as_dvec3(), n.as_dvec3());
-            reference.push(if s.inside {
-                cpu::vis_vsm::vis_vsm(&moments, &lg, &s)
+            let v = if s.inside {
+                visibility(&encoded, &lg, &s)
             } else {
                 1.0
+            };
+            reference.push(v);
+            tol.push(if s.inside {
+                tolerance(&encoded, &lg, &s, v)
+            } else {
+                0.0
             });
-            tolerance.push(common::vsm_tolerance(&moments, &lg, &s));
         }
         let partial = reference.iter().filter(|&&v| v > 0.01 && v < 0.99).count();
-        assert!(partial > 100, "{kind:?}: only {partial} penumbra points");
-        // VSM is continuous in the receiver (bilinear moments, no comparisons): every point counts.
-        common::assert_within(&format!("vsm {kind:?}"), &vis, &reference, &tolerance);
+        assert!(
+            partial > 100,
+            "{technique:?} {kind:?}: only {partial} penumbra points"
+        );
+        common::assert_within(&format!("{technique:?} {kind:?}"), &vis, &reference, &tol);
     }
+}
+
+fn blurred(t: &cpu::Texels, log_space: bool) -> cpu::Texels {
+    cpu::blur::blur_mode(
+        t,
+        2.0,
+        1.0,
+        shadowgraph::scene::BlurKernel::Gaussian,
+        log_space,
+    )
+}
+
+fn prefilter() -> shadowgraph::scene::Prefilter {
+    use shadowgraph::scene::{BlurKernel, Filter, Prefilter, Storage};
+    Prefilter {
+        storage: Storage::F32,
+        filter: Filter::Blur {
+            radius: 2.0,
+            sigma: 1.0,
+            kernel: BlurKernel::Gaussian,
+        },
+    }
+}
+
+#[test]
+fn vsm_matches_reference_on_filtered_moments() {
+    let t = Technique::Vsm {
+        prefilter: prefilter(),
+        bleed: 0.2,
+        min_variance: 1e-5,
+    };
+    check_prefiltered(
+        t,
+        wgpu::TextureFormat::Rg32Float,
+        |lin| blurred(&cpu::vsm::vsm(lin), false),
+        cpu::vis_vsm::vis_vsm,
+        |m, l, s, _| common::vsm_tolerance(m, l, s),
+        50,
+    );
+}
+
+#[test]
+fn evsm2_and_evsm4_match_reference() {
+    for (four, format, seed) in [
+        (false, wgpu::TextureFormat::Rg32Float, 60),
+        (true, wgpu::TextureFormat::Rgba32Float, 61),
+    ] {
+        let t = Technique::Evsm {
+            prefilter: prefilter(),
+            four,
+            exp_pos: 40.0,
+            exp_neg: 5.0,
+            bleed: 0.1,
+            min_variance: 1e-4,
+        };
+        let channels = if four { 4 } else { 2 };
+        check_prefiltered(
+            t,
+            format,
+            move |lin| {
+                let e = blurred(&cpu::evsm::evsm(lin, 40.0, 5.0), false);
+                let data = e
+                    .data
+                    .chunks(4)
+                    .flat_map(|c| c[..channels].to_vec())
+                    .collect();
+                cpu::Texels {
+                    channels,
+                    data,
+                    ..e
+                }
+            },
+            cpu::vis_evsm::vis_evsm,
+            |m, l, s, _| common::evsm_tolerance(m, l, s),
+            seed,
+        );
+    }
+}
+
+#[test]
+fn esm_matches_reference_in_log_space() {
+    use shadowgraph::scene::{BlurKernel, Filter};
+    let t = Technique::Esm {
+        filter: Filter::Blur {
+            radius: 2.0,
+            sigma: 1.0,
+            kernel: BlurKernel::Gaussian,
+        },
+        exponent: 80.0,
+    };
+    check_prefiltered(
+        t,
+        wgpu::TextureFormat::R32Float,
+        |lin| blurred(&cpu::esm::esm(lin, 80.0), true),
+        cpu::vis_esm::vis_esm,
+        common::esm_tolerance,
+        70,
+    );
 }

@@ -26,9 +26,13 @@ struct Light {
     blocker_samples: u32,    // pcss
     filter_samples: u32,     // pcss
     max_search: f32,         // pcss: cap on the blocker-search radius, UV
-    bleed: f32,              // vsm: light-bleeding reduction amount
-    min_variance: f32,       // vsm
-    _pad0: f32,
+    bleed: f32,              // vsm, evsm: light-bleeding reduction amount
+    min_variance: f32,       // vsm, evsm: variance floor (depth units²)
+    exp_pos: f32,            // evsm: positive exponent c⁺; esm: exponent c
+    exp_neg: f32,            // evsm: negative exponent c⁻
+    moments: u32,            // evsm: 2 or 4 stored moments
+    _pad0: u32,
+    _pad1: u32,
 }
 
 // Where a receiver lands in a light's shadow map.

@@ -41,3 +41,21 @@ fn sample_bilinear(map: texture_2d<f32>, uv: vec2<f32>) -> vec4<f32> {
 fn linstep(lo: f32, hi: f32, x: f32) -> f32 {
     return clamp((x - lo) / (hi - lo), 0.0, 1.0);
 }
+
+// Bilinear interpolation of exp(v) for a map of logarithms v (channel 0), returned as a
+// logarithm: log Σ wᵢ exp(vᵢ), evaluated around the largest tap so nothing overflows.
+fn sample_bilinear_log(map: texture_2d<f32>, uv: vec2<f32>) -> f32 {
+    let size = vec2<f32>(textureDimensions(map));
+    let f = uv * size - 0.5;
+    let i = vec2<i32>(floor(f));
+    let a = f - floor(f);
+    let smax = vec2<i32>(size) - 1;
+    let v00 = textureLoad(map, clamp(i, vec2<i32>(0), smax), 0).r;
+    let v10 = textureLoad(map, clamp(i + vec2<i32>(1, 0), vec2<i32>(0), smax), 0).r;
+    let v01 = textureLoad(map, clamp(i + vec2<i32>(0, 1), vec2<i32>(0), smax), 0).r;
+    let v11 = textureLoad(map, clamp(i + vec2<i32>(1, 1), vec2<i32>(0), smax), 0).r;
+    let m = max(max(v00, v10), max(v01, v11));
+    let sum = (1.0 - a.y) * ((1.0 - a.x) * exp(v00 - m) + a.x * exp(v10 - m))
+        + a.y * ((1.0 - a.x) * exp(v01 - m) + a.x * exp(v11 - m));
+    return m + log(sum);
+}

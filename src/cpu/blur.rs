@@ -20,6 +20,35 @@ pub fn weights(radius: f64, sigma: f64, kernel: BlurKernel) -> Vec<f64> {
     raw.into_iter().map(|w| w / total).collect()
 }
 
+/// One pass along `axis` (0 = x, 1 = y); with `log_space` the texels are logarithms and the
+/// pass computes `log Σ wᵢ exp(vᵢ)`.
+pub fn blur_pass_mode(src: &Texels, w: &[f64], axis: u32, log_space: bool) -> Texels {
+    if !log_space {
+        return blur_pass(src, w, axis);
+    }
+    let exp = Texels {
+        data: src.data.iter().map(|v| v.exp()).collect(),
+        ..src.clone()
+    };
+    let out = blur_pass(&exp, w, axis);
+    Texels {
+        data: out.data.iter().map(|v| v.ln()).collect(),
+        ..out
+    }
+}
+
+/// Both passes, in log space when `log_space`.
+pub fn blur_mode(
+    src: &Texels,
+    radius: f64,
+    sigma: f64,
+    kernel: BlurKernel,
+    log_space: bool,
+) -> Texels {
+    let w = weights(radius, sigma, kernel);
+    blur_pass_mode(&blur_pass_mode(src, &w, 0, log_space), &w, 1, log_space)
+}
+
 /// One pass along `axis` (0 = x, 1 = y).
 pub fn blur_pass(src: &Texels, w: &[f64], axis: u32) -> Texels {
     let r = w.len() as i64 - 1;

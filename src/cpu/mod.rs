@@ -2,8 +2,12 @@
 //! shader's shape so the two read side by side. Tests compare the GPU against these.
 
 pub mod blur;
+pub mod esm;
+pub mod evsm;
 pub mod light;
 pub mod linearize;
+pub mod vis_esm;
+pub mod vis_evsm;
 pub mod vis_hard;
 pub mod vis_pcf;
 pub mod vis_pcss;

@@ -124,8 +124,14 @@ pub struct ShadowFile {
     pub filter_kernel: Option<Spanned<String>>,
     /// Light-bleeding reduction: `linstep(amount, 1, p)`.
     pub bleed_reduction: Option<Spanned<f64>>,
-    /// Minimum variance (VSM).
+    /// Minimum variance (VSM, EVSM), depth units².
     pub min_variance: Option<Spanned<f64>>,
+    /// ESM exponent c.
+    pub exponent: Option<Spanned<f64>>,
+    /// EVSM positive exponent c⁺.
+    pub exponent_pos: Option<Spanned<f64>>,
+    /// EVSM4 negative exponent c⁻.
+    pub exponent_neg: Option<Spanned<f64>>,
 }
 
 /// `[[object]]`.

@@ -31,6 +31,8 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// Objects, already turned into world-space triangle meshes.
     pub objects: Vec<Object>,
+    /// Values validation changed (e.g. exponents clamped to the storage's safe limit).
+    pub warnings: Vec<String>,
 }
 
 /// A perspective camera.
@@ -153,6 +155,30 @@ pub enum Technique {
         /// Minimum variance.
         min_variance: f32,
     },
+    /// Exponential variance shadow maps (Lauritzen): depth warped to [−1, 1], then
+    /// `exp(c⁺ z')` and its square (EVSM2), plus `−exp(−c⁻ z')` and its square (EVSM4).
+    Evsm {
+        /// Storage and filter of the moments.
+        prefilter: Prefilter,
+        /// Four moments (EVSM4) rather than two (EVSM2).
+        four: bool,
+        /// Positive exponent c⁺ (already clamped to the storage's safe limit).
+        exp_pos: f32,
+        /// Negative exponent c⁻ (EVSM4; clamped likewise).
+        exp_neg: f32,
+        /// Light-bleeding reduction.
+        bleed: f32,
+        /// Variance floor in depth units², scaled through the warp's derivative.
+        min_variance: f32,
+    },
+    /// Exponential shadow maps (Annen et al. 2008): `c·z` stored and filtered in log space
+    /// (log-sum-exp), so no exponent overflows; visibility `clamp(exp(L − c·d), 0, 1)`.
+    Esm {
+        /// Filter (storage is always f32: f16 `c·z` would cost percent-level visibility error).
+        filter: Filter,
+        /// Exponent c.
+        exponent: f32,
+    },
 }
 
 impl Technique {
@@ -163,6 +189,9 @@ impl Technique {
             Technique::Pcf { .. } => "pcf",
             Technique::Pcss { .. } => "pcss",
             Technique::Vsm { .. } => "vsm",
+            Technique::Evsm { four: false, .. } => "evsm2",
+            Technique::Evsm { four: true, .. } => "evsm4",
+            Technique::Esm { .. } => "esm",
         }
     }
 }

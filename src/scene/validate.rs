@@ -19,6 +19,7 @@ const MAX_SIDE: i64 = 1 << 16;
 struct Ctx<'a> {
     path: &'a Path,
     text: &'a str,
+    warnings: std::cell::RefCell<Vec<String>>,
 }
 
 impl Ctx<'_> {
@@ -100,7 +101,11 @@ impl Ctx<'_> {
 }
 
 pub(super) fn parse(path: &Path, text: &str) -> Result<Scene> {
-    let ctx = Ctx { path, text };
+    let ctx = Ctx {
+        path,
+        text,
+        warnings: Default::default(),
+    };
     let file: SceneFile =
         toml::from_str(text).map_err(|e| ctx.err(e.span(), e.message().trim()))?;
     let width = ctx.int("output.width", &file.output.width, 1, MAX_SIDE)?;
@@ -139,6 +144,7 @@ pub(super) fn parse(path: &Path, text: &str) -> Result<Scene> {
         camera,
         lights,
         objects,
+        warnings: ctx.warnings.into_inner(),
     })
 }
 
@@ -272,15 +278,56 @@ const TECHNIQUE_KEYS: &[(&str, &[&str])] = &[
         "vsm",
         &[
             "format",
-            "filter",
-            "filter_radius",
-            "filter_sigma",
-            "filter_kernel",
+            FILTER,
+            RADIUS,
+            SIGMA,
+            KERNEL,
             "bleed_reduction",
             "min_variance",
         ],
     ),
+    (
+        "evsm2",
+        &[
+            "format",
+            FILTER,
+            RADIUS,
+            SIGMA,
+            KERNEL,
+            "bleed_reduction",
+            "min_variance",
+            "exponent_pos",
+        ],
+    ),
+    (
+        "evsm4",
+        &[
+            "format",
+            FILTER,
+            RADIUS,
+            SIGMA,
+            KERNEL,
+            "bleed_reduction",
+            "min_variance",
+            "exponent_pos",
+            "exponent_neg",
+        ],
+    ),
+    ("esm", &[FILTER, RADIUS, SIGMA, KERNEL, "exponent"]),
 ];
+const FILTER: &str = "filter";
+const RADIUS: &str = "filter_radius";
+const SIGMA: &str = "filter_sigma";
+const KERNEL: &str = "filter_kernel";
+
+/// Largest exponent whose squared moment stays finite after filtering: ln(FLT_MAX) = 88.7
+/// and ln(65504) = 11.09, halved for the square, with margin for fp32 (reference.md).
+pub fn exponent_limit(storage: Storage) -> f32 {
+    match storage {
+        Storage::F32 => 42.0,
+        Storage::F16 => 5.54,
+    }
+}
 
 fn present(s: &ShadowFile) -> Vec<(&'static str, Range<usize>)> {
     fn sp<T>(v: &Option<Spanned<T>>) -> Option<Range<usize>> {
@@ -299,6 +346,9 @@ fn present(s: &ShadowFile) -> Vec<(&'static str, Range<usize>)> {
         ("filter_kernel", sp(&s.filter_kernel)),
         ("bleed_reduction", sp(&s.bleed_reduction)),
         ("min_variance", sp(&s.min_variance)),
+        ("exponent", sp(&s.exponent)),
+        ("exponent_pos", sp(&s.exponent_pos)),
+        ("exponent_neg", sp(&s.exponent_neg)),
     ]
     .into_iter()
     .filter_map(|(k, span)| span.map(|s| (k, s)))
@@ -382,10 +432,39 @@ fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
             filter_samples: ctx.int_or(&key("filter_samples"), &s.filter_samples, 1, 1024, 32)?,
             max_search: ctx.num_or(&key("max_search"), &s.max_search, 1e-4, 1.0, 0.1)?,
         },
-        _ => Technique::Vsm {
+        "vsm" => Technique::Vsm {
             prefilter: prefilter(ctx, i, s)?,
             bleed: ctx.num_or(&key("bleed_reduction"), &s.bleed_reduction, 0.0, 0.99, 0.2)?,
             min_variance: ctx.num_or(&key("min_variance"), &s.min_variance, 0.0, 1.0, 1e-5)?,
+        },
+        "evsm2" | "evsm4" => {
+            let prefilter = prefilter(ctx, i, s)?;
+            let limit = exponent_limit(prefilter.storage);
+            let exponent = |k: &str, v: &Option<Spanned<f64>>, default: f32| -> Result<f32> {
+                let c = ctx.num_or(&key(k), v, 0.01, 1e4, default)?;
+                if c > limit {
+                    ctx.warnings.borrow_mut().push(format!(
+                        "{}{}: `{}` = {c} exceeds the safe limit {limit} for {:?} storage; clamped to {limit}",
+                        ctx.path.display(),
+                        ctx.location(v.as_ref().map(|v| v.span())),
+                        key(k),
+                        prefilter.storage
+                    ));
+                }
+                Ok(c.min(limit))
+            };
+            Technique::Evsm {
+                prefilter,
+                four: name == "evsm4",
+                exp_pos: exponent("exponent_pos", &s.exponent_pos, 40.0)?,
+                exp_neg: exponent("exponent_neg", &s.exponent_neg, 5.0)?,
+                bleed: ctx.num_or(&key("bleed_reduction"), &s.bleed_reduction, 0.0, 0.99, 0.0)?,
+                min_variance: ctx.num_or(&key("min_variance"), &s.min_variance, 0.0, 1.0, 1e-4)?,
+            }
+        }
+        _ => Technique::Esm {
+            filter: prefilter(ctx, i, s)?.filter,
+            exponent: ctx.num_or(&key("exponent"), &s.exponent, 0.01, 1e4, 80.0)?,
         },
     };
     Ok(Shadow {

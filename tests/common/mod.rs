@@ -55,21 +55,95 @@ pub fn assert_within(what: &str, gpu: &[f32], reference: &[f64], tolerance: &[f6
     );
 }
 
-/// Per-point tolerance of VSM visibility: first-order propagation of f32 rounding through
-/// σ² = E[z²] − μ² (cancellation: error ≈ 8·2⁻²⁴·(E[z²] + μ²)) and μ (≈ 8·2⁻²⁴·μ, from the
-/// bilinear mix) into p = σ² / (σ² + t²), divided by (1 − bleed) for the linstep; plus 1e-5.
+/// First-order bound on the f32 error of the one-tailed Chebyshev bound
+/// `p = σ² / (σ² + t²)`, `σ² = max(E[x²] − E[x]², floor)`, `t = r − E[x]`, when every input
+/// carries relative error `e`: the cancellation in σ² amplifies it by `E[x²] / σ²`.
+pub fn chebyshev_tolerance(mean: f64, mean_sq: f64, receiver: f64, floor: f64, e: f64) -> f64 {
+    if receiver <= mean {
+        // p = 1 here; at the boundary p is continuous (σ² / σ²).
+        return 0.0;
+    }
+    let var = (mean_sq - mean * mean).max(floor);
+    let t = receiver - mean;
+    let dvar = e * (mean_sq.abs() + 2.0 * mean * mean);
+    let dt = e * (receiver.abs() + mean.abs());
+    (t * t * dvar + 2.0 * t.abs() * var * dt) / (var + t * t).powi(2)
+}
+
+/// Tolerance of VSM visibility at `s`: inputs carry ~8 roundings (bilinear mix, depth).
 pub fn vsm_tolerance(
     moments: &shadowgraph::cpu::Texels,
     l: &shadowgraph::technique::LightGpu,
     s: &shadowgraph::cpu::light::LightSample,
 ) -> f64 {
     let m = moments.bilinear(s.uv);
-    let eps = 8.0 * 2f64.powi(-24);
-    let t = s.depth - f64::from(l.bias) - m[0];
-    let var = (m[1] - m[0] * m[0]).max(f64::from(l.min_variance));
-    let (dvar, dmu) = (eps * (m[1].abs() + m[0] * m[0]), eps * m[0].abs());
-    let dp = (t * t * dvar + 2.0 * t.abs() * var * dmu) / (var + t * t).powi(2);
+    let d = s.depth - f64::from(l.bias);
+    let dp = chebyshev_tolerance(
+        m[0],
+        m[1],
+        d,
+        f64::from(l.min_variance),
+        8.0 * 2f64.powi(-24),
+    );
     1e-5 + dp / (1.0 - f64::from(l.bleed))
+}
+
+/// Tolerance of EVSM visibility at `s`: besides the roundings of VSM, SPIR-V's `exp` is
+/// accurate to (3 + 2|x|) ULP, and the receiver's depth error is amplified by 2c.
+pub fn evsm_tolerance(
+    moments: &shadowgraph::cpu::Texels,
+    l: &shadowgraph::technique::LightGpu,
+    s: &shadowgraph::cpu::light::LightSample,
+) -> f64 {
+    let m = moments.bilinear(s.uv);
+    let [(pos, floor_pos), (neg, floor_neg)] = shadowgraph::cpu::vis_evsm::warp(l, s);
+    let ulp = 2f64.powi(-23);
+    let e = |c: f32| (3.0 + 4.0 * f64::from(c)) * ulp + 8.0 * ulp + 4.0 * f64::from(c) * ulp;
+    let mut dp = chebyshev_tolerance(m[0], m[1], pos, floor_pos, e(l.exp_pos));
+    if l.moments == 4 {
+        dp = dp.max(chebyshev_tolerance(
+            m[2],
+            m[3],
+            neg,
+            floor_neg,
+            e(l.exp_neg),
+        ));
+    }
+    1e-5 + dp / (1.0 - f64::from(l.bleed))
+}
+
+/// Tolerance of ESM visibility `v` at `s` over log map `logs`: the f32 arguments `L − c·d`
+/// (a few roundings of magnitudes up to |L| + c·d), the receiver's depth (view transform in
+/// f32: ~8 roundings of Z + near, over far − near, amplified by c), the inner exps and log of
+/// the log-space bilinear ((3 + 2|x|) ULP each) and the final exp, all relative to `v`.
+pub fn esm_tolerance(
+    logs: &shadowgraph::cpu::Texels,
+    l: &shadowgraph::technique::LightGpu,
+    s: &shadowgraph::cpu::light::LightSample,
+    v: f64,
+) -> f64 {
+    let taps: Vec<f64> = [(0, 0), (1, 0), (0, 1), (1, 1)]
+        .iter()
+        .map(|&(dx, dy)| {
+            let fx = (s.uv[0] * logs.width as f64 - 0.5).floor() as i64;
+            let fy = (s.uv[1] * logs.height as f64 - 0.5).floor() as i64;
+            logs.at(fx + dx, fy + dy)[0]
+        })
+        .collect();
+    let (lo, hi) = taps
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), &t| (a.min(t), b.max(t)));
+    let cd = f64::from(l.exp_pos) * s.depth;
+    let ulp = 2f64.powi(-23);
+    let arg = (hi - cd).abs();
+    let depth = f64::from(l.exp_pos) * 4.0 * ulp * (s.view_z + f64::from(l.near))
+        / f64::from(l.far - l.near);
+    let rel = 8.0 * ulp * (hi.abs() + cd.abs())
+        + depth
+        + (3.0 + 2.0 * (hi - lo)) * ulp
+        + (3.0 + 2.0 * arg) * ulp
+        + 3.0 * ulp;
+    1e-6 + v * rel
 }
 
 /// A linear depth map with structure: a background and overlapping random rectangles, so

@@ -1,0 +1,27 @@
+// Linear depth → exponential shadow map in log form: L = c·z, the logarithm of the moment
+// exp(c z) (Annen et al. 2008). Filtering happens in log space (log-sum-exp in `blur`), so
+// exp(c z) is never formed and no exponent overflows, whatever c.
+
+// Keep in sync with `ExpParams` in src/technique.rs.
+struct Params {
+    exp_pos: f32,
+    exp_neg: f32,
+    _pad0: f32,
+    _pad1: f32,
+}
+
+@group(0) @binding(0) var src: texture_2d<f32>;
+@group(0) @binding(1) var dst: texture_storage_2d<r32float, write>;
+@group(0) @binding(2) var<uniform> params: Params;
+
+const WG_SIZE: u32 = 16u;
+
+@compute @workgroup_size(WG_SIZE, WG_SIZE)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = textureDimensions(src);
+    if any(id.xy >= size) {
+        return;
+    }
+    let z = textureLoad(src, id.xy, 0).r;
+    textureStore(dst, id.xy, vec4<f32>(params.exp_pos * z, 0.0, 0.0, 0.0));
+}

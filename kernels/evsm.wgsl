@@ -1,0 +1,30 @@
+// Linear depth → exponential variance moments (Lauritzen): z' = 2z − 1 ∈ [−1, 1],
+//   pos = exp(c⁺ z'),  neg = −exp(−c⁻ z'),  stored (pos, pos², neg, neg²).
+// EVSM2 binds an rg32float (or rgba16float) output and keeps (pos, pos²); EVSM4 keeps all four.
+// The scene clamps c to the storage's limit (42 for f32, 5.54 for f16) so pos² stays finite.
+
+// Keep in sync with `ExpParams` in src/technique.rs.
+struct Params {
+    exp_pos: f32,
+    exp_neg: f32,
+    _pad0: f32,
+    _pad1: f32,
+}
+
+@group(0) @binding(0) var src: texture_2d<f32>;
+@group(0) @binding(1) var dst: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(2) var<uniform> params: Params;
+
+const WG_SIZE: u32 = 16u;
+
+@compute @workgroup_size(WG_SIZE, WG_SIZE)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = textureDimensions(src);
+    if any(id.xy >= size) {
+        return;
+    }
+    let w = 2.0 * textureLoad(src, id.xy, 0).r - 1.0;
+    let pos = exp(params.exp_pos * w);
+    let neg = -exp(-params.exp_neg * w);
+    textureStore(dst, id.xy, vec4<f32>(pos, pos * pos, neg, neg * neg));
+}

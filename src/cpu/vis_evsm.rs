@@ -1,0 +1,36 @@
+//! Reference of `kernels/shared/vis_evsm.wgsl`.
+
+use super::Texels;
+use super::light::LightSample;
+use crate::technique::LightGpu;
+
+/// One-tailed Chebyshev bound (`chebyshev_upper`).
+pub fn chebyshev_upper(mean: f64, mean_sq: f64, receiver: f64, floor: f64) -> f64 {
+    if receiver <= mean {
+        return 1.0;
+    }
+    let variance = (mean_sq - mean * mean).max(floor);
+    let t = receiver - mean;
+    variance / (variance + t * t)
+}
+
+/// The receiver's warped depths `(pos, neg)` and their variance floors.
+pub fn warp(l: &LightGpu, s: &LightSample) -> [(f64, f64); 2] {
+    let w = 2.0 * (s.depth - f64::from(l.bias)) - 1.0;
+    let (cp, cn) = (f64::from(l.exp_pos), f64::from(l.exp_neg));
+    let (pos, neg) = ((cp * w).exp(), -(-cn * w).exp());
+    let floor = |c: f64, v: f64| f64::from(l.min_variance) * (2.0 * c * v).powi(2);
+    [(pos, floor(cp, pos)), (neg, floor(cn, neg))]
+}
+
+/// EVSM2/EVSM4 visibility with bleeding reduction.
+pub fn vis_evsm(moments: &Texels, l: &LightGpu, s: &LightSample) -> f64 {
+    let m = moments.bilinear(s.uv);
+    let [(pos, floor_pos), (neg, floor_neg)] = warp(l, s);
+    let mut p = chebyshev_upper(m[0], m[1], pos, floor_pos);
+    if l.moments == 4 {
+        p = p.min(chebyshev_upper(m[2], m[3], neg, floor_neg));
+    }
+    let bleed = f64::from(l.bleed);
+    ((p - bleed) / (1.0 - bleed)).clamp(0.0, 1.0)
+}
