@@ -45,6 +45,18 @@ enum Command {
         #[arg(long)]
         dot: bool,
     },
+    /// Write every resource of the executed plan: OpenEXR per texture and mip level, a PNG
+    /// preview per channel, and manifest.json with provenance and per-channel statistics.
+    Dump {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// Output folder (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+        /// Dump only this resource (e.g. `light0.linear`).
+        #[arg(long)]
+        only: Option<String>,
+    },
     /// Print the adapter, its backend, and the features and limits that matter.
     Info,
     /// Time kernels by GPU timestamps against a copy kernel over the same bytes.
@@ -80,6 +92,13 @@ fn run(args: Args) -> Result<()> {
             print!("{report}");
         }
         Command::Plan { scene, dot } => print!("{}", cli::plan(&scene, dot)?),
+        Command::Dump { scene, out, only } => {
+            let gpu = Gpu::new()?;
+            print!(
+                "{}",
+                shadowgraph::dump::dump(&gpu, &scene, &out, only.as_deref())?
+            );
+        }
         Command::Info => print!("{}", Gpu::new()?.info_report()),
         Command::Bench { sizes, repeat } => {
             let gpu = Gpu::new()?;

@@ -333,7 +333,11 @@ impl Renderer {
         opts: RenderOptions,
     ) -> Result<Frame> {
         check_limits(device, scene)?;
-        let sp = plan_lights(&scene.lights)?;
+        let mut sp = plan_lights(&scene.lights)?;
+        if opts.dump {
+            // Everything is read back after the frame: no resource may share a texture.
+            sp.plan = sp.plan.unaliased();
+        }
         let verts = scene.vertices();
         let vbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("shadowgraph.vertices"),

@@ -63,6 +63,23 @@ impl Plan {
         self.resources.iter().find(|r| r.resource.name == name)
     }
 
+    /// The same plan with a texture of its own for every resource, so that every resource is
+    /// still intact when the frame ends (for dumps; the planner otherwise reuses a texture once
+    /// its resource's last reader ran).
+    pub fn unaliased(mut self) -> Plan {
+        self.slots.clear();
+        for r in self.resources.iter_mut().filter(|r| r.slot.is_some()) {
+            self.slots.push(Slot {
+                format: r.resource.format,
+                width: r.width,
+                height: r.height,
+                mips: r.resource.mips,
+            });
+            r.slot = Some(self.slots.len() - 1);
+        }
+        self
+    }
+
     /// Bytes of all slots: the texture memory the executor allocates for this plan.
     pub fn slot_bytes(&self) -> u64 {
         self.slots.iter().map(slot_bytes).sum()

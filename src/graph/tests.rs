@@ -238,3 +238,11 @@ fn text_and_dot_name_every_step() {
         "{d}"
     );
 }
+
+#[test]
+fn unaliased_plan_gives_every_resource_its_own_texture() {
+    let p = plan(&chain(), &["c"]).unwrap().unaliased();
+    let slots: Vec<usize> = p.resources.iter().filter_map(|r| r.slot).collect();
+    assert_eq!(slots, [0, 1, 2]);
+    assert_eq!(p.slots.len(), 3);
+}
