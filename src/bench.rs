@@ -17,7 +17,7 @@ use crate::error::{Error, Result};
 use crate::exec::{ComputeKernel, Executor, GpuTimer, KernelCache};
 use crate::gpu::{Gpu, scoped, submit_and_wait, write_texture};
 use crate::graph::{self, Graph, Plan};
-use crate::scene::{Light, LightKind, Shadow, Technique};
+use crate::scene::{BlurKernel, Filter, Light, LightKind, Prefilter, Shadow, Storage, Technique};
 use crate::technique;
 
 /// Untimed runs before the timed ones (pipeline warm-up, lazy clears, caches).
@@ -65,11 +65,99 @@ pub struct BenchCase {
 }
 
 /// Every benchmarked graph kernel.
-pub const CASES: &[BenchCase] = &[BenchCase {
-    name: "linearize",
-    bytes_moved: linearize_bytes,
-    build: linearize_graph,
-}];
+pub const CASES: &[BenchCase] = &[
+    BenchCase {
+        name: "linearize",
+        bytes_moved: linearize_bytes,
+        build: linearize_graph,
+    },
+    BenchCase {
+        name: "vsm",
+        bytes_moved: |n| texels(n) * (4 + 8),
+        build: |n| stage_graph(n, vsm(), "light0.linear", "light0.vsm"),
+    },
+    BenchCase {
+        name: "evsm4",
+        bytes_moved: |n| texels(n) * (4 + 16),
+        build: |n| stage_graph(n, evsm4(), "light0.linear", "light0.evsm"),
+    },
+    BenchCase {
+        name: "esm",
+        bytes_moved: |n| texels(n) * (4 + 4),
+        build: |n| stage_graph(n, esm(), "light0.linear", "light0.esm"),
+    },
+    BenchCase {
+        name: "blur rg32f r4",
+        bytes_moved: |n| 2 * texels(n) * (8 + 8),
+        build: |n| stage_graph(n, vsm(), "light0.vsm", "light0.vsm.blur_v"),
+    },
+    BenchCase {
+        name: "blur log r4",
+        bytes_moved: |n| 2 * texels(n) * (4 + 4),
+        build: |n| stage_graph(n, esm(), "light0.esm", "light0.esm.blur_v"),
+    },
+];
+
+fn texels(n: u32) -> u64 {
+    u64::from(n) * u64::from(n)
+}
+
+fn blur4() -> Filter {
+    Filter::Blur {
+        radius: 4.0,
+        sigma: 2.0,
+        kernel: BlurKernel::Gaussian,
+    }
+}
+
+fn vsm() -> Technique {
+    Technique::Vsm {
+        prefilter: Prefilter {
+            storage: Storage::F32,
+            filter: blur4(),
+        },
+        bleed: 0.2,
+        min_variance: 1e-5,
+    }
+}
+
+fn evsm4() -> Technique {
+    Technique::Evsm {
+        prefilter: Prefilter {
+            storage: Storage::F32,
+            filter: blur4(),
+        },
+        four: true,
+        exp_pos: 40.0,
+        exp_neg: 5.0,
+        bleed: 0.0,
+        min_variance: 1e-4,
+    }
+}
+
+fn esm() -> Technique {
+    Technique::Esm {
+        filter: blur4(),
+        exponent: 80.0,
+    }
+}
+
+/// The stages of a light's shipped graph between `input` (made an import, its producers
+/// dropped by the planner) and `output`: one kernel or a filter's passes, timed alone.
+fn stage_graph(n: u32, technique: Technique, input: &str, output: &str) -> BenchGraph {
+    let mut graph = Graph::default();
+    technique::add_light_nodes(&mut graph, 0, &bench_light(n, technique));
+    for r in graph.resources.iter_mut().filter(|r| r.name == input) {
+        r.imported = true;
+    }
+    graph
+        .nodes
+        .retain(|node| node.outputs.iter().all(|(_, r)| r != input));
+    BenchGraph {
+        graph,
+        outputs: vec![output.to_string()],
+    }
+}
 
 /// `linearize` reads one R32Float texel and writes one R32Float texel per texel.
 fn linearize_bytes(n: u32) -> u64 {
@@ -80,7 +168,21 @@ fn linearize_bytes(n: u32) -> u64 {
 /// the more expensive one), with its depth import switched to R32Float: a depth texture cannot
 /// be written from the CPU, and the kernel reads either through `texture_2d<f32>`.
 fn linearize_graph(n: u32) -> BenchGraph {
-    let light = Light {
+    let light = bench_light(n, Technique::Hard);
+    let mut graph = Graph::default();
+    technique::add_light_nodes(&mut graph, 0, &light);
+    for r in graph.resources.iter_mut().filter(|r| r.imported) {
+        r.format = wgpu::TextureFormat::R32Float;
+    }
+    BenchGraph {
+        graph,
+        outputs: vec![technique::linear_name(0)],
+    }
+}
+
+/// A spot light with an `n`² map and `technique`.
+fn bench_light(n: u32, technique: Technique) -> Light {
+    Light {
         kind: LightKind::Spot { fov_degrees: 60.0 },
         position: Vec3::new(0.0, 10.0, 0.0),
         target: Vec3::ZERO,
@@ -90,20 +192,11 @@ fn linearize_graph(n: u32) -> BenchGraph {
         radiance: Vec3::ONE,
         shadow_map: n,
         shadow: Shadow {
-            technique: Technique::Hard,
+            technique,
             bias: 0.0,
             slope_bias: 0.0,
             normal_bias: 0.0,
         },
-    };
-    let mut graph = Graph::default();
-    technique::add_light_nodes(&mut graph, 0, &light);
-    for r in graph.resources.iter_mut().filter(|r| r.imported) {
-        r.format = wgpu::TextureFormat::R32Float;
-    }
-    BenchGraph {
-        graph,
-        outputs: vec![technique::linear_name(0)],
     }
 }
 
@@ -309,12 +402,16 @@ fn random_imports(
         .enumerate()
     {
         let name = &r.resource.name;
-        if r.resource.format != wgpu::TextureFormat::R32Float {
-            return Err(Error::Invalid(format!(
-                "benchmark import `{name}` is {:?}; the harness fills R32Float imports only",
-                r.resource.format
-            )));
-        }
+        let channels = match r.resource.format {
+            wgpu::TextureFormat::R32Float => 1,
+            wgpu::TextureFormat::Rg32Float => 2,
+            wgpu::TextureFormat::Rgba32Float => 4,
+            other => {
+                return Err(Error::Invalid(format!(
+                    "benchmark import `{name}` is {other:?}; the harness fills 32-bit float imports only"
+                )));
+            }
+        };
         let texture = scoped(
             device,
             || {
@@ -339,7 +436,7 @@ fn random_imports(
             },
         )?;
         let texels = r.width as usize * r.height as usize;
-        let depths = random_depths(texels, 0x5EED + i as u64);
+        let depths = random_depths(texels * channels, 0x5EED + i as u64);
         write_texture(queue, &texture, bytemuck::cast_slice(&depths));
         imports.insert(name.clone(), texture);
     }
