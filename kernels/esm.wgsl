@@ -2,13 +2,7 @@
 // exp(c z) (Annen et al. 2008). Filtering happens in log space (log-sum-exp in `blur`), so
 // exp(c z) is never formed and no exponent overflows, whatever c.
 
-// Keep in sync with `ExpParams` in src/technique.rs.
-struct Params {
-    exp_pos: f32,
-    exp_neg: f32,
-    _pad0: f32,
-    _pad1: f32,
-}
+// #import shared/exp_params
 
 @group(0) @binding(0) var src: texture_2d<f32>;
 @group(0) @binding(1) var dst: texture_storage_2d<r32float, write>;

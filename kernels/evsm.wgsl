@@ -3,13 +3,7 @@
 // EVSM2 binds an rg32float (or rgba16float) output and keeps (pos, pos²); EVSM4 keeps all four.
 // The scene clamps c to the storage's limit (42 for f32, 5.54 for f16) so pos² stays finite.
 
-// Keep in sync with `ExpParams` in src/technique.rs.
-struct Params {
-    exp_pos: f32,
-    exp_neg: f32,
-    _pad0: f32,
-    _pad1: f32,
-}
+// #import shared/exp_params
 
 @group(0) @binding(0) var src: texture_2d<f32>;
 @group(0) @binding(1) var dst: texture_storage_2d<rgba32float, write>;

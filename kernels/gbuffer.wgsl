@@ -7,12 +7,7 @@ struct Camera {
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 
-// Keep in sync with `Vertex` in src/scene/mesh.rs.
-struct VsIn {
-    @location(0) position: vec3<f32>,
-    @location(1) normal: vec3<f32>,
-    @location(2) material: u32,
-}
+// #import shared/vertex
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,

@@ -6,12 +6,7 @@ struct LightView {
 
 @group(0) @binding(0) var<uniform> light: LightView;
 
-// Keep in sync with `Vertex` in src/scene/mesh.rs.
-struct VsIn {
-    @location(0) position: vec3<f32>,
-    @location(1) normal: vec3<f32>,
-    @location(2) material: u32,
-}
+// #import shared/vertex
 
 @vertex
 fn vs_main(v: VsIn) -> @builtin(position) vec4<f32> {

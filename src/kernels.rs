@@ -37,6 +37,8 @@ pub const SOURCES: &[Source] = sources![
     "esm",
     "blur",
     "shared/light",
+    "shared/vertex",
+    "shared/exp_params",
     "shared/sampling",
     "shared/vis_hard",
     "shared/vis_pcf",

@@ -15,8 +15,7 @@ pub struct Mesh {
     pub indices: Vec<u32>,
 }
 
-/// Vertex as uploaded: keep in sync with `VsIn` in `kernels/gbuffer.wgsl` and
-/// `kernels/shadow_depth.wgsl`.
+/// Vertex as uploaded: keep in sync with `VsIn` in `kernels/shared/vertex.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct Vertex {
