@@ -175,6 +175,8 @@ pub struct Renderer {
     shadow: HashMap<u32, wgpu::RenderPipeline>,
     gbuffer: Option<(wgpu::RenderPipeline, wgpu::BindGroupLayout)>,
     cmp_sampler: wgpu::Sampler,
+    /// The shading pass's outputs, kept while the image size and light count stay the same.
+    shade_targets: Option<((u32, u32, usize), Shaded)>,
 }
 
 const VERTEX_ATTRS: [wgpu::VertexAttribute; 3] =
@@ -232,6 +234,7 @@ impl Renderer {
             executor: Executor::new(),
             shadow: HashMap::new(),
             gbuffer: None,
+            shade_targets: None,
             cmp_sampler: device.create_sampler(&wgpu::SamplerDescriptor {
                 label: Some("shadowgraph.cmp_sampler"),
                 mag_filter: wgpu::FilterMode::Linear,
@@ -534,14 +537,7 @@ impl Renderer {
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(&label),
             color_attachments: &[],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
+            depth_stencil_attachment: Some(clear_depth(&view)),
             timestamp_writes,
             occlusion_query_set: None,
             multiview_mask: None,
@@ -615,14 +611,7 @@ impl Renderer {
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("gbuffer"),
             color_attachments: &[clear(&pv), clear(&nv)],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &dv,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
+            depth_stencil_attachment: Some(clear_depth(&dv)),
             timestamp_writes,
             occlusion_query_set: None,
             multiview_mask: None,
@@ -654,20 +643,16 @@ impl Renderer {
             .kernels
             .get_generated(device, "shade", Some(&block))?;
         let (w, h) = (frame.size[0], frame.size[1]);
-        let color = texture(
-            device,
-            "shadowgraph.color",
-            (w, h),
-            wgpu::TextureFormat::Rgba8Unorm,
-            wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
-        );
-        let vis_bytes = (u64::from(w) * u64::from(h) * lights.len().max(1) as u64 * 4).max(4);
-        let visibility = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("shadowgraph.visibility"),
-            size: vis_bytes,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
+        let key = (w, h, lights.len());
+        let targets = match &self.shade_targets {
+            Some((k, t)) if *k == key => t.clone(),
+            _ => {
+                let t = Shaded::new(device, key);
+                self.shade_targets = Some((key, t.clone()));
+                t
+            }
+        };
+        let Shaded { color, visibility } = targets;
         let gpu_lights: Vec<LightGpu> = lights.iter().map(LightGpu::new).collect();
         let storage = |label, bytes: &[u8]| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -767,6 +752,7 @@ impl Renderer {
 }
 
 /// The shading pass's outputs.
+#[derive(Clone)]
 pub struct Shaded {
     /// RGBA8 image (sRGB-encoded values).
     pub color: wgpu::Texture,
@@ -775,6 +761,25 @@ pub struct Shaded {
 }
 
 impl Shaded {
+    /// Targets for a `w × h` image and `lights` lights.
+    fn new(device: &wgpu::Device, (w, h, lights): (u32, u32, usize)) -> Self {
+        let color = texture(
+            device,
+            "shadowgraph.color",
+            (w, h),
+            wgpu::TextureFormat::Rgba8Unorm,
+            wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        );
+        let bytes = (u64::from(w) * u64::from(h) * lights.max(1) as u64 * 4).max(4);
+        let visibility = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("shadowgraph.visibility"),
+            size: bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        Self { color, visibility }
+    }
+
     /// Copies the visibility buffer back.
     pub fn read_visibility(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Vec<f32>> {
         let staging = device.create_buffer(&wgpu::BufferDescriptor {
@@ -822,6 +827,18 @@ fn dump_resources(
             })
         })
         .collect()
+}
+
+/// A depth attachment cleared to the far plane and kept.
+fn clear_depth(view: &wgpu::TextureView) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+    wgpu::RenderPassDepthStencilAttachment {
+        view,
+        depth_ops: Some(wgpu::Operations {
+            load: wgpu::LoadOp::Clear(1.0),
+            store: wgpu::StoreOp::Store,
+        }),
+        stencil_ops: None,
+    }
 }
 
 fn depth_only_view(t: &wgpu::Texture) -> wgpu::TextureView {
