@@ -98,7 +98,7 @@ pub const CHANNEL_TABLE: &[KindChannels] = &[
         naming: ChannelNaming::Fixed(&["z", "z2"]),
     },
     // Exponential VSM (`light{i}.evsm`): (pos, pos², neg, neg²) of the warped depth; EVSM2 in
-    // Rg32Float keeps the first two. In progress in the techniques.
+    // Rg32Float keeps the first two.
     KindChannels {
         kind: "evsm",
         naming: ChannelNaming::Fixed(&["pos", "pos2", "neg", "neg2"]),
@@ -113,17 +113,18 @@ pub const CHANNEL_TABLE: &[KindChannels] = &[
         naming: ChannelNaming::Fixed(&["pos", "pos2", "neg", "neg2"]),
     },
     // Exponential shadow map (`light{i}.esm`), stored in log form c·z = log(exp(c·z)) so that
-    // blurring (log-sum-exp) never overflows. In progress in the techniques.
+    // blurring (log-sum-exp) never overflows.
     KindChannels {
         kind: "esm",
         naming: ChannelNaming::Fixed(&["log_exp"]),
     },
-    // Future: moment shadow maps (four power moments b1..b4).
+    // Moment shadow maps: the four power moments b1..b4 (f32), or their optimized
+    // quantization (16-bit storage), named alike.
     KindChannels {
         kind: "msm",
         naming: ChannelNaming::Fixed(&["b1", "b2", "b3", "b4"]),
     },
-    // Future: convolution shadow maps, Fourier coefficients in chunks `csm0`, `csm1`, ….
+    // Convolution shadow maps: the Fourier basis in chunks `csm0`, `csm1`, … of two terms.
     KindChannels {
         kind: "csm",
         naming: ChannelNaming::Fourier,
@@ -174,7 +175,7 @@ pub fn channel_names(resource: &str, format: wgpu::TextureFormat, channels: usiz
             let pairs = channels / 2;
             (0..pairs * 2)
                 .map(|c| {
-                    let j = chunk * pairs + c / 2 + 1;
+                    let j = 2 * chunk + c / 2 + 1;
                     format!("{}_{j}", if c % 2 == 0 { "sin" } else { "cos" })
                 })
                 .collect()

@@ -82,6 +82,14 @@ pub enum Error {
         limit: u64,
     },
     /// An argument is invalid (zero size, mismatched lengths, ...).
+    /// The scene needs a device feature the adapter does not offer.
+    #[error("{what} needs the device feature {feature}, which this adapter does not offer")]
+    MissingFeature {
+        /// The scene key or API input that needs it.
+        what: String,
+        /// The wgpu feature's name.
+        feature: &'static str,
+    },
     #[error("invalid argument: {0}")]
     Invalid(String),
     /// Reading or writing a file failed.

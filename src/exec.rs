@@ -503,6 +503,10 @@ impl Executor {
 
         for (si, step) in plan.steps.iter().enumerate() {
             let node = &step.node;
+            if node.dispatch == Dispatch::MipChain {
+                self.record_mip_chain(device, encoder, node, &textures, timer.as_deref_mut())?;
+                continue;
+            }
             let formats: Vec<(String, wgpu::TextureFormat)> = node
                 .outputs
                 .iter()
@@ -579,6 +583,7 @@ impl Executor {
             )?;
             let groups = match &node.dispatch {
                 Dispatch::Groups(g) => *g,
+                Dispatch::MipChain => unreachable!("mip chains are recorded above"),
                 Dispatch::Texels(r) => {
                     let t = &textures[r];
                     kernel.groups_for(t.width(), t.height())
@@ -610,5 +615,146 @@ impl Executor {
             stats_readback,
             steps: plan.steps.iter().map(|s| s.node.name.clone()).collect(),
         })
+    }
+
+    /// Records a [`Dispatch::MipChain`] node: one compute pass, one dispatch per two levels of
+    /// the output (`kernels/mips.wgsl`), each reading the level above through a one-level view.
+    /// With an odd level count the last dispatch redoes the level before the last (identical
+    /// values) so that every dispatch writes two levels.
+    fn record_mip_chain(
+        &mut self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        node: &crate::graph::Node,
+        textures: &HashMap<String, wgpu::Texture>,
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
+        let pipeline_err = |message: String| Error::Pipeline {
+            kernel: node.kernel.clone(),
+            message: format!("node `{}`: {message}", node.name),
+        };
+        let slot = |list: &[(String, String)], name: &str| {
+            list.iter()
+                .find(|(s, _)| s == name)
+                .map(|(_, r)| textures[r].clone())
+                .ok_or_else(|| pipeline_err(format!("binds nothing to `{name}`")))
+        };
+        let src = slot(&node.inputs, "src")?;
+        let dst = slot(&node.outputs, "dst")?;
+        let formats = [
+            ("dst_a".to_string(), dst.format()),
+            ("dst_b".to_string(), dst.format()),
+        ];
+        let kernel = self
+            .kernels
+            .get_specialized(device, &node.kernel, &formats)?;
+        let levels = dst.mip_level_count();
+        let size = |l: u32| [(dst.width() >> l).max(1), (dst.height() >> l).max(1)];
+        // (read level, first written level); read level None = the `src` input.
+        let mut passes: Vec<(Option<u32>, u32)> = vec![(None, 0)];
+        let mut next = 2;
+        while next < levels {
+            let a = next.min(levels - 2);
+            passes.push((Some(a - 1), a));
+            next = a + 2;
+        }
+        let base: crate::filter::MipParams = bytemuck::try_pod_read_unaligned(
+            &node.params[..std::mem::size_of::<crate::filter::MipParams>()],
+        )
+        .map_err(|e| pipeline_err(format!("bad params: {e}")))?;
+        let align = u64::from(device.limits().min_uniform_buffer_offset_alignment).max(32);
+        let mut bytes = vec![0u8; passes.len() * align as usize];
+        for (k, (read, a)) in passes.iter().enumerate() {
+            let p = crate::filter::MipParams {
+                src_size: read.map_or([src.width(), src.height()], size),
+                a_size: size(*a),
+                b_size: if a + 1 < levels { size(a + 1) } else { [0, 0] },
+                ..base
+            };
+            let at = k * align as usize;
+            bytes[at..at + std::mem::size_of_val(&p)].copy_from_slice(bytemuck::bytes_of(&p));
+        }
+        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(&node.name),
+            contents: &bytes,
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let level_view = |t: &wgpu::Texture, level: u32| {
+            t.create_view(&wgpu::TextureViewDescriptor {
+                base_mip_level: level,
+                mip_level_count: Some(1),
+                ..Default::default()
+            })
+        };
+        let binding = |name: &str| {
+            kernel
+                .reflection
+                .binding(name)
+                .map(|b| b.binding)
+                .ok_or_else(|| pipeline_err(format!("kernel has no binding `{name}`")))
+        };
+        let (b_src, b_a, b_b, b_params) = (
+            binding("src")?,
+            binding("dst_a")?,
+            binding("dst_b")?,
+            binding("params")?,
+        );
+        let mut groups = Vec::new();
+        for (k, (read, a)) in passes.iter().enumerate() {
+            let src_view = match read {
+                None => level_view(&src, 0),
+                Some(l) => level_view(&dst, *l),
+            };
+            let b_level = if a + 1 < levels { a + 1 } else { *a };
+            let (va, vb) = (level_view(&dst, *a), level_view(&dst, b_level));
+            let entries = [
+                wgpu::BindGroupEntry {
+                    binding: b_src,
+                    resource: wgpu::BindingResource::TextureView(&src_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: b_a,
+                    resource: wgpu::BindingResource::TextureView(&va),
+                },
+                wgpu::BindGroupEntry {
+                    binding: b_b,
+                    resource: wgpu::BindingResource::TextureView(&vb),
+                },
+                wgpu::BindGroupEntry {
+                    binding: b_params,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &params,
+                        offset: k as u64 * align,
+                        size: wgpu::BufferSize::new(
+                            std::mem::size_of::<crate::filter::MipParams>() as u64,
+                        ),
+                    }),
+                },
+            ];
+            let bg = scoped(
+                device,
+                || {
+                    device.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some(&node.name),
+                        layout: &kernel.layouts[0],
+                        entries: &entries,
+                    })
+                },
+                |message| pipeline_err(format!("binding level {a}: {message}")),
+            )?;
+            let out = size(if a + 1 < levels { a + 1 } else { *a });
+            groups.push((bg, kernel.groups_for(out[0], out[1])));
+        }
+        let timestamp_writes = timer.and_then(|t| t.compute_pass(&node.name));
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(&node.name),
+            timestamp_writes,
+        });
+        pass.set_pipeline(&kernel.pipeline);
+        for (bg, g) in &groups {
+            pass.set_bind_group(0, bg, &[]);
+            pass.dispatch_workgroups(g[0], g[1], 1);
+        }
+        Ok(())
     }
 }

@@ -1,4 +1,4 @@
-//! Filters that work on any prefiltered representation: the separable blur.
+//! Filters that work on any prefiltered representation: the separable blur and the mip chain.
 
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
 use crate::scene::{BlurKernel, Filter};
@@ -74,16 +74,17 @@ pub fn add_filter(
     filter: &Filter,
     mode: BlurMode,
 ) -> String {
-    let Filter::Blur {
-        radius,
-        sigma,
-        kernel,
-    } = *filter
-    else {
-        return input.to_string();
-    };
     let Some(format) = graph.find(input).map(|r| r.format) else {
         return input.to_string();
+    };
+    let (radius, sigma, kernel) = match *filter {
+        Filter::None => return input.to_string(),
+        Filter::Mips { .. } => return add_mips(graph, light, input, format, mode),
+        Filter::Blur {
+            radius,
+            sigma,
+            kernel,
+        } => (radius, sigma, kernel),
     };
     let mut src = input.to_string();
     for (axis, pass) in [(0, "blur_h"), (1, "blur_v")] {
@@ -112,4 +113,55 @@ pub fn add_filter(
         src = out;
     }
     src
+}
+
+/// Parameters of `kernels/mips.wgsl` (mirrors its `Params`); the executor fills in the sizes
+/// of each dispatch's levels, the graph only the mode.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct MipParams {
+    /// Size of the level read.
+    pub src_size: [u32; 2],
+    /// Size of the first level written.
+    pub a_size: [u32; 2],
+    /// Size of the second level written.
+    pub b_size: [u32; 2],
+    /// 0 linear average, 1 log-sum-exp.
+    pub mode: u32,
+    /// Padding.
+    pub _pad: u32,
+}
+
+/// Adds the mip-chain node over `input`: `<input>.mips`, a copy of `input` at level 0 and
+/// area-weighted reductions below it, down to 1×1.
+fn add_mips(
+    graph: &mut Graph,
+    light: usize,
+    input: &str,
+    format: wgpu::TextureFormat,
+    mode: BlurMode,
+) -> String {
+    let out = graph.mip_resource(
+        format!("{input}.mips"),
+        format,
+        SizeRule::Reduced {
+            of: input.to_string(),
+            shift: 0,
+        },
+        Some(light),
+    );
+    let params = MipParams {
+        mode: u32::from(mode == BlurMode::LogSumExp),
+        ..Default::default()
+    };
+    graph.node(Node {
+        name: format!("{input}.mips"),
+        kernel: "mips".into(),
+        inputs: vec![("src".into(), input.to_string())],
+        outputs: vec![("dst".into(), out.clone())],
+        params: bytemuck::bytes_of(&params).to_vec(),
+        dispatch: Dispatch::MipChain,
+        light: Some(light),
+    });
+    out
 }

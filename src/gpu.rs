@@ -20,7 +20,8 @@ const WANTED_FEATURES: wgpu::Features = wgpu::Features::TIMESTAMP_QUERY
     .union(wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES)
     .union(wgpu::Features::FLOAT32_FILTERABLE)
     .union(wgpu::Features::SHADER_F64)
-    .union(wgpu::Features::SHADER_INT64);
+    .union(wgpu::Features::SHADER_INT64)
+    .union(wgpu::Features::TEXTURE_FORMAT_16BIT_NORM);
 
 impl Gpu {
     /// Picks an adapter and creates a device with the adapter's own limits.
@@ -290,24 +291,37 @@ pub fn read_texture(
 
 /// Uploads tightly packed texel data into mip 0 of a 2-D texture.
 pub fn write_texture(queue: &wgpu::Queue, texture: &wgpu::Texture, data: &[u8]) {
+    write_texture_level(queue, texture, 0, data);
+}
+
+/// Writes tightly packed texels into mip `level` of `texture`.
+pub fn write_texture_level(queue: &wgpu::Queue, texture: &wgpu::Texture, level: u32, data: &[u8]) {
     let bpp = texture
         .format()
         .block_copy_size(Some(wgpu::TextureAspect::All))
         .unwrap_or(4);
+    let (w, h) = (
+        (texture.width() >> level).max(1),
+        (texture.height() >> level).max(1),
+    );
     queue.write_texture(
         wgpu::TexelCopyTextureInfo {
             texture,
-            mip_level: 0,
+            mip_level: level,
             origin: wgpu::Origin3d::ZERO,
             aspect: wgpu::TextureAspect::All,
         },
         data,
         wgpu::TexelCopyBufferLayout {
             offset: 0,
-            bytes_per_row: Some(texture.width() * bpp),
-            rows_per_image: Some(texture.height()),
+            bytes_per_row: Some(w * bpp),
+            rows_per_image: Some(h),
         },
-        texture.size(),
+        wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        },
     );
 }
 
@@ -317,7 +331,8 @@ pub fn float_channels(format: wgpu::TextureFormat) -> Option<usize> {
     match format {
         T::R32Float | T::Depth32Float => Some(1),
         T::Rg32Float => Some(2),
-        T::Rgba32Float | T::Rgba16Float => Some(4),
+        T::Rg16Unorm => Some(2),
+        T::Rgba32Float | T::Rgba16Float | T::Rgba16Unorm => Some(4),
         _ => None,
     }
 }
@@ -354,6 +369,13 @@ pub fn read_float_texture(
     let values = if format == wgpu::TextureFormat::Rgba16Float {
         raw.chunks_exact(2)
             .map(|b| f16_to_f32(u16::from_le_bytes([b[0], b[1]])))
+            .collect()
+    } else if matches!(
+        format,
+        wgpu::TextureFormat::Rg16Unorm | wgpu::TextureFormat::Rgba16Unorm
+    ) {
+        raw.chunks_exact(2)
+            .map(|b| f32::from(u16::from_le_bytes([b[0], b[1]])) / 65535.0)
             .collect()
     } else {
         bytemuck::cast_slice(&raw).to_vec()

@@ -36,6 +36,9 @@ pub const SOURCES: &[Source] = sources![
     "evsm",
     "esm",
     "blur",
+    "msm",
+    "csm",
+    "mips",
     "shared/light",
     "shared/vertex",
     "shared/exp_params",
@@ -46,6 +49,10 @@ pub const SOURCES: &[Source] = sources![
     "shared/vis_vsm",
     "shared/vis_evsm",
     "shared/vis_esm",
+    "shared/msm_quantize",
+    "shared/vis_msm",
+    "shared/csm_basis",
+    "shared/vis_csm",
 ];
 
 /// The embedded text of `kernels/<name>.wgsl`.

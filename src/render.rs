@@ -41,7 +41,7 @@ pub struct ScenePlan {
     pub graph: Graph,
     /// The pruned, ordered plan.
     pub plan: Plan,
-    /// Per light, the resource the shading pass binds.
+    /// Per light, the resources the shading pass binds.
     pub shade_inputs: Vec<technique::ShadeInput>,
 }
 
@@ -52,7 +52,10 @@ pub fn plan_lights(lights: &[Light]) -> Result<ScenePlan> {
     for (i, l) in lights.iter().enumerate() {
         shade_inputs.push(technique::add_light_nodes(&mut graph, i, l));
     }
-    let outputs: Vec<&str> = shade_inputs.iter().map(|s| s.resource.as_str()).collect();
+    let outputs: Vec<&str> = shade_inputs
+        .iter()
+        .flat_map(|s| s.maps.iter().map(String::as_str))
+        .collect();
     let plan = plan(&graph, &outputs)?;
     Ok(ScenePlan {
         graph,
@@ -79,6 +82,26 @@ pub fn check_limits(device: &wgpu::Device, scene: &Scene) -> Result<()> {
     check("output.height".into(), scene.height)?;
     for (i, l) in scene.lights.iter().enumerate() {
         check(format!("light[{i}].shadow_map"), l.shadow_map)?;
+    }
+    check_features(device, &scene.lights)
+}
+
+/// Checks that the device offers the features the lights' techniques need.
+pub fn check_features(device: &wgpu::Device, lights: &[Light]) -> Result<()> {
+    use crate::scene::{Storage, Technique};
+    for (i, l) in lights.iter().enumerate() {
+        if let Technique::Msm { prefilter, .. } = l.shadow.technique {
+            if prefilter.storage == Storage::Unorm16
+                && !device
+                    .features()
+                    .contains(wgpu::Features::TEXTURE_FORMAT_16BIT_NORM)
+            {
+                return Err(Error::MissingFeature {
+                    what: format!("light[{i}].shadow.format = \"unorm16\""),
+                    feature: "TEXTURE_FORMAT_16BIT_NORM",
+                });
+            }
+        }
     }
     Ok(())
 }
@@ -125,8 +148,8 @@ pub struct Frame {
     pub timings: Vec<Vec<(String, f64)>>,
     /// Steps whose kernels reported replaced texels (non-finite depth), with the count.
     pub sanitized: Vec<(String, u32)>,
-    /// Per light, the map its shading reads: raw depth, linear depth or a filtered
-    /// representation (`aux` only).
+    /// Per light, the map its shading reads (level 0): raw depth, linear depth or a filtered
+    /// representation; CSM's basis maps side by side as one map of 2M channels (`aux` only).
     pub shade_maps: Vec<FloatMap>,
     /// Per light, the linear depth map, when the plan made one (`aux` only).
     pub linear_maps: Vec<Option<FloatMap>>,
@@ -150,6 +173,32 @@ pub struct FloatMap {
 }
 
 impl FloatMap {
+    /// The maps' channels side by side per texel (CSM's basis maps as one map), named after
+    /// the first.
+    pub fn concat(maps: Vec<FloatMap>) -> Result<FloatMap> {
+        let mut it = maps.into_iter();
+        let Some(mut out) = it.next() else {
+            return Err(Error::Invalid("no maps to concatenate".into()));
+        };
+        for m in it {
+            if (m.width, m.height) != (out.width, out.height) {
+                return Err(Error::Invalid(format!(
+                    "`{}` is {}x{}, `{}` {}x{}",
+                    m.resource, m.width, m.height, out.resource, out.width, out.height
+                )));
+            }
+            let channels = out.channels + m.channels;
+            out.data = out
+                .data
+                .chunks(out.channels)
+                .zip(m.data.chunks(m.channels))
+                .flat_map(|(a, b)| a.iter().chain(b).copied())
+                .collect();
+            out.channels = channels;
+        }
+        Ok(out)
+    }
+
     /// Reads `texture` (mip 0) back.
     pub fn read(
         device: &wgpu::Device,
@@ -431,7 +480,8 @@ impl Renderer {
             let maps: Vec<wgpu::TextureView> = sp
                 .shade_inputs
                 .iter()
-                .map(|s| depth_only_view(&outputs.textures[&s.resource]))
+                .flat_map(|s| &s.maps)
+                .map(|m| depth_only_view(&outputs.textures[m]))
                 .collect();
             let frame = FrameGpu {
                 size: [size.0, size.1],
@@ -492,10 +542,12 @@ impl Renderer {
             frame.position = bytemuck::cast_slice(&read_texture(device, queue, &gpos, 0)?).to_vec();
             frame.normal = bytemuck::cast_slice(&read_texture(device, queue, &gnorm, 0)?).to_vec();
             for (i, input) in sp.shade_inputs.iter().enumerate() {
-                let t = &outputs.textures[&input.resource];
-                frame
-                    .shade_maps
-                    .push(FloatMap::read(device, queue, &input.resource, t)?);
+                let maps = input
+                    .maps
+                    .iter()
+                    .map(|m| FloatMap::read(device, queue, m, &outputs.textures[m]))
+                    .collect::<Result<Vec<_>>>()?;
+                frame.shade_maps.push(FloatMap::concat(maps)?);
                 let linear = technique::linear_name(i);
                 frame.linear_maps.push(match outputs.textures.get(&linear) {
                     Some(t) => Some(FloatMap::read(device, queue, &linear, t)?),
@@ -855,27 +907,36 @@ fn depth_only_view(t: &wgpu::Texture) -> wgpu::TextureView {
 /// A map handed to [`probe`]: what the light's technique reads (linear depth as R32Float,
 /// moments as Rg32Float, …), never the raw depth of hardware PCF.
 pub struct ProbeMap<'a> {
-    /// Side length.
+    /// Side length of level 0.
     pub size: u32,
     /// Texel format of `data` (a 32-bit float format).
     pub format: wgpu::TextureFormat,
-    /// `size²` texels, row-major.
+    /// Mip levels in `data` (1 for a plain map).
+    pub mips: u32,
+    /// Every level's texels, row-major, level 0 first (level `m` is `max(1, size >> m)` wide).
     pub data: &'a [f32],
 }
 
 impl<'a> ProbeMap<'a> {
     /// A linear depth map.
     pub fn linear(size: u32, data: &'a [f32]) -> Self {
+        Self::new(size, wgpu::TextureFormat::R32Float, data)
+    }
+
+    /// A one-level map of `format`.
+    pub fn new(size: u32, format: wgpu::TextureFormat, data: &'a [f32]) -> Self {
         Self {
             size,
-            format: wgpu::TextureFormat::R32Float,
+            format,
+            mips: 1,
             data,
         }
     }
 }
 
-/// Evaluates each light's visibility at `points` (position, unit normal) on the given linear
-/// depth maps with the real shading kernel. Returns `vis[point * lights + light]`.
+/// Evaluates each light's visibility at `points` (position, unit normal) on the given maps
+/// with the real shading kernel. `maps` lists every light's maps in binding order (one per
+/// light; CSM: one per two terms). Returns `vis[point * lights + light]`.
 pub fn probe(
     renderer: &mut Renderer,
     device: &wgpu::Device,
@@ -884,10 +945,19 @@ pub fn probe(
     maps: &[ProbeMap],
     points: &[(Vec3, Vec3)],
 ) -> Result<Vec<f32>> {
-    if maps.len() != lights.len() || points.is_empty() {
-        return Err(Error::Invalid(
-            "probe needs one map per light and at least one point".into(),
-        ));
+    let needed: usize = lights
+        .iter()
+        .enumerate()
+        .map(|(i, l)| {
+            technique::add_light_nodes(&mut Graph::default(), i, l)
+                .maps
+                .len()
+        })
+        .sum();
+    if maps.len() != needed || points.is_empty() {
+        return Err(Error::Invalid(format!(
+            "probe needs {needed} map(s) for these lights and at least one point"
+        )));
     }
     let w = (points.len() as u32).min(256);
     let h = (points.len() as u32).div_ceil(w);
@@ -917,26 +987,43 @@ pub fn probe(
     let mut views = Vec::new();
     for m in maps {
         let channels = crate::gpu::float_channels(m.format).unwrap_or(0);
-        let texels = (m.size * m.size) as usize;
-        if m.format == wgpu::TextureFormat::Rgba16Float
-            || channels == 0
-            || m.data.len() != texels * channels
-        {
+        let side = |l: u32| (m.size >> l).max(1) as usize;
+        let texels: usize = (0..m.mips).map(|l| side(l) * side(l)).sum();
+        let is_f32 = crate::graph::texel_bytes(m.format) == 4 * channels as u64;
+        if !is_f32 || channels == 0 || m.mips == 0 || m.data.len() != texels * channels {
             return Err(Error::Invalid(format!(
-                "a {0}x{0} {1:?} probe map needs {2} f32 values",
+                "a {0}x{0} {1:?} probe map of {3} level(s) needs {2} f32 values",
                 m.size,
                 m.format,
-                texels * channels.max(1)
+                texels * channels.max(1),
+                m.mips
             )));
         }
-        let t = texture(
-            device,
-            "shadowgraph.probe.map",
-            (m.size, m.size),
-            m.format,
+        let t = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("shadowgraph.probe.map"),
+            size: wgpu::Extent3d {
+                width: m.size,
+                height: m.size,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: m.mips,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: m.format,
             usage,
-        );
-        write_texture(queue, &t, bytemuck::cast_slice(m.data));
+            view_formats: &[],
+        });
+        let mut at = 0;
+        for level in 0..m.mips {
+            let n = side(level) * side(level) * channels;
+            crate::gpu::write_texture_level(
+                queue,
+                &t,
+                level,
+                bytemuck::cast_slice(&m.data[at..at + n]),
+            );
+            at += n;
+        }
         views.push(t.create_view(&Default::default()));
     }
     let frame = FrameGpu {

@@ -5,7 +5,7 @@ use std::fmt::Write;
 
 use crate::filter::{BlurMode, add_filter};
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
-use crate::scene::{Light, LightKind, PcfKernel, Storage, Technique};
+use crate::scene::{Filter, Light, LightKind, PcfKernel, Storage, Technique};
 
 /// A light as the shading kernel reads it. Mirrors `struct Light` in
 /// `kernels/shared/light.wgsl` (a test checks the size against naga's layout).
@@ -40,7 +40,7 @@ pub struct LightGpu {
     pub normal_bias: f32,
     /// Spot: cos(fov/2); directional: −1.
     pub cos_outer: f32,
-    /// 0 hard, 1 pcf, 2 pcss.
+    /// 0 hard, 1 pcf, 2 pcss, 3 vsm, 4 evsm, 5 esm, 6 msm, 7 csm.
     pub technique: u32,
     /// PCF radius.
     pub radius: u32,
@@ -62,9 +62,30 @@ pub struct LightGpu {
     pub exp_neg: f32,
     /// EVSM: 2 or 4 stored moments.
     pub moments: u32,
+    /// MSM moment bias α.
+    pub moment_bias: f32,
+    /// MSM: bit 0 Hausdorff (else Hamburger), bit 1 quantized storage.
+    pub msm_flags: u32,
+    /// CSM terms M.
+    pub csm_terms: u32,
+    /// CSM ringing attenuation α.
+    pub csm_attenuation: f32,
+    /// CSM receiver-depth offset.
+    pub csm_offset: f32,
+    /// CSM response scale.
+    pub csm_scale: f32,
+    /// Mip levels of the filtered map (0 when the filter is not `mips`).
+    pub mip_levels: u32,
+    /// `log2` of the mip filter width in texels.
+    pub filter_lod: f32,
     /// Padding to the WGSL struct's 16-byte alignment.
     pub _pad: [u32; 2],
 }
+
+/// MSM flag: Hausdorff reconstruction.
+pub const MSM_HAUSDORFF: u32 = 1;
+/// MSM flag: moments stored through the optimized quantization.
+pub const MSM_QUANTIZED: u32 = 2;
 
 impl LightGpu {
     /// The GPU description of `light`.
@@ -89,6 +110,8 @@ impl LightGpu {
                 Technique::Vsm { .. } => (3, 0, 0, 0, 0, 0.0),
                 Technique::Evsm { .. } => (4, 0, 0, 0, 0, 0.0),
                 Technique::Esm { .. } => (5, 0, 0, 0, 0, 0.0),
+                Technique::Msm { .. } => (6, 0, 0, 0, 0, 0.0),
+                Technique::Csm { .. } => (7, 0, 0, 0, 0, 0.0),
             };
         let (bleed, min_variance, exp_pos, exp_neg, moments) = match light.shadow.technique {
             Technique::Vsm {
@@ -111,7 +134,38 @@ impl LightGpu {
                 if four { 4 } else { 2 },
             ),
             Technique::Esm { exponent, .. } => (0.0, 0.0, exponent, 0.0, 1),
+            Technique::Msm { bleed, .. } => (bleed, 0.0, 0.0, 0.0, 4),
             _ => (0.0, 0.0, 0.0, 0.0, 0),
+        };
+        let (moment_bias, msm_flags) = match light.shadow.technique {
+            Technique::Msm {
+                prefilter,
+                hausdorff,
+                moment_bias,
+                ..
+            } => (
+                moment_bias,
+                u32::from(hausdorff) * MSM_HAUSDORFF
+                    + u32::from(msm_quantized(prefilter.storage)) * MSM_QUANTIZED,
+            ),
+            _ => (0.0, 0),
+        };
+        let (csm_terms, csm_attenuation, csm_offset, csm_scale) = match light.shadow.technique {
+            Technique::Csm {
+                terms,
+                attenuation,
+                offset,
+                scale,
+                ..
+            } => (terms, attenuation, offset, scale),
+            _ => (0, 0.0, 0.0, 1.0),
+        };
+        let (mip_levels, filter_lod) = match light.shadow.technique.filter() {
+            Some(Filter::Mips { width }) => (
+                mip_levels(light.shadow_map, light.shadow_map),
+                width.max(1.0).log2(),
+            ),
+            _ => (0, 0.0),
         };
         let (kind, cos_outer) = match light.kind {
             LightKind::Directional { .. } => (0, -1.0),
@@ -143,6 +197,14 @@ impl LightGpu {
             exp_pos,
             exp_neg,
             moments,
+            moment_bias,
+            msm_flags,
+            csm_terms,
+            csm_attenuation,
+            csm_offset,
+            csm_scale,
+            mip_levels,
+            filter_lod,
             _pad: [0; 2],
         }
     }
@@ -214,25 +276,23 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
         light: Some(i),
     });
     let float = "texture_2d<f32>";
+    let one = |resource: String, wgsl_type| ShadeInput {
+        maps: vec![resource],
+        wgsl_type,
+    };
     match light.shadow.technique {
         Technique::Pcf {
             kernel: PcfKernel::Hardware,
             ..
-        } => ShadeInput {
-            resource: depth,
-            wgsl_type: "texture_depth_2d",
-        },
-        Technique::Hard | Technique::Pcf { .. } | Technique::Pcss { .. } => ShadeInput {
-            resource: linear,
-            wgsl_type: float,
-        },
+        } => one(depth, "texture_depth_2d"),
+        Technique::Hard | Technique::Pcf { .. } | Technique::Pcss { .. } => one(linear, float),
         Technique::Vsm { prefilter, .. } => {
             let format = moments_format(prefilter.storage, 2);
-            let moments = encode(graph, i, "vsm", &linear, format, Vec::new());
-            ShadeInput {
-                resource: add_filter(graph, i, &moments, &prefilter.filter, BlurMode::Linear),
-                wgsl_type: float,
-            }
+            let moments = encode(graph, i, "vsm", "vsm", &linear, format, Vec::new());
+            one(
+                add_filter(graph, i, &moments, &prefilter.filter, BlurMode::Linear),
+                float,
+            )
         }
         Technique::Evsm {
             prefilter,
@@ -243,22 +303,96 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
         } => {
             let format = moments_format(prefilter.storage, if four { 4 } else { 2 });
             let params = bytemuck::bytes_of(&ExpParams::new(exp_pos, exp_neg)).to_vec();
-            let moments = encode(graph, i, "evsm", &linear, format, params);
-            ShadeInput {
-                resource: add_filter(graph, i, &moments, &prefilter.filter, BlurMode::Linear),
-                wgsl_type: float,
-            }
+            let moments = encode(graph, i, "evsm", "evsm", &linear, format, params);
+            one(
+                add_filter(graph, i, &moments, &prefilter.filter, BlurMode::Linear),
+                float,
+            )
         }
         Technique::Esm { filter, exponent } => {
             let params = bytemuck::bytes_of(&ExpParams::new(exponent, 0.0)).to_vec();
             let format = wgpu::TextureFormat::R32Float;
-            let log_moment = encode(graph, i, "esm", &linear, format, params);
+            let log_moment = encode(graph, i, "esm", "esm", &linear, format, params);
+            one(
+                add_filter(graph, i, &log_moment, &filter, BlurMode::LogSumExp),
+                float,
+            )
+        }
+        Technique::Msm { prefilter, .. } => {
+            let format = moments_format(prefilter.storage, 4);
+            let params = bytemuck::bytes_of(&MsmParams {
+                quantized: u32::from(msm_quantized(prefilter.storage)),
+                _pad: [0; 3],
+            })
+            .to_vec();
+            let moments = encode(graph, i, "msm", "msm", &linear, format, params);
+            one(
+                add_filter(graph, i, &moments, &prefilter.filter, BlurMode::Linear),
+                float,
+            )
+        }
+        Technique::Csm {
+            prefilter, terms, ..
+        } => {
+            let maps = (0..csm_maps(terms))
+                .map(|chunk| {
+                    let pairs = (terms - 2 * chunk).min(2);
+                    let format = moments_format(prefilter.storage, 2 * pairs);
+                    let params = bytemuck::bytes_of(&CsmParams {
+                        first_term: 2 * chunk + 1,
+                        terms,
+                        _pad: [0; 2],
+                    })
+                    .to_vec();
+                    let name = format!("csm{chunk}");
+                    let basis = encode(graph, i, "csm", &name, &linear, format, params);
+                    add_filter(graph, i, &basis, &prefilter.filter, BlurMode::Linear)
+                })
+                .collect();
             ShadeInput {
-                resource: add_filter(graph, i, &log_moment, &filter, BlurMode::LogSumExp),
+                maps,
                 wgsl_type: float,
             }
         }
     }
+}
+
+/// Number of mip levels of a full chain for a `width`×`height` map (down to 1×1).
+pub fn mip_levels(width: u32, height: u32) -> u32 {
+    32 - width.max(height).max(1).leading_zeros()
+}
+
+/// Whether MSM at `storage` keeps its moments through the optimized quantization (every
+/// 16-bit storage does; f32 keeps the raw powers).
+pub fn msm_quantized(storage: Storage) -> bool {
+    storage != Storage::F32
+}
+
+/// Four-channel basis maps CSM with `terms` terms needs (two channels per term).
+pub fn csm_maps(terms: u32) -> u32 {
+    terms.div_ceil(2)
+}
+
+/// Parameters of `kernels/msm.wgsl` (mirrors its `Params`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct MsmParams {
+    /// 1: store the optimized quantization of the moments; 0: the raw powers.
+    pub quantized: u32,
+    /// Padding.
+    pub _pad: [u32; 3],
+}
+
+/// Parameters of `kernels/csm.wgsl` (mirrors its `Params`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct CsmParams {
+    /// Term k of the map's first pair (channels sin, cos of c_k z, then of c_{k+1} z).
+    pub first_term: u32,
+    /// Total terms M (a pair past M is written as zeros).
+    pub terms: u32,
+    /// Padding.
+    pub _pad: [u32; 2],
 }
 
 /// Parameters of `kernels/evsm.wgsl` and `kernels/esm.wgsl` (mirror their `Params`).
@@ -291,21 +425,23 @@ pub fn moments_format(storage: Storage, channels: u32) -> wgpu::TextureFormat {
         (Storage::F32, _) => wgpu::TextureFormat::Rgba32Float,
         // rg16float is no core storage format; rgba16float is.
         (Storage::F16, _) => wgpu::TextureFormat::Rgba16Float,
+        (Storage::Unorm16, _) => wgpu::TextureFormat::Rgba16Unorm,
     }
 }
 
 /// Adds the encoding node `kernel` (linear depth → representation) of light `i`, writing
-/// `light{i}.{kernel}`; the output's format picks the kernel's storage variant.
+/// `light{i}.{name}`; the output's format picks the kernel's storage variant.
 fn encode(
     graph: &mut Graph,
     i: usize,
     kernel: &str,
+    name: &str,
     linear: &str,
     format: wgpu::TextureFormat,
     params: Vec<u8>,
 ) -> String {
     let out = graph.resource(
-        format!("light{i}.{kernel}"),
+        format!("light{i}.{name}"),
         format,
         SizeRule::Reduced {
             of: linear.to_string(),
@@ -314,7 +450,7 @@ fn encode(
         Some(i),
     );
     graph.node(Node {
-        name: format!("light{i}.{kernel}"),
+        name: format!("light{i}.{name}"),
         kernel: kernel.into(),
         inputs: vec![("src".into(), linear.to_string())],
         outputs: vec![("dst".into(), out.clone())],
@@ -325,55 +461,75 @@ fn encode(
     out
 }
 
-/// How the shading kernel reads a light's map.
+/// How the shading kernel reads a light's maps.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ShadeInput {
-    /// Graph resource bound.
-    pub resource: String,
-    /// WGSL type of the binding.
+    /// Graph resources bound, in binding order (one for every technique but CSM, which binds
+    /// one map per two terms).
+    pub maps: Vec<String>,
+    /// WGSL type of each binding.
     pub wgsl_type: &'static str,
 }
 
-fn visibility_call(light: &Light, map: &str) -> (&'static str, String) {
+/// The module light `light`'s visibility function lives in, and the WGSL statements (ending in
+/// a `return`) that evaluate it with `l`, `s` in scope and its maps bound as `maps`.
+fn visibility_body(light: &Light, maps: &[String]) -> (&'static str, String) {
+    let map = maps.first().map_or("", String::as_str);
+    let call = |module, f: &str| (module, format!("return {f}({map}, l, s);"));
     match light.shadow.technique {
-        Technique::Hard => ("shared/vis_hard", format!("vis_hard({map}, l, s)")),
+        Technique::Hard => call("shared/vis_hard", "vis_hard"),
         Technique::Pcf {
             kernel: PcfKernel::Hardware,
             ..
         } => (
             "shared/vis_pcf",
-            format!("vis_pcf_hardware({map}, cmp_sampler, l, s)"),
+            format!("return vis_pcf_hardware({map}, cmp_sampler, l, s);"),
         ),
-        Technique::Pcf { .. } => ("shared/vis_pcf", format!("vis_pcf({map}, l, s)")),
-        Technique::Pcss { .. } => ("shared/vis_pcss", format!("vis_pcss({map}, l, s)")),
-        Technique::Vsm { .. } => ("shared/vis_vsm", format!("vis_vsm({map}, l, s)")),
-        Technique::Evsm { .. } => ("shared/vis_evsm", format!("vis_evsm({map}, l, s)")),
-        Technique::Esm { .. } => ("shared/vis_esm", format!("vis_esm({map}, l, s)")),
+        Technique::Pcf { .. } => call("shared/vis_pcf", "vis_pcf"),
+        Technique::Pcss { .. } => call("shared/vis_pcss", "vis_pcss"),
+        Technique::Vsm { .. } => call("shared/vis_vsm", "vis_vsm"),
+        Technique::Evsm { .. } => call("shared/vis_evsm", "vis_evsm"),
+        Technique::Esm { .. } => call("shared/vis_esm", "vis_esm"),
+        Technique::Msm { .. } => call("shared/vis_msm", "vis_msm"),
+        Technique::Csm { .. } => {
+            let mut body = String::from("var sum = 0.0;");
+            for (chunk, m) in maps.iter().enumerate() {
+                let _ = write!(body, "\n            sum += csm_chunk({m}, {chunk}u, l, s);");
+            }
+            body.push_str("\n            return csm_resolve(sum, l);");
+            ("shared/vis_csm", body)
+        }
     }
 }
 
 /// The `// #generated` block of `kernels/shade.wgsl` for these lights: imports of the
-/// techniques used, one group-1 binding per light (binding = light index) and
-/// `light_visibility`, which dispatches on the light index.
+/// techniques used, one group-1 binding per map (light by light, in [`ShadeInput::maps`]
+/// order) and `light_visibility`, which dispatches on the light index.
 pub fn shading_block(lights: &[Light]) -> String {
     let mut imports: Vec<&str> = Vec::new();
     let mut bindings = String::new();
     let mut cases = String::new();
+    let mut binding = 0;
     for (i, light) in lights.iter().enumerate() {
         let input = add_light_nodes(&mut Graph::default(), i, light);
-        let map = format!("light{i}_map");
-        let (module, call) = visibility_call(light, &map);
+        let maps: Vec<String> = (0..input.maps.len())
+            .map(|k| format!("light{i}_map{k}"))
+            .collect();
+        let (module, body) = visibility_body(light, &maps);
         if !imports.contains(&module) {
             imports.push(module);
         }
-        let _ = writeln!(
-            bindings,
-            "@group(1) @binding({i}) var {map}: {};",
-            input.wgsl_type
-        );
+        for map in &maps {
+            let _ = writeln!(
+                bindings,
+                "@group(1) @binding({binding}) var {map}: {};",
+                input.wgsl_type
+            );
+            binding += 1;
+        }
         let _ = writeln!(
             cases,
-            "        case {i}u: {{\n            let l = lights[{i}];\n            let s = light_sample(l, p, n);\n            if !s.inside {{ return 1.0; }}\n            return {call};\n        }}"
+            "        case {i}u: {{\n            let l = lights[{i}];\n            let s = light_sample(l, p, n);\n            if !s.inside {{ return 1.0; }}\n            {body}\n        }}"
         );
     }
     let mut s = String::new();

@@ -72,8 +72,27 @@ fn all_techniques() -> Vec<Technique> {
             min_variance: 1e-4,
         },
         Technique::Esm {
-            filter: Filter::None,
+            filter: Filter::Mips { width: 4.0 },
             exponent: 80.0,
+        },
+        Technique::Msm {
+            prefilter: Prefilter {
+                storage: Storage::Unorm16,
+                filter: Filter::Mips { width: 2.0 },
+            },
+            hausdorff: true,
+            moment_bias: 6e-5,
+            bleed: 0.0,
+        },
+        Technique::Csm {
+            prefilter: Prefilter {
+                storage: Storage::F16,
+                filter: Filter::None,
+            },
+            terms: 7,
+            attenuation: 1.0,
+            offset: 0.05,
+            scale: 2.0,
         },
     ]
 }
@@ -190,16 +209,29 @@ fn storage_format_variants_validate() {
     // The executor re-declares `dst` for the bound format; every format a technique can bind
     // must give a valid kernel.
     let mut failures = Vec::new();
-    for (kernel, formats) in [
-        ("vsm", ["rg32float", "rgba16float"]),
-        ("blur", ["rg32float", "rgba16float"]),
+    let all: &[&str] = &[
+        "r32float",
+        "rg32float",
+        "rgba32float",
+        "rgba16float",
+        "rgba16unorm",
+    ];
+    for (kernel, declared, formats) in [
+        ("vsm", "rg32float", &["rg32float", "rgba16float"][..]),
+        ("blur", "rg32float", all),
+        ("msm", "rgba32float", &["rgba16float", "rgba16unorm"][..]),
+        ("csm", "rgba32float", &["rg32float", "rgba16float"][..]),
+        ("mips", "rgba32float", all),
     ] {
         let base = kernels::resolve(kernel, None).unwrap();
         for f in formats {
-            let wgsl = base.replace(
-                "var dst: texture_storage_2d<rg32float,",
-                &format!("var dst: texture_storage_2d<{f},"),
-            );
+            let mut wgsl = base.clone();
+            for var in ["dst", "dst_a", "dst_b"] {
+                wgsl = wgsl.replace(
+                    &format!("var {var}: texture_storage_2d<{declared},"),
+                    &format!("var {var}: texture_storage_2d<{f},"),
+                );
+            }
             if let Err(e) = kernels::reflect(kernel, &wgsl) {
                 failures.push(format!("{kernel}@{f}: {e}"));
             }

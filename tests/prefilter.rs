@@ -262,7 +262,7 @@ fn vsm_light_plans_encode_and_two_blur_passes_only() {
         .map(|s| s.node.kernel.as_str())
         .collect();
     assert_eq!(kernels, ["linearize", "vsm", "blur", "blur"]);
-    assert_eq!(sp.shade_inputs[0].resource, "light0.vsm.blur_v");
+    assert_eq!(sp.shade_inputs[0].maps, ["light0.vsm.blur_v"]);
     // The encode's output is dead once blur_h has read it: blur_v (same shape) reuses it.
     let slot = |r: &str| sp.plan.resource(r).unwrap().slot;
     assert_eq!(slot("light0.vsm"), slot("light0.vsm.blur_v"));

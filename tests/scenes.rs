@@ -31,7 +31,7 @@ fn scenes() -> Vec<PathBuf> {
 fn pixel_reference(
     scene: &Scene,
     frame: &shadowgraph::render::Frame,
-    moments: &Texels,
+    moments: &[Texels],
     li: usize,
     px: usize,
 ) -> Option<(f64, f64)> {
@@ -64,6 +64,8 @@ fn pixel_reference(
             Technique::Vsm { .. } => cpu::vis_vsm::vis_vsm(moments, &lg, t),
             Technique::Evsm { .. } => cpu::vis_evsm::vis_evsm(moments, &lg, t),
             Technique::Esm { .. } => cpu::vis_esm::vis_esm(moments, &lg, t),
+            Technique::Msm { .. } => cpu::vis_msm::vis_msm(moments, &lg, t),
+            Technique::Csm { .. } => cpu::vis_csm::vis_csm(moments, &lg, t),
         }
     })
     .map(|v| {
@@ -76,6 +78,8 @@ fn pixel_reference(
             Technique::Vsm { .. } => common::vsm_tolerance(moments, &lg, &s),
             Technique::Evsm { .. } => common::evsm_tolerance(moments, &lg, &s),
             Technique::Esm { .. } => common::esm_tolerance(moments, &lg, &s, v),
+            Technique::Msm { .. } => common::msm_tolerance(moments, &lg, &s),
+            Technique::Csm { .. } => common::csm_tolerance(&lg),
             // Means of 0/1 taps in f32.
             _ => 1e-5,
         };
@@ -125,8 +129,17 @@ fn every_scene_renders_and_matches_the_references() {
         for li in 0..lights {
             check_prefilter_chain(&scene, &frame, li);
             let sm = &frame.shade_maps[li];
-            let moments =
+            let level0 =
                 Texels::from_f32(sm.width as usize, sm.height as usize, sm.channels, &sm.data);
+            // With the mips filter the shading reads the chain: rebuild it in f64 from level 0
+            // (the chain's own accuracy is tested in tests/prefilter.rs).
+            let technique = scene.lights[li].shadow.technique;
+            let moments = match technique.filter() {
+                Some(shadowgraph::scene::Filter::Mips { .. }) => {
+                    cpu::mips::mip_chain(&level0, matches!(technique, Technique::Esm { .. }))
+                }
+                _ => vec![level0],
+            };
             let (mut gpu_v, mut ref_v, mut tol, mut covered) =
                 (Vec::new(), Vec::new(), Vec::new(), 0);
             for px in 0..(frame.width * frame.height) as usize {
@@ -201,6 +214,31 @@ fn check_prefilter_chain(scene: &Scene, frame: &shadowgraph::render::Frame, li: 
                     1e-5,
                 )
             }
+            Technique::Msm { prefilter, .. } => {
+                let quantized = shadowgraph::technique::msm_quantized(prefilter.storage);
+                let f = move |t: &Texels| cpu::msm::msm(t, quantized);
+                (
+                    Box::new(f) as Box<dyn Fn(&Texels) -> Texels>,
+                    4,
+                    prefilter.filter,
+                    prefilter.storage,
+                    false,
+                    1e-6,
+                )
+            }
+            Technique::Csm {
+                prefilter, terms, ..
+            } => {
+                let f = move |t: &Texels| cpu::csm::csm(t, terms);
+                (
+                    Box::new(f) as Box<dyn Fn(&Texels) -> Texels>,
+                    2 * terms as usize,
+                    prefilter.filter,
+                    prefilter.storage,
+                    false,
+                    1e-6,
+                )
+            }
             _ => return,
         };
     let Some(linear) = &frame.linear_maps[li] else {
@@ -230,6 +268,14 @@ fn check_prefilter_chain(scene: &Scene, frame: &shadowgraph::render::Frame, li: 
     let (atol, rtol) = match storage {
         Storage::F32 => (1e-6, rtol),
         Storage::F16 => (1e-4, 3.0 * 2f64.powi(-10)),
+        // Rounding to 16 bits (2⁻¹⁷), after the quantization matrix's f32 products (entries up
+        // to 82: about 2·10⁻⁵).
+        Storage::Unorm16 => (6e-5, 0.0),
+    };
+    // CSM: Vulkan specifies sin/cos to 2⁻¹¹ absolute on [−π, π].
+    let atol = match scene.lights[li].shadow.technique {
+        Technique::Csm { .. } => atol + 2f64.powi(-11),
+        _ => atol,
     };
     common::assert_close(&format!("light {li} filtered map"), &got, &keep, atol, rtol);
 }

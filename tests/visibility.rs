@@ -177,15 +177,17 @@ fn pcss_matches_reference() {
     check(SPOT, t, 31);
 }
 
-/// A prefiltered technique on a map the CPU encoded and blurred from a random blocky linear
-/// map, at 3000 receivers. These techniques are continuous in the receiver (bilinear moments,
-/// no comparisons), so every point counts, each with its propagated f32 tolerance.
+/// A prefiltered technique on a map the CPU encoded (and blurred) from a random blocky linear
+/// map, at 3000 receivers. With the `mips` filter the CPU also builds the chain (in f64, then
+/// rounded to f32 as uploaded). Maps of more than four channels (CSM) are split into
+/// four-channel textures as the technique binds them. These techniques are continuous in the
+/// receiver (filtered values, no comparisons), so every point counts, each with its propagated
+/// f32 tolerance.
 fn check_prefiltered(
     technique: Technique,
-    format: wgpu::TextureFormat,
     encode: impl Fn(&cpu::Texels) -> cpu::Texels,
-    visibility: impl Fn(&cpu::Texels, &LightGpu, &cpu::light::LightSample) -> f64,
-    tolerance: impl Fn(&cpu::Texels, &LightGpu, &cpu::light::LightSample, f64) -> f64,
+    visibility: impl Fn(&[cpu::Texels], &LightGpu, &cpu::light::LightSample) -> f64,
+    tolerance: impl Fn(&[cpu::Texels], &LightGpu, &cpu::light::LightSample, f64) -> f64,
     seed: u64,
 ) {
     let g = common::gpu();
@@ -194,21 +196,59 @@ fn check_prefiltered(
         let l = light(kind, technique);
         let linear = common::blocky_map(&mut rng, MAP);
         let encoded = encode(&cpu::Texels::from_f32(MAP, MAP, 1, &linear));
-        let data: Vec<f32> = encoded.data.iter().map(|&v| v as f32).collect();
-        let encoded = cpu::Texels::from_f32(MAP, MAP, encoded.channels, &data);
+        let round = |t: &cpu::Texels| {
+            let data: Vec<f32> = t.data.iter().map(|&v| v as f32).collect();
+            cpu::Texels::from_f32(t.width, t.height, t.channels, &data)
+        };
+        let encoded = round(&encoded);
+        let levels: Vec<cpu::Texels> = match technique.filter() {
+            Some(shadowgraph::scene::Filter::Mips { .. }) => {
+                let log = matches!(technique, Technique::Esm { .. });
+                cpu::mips::mip_chain(&encoded, log)
+                    .iter()
+                    .map(round)
+                    .collect()
+            }
+            _ => vec![encoded.clone()],
+        };
+        // Split the channels into the textures the technique binds.
+        let channels = encoded.channels;
+        let mut uploads: Vec<(wgpu::TextureFormat, Vec<f32>)> = Vec::new();
+        for first in (0..channels).step_by(4) {
+            let n = (channels - first).min(4);
+            let format = match n {
+                1 => wgpu::TextureFormat::R32Float,
+                2 => wgpu::TextureFormat::Rg32Float,
+                _ => wgpu::TextureFormat::Rgba32Float,
+            };
+            let width = if n == 3 { 4 } else { n };
+            let mut data = Vec::new();
+            for level in &levels {
+                for texel in level.data.chunks(channels) {
+                    for c in 0..width {
+                        data.push(texel.get(first + c).map_or(0.0, |&v| v as f32));
+                    }
+                }
+            }
+            uploads.push((format, data));
+        }
+        let maps: Vec<ProbeMap> = uploads
+            .iter()
+            .map(|(format, data)| ProbeMap {
+                size: MAP as u32,
+                format: *format,
+                mips: levels.len() as u32,
+                data,
+            })
+            .collect();
         let points: Vec<(Vec3, Vec3)> = (0..3000).map(|_| point(&l, &mut rng)).collect();
         let mut renderer = Renderer::new(&g.device);
-        let map = ProbeMap {
-            size: MAP as u32,
-            format,
-            data: &data,
-        };
         let vis = probe(
             &mut renderer,
             &g.device,
             &g.queue,
             std::slice::from_ref(&l),
-            &[map],
+            &maps,
             &points,
         )
         .expect("probe");
@@ -217,13 +257,13 @@ fn check_prefiltered(
         for (p, n) in &points {
             let s = cpu::light::sample(&lg, p.as_dvec3(), n.as_dvec3());
             let v = if s.inside {
-                visibility(&encoded, &lg, &s)
+                visibility(&levels, &lg, &s)
             } else {
                 1.0
             };
             reference.push(v);
             tol.push(if s.inside {
-                tolerance(&encoded, &lg, &s, v)
+                tolerance(&levels, &lg, &s, v)
             } else {
                 0.0
             });
@@ -268,7 +308,6 @@ fn vsm_matches_reference_on_filtered_moments() {
     };
     check_prefiltered(
         t,
-        wgpu::TextureFormat::Rg32Float,
         |lin| blurred(&cpu::vsm::vsm(lin), false),
         cpu::vis_vsm::vis_vsm,
         |m, l, s, _| common::vsm_tolerance(m, l, s),
@@ -278,10 +317,7 @@ fn vsm_matches_reference_on_filtered_moments() {
 
 #[test]
 fn evsm2_and_evsm4_match_reference() {
-    for (four, format, seed) in [
-        (false, wgpu::TextureFormat::Rg32Float, 60),
-        (true, wgpu::TextureFormat::Rgba32Float, 61),
-    ] {
+    for (four, seed) in [(false, 60), (true, 61)] {
         let t = Technique::Evsm {
             prefilter: prefilter(),
             four,
@@ -293,7 +329,6 @@ fn evsm2_and_evsm4_match_reference() {
         let channels = if four { 4 } else { 2 };
         check_prefiltered(
             t,
-            format,
             move |lin| {
                 let e = blurred(&cpu::evsm::evsm(lin, 40.0, 5.0), false);
                 let data = e
@@ -327,7 +362,6 @@ fn esm_matches_reference_in_log_space() {
     };
     check_prefiltered(
         t,
-        wgpu::TextureFormat::R32Float,
         |lin| blurred(&cpu::esm::esm(lin, 80.0), true),
         cpu::vis_esm::vis_esm,
         common::esm_tolerance,

@@ -20,7 +20,7 @@ struct Light {
     bias: f32,               // constant bias, linear depth units
     normal_bias: f32,        // normal offset, texels, scaled by (1 − N·L)
     cos_outer: f32,          // spot cone: cos(fov/2); directional: −1
-    technique: u32,          // 0 hard, 1 pcf, 2 pcss
+    technique: u32,          // 0 hard, 1 pcf, 2 pcss, 3 vsm, 4 evsm, 5 esm, 6 msm, 7 csm
     radius: u32,             // pcf: window radius in texels
     kernel: u32,             // pcf: 0 box, 1 tent, 2 hardware 2×2
     blocker_samples: u32,    // pcss
@@ -31,6 +31,14 @@ struct Light {
     exp_pos: f32,            // evsm: positive exponent c⁺; esm: exponent c
     exp_neg: f32,            // evsm: negative exponent c⁻
     moments: u32,            // evsm: 2 or 4 stored moments
+    moment_bias: f32,        // msm: bias α toward the three-point moments
+    msm_flags: u32,          // msm: bit 0 Hausdorff (else Hamburger), bit 1 quantized storage
+    csm_terms: u32,          // csm: Fourier terms M
+    csm_attenuation: f32,    // csm: ringing attenuation α
+    csm_offset: f32,         // csm: receiver-depth offset
+    csm_scale: f32,          // csm: response scale about ½
+    mip_levels: u32,         // mips filter: levels in the map's chain (0: no mips)
+    filter_lod: f32,         // mips filter: log2 of the filter width in texels
     _pad0: u32,
     _pad1: u32,
 }

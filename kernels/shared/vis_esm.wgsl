@@ -4,6 +4,6 @@
 // #import shared/sampling
 
 fn vis_esm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    let log_moment = sample_bilinear_log(map, s.uv);
+    let log_moment = sample_map_log(map, l, s.uv);
     return clamp(exp(log_moment - l.exp_pos * (s.depth - l.bias)), 0.0, 1.0);
 }

@@ -5,7 +5,7 @@
 // #import shared/sampling
 
 fn vis_vsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    let m = sample_bilinear(map, s.uv);
+    let m = sample_map(map, l, s.uv);
     let d = s.depth - l.bias;
     if d <= m.x {
         return 1.0;

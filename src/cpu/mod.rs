@@ -2,13 +2,18 @@
 //! shader's shape so the two read side by side. Tests compare the GPU against these.
 
 pub mod blur;
+pub mod csm;
 pub mod esm;
 pub mod evsm;
 pub mod light;
 pub mod linearize;
+pub mod mips;
+pub mod msm;
+pub mod vis_csm;
 pub mod vis_esm;
 pub mod vis_evsm;
 pub mod vis_hard;
+pub mod vis_msm;
 pub mod vis_pcf;
 pub mod vis_pcss;
 pub mod vis_vsm;

@@ -23,9 +23,9 @@ pub fn warp(l: &LightGpu, s: &LightSample) -> [(f64, f64); 2] {
     [(pos, floor(cp, pos)), (neg, floor(cn, neg))]
 }
 
-/// EVSM2/EVSM4 visibility with bleeding reduction.
-pub fn vis_evsm(moments: &Texels, l: &LightGpu, s: &LightSample) -> f64 {
-    let m = moments.bilinear(s.uv);
+/// EVSM2/EVSM4 visibility with bleeding reduction (`levels`: the map, or its mip chain).
+pub fn vis_evsm(levels: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
+    let m = super::mips::sample(levels, l, s.uv);
     let [(pos, floor_pos), (neg, floor_neg)] = warp(l, s);
     let mut p = chebyshev_upper(m[0], m[1], pos, floor_pos);
     if l.moments == 4 {

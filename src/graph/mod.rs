@@ -35,7 +35,7 @@ pub struct Resource {
     pub format: wgpu::TextureFormat,
     /// Size rule.
     pub size: SizeRule,
-    /// Mip levels (1 for a plain map).
+    /// Mip levels (1 for a plain map; 0 asks the planner for the full chain down to 1×1).
     pub mips: u32,
     /// Provided from outside the graph (the rasterized shadow map); never allocated by it.
     pub imported: bool,
@@ -58,6 +58,9 @@ pub enum Dispatch {
         /// 0 for rows (horizontal), 1 for columns (vertical).
         axis: u32,
     },
+    /// A mip-chain node: the executor records one dispatch per two levels of the output
+    /// (its `dst` resource), each reading the level before (the `src` input for the first).
+    MipChain,
 }
 
 /// One kernel invocation in the graph.
@@ -106,6 +109,21 @@ impl Graph {
             imported: false,
             light,
         });
+        name
+    }
+
+    /// Declares a resource with a full mip chain (level count resolved by the planner).
+    pub fn mip_resource(
+        &mut self,
+        name: impl Into<String>,
+        format: wgpu::TextureFormat,
+        size: SizeRule,
+        light: Option<usize>,
+    ) -> String {
+        let name = self.resource(name, format, size, light);
+        if let Some(r) = self.resources.last_mut() {
+            r.mips = 0;
+        }
         name
     }
 

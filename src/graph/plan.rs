@@ -336,8 +336,11 @@ fn lifetimes(
         let i = match at.get(name) {
             Some(&i) => i,
             None => {
-                let r = &graph.resources[index[name]];
-                let (width, height) = resolve_size(graph, index, r, 0)?;
+                let mut r = graph.resources[index[name]].clone();
+                let (width, height) = resolve_size(graph, index, &r, 0)?;
+                if r.mips == 0 {
+                    r.mips = 32 - width.max(height).max(1).leading_zeros();
+                }
                 let slot = Slot {
                     format: r.format,
                     width,
@@ -345,7 +348,7 @@ fn lifetimes(
                     mips: r.mips,
                 };
                 planned.push(PlannedResource {
-                    resource: r.clone(),
+                    resource: r,
                     width,
                     height,
                     bytes: slot_bytes(&slot),

@@ -112,9 +112,9 @@ pub struct ShadowFile {
     pub filter_samples: Option<Spanned<i64>>,
     /// PCSS cap on the blocker-search radius, in shadow-map UV.
     pub max_search: Option<Spanned<f64>>,
-    /// Storage of a prefiltered representation: `f32` or `f16`.
+    /// Storage of a prefiltered representation: `f32`, `f16` or `unorm16` (MSM).
     pub format: Option<Spanned<String>>,
-    /// Prefilter: `none` or `blur`.
+    /// Prefilter: `none`, `blur` or `mips`.
     pub filter: Option<Spanned<String>>,
     /// Blur radius in texels (fractional for box edges).
     pub filter_radius: Option<Spanned<f64>>,
@@ -132,6 +132,20 @@ pub struct ShadowFile {
     pub exponent_pos: Option<Spanned<f64>>,
     /// EVSM4 negative exponent c⁻.
     pub exponent_neg: Option<Spanned<f64>>,
+    /// Mip filter width in texels.
+    pub filter_width: Option<Spanned<f64>>,
+    /// MSM reconstruction: `hamburger` or `hausdorff`.
+    pub reconstruction: Option<Spanned<String>>,
+    /// MSM moment bias α.
+    pub moment_bias: Option<Spanned<f64>>,
+    /// CSM number of Fourier terms M.
+    pub terms: Option<Spanned<i64>>,
+    /// CSM ringing attenuation α.
+    pub attenuation: Option<Spanned<f64>>,
+    /// CSM depth offset.
+    pub offset: Option<Spanned<f64>>,
+    /// CSM response scale.
+    pub scale: Option<Spanned<f64>>,
 }
 
 /// `[[object]]`.

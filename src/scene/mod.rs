@@ -5,6 +5,8 @@ pub mod format;
 pub mod mesh;
 mod validate;
 
+pub use validate::{default_moment_bias, exponent_limit};
+
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Vec3};
@@ -89,6 +91,9 @@ pub enum Storage {
     F32,
     /// 16-bit float channels.
     F16,
+    /// 16-bit normalized channels (MSM's optimized quantization; needs the device feature
+    /// `TEXTURE_FORMAT_16BIT_NORM`).
+    Unorm16,
 }
 
 /// Weights of the separable blur.
@@ -113,6 +118,12 @@ pub enum Filter {
         sigma: f32,
         /// Weights.
         kernel: BlurKernel,
+    },
+    /// A full mip chain (area-weighted 2×2 reduction, odd sizes included), sampled
+    /// trilinearly at the level of `width`.
+    Mips {
+        /// Filter width in level-0 texels (level `log2(width)` is sampled).
+        width: f32,
     },
 }
 
@@ -179,9 +190,47 @@ pub enum Technique {
         /// Exponent c.
         exponent: f32,
     },
+    /// Moment shadow maps (Peters & Klein 2015): (z, z², z³, z⁴), raw in f32 or through the
+    /// optimized 16-bit quantization; Hamburger or Hausdorff reconstruction.
+    Msm {
+        /// Storage (f32 raw; f16 or unorm16 quantized) and filter.
+        prefilter: Prefilter,
+        /// Hausdorff (support on [0, 1]) rather than Hamburger reconstruction.
+        hausdorff: bool,
+        /// Moment bias α toward the moments of a fixed three-point distribution.
+        moment_bias: f32,
+        /// Light-bleeding reduction.
+        bleed: f32,
+    },
+    /// Convolution shadow maps (Annen et al. 2007): Fourier basis sin(c_k z), cos(c_k z),
+    /// k = 1..M, in ⌈M/2⌉ four-channel maps.
+    Csm {
+        /// Storage and filter of the basis images.
+        prefilter: Prefilter,
+        /// Number of terms M (1–16).
+        terms: u32,
+        /// Ringing attenuation α: term k weighted by exp(−α (k/M)²).
+        attenuation: f32,
+        /// Offset subtracted from the receiver depth.
+        offset: f32,
+        /// Scale of the response about ½ before the clamp to [0, 1].
+        scale: f32,
+    },
 }
 
 impl Technique {
+    /// The filter of a prefiltered technique's representation.
+    pub fn filter(&self) -> Option<Filter> {
+        match *self {
+            Technique::Vsm { prefilter, .. }
+            | Technique::Evsm { prefilter, .. }
+            | Technique::Msm { prefilter, .. }
+            | Technique::Csm { prefilter, .. } => Some(prefilter.filter),
+            Technique::Esm { filter, .. } => Some(filter),
+            _ => None,
+        }
+    }
+
     /// The name used in scene files.
     pub fn name(&self) -> &'static str {
         match self {
@@ -192,6 +241,8 @@ impl Technique {
             Technique::Evsm { four: false, .. } => "evsm2",
             Technique::Evsm { four: true, .. } => "evsm4",
             Technique::Esm { .. } => "esm",
+            Technique::Msm { .. } => "msm",
+            Technique::Csm { .. } => "csm",
         }
     }
 }

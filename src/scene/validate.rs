@@ -282,6 +282,7 @@ const TECHNIQUE_KEYS: &[(&str, &[&str])] = &[
             RADIUS,
             SIGMA,
             KERNEL,
+            WIDTH,
             "bleed_reduction",
             "min_variance",
         ],
@@ -294,6 +295,7 @@ const TECHNIQUE_KEYS: &[(&str, &[&str])] = &[
             RADIUS,
             SIGMA,
             KERNEL,
+            WIDTH,
             "bleed_reduction",
             "min_variance",
             "exponent_pos",
@@ -307,25 +309,71 @@ const TECHNIQUE_KEYS: &[(&str, &[&str])] = &[
             RADIUS,
             SIGMA,
             KERNEL,
+            WIDTH,
             "bleed_reduction",
             "min_variance",
             "exponent_pos",
             "exponent_neg",
         ],
     ),
-    ("esm", &[FILTER, RADIUS, SIGMA, KERNEL, "exponent"]),
+    ("esm", &[FILTER, RADIUS, SIGMA, KERNEL, WIDTH, "exponent"]),
+    (
+        "msm",
+        &[
+            "format",
+            FILTER,
+            RADIUS,
+            SIGMA,
+            KERNEL,
+            WIDTH,
+            "reconstruction",
+            "moment_bias",
+            "bleed_reduction",
+        ],
+    ),
+    (
+        "csm",
+        &[
+            "format",
+            FILTER,
+            RADIUS,
+            SIGMA,
+            KERNEL,
+            WIDTH,
+            "terms",
+            "attenuation",
+            "offset",
+            "scale",
+        ],
+    ),
 ];
 const FILTER: &str = "filter";
 const RADIUS: &str = "filter_radius";
 const SIGMA: &str = "filter_sigma";
 const KERNEL: &str = "filter_kernel";
+const WIDTH: &str = "filter_width";
+
+/// Storage formats of the two- and four-moment float techniques.
+const FLOAT_STORAGE: &[(&str, Storage)] = &[("f32", Storage::F32), ("f16", Storage::F16)];
+
+/// Default MSM moment bias per storage: Peters & Klein's 6·10⁻⁵ for 16-bit normalized
+/// quantized moments; larger for f16 (11-bit mantissa); for f32 raw moments enough to keep the
+/// Hankel matrix positive definite under f32 shading arithmetic on flat regions (the stability
+/// suite's zero-variance cases).
+pub fn default_moment_bias(storage: Storage) -> f32 {
+    match storage {
+        Storage::F32 => 1e-5,
+        Storage::Unorm16 => 6e-5,
+        Storage::F16 => 5e-4,
+    }
+}
 
 /// Largest exponent whose squared moment stays finite after filtering: ln(FLT_MAX) = 88.7
 /// and ln(65504) = 11.09, halved for the square, with margin for fp32 (reference.md).
 pub fn exponent_limit(storage: Storage) -> f32 {
     match storage {
         Storage::F32 => 42.0,
-        Storage::F16 => 5.54,
+        Storage::F16 | Storage::Unorm16 => 5.54,
     }
 }
 
@@ -349,6 +397,13 @@ fn present(s: &ShadowFile) -> Vec<(&'static str, Range<usize>)> {
         ("exponent", sp(&s.exponent)),
         ("exponent_pos", sp(&s.exponent_pos)),
         ("exponent_neg", sp(&s.exponent_neg)),
+        ("filter_width", sp(&s.filter_width)),
+        ("reconstruction", sp(&s.reconstruction)),
+        ("moment_bias", sp(&s.moment_bias)),
+        ("terms", sp(&s.terms)),
+        ("attenuation", sp(&s.attenuation)),
+        ("offset", sp(&s.offset)),
+        ("scale", sp(&s.scale)),
     ]
     .into_iter()
     .filter_map(|(k, span)| span.map(|s| (k, s)))
@@ -433,12 +488,12 @@ fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
             max_search: ctx.num_or(&key("max_search"), &s.max_search, 1e-4, 1.0, 0.1)?,
         },
         "vsm" => Technique::Vsm {
-            prefilter: prefilter(ctx, i, s)?,
+            prefilter: prefilter(ctx, i, s, FLOAT_STORAGE)?,
             bleed: ctx.num_or(&key("bleed_reduction"), &s.bleed_reduction, 0.0, 0.99, 0.2)?,
             min_variance: ctx.num_or(&key("min_variance"), &s.min_variance, 0.0, 1.0, 1e-5)?,
         },
         "evsm2" | "evsm4" => {
-            let prefilter = prefilter(ctx, i, s)?;
+            let prefilter = prefilter(ctx, i, s, FLOAT_STORAGE)?;
             let limit = exponent_limit(prefilter.storage);
             let exponent = |k: &str, v: &Option<Spanned<f64>>, default: f32| -> Result<f32> {
                 let c = ctx.num_or(&key(k), v, 0.01, 1e4, default)?;
@@ -462,8 +517,44 @@ fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
                 min_variance: ctx.num_or(&key("min_variance"), &s.min_variance, 0.0, 1.0, 1e-4)?,
             }
         }
+        "msm" => {
+            let storages = [
+                ("f32", Storage::F32),
+                ("f16", Storage::F16),
+                ("unorm16", Storage::Unorm16),
+            ];
+            let prefilter = prefilter(ctx, i, s, &storages)?;
+            let reconstructions = [("hamburger", false), ("hausdorff", true)];
+            Technique::Msm {
+                prefilter,
+                hausdorff: ctx.choice(
+                    &key("reconstruction"),
+                    &s.reconstruction,
+                    &reconstructions,
+                    false,
+                )?,
+                moment_bias: ctx.num_or(
+                    &key("moment_bias"),
+                    &s.moment_bias,
+                    0.0,
+                    0.5,
+                    default_moment_bias(prefilter.storage),
+                )?,
+                bleed: ctx.num_or(&key("bleed_reduction"), &s.bleed_reduction, 0.0, 0.99, 0.0)?,
+            }
+        }
+        "csm" => {
+            let terms = ctx.int_or(&key("terms"), &s.terms, 1, 16, 8)?;
+            Technique::Csm {
+                prefilter: prefilter(ctx, i, s, FLOAT_STORAGE)?,
+                terms,
+                attenuation: ctx.num_or(&key("attenuation"), &s.attenuation, 0.0, 20.0, 1.0)?,
+                offset: ctx.num_or(&key("offset"), &s.offset, 0.0, 0.5, 0.5 / terms as f32)?,
+                scale: ctx.num_or(&key("scale"), &s.scale, 1.0, 16.0, 2.0)?,
+            }
+        }
         _ => Technique::Esm {
-            filter: prefilter(ctx, i, s)?.filter,
+            filter: prefilter(ctx, i, s, &[("f32", Storage::F32)])?.filter,
             exponent: ctx.num_or(&key("exponent"), &s.exponent, 0.01, 1e4, 80.0)?,
         },
     };
@@ -475,66 +566,82 @@ fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
     })
 }
 
-fn prefilter(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Prefilter> {
+fn prefilter(
+    ctx: &Ctx,
+    i: usize,
+    s: &ShadowFile,
+    storages: &[(&str, Storage)],
+) -> Result<Prefilter> {
     let key = |k: &str| format!("light[{i}].shadow.{k}");
-    let storage = ctx.choice(
-        &key("format"),
-        &s.format,
-        &[("f32", Storage::F32), ("f16", Storage::F16)],
-        Storage::F32,
-    )?;
-    let blur = ctx.choice(
+    let storage = ctx.choice(&key("format"), &s.format, storages, Storage::F32)?;
+    #[derive(Clone, Copy, PartialEq)]
+    enum Kind {
+        None,
+        Blur,
+        Mips,
+    }
+    let kind = ctx.choice(
         &key("filter"),
         &s.filter,
-        &[("none", false), ("blur", true)],
-        true,
+        &[
+            ("none", Kind::None),
+            ("blur", Kind::Blur),
+            ("mips", Kind::Mips),
+        ],
+        Kind::Blur,
     )?;
-    let filter = if blur {
-        let radius = ctx.num_or(
-            &key("filter_radius"),
-            &s.filter_radius,
-            0.0,
-            f64::from(crate::filter::MAX_BLUR_RADIUS),
-            2.0,
+    if kind != Kind::Blur {
+        let why = "needs `filter = \"blur\"`";
+        ctx.reject(&key("filter_radius"), &s.filter_radius, why)?;
+        ctx.reject(&key("filter_sigma"), &s.filter_sigma, why)?;
+        ctx.reject(&key("filter_kernel"), &s.filter_kernel, why)?;
+    }
+    if kind != Kind::Mips {
+        ctx.reject(
+            &key("filter_width"),
+            &s.filter_width,
+            "needs `filter = \"mips\"`",
         )?;
-        let kernel = ctx.choice(
-            &key("filter_kernel"),
-            &s.filter_kernel,
-            &[("gaussian", BlurKernel::Gaussian), ("box", BlurKernel::Box)],
-            BlurKernel::Gaussian,
-        )?;
-        if kernel == BlurKernel::Box {
-            ctx.reject(
+    }
+    let filter = match kind {
+        Kind::None => Filter::None,
+        Kind::Mips => Filter::Mips {
+            width: ctx.num_or(&key("filter_width"), &s.filter_width, 1.0, 65536.0, 1.0)?,
+        },
+        Kind::Blur => {
+            let radius = ctx.num_or(
+                &key("filter_radius"),
+                &s.filter_radius,
+                0.0,
+                f64::from(crate::filter::MAX_BLUR_RADIUS),
+                2.0,
+            )?;
+            let kernel = ctx.choice(
+                &key("filter_kernel"),
+                &s.filter_kernel,
+                &[("gaussian", BlurKernel::Gaussian), ("box", BlurKernel::Box)],
+                BlurKernel::Gaussian,
+            )?;
+            if kernel == BlurKernel::Box {
+                ctx.reject(
+                    &key("filter_sigma"),
+                    &s.filter_sigma,
+                    "does not apply to the box kernel",
+                )?;
+            }
+            let sigma = ctx.num_or(
                 &key("filter_sigma"),
                 &s.filter_sigma,
-                "does not apply to the box kernel",
+                0.1,
+                100.0,
+                (0.5 * radius).max(0.5),
             )?;
+            Filter::Blur {
+                radius,
+                sigma,
+                kernel,
+            }
         }
-        let sigma = ctx.num_or(
-            &key("filter_sigma"),
-            &s.filter_sigma,
-            0.1,
-            100.0,
-            (0.5 * radius).max(0.5),
-        )?;
-        Filter::Blur {
-            radius,
-            sigma,
-            kernel,
-        }
-    } else {
-        for (k, v) in [
-            ("filter_radius", &s.filter_radius),
-            ("filter_sigma", &s.filter_sigma),
-        ] {
-            ctx.reject(&key(k), v, "needs `filter = \"blur\"`")?;
-        }
-        ctx.reject(
-            &key("filter_kernel"),
-            &s.filter_kernel,
-            "needs `filter = \"blur\"`",
-        )?;
-        Filter::None
     };
     Ok(Prefilter { storage, filter })
 }

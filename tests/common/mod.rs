@@ -72,11 +72,11 @@ pub fn chebyshev_tolerance(mean: f64, mean_sq: f64, receiver: f64, floor: f64, e
 
 /// Tolerance of VSM visibility at `s`: inputs carry ~8 roundings (bilinear mix, depth).
 pub fn vsm_tolerance(
-    moments: &shadowgraph::cpu::Texels,
+    moments: &[shadowgraph::cpu::Texels],
     l: &shadowgraph::technique::LightGpu,
     s: &shadowgraph::cpu::light::LightSample,
 ) -> f64 {
-    let m = moments.bilinear(s.uv);
+    let m = shadowgraph::cpu::mips::sample(moments, l, s.uv);
     let d = s.depth - f64::from(l.bias);
     let dp = chebyshev_tolerance(
         m[0],
@@ -91,11 +91,11 @@ pub fn vsm_tolerance(
 /// Tolerance of EVSM visibility at `s`: besides the roundings of VSM, SPIR-V's `exp` is
 /// accurate to (3 + 2|x|) ULP, and the receiver's depth error is amplified by 2c.
 pub fn evsm_tolerance(
-    moments: &shadowgraph::cpu::Texels,
+    moments: &[shadowgraph::cpu::Texels],
     l: &shadowgraph::technique::LightGpu,
     s: &shadowgraph::cpu::light::LightSample,
 ) -> f64 {
-    let m = moments.bilinear(s.uv);
+    let m = shadowgraph::cpu::mips::sample(moments, l, s.uv);
     let [(pos, floor_pos), (neg, floor_neg)] = shadowgraph::cpu::vis_evsm::warp(l, s);
     let ulp = 2f64.powi(-23);
     let e = |c: f32| (3.0 + 4.0 * f64::from(c)) * ulp + 8.0 * ulp + 4.0 * f64::from(c) * ulp;
@@ -117,18 +117,14 @@ pub fn evsm_tolerance(
 /// f32: ~8 roundings of Z + near, over far − near, amplified by c), the inner exps and log of
 /// the log-space bilinear ((3 + 2|x|) ULP each) and the final exp, all relative to `v`.
 pub fn esm_tolerance(
-    logs: &shadowgraph::cpu::Texels,
+    logs: &[shadowgraph::cpu::Texels],
     l: &shadowgraph::technique::LightGpu,
     s: &shadowgraph::cpu::light::LightSample,
     v: f64,
 ) -> f64 {
-    let taps: Vec<f64> = [(0, 0), (1, 0), (0, 1), (1, 1)]
+    let taps: Vec<f64> = shadowgraph::cpu::mips::taps(logs, l, s.uv)
         .iter()
-        .map(|&(dx, dy)| {
-            let fx = (s.uv[0] * logs.width as f64 - 0.5).floor() as i64;
-            let fy = (s.uv[1] * logs.height as f64 - 0.5).floor() as i64;
-            logs.at(fx + dx, fy + dy)[0]
-        })
+        .map(|(_, t)| t[0])
         .collect();
     let (lo, hi) = taps
         .iter()
@@ -193,4 +189,50 @@ pub fn robust(
         }
     }
     Some(v)
+}
+
+/// Tolerance of MSM visibility at `s`: Cholesky in f32 is backward stable, so the GPU computes
+/// the exact answer for moments off by a few dozen roundings; the tolerance is twice the
+/// largest change of the f64 reference over 16 such perturbations (relative 32·2⁻²⁴ per
+/// moment, ±8·2⁻²⁴ on the receiver depth), plus 1e-4 for the final rational expression.
+pub fn msm_tolerance(
+    moments: &[shadowgraph::cpu::Texels],
+    l: &shadowgraph::technique::LightGpu,
+    s: &shadowgraph::cpu::light::LightSample,
+) -> f64 {
+    use shadowgraph::cpu::vis_msm::{biased_moments, intensity};
+    use shadowgraph::technique::MSM_HAUSDORFF;
+    let b = biased_moments(moments, l, s);
+    let d = s.depth - f64::from(l.bias);
+    let hausdorff = l.msm_flags & MSM_HAUSDORFF != 0;
+    let vis = |b: [f64; 4], d: f64| {
+        let v = 1.0 - intensity(b, d, hausdorff).clamp(0.0, 1.0);
+        if v.is_nan() { 1.0 } else { v }
+    };
+    let base = vis(b, d);
+    let e = 32.0 * 2f64.powi(-24);
+    let mut worst: f64 = 0.0;
+    for k in 0..16u32 {
+        let sign = |bit: u32| if k >> bit & 1 == 1 { 1.0 } else { -1.0 };
+        let p: [f64; 4] = std::array::from_fn(|i| b[i] * (1.0 + sign(i as u32) * e));
+        let dd = d + sign(k % 4) * 8.0 * 2f64.powi(-24);
+        worst = worst.max((vis(p, dd) - base).abs());
+    }
+    let bleed = f64::from(l.bleed);
+    (1e-4 + 2.0 * worst) / (1.0 - bleed)
+}
+
+/// Tolerance of CSM visibility: Vulkan specifies `sin`/`cos` to 2⁻¹¹ absolute on [−π, π]
+/// (the kernels reduce their arguments there), so term k may be off by w_k · 2 · 2⁻¹¹ in the
+/// receiver's factors; the sum is scaled by `scale`. Plus 1e-5 for the f32 sum.
+pub fn csm_tolerance(l: &shadowgraph::technique::LightGpu) -> f64 {
+    let m = f64::from(l.csm_terms);
+    let weights: f64 = (1..=l.csm_terms)
+        .map(|k| {
+            let kf = f64::from(k) / m;
+            2.0 / (std::f64::consts::PI * f64::from(2 * k - 1))
+                * (-f64::from(l.csm_attenuation) * kf * kf).exp()
+        })
+        .sum();
+    1e-5 + f64::from(l.csm_scale) * weights * 2.0 * 2f64.powi(-11)
 }

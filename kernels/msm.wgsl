@@ -1,0 +1,36 @@
+// Linear depth → four moments (z, z², z³, z⁴) for moment shadow maps (Peters & Klein 2015).
+// f32 storage keeps the raw powers; 16-bit storage (rgba16unorm, rgba16float) keeps the
+// optimized quantization of the paper's section 4.3: an affine map that spreads the moments of
+// any z ∈ [0, 1] over [0, 1] so 16 bits lose the least (shared/msm_quantize).
+// Storage: rgba32float by default; the executor re-declares `dst` for the bound format.
+
+// #import shared/msm_quantize
+
+// Keep in sync with `MsmParams` in src/technique.rs.
+struct Params {
+    quantized: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+@group(0) @binding(0) var src: texture_2d<f32>;
+@group(0) @binding(1) var dst: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(2) var<uniform> params: Params;
+
+const WG_SIZE: u32 = 16u;
+
+@compute @workgroup_size(WG_SIZE, WG_SIZE)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = textureDimensions(src);
+    if any(id.xy >= size) {
+        return;
+    }
+    let z = textureLoad(src, id.xy, 0).r;
+    let z2 = z * z;
+    var b = vec4<f32>(z, z2, z2 * z, z2 * z2);
+    if params.quantized == 1u {
+        b = msm_quantize(b);
+    }
+    textureStore(dst, id.xy, b);
+}

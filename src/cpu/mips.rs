@@ -1,0 +1,109 @@
+//! Reference of `kernels/mips.wgsl` and of `sample_map` / `sample_map_log` in
+//! `kernels/shared/sampling.wgsl`.
+
+use super::Texels;
+use crate::technique::LightGpu;
+
+/// Weight of texel `i` of an `n_from`-texel axis in texel `j` of its `n_to`-texel reduction:
+/// the overlap of `[i/n_from, (i+1)/n_from)` and `[j/n_to, (j+1)/n_to)` over the latter's length.
+fn weight(i: usize, j: usize, n_from: usize, n_to: usize) -> f64 {
+    let lo = (i * n_to).max(j * n_from);
+    let hi = ((i + 1) * n_to).min((j + 1) * n_from);
+    if hi <= lo {
+        0.0
+    } else {
+        (hi - lo) as f64 / n_from as f64
+    }
+}
+
+/// `t` reduced to `w`×`h` by area-weighted means (of `exp(v)`, as a log, when `log`).
+pub fn reduce(t: &Texels, w: usize, h: usize, log: bool) -> Texels {
+    let mut data = Vec::with_capacity(w * h * t.channels);
+    for y in 0..h {
+        for x in 0..w {
+            let mut taps = Vec::new();
+            for sy in 0..t.height {
+                let wy = weight(sy, y, t.height, h);
+                if wy == 0.0 {
+                    continue;
+                }
+                for sx in 0..t.width {
+                    let wx = weight(sx, x, t.width, w);
+                    if wx > 0.0 {
+                        taps.push((wx * wy, t.at(sx as i64, sy as i64)));
+                    }
+                }
+            }
+            data.extend(
+                (0..t.channels).map(|c| combine(taps.iter().map(|(w, v)| (*w, v[c])), log)),
+            );
+        }
+    }
+    Texels {
+        width: w,
+        height: h,
+        channels: t.channels,
+        data,
+    }
+}
+
+/// `Σ wᵢ vᵢ`, or `log Σ wᵢ exp(vᵢ)` when `log`.
+fn combine(taps: impl Iterator<Item = (f64, f64)> + Clone, log: bool) -> f64 {
+    if !log {
+        return taps.map(|(w, v)| w * v).sum();
+    }
+    let m = taps.clone().map(|(_, v)| v).fold(f64::MIN, f64::max);
+    m + taps.map(|(w, v)| w * (v - m).exp()).sum::<f64>().ln()
+}
+
+/// The full chain of `t`: level 0 is `t`, level m is `max(1, size >> m)`, each reduced from the
+/// one above, down to 1×1.
+pub fn mip_chain(t: &Texels, log: bool) -> Vec<Texels> {
+    let mut levels = vec![t.clone()];
+    while let Some(last) = levels.last() {
+        if last.width == 1 && last.height == 1 {
+            break;
+        }
+        let (w, h) = ((last.width / 2).max(1), (last.height / 2).max(1));
+        let next = reduce(last, w, h, log);
+        levels.push(next);
+    }
+    levels
+}
+
+/// The `(weight, texel)` taps `sample_map` reads at `uv`: bilinear on level 0, or with a mip
+/// chain (`l.mip_levels > 1`) bilinear on the two levels around `l.filter_lod`.
+pub fn taps<'a>(levels: &'a [Texels], l: &LightGpu, uv: [f64; 2]) -> Vec<(f64, &'a [f64])> {
+    let bilinear = |t: &'a Texels, scale: f64| {
+        let fx = uv[0] * t.width as f64 - 0.5;
+        let fy = uv[1] * t.height as f64 - 0.5;
+        let (x0, y0) = (fx.floor() as i64, fy.floor() as i64);
+        let (ax, ay) = (fx - fx.floor(), fy - fy.floor());
+        [
+            ((1.0 - ax) * (1.0 - ay), 0, 0),
+            (ax * (1.0 - ay), 1, 0),
+            ((1.0 - ax) * ay, 0, 1),
+            (ax * ay, 1, 1),
+        ]
+        .map(|(w, dx, dy)| (scale * w, t.at(x0 + dx, y0 + dy)))
+    };
+    if l.mip_levels <= 1 || levels.len() <= 1 {
+        return bilinear(&levels[0], 1.0).to_vec();
+    }
+    let top = (l.mip_levels.min(levels.len() as u32) - 1) as f64;
+    let lod = f64::from(l.filter_lod).clamp(0.0, top);
+    let l0 = lod.floor() as usize;
+    let l1 = (l0 + 1).min(top as usize);
+    let t = lod - lod.floor();
+    let mut v = bilinear(&levels[l0], 1.0 - t).to_vec();
+    v.extend(bilinear(&levels[l1], t));
+    v
+}
+
+/// `sample_map`: the filtered representation at `uv`.
+pub fn sample(levels: &[Texels], l: &LightGpu, uv: [f64; 2]) -> Vec<f64> {
+    let taps = taps(levels, l, uv);
+    (0..levels[0].channels)
+        .map(|c| taps.iter().map(|(w, v)| w * v[c]).sum())
+        .collect()
+}
