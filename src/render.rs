@@ -151,6 +151,9 @@ pub struct Frame {
     /// Per light, the map its shading reads (level 0): raw depth, linear depth or a filtered
     /// representation; CSM's basis maps side by side as one map of 2M channels (`aux` only).
     pub shade_maps: Vec<FloatMap>,
+    /// Per light, the further mip levels of its map (level 1 down to 1×1; empty without the
+    /// `mips` filter), channels concatenated like `shade_maps` (`aux` only).
+    pub shade_mips: Vec<Vec<FloatMap>>,
     /// Per light, the linear depth map, when the plan made one (`aux` only).
     pub linear_maps: Vec<Option<FloatMap>>,
     /// Every resource of the plan in plan order (`dump` only).
@@ -206,11 +209,22 @@ impl FloatMap {
         resource: &str,
         texture: &wgpu::Texture,
     ) -> Result<Self> {
-        let (channels, data) = crate::gpu::read_float_texture(device, queue, texture, 0)?;
+        Self::read_level(device, queue, resource, texture, 0)
+    }
+
+    /// Reads mip `level` of `texture` back.
+    pub fn read_level(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        resource: &str,
+        texture: &wgpu::Texture,
+        level: u32,
+    ) -> Result<Self> {
+        let (channels, data) = crate::gpu::read_float_texture(device, queue, texture, level)?;
         Ok(Self {
             resource: resource.to_string(),
-            width: texture.width(),
-            height: texture.height(),
+            width: (texture.width() >> level).max(1),
+            height: (texture.height() >> level).max(1),
             channels,
             data,
         })
@@ -532,6 +546,7 @@ impl Renderer {
             timings,
             sanitized,
             shade_maps: Vec::new(),
+            shade_mips: Vec::new(),
             linear_maps: Vec::new(),
             resources: Vec::new(),
         };
@@ -548,6 +563,22 @@ impl Renderer {
                     .map(|m| FloatMap::read(device, queue, m, &outputs.textures[m]))
                     .collect::<Result<Vec<_>>>()?;
                 frame.shade_maps.push(FloatMap::concat(maps)?);
+                let levels = input
+                    .maps
+                    .first()
+                    .map_or(1, |m| outputs.textures[m].mip_level_count());
+                let mut mips = Vec::new();
+                for level in 1..levels {
+                    let maps = input
+                        .maps
+                        .iter()
+                        .map(|m| {
+                            FloatMap::read_level(device, queue, m, &outputs.textures[m], level)
+                        })
+                        .collect::<Result<Vec<_>>>()?;
+                    mips.push(FloatMap::concat(maps)?);
+                }
+                frame.shade_mips.push(mips);
                 let linear = technique::linear_name(i);
                 frame.linear_maps.push(match outputs.textures.get(&linear) {
                     Some(t) => Some(FloatMap::read(device, queue, &linear, t)?),

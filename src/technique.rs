@@ -504,11 +504,15 @@ fn visibility_body(light: &Light, maps: &[String]) -> (&'static str, String) {
 
 /// The `// #generated` block of `kernels/shade.wgsl` for these lights: imports of the
 /// techniques used, one group-1 binding per map (light by light, in [`ShadeInput::maps`]
-/// order) and `light_visibility`, which dispatches on the light index.
+/// order), one visibility function per light and `light_visibility`, which dispatches on the
+/// light index. Every invocation evaluates its lights' visibility, also outside the map (then
+/// discarded by a `select`): llvmpipe (lavapipe) mis-fetches explicit mip levels when some
+/// invocations of a SIMD group have left the code path, so no path branches before sampling.
 pub fn shading_block(lights: &[Light]) -> String {
     let mut imports: Vec<&str> = Vec::new();
     let mut bindings = String::new();
     let mut cases = String::new();
+    let mut functions = String::new();
     let mut binding = 0;
     for (i, light) in lights.iter().enumerate() {
         let input = add_light_nodes(&mut Graph::default(), i, light);
@@ -528,8 +532,12 @@ pub fn shading_block(lights: &[Light]) -> String {
             binding += 1;
         }
         let _ = writeln!(
+            functions,
+            "fn light{i}_visibility(l: Light, s: LightSample) -> f32 {{\n    {body}\n}}"
+        );
+        let _ = writeln!(
             cases,
-            "        case {i}u: {{\n            let l = lights[{i}];\n            let s = light_sample(l, p, n);\n            if !s.inside {{ return 1.0; }}\n            {body}\n        }}"
+            "        case {i}u: {{\n            let l = lights[{i}];\n            let s = light_sample(l, p, n);\n            return select(1.0, light{i}_visibility(l, s), s.inside);\n        }}"
         );
     }
     let mut s = String::new();
@@ -537,6 +545,7 @@ pub fn shading_block(lights: &[Light]) -> String {
         let _ = writeln!(s, "// #import {m}");
     }
     s.push_str(&bindings);
+    s.push_str(&functions);
     let _ = write!(
         s,
         "fn light_visibility(i: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {{\n    switch i {{\n{cases}        default: {{ return 1.0; }}\n    }}\n}}\n"

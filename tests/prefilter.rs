@@ -34,6 +34,11 @@ fn upload(g: &Gpu, w: u32, h: u32, format: wgpu::TextureFormat, data: &[f32]) ->
 /// Plans `graph` for `output`, runs it with `input` imported as "in" (the output poisoned with
 /// NaN first, so unwritten texels show) and reads the output back.
 fn run(g: &Gpu, graph: &Graph, output: &str, input: wgpu::Texture) -> Texels {
+    run_levels(g, graph, output, input).swap_remove(0)
+}
+
+/// [`run`], reading back every mip level of the output.
+fn run_levels(g: &Gpu, graph: &Graph, output: &str, input: wgpu::Texture) -> Vec<Texels> {
     let plan = plan(graph, &[output]).expect("plan");
     let mut exec = Executor::new();
     let imports = HashMap::from([("in".to_string(), input)]);
@@ -49,7 +54,9 @@ fn run(g: &Gpu, graph: &Graph, output: &str, input: wgpu::Texture) -> Texels {
     } else {
         4
     };
-    if out_tex.format() != wgpu::TextureFormat::Rgba16Float {
+    let f32_texels =
+        shadowgraph::graph::texel_bytes(out_tex.format()) == 4 * poison_channels as u64;
+    if f32_texels && out_tex.mip_level_count() == 1 {
         write_texture(
             &g.queue,
             out_tex,
@@ -61,8 +68,14 @@ fn run(g: &Gpu, graph: &Graph, output: &str, input: wgpu::Texture) -> Texels {
         .record(&g.device, &mut enc, &plan, &imports, None)
         .expect("record");
     submit_and_wait(&g.device, &g.queue, enc, "run").unwrap();
-    let (c, v) = read_float_texture(&g.device, &g.queue, &outputs.textures[output], 0).unwrap();
-    Texels::from_f32(w as usize, h as usize, c, &v)
+    let t = &outputs.textures[output];
+    (0..t.mip_level_count())
+        .map(|level| {
+            let (c, v) = read_float_texture(&g.device, &g.queue, t, level).unwrap();
+            let (lw, lh) = ((w >> level).max(1), (h >> level).max(1));
+            Texels::from_f32(lw as usize, lh as usize, c, &v)
+        })
+        .collect()
 }
 
 fn random_linear(rng: &mut impl Rng, w: usize, h: usize) -> Vec<f32> {
@@ -364,4 +377,268 @@ fn evsm_and_esm_encodings_match_reference() {
 
 fn channels_of(t: &Texels, n: usize) -> Vec<f32> {
     channels(t, n)
+}
+
+#[test]
+fn msm_encoding_matches_reference_for_each_storage() {
+    use shadowgraph::filter::BlurMode;
+    use shadowgraph::technique::MsmParams;
+    let g = common::gpu();
+    let mut rng = common::rng(43);
+    let (w, h) = (1000u32, 37u32);
+    let lin = random_linear(&mut rng, w as usize, h as usize);
+    let input = Texels::from_f32(w as usize, h as usize, 1, &lin);
+    let blur = Filter::Blur {
+        radius: 2.0,
+        sigma: 1.0,
+        kernel: BlurKernel::Gaussian,
+    };
+    for (format, quantized, filter, atol, rtol) in [
+        // Raw powers of z ≤ 1: a few roundings each.
+        (
+            wgpu::TextureFormat::Rgba32Float,
+            false,
+            None,
+            1e-7,
+            4.0 * 2f64.powi(-24),
+        ),
+        (
+            wgpu::TextureFormat::Rgba32Float,
+            false,
+            Some(blur),
+            1e-7,
+            1e-6,
+        ),
+        // Quantization matrix entries up to 82 in f32 (~2·10⁻⁵ absolute), then f16 storage
+        // after the encoding and each blur pass (Vulkan allows round-toward-zero: 2⁻¹⁰
+        // relative each, three times) or 16-bit rounding (2⁻¹⁷ absolute).
+        (
+            wgpu::TextureFormat::Rgba16Float,
+            true,
+            Some(blur),
+            3e-5,
+            3.0 * 2f64.powi(-10),
+        ),
+        (
+            wgpu::TextureFormat::Rgba16Unorm,
+            true,
+            None,
+            3e-5 + 2f64.powi(-17),
+            0.0,
+        ),
+    ] {
+        let params = bytemuck::bytes_of(&MsmParams {
+            quantized: u32::from(quantized),
+            _pad: [0; 3],
+        })
+        .to_vec();
+        let (graph, out) = encode_graph("msm", params, w, h, format, filter, BlurMode::Linear);
+        let gpu = run(
+            &g,
+            &graph,
+            &out,
+            upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin),
+        );
+        let mut expected = cpu::msm::msm(&input, quantized);
+        if filter.is_some() {
+            expected = cpu::blur::blur(&expected, 2.0, 1.0, BlurKernel::Gaussian);
+        }
+        common::assert_close(
+            &format!("msm {format:?} blur {}", filter.is_some()),
+            &channels(&gpu, 4),
+            &expected.data,
+            atol,
+            rtol,
+        );
+        if quantized {
+            // The optimized quantization keeps every z ∈ [0, 1] inside [0, 1].
+            assert!(
+                gpu.data.iter().all(|v| (-1e-6..=1.0 + 1e-6).contains(v)),
+                "quantized moments leave [0, 1]"
+            );
+        }
+    }
+    // Dequantization inverts quantization (the two published matrices).
+    for z in [0.0, 0.1, 0.5, 0.93, 1.0] {
+        let b = [z, z * z, z * z * z, z * z * z * z];
+        let back = cpu::msm::dequantize(cpu::msm::quantize(b));
+        for i in 0..4 {
+            assert!((back[i] - b[i]).abs() < 1e-8, "z = {z}: {back:?} vs {b:?}");
+        }
+    }
+}
+
+#[test]
+fn csm_basis_matches_reference() {
+    use shadowgraph::filter::BlurMode;
+    use shadowgraph::technique::CsmParams;
+    let g = common::gpu();
+    let mut rng = common::rng(44);
+    let (w, h) = (257u32, 31u32);
+    let lin = random_linear(&mut rng, w as usize, h as usize);
+    let input = Texels::from_f32(w as usize, h as usize, 1, &lin);
+    let terms = 7;
+    let expected = cpu::csm::csm(&input, terms);
+    for (first_term, format) in [
+        (1u32, wgpu::TextureFormat::Rgba32Float),
+        (5, wgpu::TextureFormat::Rgba16Float),
+        (7, wgpu::TextureFormat::Rg32Float),
+    ] {
+        let params = bytemuck::bytes_of(&CsmParams {
+            first_term,
+            terms,
+            _pad: [0; 2],
+        })
+        .to_vec();
+        let (graph, out) = encode_graph("csm", params, w, h, format, None, BlurMode::Linear);
+        let gpu = run(
+            &g,
+            &graph,
+            &out,
+            upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin),
+        );
+        let n = (2 * (terms - first_term + 1)).min(4) as usize;
+        let first = 2 * (first_term as usize - 1);
+        let keep: Vec<f64> = expected
+            .data
+            .chunks(expected.channels)
+            .flat_map(|c| c[first..first + n].to_vec())
+            .collect();
+        // Vulkan's sin/cos: 2⁻¹¹ absolute on [−π, π] (the kernel reduces its argument there);
+        // f16 storage adds 2⁻¹¹ relative.
+        let rtol = if format == wgpu::TextureFormat::Rgba16Float {
+            2f64.powi(-11)
+        } else {
+            0.0
+        };
+        common::assert_close(
+            &format!("csm terms {first_term}.. {format:?}"),
+            &channels(&gpu, n),
+            &keep,
+            2f64.powi(-11),
+            rtol,
+        );
+    }
+}
+
+#[test]
+fn mip_chain_matches_reference_and_ends_at_the_mean() {
+    use shadowgraph::filter::BlurMode;
+    let g = common::gpu();
+    let mut rng = common::rng(45);
+    for (w, h, mode) in [
+        (1000u32, 37u32, BlurMode::Linear),
+        (61, 61, BlurMode::Linear),
+        (64, 64, BlurMode::LogSumExp),
+        (1, 57, BlurMode::Linear),
+        (1, 1, BlurMode::Linear),
+        (130, 7, BlurMode::LogSumExp),
+    ] {
+        let lin = random_linear(&mut rng, w as usize, h as usize);
+        let log = mode == BlurMode::LogSumExp;
+        // Log mode holds logarithms (ESM's c·z with c = 80); linear mode the VSM moments.
+        let data: Vec<f32> = if log {
+            lin.iter().map(|z| 80.0 * z).collect()
+        } else {
+            lin.clone()
+        };
+        let mut graph = Graph::default();
+        graph.import("in", wgpu::TextureFormat::R32Float, w, h, Some(0));
+        let out = shadowgraph::filter::add_filter(
+            &mut graph,
+            0,
+            "in",
+            &Filter::Mips { width: 1.0 },
+            mode,
+        );
+        let gpu = run_levels(
+            &g,
+            &graph,
+            &out,
+            upload(&g, w, h, wgpu::TextureFormat::R32Float, &data),
+        );
+        let input = Texels::from_f32(w as usize, h as usize, 1, &data);
+        let expected = cpu::mips::mip_chain(&input, log);
+        assert_eq!(gpu.len(), expected.len(), "{w}x{h}: level count");
+        for (level, (got, want)) in gpu.iter().zip(&expected).enumerate() {
+            assert_eq!((got.width, got.height), (want.width, want.height));
+            // Each level: at most 16 weighted taps of the level above in f32, so a few ULP per
+            // level, compounding over the chain (≤ 11 levels here); log mode adds exp/log at
+            // (3 + 2|x|) ULP with |x| ≤ 80.
+            let (atol, rtol) = if log {
+                (4.0 * (3.0 + 2.0 * 80.0) * 2f64.powi(-23), 2f64.powi(-20))
+            } else {
+                (0.0, 8.0 * (level as f64 + 1.0) * 2f64.powi(-24))
+            };
+            common::assert_close(
+                &format!("{w}x{h} {mode:?} level {level}"),
+                &channels(got, 1),
+                &want.data,
+                atol,
+                rtol,
+            );
+        }
+        // The last level is the mean of the whole map (of exp(v), as a log, in log mode),
+        // computed directly, not through the chain.
+        let last = gpu.last().unwrap().data[0];
+        let n = data.len() as f64;
+        let mean = if log {
+            let m = data.iter().fold(f32::MIN, |a, &b| a.max(b)) as f64;
+            m + (data.iter().map(|&v| (f64::from(v) - m).exp()).sum::<f64>() / n).ln()
+        } else {
+            data.iter().map(|&v| f64::from(v)).sum::<f64>() / n
+        };
+        let tol = if log { 1e-3 } else { 1e-5 * mean.abs() };
+        assert!(
+            (last - mean).abs() <= tol,
+            "{w}x{h}: last level {last} vs mean {mean}"
+        );
+    }
+}
+
+#[test]
+fn mip_chain_of_16_bit_maps_matches_reference() {
+    use shadowgraph::filter::BlurMode;
+    use shadowgraph::technique::MsmParams;
+    let g = common::gpu();
+    let mut rng = common::rng(46);
+    let (w, h) = (200u32, 75u32);
+    let lin = random_linear(&mut rng, w as usize, h as usize);
+    for format in [
+        wgpu::TextureFormat::Rgba16Float,
+        wgpu::TextureFormat::Rgba16Unorm,
+        wgpu::TextureFormat::Rgba32Float,
+    ] {
+        let params = bytemuck::bytes_of(&MsmParams {
+            quantized: 1,
+            _pad: [0; 3],
+        })
+        .to_vec();
+        let (graph, out) = encode_graph(
+            "msm",
+            params,
+            w,
+            h,
+            format,
+            Some(Filter::Mips { width: 1.0 }),
+            BlurMode::Linear,
+        );
+        let gpu = run_levels(
+            &g,
+            &graph,
+            &out,
+            upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin),
+        );
+        for level in 1..gpu.len() {
+            let above = &gpu[level - 1];
+            let want = cpu::mips::reduce(above, gpu[level].width, gpu[level].height, false);
+            common::assert_close(
+                &format!("{format:?} level {level}"),
+                &channels(&gpu[level], 4),
+                &want.data,
+                2f64.powi(-15),
+                2f64.powi(-9),
+            );
+        }
+    }
 }

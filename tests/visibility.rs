@@ -368,3 +368,106 @@ fn esm_matches_reference_in_log_space() {
         70,
     );
 }
+
+fn msm(storage: shadowgraph::scene::Storage, hausdorff: bool, filter: Filter) -> Technique {
+    Technique::Msm {
+        prefilter: shadowgraph::scene::Prefilter { storage, filter },
+        hausdorff,
+        moment_bias: shadowgraph::scene::default_moment_bias(storage),
+        bleed: 0.05,
+    }
+}
+
+use shadowgraph::scene::{Filter, Storage};
+
+#[test]
+fn msm_hamburger_and_hausdorff_match_reference() {
+    let blur = prefilter().filter;
+    for (hausdorff, seed) in [(false, 80), (true, 81)] {
+        check_prefiltered(
+            msm(Storage::F32, hausdorff, blur),
+            |lin| blurred(&cpu::msm::msm(lin, false), false),
+            cpu::vis_msm::vis_msm,
+            |m, l, s, _| common::msm_tolerance(m, l, s),
+            seed,
+        );
+    }
+}
+
+#[test]
+fn msm_quantized_moments_match_reference() {
+    // The shading dequantizes whatever the texture holds; the values here are the f32
+    // quantized moments, so only the storage's bias and flag differ from the f32 case.
+    check_prefiltered(
+        msm(Storage::Unorm16, false, prefilter().filter),
+        |lin| blurred(&cpu::msm::msm(lin, true), false),
+        cpu::vis_msm::vis_msm,
+        |m, l, s, _| common::msm_tolerance(m, l, s),
+        82,
+    );
+}
+
+fn csm(terms: u32, filter: Filter) -> Technique {
+    Technique::Csm {
+        prefilter: shadowgraph::scene::Prefilter {
+            storage: Storage::F32,
+            filter,
+        },
+        terms,
+        attenuation: 1.0,
+        offset: 0.5 / terms as f32,
+        scale: 2.0,
+    }
+}
+
+#[test]
+fn csm_matches_reference_for_odd_and_even_terms() {
+    for (terms, seed) in [(7, 90), (16, 91)] {
+        check_prefiltered(
+            csm(terms, prefilter().filter),
+            move |lin| blurred(&cpu::csm::csm(lin, terms), false),
+            cpu::vis_csm::vis_csm,
+            |_, l, _, _| common::csm_tolerance(l),
+            seed,
+        );
+    }
+}
+
+#[test]
+fn mip_filtered_lookups_match_reference_trilinearly() {
+    // A width of 2.6 texels samples between levels 1 and 2 of the chain.
+    let mips = Filter::Mips { width: 2.6 };
+    let vsm = Technique::Vsm {
+        prefilter: shadowgraph::scene::Prefilter {
+            storage: Storage::F32,
+            filter: mips,
+        },
+        bleed: 0.2,
+        min_variance: 1e-5,
+    };
+    check_prefiltered(
+        vsm,
+        cpu::vsm::vsm,
+        cpu::vis_vsm::vis_vsm,
+        |m, l, s, _| common::vsm_tolerance(m, l, s),
+        100,
+    );
+    let esm = Technique::Esm {
+        filter: mips,
+        exponent: 80.0,
+    };
+    check_prefiltered(
+        esm,
+        |lin| cpu::esm::esm(lin, 80.0),
+        cpu::vis_esm::vis_esm,
+        common::esm_tolerance,
+        101,
+    );
+    check_prefiltered(
+        csm(5, mips),
+        |lin| cpu::csm::csm(lin, 5),
+        cpu::vis_csm::vis_csm,
+        |_, l, _, _| common::csm_tolerance(l),
+        102,
+    );
+}
