@@ -199,6 +199,16 @@ impl Prefilter {
         wgsl::host_block(&self.config.technique, group, first_binding)
     }
 
+    /// The host's bind group layout entries for [`Prefilter::wgsl`]'s bindings (maps, then
+    /// the comparison sampler where needed), visible to `visibility`.
+    pub fn layout_entries(
+        &self,
+        first_binding: u32,
+        visibility: wgpu::ShaderStages,
+    ) -> Result<Vec<wgpu::BindGroupLayoutEntry>> {
+        wgsl::layout_entries(&self.config.technique, first_binding, visibility)
+    }
+
     /// Whether the technique reads the raw depth through a comparison sampler (hardware PCF):
     /// the host binds one (linear filtering, compare less-equal) after the maps.
     pub fn needs_comparison_sampler(&self) -> Result<bool> {

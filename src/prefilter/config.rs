@@ -152,6 +152,12 @@ impl PrefilterConfig {
         })
     }
 
+    /// The same on `size`² maps.
+    pub fn with_size(mut self, size: u32) -> Self {
+        self.size = size;
+        self
+    }
+
     /// The same with constant bias `bias` (linear depth units).
     pub fn with_bias(mut self, bias: f32) -> Self {
         self.bias = bias;
@@ -383,16 +389,16 @@ impl LightParams {
             let d = clip.z / clip.w;
             if (clip.w - w).abs() > 1e-4 * w || (d - depth).abs() > 1e-4 {
                 let kind = if self.perspective {
-                    "perspective"
+                    "a perspective"
                 } else {
-                    "orthographic"
+                    "an orthographic"
                 };
                 return Err(err(
                     "projection",
                     format!(
-                        "maps the {plane} plane (z = −{z}) to depth {d} with w = {}; a {kind} \
-                         projection with depth 0 at near and 1 at far (not reversed Z) gives \
-                         {depth} with w = {w}",
+                        "maps the {plane} plane (z = −{z}) to depth {d} with w = {}, where \
+                         {kind} projection with depth 0 at near and 1 at far (not reversed Z) \
+                         gives depth {depth} with w = {w}",
                         clip.w
                     ),
                 ));

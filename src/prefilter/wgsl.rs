@@ -230,3 +230,25 @@ fn split_tokens(text: &str) -> Vec<&str> {
     }
     out
 }
+
+/// Bind group layout entries of the bindings [`host_block`] declares from `first_binding` on,
+/// reflected from that WGSL: unfilterable-float textures for maps (f32 maps need no filtering
+/// feature), a depth texture and comparison sampler for hardware PCF.
+pub fn layout_entries(
+    technique: &Technique,
+    first_binding: u32,
+    visibility: wgpu::ShaderStages,
+) -> Result<Vec<wgpu::BindGroupLayoutEntry>> {
+    let block = host_block(technique, 0, first_binding)?;
+    let (_, reflection) = kernels::reflect(&format!("export/{}", technique.name()), &block)?;
+    Ok(reflection
+        .bindings
+        .iter()
+        .map(|b| wgpu::BindGroupLayoutEntry {
+            binding: b.binding,
+            visibility,
+            ty: b.ty,
+            count: None,
+        })
+        .collect())
+}
