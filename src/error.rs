@@ -81,6 +81,9 @@ pub enum Error {
         /// The device limit.
         limit: u64,
     },
+    /// What a host handed the plug-in stage is unusable (see [`crate::prefilter`]).
+    #[error("plug-in stage: {0}")]
+    Stage(#[from] crate::prefilter::StageError),
     /// An argument is invalid (zero size, mismatched lengths, ...).
     /// The scene needs a device feature the adapter does not offer.
     #[error("{what} needs the device feature {feature}, which this adapter does not offer")]

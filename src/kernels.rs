@@ -76,6 +76,15 @@ pub fn resolve(name: &str, generated: Option<&str>) -> Result<String> {
     Ok(out)
 }
 
+/// Resolves the `// #import` lines of `text`, WGSL that is not a file in `kernels/` (e.g. the
+/// plug-in stage's exported library); `name` labels errors.
+pub fn resolve_source(name: &str, text: &str) -> Result<String> {
+    let mut seen = HashSet::new();
+    let mut out = String::new();
+    resolve_text(name, text, None, &mut seen, &mut out)?;
+    Ok(out)
+}
+
 fn resolve_text(
     name: &str,
     text: &str,

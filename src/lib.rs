@@ -10,6 +10,7 @@ pub mod gpu;
 pub mod graph;
 pub mod io;
 pub mod kernels;
+pub mod prefilter;
 pub mod render;
 pub mod scene;
 pub mod technique;

@@ -1,0 +1,538 @@
+//! A small renderer of its own — its own device, geometry, depth pass, pipelines and shading,
+//! in plain wgpu — that uses shadowgraph only as a plug-in preprocess stage: each frame it
+//! hands its shadow depth texture to one `Prefilter` per moment technique and shades with the
+//! WGSL the stage exports. Writes a 2×2 panel PNG (VSM, EVSM2 / EVSM4, ESM).
+//!
+//!     cargo run --release --example host_renderer [-- out.png]     (default target/host_renderer.png)
+
+use anyhow::{Context, Result};
+use glam::{Mat4, Vec3};
+use shadowgraph::prefilter::{LightParams, Prefilter, PrefilterConfig};
+use wgpu::util::DeviceExt;
+
+const PANEL: (u32, u32) = (384, 288);
+const SHADOW_MAP: u32 = 1024;
+const FRAMES: u32 = 3;
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Vertex {
+    position: [f32; 3],
+    normal: [f32; 3],
+    color: [f32; 3],
+}
+
+/// The host's shading: Lambert and ambient, with shadowgraph's visibility per fragment.
+const SHADE: &str = "
+@group(0) @binding(0) var<uniform> camera: mat4x4<f32>;
+@group(0) @binding(1) var<uniform> light: Light;
+
+struct VsOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) color: vec3<f32>,
+}
+
+@vertex
+fn vs_main(@location(0) p: vec3<f32>, @location(1) n: vec3<f32>, @location(2) c: vec3<f32>) -> VsOut {
+    return VsOut(camera * vec4<f32>(p, 1.0), p, n, c);
+}
+
+@fragment
+fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
+    let n = normalize(in.normal);
+    let lit = max(dot(n, -light.direction), 0.0) * shadowgraph_visibility(light, in.world, n);
+    return vec4<f32>(in.color * (0.15 + 0.85 * lit), 1.0);
+}
+";
+
+/// The host's depth pass from the light.
+const DEPTH: &str = "
+@group(0) @binding(0) var<uniform> view_proj: mat4x4<f32>;
+@vertex
+fn vs_main(@location(0) p: vec3<f32>) -> @builtin(position) vec4<f32> {
+    return view_proj * vec4<f32>(p, 1.0);
+}
+";
+
+fn main() -> Result<()> {
+    let out = std::env::args()
+        .nth(1)
+        .unwrap_or_else(|| "target/host_renderer.png".into());
+    let start = std::time::Instant::now();
+    let (device, queue) = pollster::block_on(device())?;
+    let host = Host::new(&device);
+    let configs = [
+        PrefilterConfig::vsm(SHADOW_MAP),
+        PrefilterConfig::evsm2(SHADOW_MAP),
+        PrefilterConfig::evsm4(SHADOW_MAP),
+        PrefilterConfig::esm(SHADOW_MAP),
+    ];
+    let mut panels = Vec::new();
+    for config in &configs {
+        // The stage: pipelines once; its WGSL and layout go into the host's own pipeline.
+        let mut stage = Prefilter::new(&device, config)?;
+        if device.features().contains(wgpu::Features::TIMESTAMP_QUERY) {
+            stage.enable_timing(&device, &queue)?;
+        }
+        let maps_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("host.maps"),
+            entries: &stage.layout_entries(0, wgpu::ShaderStages::FRAGMENT)?,
+        });
+        let pipeline = host.shade_pipeline(&device, &stage.wgsl(1, 0)?, &maps_layout);
+        panels.push((stage, maps_layout, pipeline));
+    }
+    let mut rgba = Vec::new();
+    for frame in 0..FRAMES {
+        // The light moves a little each frame: new matrices, same stages and textures.
+        let angle = 3.9 + 0.05 * frame as f32;
+        let eye = Vec3::new(8.0 * angle.cos(), 6.0, 8.0 * angle.sin());
+        let view = Mat4::look_at_rh(eye, Vec3::ZERO, Vec3::Y);
+        let light = LightParams::orthographic(view, 5.0, 4.0, 20.0);
+        let mut enc = device.create_command_encoder(&Default::default());
+        host.depth_pass(&device, &mut enc, &light);
+        let mut shaded = Vec::new();
+        for (stage, maps_layout, pipeline) in &mut panels {
+            let out = stage.record(&device, &mut enc, &host.shadow, &light)?;
+            // Pooled textures may swap between frames: bind this frame's views.
+            let entries: Vec<wgpu::BindGroupEntry> = out
+                .maps
+                .iter()
+                .enumerate()
+                .map(|(k, m)| wgpu::BindGroupEntry {
+                    binding: k as u32,
+                    resource: wgpu::BindingResource::TextureView(&m.view),
+                })
+                .collect();
+            let maps = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("host.maps"),
+                layout: maps_layout,
+                entries: &entries,
+            });
+            let frame_bg = host.frame_bind_group(&device, bytemuck::bytes_of(&out.light));
+            shaded.push((pipeline.clone(), frame_bg, maps));
+        }
+        host.shade_pass(&mut enc, &shaded);
+        let readback = host.copy_color(&device, &mut enc);
+        queue.submit([enc.finish()]);
+        rgba = read(&device, &readback)?;
+    }
+    image::save_buffer(
+        &out,
+        &rgba,
+        2 * PANEL.0,
+        2 * PANEL.1,
+        image::ColorType::Rgba8,
+    )
+    .with_context(|| format!("writing {out}"))?;
+    for (stage, _, _) in &panels {
+        let name = stage.config().technique.name();
+        let times: Vec<String> = stage
+            .timings(&device)?
+            .iter()
+            .map(|(k, ms)| format!("{k} {ms:.2} ms"))
+            .collect();
+        println!(
+            "{name:>6}: {} textures; {}",
+            stage.texture_count(),
+            times.join(", ")
+        );
+    }
+    println!(
+        "wrote {out} ({}x{}: vsm, evsm2 / evsm4, esm), {FRAMES} frames in {:.2} s",
+        2 * PANEL.0,
+        2 * PANEL.1,
+        start.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+async fn device() -> Result<(wgpu::Device, wgpu::Queue)> {
+    let instance =
+        wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+    let adapter = instance
+        .request_adapter(&Default::default())
+        .await
+        .context("no GPU adapter (without a GPU: apt-get install mesa-vulkan-drivers)")?;
+    let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
+    Ok(adapter
+        .request_device(&wgpu::DeviceDescriptor {
+            label: Some("host"),
+            required_features: features,
+            ..Default::default()
+        })
+        .await?)
+}
+
+/// Everything the host owns: geometry, its shadow depth texture, colour and depth targets,
+/// the depth pipeline and the shading pipelines' shared layout.
+struct Host {
+    vertices: wgpu::Buffer,
+    count: u32,
+    shadow: wgpu::Texture,
+    color: wgpu::Texture,
+    depth: wgpu::Texture,
+    depth_pipeline: wgpu::RenderPipeline,
+    frame_layout: wgpu::BindGroupLayout,
+    camera: Mat4,
+}
+
+fn target(device: &wgpu::Device, (w, h): (u32, u32), format: wgpu::TextureFormat) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("host.target"),
+        size: wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        // The shadow map is also read by the stage: TEXTURE_BINDING.
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
+}
+
+fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+const ATTRIBUTES: [wgpu::VertexAttribute; 3] =
+    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3];
+
+fn vertex_layout() -> wgpu::VertexBufferLayout<'static> {
+    wgpu::VertexBufferLayout {
+        array_stride: size_of::<Vertex>() as u64,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &ATTRIBUTES,
+    }
+}
+
+fn depth_state(slope_scale: f32) -> wgpu::DepthStencilState {
+    wgpu::DepthStencilState {
+        format: wgpu::TextureFormat::Depth32Float,
+        depth_write_enabled: Some(true),
+        depth_compare: Some(wgpu::CompareFunction::Less),
+        stencil: Default::default(),
+        bias: wgpu::DepthBiasState {
+            constant: 0,
+            slope_scale,
+            clamp: 0.0,
+        },
+    }
+}
+
+impl Host {
+    fn new(device: &wgpu::Device) -> Self {
+        let verts = scene();
+        let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("host.vertices"),
+            contents: bytemuck::cast_slice(&verts),
+            usage: wgpu::BufferUsages::VERTEX,
+        });
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("host.depth"),
+            source: wgpu::ShaderSource::Wgsl(DEPTH.into()),
+        });
+        let depth_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("host.depth"),
+            layout: None,
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[Some(vertex_layout())],
+            },
+            primitive: Default::default(),
+            depth_stencil: Some(depth_state(1.5)),
+            multisample: Default::default(),
+            fragment: None,
+            multiview_mask: None,
+            cache: None,
+        });
+        let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("host.frame"),
+            entries: &[
+                uniform_entry(0, wgpu::ShaderStages::VERTEX),
+                uniform_entry(1, wgpu::ShaderStages::FRAGMENT),
+            ],
+        });
+        let aspect = PANEL.0 as f32 / PANEL.1 as f32;
+        let camera = Mat4::perspective_rh(0.75, aspect, 0.1, 100.0)
+            * Mat4::look_at_rh(Vec3::new(3.0, 4.0, 6.5), Vec3::new(0.2, 0.5, 0.5), Vec3::Y);
+        let size = (2 * PANEL.0, 2 * PANEL.1);
+        Self {
+            count: verts.len() as u32,
+            vertices,
+            shadow: target(
+                device,
+                (SHADOW_MAP, SHADOW_MAP),
+                wgpu::TextureFormat::Depth32Float,
+            ),
+            color: target(device, size, wgpu::TextureFormat::Rgba8UnormSrgb),
+            depth: target(device, size, wgpu::TextureFormat::Depth32Float),
+            depth_pipeline,
+            frame_layout,
+            camera,
+        }
+    }
+
+    fn shade_pipeline(
+        &self,
+        device: &wgpu::Device,
+        stage_wgsl: &str,
+        maps_layout: &wgpu::BindGroupLayout,
+    ) -> wgpu::RenderPipeline {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("host.shade"),
+            source: wgpu::ShaderSource::Wgsl(format!("{stage_wgsl}{SHADE}").into()),
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("host.shade"),
+            bind_group_layouts: &[Some(&self.frame_layout), Some(maps_layout)],
+            immediate_size: 0,
+        });
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("host.shade"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[Some(vertex_layout())],
+            },
+            primitive: Default::default(),
+            depth_stencil: Some(depth_state(0.0)),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::TextureFormat::Rgba8UnormSrgb.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    }
+
+    fn depth_pass(
+        &self,
+        device: &wgpu::Device,
+        enc: &mut wgpu::CommandEncoder,
+        light: &LightParams,
+    ) {
+        let vp = (light.projection * light.view).to_cols_array();
+        let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("host.light_view_proj"),
+            contents: bytemuck::cast_slice(&vp),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("host.depth"),
+            layout: &self.depth_pipeline.get_bind_group_layout(0),
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: buffer.as_entire_binding(),
+            }],
+        });
+        let view = self.shadow.create_view(&Default::default());
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("host.depth"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(clear_depth(&view)),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.depth_pipeline);
+        pass.set_bind_group(0, &bg, &[]);
+        pass.set_vertex_buffer(0, self.vertices.slice(..));
+        pass.draw(0..self.count, 0..1);
+    }
+
+    /// Camera and light uniforms of one panel (`light` is the stage's `struct Light` bytes).
+    fn frame_bind_group(&self, device: &wgpu::Device, light: &[u8]) -> wgpu::BindGroup {
+        let uniform = |contents: &[u8]| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("host.uniform"),
+                contents,
+                usage: wgpu::BufferUsages::UNIFORM,
+            })
+        };
+        let camera = uniform(bytemuck::cast_slice(&self.camera.to_cols_array()));
+        let light = uniform(light);
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("host.frame"),
+            layout: &self.frame_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: camera.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: light.as_entire_binding(),
+                },
+            ],
+        })
+    }
+
+    /// One draw of the scene per panel, each in its quarter of the image.
+    fn shade_pass(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        panels: &[(wgpu::RenderPipeline, wgpu::BindGroup, wgpu::BindGroup)],
+    ) {
+        let (cv, dv) = (
+            self.color.create_view(&Default::default()),
+            self.depth.create_view(&Default::default()),
+        );
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("host.shade"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &cv,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color {
+                        r: 0.3,
+                        g: 0.38,
+                        b: 0.5,
+                        a: 1.0,
+                    }),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(clear_depth(&dv)),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_vertex_buffer(0, self.vertices.slice(..));
+        for (k, (pipeline, frame, maps)) in panels.iter().enumerate() {
+            let (x, y) = ((k as u32 % 2) * PANEL.0, (k as u32 / 2) * PANEL.1);
+            pass.set_viewport(x as f32, y as f32, PANEL.0 as f32, PANEL.1 as f32, 0.0, 1.0);
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, frame, &[]);
+            pass.set_bind_group(1, maps, &[]);
+            pass.draw(0..self.count, 0..1);
+        }
+    }
+
+    fn copy_color(&self, device: &wgpu::Device, enc: &mut wgpu::CommandEncoder) -> wgpu::Buffer {
+        let (w, h) = (self.color.width(), self.color.height());
+        // 2 · 384 · 4 bytes per row: a multiple of COPY_BYTES_PER_ROW_ALIGNMENT (256).
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("host.readback"),
+            size: u64::from(w * h * 4),
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        enc.copy_texture_to_buffer(
+            self.color.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(w * 4),
+                    rows_per_image: Some(h),
+                },
+            },
+            self.color.size(),
+        );
+        buffer
+    }
+}
+
+fn clear_depth(view: &wgpu::TextureView) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+    wgpu::RenderPassDepthStencilAttachment {
+        view,
+        depth_ops: Some(wgpu::Operations {
+            load: wgpu::LoadOp::Clear(1.0),
+            store: wgpu::StoreOp::Store,
+        }),
+        stencil_ops: None,
+    }
+}
+
+fn read(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
+    buffer.map_async(wgpu::MapMode::Read, .., |r| {
+        if let Err(e) = r {
+            eprintln!("readback failed: {e}");
+        }
+    });
+    device.poll(wgpu::PollType::wait_indefinitely())?;
+    let data = buffer.get_mapped_range(..)?.to_vec();
+    buffer.unmap();
+    Ok(data)
+}
+
+/// A ground slab, three boxes and a thin pillar.
+fn scene() -> Vec<Vertex> {
+    let mut v = Vec::new();
+    cuboid(
+        &mut v,
+        Vec3::new(0.0, -0.05, 0.0),
+        Vec3::new(12.0, 0.1, 12.0),
+        [0.75, 0.74, 0.7],
+    );
+    cuboid(
+        &mut v,
+        Vec3::new(-1.2, 0.6, 0.4),
+        Vec3::new(1.2, 1.2, 1.2),
+        [0.8, 0.35, 0.3],
+    );
+    cuboid(
+        &mut v,
+        Vec3::new(1.4, 0.35, -0.6),
+        Vec3::new(0.9, 0.7, 1.8),
+        [0.3, 0.5, 0.8],
+    );
+    cuboid(
+        &mut v,
+        Vec3::new(0.5, 1.6, 1.8),
+        Vec3::new(0.8, 0.2, 0.8),
+        [0.4, 0.7, 0.4],
+    );
+    cuboid(
+        &mut v,
+        Vec3::new(0.5, 0.75, 1.8),
+        Vec3::new(0.12, 1.5, 0.12),
+        [0.6, 0.6, 0.6],
+    );
+    v
+}
+
+fn cuboid(out: &mut Vec<Vertex>, center: Vec3, size: Vec3, color: [f32; 3]) {
+    let half = 0.5 * size;
+    for axis in 0..3 {
+        for sign in [-1.0, 1.0] {
+            let n = Vec3::AXES[axis] * sign;
+            let (u, w) = (Vec3::AXES[(axis + 1) % 3], Vec3::AXES[(axis + 2) % 3]);
+            let (hu, hw) = (u * half[(axis + 1) % 3], w * half[(axis + 2) % 3]);
+            let c = center + n * half[axis];
+            let corners = [c - hu - hw, c + hu - hw, c + hu + hw, c - hu + hw];
+            for i in [0, 1, 2, 0, 2, 3] {
+                out.push(Vertex {
+                    position: corners[i].to_array(),
+                    normal: n.to_array(),
+                    color,
+                });
+            }
+        }
+    }
+}

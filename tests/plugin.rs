@@ -1,0 +1,482 @@
+//! The plug-in stage inside a host: from a depth texture the host rasterized itself, the
+//! stage's maps equal the renderer's, and the exported WGSL with `PrefilterOutput::light`
+//! gives the renderer's visibility; recording every frame keeps memory constant; a size
+//! change reallocates; per-kernel timings.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use shadowgraph::exec::ComputeKernel;
+use shadowgraph::gpu::{Gpu, read_float_texture, submit_and_wait};
+use shadowgraph::prefilter::{LightParams, Prefilter, PrefilterConfig, StageError};
+use shadowgraph::render::{Frame, RenderOptions, Renderer};
+use shadowgraph::scene::{Scene, Vertex};
+use shadowgraph::technique::depth_name;
+use wgpu::util::DeviceExt;
+
+/// The host's own depth pass: its own shader and pipeline, the light's matrices and slope
+/// bias, into a texture the host owns.
+const HOST_DEPTH: &str = "
+@group(0) @binding(0) var<uniform> view_proj: mat4x4<f32>;
+@vertex
+fn vs_main(@location(0) p: vec3<f32>) -> @builtin(position) vec4<f32> {
+    return view_proj * vec4<f32>(p, 1.0);
+}
+";
+
+fn host_depth(
+    g: &Gpu,
+    vertices: &[Vertex],
+    light: &LightParams,
+    slope_bias: f32,
+    size: u32,
+) -> wgpu::Texture {
+    let d = &g.device;
+    let depth = d.create_texture(&wgpu::TextureDescriptor {
+        label: Some("host.depth"),
+        size: wgpu::Extent3d {
+            width: size,
+            height: size,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Depth32Float,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    });
+    let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("host.depth"),
+        source: wgpu::ShaderSource::Wgsl(HOST_DEPTH.into()),
+    });
+    let pipeline = d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("host.depth"),
+        layout: None,
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[Some(wgpu::VertexBufferLayout {
+                array_stride: size_of::<Vertex>() as u64,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &wgpu::vertex_attr_array![0 => Float32x3],
+            })],
+        },
+        primitive: Default::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: wgpu::TextureFormat::Depth32Float,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: wgpu::DepthBiasState {
+                constant: 0,
+                slope_scale: slope_bias,
+                clamp: 0.0,
+            },
+        }),
+        multisample: Default::default(),
+        fragment: None,
+        multiview_mask: None,
+        cache: None,
+    });
+    let vp = (light.projection * light.view).to_cols_array();
+    let ubuf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("host.view_proj"),
+        contents: bytemuck::cast_slice(&vp),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let vbuf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("host.vertices"),
+        contents: bytemuck::cast_slice(vertices),
+        usage: wgpu::BufferUsages::VERTEX,
+    });
+    let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("host.depth"),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: ubuf.as_entire_binding(),
+        }],
+    });
+    let view = depth.create_view(&Default::default());
+    let mut enc = d.create_command_encoder(&Default::default());
+    {
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("host.depth"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &bg, &[]);
+        pass.set_vertex_buffer(0, vbuf.slice(..));
+        pass.draw(0..vertices.len() as u32, 0..1);
+    }
+    submit_and_wait(d, &g.queue, enc, "host depth").expect("host depth pass");
+    depth
+}
+
+/// Records the stage over `depth` in an encoder of the host's, submits, reads map `k` back.
+fn run_stage(
+    g: &Gpu,
+    stage: &mut Prefilter,
+    depth: &wgpu::Texture,
+    light: &LightParams,
+) -> Vec<Vec<f32>> {
+    let mut enc = g.device.create_command_encoder(&Default::default());
+    let out = stage
+        .record(&g.device, &mut enc, depth, light)
+        .expect("record");
+    submit_and_wait(&g.device, &g.queue, enc, "stage").expect("submit");
+    out.maps
+        .iter()
+        .map(|m| {
+            read_float_texture(&g.device, &g.queue, &m.texture, 0)
+                .expect("readback")
+                .1
+        })
+        .collect()
+}
+
+/// Host shading of given points through the stage's exported WGSL (`shadowgraph_visibility`
+/// with `PrefilterOutput::light`), as a compute pass of the host's.
+const HOST_PROBE: &str = "
+@group(0) @binding(0) var<uniform> light: Light;
+@group(0) @binding(1) var<storage, read> positions: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read> normals: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read_write> visibility: array<f32>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= arrayLength(&visibility) {
+        return;
+    }
+    visibility[id.x] = shadowgraph_visibility(light, positions[id.x].xyz,
+                                              normalize(normals[id.x].xyz));
+}
+";
+
+/// Visibility at every pixel of `frame` (its G-buffer) through the host's WGSL.
+fn host_visibility(
+    g: &Gpu,
+    stage: &mut Prefilter,
+    depth: &wgpu::Texture,
+    light: &LightParams,
+    frame: &Frame,
+) -> Vec<f32> {
+    let d = &g.device;
+    let wgsl = format!("{}{HOST_PROBE}", stage.wgsl(1, 0).expect("host WGSL"));
+    let kernel = ComputeKernel::new(d, "host_probe", &wgsl).expect("host probe compiles");
+    let mut enc = d.create_command_encoder(&Default::default());
+    let out = stage.record(d, &mut enc, depth, light).expect("record");
+    let storage = |data: &[f32], usage| {
+        d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("host.probe"),
+            contents: bytemuck::cast_slice(data),
+            usage,
+        })
+    };
+    let n = (frame.width * frame.height) as usize;
+    let light_buf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("host.light"),
+        contents: bytemuck::bytes_of(&out.light),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let pos = storage(&frame.position, wgpu::BufferUsages::STORAGE);
+    let nor = storage(&frame.normal, wgpu::BufferUsages::STORAGE);
+    let vis = storage(
+        &vec![-1.0; n],
+        wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+    );
+    let bg0 = d.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("host.probe"),
+        layout: &kernel.layouts[0],
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: light_buf.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: pos.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: nor.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 3,
+                resource: vis.as_entire_binding(),
+            },
+        ],
+    });
+    let sampler = d.create_sampler(&wgpu::SamplerDescriptor {
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        compare: Some(wgpu::CompareFunction::LessEqual),
+        ..Default::default()
+    });
+    let mut entries: Vec<wgpu::BindGroupEntry> = out
+        .maps
+        .iter()
+        .enumerate()
+        .map(|(k, m)| wgpu::BindGroupEntry {
+            binding: k as u32,
+            resource: wgpu::BindingResource::TextureView(&m.view),
+        })
+        .collect();
+    if stage.needs_comparison_sampler().expect("block") {
+        entries.push(wgpu::BindGroupEntry {
+            binding: out.maps.len() as u32,
+            resource: wgpu::BindingResource::Sampler(&sampler),
+        });
+    }
+    let bg1 = d.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("host.probe.maps"),
+        layout: &kernel.layouts[1],
+        entries: &entries,
+    });
+    {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&kernel.pipeline);
+        pass.set_bind_group(0, &bg0, &[]);
+        pass.set_bind_group(1, &bg1, &[]);
+        pass.dispatch_workgroups((n as u32).div_ceil(64), 1, 1);
+    }
+    let readback = d.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("host.probe.readback"),
+        size: vis.size(),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    enc.copy_buffer_to_buffer(&vis, 0, &readback, 0, vis.size());
+    submit_and_wait(d, &g.queue, enc, "host probe").expect("submit");
+    let raw = shadowgraph::gpu::read_buffer(d, &readback).expect("readback");
+    bytemuck::cast_slice(&raw).to_vec()
+}
+
+fn scenes() -> Vec<PathBuf> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let mut v: Vec<PathBuf> = [root.clone(), root.join("techniques")]
+        .iter()
+        .flat_map(|d| {
+            std::fs::read_dir(d)
+                .expect("scenes/")
+                .map(|e| e.expect("entry").path())
+        })
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    v.sort();
+    v
+}
+
+/// Count of values that differ bit for bit, and the largest difference.
+fn differences(a: &[f32], b: &[f32]) -> (usize, f32) {
+    assert_eq!(a.len(), b.len(), "lengths");
+    a.iter().zip(b).fold((0, 0.0f32), |(n, worst), (x, y)| {
+        if x.to_bits() == y.to_bits() {
+            (n, worst)
+        } else {
+            (n + 1, worst.max((x - y).abs()))
+        }
+    })
+}
+
+/// For every light of every bundled scene: the host's depth equals the renderer's raster,
+/// so the stage's maps must equal the renderer's bit for bit (the same kernels on the same
+/// inputs; tolerance 0). Visibility through the exported WGSL and `PrefilterOutput::light`:
+/// that light's position, direction and map width come from inverting the host's matrices
+/// rather than from the scene, an ulp-level change that can flip a comparison exactly at a
+/// texel edge; so |Δ| ≤ 1e-5 at ≥ 99.9% of covered pixels and ≤ 1e-3 summed over all.
+#[test]
+fn stage_outputs_equal_the_renderers() {
+    let g = common::gpu();
+    let mut renderer = Renderer::new(&g.device);
+    for path in scenes() {
+        let scene = Scene::load(&path).expect("scene loads");
+        let name = path
+            .file_name()
+            .unwrap_or_default()
+            .to_string_lossy()
+            .to_string();
+        let frame = renderer
+            .render(
+                &g.device,
+                &g.queue,
+                &scene,
+                RenderOptions {
+                    aux: true,
+                    repeat: 1,
+                    dump: true,
+                },
+            )
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let vertices = scene.vertices();
+        let lights = scene.lights.len();
+        for (li, light) in scene.lights.iter().enumerate() {
+            let what = format!("{name} light {li} ({})", light.shadow.technique.name());
+            let params = LightParams::from_light(light);
+            let depth = host_depth(
+                &g,
+                &vertices,
+                &params,
+                light.shadow.slope_bias,
+                light.shadow_map,
+            );
+            let renderer_depth = frame
+                .resources
+                .iter()
+                .find(|r| r.levels[0].resource == depth_name(li))
+                .expect("dump holds the raster");
+            let host = read_float_texture(&g.device, &g.queue, &depth, 0)
+                .expect("readback")
+                .1;
+            let (n, worst) = differences(&host, &renderer_depth.levels[0].data);
+            assert_eq!(
+                n, 0,
+                "{what}: host depth differs from the renderer's at {n} texels (worst {worst:e})"
+            );
+
+            let mut stage = Prefilter::new(&g.device, &PrefilterConfig::from_light(light))
+                .unwrap_or_else(|e| panic!("{what}: {e}"));
+            let maps = run_stage(&g, &mut stage, &depth, &params);
+            assert_eq!(maps.len(), 1, "{what}: one map per light today");
+            let (n, worst) = differences(&maps[0], &frame.shade_maps[li].data);
+            assert_eq!(
+                n, 0,
+                "{what}: stage map differs at {n} values (worst {worst:e})"
+            );
+
+            let vis = host_visibility(&g, &mut stage, &depth, &params, &frame);
+            let (mut covered, mut off, mut total) = (0, 0, 0.0f64);
+            for (px, v) in vis.iter().enumerate() {
+                if frame.position[4 * px + 3] == 0.0 {
+                    continue;
+                }
+                covered += 1;
+                let diff = f64::from((v - frame.visibility[px * lights + li]).abs());
+                total += diff;
+                if diff > 1e-5 {
+                    off += 1;
+                }
+            }
+            assert!(
+                off * 1000 <= covered && total <= 1e-3 * covered as f64,
+                "{what}: {off} of {covered} pixels off by > 1e-5, mean |Δ| {:e}",
+                total / covered as f64
+            );
+        }
+    }
+}
+
+/// Recording every frame reuses the pool and the pipelines; a size change reallocates (to
+/// what a fresh stage holds at that size) and gives what a fresh stage gives.
+#[test]
+fn every_frame_reuses_textures_and_a_resize_reallocates() {
+    let g = common::gpu();
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/techniques/vsm.toml");
+    let scene = Scene::load(path).expect("scene");
+    let light = &scene.lights[0];
+    let params = LightParams::from_light(light);
+    let vertices = scene.vertices();
+    let depth = |size| host_depth(&g, &vertices, &params, light.shadow.slope_bias, size);
+    let (small, large) = (depth(96), depth(160));
+    let config = PrefilterConfig::from_light(light);
+    let mut stage = Prefilter::new(&g.device, &config.with_size(96)).expect("stage");
+    let pipelines = stage.pipeline_count();
+    let first = run_stage(&g, &mut stage, &small, &params);
+    let textures = stage.texture_count();
+    assert!(textures > 0);
+    for frame in 0..200 {
+        let mut enc = g.device.create_command_encoder(&Default::default());
+        let out = stage
+            .record(&g.device, &mut enc, &small, &params)
+            .expect("record");
+        assert_eq!(out.maps[0].texture.width(), 96);
+        g.queue.submit([enc.finish()]);
+        assert_eq!(stage.texture_count(), textures, "frame {frame}: pool grew");
+        assert_eq!(
+            stage.pipeline_count(),
+            pipelines,
+            "frame {frame}: pipelines made again"
+        );
+    }
+    g.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .expect("poll");
+
+    let resized = run_stage(&g, &mut stage, &large, &params);
+    let mut fresh = Prefilter::new(&g.device, &config.with_size(160)).expect("stage");
+    let expected = run_stage(&g, &mut fresh, &large, &params);
+    assert_eq!(stage.size(), 160);
+    assert_eq!(
+        stage.texture_count(),
+        fresh.texture_count(),
+        "old-size textures kept"
+    );
+    assert_eq!(
+        stage.pipeline_count(),
+        pipelines,
+        "a resize keeps pipelines"
+    );
+    assert_eq!(
+        differences(&resized[0], &expected[0]).0,
+        0,
+        "resized output"
+    );
+    assert_eq!(resized[0].len(), 160 * 160 * 2);
+
+    let back = run_stage(&g, &mut stage, &small, &params);
+    assert_eq!(stage.texture_count(), textures);
+    assert_eq!(
+        differences(&back[0], &first[0]).0,
+        0,
+        "back to the first size"
+    );
+}
+
+/// Per-kernel timings, named by node, when the device has timestamps; otherwise asking is
+/// the named missing-feature error.
+#[test]
+fn kernels_are_timed_when_the_device_can() {
+    let g = common::gpu();
+    let mut stage = Prefilter::new(&g.device, &PrefilterConfig::vsm(128)).expect("stage");
+    match stage.enable_timing(&g.device, &g.queue) {
+        Err(shadowgraph::Error::Stage(StageError::MissingFeature { feature, .. })) => {
+            assert!(
+                !g.device
+                    .features()
+                    .contains(wgpu::Features::TIMESTAMP_QUERY)
+            );
+            assert_eq!(feature, wgpu::Features::TIMESTAMP_QUERY);
+            return;
+        }
+        Err(e) => panic!("{e}"),
+        Ok(()) => {}
+    }
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/techniques/vsm.toml");
+    let scene = Scene::load(path).expect("scene");
+    let params = LightParams::from_light(&scene.lights[0]);
+    let depth = host_depth(&g, &scene.vertices(), &params, 1.0, 128);
+    let _ = run_stage(&g, &mut stage, &depth, &params);
+    let timings = stage.timings(&g.device).expect("timings");
+    let names: Vec<&str> = timings.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(names, ["linearize", "vsm", "vsm.blur_h", "vsm.blur_v"]);
+    assert!(
+        timings.iter().all(|(_, ms)| ms.is_finite() && *ms >= 0.0),
+        "{timings:?}"
+    );
+}

@@ -1,0 +1,345 @@
+//! Every mistake a host can make with the plug-in stage is a typed error naming what is wrong,
+//! never a panic or a wgpu validation error.
+
+mod common;
+
+use shadowgraph::Error;
+use shadowgraph::gpu::Gpu;
+use shadowgraph::prefilter::{LightParams, Prefilter, PrefilterConfig, StageError};
+
+fn texture(
+    g: &Gpu,
+    format: wgpu::TextureFormat,
+    (w, h, layers): (u32, u32, u32),
+    samples: u32,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    g.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("host.depth"),
+        size: wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: layers,
+        },
+        mip_level_count: 1,
+        sample_count: samples,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
+const READABLE: wgpu::TextureUsages =
+    wgpu::TextureUsages::RENDER_ATTACHMENT.union(wgpu::TextureUsages::TEXTURE_BINDING);
+
+fn light() -> LightParams {
+    LightParams::orthographic(
+        glam::Mat4::look_at_rh(
+            glam::Vec3::new(0.0, 5.0, 1.0),
+            glam::Vec3::ZERO,
+            glam::Vec3::Y,
+        ),
+        2.0,
+        1.0,
+        10.0,
+    )
+}
+
+/// `record` over `depth`, expecting a stage error.
+fn record_err(g: &Gpu, depth: &wgpu::Texture, light: &LightParams) -> StageError {
+    let mut stage = Prefilter::new(&g.device, &PrefilterConfig::vsm(64)).expect("stage");
+    let mut enc = g.device.create_command_encoder(&Default::default());
+    match stage.record(&g.device, &mut enc, depth, light) {
+        Err(Error::Stage(e)) => e,
+        Err(e) => panic!("expected a stage error, got {e}"),
+        Ok(_) => panic!("expected a stage error, got maps"),
+    }
+}
+
+#[test]
+fn unusable_depth_textures_are_named() {
+    let g = common::gpu();
+    let colour = texture(&g, wgpu::TextureFormat::R32Float, (64, 64, 1), 1, READABLE);
+    let e = record_err(&g, &colour, &light());
+    assert!(
+        matches!(e, StageError::DepthFormat { format, .. } if format == wgpu::TextureFormat::R32Float),
+        "{e}"
+    );
+    assert!(
+        e.to_string().contains("R32Float") && e.to_string().contains("Depth32Float"),
+        "{e}"
+    );
+
+    let unbound = texture(
+        &g,
+        wgpu::TextureFormat::Depth32Float,
+        (64, 64, 1),
+        1,
+        wgpu::TextureUsages::RENDER_ATTACHMENT,
+    );
+    let e = record_err(&g, &unbound, &light());
+    assert!(matches!(e, StageError::DepthUsage { .. }), "{e}");
+    assert!(e.to_string().contains("TEXTURE_BINDING"), "{e}");
+
+    let wide = texture(
+        &g,
+        wgpu::TextureFormat::Depth32Float,
+        (64, 32, 1),
+        1,
+        READABLE,
+    );
+    let e = record_err(&g, &wide, &light());
+    assert!(
+        matches!(
+            e,
+            StageError::DepthNotSquare {
+                width: 64,
+                height: 32
+            }
+        ),
+        "{e}"
+    );
+
+    let layered = texture(
+        &g,
+        wgpu::TextureFormat::Depth32Float,
+        (64, 64, 2),
+        1,
+        READABLE,
+    );
+    let e = record_err(&g, &layered, &light());
+    assert!(
+        matches!(e, StageError::DepthLayout { layers: 2, .. }),
+        "{e}"
+    );
+
+    let msaa = texture(
+        &g,
+        wgpu::TextureFormat::Depth32Float,
+        (64, 64, 1),
+        4,
+        READABLE,
+    );
+    let e = record_err(&g, &msaa, &light());
+    assert!(
+        matches!(e, StageError::DepthLayout { samples: 4, .. }),
+        "{e}"
+    );
+}
+
+/// The other accepted depth formats run and give the Depth32Float result to within their
+/// precision: nothing is rasterized here, so every texel is the cleared 1.0, which each
+/// format holds exactly.
+#[test]
+fn every_accepted_depth_format_runs() {
+    let g = common::gpu();
+    let mut stage = Prefilter::new(&g.device, &PrefilterConfig::vsm(32)).expect("stage");
+    for format in shadowgraph::prefilter::DEPTH_FORMATS {
+        if !format
+            .required_features()
+            .iter()
+            .all(|f| g.device.features().contains(f))
+        {
+            continue;
+        }
+        let depth = texture(&g, format, (32, 32, 1), 1, READABLE);
+        let mut enc = g.device.create_command_encoder(&Default::default());
+        let view = depth.create_view(&Default::default());
+        drop(enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("clear"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: format.has_stencil_aspect().then_some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(0),
+                    store: wgpu::StoreOp::Store,
+                }),
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        }));
+        let out = stage
+            .record(&g.device, &mut enc, &depth, &light())
+            .unwrap_or_else(|e| panic!("{format:?}: {e}"));
+        shadowgraph::gpu::submit_and_wait(&g.device, &g.queue, enc, "stage")
+            .unwrap_or_else(|e| panic!("{format:?}: {e}"));
+        let (_, moments) =
+            shadowgraph::gpu::read_float_texture(&g.device, &g.queue, &out.maps[0].texture, 0)
+                .expect("readback");
+        assert!(
+            moments.chunks(2).all(|m| m == [1.0, 1.0]),
+            "{format:?}: moments of a cleared map are not (1, 1)"
+        );
+    }
+}
+
+#[test]
+fn inconsistent_light_params_are_named() {
+    let g = common::gpu();
+    let depth = texture(
+        &g,
+        wgpu::TextureFormat::Depth32Float,
+        (64, 64, 1),
+        1,
+        READABLE,
+    );
+    let view = light().view;
+    let cases: Vec<(LightParams, &str)> = vec![
+        (
+            LightParams {
+                near: 10.0,
+                far: 1.0,
+                ..light()
+            },
+            "far",
+        ),
+        (
+            LightParams {
+                near: 0.0,
+                ..light()
+            },
+            "near",
+        ),
+        (
+            LightParams {
+                view: glam::Mat4::from_cols_array(&[f32::NAN; 16]),
+                ..light()
+            },
+            "view",
+        ),
+        // Reversed Z: depth 1 at near, 0 at far.
+        (
+            LightParams {
+                projection: glam::Mat4::orthographic_rh(-2.0, 2.0, -2.0, 2.0, 10.0, 1.0),
+                ..light()
+            },
+            "projection",
+        ),
+        // A perspective matrix declared orthographic.
+        (
+            LightParams {
+                projection: glam::Mat4::perspective_rh(1.0, 1.0, 1.0, 10.0),
+                ..light()
+            },
+            "projection",
+        ),
+        // Planes that are not the projection's.
+        (
+            LightParams {
+                far: 20.0,
+                ..LightParams::perspective(view, 1.0, 1.0, 10.0)
+            },
+            "projection",
+        ),
+    ];
+    for (params, field) in cases {
+        let e = record_err(&g, &depth, &params);
+        assert!(
+            matches!(e, StageError::LightParams { field: f, .. } if f == field),
+            "expected `{field}`: {e}"
+        );
+    }
+}
+
+#[test]
+fn invalid_configs_are_named_by_new() {
+    let g = common::gpu();
+    let mut config = PrefilterConfig::vsm(64).with_blur(40.0);
+    match Prefilter::new(&g.device, &config) {
+        Err(Error::Stage(StageError::Config { field, message })) => {
+            assert_eq!(field, "filter_radius", "{message}");
+            assert!(message.contains("[0, 32]"), "{message}");
+        }
+        Err(e) => panic!("{e}"),
+        Ok(_) => panic!("radius 40 accepted"),
+    }
+    config = PrefilterConfig::evsm2(64);
+    if let shadowgraph::scene::Technique::Evsm { exp_pos, .. } = &mut config.technique {
+        *exp_pos = 80.0;
+    }
+    let stage = Prefilter::new(&g.device, &config).expect("clamped, not rejected");
+    assert!(
+        stage.warnings().len() == 1 && stage.warnings()[0].contains("exponent_pos"),
+        "{:?}",
+        stage.warnings()
+    );
+}
+
+/// A device (and queue) of the same adapter with `limits` and no optional features.
+fn device_with(g: &Gpu, limits: wgpu::Limits) -> (wgpu::Device, wgpu::Queue) {
+    pollster::block_on(g.adapter.request_device(&wgpu::DeviceDescriptor {
+        label: Some("limited"),
+        required_limits: limits,
+        ..Default::default()
+    }))
+    .expect("a device with lower limits")
+}
+
+fn limit_error(device: &wgpu::Device, config: &PrefilterConfig) -> String {
+    match Prefilter::new(device, config) {
+        Err(e @ Error::Limit { .. }) => e.to_string(),
+        Err(e) => panic!("expected a limit error, got {e}"),
+        Ok(_) => panic!("expected a limit error"),
+    }
+}
+
+#[test]
+fn sizes_and_kernels_past_the_device_limits_are_named() {
+    let g = common::gpu();
+    let (small, _) = device_with(
+        &g,
+        wgpu::Limits {
+            max_texture_dimension_2d: 1024,
+            ..g.adapter.limits()
+        },
+    );
+    let e = limit_error(&small, &PrefilterConfig::vsm(2048));
+    assert!(
+        e.contains("map size") && e.contains("2048") && e.contains("1024"),
+        "{e}"
+    );
+
+    let (little_memory, _) = device_with(
+        &g,
+        wgpu::Limits {
+            max_compute_workgroup_storage_size: 2048,
+            ..g.adapter.limits()
+        },
+    );
+    let e = limit_error(&little_memory, &PrefilterConfig::vsm(64));
+    assert!(
+        e.contains("`blur`") && e.contains("max_compute_workgroup_storage_size"),
+        "{e}"
+    );
+    // Unfiltered VSM runs no blur, so that device can run it.
+    let unfiltered = PrefilterConfig::vsm(64).with_filter(shadowgraph::scene::Filter::None);
+    Prefilter::new(&little_memory, &unfiltered).expect("no blur, no workgroup memory");
+
+    let (no_compute, _) = device_with(&g, wgpu::Limits::downlevel_webgl2_defaults());
+    let e = limit_error(&no_compute, &PrefilterConfig::vsm(64));
+    assert!(e.contains("kernel `linearize`"), "{e}");
+}
+
+#[test]
+fn timing_without_timestamps_is_a_missing_feature() {
+    let g = common::gpu();
+    let (plain, queue) = device_with(&g, g.adapter.limits());
+    let mut stage = Prefilter::new(&plain, &PrefilterConfig::esm(64)).expect("stage");
+    match stage.enable_timing(&plain, &queue) {
+        Err(Error::Stage(StageError::MissingFeature {
+            feature,
+            needed_for,
+        })) => {
+            assert_eq!(feature, wgpu::Features::TIMESTAMP_QUERY);
+            assert!(needed_for.contains("timing"));
+        }
+        Err(e) => panic!("{e}"),
+        Ok(()) => panic!("timing enabled without TIMESTAMP_QUERY"),
+    }
+}

@@ -1,0 +1,353 @@
+//! The plug-in stage without a GPU: the exported WGSL is current and compiles inside a host's
+//! shader (naga), the host block of every technique validates, and configurations follow the
+//! scene file's rules and defaults.
+
+use std::path::Path;
+
+use shadowgraph::kernels;
+use shadowgraph::prefilter::{PrefilterConfig, StageError, wgsl};
+use shadowgraph::scene::{BlurKernel, Filter, PcfKernel, Prefilter, Scene, Storage, Technique};
+use shadowgraph::technique::LightGpu;
+
+fn every_technique() -> Vec<Technique> {
+    let blur = Filter::Blur {
+        radius: 2.0,
+        sigma: 1.0,
+        kernel: BlurKernel::Box,
+    };
+    vec![
+        Technique::Hard,
+        Technique::Pcf {
+            radius: 2,
+            kernel: PcfKernel::Tent,
+        },
+        Technique::Pcf {
+            radius: 0,
+            kernel: PcfKernel::Hardware,
+        },
+        Technique::Pcss {
+            blocker_samples: 16,
+            filter_samples: 32,
+            max_search: 0.1,
+        },
+        PrefilterConfig::vsm(64).technique,
+        PrefilterConfig::vsm(64)
+            .with_storage(Storage::F16)
+            .with_filter(blur)
+            .technique,
+        PrefilterConfig::evsm2(64).technique,
+        PrefilterConfig::evsm4(64)
+            .with_storage(Storage::F16)
+            .technique,
+        PrefilterConfig::esm(64).with_filter(Filter::None).technique,
+    ]
+}
+
+#[test]
+fn exported_library_is_current() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(wgsl::LIBRARY_PATH);
+    let generated = wgsl::library().expect("library resolves");
+    if std::env::var_os("SHADOWGRAPH_BLESS").is_some() {
+        std::fs::create_dir_all(path.parent().expect("parent")).expect("mkdir");
+        std::fs::write(&path, &generated).expect("write the exported WGSL");
+    }
+    let committed = std::fs::read_to_string(&path).unwrap_or_default();
+    assert!(
+        committed == generated,
+        "{} is stale: regenerate with `SHADOWGRAPH_BLESS=1 cargo test --release --test \
+         plugin_wgsl`",
+        wgsl::LIBRARY_PATH
+    );
+    assert!(!generated.contains("#import"), "imports left unresolved");
+}
+
+/// What a host writes around the committed file: its own bindings, a `Light` uniform and a
+/// fragment shader calling the visibility functions.
+const HOST_SHADER: &str = "
+@group(0) @binding(0) var<uniform> shadow_light: Light;
+@group(1) @binding(0) var vsm_map: texture_2d<f32>;
+@group(1) @binding(1) var esm_map: texture_2d<f32>;
+@group(1) @binding(2) var raw_depth: texture_depth_2d;
+@group(1) @binding(3) var shadow_cmp: sampler_comparison;
+
+@fragment
+fn fs_main(@location(0) p: vec3<f32>, @location(1) n: vec3<f32>) -> @location(0) vec4<f32> {
+    let s = light_sample(shadow_light, p, normalize(n));
+    var v = vec3<f32>(1.0);
+    if s.inside {
+        v = vec3<f32>(vis_vsm(vsm_map, shadow_light, s), vis_esm(esm_map, shadow_light, s),
+                      vis_pcf_hardware(raw_depth, shadow_cmp, shadow_light, s));
+    }
+    return vec4<f32>(v, 1.0);
+}
+";
+
+#[test]
+fn host_shader_including_the_library_validates() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(wgsl::LIBRARY_PATH);
+    let library = std::fs::read_to_string(path).expect("exported WGSL present");
+    let host = format!("{library}{HOST_SHADER}");
+    let module = kernels::validate("host", &host).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(
+        kernels::struct_size(&module, "Light"),
+        Some(size_of::<LightGpu>() as u32),
+        "LightGpu vs the exported struct Light"
+    );
+    for name in [
+        "vis_hard", "vis_pcf", "vis_pcss", "vis_vsm", "vis_evsm", "vis_esm",
+    ] {
+        assert!(
+            library.contains(&format!("//   fn {name}(")),
+            "{name} undocumented"
+        );
+    }
+}
+
+#[test]
+fn host_block_of_every_technique_validates_with_its_bindings() {
+    let mut failures = Vec::new();
+    for t in every_technique() {
+        let block = wgsl::host_block(&t, 2, 3).expect("host block");
+        let host = format!(
+            "{block}
+@group(0) @binding(0) var<uniform> l: Light;
+@fragment
+fn fs_main(@location(0) p: vec3<f32>) -> @location(0) vec4<f32> {{
+    return vec4<f32>(shadowgraph_visibility(l, p, vec3<f32>(0.0, 1.0, 0.0)));
+}}"
+        );
+        match kernels::reflect(t.name(), &host) {
+            Err(e) => failures.push(format!("{}: {e}", t.name())),
+            Ok((_, r)) => {
+                let group2: Vec<(u32, String)> = r
+                    .bindings
+                    .iter()
+                    .filter(|b| b.group == 2)
+                    .map(|b| (b.binding, b.name.clone()))
+                    .collect();
+                // Maps from binding 3 on, consecutively (one or more), then the sampler.
+                let maps = group2
+                    .iter()
+                    .filter(|(_, n)| n.starts_with("shadowgraph_map"))
+                    .count();
+                let mut expected: Vec<(u32, String)> = (0..maps)
+                    .map(|k| (3 + k as u32, format!("shadowgraph_map{k}")))
+                    .collect();
+                if wgsl::needs_comparison_sampler(&t).expect("block") {
+                    expected.push((3 + maps as u32, "shadowgraph_cmp_sampler".into()));
+                }
+                if maps == 0 || group2 != expected {
+                    failures.push(format!("{}: bindings {group2:?}", t.name()));
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n\n"));
+}
+
+/// A one-light scene whose `[light.shadow]` table holds `keys`.
+fn scene_with(technique: &str, keys: &str, light_size: f32) -> shadowgraph::Result<Scene> {
+    let text = format!(
+        "[output]\nwidth = 8\nheight = 8\n[camera]\nposition = [0.0, 2.0, 5.0]\n\
+         target = [0.0, 0.0, 0.0]\nfov_y_degrees = 40.0\n[[light]]\nkind = \"directional\"\n\
+         position = [1.0, 5.0, 0.0]\ntarget = [0.0, 0.0, 0.0]\nextent = 2.0\nsize = {light_size}\n\
+         shadow_map = 64\n[light.shadow]\ntechnique = \"{technique}\"\n{keys}\n\
+         [[object]]\nshape = \"plane\"\nsize = 1.0\n"
+    );
+    Scene::parse(Path::new("rules.toml"), &text)
+}
+
+#[test]
+fn constructors_have_the_scene_defaults() {
+    for (name, config) in [
+        ("vsm", PrefilterConfig::vsm(64)),
+        ("evsm2", PrefilterConfig::evsm2(64)),
+        ("evsm4", PrefilterConfig::evsm4(64)),
+        ("esm", PrefilterConfig::esm(64)),
+    ] {
+        let scene = scene_with(name, "", 0.0).expect("scene");
+        let from_scene = PrefilterConfig::from_light(&scene.lights[0]);
+        let (validated, _) = config.validated().expect("defaults are valid");
+        assert_eq!(validated, from_scene, "{name}");
+    }
+}
+
+fn vsm(bleed: f32, min_variance: f32) -> PrefilterConfig {
+    let mut c = PrefilterConfig::vsm(64);
+    c.technique = Technique::Vsm {
+        prefilter: Prefilter {
+            storage: Storage::F32,
+            filter: Filter::Blur {
+                radius: 2.0,
+                sigma: 1.0,
+                kernel: BlurKernel::Gaussian,
+            },
+        },
+        bleed,
+        min_variance,
+    };
+    c
+}
+
+fn evsm(mut c: PrefilterConfig, pos: f32, neg: f32) -> PrefilterConfig {
+    if let Technique::Evsm {
+        exp_pos, exp_neg, ..
+    } = &mut c.technique
+    {
+        (*exp_pos, *exp_neg) = (pos, neg);
+    }
+    c
+}
+
+fn esm(c: f32) -> PrefilterConfig {
+    let mut config = PrefilterConfig::esm(64);
+    if let Technique::Esm { exponent, .. } = &mut config.technique {
+        *exponent = c;
+    }
+    config
+}
+
+fn pcss() -> PrefilterConfig {
+    PrefilterConfig::new(
+        Technique::Pcss {
+            blocker_samples: 16,
+            filter_samples: 32,
+            max_search: 0.1,
+        },
+        64,
+    )
+}
+
+#[test]
+fn configs_follow_the_scene_rules() {
+    // (scene technique, its keys, light size, the same as a config): both accept (with the
+    // same technique after clamping, and as many warnings) or both reject, naming the key.
+    let pcf33 = Technique::Pcf {
+        radius: 33,
+        kernel: PcfKernel::Box,
+    };
+    let cases: Vec<(&str, &str, f32, PrefilterConfig)> = vec![
+        ("vsm", "bleed_reduction = 0.99", 0.0, vsm(0.99, 1e-5)),
+        ("vsm", "bleed_reduction = 1.0", 0.0, vsm(1.0, 1e-5)),
+        ("vsm", "min_variance = 1.5", 0.0, vsm(0.2, 1.5)),
+        (
+            "vsm",
+            "filter_radius = 32",
+            0.0,
+            PrefilterConfig::vsm(64).with_blur(32.0),
+        ),
+        (
+            "vsm",
+            "filter_radius = 33",
+            0.0,
+            PrefilterConfig::vsm(64).with_blur(33.0),
+        ),
+        (
+            "vsm",
+            "filter = \"none\"\nformat = \"f16\"",
+            0.0,
+            PrefilterConfig::vsm(64)
+                .with_filter(Filter::None)
+                .with_storage(Storage::F16),
+        ),
+        (
+            "evsm2",
+            "exponent_pos = 50.0",
+            0.0,
+            evsm(PrefilterConfig::evsm2(64), 50.0, 5.0),
+        ),
+        (
+            "evsm4",
+            "format = \"f16\"\nexponent_neg = 10.0",
+            0.0,
+            evsm(
+                PrefilterConfig::evsm4(64).with_storage(Storage::F16),
+                40.0,
+                10.0,
+            ),
+        ),
+        (
+            "evsm2",
+            "exponent_pos = 0.001",
+            0.0,
+            evsm(PrefilterConfig::evsm2(64), 0.001, 5.0),
+        ),
+        ("esm", "exponent = 10000.0", 0.0, esm(1e4)),
+        ("esm", "exponent = 10001.0", 0.0, esm(10001.0)),
+        (
+            "hard",
+            "bias = 2.0",
+            0.0,
+            PrefilterConfig::new(Technique::Hard, 64).with_bias(2.0),
+        ),
+        ("pcf", "radius = 33", 0.0, PrefilterConfig::new(pcf33, 64)),
+        ("pcss", "", 0.0, pcss()),
+        ("pcss", "", 0.5, pcss()),
+    ];
+    for (technique, keys, light_size, mut config) in cases {
+        config.light_size = light_size;
+        let scene = scene_with(technique, keys, light_size);
+        let stage = config.validated();
+        match (&scene, &stage) {
+            (Ok(s), Ok((c, warnings))) => {
+                assert_eq!(
+                    c.technique, s.lights[0].shadow.technique,
+                    "{technique} {keys}"
+                );
+                assert_eq!(
+                    warnings.len(),
+                    s.warnings.len(),
+                    "{technique} {keys}: {warnings:?}"
+                );
+            }
+            (Err(scene_err), Err(StageError::Config { field, .. })) => {
+                let key = field.split(' ').next().unwrap_or_default();
+                assert!(
+                    scene_err.to_string().contains(key),
+                    "{technique} {keys}: the stage names `{field}`, the scene says {scene_err}"
+                );
+            }
+            _ => panic!(
+                "{technique} {keys}: scene {:?} but stage {:?}",
+                scene.as_ref().map(|_| ()),
+                stage.map(|_| ())
+            ),
+        }
+    }
+}
+
+#[test]
+fn settings_that_do_not_apply_are_named() {
+    let e = PrefilterConfig::esm(64)
+        .with_storage(Storage::F16)
+        .validated()
+        .unwrap_err();
+    assert!(
+        matches!(&e, StageError::Config { field, .. } if field == "format"),
+        "{e}"
+    );
+    assert!(e.to_string().contains("esm"), "{e}");
+    let e = PrefilterConfig::new(Technique::Hard, 64)
+        .with_blur(2.0)
+        .validated()
+        .unwrap_err();
+    assert!(e.to_string().contains("filter"), "{e}");
+    let e = PrefilterConfig::vsm(0).validated().unwrap_err();
+    assert!(e.to_string().contains("size"), "{e}");
+    // A scene's prefilter field set by hand is still checked.
+    let mut c = PrefilterConfig::vsm(64);
+    c.technique = Technique::Vsm {
+        prefilter: Prefilter {
+            storage: Storage::F32,
+            filter: Filter::Blur {
+                radius: 2.0,
+                sigma: 0.0,
+                kernel: BlurKernel::Gaussian,
+            },
+        },
+        bleed: 0.2,
+        min_variance: 1e-5,
+    };
+    let e = c.validated().unwrap_err();
+    assert!(e.to_string().contains("filter_sigma"), "{e}");
+}
