@@ -35,7 +35,7 @@ use crate::error::{Error, Result};
 use crate::exec::{Executor, GpuTimer};
 use crate::graph::{Graph, Plan, plan};
 use crate::scene::Light;
-use crate::technique::{self, LightGpu, ShadeInput};
+use crate::technique::{self, LightGpu};
 
 /// Depth formats the `linearize` kernel reads (as unfilterable float, depth aspect only).
 pub const DEPTH_FORMATS: [wgpu::TextureFormat; 5] = [
@@ -75,7 +75,7 @@ pub struct PrefilterOutput {
 struct Planned {
     key: PlanKey,
     plan: Plan,
-    maps: Vec<ShadeInput>,
+    maps: Vec<MapInput>,
 }
 
 /// What a plan depends on besides the technique: the map size and the linearization.
@@ -300,8 +300,25 @@ fn plan_for(config: &PrefilterConfig, light: &LightParams, size: u32) -> Result<
 
 /// The maps light 0's technique reads, in binding order. `add_light_nodes` returns one per
 /// light today; when it returns a list, this is the one line to change.
-fn light_maps(graph: &mut Graph, light: &Light) -> Vec<ShadeInput> {
-    vec![technique::add_light_nodes(graph, 0, light)]
+fn light_maps(graph: &mut Graph, light: &Light) -> Vec<MapInput> {
+    let input = technique::add_light_nodes(graph, 0, light);
+    input
+        .maps
+        .into_iter()
+        .map(|resource| MapInput {
+            resource,
+            wgsl_type: input.wgsl_type,
+        })
+        .collect()
+}
+
+/// One map the technique's visibility function reads.
+#[derive(Clone, Debug)]
+struct MapInput {
+    /// Graph resource.
+    resource: String,
+    /// WGSL type of its binding.
+    wgsl_type: &'static str,
 }
 
 /// The side of `depth`, or what makes it unusable.

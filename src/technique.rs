@@ -473,7 +473,7 @@ pub struct ShadeInput {
 
 /// The module light `light`'s visibility function lives in, and the WGSL statements (ending in
 /// a `return`) that evaluate it with `l`, `s` in scope and its maps bound as `maps`.
-fn visibility_body(light: &Light, maps: &[String]) -> (&'static str, String) {
+pub fn visibility_body(light: &Light, maps: &[String]) -> (&'static str, String) {
     let map = maps.first().map_or("", String::as_str);
     let call = |module, f: &str| (module, format!("return {f}({map}, l, s);"));
     match light.shadow.technique {

@@ -136,6 +136,19 @@ fn run_stage(
     depth: &wgpu::Texture,
     light: &LightParams,
 ) -> Vec<Vec<f32>> {
+    run_stage_channels(g, stage, depth, light)
+        .into_iter()
+        .map(|(_, d)| d)
+        .collect()
+}
+
+/// [`run_stage`] with each map's channel count.
+fn run_stage_channels(
+    g: &Gpu,
+    stage: &mut Prefilter,
+    depth: &wgpu::Texture,
+    light: &LightParams,
+) -> Vec<(usize, Vec<f32>)> {
     let mut enc = g.device.create_command_encoder(&Default::default());
     let out = stage
         .record(&g.device, &mut enc, depth, light)
@@ -143,11 +156,7 @@ fn run_stage(
     submit_and_wait(&g.device, &g.queue, enc, "stage").expect("submit");
     out.maps
         .iter()
-        .map(|m| {
-            read_float_texture(&g.device, &g.queue, &m.texture, 0)
-                .expect("readback")
-                .1
-        })
+        .map(|m| read_float_texture(&g.device, &g.queue, &m.texture, 0).expect("readback"))
         .collect()
 }
 
@@ -352,9 +361,16 @@ fn stage_outputs_equal_the_renderers() {
 
             let mut stage = Prefilter::new(&g.device, &PrefilterConfig::from_light(light))
                 .unwrap_or_else(|e| panic!("{what}: {e}"));
-            let maps = run_stage(&g, &mut stage, &depth, &params);
-            assert_eq!(maps.len(), 1, "{what}: one map per light today");
-            let (n, worst) = differences(&maps[0], &frame.shade_maps[li].data);
+            // The renderer's map holds every map's channels side by side (CSM: 2M channels).
+            let maps = run_stage_channels(&g, &mut stage, &depth, &params);
+            let texels = (light.shadow_map * light.shadow_map) as usize;
+            let concat: Vec<f32> = (0..texels)
+                .flat_map(|t| {
+                    maps.iter()
+                        .flat_map(move |(c, d)| d[t * c..(t + 1) * c].iter().copied())
+                })
+                .collect();
+            let (n, worst) = differences(&concat, &frame.shade_maps[li].data);
             assert_eq!(
                 n, 0,
                 "{what}: stage map differs at {n} values (worst {worst:e})"

@@ -24,12 +24,15 @@
 //   fn vis_vsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
 //   fn vis_evsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
 //   fn vis_esm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
+//   fn vis_msm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
 //
 // Names defined here (a host must not reuse them):
-//   GOLDEN_ANGLE Light LightSample chebyshev_upper light_linear_to_ndc light_linear_to_z
-//   light_map_width light_sample light_to_light linstep load_depth pcss_search_radius
-//   sample_bilinear sample_bilinear_log texel_of vis_esm vis_evsm vis_hard vis_pcf
-//   vis_pcf_hardware vis_pcss vis_vsm vogel_disc
+//   CSM_PI GOLDEN_ANGLE Light LightSample MSM_B0 bilinear_level bilinear_log_level
+//   chebyshev_upper csm_chunk csm_resolve csm_sin_cos light_linear_to_ndc light_linear_to_z
+//   light_map_width light_sample light_to_light linstep load_depth msm_dequantize msm_intensity
+//   msm_quantize pcss_search_radius sample_bilinear sample_bilinear_log sample_map
+//   sample_map_log texel_of vis_esm vis_evsm vis_hard vis_msm vis_pcf vis_pcf_hardware vis_pcss
+//   vis_vsm vogel_disc
 
 // Shared light description and light-space helpers (import-only module).
 //
@@ -53,7 +56,7 @@ struct Light {
     bias: f32,               // constant bias, linear depth units
     normal_bias: f32,        // normal offset, texels, scaled by (1 − N·L)
     cos_outer: f32,          // spot cone: cos(fov/2); directional: −1
-    technique: u32,          // 0 hard, 1 pcf, 2 pcss
+    technique: u32,          // 0 hard, 1 pcf, 2 pcss, 3 vsm, 4 evsm, 5 esm, 6 msm, 7 csm
     radius: u32,             // pcf: window radius in texels
     kernel: u32,             // pcf: 0 box, 1 tent, 2 hardware 2×2
     blocker_samples: u32,    // pcss
@@ -64,6 +67,14 @@ struct Light {
     exp_pos: f32,            // evsm: positive exponent c⁺; esm: exponent c
     exp_neg: f32,            // evsm: negative exponent c⁻
     moments: u32,            // evsm: 2 or 4 stored moments
+    moment_bias: f32,        // msm: bias α toward the three-point moments
+    msm_flags: u32,          // msm: bit 0 Hausdorff (else Hamburger), bit 1 quantized storage
+    csm_terms: u32,          // csm: Fourier terms M
+    csm_attenuation: f32,    // csm: ringing attenuation α
+    csm_offset: f32,         // csm: receiver-depth offset
+    csm_scale: f32,          // csm: response scale about ½
+    mip_levels: u32,         // mips filter: levels in the map's chain (0: no mips)
+    filter_lod: f32,         // mips filter: log2 of the filter width in texels
     _pad0: u32,
     _pad1: u32,
 }
@@ -149,16 +160,33 @@ fn load_depth(map: texture_2d<f32>, t: vec2<i32>) -> f32 {
 // clamp-to-edge, from four loads: exact and filter-feature independent (f32 maps need not be
 // filterable).
 fn sample_bilinear(map: texture_2d<f32>, uv: vec2<f32>) -> vec4<f32> {
-    let size = vec2<f32>(textureDimensions(map));
+    return bilinear_level(map, uv, 0);
+}
+
+// `sample_bilinear` on mip `level` (texel centres at (i + ½) / level size).
+fn bilinear_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> vec4<f32> {
+    let size = vec2<f32>(textureDimensions(map, level));
     let f = uv * size - 0.5;
     let i = vec2<i32>(floor(f));
     let a = f - floor(f);
     let smax = vec2<i32>(size) - 1;
-    let t00 = textureLoad(map, clamp(i, vec2<i32>(0), smax), 0);
-    let t10 = textureLoad(map, clamp(i + vec2<i32>(1, 0), vec2<i32>(0), smax), 0);
-    let t01 = textureLoad(map, clamp(i + vec2<i32>(0, 1), vec2<i32>(0), smax), 0);
-    let t11 = textureLoad(map, clamp(i + vec2<i32>(1, 1), vec2<i32>(0), smax), 0);
+    let t00 = textureLoad(map, clamp(i, vec2<i32>(0), smax), level);
+    let t10 = textureLoad(map, clamp(i + vec2<i32>(1, 0), vec2<i32>(0), smax), level);
+    let t01 = textureLoad(map, clamp(i + vec2<i32>(0, 1), vec2<i32>(0), smax), level);
+    let t11 = textureLoad(map, clamp(i + vec2<i32>(1, 1), vec2<i32>(0), smax), level);
     return mix(mix(t00, t10, a.x), mix(t01, t11, a.x), a.y);
+}
+
+// A light's filtered representation at uv: bilinear, or with the `mips` filter trilinear at
+// level log2(filter width) (clamped to the chain).
+fn sample_map(map: texture_2d<f32>, l: Light, uv: vec2<f32>) -> vec4<f32> {
+    if l.mip_levels <= 1u {
+        return sample_bilinear(map, uv);
+    }
+    let lod = clamp(l.filter_lod, 0.0, f32(l.mip_levels - 1u));
+    let l0 = i32(floor(lod));
+    let l1 = min(l0 + 1, i32(l.mip_levels) - 1);
+    return mix(bilinear_level(map, uv, l0), bilinear_level(map, uv, l1), lod - floor(lod));
 }
 
 // linstep(lo, hi, x): the light-bleeding reduction of VSM-family techniques.
@@ -169,15 +197,35 @@ fn linstep(lo: f32, hi: f32, x: f32) -> f32 {
 // Bilinear interpolation of exp(v) for a map of logarithms v (channel 0), returned as a
 // logarithm: log Σ wᵢ exp(vᵢ), evaluated around the largest tap so nothing overflows.
 fn sample_bilinear_log(map: texture_2d<f32>, uv: vec2<f32>) -> f32 {
-    let size = vec2<f32>(textureDimensions(map));
+    return bilinear_log_level(map, uv, 0);
+}
+
+// `sample_map` for a map of logarithms: the same weights applied to exp(v), as a logarithm.
+fn sample_map_log(map: texture_2d<f32>, l: Light, uv: vec2<f32>) -> f32 {
+    if l.mip_levels <= 1u {
+        return sample_bilinear_log(map, uv);
+    }
+    let lod = clamp(l.filter_lod, 0.0, f32(l.mip_levels - 1u));
+    let l0 = i32(floor(lod));
+    let l1 = min(l0 + 1, i32(l.mip_levels) - 1);
+    let v0 = bilinear_log_level(map, uv, l0);
+    let v1 = bilinear_log_level(map, uv, l1);
+    let t = lod - floor(lod);
+    let m = max(v0, v1);
+    return m + log((1.0 - t) * exp(v0 - m) + t * exp(v1 - m));
+}
+
+// `sample_bilinear_log` on mip `level`.
+fn bilinear_log_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> f32 {
+    let size = vec2<f32>(textureDimensions(map, level));
     let f = uv * size - 0.5;
     let i = vec2<i32>(floor(f));
     let a = f - floor(f);
     let smax = vec2<i32>(size) - 1;
-    let v00 = textureLoad(map, clamp(i, vec2<i32>(0), smax), 0).r;
-    let v10 = textureLoad(map, clamp(i + vec2<i32>(1, 0), vec2<i32>(0), smax), 0).r;
-    let v01 = textureLoad(map, clamp(i + vec2<i32>(0, 1), vec2<i32>(0), smax), 0).r;
-    let v11 = textureLoad(map, clamp(i + vec2<i32>(1, 1), vec2<i32>(0), smax), 0).r;
+    let v00 = textureLoad(map, clamp(i, vec2<i32>(0), smax), level).r;
+    let v10 = textureLoad(map, clamp(i + vec2<i32>(1, 0), vec2<i32>(0), smax), level).r;
+    let v01 = textureLoad(map, clamp(i + vec2<i32>(0, 1), vec2<i32>(0), smax), level).r;
+    let v11 = textureLoad(map, clamp(i + vec2<i32>(1, 1), vec2<i32>(0), smax), level).r;
     let m = max(max(v00, v10), max(v01, v11));
     let sum = (1.0 - a.y) * ((1.0 - a.x) * exp(v00 - m) + a.x * exp(v10 - m))
         + a.y * ((1.0 - a.x) * exp(v01 - m) + a.x * exp(v11 - m));
@@ -256,7 +304,7 @@ fn vis_pcss(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
 // then the light-bleeding reduction linstep(bleed, 1, p_max).
 
 fn vis_vsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    let m = sample_bilinear(map, s.uv);
+    let m = sample_map(map, l, s.uv);
     let d = s.depth - l.bias;
     if d <= m.x {
         return 1.0;
@@ -280,7 +328,7 @@ fn chebyshev_upper(mean: f32, mean_sq: f32, receiver: f32, floor: f32) -> f32 {
 }
 
 fn vis_evsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    let m = sample_bilinear(map, s.uv);
+    let m = sample_map(map, l, s.uv);
     let w = 2.0 * (s.depth - l.bias) - 1.0;
     let pos = exp(l.exp_pos * w);
     let slope_pos = 2.0 * l.exp_pos * pos;
@@ -296,6 +344,139 @@ fn vis_evsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
 // moment kept as its logarithm L, so the product is exp(L − c d) and never overflows.
 
 fn vis_esm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    let log_moment = sample_bilinear_log(map, s.uv);
+    let log_moment = sample_map_log(map, l, s.uv);
     return clamp(exp(log_moment - l.exp_pos * (s.depth - l.bias)), 0.0, 1.0);
+}
+// Moment shadow maps (Peters & Klein 2015), four moments b = (z, z², z³, z⁴) of the filtered
+// depth distribution. The moments are biased toward those of a fixed three-point distribution
+// (b' = (1 − α) b + α b₀) so the Hankel matrix stays positive definite, then:
+// Hamburger: solve B c = (1, d, d²) by Cholesky, the roots z₂ ≤ z₃ of c₃x² + c₂x + c₁ are the
+// other support points of the distribution through d that matches b', and the fraction of it
+// in front of d is the shadow intensity (three cases by where d lies). Hausdorff: the same when
+// z₂, z₃ lie in [0, 1], else the four-point solution supported on [0, 1].
+// Degenerate moments (bias 0 on a flat map) fall back to the two-moment Chebyshev bound or the
+// step at the mean instead of dividing by zero.
+// The optimized 16-bit moment quantization of Peters & Klein (2015), section 4.3, and its
+// inverse (import-only module). The moment vector multiplies the matrices from the left (as a
+// row vector); the constructors list their columns.
+
+fn msm_quantize(b: vec4<f32>) -> vec4<f32> {
+    let m = mat4x4<f32>(
+        vec4<f32>(-2.07224649, 32.23703778, -68.571074599, 39.3703274134),
+        vec4<f32>(13.7948857237, -59.4683975703, 82.0359750338, -35.364903257),
+        vec4<f32>(0.105877704, -1.9077466311, 9.3496555107, -6.6543490743),
+        vec4<f32>(9.7924062118, -33.7652110555, 47.9456096605, -23.9728048165),
+    );
+    return b * m + vec4<f32>(0.035955884801, 0.0, 0.0, 0.0);
+}
+
+fn msm_dequantize(q: vec4<f32>) -> vec4<f32> {
+    let m = mat4x4<f32>(
+        vec4<f32>(0.2227744146, 0.0771972861, 0.7926986636, 0.0319417555),
+        vec4<f32>(0.1549679261, 0.1394629426, 0.7963415838, -0.1722823173),
+        vec4<f32>(0.1451988946, 0.2120202157, 0.7258694464, -0.2758014811),
+        vec4<f32>(0.163127443, 0.2591432266, 0.6539092497, -0.3376131734),
+    );
+    return (q - vec4<f32>(0.035955884801, 0.0, 0.0, 0.0)) * m;
+}
+
+// Moments of {0, ½, 1} with weights (3/16, 10/16, 3/16): Peters' b₀ = (0, 0.375, 0, 0.375)
+// on [−1, 1], mapped to depth in [0, 1].
+const MSM_B0: vec4<f32> = vec4<f32>(0.5, 0.34375, 0.265625, 0.2265625);
+
+// Shadow intensity (share of the depth distribution in front of d) from biased moments b.
+fn msm_intensity(b: vec4<f32>, d: f32, hausdorff: bool) -> f32 {
+    let var1 = b.y - b.x * b.x;
+    if !(var1 > 1e-12) {
+        return select(0.0, 1.0, d > b.x);
+    }
+    let l32 = (b.z - b.x * b.y) / var1;
+    let d3 = b.w - b.y * b.y - l32 * l32 * var1;
+    if !(d3 > 0.0) {
+        // Rank-deficient: two support points; Chebyshev's bound is the best statement left.
+        if d <= b.x {
+            return 0.0;
+        }
+        let t = d - b.x;
+        return t * t / (var1 + t * t);
+    }
+    // Forward substitution, scaling by the diagonal, back substitution.
+    let y2 = d - b.x;
+    let y3 = d * d - b.y - l32 * y2;
+    let c3 = y3 / d3;
+    let c2 = y2 / var1 - l32 * c3;
+    let c1 = 1.0 - b.x * c2 - b.y * c3;
+    let p = c2 / c3;
+    let q = c1 / c3;
+    let r = sqrt(max(0.25 * p * p - q, 0.0));
+    let z2 = -0.5 * p - r;
+    let z3 = -0.5 * p + r;
+    if hausdorff && (z2 < 0.0 || z3 > 1.0) {
+        let free = ((b.z - b.y) * d + b.z - b.w) / ((b.y - b.x) * d + b.y - b.z);
+        let w1 = select(0.0, 1.0, d > free);
+        return (b.y - b.x + (b.z - b.x - (free + 1.0) * (b.y - b.x)) * (free - w1 - d)
+            / (d * (d - free))) / (free - w1) + 1.0 - b.x;
+    }
+    if d <= z2 {
+        return 0.0;
+    }
+    if d <= z3 {
+        return (d * z3 - b.x * (d + z3) + b.y) / ((z3 - z2) * (d - z2));
+    }
+    return 1.0 - (z2 * z3 - b.x * (z2 + z3) + b.y) / ((d - z2) * (d - z3));
+}
+
+fn vis_msm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
+    var b = sample_map(map, l, s.uv);
+    if (l.msm_flags & 2u) != 0u {
+        b = msm_dequantize(b);
+    }
+    b = mix(b, MSM_B0, l.moment_bias);
+    let intensity = msm_intensity(b, s.depth - l.bias, (l.msm_flags & 1u) != 0u);
+    let v = 1.0 - clamp(intensity, 0.0, 1.0);
+    // NaN compares false both ways: a non-finite intensity reads as fully lit.
+    return linstep(l.bleed, 1.0, select(1.0, v, v == v));
+}
+// Convolution shadow maps (Annen et al. 2007): the step H(z − d) as its Fourier series
+//   f(d, z) ≈ ½ + Σ_k w_k [cos(c_k d) sin(c_k z) − sin(c_k d) cos(c_k z)],
+//   c_k = π (2k − 1),  w_k = (2 / c_k) · exp(−α (k / M)²)   (α: ringing attenuation),
+// linear in the basis images, so their filtered values give the filtered test. d is shifted by
+// an offset so a receiver at its own depth is not read as ½, and the response is scaled about
+// ½ and clamped to [0, 1], which cuts the remaining ringing (seed 000).
+// The shading block sums `csm_chunk` over the light's maps (two terms each), then calls
+// `csm_resolve`.
+// The CSM Fourier basis (import-only module): (sin c_k x, cos c_k x), c_k = π (2k − 1).
+
+const CSM_PI: f32 = 3.141592653589793;
+
+// (sin, cos) of π (2k − 1) x, with (2k − 1) x reduced to [−1, 1] (period 2) before the
+// multiplication by π, so the trigonometric argument stays in [−π, π].
+fn csm_sin_cos(k: u32, x: f32) -> vec2<f32> {
+    let y = f32(2u * k - 1u) * x;
+    let t = CSM_PI * (y - 2.0 * round(0.5 * y));
+    return vec2<f32>(sin(t), cos(t));
+}
+
+// Terms 2·chunk + 1 and 2·chunk + 2 (those ≤ M) of the series at this receiver.
+fn csm_chunk(map: texture_2d<f32>, chunk: u32, l: Light, s: LightSample) -> f32 {
+    let v = sample_map(map, l, s.uv);
+    let d = s.depth - l.bias - l.csm_offset;
+    let m = f32(l.csm_terms);
+    var sum = 0.0;
+    for (var j = 0u; j < 2u; j++) {
+        let k = 2u * chunk + 1u + j;
+        if k > l.csm_terms {
+            break;
+        }
+        let kf = f32(k) / m;
+        let w = 2.0 / (CSM_PI * f32(2u * k - 1u)) * exp(-l.csm_attenuation * kf * kf);
+        let basis = select(v.xy, v.zw, j == 1u);
+        let sc = csm_sin_cos(k, d);
+        sum += w * (sc.y * basis.x - sc.x * basis.y);
+    }
+    return sum;
+}
+
+fn csm_resolve(sum: f32, l: Light) -> f32 {
+    return clamp(l.csm_scale * sum + 0.5, 0.0, 1.0);
 }

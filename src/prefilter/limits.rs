@@ -39,7 +39,7 @@ pub(super) fn check(device: &wgpu::Device, plan: &Plan, size: u32) -> Result<()>
             workgroups.insert(name, refl.workgroup_size.unwrap_or([1, 1, 1]));
         }
         let wg = workgroups.get(name).copied().unwrap_or([1, 1, 1]);
-        let groups = dispatch_groups(plan, &step.node.dispatch, wg);
+        let groups = dispatch_groups(plan, &step.node, wg);
         for g in groups {
             over(
                 format!(
@@ -145,9 +145,18 @@ fn kernel_needs(
 }
 
 /// Workgroup counts of a node's dispatch (as the executor computes them).
-fn dispatch_groups(plan: &Plan, dispatch: &Dispatch, wg: [u32; 3]) -> [u32; 3] {
+fn dispatch_groups(plan: &Plan, node: &crate::graph::Node, wg: [u32; 3]) -> [u32; 3] {
     let size = |r: &str| plan.resource(r).map_or((1, 1), |p| (p.width, p.height));
-    match dispatch {
+    match &node.dispatch {
+        // The largest of a mip chain's dispatches covers level 1 (level 0 for a 1×1 map).
+        Dispatch::MipChain => {
+            let (w, h) = node.outputs.first().map_or((1, 1), |(_, r)| size(r));
+            [
+                (w / 2).max(1).div_ceil(wg[0]),
+                (h / 2).max(1).div_ceil(wg[1]),
+                1,
+            ]
+        }
         Dispatch::Groups(g) => *g,
         Dispatch::Texels(r) => {
             let (w, h) = size(r);

@@ -1,8 +1,8 @@
 //! The WGSL a host includes to sample the stage's outputs: the visibility functions of
 //! `kernels/shared/vis_*.wgsl` with `shared/light` and `shared/sampling`, import-resolved.
 //!
-//! What a technique calls and binds is read from [`crate::technique::shading_block`], the
-//! block the renderer's own shading kernel is completed with, so the host calls exactly what
+//! What a technique calls and binds comes from [`crate::technique::visibility_body`], the code
+//! the renderer's own shading kernel is completed with, so the host calls exactly what
 //! the renderer calls, and a new technique needs nothing here.
 
 use std::fmt::Write;
@@ -10,7 +10,6 @@ use std::fmt::Write;
 use crate::error::{Error, Result};
 use crate::kernels;
 use crate::scene::{Light, Technique};
-use crate::technique::shading_block;
 
 use super::{LightParams, PrefilterConfig};
 
@@ -97,52 +96,41 @@ fn defined_names(wgsl: &str) -> Result<Vec<String>> {
     Ok(names)
 }
 
-/// The maps and call a technique's shading block declares.
+/// The maps and visibility statements of a technique (as the renderer's shading block has
+/// them, from [`crate::technique::visibility_body`]).
 struct Block {
     imports: Vec<String>,
     /// `(name, WGSL type)` per map, in binding order.
     maps: Vec<(String, String)>,
-    call: String,
+    /// Statements ending in a `return`, with `l: Light` and `s: LightSample` in scope.
+    body: String,
 }
 
-/// A light with `technique` (the shading block depends on nothing else).
+/// A light with `technique` (the visibility code depends on nothing else).
 fn light_with(technique: &Technique) -> Light {
     let params = LightParams::orthographic(glam::Mat4::IDENTITY, 1.0, 0.1, 1.0);
     params.scene_light(&PrefilterConfig::new(*technique, 1), 1)
 }
 
-/// Reads the renderer's shading block for one light with `technique`: its imports, its map
-/// bindings and the visibility call of its one case.
+/// The imports, map bindings and visibility statements of `technique`.
 fn block_of(technique: &Technique) -> Result<Block> {
-    let text = shading_block(&[light_with(technique)]);
-    let mut block = Block {
-        imports: Vec::new(),
-        maps: Vec::new(),
-        call: String::new(),
-    };
-    for line in text.lines().map(str::trim) {
-        if let Some(m) = line.strip_prefix("// #import ") {
-            block.imports.push(m.trim().to_string());
-        } else if line.starts_with("@group(") {
-            let decl = line.split_once(" var ").map(|(_, d)| d);
-            let Some((name, ty)) = decl.and_then(|d| d.split_once(':')) else {
-                return Err(malformed(&text));
-            };
-            let ty = ty.trim().trim_end_matches(';').trim();
-            block.maps.push((name.trim().to_string(), ty.to_string()));
-        } else if let Some(e) = line
-            .strip_prefix("return ")
-            .and_then(|e| e.strip_suffix(';'))
-        {
-            if block.call.is_empty() && e != "1.0" {
-                block.call = e.to_string();
-            }
-        }
+    let light = light_with(technique);
+    let input = crate::technique::add_light_nodes(&mut crate::graph::Graph::default(), 0, &light);
+    let names: Vec<String> = (0..input.maps.len())
+        .map(|k| format!("light0_map{k}"))
+        .collect();
+    let (module, body) = crate::technique::visibility_body(&light, &names);
+    if names.is_empty() || body.is_empty() {
+        return Err(malformed(&body));
     }
-    if block.call.is_empty() || block.maps.is_empty() {
-        return Err(malformed(&text));
-    }
-    Ok(block)
+    Ok(Block {
+        imports: vec![module.to_string()],
+        maps: names
+            .into_iter()
+            .map(|n| (n, input.wgsl_type.to_string()))
+            .collect(),
+        body,
+    })
 }
 
 fn malformed(text: &str) -> Error {
@@ -162,7 +150,7 @@ pub fn technique_functions(technique: &Technique) -> Result<String> {
 
 /// Whether `technique` binds a comparison sampler after its maps (hardware PCF).
 pub fn needs_comparison_sampler(technique: &Technique) -> Result<bool> {
-    Ok(split_tokens(&block_of(technique)?.call).contains(&CMP_SAMPLER))
+    Ok(split_tokens(&block_of(technique)?.body).contains(&CMP_SAMPLER))
 }
 
 /// A host's WGSL for `technique`: [`technique_functions`], one binding per map at
@@ -189,7 +177,7 @@ pub fn host_block(technique: &Technique, group: u32, first_binding: u32) -> Resu
         );
     }
     let mut call = String::new();
-    for t in split_tokens(&block.call) {
+    for t in split_tokens(&block.body) {
         match block.maps.iter().position(|(n, _)| n == t) {
             Some(k) => {
                 let _ = write!(call, "{MAP_PREFIX}{k}");
@@ -205,11 +193,14 @@ pub fn host_block(technique: &Technique, group: u32, first_binding: u32) -> Resu
             "@group({group}) @binding({binding}) var {HOST_CMP_SAMPLER}: sampler_comparison;"
         );
     }
+    // Evaluated also outside the map, then discarded: no invocation leaves before sampling
+    // (llvmpipe mis-fetches explicit mip levels under divergence; see `shading_block`).
     let _ = write!(
         s,
-        "fn shadowgraph_visibility(l: Light, p: vec3<f32>, n: vec3<f32>) -> f32 {{\n    \
-         let s = light_sample(l, p, n);\n    if !s.inside {{\n        return 1.0;\n    }}\n    \
-         return {call};\n}}\n"
+        "fn shadowgraph_light_visibility(l: Light, s: LightSample) -> f32 {{\n    {call}\n}}\n\
+         fn shadowgraph_visibility(l: Light, p: vec3<f32>, n: vec3<f32>) -> f32 {{\n    \
+         let s = light_sample(l, p, n);\n    \
+         return select(1.0, shadowgraph_light_visibility(l, s), s.inside);\n}}\n"
     );
     Ok(s)
 }

@@ -13,7 +13,6 @@ use glam::{Mat4, Vec3};
 
 use crate::error::{Error, Result};
 pub use mesh::{Mesh, Vertex};
-pub use validate::exponent_limit;
 
 /// A loaded, validated scene.
 #[derive(Clone, Debug)]
