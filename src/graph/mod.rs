@@ -24,6 +24,17 @@ pub enum SizeRule {
         /// Halvings.
         shift: u32,
     },
+    /// The number of `x × y` blocks covering another resource: its width divided by `x` and
+    /// its height by `y`, each rounded up (at least 1). One texel per block of a blocked pass,
+    /// e.g. the per-row block totals of a scan (`x` = block length, `y` = 1).
+    Blocks {
+        /// The resource whose size this follows.
+        of: String,
+        /// Block width in texels (0 is treated as 1).
+        x: u32,
+        /// Block height in texels (0 is treated as 1).
+        y: u32,
+    },
 }
 
 /// A named, typed texture in the graph.

@@ -311,17 +311,35 @@ fn resolve_size(
     match &r.size {
         SizeRule::Fixed { width, height } => Ok((*width, *height)),
         SizeRule::Reduced { of, shift } => {
-            let base = index
-                .get(of.as_str())
-                .ok_or_else(|| bad(&format!("follows undeclared resource `{of}`")))?;
-            let (w, h) = resolve_size(graph, index, &graph.resources[*base], depth + 1)?;
+            let (w, h) = resolve_base(graph, index, of, depth, &bad)?;
             let reduce = |v: u32| {
                 v.div_ceil(1u32.checked_shl(*shift).unwrap_or(u32::MAX))
                     .max(1)
             };
             Ok((reduce(w), reduce(h)))
         }
+        SizeRule::Blocks { of, x, y } => {
+            let (w, h) = resolve_base(graph, index, of, depth, &bad)?;
+            Ok((
+                w.div_ceil((*x).max(1)).max(1),
+                h.div_ceil((*y).max(1)).max(1),
+            ))
+        }
     }
+}
+
+/// The size of `of`, the resource a size rule follows.
+fn resolve_base(
+    graph: &Graph,
+    index: &HashMap<&str, usize>,
+    of: &str,
+    depth: usize,
+    bad: &dyn Fn(&str) -> GraphError,
+) -> Result<(u32, u32), GraphError> {
+    let base = index
+        .get(of)
+        .ok_or_else(|| bad(&format!("follows undeclared resource `{of}`")))?;
+    resolve_size(graph, index, &graph.resources[*base], depth + 1)
 }
 
 fn lifetimes(
