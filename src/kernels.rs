@@ -36,6 +36,11 @@ pub const SOURCES: &[Source] = sources![
     "evsm",
     "esm",
     "blur",
+    "sat_rows",
+    "sat_carry",
+    "sat_cols_reduce",
+    "sat_cols",
+    "sat_cols_f32",
     "shared/light",
     "shared/vertex",
     "shared/exp_params",
@@ -46,6 +51,8 @@ pub const SOURCES: &[Source] = sources![
     "shared/vis_vsm",
     "shared/vis_evsm",
     "shared/vis_esm",
+    "shared/sat_scan",
+    "shared/sat",
 ];
 
 /// The embedded text of `kernels/<name>.wgsl`.

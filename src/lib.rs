@@ -11,6 +11,7 @@ pub mod graph;
 pub mod io;
 pub mod kernels;
 pub mod render;
+pub mod sat;
 pub mod scene;
 pub mod technique;
 

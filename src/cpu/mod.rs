@@ -6,6 +6,7 @@ pub mod esm;
 pub mod evsm;
 pub mod light;
 pub mod linearize;
+pub mod sat;
 pub mod vis_esm;
 pub mod vis_evsm;
 pub mod vis_hard;
