@@ -3,7 +3,7 @@
 
 use std::collections::{BTreeSet, HashMap, HashSet};
 
-use super::{Graph, GraphError, Node, Resource, SizeRule, texel_bytes};
+use super::{Graph, GraphError, Node, Resource, SizeRule, block_count, texel_bytes};
 
 /// One step of a plan: a node to run, in order.
 #[derive(Clone, Debug)]
@@ -320,10 +320,7 @@ fn resolve_size(
         }
         SizeRule::Blocks { of, x, y } => {
             let (w, h) = resolve_base(graph, index, of, depth, &bad)?;
-            Ok((
-                w.div_ceil((*x).max(1)).max(1),
-                h.div_ceil((*y).max(1)).max(1),
-            ))
+            Ok((block_count(w, *x), block_count(h, *y)))
         }
     }
 }

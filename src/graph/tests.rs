@@ -266,7 +266,11 @@ fn block_sizes_round_up_per_axis() {
     assert_eq!(r("rows"), (4, 37));
     assert_eq!(r("cols"), (1000, 1));
     assert_eq!(r("both"), (143, 8));
-    assert_eq!(r("zero"), (1000, 37));
+    assert_eq!(r("zero"), (1, 1));
+    assert_eq!(
+        (block_count(1, 256), block_count(0, 4), block_count(9, 0)),
+        (1, 1, 1)
+    );
     assert!(matches!(
         plan(&g, &["ghost_blocks"]),
         Err(GraphError::BadSize { .. })
