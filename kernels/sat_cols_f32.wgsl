@@ -10,10 +10,13 @@
 
 @compute @workgroup_size(WG_SIZE)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    let x = wg.y;
-    let y = wg.x * WG_SIZE + li;
-    let sat = sat_column(src, row_carry, col_carry, params, li, wg.x, x);
-    if y < textureDimensions(src).y {
-        textureStore(dst, vec2<u32>(x, y), bitcast<vec4<f32>>(sat));
+    let x = wg.x;
+    let height = textureDimensions(src).y;
+    let sat = sat_column(src, row_carry, col_carry, params, li, wg.y, x);
+    for (var k = 0u; k < ITEMS; k++) {
+        let y = sat_column_row(wg.y, li, k);
+        if y < height {
+            textureStore(dst, vec2<u32>(x, y), bitcast<vec4<f32>>(sat[k]));
+        }
     }
 }

@@ -1,6 +1,6 @@
-// Summed-area table, pass 3 of 5: the total of each block of WG_SIZE rows of each column of the
-// full row prefix R(x, y) = rows(x, y) + row_carry(x / WG_SIZE, y), one texel per block:
-// width × ceil(height / WG_SIZE). Only the up-sweep half of the scan tree is needed.
+// Summed-area table, pass 3 of 5: the total of each block of BLOCK rows of each column of the
+// full row prefix R(x, y) = rows(x, y) + row_carry(x / BLOCK, y), one workgroup and one texel
+// per block: width × ⌈height / BLOCK⌉. Only the up-sweep half of the scan tree is needed.
 // #import shared/sat_scan
 
 @group(0) @binding(0) var src: texture_2d<u32>;
@@ -11,15 +11,9 @@
 @compute @workgroup_size(WG_SIZE)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     let fs = params.float_sums != 0u;
-    let x = wg.y;
-    let y = wg.x * WG_SIZE + li;
-    var v = vec4<u32>(0u);
-    if y < textureDimensions(src).y {
-        let r = textureLoad(src, vec2<u32>(x, y), 0);
-        v = sat_add(r, textureLoad(row_carry, vec2<u32>(x / WG_SIZE, y), 0), fs);
-    }
-    let total = sat_reduce(li, v, fs);
+    let x = wg.x;
+    let total = sat_reduce_block(li, sat_row_prefix(src, row_carry, fs, li, wg.y, x), fs);
     if li == 0u {
-        textureStore(dst, vec2<u32>(x, wg.x), total);
+        textureStore(dst, vec2<u32>(x, wg.y), total);
     }
 }

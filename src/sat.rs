@@ -5,9 +5,13 @@
 //! workgroup ever waits on another (no decoupled look-back, which needs forward-progress
 //! guarantees that Vulkan and WebGPU do not give):
 //!
-//! 1. `sat_rows`: encode each texel and scan each row in blocks of [`SAT_BLOCK`] texels
-//!    (Blelloch's up-sweep/down-sweep in workgroup memory); block totals to `.row_sums`.
-//! 2. `sat_carry`: the exclusive prefix of each row's block totals (`.row_carry`).
+//! 1. `sat_rows`: encode each texel and scan each row in blocks of [`SAT_BLOCK`] texels, one
+//!    workgroup per block (4 texels per invocation scanned in registers, the invocations'
+//!    totals by Blelloch's up-sweep/down-sweep in workgroup memory); block totals to
+//!    `.row_sums`.
+//! 2. `sat_carry`: the exclusive prefix of each row's block totals (`.row_carry`), one
+//!    invocation per row ([`SAT_CARRY_LINES`] per workgroup), serially: a row has at most
+//!    ⌈32768 / [`SAT_BLOCK`]⌉ = 32 totals.
 //! 3. `sat_cols_reduce`: totals of blocks of [`SAT_BLOCK`] rows of the full row prefix
 //!    (`.rows` plus `.row_carry`, added on load) per column (`.col_sums`).
 //! 4. `sat_carry`: their exclusive prefix down each column (`.col_carry`).
@@ -33,9 +37,12 @@
 use crate::error::{Error, Result};
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
 
-/// Texels per scanned block: the workgroup size of the `sat_*` kernels (`WG_SIZE` in
+/// Texels per scanned block, one workgroup each (`BLOCK` = `WG_SIZE · ITEMS` in
 /// `kernels/shared/sat_scan.wgsl`; a test checks them against each other).
-pub const SAT_BLOCK: u32 = 256;
+pub const SAT_BLOCK: u32 = 1024;
+
+/// Lines of block totals per `sat_carry` workgroup, one per invocation (its workgroup size).
+pub const SAT_CARRY_LINES: u32 = 64;
 
 /// The largest `max_area` the fixed-point coding accepts: one unit per texel must fit an i32.
 pub const MAX_FIXED_AREA: u64 = (1 << 31) - 1;
@@ -246,9 +253,10 @@ pub fn add_sat(graph: &mut Graph, light: usize, input: &str, coding: &SatCoding)
     let col_carry = res("col_carry", blocks(1, SAT_BLOCK));
     let out = graph.resource(name.clone(), coding.variant.format(), same, Some(light));
 
-    let along = |of: &str, axis: u32| Dispatch::Axis {
+    let blocks_of = |of: &str, x, y| Dispatch::Blocks {
         of: of.to_string(),
-        axis,
+        x,
+        y,
     };
     let bind = |pairs: &[(&str, &str)]| -> Vec<(String, String)> {
         pairs
@@ -263,7 +271,7 @@ pub fn add_sat(graph: &mut Graph, light: usize, input: &str, coding: &SatCoding)
             bind(&[("src", input)]),
             bind(&[("dst", &rows), ("sums", &row_sums)]),
             0,
-            along(input, 0),
+            blocks_of(input, SAT_BLOCK, 1),
         ),
         (
             format!("{name}.row_carry"),
@@ -271,7 +279,7 @@ pub fn add_sat(graph: &mut Graph, light: usize, input: &str, coding: &SatCoding)
             bind(&[("src", &row_sums)]),
             bind(&[("dst", &row_carry)]),
             0,
-            along(&row_sums, 0),
+            blocks_of(&row_sums, 0, SAT_CARRY_LINES),
         ),
         (
             format!("{name}.col_sums"),
@@ -279,7 +287,7 @@ pub fn add_sat(graph: &mut Graph, light: usize, input: &str, coding: &SatCoding)
             bind(&[("src", &rows), ("row_carry", &row_carry)]),
             bind(&[("dst", &col_sums)]),
             1,
-            along(input, 1),
+            blocks_of(input, 1, SAT_BLOCK),
         ),
         (
             format!("{name}.col_carry"),
@@ -287,7 +295,7 @@ pub fn add_sat(graph: &mut Graph, light: usize, input: &str, coding: &SatCoding)
             bind(&[("src", &col_sums)]),
             bind(&[("dst", &col_carry)]),
             1,
-            along(&col_sums, 1),
+            blocks_of(&col_sums, SAT_CARRY_LINES, 0),
         ),
         (
             name.clone(),
@@ -299,7 +307,7 @@ pub fn add_sat(graph: &mut Graph, light: usize, input: &str, coding: &SatCoding)
             ]),
             bind(&[("dst", &out)]),
             1,
-            along(input, 1),
+            blocks_of(input, 1, SAT_BLOCK),
         ),
     ];
     for (node, kernel, inputs, outputs, axis, dispatch) in passes {
@@ -369,7 +377,7 @@ mod tests {
     #[test]
     fn sat_plans_five_passes_sized_by_blocks() {
         let mut g = Graph::default();
-        g.import("in", wgpu::TextureFormat::Rg32Float, 1000, 37, Some(0));
+        g.import("in", wgpu::TextureFormat::Rg32Float, 3000, 37, Some(0));
         let coding = SatCoding::fixed(64, [0.0; 4], [1.0; 4]).unwrap();
         let out = add_sat(&mut g, 0, "in", &coding);
         assert_eq!(out, "in.sat");
@@ -390,10 +398,10 @@ mod tests {
             (r.width, r.height, r.resource.format)
         };
         let u = wgpu::TextureFormat::Rgba32Uint;
-        assert_eq!(size("in.sat"), (1000, 37, u));
-        assert_eq!(size("in.sat.rows"), (1000, 37, u));
-        assert_eq!(size("in.sat.row_carry"), (4, 37, u));
-        assert_eq!(size("in.sat.col_carry"), (1000, 1, u));
+        assert_eq!(size("in.sat"), (3000, 37, u));
+        assert_eq!(size("in.sat.rows"), (3000, 37, u));
+        assert_eq!(size("in.sat.row_carry"), (3, 37, u));
+        assert_eq!(size("in.sat.col_carry"), (3000, 1, u));
         let params: &SatParams = bytemuck::from_bytes(&p.steps[0].node.params);
         assert_eq!((params.channels, params.float_sums), (2, 0));
 
