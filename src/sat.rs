@@ -253,75 +253,117 @@ pub fn add_sat(graph: &mut Graph, light: usize, input: &str, coding: &SatCoding)
     let col_carry = res("col_carry", blocks(1, SAT_BLOCK));
     let out = graph.resource(name.clone(), coding.variant.format(), same, Some(light));
 
-    let blocks_of = |of: &str, x, y| Dispatch::Blocks {
-        of: of.to_string(),
-        x,
-        y,
+    let names = SatNames {
+        input,
+        rows: &rows,
+        row_sums: &row_sums,
+        row_carry: &row_carry,
+        col_sums: &col_sums,
+        col_carry: &col_carry,
+        out: &out,
     };
-    let bind = |pairs: &[(&str, &str)]| -> Vec<(String, String)> {
-        pairs
-            .iter()
-            .map(|(b, r)| (b.to_string(), r.to_string()))
-            .collect()
-    };
-    let passes = [
-        (
-            format!("{name}.rows"),
-            "sat_rows",
-            bind(&[("src", input)]),
-            bind(&[("dst", &rows), ("sums", &row_sums)]),
-            0,
-            blocks_of(input, SAT_BLOCK, 1),
-        ),
-        (
-            format!("{name}.row_carry"),
-            "sat_carry",
-            bind(&[("src", &row_sums)]),
-            bind(&[("dst", &row_carry)]),
-            0,
-            blocks_of(&row_sums, 0, SAT_CARRY_LINES),
-        ),
-        (
-            format!("{name}.col_sums"),
-            "sat_cols_reduce",
-            bind(&[("src", &rows), ("row_carry", &row_carry)]),
-            bind(&[("dst", &col_sums)]),
-            1,
-            blocks_of(input, 1, SAT_BLOCK),
-        ),
-        (
-            format!("{name}.col_carry"),
-            "sat_carry",
-            bind(&[("src", &col_sums)]),
-            bind(&[("dst", &col_carry)]),
-            1,
-            blocks_of(&col_sums, SAT_CARRY_LINES, 0),
-        ),
-        (
-            name.clone(),
-            coding.variant.last_kernel(),
-            bind(&[
-                ("src", &rows),
-                ("row_carry", &row_carry),
-                ("col_carry", &col_carry),
-            ]),
-            bind(&[("dst", &out)]),
-            1,
-            blocks_of(input, 1, SAT_BLOCK),
-        ),
-    ];
-    for (node, kernel, inputs, outputs, axis, dispatch) in passes {
+    for pass in passes(&names, coding.variant) {
         graph.node(Node {
-            name: node,
-            kernel: kernel.into(),
-            inputs,
-            outputs,
-            params: bytemuck::bytes_of(&coding.params(channels, axis)).to_vec(),
-            dispatch,
+            name: format!("{name}{}", pass.suffix),
+            kernel: pass.kernel.into(),
+            inputs: named(pass.inputs),
+            outputs: named(pass.outputs),
+            params: bytemuck::bytes_of(&coding.params(channels, pass.axis)).to_vec(),
+            dispatch: Dispatch::Blocks {
+                of: pass.blocks_of.to_string(),
+                x: pass.block[0],
+                y: pass.block[1],
+            },
             light: Some(light),
         });
     }
     out
+}
+
+/// The resources of one table.
+struct SatNames<'a> {
+    input: &'a str,
+    rows: &'a str,
+    row_sums: &'a str,
+    row_carry: &'a str,
+    col_sums: &'a str,
+    col_carry: &'a str,
+    out: &'a str,
+}
+
+/// One pass of [`add_sat`]: a node named `<table><suffix>` with one workgroup per `block` of
+/// `blocks_of`.
+struct Pass<'a> {
+    suffix: &'a str,
+    kernel: &'a str,
+    inputs: Vec<(&'a str, &'a str)>,
+    outputs: Vec<(&'a str, &'a str)>,
+    axis: u32,
+    blocks_of: &'a str,
+    block: [u32; 2],
+}
+
+/// The five passes, in order (see the module documentation).
+fn passes<'a>(n: &SatNames<'a>, variant: SatVariant) -> [Pass<'a>; 5] {
+    let (b, lines) = (SAT_BLOCK, SAT_CARRY_LINES);
+    [
+        Pass {
+            suffix: ".rows",
+            kernel: "sat_rows",
+            inputs: vec![("src", n.input)],
+            outputs: vec![("dst", n.rows), ("sums", n.row_sums)],
+            axis: 0,
+            blocks_of: n.input,
+            block: [b, 1],
+        },
+        Pass {
+            suffix: ".row_carry",
+            kernel: "sat_carry",
+            inputs: vec![("src", n.row_sums)],
+            outputs: vec![("dst", n.row_carry)],
+            axis: 0,
+            blocks_of: n.row_sums,
+            block: [0, lines],
+        },
+        Pass {
+            suffix: ".col_sums",
+            kernel: "sat_cols_reduce",
+            inputs: vec![("src", n.rows), ("row_carry", n.row_carry)],
+            outputs: vec![("dst", n.col_sums)],
+            axis: 1,
+            blocks_of: n.input,
+            block: [1, b],
+        },
+        Pass {
+            suffix: ".col_carry",
+            kernel: "sat_carry",
+            inputs: vec![("src", n.col_sums)],
+            outputs: vec![("dst", n.col_carry)],
+            axis: 1,
+            blocks_of: n.col_sums,
+            block: [lines, 0],
+        },
+        Pass {
+            suffix: "",
+            kernel: variant.last_kernel(),
+            inputs: vec![
+                ("src", n.rows),
+                ("row_carry", n.row_carry),
+                ("col_carry", n.col_carry),
+            ],
+            outputs: vec![("dst", n.out)],
+            axis: 1,
+            blocks_of: n.input,
+            block: [1, b],
+        },
+    ]
+}
+
+fn named(pairs: Vec<(&str, &str)>) -> Vec<(String, String)> {
+    pairs
+        .into_iter()
+        .map(|(b, r)| (b.to_string(), r.to_string()))
+        .collect()
 }
 
 #[cfg(test)]
