@@ -203,9 +203,12 @@ pub fn fixed_scale(max_area: u64, lo: f32, hi: f32) -> Result<f32> {
 }
 
 /// The largest integer window a lookup of a `width × height` rectangle (texels, any
-/// position) touches: `(⌈width⌉ + 1)·(⌈height⌉ + 1)`; pass it to [`SatCoding::fixed`].
+/// position) touches: `(⌈width⌉ + 1)·(⌈height⌉ + 1)`, a side thinner than the lookups' minimum
+/// extent (2⁻⁸ texel, `SAT_MIN_EXTENT` in `kernels/shared/sat.wgsl`) counting as that; pass it
+/// to [`SatCoding::fixed`]. The sides are those the shader sees, `x1 − x0` in f32 (an edge
+/// computed as `x0 + w` may round past `w`).
 pub fn lookup_area(width: f32, height: f32) -> u64 {
-    let side = |v: f32| v.max(0.0).ceil() as u64 + 1;
+    let side = |v: f32| v.max(1.0 / 256.0).ceil() as u64 + 1;
     side(width) * side(height)
 }
 
@@ -413,7 +416,15 @@ mod tests {
     fn lookup_area_covers_any_placement() {
         assert_eq!(lookup_area(1.0, 1.0), 4);
         assert_eq!(lookup_area(0.25, 3.5), 2 * 5);
-        assert_eq!(lookup_area(0.0, 0.0), 1);
+        assert_eq!(lookup_area(0.0, 0.0), 4);
+        // The nodes of an edge pair x0, x1 = x0 + w are ⌊x0⌋ ..= ⌊x1⌋ + 1, as in `sat_nodes`.
+        for i in 0..2000u32 {
+            let x0 = (i as f32 * 0.618_034).fract() * 50.0;
+            let w = (i as f32 * 0.414_213_6).fract() * 9.0;
+            let x1 = x0 + w.max(1.0 / 256.0);
+            let span = (x1.floor() - x0.floor()) as u64 + 1;
+            assert!(span * span <= lookup_area(w, w), "x0 {x0} w {w}");
+        }
     }
 
     #[test]

@@ -12,7 +12,8 @@
 // then is it weighted in f32.
 //
 // A rectangle is ordered, clamped to the map and, where thinner than SAT_MIN_EXTENT, widened
-// to it inside the map (the mean then tends to the point value, never 0/0).
+// to it inside the map (the mean then tends to the point value, never 0/0). Channels the
+// representation does not have hold 0 in the table and decode to `offset`.
 
 const SAT_MIN_EXTENT: f32 = 0.00390625; // 2⁻⁸ texel
 
