@@ -9,7 +9,7 @@ use wgpu::util::DeviceExt;
 
 use crate::error::{Error, Result};
 use crate::gpu::{read_buffer, scoped};
-use crate::graph::{Dispatch, Plan, Slot};
+use crate::graph::{Dispatch, Plan, Slot, block_count};
 use crate::kernels::{self, Reflection};
 
 /// A compute pipeline with the layouts reflected from its WGSL.
@@ -587,6 +587,15 @@ impl Executor {
                 Dispatch::Texels(r) => {
                     let t = &textures[r];
                     kernel.groups_for(t.width(), t.height())
+                }
+                Dispatch::Blocks { of, x, y } => {
+                    let t = textures.get(of).ok_or_else(|| {
+                        Error::Invalid(format!(
+                            "node `{}` dispatches over `{of}`, which is not in the plan",
+                            node.name
+                        ))
+                    })?;
+                    [block_count(t.width(), *x), block_count(t.height(), *y), 1]
                 }
                 Dispatch::Axis { of, axis } => {
                     let t = &textures[of];

@@ -39,6 +39,11 @@ pub const SOURCES: &[Source] = sources![
     "msm",
     "csm",
     "mips",
+    "sat_rows",
+    "sat_carry",
+    "sat_cols_reduce",
+    "sat_cols",
+    "sat_cols_f32",
     "shared/light",
     "shared/vertex",
     "shared/exp_params",
@@ -53,6 +58,8 @@ pub const SOURCES: &[Source] = sources![
     "shared/vis_msm",
     "shared/csm_basis",
     "shared/vis_csm",
+    "shared/sat_scan",
+    "shared/sat",
 ];
 
 /// The embedded text of `kernels/<name>.wgsl`.

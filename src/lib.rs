@@ -12,6 +12,7 @@ pub mod io;
 pub mod kernels;
 pub mod prefilter;
 pub mod render;
+pub mod sat;
 pub mod scene;
 pub mod technique;
 

@@ -9,6 +9,7 @@ pub mod light;
 pub mod linearize;
 pub mod mips;
 pub mod msm;
+pub mod sat;
 pub mod vis_csm;
 pub mod vis_esm;
 pub mod vis_evsm;

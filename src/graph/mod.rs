@@ -24,6 +24,17 @@ pub enum SizeRule {
         /// Halvings.
         shift: u32,
     },
+    /// The number of `x × y` blocks covering another resource: [`block_count`] along each
+    /// axis. One texel per block of a blocked pass, e.g. the per-row block totals of a scan
+    /// (`x` = block length, `y` = 1).
+    Blocks {
+        /// The resource whose size this follows.
+        of: String,
+        /// Block width in texels (0: the whole width).
+        x: u32,
+        /// Block height in texels (0: the whole height).
+        y: u32,
+    },
 }
 
 /// A named, typed texture in the graph.
@@ -50,6 +61,18 @@ pub enum Dispatch {
     Texels(String),
     /// An explicit workgroup count.
     Groups([u32; 3]),
+    /// One workgroup per `x × y` block of this resource (one of the node's own):
+    /// `[block_count(width, x), block_count(height, y), 1]`, as [`SizeRule::Blocks`] sizes
+    /// the blocks' outputs. For passes whose workgroups each own a block of a size that is not
+    /// the kernel's workgroup size (several texels per invocation, or one line per invocation).
+    Blocks {
+        /// The resource whose size counts.
+        of: String,
+        /// Block width in texels (0: the whole width, one group).
+        x: u32,
+        /// Block height in texels (0: the whole height, one group).
+        y: u32,
+    },
     /// One invocation per texel along `axis` (0 = x, 1 = y) of this resource, one workgroup
     /// row per line across it: `[ceil(len / workgroup x), lines, 1]` (separable passes).
     Axis {
@@ -214,6 +237,16 @@ pub enum GraphError {
         /// What is wrong.
         message: String,
     },
+}
+
+/// Blocks of `block` texels covering `len` texels, rounded up, at least 1; a `block` of 0
+/// spans the whole length (one block).
+pub fn block_count(len: u32, block: u32) -> u32 {
+    if block == 0 {
+        1
+    } else {
+        len.div_ceil(block).max(1)
+    }
 }
 
 /// Bytes of one texel of `format` (0 where the format has no fixed size).

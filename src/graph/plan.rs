@@ -3,7 +3,7 @@
 
 use std::collections::{BTreeSet, HashMap, HashSet};
 
-use super::{Graph, GraphError, Node, Resource, SizeRule, texel_bytes};
+use super::{Graph, GraphError, Node, Resource, SizeRule, block_count, texel_bytes};
 
 /// One step of a plan: a node to run, in order.
 #[derive(Clone, Debug)]
@@ -311,17 +311,32 @@ fn resolve_size(
     match &r.size {
         SizeRule::Fixed { width, height } => Ok((*width, *height)),
         SizeRule::Reduced { of, shift } => {
-            let base = index
-                .get(of.as_str())
-                .ok_or_else(|| bad(&format!("follows undeclared resource `{of}`")))?;
-            let (w, h) = resolve_size(graph, index, &graph.resources[*base], depth + 1)?;
+            let (w, h) = resolve_base(graph, index, of, depth, &bad)?;
             let reduce = |v: u32| {
                 v.div_ceil(1u32.checked_shl(*shift).unwrap_or(u32::MAX))
                     .max(1)
             };
             Ok((reduce(w), reduce(h)))
         }
+        SizeRule::Blocks { of, x, y } => {
+            let (w, h) = resolve_base(graph, index, of, depth, &bad)?;
+            Ok((block_count(w, *x), block_count(h, *y)))
+        }
     }
+}
+
+/// The size of `of`, the resource a size rule follows.
+fn resolve_base(
+    graph: &Graph,
+    index: &HashMap<&str, usize>,
+    of: &str,
+    depth: usize,
+    bad: &dyn Fn(&str) -> GraphError,
+) -> Result<(u32, u32), GraphError> {
+    let base = index
+        .get(of)
+        .ok_or_else(|| bad(&format!("follows undeclared resource `{of}`")))?;
+    resolve_size(graph, index, &graph.resources[*base], depth + 1)
 }
 
 fn lifetimes(

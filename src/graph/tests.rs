@@ -226,6 +226,58 @@ fn reduced_sizes_round_up_and_reject_bad_rules() {
 }
 
 #[test]
+fn block_sizes_round_up_per_axis() {
+    let mut g = Graph::default();
+    g.import("map", F, 1000, 37, None);
+    for (name, x, y) in [
+        ("rows", 256, 1),
+        ("cols", 1, 256),
+        ("both", 7, 5),
+        ("zero", 0, 0),
+    ] {
+        g.resource(
+            name,
+            F,
+            SizeRule::Blocks {
+                of: "map".into(),
+                x,
+                y,
+            },
+            None,
+        );
+        g.node(node(name, &["map"], &[name]));
+    }
+    g.resource(
+        "ghost_blocks",
+        F,
+        SizeRule::Blocks {
+            of: "ghost".into(),
+            x: 2,
+            y: 2,
+        },
+        None,
+    );
+    g.node(node("g", &["map"], &["ghost_blocks"]));
+    let p = plan(&g, &["rows", "cols", "both", "zero"]).unwrap();
+    let r = |n: &str| {
+        let r = p.resource(n).unwrap();
+        (r.width, r.height)
+    };
+    assert_eq!(r("rows"), (4, 37));
+    assert_eq!(r("cols"), (1000, 1));
+    assert_eq!(r("both"), (143, 8));
+    assert_eq!(r("zero"), (1, 1));
+    assert_eq!(
+        (block_count(1, 256), block_count(0, 4), block_count(9, 0)),
+        (1, 1, 1)
+    );
+    assert!(matches!(
+        plan(&g, &["ghost_blocks"]),
+        Err(GraphError::BadSize { .. })
+    ));
+}
+
+#[test]
 fn text_and_dot_name_every_step() {
     let p = plan(&chain(), &["c"]).unwrap();
     let t = p.to_text(&["test light".into()]);

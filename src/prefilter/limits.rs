@@ -158,6 +158,14 @@ fn dispatch_groups(plan: &Plan, node: &crate::graph::Node, wg: [u32; 3]) -> [u32
             ]
         }
         Dispatch::Groups(g) => *g,
+        Dispatch::Blocks { of, x, y } => {
+            let (w, h) = size(of);
+            [
+                crate::graph::block_count(w, *x),
+                crate::graph::block_count(h, *y),
+                1,
+            ]
+        }
         Dispatch::Texels(r) => {
             let (w, h) = size(r);
             [w.div_ceil(wg[0]), h.div_ceil(wg[1]), 1]

@@ -1,0 +1,22 @@
+// Summed-area table, pass 5 of 5, f32 variant: as sat_cols, but the sums are f32 (their bits
+// travel in the u32 intermediates) and the table is stored as rgba32float.
+// #import shared/sat_scan
+
+@group(0) @binding(0) var src: texture_2d<u32>;
+@group(0) @binding(1) var row_carry: texture_2d<u32>;
+@group(0) @binding(2) var col_carry: texture_2d<u32>;
+@group(0) @binding(3) var dst: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(4) var<uniform> params: SatParams;
+
+@compute @workgroup_size(WG_SIZE)
+fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    let x = wg.x;
+    let height = textureDimensions(src).y;
+    let sat = sat_column(src, row_carry, col_carry, params, li, wg.y, x);
+    for (var k = 0u; k < ITEMS; k++) {
+        let y = sat_column_row(wg.y, li, k);
+        if y < height {
+            textureStore(dst, vec2<u32>(x, y), bitcast<vec4<f32>>(sat[k]));
+        }
+    }
+}

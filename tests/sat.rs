@@ -1,0 +1,688 @@
+//! Summed-area tables on the GPU against their references (`cpu::sat`): the fixed-point table
+//! bit for bit against the wrapping-u32 reference, its window sums decoded against f64 sums of
+//! the raw values; the f32 table against the f64 table within the rounding bound of its scan
+//! tree; the rectangle-mean lookups of `shared/sat` against direct f64 integration; property
+//! tests on random small maps.
+
+mod common;
+
+use std::cell::RefCell;
+use std::collections::HashMap;
+
+use proptest::prelude::*;
+use proptest::test_runner::{Config, TestRunner};
+use rand::Rng;
+use shadowgraph::cpu::{Texels, sat as reference};
+use shadowgraph::exec::{ComputeKernel, Executor};
+use shadowgraph::gpu::{Gpu, read_buffer, read_texture, submit_and_wait, write_texture};
+use shadowgraph::graph::{Graph, plan, texel_bytes};
+use shadowgraph::kernels;
+use shadowgraph::sat::{
+    SAT_BLOCK, SAT_CARRY_LINES, SatCoding, SatParams, SatVariant, add_sat, lookup_area,
+};
+use wgpu::util::DeviceExt;
+
+/// f32's unit roundoff (round to nearest; Vulkan's f32 add, sub and mul are correctly rounded).
+const U: f64 = 1.0 / (1u64 << 24) as f64;
+
+/// Largest depth of the GPU's summation tree for one f32 table texel of a `w × h` map, per
+/// axis, with n = ⌈side / SAT_BLOCK⌉ blocks a line: the in-block prefix (3 serial adds in an
+/// invocation, 16 on a Blelloch path over 256 invocations, 1 to add the prefix: 20) or the block
+/// carry (block total 3 + 8, then n − 1 serial adds) plus adding it: max(20, 10 + n) + 1 along
+/// rows, the same again on top of the row prefix along columns. Every f32 table texel is within
+/// γ_d ≈ d·U of Σ|values| over its rectangle (d ≤ 42 for maps up to 1024²).
+fn scan_depth(w: usize, h: usize) -> f64 {
+    let axis = |side: usize| (20.max(10 + side.div_ceil(SAT_BLOCK as usize)) + 1) as f64;
+    axis(w) + axis(h) + 1.0
+}
+
+/// A random representation: `channels` f32 values per texel in `[lo, hi)`, never all zero.
+#[derive(Clone, Debug)]
+struct Map {
+    w: usize,
+    h: usize,
+    channels: usize,
+    values: Vec<f32>,
+}
+
+impl Map {
+    fn random(rng: &mut impl Rng, w: usize, h: usize, channels: usize, lo: f32, hi: f32) -> Self {
+        let values = (0..w * h * channels)
+            .map(|_| rng.random_range(lo..hi))
+            .collect();
+        Self {
+            w,
+            h,
+            channels,
+            values,
+        }
+    }
+
+    fn texels(&self) -> Texels {
+        Texels::from_f32(self.w, self.h, self.channels, &self.values)
+    }
+
+    fn format(&self) -> wgpu::TextureFormat {
+        match self.channels {
+            1 => wgpu::TextureFormat::R32Float,
+            2 => wgpu::TextureFormat::Rg32Float,
+            _ => wgpu::TextureFormat::Rgba32Float,
+        }
+    }
+}
+
+/// A table built on the GPU: its texture (valid until the executor's next run) and bytes.
+struct Table {
+    texture: wgpu::Texture,
+    bytes: Vec<u8>,
+}
+
+impl Table {
+    fn fixed(&self) -> &[[u32; 4]] {
+        bytemuck::cast_slice(&self.bytes)
+    }
+
+    fn float(&self) -> &[f32] {
+        bytemuck::cast_slice(&self.bytes)
+    }
+}
+
+/// Plans `add_sat` over `map` imported as `in`, runs it with every planned texture poisoned
+/// (all bits set: NaN for floats) so unwritten texels show, and reads the table back.
+fn build(g: &Gpu, exec: &mut Executor, map: &Map, coding: &SatCoding) -> Table {
+    let mut graph = Graph::default();
+    graph.import("in", map.format(), map.w as u32, map.h as u32, Some(0));
+    let out = add_sat(&mut graph, 0, "in", coding);
+    let plan = plan(&graph, &[&out]).expect("plan");
+    let input = g.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("test.sat.input"),
+        size: wgpu::Extent3d {
+            width: map.w as u32,
+            height: map.h as u32,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: map.format(),
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    write_texture(&g.queue, &input, bytemuck::cast_slice(&map.values));
+    let imports = HashMap::from([("in".to_string(), input)]);
+    let mut enc = g.device.create_command_encoder(&Default::default());
+    let outputs = exec
+        .record(&g.device, &mut enc, &plan, &imports, None)
+        .expect("record");
+    // Queue writes land before the submitted passes run.
+    for (name, t) in &outputs.textures {
+        if name != "in" {
+            let bytes = texel_bytes(t.format()) as usize * (t.width() * t.height()) as usize;
+            write_texture(&g.queue, t, &vec![0xFF; bytes]);
+        }
+    }
+    submit_and_wait(&g.device, &g.queue, enc, "sat").expect("run");
+    let texture = outputs.textures[&out].clone();
+    let bytes = read_texture(&g.device, &g.queue, &texture, 0).expect("readback");
+    Table { texture, bytes }
+}
+
+/// Integer windows `[x0, x1) × [y0, y1)` to check: random ones, the full map, and windows at
+/// the far corner and along the far edges (where the corner sums are largest).
+fn windows(rng: &mut impl Rng, w: usize, h: usize, random: usize) -> Vec<[usize; 4]> {
+    let k = w.min(h).min(7);
+    let mut out = vec![
+        [0, 0, w, h],
+        [w - 1, h - 1, w, h],
+        [w - k, h - k, w, h],
+        [0, h - 1, w, h],
+        [w - 1, 0, w, h],
+    ];
+    for _ in 0..random {
+        let (a, b) = (rng.random_range(0..=w), rng.random_range(0..=w));
+        let (c, d) = (rng.random_range(0..=h), rng.random_range(0..=h));
+        out.push([a.min(b), c.min(d), a.max(b), c.max(d)]);
+    }
+    out
+}
+
+/// The fixed-point table equals the wrapping-u32 reference bit for bit; unused channels are 0;
+/// every window decodes to the f64 sum of the raw values within its quantization:
+/// `area·½/scale` (rounding each code) `+ U·Σ|v − offset|` (the f32 subtraction; the scale is
+/// a power of two, so the product is exact). `max_window` bounds the windows checked.
+fn check_fixed(
+    what: &str,
+    rng: &mut impl Rng,
+    map: &Map,
+    coding: &SatCoding,
+    table: &Table,
+    max_window: Option<usize>,
+) {
+    let input = map.texels();
+    let expected = reference::sat_fixed(&input, coding);
+    let got = table.fixed();
+    if let Some(i) = (0..expected.len()).find(|&i| got[i] != expected[i]) {
+        let mismatches = (0..expected.len())
+            .filter(|&i| got[i] != expected[i])
+            .count();
+        panic!(
+            "{what}: {mismatches} of {} texels differ; first ({}, {}): gpu {:08x?} ref {:08x?}",
+            expected.len(),
+            i % map.w,
+            i / map.w,
+            got[i],
+            expected[i]
+        );
+    }
+    assert!(
+        got.iter()
+            .all(|t| t[map.channels..].iter().all(|&v| v == 0)),
+        "{what}: unused channels"
+    );
+    let raw = reference::sat(&input);
+    let dev = reference::sat(&Texels {
+        data: input
+            .data
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| (v - f64::from(coding.offset[i % map.channels])).abs())
+            .collect(),
+        ..input.clone()
+    });
+    let mut gpu = Vec::new();
+    let mut want = Vec::new();
+    let mut tol = Vec::new();
+    for [x0, y0, x1, y1] in windows(rng, map.w, map.h, 200) {
+        let area = ((x1 - x0) * (y1 - y0)) as f64;
+        if max_window.is_some_and(|m| x1 - x0 > m || y1 - y0 > m) {
+            continue;
+        }
+        let codes = reference::window_fixed(got, map.w, x0, y0, x1, y1);
+        let sums = reference::window(&raw, x0, y0, x1, y1);
+        let spread = reference::window(&dev, x0, y0, x1, y1);
+        for c in 0..map.channels {
+            let decoded = reference::decode_window(f64::from(codes[c]), area, coding, c);
+            gpu.push(decoded as f32);
+            want.push(sums[c]);
+            // The f32 of the decoded sum adds U·|sum|; the f64 sums are exact to ~1e-12.
+            tol.push(
+                area * 0.5 / f64::from(coding.scale[c]) + U * spread[c] + U * sums[c].abs() + 1e-9,
+            );
+        }
+    }
+    common::assert_within(&format!("{what}: decoded windows"), &gpu, &want, &tol);
+}
+
+/// The f32 table within `scan_depth`·U of Σ|x| of each texel's rectangle, x the scaled values
+/// (≤ 42·U ≈ 2.5e-6 of the absolute sum up to 1024²); windows from four lookups within
+/// (depth + 3)·U of the absolute sums at their four corners — fp32's weakness: the error
+/// follows the corners, not the window.
+fn check_float(what: &str, rng: &mut impl Rng, map: &Map, coding: &SatCoding, table: &Table) {
+    let x = reference::scaled_texels(&map.texels(), coding);
+    let exact = reference::sat(&x);
+    let abs = reference::sat(&Texels {
+        data: x.data.iter().map(|v| v.abs()).collect(),
+        ..x.clone()
+    });
+    let got = table.float();
+    let depth = scan_depth(map.w, map.h);
+    let tol: Vec<f64> = abs.data.iter().map(|a| depth * U * a).collect();
+    common::assert_within(&format!("{what}: table"), got, &exact.data, &tol);
+    let gpu_table = Texels::from_f32(map.w, map.h, 4, got);
+    let mut gpu = Vec::new();
+    let mut want = Vec::new();
+    let mut tol = Vec::new();
+    for [x0, y0, x1, y1] in windows(rng, map.w, map.h, 200) {
+        let g = reference::window(&gpu_table, x0, y0, x1, y1);
+        let e = reference::window(&exact, x0, y0, x1, y1);
+        let corners: Vec<f64> = (0..4)
+            .map(|c| {
+                [(x0, y0), (x1, y0), (x0, y1), (x1, y1)]
+                    .iter()
+                    .map(|&(a, b)| reference::window(&abs, 0, 0, a, b)[c])
+                    .sum()
+            })
+            .collect();
+        for c in 0..4 {
+            gpu.push(g[c] as f32);
+            want.push(e[c]);
+            tol.push((depth + 3.0) * U * corners[c] + U * e[c].abs());
+        }
+    }
+    common::assert_within(&format!("{what}: windows"), &gpu, &want, &tol);
+}
+
+/// A `const NAME: u32` of a kernel, from naga's IR.
+fn wgsl_const(module: &naga::Module, name: &str) -> Option<u32> {
+    let (_, c) = module
+        .constants
+        .iter()
+        .find(|(_, c)| c.name.as_deref() == Some(name))?;
+    match module.global_expressions[c.init] {
+        naga::Expression::Literal(naga::Literal::U32(v)) => Some(v),
+        _ => None,
+    }
+}
+
+#[test]
+fn sat_block_and_params_match_the_wgsl() {
+    for kernel in [
+        "sat_rows",
+        "sat_carry",
+        "sat_cols_reduce",
+        "sat_cols",
+        "sat_cols_f32",
+    ] {
+        let wgsl = kernels::resolve(kernel, None).unwrap();
+        let (module, r) = kernels::reflect(kernel, &wgsl).unwrap();
+        let block = wgsl_const(&module, "BLOCK");
+        let items = wgsl_const(&module, "ITEMS").unwrap_or(0);
+        assert_eq!(block, Some(SAT_BLOCK), "{kernel}: BLOCK");
+        let wg = r.workgroup_size.unwrap_or_default();
+        if kernel == "sat_carry" {
+            assert_eq!(wg, [SAT_CARRY_LINES, 1, 1], "{kernel}");
+        } else {
+            assert_eq!([wg[0] * items, wg[1], wg[2]], [SAT_BLOCK, 1, 1], "{kernel}");
+        }
+        assert_eq!(
+            kernels::struct_size(&module, "SatParams"),
+            Some(size_of::<SatParams>() as u32),
+            "{kernel}: SatParams vs struct SatParams"
+        );
+    }
+}
+
+/// The sizes asked for, plus lines of several blocks each way (the carry passes).
+const SIZES: [(usize, usize); 8] = [
+    (1, 1),
+    (1, 57),
+    (61, 1),
+    (1000, 37),
+    (256, 256),
+    (1024, 1024),
+    (3000, 5),
+    (3, 2100),
+];
+
+#[test]
+fn fixed_sat_is_bit_identical_to_the_integer_reference() {
+    let g = common::gpu();
+    let mut exec = Executor::new();
+    let mut rng = common::rng(70);
+    for (i, (w, h)) in SIZES.into_iter().enumerate() {
+        let channels = [1, 2, 4][i % 3];
+        let map = Map::random(&mut rng, w, h, channels, 0.05, 1.0);
+        // Every window of the map, the full map included, decodes exactly.
+        let coding = SatCoding::fixed((w * h) as u64, [0.0; 4], [1.0; 4]).unwrap();
+        let table = build(&g, &mut exec, &map, &coding);
+        check_fixed(
+            &format!("fixed {w}x{h}"),
+            &mut rng,
+            &map,
+            &coding,
+            &table,
+            None,
+        );
+    }
+}
+
+#[test]
+fn fixed_sat_wraps_yet_keeps_small_windows_exact() {
+    // Scale for 33×33 windows of values in [-2, 3]: codes up to ±2²¹, corner sums near 2⁴⁰
+    // wrap many times over, and every window of up to 33×33 is still exact.
+    let g = common::gpu();
+    let mut exec = Executor::new();
+    let mut rng = common::rng(71);
+    let map = Map::random(&mut rng, 1024, 1024, 2, -2.0, 3.0);
+    let coding = SatCoding::fixed(33 * 33, [-2.0; 4], [3.0; 4]).unwrap();
+    let table = build(&g, &mut exec, &map, &coding);
+    check_fixed(
+        "fixed 1024² (33² windows)",
+        &mut rng,
+        &map,
+        &coding,
+        &table,
+        Some(33),
+    );
+    let (w, h) = (map.w, map.h);
+    let small: Vec<[usize; 4]> = (0..300)
+        .map(|_| {
+            let (x, y) = (rng.random_range(0..w - 33), rng.random_range(0..h - 33));
+            let (a, b) = (rng.random_range(1..=33), rng.random_range(1..=33));
+            [x, y, x + a, y + b]
+        })
+        .chain([[w - 33, h - 33, w, h]])
+        .collect();
+    let raw = reference::sat(&map.texels());
+    for [x0, y0, x1, y1] in small {
+        let area = ((x1 - x0) * (y1 - y0)) as f64;
+        let codes = reference::window_fixed(table.fixed(), w, x0, y0, x1, y1);
+        let sums = reference::window(&raw, x0, y0, x1, y1);
+        for c in 0..2 {
+            let d = reference::decode_window(f64::from(codes[c]), area, &coding, c);
+            let tol = area * (0.5 / f64::from(coding.scale[c]) + 2.5 * U) + 1e-9;
+            assert!(
+                (d - sums[c]).abs() <= tol,
+                "window {x0},{y0}..{x1},{y1} c{c}: {d} vs {}",
+                sums[c]
+            );
+        }
+    }
+}
+
+#[test]
+fn fixed_sat_of_a_4096_map_is_bit_identical() {
+    // The stability case: 4096² (4 column blocks and 4 row blocks a line), corner sums near
+    // 2⁴⁴ in units of the scale for 64×64-texel lookups, wrapped; still bit for bit.
+    let g = common::gpu();
+    let mut exec = Executor::new();
+    let mut rng = common::rng(75);
+    let map = Map::random(&mut rng, 4096, 4096, 1, 0.0, 1.0);
+    let coding = SatCoding::fixed(lookup_area(64.0, 64.0), [0.0; 4], [1.0; 4]).unwrap();
+    let table = build(&g, &mut exec, &map, &coding);
+    check_fixed("fixed 4096²", &mut rng, &map, &coding, &table, Some(65));
+}
+
+#[test]
+fn float_sat_is_within_the_scan_rounding_bound() {
+    let g = common::gpu();
+    let mut exec = Executor::new();
+    let mut rng = common::rng(72);
+    for (i, (w, h)) in SIZES.into_iter().enumerate() {
+        let channels = [4, 1, 2][i % 3];
+        let map = Map::random(&mut rng, w, h, channels, 0.05, 1.0);
+        let coding = SatCoding::float([0.0; 4], [1.0; 4]).unwrap();
+        let table = build(&g, &mut exec, &map, &coding);
+        check_float(&format!("float {w}x{h}"), &mut rng, &map, &coding, &table);
+    }
+}
+
+#[test]
+fn constant_depth_0_999_map() {
+    let g = common::gpu();
+    let mut exec = Executor::new();
+    let mut rng = common::rng(73);
+    let (w, h) = (512, 384);
+    let map = Map {
+        w,
+        h,
+        channels: 1,
+        values: vec![0.999; w * h],
+    };
+    let fixed = SatCoding::fixed((w * h) as u64, [0.0; 4], [1.0; 4]).unwrap();
+    let table = build(&g, &mut exec, &map, &fixed);
+    check_fixed("fixed constant", &mut rng, &map, &fixed, &table, None);
+    // Every window holds exactly area × the code of 0.999.
+    let code = reference::encode_fixed(0.999, &fixed, 0) as i32;
+    for [x0, y0, x1, y1] in windows(&mut rng, w, h, 100) {
+        let area = ((x1 - x0) * (y1 - y0)) as i64;
+        let got = reference::window_fixed(table.fixed(), w, x0, y0, x1, y1)[0];
+        assert_eq!(
+            i64::from(got),
+            area * i64::from(code),
+            "{x0},{y0}..{x1},{y1}"
+        );
+    }
+    let float = SatCoding::float([0.0; 4], [1.0; 4]).unwrap();
+    let table = build(&g, &mut exec, &map, &float);
+    check_float("float constant", &mut rng, &map, &float, &table);
+}
+
+/// `shared/sat`'s lookups run by a test kernel: one rectangle per invocation.
+fn probe_wgsl(variant: SatVariant) -> String {
+    let (ty, f) = match variant {
+        SatVariant::Fixed => ("u32", "sat_mean_fixed"),
+        SatVariant::Float => ("f32", "sat_mean_float"),
+    };
+    let module = kernels::resolve("shared/sat", None).unwrap();
+    format!(
+        "{module}
+struct Coding {{ offset: vec4<f32>, scale: vec4<f32> }}
+@group(0) @binding(0) var table: texture_2d<{ty}>;
+@group(0) @binding(1) var<storage, read> rects: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read_write> means: array<vec4<f32>>;
+@group(0) @binding(3) var<uniform> coding: Coding;
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
+    if id.x < arrayLength(&rects) {{
+        means[id.x] = {f}(table, rects[id.x], coding.offset, coding.scale);
+    }}
+}}
+"
+    )
+}
+
+/// Means over `rects` looked up on the GPU from `table`.
+fn probe(g: &Gpu, table: &wgpu::Texture, coding: &SatCoding, rects: &[[f32; 4]]) -> Vec<[f32; 4]> {
+    let d = &g.device;
+    let k = ComputeKernel::new(d, "sat_probe", &probe_wgsl(coding.variant)).expect("probe kernel");
+    let init = |label, contents: &[u8], usage| {
+        d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents,
+            usage,
+        })
+    };
+    let rects_buf = init(
+        "rects",
+        bytemuck::cast_slice(rects),
+        wgpu::BufferUsages::STORAGE,
+    );
+    let bytes = (rects.len() * 16) as u64;
+    let means = d.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("means"),
+        size: bytes,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let readback = d.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("means.readback"),
+        size: bytes,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let uniform: [[f32; 4]; 2] = [coding.offset, coding.scale];
+    let coding_buf = init(
+        "coding",
+        bytemuck::bytes_of(&uniform),
+        wgpu::BufferUsages::UNIFORM,
+    );
+    let view = table.create_view(&Default::default());
+    let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("sat_probe"),
+        layout: &k.layouts[0],
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::TextureView(&view),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: rects_buf.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: means.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 3,
+                resource: coding_buf.as_entire_binding(),
+            },
+        ],
+    });
+    let mut enc = d.create_command_encoder(&Default::default());
+    {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&k.pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        pass.dispatch_workgroups((rects.len() as u32).div_ceil(64), 1, 1);
+    }
+    enc.copy_buffer_to_buffer(&means, 0, &readback, 0, bytes);
+    submit_and_wait(d, &g.queue, enc, "sat_probe").expect("probe");
+    bytemuck::cast_slice(&read_buffer(d, &readback).expect("readback")).to_vec()
+}
+
+/// Random rectangles up to `max` texels a side, some reversed, partly or wholly outside the
+/// map, thinner than the minimum extent, the whole map and the far corner.
+fn rects(rng: &mut impl Rng, w: f32, h: f32, max: f32) -> Vec<[f32; 4]> {
+    let mut out = vec![
+        // The whole map, or the largest rectangle at the far corner.
+        [(w - max).max(0.0), (h - max).max(0.0), w, h],
+        [w - 0.3, h - 0.7, w, h],
+        [w - 2.5, h - 1.25, w + 3.0, h + 3.0],
+        [-5.0, -5.0, -1.0, -1.0],
+        [w + 1.0, 3.0, w + 2.0, 4.0],
+        [2.5, 1.5, 2.5, 1.5],
+        [w - 1.0, h - 1.0, w - 1.0 + 1e-4, h],
+    ];
+    for i in 0..300 {
+        let (x, y) = (
+            rng.random_range(-2.0..w + 1.0),
+            rng.random_range(-2.0..h + 1.0),
+        );
+        let sw: f32 = rng.random_range(0.0..max.min(w + 3.0));
+        let sh: f32 = rng.random_range(0.0..max.min(h + 3.0));
+        out.push(if i % 5 == 0 {
+            [x + sw, y + sh, x, y]
+        } else {
+            [x, y, x + sw, y + sh]
+        });
+    }
+    out
+}
+
+/// The lookups against direct f64 integration of the raw map. Fixed: quantization ½/scale
+/// plus U·max|v − o| (the subtraction), and the f32 weighting of the 16 windows: ≲ 32 roundings
+/// of Σ|w·window| ≤ (lookup area)·max|v − o|, relative to the rectangle's area. Float: the
+/// same weighting, plus every window's error, ≤ (depth + 3)·U times the absolute sums at
+/// its four corners, each at most the sum over [0, X₁) × [0, Y₁), X₁, Y₁ the far node.
+/// Both: 4·U·(|mean| + |offset|) for the area, the division and the final add.
+fn check_means(what: &str, map: &Map, coding: &SatCoding, rects: &[[f32; 4]], got: &[[f32; 4]]) {
+    let input = map.texels();
+    let x = reference::scaled_texels(&input, coding);
+    let abs = reference::sat(&Texels {
+        data: x.data.iter().map(|v| v.abs()).collect(),
+        ..x.clone()
+    });
+    // max |v − offset| per channel.
+    let mut spread = [0.0f64; 4];
+    for (i, &v) in input.data.iter().enumerate() {
+        let c = i % map.channels;
+        spread[c] = spread[c].max((v - f64::from(coding.offset[c])).abs());
+    }
+    let depth = scan_depth(map.w, map.h);
+    let mut gpu = Vec::new();
+    let mut want = Vec::new();
+    let mut tol = Vec::new();
+    for (rect, g) in rects.iter().zip(got) {
+        let r = reference::clamp_rect(*rect, map.w, map.h);
+        let (rw, rh) = (r[2] - r[0], r[3] - r[1]);
+        let area = f64::from(rw) * f64::from(rh);
+        let lookup = lookup_area(rw, rh) as f64;
+        let far_x = ((r[2].floor() as usize) + 1).min(map.w);
+        let far_y = ((r[3].floor() as usize) + 1).min(map.h);
+        let corner = reference::window(&abs, 0, 0, far_x, far_y);
+        let mean = reference::rect_mean(&input, *rect);
+        for c in 0..map.channels {
+            let s = f64::from(coding.scale[c]);
+            let o = f64::from(coding.offset[c]);
+            let weighting = 32.0 * U * lookup * spread[c] / area;
+            let base = weighting + 4.0 * U * (mean[c].abs() + o.abs());
+            let t = match coding.variant {
+                SatVariant::Fixed => base + 0.5 / s + U * spread[c],
+                SatVariant::Float => base + (depth + 3.0) * U * 4.0 * corner[c] / area,
+            };
+            gpu.push(g[c]);
+            want.push(mean[c]);
+            tol.push(t);
+        }
+    }
+    common::assert_within(what, &gpu, &want, &tol);
+}
+
+#[test]
+fn rect_mean_lookups_match_direct_integration() {
+    let g = common::gpu();
+    let mut exec = Executor::new();
+    let mut rng = common::rng(74);
+    let (w, h) = (300, 270);
+    let map = Map::random(&mut rng, w, h, 2, 0.0, 1.0);
+    let (wf, hf) = (w as f32, h as f32);
+    // Any rectangle, up to the whole map: the scale for the map's lookup area.
+    let whole = rects(&mut rng, wf, hf, wf.max(hf));
+    // Rectangles up to 8 texels: a 2⁵-times finer scale, and the table wraps.
+    let small = rects(&mut rng, wf, hf, 8.0);
+    let codings = [
+        (
+            SatCoding::fixed(lookup_area(wf, hf), [0.0; 4], [1.0; 4]).unwrap(),
+            &whole,
+        ),
+        (
+            SatCoding::fixed(lookup_area(8.0, 8.0), [0.0; 4], [1.0; 4]).unwrap(),
+            &small,
+        ),
+        (SatCoding::float([0.0; 4], [1.0; 4]).unwrap(), &whole),
+        (SatCoding::float([0.0; 4], [1.0; 4]).unwrap(), &small),
+    ];
+    for (coding, rects) in codings {
+        let table = build(&g, &mut exec, &map, &coding);
+        let means = probe(&g, &table.texture, &coding, rects);
+        check_means(
+            &format!("{:?} means, scale {}", coding.variant, coding.scale[0]),
+            &map,
+            &coding,
+            rects,
+            &means,
+        );
+    }
+}
+
+/// Random small maps: lines of one to three blocks in either direction, 1, 2 or 4 channels,
+/// random value ranges, both variants.
+#[test]
+fn property_sat_matches_the_references_on_random_small_maps() {
+    let g = common::gpu();
+    let exec = RefCell::new(Executor::new());
+    let mut runner = TestRunner::new(Config {
+        cases: 24,
+        max_shrink_iters: 16,
+        failure_persistence: None,
+        ..Config::default()
+    });
+    let strategy = (
+        1usize..=2600,
+        1usize..=12,
+        any::<bool>(),
+        prop::sample::select(vec![1usize, 2, 4]),
+        -4.0f32..4.0,
+        0.01f32..8.0,
+        any::<bool>(),
+        any::<u64>(),
+    );
+    runner
+        .run(
+            &strategy,
+            |(long, short, transpose, channels, lo, span, fixed, seed)| {
+                let (w, h) = if transpose {
+                    (short, long)
+                } else {
+                    (long, short)
+                };
+                let mut rng = common::rng(seed);
+                let map = Map::random(&mut rng, w, h, channels, lo, lo + span);
+                let what = format!("{w}x{h}x{channels} [{lo}, {}] fixed {fixed}", lo + span);
+                let mut exec = exec.borrow_mut();
+                if fixed {
+                    let coding = SatCoding::fixed((w * h) as u64, [lo; 4], [lo + span; 4]).unwrap();
+                    let table = build(&g, &mut exec, &map, &coding);
+                    check_fixed(&what, &mut rng, &map, &coding, &table, None);
+                } else {
+                    let coding = SatCoding::float([lo; 4], [lo + span; 4]).unwrap();
+                    let table = build(&g, &mut exec, &map, &coding);
+                    check_float(&what, &mut rng, &map, &coding, &table);
+                }
+                Ok(())
+            },
+        )
+        .unwrap();
+}
