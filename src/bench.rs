@@ -98,6 +98,27 @@ pub const CASES: &[BenchCase] = &[
         build: |n| stage_graph(n, esm(), "light0.esm", "light0.esm.blur_v"),
     },
     BenchCase {
+        name: "msm",
+        bytes_moved: |n| texels(n) * (4 + 16),
+        build: |n| stage_graph(n, msm(Storage::F32), "light0.linear", "light0.msm"),
+    },
+    BenchCase {
+        name: "msm f16 quantized",
+        bytes_moved: |n| texels(n) * (4 + 8),
+        build: |n| stage_graph(n, msm(Storage::F16), "light0.linear", "light0.msm"),
+    },
+    BenchCase {
+        name: "csm (2 terms)",
+        bytes_moved: |n| texels(n) * (4 + 16),
+        build: |n| stage_graph(n, csm(), "light0.linear", "light0.csm0"),
+    },
+    BenchCase {
+        name: "mips rgba32f",
+        // Level 0 copied, each further level read once (as the level above) and written once.
+        bytes_moved: |n| 2 * 16 * mip_texels(n),
+        build: |n| stage_graph(n, msm_mips(), "light0.msm", "light0.msm.mips"),
+    },
+    BenchCase {
         name: "sat fixed",
         bytes_moved: sat_bytes,
         build: |n| sat_graph(n, SatVariant::Fixed),
@@ -144,6 +165,49 @@ fn evsm4() -> Technique {
         bleed: 0.0,
         min_variance: 1e-4,
     }
+}
+
+fn msm(storage: Storage) -> Technique {
+    Technique::Msm {
+        prefilter: Prefilter {
+            storage,
+            filter: blur4(),
+        },
+        hausdorff: false,
+        moment_bias: crate::scene::default_moment_bias(storage),
+        bleed: 0.0,
+    }
+}
+
+fn msm_mips() -> Technique {
+    Technique::Msm {
+        prefilter: Prefilter {
+            storage: Storage::F32,
+            filter: Filter::Mips { width: 1.0 },
+        },
+        hausdorff: false,
+        moment_bias: 1e-5,
+        bleed: 0.0,
+    }
+}
+
+fn csm() -> Technique {
+    Technique::Csm {
+        prefilter: Prefilter {
+            storage: Storage::F32,
+            filter: blur4(),
+        },
+        terms: 2,
+        attenuation: 1.0,
+        offset: 0.25,
+        scale: 2.0,
+    }
+}
+
+/// Texels of a full mip chain of an `n`² map.
+fn mip_texels(n: u32) -> u64 {
+    let levels = technique::mip_levels(n, n);
+    (0..levels).map(|l| texels((n >> l).max(1))).sum()
 }
 
 fn esm() -> Technique {
