@@ -357,3 +357,107 @@ fn plan_contains_only_what_techniques_need() {
         );
     }
 }
+
+/// Every technique (with each filter) on every bundled scene, at a reduced size: no NaN or Inf,
+/// visibility in [0, 1] and some shadow cast (some pixel below 0.95: a thin pole on a 512² map
+/// seen in 120×90 pixels casts little).
+#[test]
+fn every_technique_renders_every_bundled_scene() {
+    use shadowgraph::scene::{BlurKernel, Filter, Prefilter, Storage};
+    let blur = Filter::Blur {
+        radius: 2.0,
+        sigma: 1.0,
+        kernel: BlurKernel::Gaussian,
+    };
+    let pre = |storage, filter| Prefilter { storage, filter };
+    let techniques = [
+        Technique::Hard,
+        Technique::Pcf {
+            radius: 1,
+            kernel: PcfKernel::Hardware,
+        },
+        Technique::Pcss {
+            blocker_samples: 8,
+            filter_samples: 16,
+            max_search: 0.05,
+        },
+        Technique::Vsm {
+            prefilter: pre(Storage::F16, Filter::Mips { width: 2.0 }),
+            bleed: 0.2,
+            min_variance: 1e-5,
+        },
+        Technique::Evsm {
+            prefilter: pre(Storage::F32, blur),
+            four: true,
+            exp_pos: 40.0,
+            exp_neg: 5.0,
+            bleed: 0.0,
+            min_variance: 1e-4,
+        },
+        Technique::Esm {
+            filter: Filter::Mips { width: 3.0 },
+            exponent: 80.0,
+        },
+        Technique::Msm {
+            prefilter: pre(Storage::F32, blur),
+            hausdorff: false,
+            moment_bias: 1e-5,
+            bleed: 0.0,
+        },
+        Technique::Msm {
+            prefilter: pre(Storage::F16, Filter::Mips { width: 1.5 }),
+            hausdorff: true,
+            moment_bias: 5e-4,
+            bleed: 0.0,
+        },
+        Technique::Csm {
+            prefilter: pre(Storage::F32, blur),
+            terms: 9,
+            attenuation: 1.0,
+            offset: 0.05,
+            scale: 2.0,
+        },
+    ];
+    let g = common::gpu();
+    let mut renderer = Renderer::new(&g.device);
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    for entry in std::fs::read_dir(&root).expect("scenes/") {
+        let path = entry.expect("entry").path();
+        if path.extension().is_none_or(|x| x != "toml") {
+            continue;
+        }
+        let base = Scene::load(&path).expect("scene");
+        for t in techniques {
+            let mut scene = base.clone();
+            (scene.width, scene.height) = (120, 90);
+            for l in &mut scene.lights {
+                l.shadow.technique = t;
+                l.shadow_map = l.shadow_map.min(512);
+            }
+            let what = format!("{} with {}", path.display(), t.name());
+            let frame = renderer
+                .render(
+                    &g.device,
+                    &g.queue,
+                    &scene,
+                    RenderOptions {
+                        aux: false,
+                        repeat: 1,
+                        dump: false,
+                    },
+                )
+                .unwrap_or_else(|e| panic!("{what}: {e}"));
+            assert!(
+                frame
+                    .visibility
+                    .iter()
+                    .all(|v| v.is_finite() && (0.0..=1.0).contains(v)),
+                "{what}: visibility not finite in [0, 1]"
+            );
+            assert!(
+                frame.visibility.iter().any(|&v| v < 0.95),
+                "{what}: no shadow at all"
+            );
+        }
+    }
+}
