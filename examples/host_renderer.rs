@@ -1,7 +1,7 @@
 //! A small renderer of its own — its own device, geometry, depth pass, pipelines and shading,
 //! in plain wgpu — that uses shadowgraph only as a plug-in preprocess stage: each frame it
 //! hands its shadow depth texture to one `Prefilter` per moment technique and shades with the
-//! WGSL the stage exports. Writes a 2×2 panel PNG (VSM, EVSM2 / EVSM4, ESM).
+//! WGSL the stage exports. Writes a 2×2 panel PNG (VSM, EVSM4 / MSM, CSM).
 //!
 //!     cargo run --release --example host_renderer [-- out.png]     (default target/host_renderer.png)
 
@@ -65,9 +65,9 @@ fn main() -> Result<()> {
     let host = Host::new(&device);
     let configs = [
         PrefilterConfig::vsm(SHADOW_MAP),
-        PrefilterConfig::evsm2(SHADOW_MAP),
         PrefilterConfig::evsm4(SHADOW_MAP),
-        PrefilterConfig::esm(SHADOW_MAP),
+        PrefilterConfig::msm(SHADOW_MAP),
+        PrefilterConfig::csm(SHADOW_MAP, 8),
     ];
     let mut panels = Vec::new();
     for config in &configs {
@@ -140,7 +140,7 @@ fn main() -> Result<()> {
         );
     }
     println!(
-        "wrote {out} ({}x{}: vsm, evsm2 / evsm4, esm), {FRAMES} frames in {:.2} s",
+        "wrote {out} ({}x{}: vsm, evsm4 / msm, csm), {FRAMES} frames in {:.2} s",
         2 * PANEL.0,
         2 * PANEL.1,
         start.elapsed().as_secs_f64()

@@ -107,6 +107,40 @@ impl PrefilterConfig {
         )
     }
 
+    /// MSM, 32-bit raw moments, Hamburger reconstruction, the scene default blur.
+    pub fn msm(size: u32) -> Self {
+        Self::new(
+            Technique::Msm {
+                prefilter: crate::scene::Prefilter {
+                    storage: Storage::F32,
+                    filter: DEFAULT_BLUR,
+                },
+                hausdorff: false,
+                moment_bias: crate::scene::default_moment_bias(Storage::F32),
+                bleed: 0.0,
+            },
+            size,
+        )
+    }
+
+    /// CSM with `terms` Fourier terms and the scene defaults (attenuation 1, offset ½/M,
+    /// scale 2), the scene default blur.
+    pub fn csm(size: u32, terms: u32) -> Self {
+        Self::new(
+            Technique::Csm {
+                prefilter: crate::scene::Prefilter {
+                    storage: Storage::F32,
+                    filter: DEFAULT_BLUR,
+                },
+                terms,
+                attenuation: 1.0,
+                offset: 0.5 / terms.max(1) as f32,
+                scale: 2.0,
+            },
+            size,
+        )
+    }
+
     /// The technique, map size and shading constants of a scene's light.
     pub fn from_light(light: &Light) -> Self {
         Self {
@@ -119,10 +153,16 @@ impl PrefilterConfig {
         }
     }
 
-    /// The same with moments stored at `storage` precision (VSM, EVSM; ESM is always f32).
+    /// The same with moments stored at `storage` precision (VSM, EVSM, MSM, CSM; ESM is always
+    /// f32; `Unorm16` only for MSM).
     pub fn with_storage(mut self, storage: Storage) -> Self {
         match &mut self.technique {
-            Technique::Vsm { prefilter, .. } | Technique::Evsm { prefilter, .. } => {
+            Technique::Msm { prefilter, .. } => prefilter.storage = storage,
+            Technique::Vsm { prefilter, .. }
+            | Technique::Evsm { prefilter, .. }
+            | Technique::Csm { prefilter, .. }
+                if storage != Storage::Unorm16 =>
+            {
                 prefilter.storage = storage;
             }
             _ => self.not_applicable = Some("format"),
@@ -130,10 +170,13 @@ impl PrefilterConfig {
         self
     }
 
-    /// The same with `filter` over the representation (VSM, EVSM, ESM).
+    /// The same with `filter` over the representation (VSM, EVSM, ESM, MSM, CSM).
     pub fn with_filter(mut self, filter: Filter) -> Self {
         match &mut self.technique {
-            Technique::Vsm { prefilter, .. } | Technique::Evsm { prefilter, .. } => {
+            Technique::Vsm { prefilter, .. }
+            | Technique::Evsm { prefilter, .. }
+            | Technique::Msm { prefilter, .. }
+            | Technique::Csm { prefilter, .. } => {
                 prefilter.filter = filter;
             }
             Technique::Esm { filter: f, .. } => *f = filter,
@@ -293,6 +336,31 @@ fn technique(
             range("exponent", exponent, 0.01, 1e4)?;
             t
         }
+        Technique::Msm {
+            prefilter,
+            moment_bias,
+            bleed,
+            ..
+        } => {
+            filter(&prefilter.filter)?;
+            range("moment_bias", moment_bias, 0.0, 0.5)?;
+            range("bleed_reduction", bleed, 0.0, 0.99)?;
+            t
+        }
+        Technique::Csm {
+            prefilter,
+            terms,
+            attenuation,
+            offset,
+            scale,
+        } => {
+            filter(&prefilter.filter)?;
+            range("terms", terms as f32, 1.0, 16.0)?;
+            range("attenuation", attenuation, 0.0, 20.0)?;
+            range("offset", offset, 0.0, 0.5)?;
+            range("scale", scale, 1.0, 16.0)?;
+            t
+        }
         _ => t,
     })
 }
@@ -301,6 +369,9 @@ fn filter(f: &Filter) -> Result<(), StageError> {
     if let Filter::Blur { radius, sigma, .. } = *f {
         range("filter_radius", radius, 0.0, f64::from(MAX_BLUR_RADIUS))?;
         range("filter_sigma", sigma, 0.1, 100.0)?;
+    }
+    if let Filter::Mips { width } = *f {
+        range("filter_width", width, 1.0, 65536.0)?;
     }
     Ok(())
 }
