@@ -583,7 +583,8 @@ impl Executor {
             )?;
             let groups = match &node.dispatch {
                 Dispatch::Groups(g) => *g,
-                Dispatch::MipChain => unreachable!("mip chains are recorded above"),
+                // Recorded by `record_mip_chain` before this point.
+                Dispatch::MipChain => continue,
                 Dispatch::Texels(r) => {
                     let t = &textures[r];
                     kernel.groups_for(t.width(), t.height())

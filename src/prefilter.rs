@@ -115,6 +115,11 @@ impl Prefilter {
         let (config, warnings) = config.validated()?;
         let planned = plan_for(&config, &planning_params(), config.size)?;
         limits::check(device, &planned.plan, config.size)?;
+        // Features the technique's storage needs (e.g. unorm16 MSM moments).
+        crate::render::check_features(
+            device,
+            &[planning_params().scene_light(&config, config.size)],
+        )?;
         let mut executor = Executor::new();
         executor.prepare(device, &planned.plan)?;
         Ok(Self {

@@ -343,3 +343,24 @@ fn timing_without_timestamps_is_a_missing_feature() {
         Ok(()) => panic!("timing enabled without TIMESTAMP_QUERY"),
     }
 }
+
+#[test]
+fn unorm16_msm_without_the_16_bit_norm_feature_is_a_missing_feature() {
+    let g = common::gpu();
+    let (plain, _) = device_with(&g, g.adapter.limits());
+    let config = PrefilterConfig::msm(64).with_storage(shadowgraph::scene::Storage::Unorm16);
+    match Prefilter::new(&plain, &config) {
+        Err(e @ Error::MissingFeature { .. }) => {
+            let m = e.to_string();
+            assert!(
+                m.contains("unorm16") && m.contains("TEXTURE_FORMAT_16BIT_NORM"),
+                "{m}"
+            );
+        }
+        Err(e) => panic!("expected a missing feature, got {e}"),
+        Ok(_) => panic!("unorm16 MSM accepted without TEXTURE_FORMAT_16BIT_NORM"),
+    }
+    // f16 quantized moments need no feature.
+    let f16 = PrefilterConfig::msm(64).with_storage(shadowgraph::scene::Storage::F16);
+    Prefilter::new(&plain, &f16).expect("f16 MSM on a plain device");
+}

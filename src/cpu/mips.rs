@@ -19,17 +19,17 @@ fn weight(i: usize, j: usize, n_from: usize, n_to: usize) -> f64 {
 /// `t` reduced to `w`×`h` by area-weighted means (of `exp(v)`, as a log, when `log`).
 pub fn reduce(t: &Texels, w: usize, h: usize, log: bool) -> Texels {
     let mut data = Vec::with_capacity(w * h * t.channels);
+    // Texel j of an n_to axis covers texels [j·n_from/n_to, ⌈(j+1)·n_from/n_to⌉) above.
+    let covered =
+        |j: usize, n_from: usize, n_to: usize| j * n_from / n_to..((j + 1) * n_from).div_ceil(n_to);
     for y in 0..h {
         for x in 0..w {
             let mut taps = Vec::new();
-            for sy in 0..t.height {
+            for sy in covered(y, t.height, h) {
                 let wy = weight(sy, y, t.height, h);
-                if wy == 0.0 {
-                    continue;
-                }
-                for sx in 0..t.width {
+                for sx in covered(x, t.width, w) {
                     let wx = weight(sx, x, t.width, w);
-                    if wx > 0.0 {
+                    if wx * wy > 0.0 {
                         taps.push((wx * wy, t.at(sx as i64, sy as i64)));
                     }
                 }
