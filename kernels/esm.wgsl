@@ -1,6 +1,7 @@
 // Linear depth → exponential shadow map in log form: L = c·z, the logarithm of the moment
 // exp(c z) (Annen et al. 2008). Filtering happens in log space (log-sum-exp in `blur`), so
-// exp(c z) is never formed and no exponent overflows, whatever c.
+// exp(c z) is never formed and no exponent overflows, whatever c. With `params.linear` (the
+// `sat` filter) it stores exp(c (z − 1)) instead.
 
 // #import shared/exp_params
 
@@ -17,5 +18,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let z = textureLoad(src, id.xy, 0).r;
-    textureStore(dst, id.xy, vec4<f32>(params.exp_pos * z, 0.0, 0.0, 0.0));
+    // For a summed-area table (which sums linearly) the moment itself, scaled by exp(−c) so it
+    // stays in [e^{−c}, 1].
+    let v = select(params.exp_pos * z, exp(params.exp_pos * (z - 1.0)), params.linear == 1u);
+    textureStore(dst, id.xy, vec4<f32>(v, 0.0, 0.0, 0.0));
 }

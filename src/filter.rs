@@ -78,7 +78,8 @@ pub fn add_filter(
         return input.to_string();
     };
     let (radius, sigma, kernel) = match *filter {
-        Filter::None => return input.to_string(),
+        // The table needs the technique's value ranges: `technique::filtered` adds it.
+        Filter::None | Filter::Sat { .. } => return input.to_string(),
         Filter::Mips { .. } => return add_mips(graph, light, input, format, mode),
         Filter::Blur {
             radius,

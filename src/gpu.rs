@@ -333,6 +333,8 @@ pub fn float_channels(format: wgpu::TextureFormat) -> Option<usize> {
         T::Rg32Float => Some(2),
         T::Rg16Unorm => Some(2),
         T::Rgba32Float | T::Rgba16Float | T::Rgba16Unorm => Some(4),
+        // Summed-area tables and their intermediates: raw words read as i32 (dumps only).
+        T::Rgba32Uint => Some(4),
         _ => None,
     }
 }
@@ -376,6 +378,10 @@ pub fn read_float_texture(
     ) {
         raw.chunks_exact(2)
             .map(|b| f32::from(u16::from_le_bytes([b[0], b[1]])) / 65535.0)
+            .collect()
+    } else if format == wgpu::TextureFormat::Rgba32Uint {
+        raw.chunks_exact(4)
+            .map(|b| i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f32)
             .collect()
     } else {
         bytemuck::cast_slice(&raw).to_vec()

@@ -60,6 +60,7 @@ pub const SOURCES: &[Source] = sources![
     "shared/vis_csm",
     "shared/sat_scan",
     "shared/sat",
+    "shared/sat_lookup",
 ];
 
 /// The embedded text of `kernels/<name>.wgsl`.

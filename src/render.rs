@@ -50,6 +50,7 @@ pub fn plan_lights(lights: &[Light]) -> Result<ScenePlan> {
     let mut graph = Graph::default();
     let mut shade_inputs = Vec::new();
     for (i, l) in lights.iter().enumerate() {
+        technique::sat_coding(l).map_err(|e| Error::Invalid(format!("light[{i}]: {e}")))?;
         shade_inputs.push(technique::add_light_nodes(&mut graph, i, l));
     }
     let outputs: Vec<&str> = shade_inputs
@@ -229,6 +230,34 @@ impl FloatMap {
             data,
         })
     }
+}
+
+/// Reads summed-area table `name` back as the per-texel representation it sums
+/// ([`crate::sat::decode_table`]), `channels` of them (the table's input's).
+pub fn read_sat_map(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    name: &str,
+    texture: &wgpu::Texture,
+    coding: &crate::sat::SatCoding,
+    channels: usize,
+) -> Result<FloatMap> {
+    let raw = crate::gpu::read_texture(device, queue, texture, 0)?;
+    let (width, height) = (texture.width(), texture.height());
+    let data = crate::sat::decode_table(
+        bytemuck::cast_slice(&raw),
+        width as usize,
+        height as usize,
+        coding,
+        channels,
+    );
+    Ok(FloatMap {
+        resource: name.to_string(),
+        width,
+        height,
+        channels,
+        data,
+    })
 }
 
 /// Renders scenes; holds pipelines and pooled textures across frames.
@@ -557,10 +586,16 @@ impl Renderer {
             frame.position = bytemuck::cast_slice(&read_texture(device, queue, &gpos, 0)?).to_vec();
             frame.normal = bytemuck::cast_slice(&read_texture(device, queue, &gnorm, 0)?).to_vec();
             for (i, input) in sp.shade_inputs.iter().enumerate() {
+                let coding = technique::sat_coding(&scene.lights[i])?;
+                let channels = technique::map_channels(&scene.lights[i]);
                 let maps = input
                     .maps
                     .iter()
-                    .map(|m| FloatMap::read(device, queue, m, &outputs.textures[m]))
+                    .zip(channels)
+                    .map(|(m, n)| match &coding {
+                        Some(c) => read_sat_map(device, queue, m, &outputs.textures[m], c, n),
+                        None => FloatMap::read(device, queue, m, &outputs.textures[m]),
+                    })
                     .collect::<Result<Vec<_>>>()?;
                 frame.shade_maps.push(FloatMap::concat(maps)?);
                 let levels = input

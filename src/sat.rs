@@ -283,6 +283,61 @@ pub fn add_sat(graph: &mut Graph, light: usize, input: &str, coding: &SatCoding)
     out
 }
 
+/// The per-texel values a table holds, decoded: texel `(x, y)` of channel `c` is the 1×1
+/// window sum `S(x, y) − S(x − 1, y) − S(x, y − 1) + S(x − 1, y − 1)` (wrapping u32 read as
+/// i32 for the fixed variant, exact; f64 differences of the f32 sums for the float variant),
+/// divided by the scale, plus the offset. `table` holds the table's raw 32-bit words (4 per
+/// texel, row-major); the first `channels` channels are returned. For the fixed variant this is
+/// the quantized representation the lookups integrate, exactly.
+pub fn decode_table(
+    table: &[u32],
+    width: usize,
+    height: usize,
+    coding: &SatCoding,
+    channels: usize,
+) -> Vec<f32> {
+    let at = |x: usize, y: usize, c: usize| table[(y * width + x) * 4 + c];
+    let mut out = Vec::with_capacity(width * height * channels);
+    for y in 0..height {
+        for x in 0..width {
+            for c in 0..channels {
+                let sum = match coding.variant {
+                    SatVariant::Fixed => {
+                        let mut v = at(x, y, c);
+                        if x > 0 {
+                            v = v.wrapping_sub(at(x - 1, y, c));
+                        }
+                        if y > 0 {
+                            v = v.wrapping_sub(at(x, y - 1, c));
+                        }
+                        if x > 0 && y > 0 {
+                            v = v.wrapping_add(at(x - 1, y - 1, c));
+                        }
+                        f64::from(v as i32)
+                    }
+                    SatVariant::Float => {
+                        let f = |x: usize, y: usize| f64::from(f32::from_bits(at(x, y, c)));
+                        let mut v = f(x, y);
+                        if x > 0 {
+                            v -= f(x - 1, y);
+                        }
+                        if y > 0 {
+                            v -= f(x, y - 1);
+                        }
+                        if x > 0 && y > 0 {
+                            v += f(x - 1, y - 1);
+                        }
+                        v
+                    }
+                };
+                let value = sum / f64::from(coding.scale[c]) + f64::from(coding.offset[c]);
+                out.push(value as f32);
+            }
+        }
+    }
+    out
+}
+
 /// The resources of one table.
 struct SatNames<'a> {
     input: &'a str,

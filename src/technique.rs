@@ -5,6 +5,7 @@ use std::fmt::Write;
 
 use crate::filter::{BlurMode, add_filter};
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
+use crate::sat::{SatCoding, SatVariant, add_sat, lookup_area};
 use crate::scene::{Filter, Light, LightKind, PcfKernel, Storage, Technique};
 
 /// A light as the shading kernel reads it. Mirrors `struct Light` in
@@ -78,8 +79,14 @@ pub struct LightGpu {
     pub mip_levels: u32,
     /// `log2` of the mip filter width in texels.
     pub filter_lod: f32,
+    /// SAT filter: box width in texels (0 when the filter is not `sat`).
+    pub filter_width: f32,
     /// Padding to the WGSL struct's 16-byte alignment.
-    pub _pad: [u32; 2],
+    pub _pad: u32,
+    /// SAT filter: the table's per-channel offset ([`SatCoding::offset`]).
+    pub sat_offset: [f32; 4],
+    /// SAT filter: the table's per-channel scale ([`SatCoding::scale`]).
+    pub sat_scale: [f32; 4],
 }
 
 /// MSM flag: Hausdorff reconstruction.
@@ -205,9 +212,78 @@ impl LightGpu {
             csm_scale,
             mip_levels,
             filter_lod,
-            _pad: [0; 2],
+            filter_width: 0.0,
+            _pad: 0,
+            sat_offset: [0.0; 4],
+            sat_scale: [1.0; 4],
         }
+        .with_sat(light)
     }
+
+    /// The SAT fields for `light` (left as they are without the `sat` filter or when its
+    /// coding is invalid, which [`sat_coding`] reports).
+    fn with_sat(mut self, light: &Light) -> Self {
+        if let (Some(Filter::Sat { width, .. }), Ok(Some(c))) =
+            (light.shadow.technique.filter(), sat_coding(light))
+        {
+            self.filter_width = width;
+            self.sat_offset = c.offset;
+            self.sat_scale = c.scale;
+        }
+        self
+    }
+}
+
+/// The summed-area-table coding of light `light`'s representation when its filter is `sat`
+/// (`None` otherwise): the value range of every channel over linear depths in [0, 1], and
+/// the largest window the lookups touch ([`lookup_area`] of the filter width).
+///
+/// Ranges: VSM and raw MSM moments [0, 1]; EVSM `±exp(±c z')` and their squares over
+/// z' ∈ [−1, 1] as `±max |v|` (offset 0); ESM (stored linearly for the table)
+/// `exp(c (z − 1)) ∈ [e^{−c}, 1]` as ±1; CSM's
+/// sines and cosines [−1, 1]; quantized MSM moments the range of the quantization over the
+/// moment curve, sampled at 4097 depths and widened by 10⁻³ of the range (the curve is a
+/// quartic: sampling misses its extremes by far less).
+pub fn sat_coding(light: &Light) -> crate::error::Result<Option<SatCoding>> {
+    let Some(Filter::Sat { width, variant }) = light.shadow.technique.filter() else {
+        return Ok(None);
+    };
+    let (lo, hi): ([f32; 4], [f32; 4]) = match light.shadow.technique {
+        // Exponential moments span orders of magnitude, most of them close to 0: coded about 0
+        // (range ±max|v|) every value keeps f32's relative precision through the lookups'
+        // weighting, where a centred offset would leave the small ones an absolute error of
+        // 2⁻²⁴ of the largest.
+        Technique::Evsm {
+            exp_pos, exp_neg, ..
+        } => {
+            let (p, n) = (exp_pos, exp_neg);
+            let hi = [p.exp(), (2.0 * p).exp(), n.exp(), (2.0 * n).exp()];
+            (hi.map(|v| -v), hi)
+        }
+        Technique::Esm { .. } => ([-1.0, 0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]),
+        Technique::Msm { prefilter, .. } if msm_quantized(prefilter.storage) => {
+            let (mut lo, mut hi) = ([f64::MAX; 4], [f64::MIN; 4]);
+            for k in 0..=4096 {
+                let z = f64::from(k) / 4096.0;
+                let q = crate::cpu::msm::quantize([z, z * z, z.powi(3), z.powi(4)]);
+                for c in 0..4 {
+                    lo[c] = lo[c].min(q[c]);
+                    hi[c] = hi[c].max(q[c]);
+                }
+            }
+            let pad = |c: usize| 1e-3 * (hi[c] - lo[c]);
+            (
+                std::array::from_fn(|c| (lo[c] - pad(c)) as f32),
+                std::array::from_fn(|c| (hi[c] + pad(c)) as f32),
+            )
+        }
+        Technique::Csm { .. } => ([-1.0; 4], [1.0; 4]),
+        _ => ([0.0; 4], [1.0; 4]),
+    };
+    Ok(Some(match variant {
+        SatVariant::Fixed => SatCoding::fixed(lookup_area(width, width), lo, hi)?,
+        SatVariant::Float => SatCoding::float(lo, hi)?,
+    }))
 }
 
 /// Parameters of `kernels/linearize.wgsl` (mirrors its `Params`).
@@ -275,7 +351,7 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
         dispatch: Dispatch::Texels(linear.clone()),
         light: Some(i),
     });
-    let float = "texture_2d<f32>";
+    let float = map_type(light);
     let one = |resource: String, wgsl_type| ShadeInput {
         maps: vec![resource],
         wgsl_type,
@@ -289,10 +365,7 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
         Technique::Vsm { prefilter, .. } => {
             let format = moments_format(prefilter.storage, 2);
             let moments = encode(graph, i, "vsm", "vsm", &linear, format, Vec::new());
-            one(
-                add_filter(graph, i, &moments, &prefilter.filter, BlurMode::Linear),
-                float,
-            )
+            one(filtered(graph, i, light, &moments, BlurMode::Linear), float)
         }
         Technique::Evsm {
             prefilter,
@@ -304,17 +377,16 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
             let format = moments_format(prefilter.storage, if four { 4 } else { 2 });
             let params = bytemuck::bytes_of(&ExpParams::new(exp_pos, exp_neg)).to_vec();
             let moments = encode(graph, i, "evsm", "evsm", &linear, format, params);
-            one(
-                add_filter(graph, i, &moments, &prefilter.filter, BlurMode::Linear),
-                float,
-            )
+            one(filtered(graph, i, light, &moments, BlurMode::Linear), float)
         }
         Technique::Esm { filter, exponent } => {
-            let params = bytemuck::bytes_of(&ExpParams::new(exponent, 0.0)).to_vec();
+            let mut params = ExpParams::new(exponent, 0.0);
+            params.linear = u32::from(matches!(filter, Filter::Sat { .. }));
+            let params = bytemuck::bytes_of(&params).to_vec();
             let format = wgpu::TextureFormat::R32Float;
             let log_moment = encode(graph, i, "esm", "esm", &linear, format, params);
             one(
-                add_filter(graph, i, &log_moment, &filter, BlurMode::LogSumExp),
+                filtered(graph, i, light, &log_moment, BlurMode::LogSumExp),
                 float,
             )
         }
@@ -326,10 +398,7 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
             })
             .to_vec();
             let moments = encode(graph, i, "msm", "msm", &linear, format, params);
-            one(
-                add_filter(graph, i, &moments, &prefilter.filter, BlurMode::Linear),
-                float,
-            )
+            one(filtered(graph, i, light, &moments, BlurMode::Linear), float)
         }
         Technique::Csm {
             prefilter, terms, ..
@@ -346,7 +415,7 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
                     .to_vec();
                     let name = format!("csm{chunk}");
                     let basis = encode(graph, i, "csm", &name, &linear, format, params);
-                    add_filter(graph, i, &basis, &prefilter.filter, BlurMode::Linear)
+                    filtered(graph, i, light, &basis, BlurMode::Linear)
                 })
                 .collect();
             ShadeInput {
@@ -354,6 +423,51 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
                 wgsl_type: float,
             }
         }
+    }
+}
+
+/// The filter of light `light`'s representation applied to `input`: the blur or mip chain of
+/// [`add_filter`], or the summed-area table of [`add_sat`] coded by [`sat_coding`] (whose
+/// errors `render::plan_lights` reports before any graph is built).
+fn filtered(graph: &mut Graph, i: usize, light: &Light, input: &str, mode: BlurMode) -> String {
+    match light.shadow.technique.filter() {
+        Some(Filter::Sat { .. }) => match sat_coding(light) {
+            Ok(Some(coding)) => add_sat(graph, i, input, &coding),
+            _ => input.to_string(),
+        },
+        Some(filter) => add_filter(graph, i, input, &filter, mode),
+        None => input.to_string(),
+    }
+}
+
+/// Channels of the representation behind each map the shading binds for `light` (for a
+/// summed-area table, those of the table's input: the table itself always has four).
+pub fn map_channels(light: &Light) -> Vec<usize> {
+    let mut graph = Graph::default();
+    let input = add_light_nodes(&mut graph, 0, light);
+    input
+        .maps
+        .iter()
+        .map(|m| {
+            let source = m
+                .strip_suffix(".sat")
+                .filter(|_| sat_coding(light).ok().flatten().is_some());
+            graph
+                .find(source.unwrap_or(m))
+                .map_or(4, |r| crate::sat::format_channels(r.format) as usize)
+        })
+        .collect()
+}
+
+/// The WGSL type of a prefiltered technique's maps: `texture_2d<u32>` for a fixed-point
+/// summed-area table, else `texture_2d<f32>`.
+pub fn map_type(light: &Light) -> &'static str {
+    match light.shadow.technique.filter() {
+        Some(Filter::Sat {
+            variant: SatVariant::Fixed,
+            ..
+        }) => "texture_2d<u32>",
+        _ => "texture_2d<f32>",
     }
 }
 
@@ -403,8 +517,11 @@ pub struct ExpParams {
     pub exp_pos: f32,
     /// c⁻ (EVSM4).
     pub exp_neg: f32,
+    /// ESM: 1 stores `exp(c (z − 1))` (for a summed-area table, which sums linearly) instead
+    /// of the log moment `c z`.
+    pub linear: u32,
     /// Padding.
-    pub _pad: [f32; 2],
+    pub _pad: u32,
 }
 
 impl ExpParams {
@@ -413,7 +530,8 @@ impl ExpParams {
         Self {
             exp_pos,
             exp_neg,
-            _pad: [0.0; 2],
+            linear: 0,
+            _pad: 0,
         }
     }
 }
@@ -471,9 +589,55 @@ pub struct ShadeInput {
     pub wgsl_type: &'static str,
 }
 
-/// The module light `light`'s visibility function lives in, and the WGSL statements (ending in
+/// The modules light `light`'s visibility function needs, and the WGSL statements (ending in
 /// a `return`) that evaluate it with `l`, `s` in scope and its maps bound as `maps`.
-pub fn visibility_body(light: &Light, maps: &[String]) -> (&'static str, String) {
+pub fn visibility_body(light: &Light, maps: &[String]) -> (Vec<&'static str>, String) {
+    if let Some(Filter::Sat { variant, .. }) = light.shadow.technique.filter() {
+        let (module, body) = sat_visibility_body(light, maps, variant);
+        return (vec![module, "shared/sat_lookup"], body);
+    }
+    let (module, body) = filtered_visibility_body(light, maps);
+    (vec![module], body)
+}
+
+/// [`visibility_body`] with the `sat` filter: each map's rectangle mean, then the technique's
+/// `*_of` function.
+fn sat_visibility_body(
+    light: &Light,
+    maps: &[String],
+    variant: SatVariant,
+) -> (&'static str, String) {
+    let sample = |map: &str| {
+        let f = match variant {
+            SatVariant::Fixed => "sat_sample_fixed",
+            SatVariant::Float => "sat_sample_float",
+        };
+        format!("{f}({map}, l, s.uv, l.filter_width)")
+    };
+    let map = maps.first().map_or("", String::as_str);
+    let call = |module, f: &str| (module, format!("return {f}({}, l, s);", sample(map)));
+    match light.shadow.technique {
+        Technique::Evsm { .. } => call("shared/vis_evsm", "vis_evsm_of"),
+        Technique::Esm { .. } => call("shared/vis_esm", "vis_esm_of_sat"),
+        Technique::Msm { .. } => call("shared/vis_msm", "vis_msm_of"),
+        Technique::Csm { .. } => {
+            let mut body = String::from("var sum = 0.0;");
+            for (chunk, m) in maps.iter().enumerate() {
+                let _ = write!(
+                    body,
+                    "\n            sum += csm_chunk_of({}, {chunk}u, l, s);",
+                    sample(m)
+                );
+            }
+            body.push_str("\n            return csm_resolve(sum, l);");
+            ("shared/vis_csm", body)
+        }
+        _ => call("shared/vis_vsm", "vis_vsm_of"),
+    }
+}
+
+/// [`visibility_body`] without the `sat` filter.
+fn filtered_visibility_body(light: &Light, maps: &[String]) -> (&'static str, String) {
     let map = maps.first().map_or("", String::as_str);
     let call = |module, f: &str| (module, format!("return {f}({map}, l, s);"));
     match light.shadow.technique {
@@ -519,9 +683,11 @@ pub fn shading_block(lights: &[Light]) -> String {
         let maps: Vec<String> = (0..input.maps.len())
             .map(|k| format!("light{i}_map{k}"))
             .collect();
-        let (module, body) = visibility_body(light, &maps);
-        if !imports.contains(&module) {
-            imports.push(module);
+        let (modules, body) = visibility_body(light, &maps);
+        for module in modules {
+            if !imports.contains(&module) {
+                imports.push(module);
+            }
         }
         for map in &maps {
             let _ = writeln!(

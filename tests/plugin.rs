@@ -160,6 +160,37 @@ fn run_stage_channels(
         .collect()
 }
 
+/// The stage's maps as the renderer's `Frame::shade_maps` holds them: summed-area tables
+/// decoded to the representation they sum (`render::read_sat_map`, as the renderer reads its
+/// own), other maps as they are.
+fn stage_maps_as_frame(
+    g: &Gpu,
+    stage: &mut Prefilter,
+    depth: &wgpu::Texture,
+    params: &LightParams,
+    light: &shadowgraph::scene::Light,
+) -> Vec<(usize, Vec<f32>)> {
+    let Some(coding) = shadowgraph::technique::sat_coding(light).expect("coding") else {
+        return run_stage_channels(g, stage, depth, params);
+    };
+    let mut enc = g.device.create_command_encoder(&Default::default());
+    let out = stage
+        .record(&g.device, &mut enc, depth, params)
+        .expect("record");
+    submit_and_wait(&g.device, &g.queue, enc, "stage").expect("submit");
+    out.maps
+        .iter()
+        .zip(shadowgraph::technique::map_channels(light))
+        .map(|(m, n)| {
+            let map = shadowgraph::render::read_sat_map(
+                &g.device, &g.queue, "stage", &m.texture, &coding, n,
+            )
+            .expect("readback");
+            (map.channels, map.data)
+        })
+        .collect()
+}
+
 /// Host shading of given points through the stage's exported WGSL (`shadowgraph_visibility`
 /// with `PrefilterOutput::light`), as a compute pass of the host's.
 const HOST_PROBE: &str = "
@@ -362,7 +393,7 @@ fn stage_outputs_equal_the_renderers() {
             let mut stage = Prefilter::new(&g.device, &PrefilterConfig::from_light(light))
                 .unwrap_or_else(|e| panic!("{what}: {e}"));
             // The renderer's map holds every map's channels side by side (CSM: 2M channels).
-            let maps = run_stage_channels(&g, &mut stage, &depth, &params);
+            let maps = stage_maps_as_frame(&g, &mut stage, &depth, &params, light);
             let texels = (light.shadow_map * light.shadow_map) as usize;
             let concat: Vec<f32> = (0..texels)
                 .flat_map(|t| {

@@ -868,3 +868,85 @@ fn bundled_scenes_cast_shadows_the_camera_sees() {
         }
     }
 }
+
+#[test]
+fn sat_filter_keys() {
+    use shadowgraph::sat::SatVariant;
+    use shadowgraph::scene::Filter;
+    // `sat_sums` needs the sat filter; `filter_width` needs mips or sat.
+    let text = scene_with(&[(
+        "technique = \"hard\"",
+        "technique = \"vsm\"\nfilter = \"blur\"\nsat_sums = \"float\"",
+    )]);
+    expect(&text, "sat_sums", &["light[0].shadow.sat_sums", "sat"]);
+    let text = scene_with(&[(
+        "technique = \"hard\"",
+        "technique = \"vsm\"\nfilter = \"sat\"\nsat_sums = \"double\"",
+    )]);
+    expect(&text, "sat_sums", &["light[0].shadow.sat_sums", "double"]);
+    let text = scene_with(&[(
+        "technique = \"hard\"",
+        "technique = \"vsm\"\nfilter = \"sat\"\nfilter_width = 2000.0",
+    )]);
+    expect(&text, "filter_width", &["light[0].shadow.filter_width"]);
+
+    let text = scene_with(&[(
+        "technique = \"hard\"",
+        "technique = \"msm\"\nfilter = \"sat\"\nfilter_width = 7.5\nsat_sums = \"float\"",
+    )]);
+    let s = parse(&text).expect("sat parameters parse");
+    assert_eq!(
+        s.lights[0].shadow.technique.filter(),
+        Some(Filter::Sat {
+            width: 7.5,
+            variant: SatVariant::Float
+        })
+    );
+}
+
+/// Exponents past what a summed-area table keeps accurate are clamped to
+/// `sat_exponent_limit`, with a warning when the scene set them; defaults clamp silently.
+#[test]
+fn sat_filter_clamps_exponents() {
+    use shadowgraph::scene::{Filter, sat_exponent_limit};
+    let text = scene_with(&[(
+        "technique = \"hard\"",
+        "technique = \"evsm4\"\nfilter = \"sat\"\nfilter_width = 4.0",
+    )]);
+    let s = parse(&text).expect("parses");
+    let filter = Filter::Sat {
+        width: 4.0,
+        variant: shadowgraph::sat::SatVariant::Fixed,
+    };
+    // (4 + 1)² = 25 texels: ½ ln(2²² / 25) = 6.0.
+    let limit = sat_exponent_limit(&filter, false).expect("a limit");
+    assert!(
+        (limit - 0.5 * (4194304.0f32 / 25.0).ln()).abs() < 1e-5,
+        "{limit}"
+    );
+    let Technique::Evsm {
+        exp_pos, exp_neg, ..
+    } = s.lights[0].shadow.technique
+    else {
+        panic!("evsm4")
+    };
+    assert_eq!((exp_pos, exp_neg), (limit, 5.0f32.min(limit)));
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+
+    let text = scene_with(&[(
+        "technique = \"hard\"",
+        "technique = \"esm\"\nfilter = \"sat\"\nfilter_width = 4.0\nexponent = 60.0",
+    )]);
+    let s = parse(&text).expect("parses");
+    let esm_limit = sat_exponent_limit(&filter, true).expect("a limit");
+    assert!((esm_limit - 4.0 * limit).abs() < 1e-4);
+    let Technique::Esm { exponent, .. } = s.lights[0].shadow.technique else {
+        panic!("esm")
+    };
+    assert_eq!(exponent, esm_limit);
+    assert!(
+        s.warnings.iter().any(|w| w.contains("exponent")),
+        "{:?}",
+        s.warnings
+    );
+}

@@ -77,6 +77,9 @@ fn pixel_reference(
             } => 1.0 / 64.0,
             Technique::Vsm { .. } => common::vsm_tolerance(moments, &lg, &s),
             Technique::Evsm { .. } => common::evsm_tolerance(moments, &lg, &s),
+            Technique::Esm { .. } if lg.filter_width > 0.0 => {
+                common::esm_sat_tolerance(moments, &lg, &s, v)
+            }
             Technique::Esm { .. } => common::esm_tolerance(moments, &lg, &s, v),
             Technique::Msm { .. } => common::msm_tolerance(moments, &lg, &s),
             Technique::Csm { .. } => common::csm_tolerance(&lg),
@@ -202,6 +205,22 @@ fn check_prefilter_chain(scene: &Scene, frame: &shadowgraph::render::Frame, li: 
                     rtol,
                 )
             }
+            Technique::Esm {
+                filter: filter @ Filter::Sat { .. },
+                exponent,
+            } => {
+                // Stored linearly for the table: exp(c (z − 1)), SPIR-V's exp to (3 + 2|x|) ULP.
+                let f = move |t: &Texels| cpu::esm::esm_linear(t, exponent.into());
+                let rtol = 4.0 * (3.0 + 2.0 * f64::from(exponent)) * 2f64.powi(-23);
+                (
+                    Box::new(f) as Box<dyn Fn(&Texels) -> Texels>,
+                    1,
+                    filter,
+                    Storage::F32,
+                    false,
+                    rtol,
+                )
+            }
             Technique::Esm { filter, exponent } => {
                 let f = move |t: &Texels| cpu::esm::esm(t, exponent.into());
                 // Log-space blur: exp and log of each tap, absolute error relative to |c·z|.
@@ -277,7 +296,33 @@ fn check_prefilter_chain(scene: &Scene, frame: &shadowgraph::render::Frame, li: 
         Technique::Csm { .. } => atol + 2f64.powi(-11),
         _ => atol,
     };
-    common::assert_close(&format!("light {li} filtered map"), &got, &keep, atol, rtol);
+    let what = format!("light {li} filtered map");
+    let coding = shadowgraph::technique::sat_coding(&scene.lights[li]).expect("valid coding");
+    match coding {
+        // The table's texels decode to the representation quantized to the coding's step:
+        // ½ / scale per channel, plus f32 rounding of the scaled value (2⁻²⁴ of it, twice).
+        Some(c) if c.variant == shadowgraph::sat::SatVariant::Fixed => {
+            for ch in 0..channels {
+                let pick = |v: &[f32]| -> Vec<f32> {
+                    v.iter().skip(ch).step_by(channels).copied().collect()
+                };
+                let want: Vec<f64> = keep.iter().skip(ch).step_by(channels).copied().collect();
+                let k = ch % 4;
+                let step = 0.5 / f64::from(c.scale[k]) * (1.0 + 2f64.powi(-20));
+                common::assert_close(
+                    &format!("{what} channel {ch}"),
+                    &pick(&got),
+                    &want,
+                    atol + step,
+                    rtol + 2f64.powi(-22),
+                );
+            }
+        }
+        // The f32 table's texels are differences of sums: their error is the stability
+        // report's subject (tests/stability.rs); only finiteness is checked here.
+        Some(_) => assert!(got.iter().all(|v| v.is_finite()), "{what}: non-finite"),
+        None => common::assert_close(&what, &got, &keep, atol, rtol),
+    }
 }
 
 #[test]
@@ -370,6 +415,15 @@ fn every_technique_renders_every_bundled_scene() {
         kernel: BlurKernel::Gaussian,
     };
     let pre = |storage, filter| Prefilter { storage, filter };
+    let sat = Filter::Sat {
+        width: 4.5,
+        variant: shadowgraph::sat::SatVariant::Fixed,
+    };
+    let sat_float = Filter::Sat {
+        width: 2.0,
+        variant: shadowgraph::sat::SatVariant::Float,
+    };
+    let sat_limit = shadowgraph::scene::sat_exponent_limit(&sat, false).expect("sat limit");
     let techniques = [
         Technique::Hard,
         Technique::Pcf {
@@ -415,6 +469,36 @@ fn every_technique_renders_every_bundled_scene() {
             terms: 9,
             attenuation: 1.0,
             offset: 0.05,
+            scale: 2.0,
+        },
+        Technique::Vsm {
+            prefilter: pre(Storage::F32, sat_float),
+            bleed: 0.2,
+            min_variance: 1e-5,
+        },
+        Technique::Evsm {
+            prefilter: pre(Storage::F16, sat),
+            four: false,
+            exp_pos: sat_limit,
+            exp_neg: sat_limit,
+            bleed: 0.0,
+            min_variance: 1e-4,
+        },
+        Technique::Esm {
+            filter: sat,
+            exponent: 4.0 * sat_limit,
+        },
+        Technique::Msm {
+            prefilter: pre(Storage::F16, sat),
+            hausdorff: false,
+            moment_bias: 5e-4,
+            bleed: 0.0,
+        },
+        Technique::Csm {
+            prefilter: pre(Storage::F32, sat),
+            terms: 5,
+            attenuation: 1.0,
+            offset: 0.1,
             scale: 2.0,
         },
     ];

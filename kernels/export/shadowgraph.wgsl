@@ -22,17 +22,23 @@
 //   fn vis_pcf_hardware(map: texture_depth_2d, cmp: sampler_comparison, l: Light, s: LightSample) -> f32
 //   fn vis_pcss(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
 //   fn vis_vsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
+//   fn vis_vsm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32
 //   fn vis_evsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
+//   fn vis_evsm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32
 //   fn vis_esm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
+//   fn vis_esm_of_sat(m: vec4<f32>, l: Light, s: LightSample) -> f32
+//   fn vis_esm_of_log(log_moment: f32, l: Light, s: LightSample) -> f32
 //   fn vis_msm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
+//   fn vis_msm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32
 //
 // Names defined here (a host must not reuse them):
 //   CSM_PI GOLDEN_ANGLE Light LightSample MSM_B0 bilinear_level bilinear_log_level
-//   chebyshev_upper csm_chunk csm_resolve csm_sin_cos light_linear_to_ndc light_linear_to_z
-//   light_map_width light_sample light_to_light linstep load_depth msm_dequantize msm_intensity
-//   msm_quantize pcss_search_radius sample_bilinear sample_bilinear_log sample_map
-//   sample_map_log texel_of vis_esm vis_evsm vis_hard vis_msm vis_pcf vis_pcf_hardware vis_pcss
-//   vis_vsm vogel_disc
+//   chebyshev_upper csm_chunk csm_chunk_of csm_resolve csm_sin_cos light_linear_to_ndc
+//   light_linear_to_z light_map_width light_sample light_to_light linstep load_depth
+//   msm_dequantize msm_intensity msm_quantize pcss_search_radius sample_bilinear
+//   sample_bilinear_log sample_map sample_map_log texel_of vis_esm vis_esm_of_log vis_esm_of_sat
+//   vis_evsm vis_evsm_of vis_hard vis_msm vis_msm_of vis_pcf vis_pcf_hardware vis_pcss vis_vsm
+//   vis_vsm_of vogel_disc
 
 // Shared light description and light-space helpers (import-only module).
 //
@@ -75,8 +81,10 @@ struct Light {
     csm_scale: f32,          // csm: response scale about ½
     mip_levels: u32,         // mips filter: levels in the map's chain (0: no mips)
     filter_lod: f32,         // mips filter: log2 of the filter width in texels
+    filter_width: f32,       // sat filter: box width in texels (0: no sat)
     _pad0: u32,
-    _pad1: u32,
+    sat_offset: vec4<f32>,   // sat filter: the table's coding (SatCoding in src/sat.rs)
+    sat_scale: vec4<f32>,
 }
 
 // Where a receiver lands in a light's shadow map.
@@ -304,7 +312,12 @@ fn vis_pcss(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
 // then the light-bleeding reduction linstep(bleed, 1, p_max).
 
 fn vis_vsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    let m = sample_map(map, l, s.uv);
+    return vis_vsm_of(sample_map(map, l, s.uv), l, s);
+}
+
+// The bound from filtered moments `m` however they were filtered (the `sat` filter calls this
+// with its rectangle mean).
+fn vis_vsm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
     let d = s.depth - l.bias;
     if d <= m.x {
         return 1.0;
@@ -328,7 +341,11 @@ fn chebyshev_upper(mean: f32, mean_sq: f32, receiver: f32, floor: f32) -> f32 {
 }
 
 fn vis_evsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    let m = sample_map(map, l, s.uv);
+    return vis_evsm_of(sample_map(map, l, s.uv), l, s);
+}
+
+// The bounds from filtered moments `m` however they were filtered.
+fn vis_evsm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
     let w = 2.0 * (s.depth - l.bias) - 1.0;
     let pos = exp(l.exp_pos * w);
     let slope_pos = 2.0 * l.exp_pos * pos;
@@ -344,7 +361,16 @@ fn vis_evsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
 // moment kept as its logarithm L, so the product is exp(L − c d) and never overflows.
 
 fn vis_esm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    let log_moment = sample_map_log(map, l, s.uv);
+    return vis_esm_of_log(sample_map_log(map, l, s.uv), l, s);
+}
+
+// The `sat` filter's table sums the moment scaled by exp(−c), m = E[exp(c (z − 1))]: its log
+// moment is ln m + c. A mean that quantization left at or below 0 reads as fully shadowed.
+fn vis_esm_of_sat(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
+    return vis_esm_of_log(log(max(m.x, 1e-37)) + l.exp_pos, l, s);
+}
+
+fn vis_esm_of_log(log_moment: f32, l: Light, s: LightSample) -> f32 {
     return clamp(exp(log_moment - l.exp_pos * (s.depth - l.bias)), 0.0, 1.0);
 }
 // Moment shadow maps (Peters & Klein 2015), four moments b = (z, z², z³, z⁴) of the filtered
@@ -427,7 +453,12 @@ fn msm_intensity(b: vec4<f32>, d: f32, hausdorff: bool) -> f32 {
 }
 
 fn vis_msm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    var b = sample_map(map, l, s.uv);
+    return vis_msm_of(sample_map(map, l, s.uv), l, s);
+}
+
+// Visibility from filtered (possibly quantized) moments `m` however they were filtered.
+fn vis_msm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
+    var b = m;
     if (l.msm_flags & 2u) != 0u {
         b = msm_dequantize(b);
     }
@@ -459,7 +490,11 @@ fn csm_sin_cos(k: u32, x: f32) -> vec2<f32> {
 
 // Terms 2·chunk + 1 and 2·chunk + 2 (those ≤ M) of the series at this receiver.
 fn csm_chunk(map: texture_2d<f32>, chunk: u32, l: Light, s: LightSample) -> f32 {
-    let v = sample_map(map, l, s.uv);
+    return csm_chunk_of(sample_map(map, l, s.uv), chunk, l, s);
+}
+
+// The same from the chunk's filtered basis values `v` however they were filtered.
+fn csm_chunk_of(v: vec4<f32>, chunk: u32, l: Light, s: LightSample) -> f32 {
     let d = s.depth - l.bias - l.csm_offset;
     let m = f32(l.csm_terms);
     var sum = 0.0;

@@ -4,6 +4,6 @@
 struct Params {
     exp_pos: f32,            // evsm: c⁺; esm: c
     exp_neg: f32,            // evsm: c⁻
-    _pad0: f32,
-    _pad1: f32,
+    linear: u32,             // esm: 1 stores exp(c (z − 1)) (for a summed-area table), 0 c·z
+    _pad0: u32,
 }

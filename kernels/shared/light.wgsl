@@ -39,8 +39,10 @@ struct Light {
     csm_scale: f32,          // csm: response scale about ½
     mip_levels: u32,         // mips filter: levels in the map's chain (0: no mips)
     filter_lod: f32,         // mips filter: log2 of the filter width in texels
+    filter_width: f32,       // sat filter: box width in texels (0: no sat)
     _pad0: u32,
-    _pad1: u32,
+    sat_offset: vec4<f32>,   // sat filter: the table's coding (SatCoding in src/sat.rs)
+    sat_scale: vec4<f32>,
 }
 
 // Where a receiver lands in a light's shadow map.

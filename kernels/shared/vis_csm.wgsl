@@ -12,7 +12,11 @@
 
 // Terms 2·chunk + 1 and 2·chunk + 2 (those ≤ M) of the series at this receiver.
 fn csm_chunk(map: texture_2d<f32>, chunk: u32, l: Light, s: LightSample) -> f32 {
-    let v = sample_map(map, l, s.uv);
+    return csm_chunk_of(sample_map(map, l, s.uv), chunk, l, s);
+}
+
+// The same from the chunk's filtered basis values `v` however they were filtered.
+fn csm_chunk_of(v: vec4<f32>, chunk: u32, l: Light, s: LightSample) -> f32 {
     let d = s.depth - l.bias - l.csm_offset;
     let m = f32(l.csm_terms);
     var sum = 0.0;

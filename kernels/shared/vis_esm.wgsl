@@ -4,6 +4,15 @@
 // #import shared/sampling
 
 fn vis_esm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    let log_moment = sample_map_log(map, l, s.uv);
+    return vis_esm_of_log(sample_map_log(map, l, s.uv), l, s);
+}
+
+// The `sat` filter's table sums the moment scaled by exp(−c), m = E[exp(c (z − 1))]: its log
+// moment is ln m + c. A mean that quantization left at or below 0 reads as fully shadowed.
+fn vis_esm_of_sat(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
+    return vis_esm_of_log(log(max(m.x, 1e-37)) + l.exp_pos, l, s);
+}
+
+fn vis_esm_of_log(log_moment: f32, l: Light, s: LightSample) -> f32 {
     return clamp(exp(log_moment - l.exp_pos * (s.depth - l.bias)), 0.0, 1.0);
 }

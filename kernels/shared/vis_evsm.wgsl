@@ -15,7 +15,11 @@ fn chebyshev_upper(mean: f32, mean_sq: f32, receiver: f32, floor: f32) -> f32 {
 }
 
 fn vis_evsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    let m = sample_map(map, l, s.uv);
+    return vis_evsm_of(sample_map(map, l, s.uv), l, s);
+}
+
+// The bounds from filtered moments `m` however they were filtered.
+fn vis_evsm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
     let w = 2.0 * (s.depth - l.bias) - 1.0;
     let pos = exp(l.exp_pos * w);
     let slope_pos = 2.0 * l.exp_pos * pos;

@@ -58,7 +58,12 @@ fn msm_intensity(b: vec4<f32>, d: f32, hausdorff: bool) -> f32 {
 }
 
 fn vis_msm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    var b = sample_map(map, l, s.uv);
+    return vis_msm_of(sample_map(map, l, s.uv), l, s);
+}
+
+// Visibility from filtered (possibly quantized) moments `m` however they were filtered.
+fn vis_msm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
+    var b = m;
     if (l.msm_flags & 2u) != 0u {
         b = msm_dequantize(b);
     }

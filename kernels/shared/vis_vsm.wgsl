@@ -5,7 +5,12 @@
 // #import shared/sampling
 
 fn vis_vsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    let m = sample_map(map, l, s.uv);
+    return vis_vsm_of(sample_map(map, l, s.uv), l, s);
+}
+
+// The bound from filtered moments `m` however they were filtered (the `sat` filter calls this
+// with its rectangle mean).
+fn vis_vsm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
     let d = s.depth - l.bias;
     if d <= m.x {
         return 1.0;

@@ -87,6 +87,9 @@ pub fn taps<'a>(levels: &'a [Texels], l: &LightGpu, uv: [f64; 2]) -> Vec<(f64, &
         ]
         .map(|(w, dx, dy)| (scale * w, t.at(x0 + dx, y0 + dy)))
     };
+    if l.filter_width > 0.0 {
+        return sat_taps(&levels[0], l, uv);
+    }
     if l.mip_levels <= 1 || levels.len() <= 1 {
         return bilinear(&levels[0], 1.0).to_vec();
     }
@@ -98,6 +101,29 @@ pub fn taps<'a>(levels: &'a [Texels], l: &LightGpu, uv: [f64; 2]) -> Vec<(f64, &
     let mut v = bilinear(&levels[l0], 1.0 - t).to_vec();
     v.extend(bilinear(&levels[l1], t));
     v
+}
+
+/// The `sat` filter's taps (`sat_sample_*` in `kernels/shared/sat_lookup.wgsl`): every texel
+/// the square of `l.filter_width` texels centred on `uv` overlaps, weighted by its overlap over
+/// the (clamped) square's area; the rectangle itself is formed in f32 as the shader forms it.
+pub fn sat_taps<'a>(t: &'a Texels, l: &LightGpu, uv: [f64; 2]) -> Vec<(f64, &'a [f64])> {
+    let (cx, cy) = (uv[0] as f32 * l.map_size[0], uv[1] as f32 * l.map_size[1]);
+    let h = 0.5 * l.filter_width;
+    let rect = [cx - h, cy - h, cx + h, cy + h];
+    let [x0, y0, x1, y1] = super::sat::clamp_rect(rect, t.width, t.height).map(f64::from);
+    let area = (x1 - x0) * (y1 - y0);
+    let overlap = |lo: f64, hi: f64, i: usize| (hi.min(i as f64 + 1.0) - lo.max(i as f64)).max(0.0);
+    let mut taps = Vec::new();
+    for j in (y0.floor() as usize)..(y1.ceil() as usize).min(t.height) {
+        let wy = overlap(y0, y1, j);
+        for i in (x0.floor() as usize)..(x1.ceil() as usize).min(t.width) {
+            let w = wy * overlap(x0, x1, i) / area;
+            if w > 0.0 {
+                taps.push((w, t.at(i as i64, j as i64)));
+            }
+        }
+    }
+    taps
 }
 
 /// `sample_map`: the filtered representation at `uv`.

@@ -373,6 +373,9 @@ fn filter(f: &Filter) -> Result<(), StageError> {
     if let Filter::Mips { width } = *f {
         range("filter_width", width, 1.0, 65536.0)?;
     }
+    if let Filter::Sat { width, .. } = *f {
+        range("filter_width", width, 1.0, 1024.0)?;
+    }
     Ok(())
 }
 

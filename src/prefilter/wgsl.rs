@@ -119,12 +119,12 @@ fn block_of(technique: &Technique) -> Result<Block> {
     let names: Vec<String> = (0..input.maps.len())
         .map(|k| format!("light0_map{k}"))
         .collect();
-    let (module, body) = crate::technique::visibility_body(&light, &names);
+    let (modules, body) = crate::technique::visibility_body(&light, &names);
     if names.is_empty() || body.is_empty() {
         return Err(malformed(&body));
     }
     Ok(Block {
-        imports: vec![module.to_string()],
+        imports: modules.iter().map(|m| m.to_string()).collect(),
         maps: names
             .into_iter()
             .map(|n| (n, input.wgsl_type.to_string()))

@@ -132,8 +132,10 @@ pub struct ShadowFile {
     pub exponent_pos: Option<Spanned<f64>>,
     /// EVSM4 negative exponent c⁻.
     pub exponent_neg: Option<Spanned<f64>>,
-    /// Mip filter width in texels.
+    /// Mip or SAT filter width in texels.
     pub filter_width: Option<Spanned<f64>>,
+    /// SAT sums: `fixed` (u32 fixed point, exact window sums) or `float` (f32).
+    pub sat_sums: Option<Spanned<String>>,
     /// MSM reconstruction: `hamburger` or `hausdorff`.
     pub reconstruction: Option<Spanned<String>>,
     /// MSM moment bias α.

@@ -5,7 +5,7 @@ pub mod format;
 pub mod mesh;
 mod validate;
 
-pub use validate::{default_moment_bias, exponent_limit};
+pub use validate::{default_moment_bias, exponent_limit, sat_exponent_limit};
 
 use std::path::{Path, PathBuf};
 
@@ -124,6 +124,14 @@ pub enum Filter {
     Mips {
         /// Filter width in level-0 texels (level `log2(width)` is sampled).
         width: f32,
+    },
+    /// A summed-area table (`src/sat.rs`), read as the mean over a `width`-texel square
+    /// around the receiver with four lookups per channel and sub-texel edges.
+    Sat {
+        /// Box width in texels.
+        width: f32,
+        /// How the table stores its sums.
+        variant: crate::sat::SatVariant,
     },
 }
 

@@ -283,6 +283,7 @@ const TECHNIQUE_KEYS: &[(&str, &[&str])] = &[
             SIGMA,
             KERNEL,
             WIDTH,
+            SAT_SUMS,
             "bleed_reduction",
             "min_variance",
         ],
@@ -296,6 +297,7 @@ const TECHNIQUE_KEYS: &[(&str, &[&str])] = &[
             SIGMA,
             KERNEL,
             WIDTH,
+            SAT_SUMS,
             "bleed_reduction",
             "min_variance",
             "exponent_pos",
@@ -310,13 +312,17 @@ const TECHNIQUE_KEYS: &[(&str, &[&str])] = &[
             SIGMA,
             KERNEL,
             WIDTH,
+            SAT_SUMS,
             "bleed_reduction",
             "min_variance",
             "exponent_pos",
             "exponent_neg",
         ],
     ),
-    ("esm", &[FILTER, RADIUS, SIGMA, KERNEL, WIDTH, "exponent"]),
+    (
+        "esm",
+        &[FILTER, RADIUS, SIGMA, KERNEL, WIDTH, SAT_SUMS, "exponent"],
+    ),
     (
         "msm",
         &[
@@ -326,6 +332,7 @@ const TECHNIQUE_KEYS: &[(&str, &[&str])] = &[
             SIGMA,
             KERNEL,
             WIDTH,
+            SAT_SUMS,
             "reconstruction",
             "moment_bias",
             "bleed_reduction",
@@ -340,6 +347,7 @@ const TECHNIQUE_KEYS: &[(&str, &[&str])] = &[
             SIGMA,
             KERNEL,
             WIDTH,
+            SAT_SUMS,
             "terms",
             "attenuation",
             "offset",
@@ -352,6 +360,7 @@ const RADIUS: &str = "filter_radius";
 const SIGMA: &str = "filter_sigma";
 const KERNEL: &str = "filter_kernel";
 const WIDTH: &str = "filter_width";
+const SAT_SUMS: &str = "sat_sums";
 
 /// Storage formats of the two- and four-moment float techniques.
 const FLOAT_STORAGE: &[(&str, Storage)] = &[("f32", Storage::F32), ("f16", Storage::F16)];
@@ -377,6 +386,40 @@ pub fn exponent_limit(storage: Storage) -> f32 {
     }
 }
 
+/// The largest exponent a summed-area table keeps accurate (`None` without the `sat` filter).
+///
+/// Window sums are linear, so a table's error is absolute: the fixed-point coding's step per
+/// mean is `½ / scale ≈ range · A / 2³²` for windows of `A` texels (src/sat.rs), the f32
+/// coding's no better. EVSM's squared moment spans `e^{−2c}..e^{2c}`; its step at the centre
+/// of the depth range (moment 1) stays below 2⁻¹⁰ while `e^{2c} · A / 2³² ≤ 2⁻¹⁰`, so
+/// `c ≤ ½ ln(2²² / A)`. ESM's `exp(c (z − 1)) ∈ [e^{−c}, 1]` has visibility
+/// `mean · e^{c (1 − d)}`, whose error at mid depth stays below 2⁻¹⁰ while
+/// `e^{c/2} · A / 2³² ≤ 2⁻¹⁰`, so `c ≤ 2 ln(2²² / A)`.
+pub fn sat_exponent_limit(filter: &Filter, esm: bool) -> Option<f32> {
+    let Filter::Sat { width, .. } = *filter else {
+        return None;
+    };
+    let area = crate::sat::lookup_area(width, width) as f64;
+    let c = 0.5 * (f64::from(1u32 << 22) / area).ln().max(0.02);
+    Some(if esm { 4.0 * c } else { c } as f32)
+}
+
+/// `c` clamped to the SAT limit, with a warning when the scene set it explicitly.
+fn clamp_for_sat(ctx: &Ctx, key: &str, v: &Option<Spanned<f64>>, c: f32, sat: Option<f32>) -> f32 {
+    let Some(limit) = sat else {
+        return c;
+    };
+    if c > limit && v.is_some() {
+        ctx.warnings.borrow_mut().push(format!(
+            "{}{}: `{key}` = {c} exceeds {limit:.2}, the largest a summed-area table of this \
+             `filter_width` keeps accurate; clamped",
+            ctx.path.display(),
+            ctx.location(v.as_ref().map(|v| v.span())),
+        ));
+    }
+    c.min(limit)
+}
+
 fn present(s: &ShadowFile) -> Vec<(&'static str, Range<usize>)> {
     fn sp<T>(v: &Option<Spanned<T>>) -> Option<Range<usize>> {
         v.as_ref().map(|v| v.span())
@@ -398,6 +441,7 @@ fn present(s: &ShadowFile) -> Vec<(&'static str, Range<usize>)> {
         ("exponent_pos", sp(&s.exponent_pos)),
         ("exponent_neg", sp(&s.exponent_neg)),
         ("filter_width", sp(&s.filter_width)),
+        ("sat_sums", sp(&s.sat_sums)),
         ("reconstruction", sp(&s.reconstruction)),
         ("moment_bias", sp(&s.moment_bias)),
         ("terms", sp(&s.terms)),
@@ -495,6 +539,7 @@ fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
         "evsm2" | "evsm4" => {
             let prefilter = prefilter(ctx, i, s, FLOAT_STORAGE)?;
             let limit = exponent_limit(prefilter.storage);
+            let sat = sat_exponent_limit(&prefilter.filter, false);
             let exponent = |k: &str, v: &Option<Spanned<f64>>, default: f32| -> Result<f32> {
                 let c = ctx.num_or(&key(k), v, 0.01, 1e4, default)?;
                 if c > limit {
@@ -506,7 +551,8 @@ fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
                         prefilter.storage
                     ));
                 }
-                Ok(c.min(limit))
+                let c = c.min(limit);
+                Ok(clamp_for_sat(ctx, &key(k), v, c, sat))
             };
             Technique::Evsm {
                 prefilter,
@@ -553,10 +599,15 @@ fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
                 scale: ctx.num_or(&key("scale"), &s.scale, 1.0, 16.0, 2.0)?,
             }
         }
-        _ => Technique::Esm {
-            filter: prefilter(ctx, i, s, &[("f32", Storage::F32)])?.filter,
-            exponent: ctx.num_or(&key("exponent"), &s.exponent, 0.01, 1e4, 80.0)?,
-        },
+        _ => {
+            let filter = prefilter(ctx, i, s, &[("f32", Storage::F32)])?.filter;
+            let c = ctx.num_or(&key("exponent"), &s.exponent, 0.01, 1e4, 80.0)?;
+            let sat = sat_exponent_limit(&filter, true);
+            Technique::Esm {
+                filter,
+                exponent: clamp_for_sat(ctx, &key("exponent"), &s.exponent, c, sat),
+            }
+        }
     };
     Ok(Shadow {
         technique,
@@ -579,6 +630,7 @@ fn prefilter(
         None,
         Blur,
         Mips,
+        Sat,
     }
     let kind = ctx.choice(
         &key("filter"),
@@ -587,6 +639,7 @@ fn prefilter(
             ("none", Kind::None),
             ("blur", Kind::Blur),
             ("mips", Kind::Mips),
+            ("sat", Kind::Sat),
         ],
         Kind::Blur,
     )?;
@@ -596,17 +649,32 @@ fn prefilter(
         ctx.reject(&key("filter_sigma"), &s.filter_sigma, why)?;
         ctx.reject(&key("filter_kernel"), &s.filter_kernel, why)?;
     }
-    if kind != Kind::Mips {
+    if !matches!(kind, Kind::Mips | Kind::Sat) {
         ctx.reject(
             &key("filter_width"),
             &s.filter_width,
-            "needs `filter = \"mips\"`",
+            "needs `filter = \"mips\"` or `\"sat\"`",
         )?;
+    }
+    if kind != Kind::Sat {
+        ctx.reject(&key(SAT_SUMS), &s.sat_sums, "needs `filter = \"sat\"`")?;
     }
     let filter = match kind {
         Kind::None => Filter::None,
         Kind::Mips => Filter::Mips {
             width: ctx.num_or(&key("filter_width"), &s.filter_width, 1.0, 65536.0, 1.0)?,
+        },
+        Kind::Sat => Filter::Sat {
+            width: ctx.num_or(&key("filter_width"), &s.filter_width, 1.0, 1024.0, 3.0)?,
+            variant: ctx.choice(
+                &key(SAT_SUMS),
+                &s.sat_sums,
+                &[
+                    ("fixed", crate::sat::SatVariant::Fixed),
+                    ("float", crate::sat::SatVariant::Float),
+                ],
+                crate::sat::SatVariant::Fixed,
+            )?,
         },
         Kind::Blur => {
             let radius = ctx.num_or(

@@ -142,6 +142,31 @@ pub fn esm_tolerance(
     1e-6 + v * rel
 }
 
+/// Tolerance of ESM through a summed-area table at visibility `v` (`vis_esm_of_sat`): the
+/// table mean m in f32 from 16 weighted window sums (32 roundings of 2⁻²⁴ of m, the coding
+/// being about 0), SPIR-V's `log` (2⁻²¹ absolute near 1, else 3 ULP of |ln m|), the exponent
+/// x = ln m + c − c·d formed in f32 (4 ULP of c + c·d), `exp` to (3 + 2|x|) ULP, and the
+/// receiver depth's f32 rounding scaled by c (as in [`esm_tolerance`]).
+pub fn esm_sat_tolerance(
+    moments: &[shadowgraph::cpu::Texels],
+    l: &shadowgraph::technique::LightGpu,
+    s: &shadowgraph::cpu::light::LightSample,
+    v: f64,
+) -> f64 {
+    let m = shadowgraph::cpu::mips::sample(moments, l, s.uv)[0].max(1e-37);
+    let c = f64::from(l.exp_pos);
+    let ulp = 2f64.powi(-23);
+    let x = m.ln() + c - c * s.depth;
+    let depth = c * 4.0 * ulp * (s.view_z + f64::from(l.near)) / f64::from(l.far - l.near);
+    let rel = 16.0 * ulp
+        + 2f64.powi(-21)
+        + 3.0 * ulp * m.ln().abs()
+        + 4.0 * ulp * (c + c * s.depth)
+        + (3.0 + 2.0 * x.abs()) * ulp
+        + depth;
+    1e-6 + v * rel
+}
+
 /// A linear depth map with structure: a background and overlapping random rectangles, so
 /// windows see mixes of occluders (never all zeros).
 pub fn blocky_map(rng: &mut SmallRng, size: usize) -> Vec<f32> {

@@ -1,0 +1,24 @@
+// The `sat` filter's lookups for the shading side (import-only module): a light's filtered
+// representation at a receiver as the mean over a square of `width` shadow-map texels centred
+// on it, from the light's summed-area table, four lookups per channel (sixteen with the
+// sub-texel edges) whatever the width. Any other rectangle, e.g. a per-pixel penumbra width,
+// goes through `sat_rect` with that width.
+// #import shared/light
+// #import shared/sat
+
+// The square of `width` texels centred on uv, in texel units (x0, y0, x1, y1).
+fn sat_rect(l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
+    let c = uv * l.map_size;
+    let h = vec2<f32>(0.5 * width);
+    return vec4<f32>(c - h, c + h);
+}
+
+// The mean over `sat_rect(l, uv, width)` from a fixed-point table (rgba32uint).
+fn sat_sample_fixed(map: texture_2d<u32>, l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
+    return sat_mean_fixed(map, sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
+}
+
+// The mean over `sat_rect(l, uv, width)` from an f32 table (rgba32float).
+fn sat_sample_float(map: texture_2d<f32>, l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
+    return sat_mean_float(map, sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
+}
