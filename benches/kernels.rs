@@ -1,7 +1,8 @@
 //! `cargo bench --bench kernels`: the kernel microbenchmark of `shadowgraph bench`.
 //!
 //! Sizes come from `SHADOWGRAPH_BENCH_SIZES` (comma list, default `512,1024,2048`), timed runs
-//! per kernel from `SHADOWGRAPH_BENCH_REPEAT` (default 10).
+//! per kernel from `SHADOWGRAPH_BENCH_REPEAT` (default 10). With `SHADOWGRAPH_BENCH_LOOKUP`
+//! set, the shading pass's lookup cost (PCF against summed-area tables, 3² to 65²) follows.
 
 use std::process::ExitCode;
 
@@ -37,7 +38,14 @@ fn repeat() -> Result<u32, String> {
 fn run() -> Result<String, String> {
     let (sizes, repeat) = (sizes()?, repeat()?);
     let gpu = Gpu::new().map_err(|e| e.to_string())?;
-    bench::run(&gpu, &sizes, repeat).map_err(|e| e.to_string())
+    let mut report = bench::run(&gpu, &sizes, repeat).map_err(|e| e.to_string())?;
+    if std::env::var_os("SHADOWGRAPH_BENCH_LOOKUP").is_some() {
+        let rows =
+            bench::lookup_cost(&gpu, bench::LOOKUP_WIDTHS, repeat).map_err(|e| e.to_string())?;
+        let cpu = gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu;
+        report += &bench::format_lookup_table(&gpu.describe(), cpu, repeat, &rows);
+    }
+    Ok(report)
 }
 
 fn main() -> ExitCode {

@@ -67,6 +67,10 @@ enum Command {
         /// Timed repetitions per kernel and size (the median is reported).
         #[arg(long, default_value_t = 10)]
         repeat: u32,
+        /// Instead: the shading pass's cost as the filter widens, PCF against summed-area
+        /// tables, at these odd widths (texels).
+        #[arg(long, value_delimiter = ',', num_args = 0.., default_missing_value = "3,5,9,17,33,65")]
+        lookup: Option<Vec<u32>>,
     },
 }
 
@@ -100,9 +104,28 @@ fn run(args: Args) -> Result<()> {
             );
         }
         Command::Info => print!("{}", Gpu::new()?.info_report()),
-        Command::Bench { sizes, repeat } => {
+        Command::Bench {
+            sizes,
+            repeat,
+            lookup,
+        } => {
             let gpu = Gpu::new()?;
-            print!("{}", shadowgraph::bench::run(&gpu, &sizes, repeat)?);
+            match lookup {
+                Some(widths) => {
+                    let rows = shadowgraph::bench::lookup_cost(&gpu, &widths, repeat)?;
+                    let cpu = gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu;
+                    print!(
+                        "{}",
+                        shadowgraph::bench::format_lookup_table(
+                            &gpu.describe(),
+                            cpu,
+                            repeat,
+                            &rows
+                        )
+                    );
+                }
+                None => print!("{}", shadowgraph::bench::run(&gpu, &sizes, repeat)?),
+            }
         }
     }
     Ok(())

@@ -84,3 +84,27 @@ fn bad_scene_path_is_an_error_naming_the_file() {
         .to_string();
     assert!(e.contains("no/such/scene.toml"), "{e}");
 }
+
+/// `bench --lookup`: one row per width with positive, finite times for the three lookups;
+/// even or out-of-range widths are errors naming the width. (The times themselves are the
+/// benchmark's business, not a test's.)
+#[test]
+fn lookup_benchmark_reports_every_width() {
+    let g = common::gpu();
+    let rows = shadowgraph::bench::lookup_cost(&g, &[3, 9], 1).expect("lookup bench");
+    assert_eq!(rows.iter().map(|r| r.width).collect::<Vec<_>>(), vec![3, 9]);
+    for r in &rows {
+        for v in [r.pcf_ms, r.sat_fixed_ms, r.sat_float_ms] {
+            assert!(v.is_finite() && v > 0.0, "{r:?}");
+        }
+    }
+    let table = shadowgraph::bench::format_lookup_table("test", true, 1, &rows);
+    assert!(
+        table.contains("   3²") && table.contains("   9²"),
+        "{table}"
+    );
+    for bad in [4, 0, 67] {
+        let e = shadowgraph::bench::lookup_cost(&g, &[bad], 1).expect_err("bad width");
+        assert!(e.to_string().contains(&format!("width {bad}")), "{e}");
+    }
+}
