@@ -1,17 +1,25 @@
 // The thin shading pass: Lambert + ambient over the G-buffer, one visibility function per
 // light's technique. The `// #generated` block binds each light's maps (group 1) and defines
-// `light_visibility(i, p, n)`, calling only the techniques the scene uses.
+// `light_visibility(i, p, n, dpdx, dpdy)`, calling only the techniques the scene uses.
 // #import shared/light
 
 // Keep in sync with `FrameGpu` in src/render.rs.
 struct Frame {
     size: vec2<u32>,
     light_count: u32,
-    _pad0: u32,
+    has_camera: u32,         // 1: the ray fields below hold the camera (else footprints are 0)
     ambient: vec3<f32>,
     _pad1: f32,
     background: vec3<f32>,
     _pad2: f32,
+    camera: vec3<f32>,       // eye position
+    _pad3: f32,
+    ray00: vec3<f32>,        // unnormalized view ray through pixel corner (0, 0) ...
+    _pad4: f32,
+    ray_dx: vec3<f32>,       // ... plus (x + ½)·ray_dx + (y + ½)·ray_dy through pixel (x, y)
+    _pad5: f32,
+    ray_dy: vec3<f32>,
+    _pad6: f32,
 }
 
 @group(0) @binding(0) var g_position: texture_2d<f32>;
@@ -30,6 +38,32 @@ const WG_SIZE: u32 = 8u;
 fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
     let x = clamp(c, vec3<f32>(0.0), vec3<f32>(1.0));
     return select(1.055 * pow(x, vec3<f32>(1.0 / 2.4)) - 0.055, 12.92 * x, x <= vec3<f32>(0.0031308));
+}
+
+// How far the receiver p (normal n) seen through pixel xy moves to the next pixel in x and in
+// y: ray differentials on the receiver's tangent plane, p(x) = eye + t(x)·d(x) with
+// t = (p − eye)·n / (d·n), so dp/dx = t·(d_x − d·(d_x·n)/(d·n)). Grazing views (|d·n| below
+// 10⁻³|d|) are held at that slope. Zero without a camera (the probe).
+struct Differentials {
+    dpdx: vec3<f32>,
+    dpdy: vec3<f32>,
+}
+
+fn pixel_differentials(xy: vec2<u32>, p: vec3<f32>, n: vec3<f32>) -> Differentials {
+    var out: Differentials;
+    out.dpdx = vec3<f32>(0.0);
+    out.dpdy = vec3<f32>(0.0);
+    if frame.has_camera == 0u {
+        return out;
+    }
+    let d = frame.ray00 + (f32(xy.x) + 0.5) * frame.ray_dx + (f32(xy.y) + 0.5) * frame.ray_dy;
+    let dn0 = dot(d, n);
+    let floor = 1e-3 * length(d);
+    let dn = select(min(dn0, -floor), max(dn0, floor), dn0 >= 0.0);
+    let t = dot(p - frame.camera, n) / dn;
+    out.dpdx = t * (frame.ray_dx - d * (dot(frame.ray_dx, n) / dn));
+    out.dpdy = t * (frame.ray_dy - d * (dot(frame.ray_dy, n) / dn));
+    return out;
 }
 
 // Spot lights light only their cone (soft edge over the outer 10% of the angle).
@@ -55,9 +89,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let n = select(normalize(gn.xyz), vec3<f32>(0.0, 1.0, 0.0), background || dot(gn.xyz, gn.xyz) == 0.0);
     let albedo = materials[min(u32(gn.w), arrayLength(&materials) - 1u)].rgb;
     var radiance = frame.ambient * albedo;
+    let dp = pixel_differentials(xy, gp.xyz, n);
     for (var i = 0u; i < frame.light_count; i++) {
         let l = lights[i];
-        let v = select(light_visibility(i, gp.xyz, n), 1.0, background);
+        let v = select(light_visibility(i, gp.xyz, n, dp.dpdx, dp.dpdy), 1.0, background);
         if inside {
             out_visibility[base + i] = v;
         }

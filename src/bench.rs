@@ -183,7 +183,10 @@ fn msm_mips() -> Technique {
     Technique::Msm {
         prefilter: Prefilter {
             storage: Storage::F32,
-            filter: Filter::Mips { width: 1.0 },
+            filter: Filter::Mips {
+                width: 1.0,
+                max_anisotropy: 0,
+            },
         },
         hausdorff: false,
         moment_bias: 1e-5,

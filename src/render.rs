@@ -4,6 +4,7 @@
 
 use std::collections::HashMap;
 
+use bytemuck::Zeroable;
 use glam::Vec3;
 use wgpu::util::DeviceExt;
 
@@ -23,8 +24,8 @@ pub struct FrameGpu {
     pub size: [u32; 2],
     /// Number of lights.
     pub light_count: u32,
-    /// Padding.
-    pub _pad0: u32,
+    /// 1 when the ray fields hold the camera (pixel footprints), 0 for the probe.
+    pub has_camera: u32,
     /// Ambient colour.
     pub ambient: [f32; 3],
     /// Padding.
@@ -33,6 +34,72 @@ pub struct FrameGpu {
     pub background: [f32; 3],
     /// Padding.
     pub _pad2: f32,
+    /// Eye position.
+    pub camera: [f32; 3],
+    /// Padding.
+    pub _pad3: f32,
+    /// Unnormalized view ray through pixel corner (0, 0).
+    pub ray00: [f32; 3],
+    /// Padding.
+    pub _pad4: f32,
+    /// Ray change per pixel in x: pixel (x, y)'s ray is `ray00 + (x + ½)·ray_dx + (y + ½)·ray_dy`.
+    pub ray_dx: [f32; 3],
+    /// Padding.
+    pub _pad5: f32,
+    /// Ray change per pixel in y.
+    pub ray_dy: [f32; 3],
+    /// Padding.
+    pub _pad6: f32,
+}
+
+impl FrameGpu {
+    /// Frame constants for `scene` rendered at `width × height`, with the camera's rays.
+    pub fn new(scene: &Scene, width: u32, height: u32) -> Self {
+        let rays = CameraRays::new(&scene.camera, width, height);
+        Self {
+            size: [width, height],
+            light_count: scene.lights.len() as u32,
+            has_camera: 1,
+            ambient: scene.ambient.to_array(),
+            background: scene.background.to_array(),
+            camera: scene.camera.position.to_array(),
+            ray00: rays.ray00.to_array(),
+            ray_dx: rays.ray_dx.to_array(),
+            ray_dy: rays.ray_dy.to_array(),
+            ..Self::zeroed()
+        }
+    }
+}
+
+/// A pinhole camera's unnormalized view rays as `glam`'s `look_at_rh` and `perspective_rh`
+/// (the G-buffer's projection) make them: forward `f`, right `s = f × up`, up `u = s × f`,
+/// `t = tan(fov_y / 2)`; pixel (x, y) of a `w × h` image sees along
+/// `ray00 + (x + ½)·ray_dx + (y + ½)·ray_dy` with `ray00 = f − t·aspect·s + t·u`,
+/// `ray_dx = 2t·aspect/w · s`, `ray_dy = −2t/h · u`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraRays {
+    /// Ray through pixel corner (0, 0).
+    pub ray00: glam::Vec3,
+    /// Per pixel in x.
+    pub ray_dx: glam::Vec3,
+    /// Per pixel in y.
+    pub ray_dy: glam::Vec3,
+}
+
+impl CameraRays {
+    /// The rays of `camera` for a `width × height` image.
+    pub fn new(camera: &crate::scene::Camera, width: u32, height: u32) -> Self {
+        let f = (camera.target - camera.position).normalize();
+        let s = f.cross(camera.up).normalize();
+        let u = s.cross(f);
+        let t = (0.5 * camera.fov_y_degrees.to_radians()).tan();
+        let aspect = width as f32 / height as f32;
+        Self {
+            ray00: f - t * aspect * s + t * u,
+            ray_dx: (2.0 * t * aspect / width as f32) * s,
+            ray_dy: (-2.0 * t / height as f32) * u,
+        }
+    }
 }
 
 /// The graph of a scene, its plan, and what the shading pass reads per light.
@@ -526,15 +593,7 @@ impl Renderer {
                 .flat_map(|s| &s.maps)
                 .map(|m| depth_only_view(&outputs.textures[m]))
                 .collect();
-            let frame = FrameGpu {
-                size: [size.0, size.1],
-                light_count: scene.lights.len() as u32,
-                _pad0: 0,
-                ambient: scene.ambient.to_array(),
-                _pad1: 0.0,
-                background: scene.background.to_array(),
-                _pad2: 0.0,
-            };
+            let frame = FrameGpu::new(scene, size.0, size.1);
             let shaded = self.shade(
                 device,
                 &mut enc,
@@ -1095,11 +1154,7 @@ pub fn probe(
     let frame = FrameGpu {
         size: [w, h],
         light_count: lights.len() as u32,
-        _pad0: 0,
-        ambient: [0.0; 3],
-        _pad1: 0.0,
-        background: [0.0; 3],
-        _pad2: 0.0,
+        ..FrameGpu::zeroed()
     };
     let mut enc = device.create_command_encoder(&Default::default());
     let shaded = renderer.shade(

@@ -81,8 +81,9 @@ pub struct LightGpu {
     pub filter_lod: f32,
     /// SAT filter: box width in texels (0 when the filter is not `sat`).
     pub filter_width: f32,
-    /// Padding to the WGSL struct's 16-byte alignment.
-    pub _pad: u32,
+    /// Mips filter: 0 reads a fixed width; ≥ 1 follows the pixel's footprint with up to this
+    /// many trilinear taps along its major axis.
+    pub max_anisotropy: u32,
     /// SAT filter: the table's per-channel offset ([`SatCoding::offset`]).
     pub sat_offset: [f32; 4],
     /// SAT filter: the table's per-channel scale ([`SatCoding::scale`]).
@@ -167,12 +168,16 @@ impl LightGpu {
             } => (terms, attenuation, offset, scale),
             _ => (0, 0.0, 0.0, 1.0),
         };
-        let (mip_levels, filter_lod) = match light.shadow.technique.filter() {
-            Some(Filter::Mips { width }) => (
+        let (mip_levels, filter_lod, max_anisotropy) = match light.shadow.technique.filter() {
+            Some(Filter::Mips {
+                width,
+                max_anisotropy,
+            }) => (
                 mip_levels(light.shadow_map, light.shadow_map),
                 width.max(1.0).log2(),
+                max_anisotropy,
             ),
-            _ => (0, 0.0),
+            _ => (0, 0.0, 0),
         };
         let (kind, cos_outer) = match light.kind {
             LightKind::Directional { .. } => (0, -1.0),
@@ -213,7 +218,7 @@ impl LightGpu {
             mip_levels,
             filter_lod,
             filter_width: 0.0,
-            _pad: 0,
+            max_anisotropy,
             sat_offset: [0.0; 4],
             sat_scale: [1.0; 4],
         }
@@ -701,9 +706,16 @@ pub fn shading_block(lights: &[Light]) -> String {
             functions,
             "fn light{i}_visibility(l: Light, s: LightSample) -> f32 {{\n    {body}\n}}"
         );
+        // Only anisotropic mip lookups read the footprint (two more projections per pixel).
+        let footprint = match light.shadow.technique.filter() {
+            Some(Filter::Mips { max_anisotropy, .. }) if max_anisotropy > 0 => {
+                "\n            s.footprint = light_footprint(l, s, p, n, dpdx, dpdy);"
+            }
+            _ => "",
+        };
         let _ = writeln!(
             cases,
-            "        case {i}u: {{\n            let l = lights[{i}];\n            let s = light_sample(l, p, n);\n            return select(1.0, light{i}_visibility(l, s), s.inside);\n        }}"
+            "        case {i}u: {{\n            let l = lights[{i}];\n            var s = light_sample(l, p, n);{footprint}\n            return select(1.0, light{i}_visibility(l, s), s.inside);\n        }}"
         );
     }
     let mut s = String::new();
@@ -714,7 +726,7 @@ pub fn shading_block(lights: &[Light]) -> String {
     s.push_str(&functions);
     let _ = write!(
         s,
-        "fn light_visibility(i: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {{\n    switch i {{\n{cases}        default: {{ return 1.0; }}\n    }}\n}}\n"
+        "fn light_visibility(i: u32, p: vec3<f32>, n: vec3<f32>, dpdx: vec3<f32>, dpdy: vec3<f32>) -> f32 {{\n    switch i {{\n{cases}        default: {{ return 1.0; }}\n    }}\n}}\n"
     );
     s
 }

@@ -72,13 +72,19 @@ fn all_techniques() -> Vec<Technique> {
             min_variance: 1e-4,
         },
         Technique::Esm {
-            filter: Filter::Mips { width: 4.0 },
+            filter: Filter::Mips {
+                width: 4.0,
+                max_anisotropy: 0,
+            },
             exponent: 80.0,
         },
         Technique::Msm {
             prefilter: Prefilter {
                 storage: Storage::Unorm16,
-                filter: Filter::Mips { width: 2.0 },
+                filter: Filter::Mips {
+                    width: 2.0,
+                    max_anisotropy: 0,
+                },
             },
             hausdorff: true,
             moment_bias: 6e-5,

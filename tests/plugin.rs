@@ -198,25 +198,48 @@ const HOST_PROBE: &str = "
 @group(0) @binding(1) var<storage, read> positions: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read> normals: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> visibility: array<f32>;
+@group(0) @binding(4) var<storage, read> differentials: array<vec4<f32>>;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= arrayLength(&visibility) {
         return;
     }
-    visibility[id.x] = shadowgraph_visibility(light, positions[id.x].xyz,
-                                              normalize(normals[id.x].xyz));
+    visibility[id.x] = shadowgraph_visibility_footprint(light, positions[id.x].xyz,
+        normalize(normals[id.x].xyz), differentials[2u * id.x].xyz, differentials[2u * id.x + 1u].xyz);
 }
 ";
 
-/// Visibility at every pixel of `frame` (its G-buffer) through the host's WGSL.
+/// Visibility at every pixel of `frame` (its G-buffer) through the host's WGSL, each pixel
+/// with its footprint (`cpu::shade::pixel_differentials` of `scene`'s camera, as a fragment
+/// shader's dpdx/dpdy would give it).
 fn host_visibility(
     g: &Gpu,
     stage: &mut Prefilter,
     depth: &wgpu::Texture,
     light: &LightParams,
     frame: &Frame,
+    scene: &Scene,
 ) -> Vec<f32> {
+    let rays = shadowgraph::render::CameraRays::new(&scene.camera, frame.width, frame.height);
+    let eye = scene.camera.position.as_dvec3();
+    let mut diffs = Vec::with_capacity(8 * (frame.width * frame.height) as usize);
+    for y in 0..frame.height {
+        for x in 0..frame.width {
+            let i = 4 * (y * frame.width + x) as usize;
+            let p = glam::Vec3::from_slice(&frame.position[i..i + 3]).as_dvec3();
+            let n = glam::Vec3::from_slice(&frame.normal[i..i + 3]).as_dvec3();
+            let n = if n.length() > 0.0 {
+                n.normalize()
+            } else {
+                glam::DVec3::Y
+            };
+            let (dx, dy) = shadowgraph::cpu::shade::pixel_differentials(eye, &rays, x, y, p, n);
+            for v in [dx, dy] {
+                diffs.extend([v.x as f32, v.y as f32, v.z as f32, 0.0]);
+            }
+        }
+    }
     let d = &g.device;
     let wgsl = format!("{}{HOST_PROBE}", stage.wgsl(1, 0).expect("host WGSL"));
     let kernel = ComputeKernel::new(d, "host_probe", &wgsl).expect("host probe compiles");
@@ -237,6 +260,7 @@ fn host_visibility(
     });
     let pos = storage(&frame.position, wgpu::BufferUsages::STORAGE);
     let nor = storage(&frame.normal, wgpu::BufferUsages::STORAGE);
+    let dif = storage(&diffs, wgpu::BufferUsages::STORAGE);
     let vis = storage(
         &vec![-1.0; n],
         wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
@@ -260,6 +284,10 @@ fn host_visibility(
             wgpu::BindGroupEntry {
                 binding: 3,
                 resource: vis.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 4,
+                resource: dif.as_entire_binding(),
             },
         ],
     });
@@ -407,7 +435,7 @@ fn stage_outputs_equal_the_renderers() {
                 "{what}: stage map differs at {n} values (worst {worst:e})"
             );
 
-            let vis = host_visibility(&g, &mut stage, &depth, &params, &frame);
+            let vis = host_visibility(&g, &mut stage, &depth, &params, &frame, &scene);
             let (mut covered, mut off, mut total) = (0, 0, 0.0f64);
             for (px, v) in vis.iter().enumerate() {
                 if frame.position[4 * px + 3] == 0.0 {

@@ -548,7 +548,10 @@ fn mip_chain_matches_reference_and_ends_at_the_mean() {
             &mut graph,
             0,
             "in",
-            &Filter::Mips { width: 1.0 },
+            &Filter::Mips {
+                width: 1.0,
+                max_anisotropy: 0,
+            },
             mode,
         );
         let gpu = run_levels(
@@ -620,7 +623,10 @@ fn mip_chain_of_16_bit_maps_matches_reference() {
             w,
             h,
             format,
-            Some(Filter::Mips { width: 1.0 }),
+            Some(Filter::Mips {
+                width: 1.0,
+                max_anisotropy: 0,
+            }),
             BlurMode::Linear,
         );
         let gpu = run_levels(
@@ -682,7 +688,10 @@ fn plans_hold_exactly_what_each_light_needs() {
     let msm = Technique::Msm {
         prefilter: Prefilter {
             storage: Storage::F16,
-            filter: Filter::Mips { width: 2.0 },
+            filter: Filter::Mips {
+                width: 2.0,
+                max_anisotropy: 0,
+            },
         },
         hausdorff: false,
         moment_bias: 5e-4,

@@ -950,3 +950,35 @@ fn sat_filter_clamps_exponents() {
         s.warnings
     );
 }
+
+/// `max_anisotropy` belongs to the mips filter, 0–16.
+#[test]
+fn max_anisotropy_key() {
+    use shadowgraph::scene::Filter;
+    let text = scene_with(&[(
+        "technique = \"hard\"",
+        "technique = \"vsm\"\nfilter = \"blur\"\nmax_anisotropy = 4",
+    )]);
+    expect(
+        &text,
+        "max_anisotropy",
+        &["light[0].shadow.max_anisotropy", "mips"],
+    );
+    let text = scene_with(&[(
+        "technique = \"hard\"",
+        "technique = \"vsm\"\nfilter = \"mips\"\nmax_anisotropy = 17",
+    )]);
+    expect(&text, "max_anisotropy", &["light[0].shadow.max_anisotropy"]);
+    let text = scene_with(&[(
+        "technique = \"hard\"",
+        "technique = \"esm\"\nfilter = \"mips\"\nfilter_width = 2.0\nmax_anisotropy = 16",
+    )]);
+    let s = parse(&text).expect("parses");
+    assert_eq!(
+        s.lights[0].shadow.technique.filter(),
+        Some(Filter::Mips {
+            width: 2.0,
+            max_anisotropy: 16
+        })
+    );
+}

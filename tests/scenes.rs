@@ -39,17 +39,28 @@ fn pixel_reference(
     let lg = LightGpu::new(light);
     let p = &frame.position[4 * px..4 * px + 3];
     let n = &frame.normal[4 * px..4 * px + 3];
-    let s = cpu::light::sample(
-        &lg,
-        glam::DVec3::new(p[0].into(), p[1].into(), p[2].into()),
-        glam::DVec3::new(n[0].into(), n[1].into(), n[2].into()).normalize(),
-    );
+    let p = glam::DVec3::new(p[0].into(), p[1].into(), p[2].into());
+    let n = glam::DVec3::new(n[0].into(), n[1].into(), n[2].into()).normalize();
+    let mut s = cpu::light::sample(&lg, p, n);
+    if lg.max_anisotropy > 0 {
+        // The pixel's footprint, as the shading kernel derives it from the camera's rays.
+        let rays = shadowgraph::render::CameraRays::new(&scene.camera, frame.width, frame.height);
+        let (x, y) = (px as u32 % frame.width, px as u32 / frame.width);
+        let eye = scene.camera.position.as_dvec3();
+        let (dx, dy) = cpu::shade::pixel_differentials(eye, &rays, x, y, p, n);
+        s.footprint = cpu::light::footprint(&lg, &s, p, n, dx, dy);
+        // Where the tap count sits at a ceiling's step, f32 and f64 may take different counts.
+        let ratio = cpu::mips::mip_taps(&lg, &s).ratio;
+        if (ratio - ratio.round()).abs() < 1e-3 * ratio.max(1.0) {
+            return None;
+        }
+    }
     let size = light.shadow_map as usize;
     let map = Map {
         size,
         texels: &frame.shade_maps[li].data,
     };
-    common::robust(&s, size, |t| {
+    let vis = |t: &cpu::light::LightSample| {
         if !t.inside {
             return 1.0;
         }
@@ -67,8 +78,8 @@ fn pixel_reference(
             Technique::Msm { .. } => cpu::vis_msm::vis_msm(moments, &lg, t),
             Technique::Csm { .. } => cpu::vis_csm::vis_csm(moments, &lg, t),
         }
-    })
-    .map(|v| {
+    };
+    common::robust(&s, size, vis).map(|v| {
         let tolerance = match light.shadow.technique {
             // Vulkan allows 8-bit bilinear weights: each of four may be off by 2⁻⁸.
             Technique::Pcf {
@@ -85,6 +96,30 @@ fn pixel_reference(
             Technique::Csm { .. } => common::csm_tolerance(&lg),
             // Means of 0/1 taps in f32.
             _ => 1e-5,
+        };
+        // The GPU's footprint is a difference of f32 UVs times the map size: 2⁻²⁴ · 1024 ≈
+        // 6·10⁻⁵ texels on an axis of a texel or more, so up to about 10⁻⁴ relative. It moves
+        // the taps' level and spacing: add twice the reference's change under a ±2·10⁻⁴ scaling
+        // of the footprint, and 8 f32 roundings per tap for the taps' running mean.
+        let tolerance = if lg.max_anisotropy > 0 {
+            let spread = [1.0 - 2e-4, 1.0 + 2e-4]
+                .iter()
+                .map(|k| {
+                    let mut t = s;
+                    t.footprint = s.footprint.map(|f| f * k);
+                    (vis(&t) - v).abs()
+                })
+                .fold(0.0, f64::max);
+            let taps = f64::from(cpu::mips::mip_taps(&lg, &s).count);
+            // ESM's running log-sum-exp re-rounds the logarithm (|L| ≤ c) at every tap: 8 ULP
+            // of c, relative in the visibility.
+            let esm_logs = match light.shadow.technique {
+                Technique::Esm { exponent, .. } => 8.0 * 2f64.powi(-23) * f64::from(exponent) * v,
+                _ => 0.0,
+            };
+            tolerance + 2.0 * spread + taps * 8.0 * 2f64.powi(-23) * v + esm_logs
+        } else {
+            tolerance
         };
         (v, tolerance)
     })
@@ -436,7 +471,13 @@ fn every_technique_renders_every_bundled_scene() {
             max_search: 0.05,
         },
         Technique::Vsm {
-            prefilter: pre(Storage::F16, Filter::Mips { width: 2.0 }),
+            prefilter: pre(
+                Storage::F16,
+                Filter::Mips {
+                    width: 2.0,
+                    max_anisotropy: 0,
+                },
+            ),
             bleed: 0.2,
             min_variance: 1e-5,
         },
@@ -449,7 +490,10 @@ fn every_technique_renders_every_bundled_scene() {
             min_variance: 1e-4,
         },
         Technique::Esm {
-            filter: Filter::Mips { width: 3.0 },
+            filter: Filter::Mips {
+                width: 3.0,
+                max_anisotropy: 0,
+            },
             exponent: 80.0,
         },
         Technique::Msm {
@@ -459,7 +503,13 @@ fn every_technique_renders_every_bundled_scene() {
             bleed: 0.0,
         },
         Technique::Msm {
-            prefilter: pre(Storage::F16, Filter::Mips { width: 1.5 }),
+            prefilter: pre(
+                Storage::F16,
+                Filter::Mips {
+                    width: 1.5,
+                    max_anisotropy: 0,
+                },
+            ),
             hausdorff: true,
             moment_bias: 5e-4,
             bleed: 0.0,

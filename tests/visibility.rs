@@ -436,7 +436,10 @@ fn csm_matches_reference_for_odd_and_even_terms() {
 #[test]
 fn mip_filtered_lookups_match_reference_trilinearly() {
     // A width of 2.6 texels samples between levels 1 and 2 of the chain.
-    let mips = Filter::Mips { width: 2.6 };
+    let mips = Filter::Mips {
+        width: 2.6,
+        max_anisotropy: 0,
+    };
     let vsm = Technique::Vsm {
         prefilter: shadowgraph::scene::Prefilter {
             storage: Storage::F32,

@@ -32,13 +32,13 @@
 //   fn vis_msm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32
 //
 // Names defined here (a host must not reuse them):
-//   CSM_PI GOLDEN_ANGLE Light LightSample MSM_B0 bilinear_level bilinear_log_level
-//   chebyshev_upper csm_chunk csm_chunk_of csm_resolve csm_sin_cos light_linear_to_ndc
-//   light_linear_to_z light_map_width light_sample light_to_light linstep load_depth
-//   msm_dequantize msm_intensity msm_quantize pcss_search_radius sample_bilinear
-//   sample_bilinear_log sample_map sample_map_log texel_of vis_esm vis_esm_of_log vis_esm_of_sat
-//   vis_evsm vis_evsm_of vis_hard vis_msm vis_msm_of vis_pcf vis_pcf_hardware vis_pcss vis_vsm
-//   vis_vsm_of vogel_disc
+//   CSM_PI GOLDEN_ANGLE Light LightSample MSM_B0 MipTaps bilinear_level bilinear_log_level
+//   chebyshev_upper csm_chunk csm_chunk_of csm_resolve csm_sin_cos level_size light_footprint
+//   light_linear_to_ndc light_linear_to_z light_map_width light_sample light_to_light linstep
+//   load_depth mip_tap_uv mip_taps msm_dequantize msm_intensity msm_quantize pcss_search_radius
+//   sample_bilinear sample_bilinear_log sample_map sample_map_log texel_of trilinear
+//   trilinear_log vis_esm vis_esm_of_log vis_esm_of_sat vis_evsm vis_evsm_of vis_hard vis_msm
+//   vis_msm_of vis_pcf vis_pcf_hardware vis_pcss vis_vsm vis_vsm_of vogel_disc
 
 // Shared light description and light-space helpers (import-only module).
 //
@@ -82,7 +82,7 @@ struct Light {
     mip_levels: u32,         // mips filter: levels in the map's chain (0: no mips)
     filter_lod: f32,         // mips filter: log2 of the filter width in texels
     filter_width: f32,       // sat filter: box width in texels (0: no sat)
-    _pad0: u32,
+    max_anisotropy: u32,     // mips filter: 0 fixed width; ≥ 1 per-pixel footprint, up to this many taps
     sat_offset: vec4<f32>,   // sat filter: the table's coding (SatCoding in src/sat.rs)
     sat_scale: vec4<f32>,
 }
@@ -93,6 +93,7 @@ struct LightSample {
     depth: f32,      // receiver's linear depth d
     view_z: f32,     // receiver's distance Z along the light axis
     inside: bool,    // inside the map and the depth range
+    footprint: vec4<f32>, // the pixel's footprint in the map, texels: axes (x, y) and (z, w); 0 unknown
 }
 
 // World width of the whole map at view distance z.
@@ -125,7 +126,16 @@ fn light_sample(l: Light, p: vec3<f32>, n: vec3<f32>) -> LightSample {
     s.depth = (s.view_z - l.near) / (l.far - l.near);
     s.inside = clip.w > 0.0 && all(s.uv >= vec2<f32>(0.0)) && all(s.uv <= vec2<f32>(1.0))
         && s.depth >= 0.0 && s.depth <= 1.0;
+    s.footprint = vec4<f32>(0.0);
     return s;
+}
+
+// The footprint in light l's map, in texels, of the pixel whose receiver p (normal n) moves by
+// dpdx and dpdy from one pixel to the next: the differences of the projected points.
+fn light_footprint(l: Light, s: LightSample, p: vec3<f32>, n: vec3<f32>, dpdx: vec3<f32>, dpdy: vec3<f32>) -> vec4<f32> {
+    let a = (light_sample(l, p + dpdx, n).uv - s.uv) * l.map_size;
+    let b = (light_sample(l, p + dpdy, n).uv - s.uv) * l.map_size;
+    return vec4<f32>(a, b);
 }
 
 // Linear depth → the depth buffer's value (for the hardware comparison sampler).
@@ -171,9 +181,16 @@ fn sample_bilinear(map: texture_2d<f32>, uv: vec2<f32>) -> vec4<f32> {
     return bilinear_level(map, uv, 0);
 }
 
+// The size of mip `level`, max(1, size >> level), from level 0's: llvmpipe answers
+// textureDimensions(map, level) with one invocation's level when the invocations' levels differ
+// (per-pixel footprints), which sends the others' loads out of range.
+fn level_size(map: texture_2d<f32>, level: i32) -> vec2<f32> {
+    return vec2<f32>(max(textureDimensions(map) >> vec2<u32>(u32(level)), vec2<u32>(1u)));
+}
+
 // `sample_bilinear` on mip `level` (texel centres at (i + ½) / level size).
 fn bilinear_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> vec4<f32> {
-    let size = vec2<f32>(textureDimensions(map, level));
+    let size = level_size(map, level);
     let f = uv * size - 0.5;
     let i = vec2<i32>(floor(f));
     let a = f - floor(f);
@@ -185,16 +202,78 @@ fn bilinear_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> vec4<f32> 
     return mix(mix(t00, t10, a.x), mix(t01, t11, a.x), a.y);
 }
 
-// A light's filtered representation at uv: bilinear, or with the `mips` filter trilinear at
-// level log2(filter width) (clamped to the chain).
-fn sample_map(map: texture_2d<f32>, l: Light, uv: vec2<f32>) -> vec4<f32> {
-    if l.mip_levels <= 1u {
-        return sample_bilinear(map, uv);
-    }
-    let lod = clamp(l.filter_lod, 0.0, f32(l.mip_levels - 1u));
+// Trilinear sample of a mip chain at `lod` (clamped to the chain).
+fn trilinear(map: texture_2d<f32>, l: Light, uv: vec2<f32>, lod_in: f32) -> vec4<f32> {
+    let lod = clamp(lod_in, 0.0, f32(l.mip_levels - 1u));
     let l0 = i32(floor(lod));
     let l1 = min(l0 + 1, i32(l.mip_levels) - 1);
     return mix(bilinear_level(map, uv, l0), bilinear_level(map, uv, l1), lod - floor(lod));
+}
+
+// How a pixel's footprint is read from a mip chain: `count` trilinear taps at `lod`, spaced by
+// `step` (UV) along the footprint's major axis and centred on the receiver.
+struct MipTaps {
+    lod: f32,
+    count: u32,
+    step: vec2<f32>,
+}
+
+// With `max_anisotropy` 0 (or no footprint): one tap at log2(filter width). Otherwise the
+// footprint's axes a, b (texels) give major = max(|a|, |b|), minor = min; the width is
+// w = max(filter width, minor), the taps n = clamp(⌈major / w⌉, 1, max_anisotropy), each at
+// level log2(max(w, major / n)), spaced major / n apart along the major axis.
+fn mip_taps(l: Light, s: LightSample) -> MipTaps {
+    var t: MipTaps;
+    t.lod = l.filter_lod;
+    t.count = 1u;
+    t.step = vec2<f32>(0.0);
+    let la = length(s.footprint.xy);
+    let lb = length(s.footprint.zw);
+    let major = max(la, lb);
+    if l.max_anisotropy == 0u || !(major > 0.0) {
+        return t;
+    }
+    let axis = select(s.footprint.zw, s.footprint.xy, la >= lb);
+    let w = max(exp2(l.filter_lod), min(la, lb));
+    t.count = u32(clamp(ceil(major / w), 1.0, f32(l.max_anisotropy)));
+    let n = f32(t.count);
+    t.lod = log2(max(w, major / n));
+    t.step = axis / (n * l.map_size);
+    return t;
+}
+
+// The UV of tap k of `t` around uv.
+fn mip_tap_uv(t: MipTaps, uv: vec2<f32>, k: u32) -> vec2<f32> {
+    return uv + t.step * (f32(k) + 0.5 - 0.5 * f32(t.count));
+}
+
+// A light's filtered representation at a receiver: bilinear, or with the `mips` filter
+// trilinear at log2(filter width), or along the pixel's footprint (`mip_taps`). The loop runs
+// `max_anisotropy` times for every invocation and weights the taps past `count` by 0: no
+// invocation leaves the loop early (llvmpipe mis-fetches explicit levels under divergence).
+fn sample_map(map: texture_2d<f32>, l: Light, s: LightSample) -> vec4<f32> {
+    if l.mip_levels <= 1u {
+        return sample_bilinear(map, s.uv);
+    }
+    let t = mip_taps(l, s);
+    var sum = trilinear(map, l, mip_tap_uv(t, s.uv, 0u), t.lod);
+    for (var k = 1u; k < l.max_anisotropy; k++) {
+        let v = trilinear(map, l, mip_tap_uv(t, s.uv, k), t.lod);
+        sum += select(vec4<f32>(0.0), v, k < t.count);
+    }
+    return sum / f32(t.count);
+}
+
+// Trilinear sample of a map of logarithms at `lod`, as a logarithm.
+fn trilinear_log(map: texture_2d<f32>, l: Light, uv: vec2<f32>, lod_in: f32) -> f32 {
+    let lod = clamp(lod_in, 0.0, f32(l.mip_levels - 1u));
+    let l0 = i32(floor(lod));
+    let l1 = min(l0 + 1, i32(l.mip_levels) - 1);
+    let v0 = bilinear_log_level(map, uv, l0);
+    let v1 = bilinear_log_level(map, uv, l1);
+    let t = lod - floor(lod);
+    let m = max(v0, v1);
+    return m + log((1.0 - t) * exp(v0 - m) + t * exp(v1 - m));
 }
 
 // linstep(lo, hi, x): the light-bleeding reduction of VSM-family techniques.
@@ -208,24 +287,29 @@ fn sample_bilinear_log(map: texture_2d<f32>, uv: vec2<f32>) -> f32 {
     return bilinear_log_level(map, uv, 0);
 }
 
-// `sample_map` for a map of logarithms: the same weights applied to exp(v), as a logarithm.
-fn sample_map_log(map: texture_2d<f32>, l: Light, uv: vec2<f32>) -> f32 {
+// `sample_map` for a map of logarithms: the same weights applied to exp(v), as a logarithm
+// (taps combined around the largest so far, so nothing overflows).
+fn sample_map_log(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     if l.mip_levels <= 1u {
-        return sample_bilinear_log(map, uv);
+        return sample_bilinear_log(map, s.uv);
     }
-    let lod = clamp(l.filter_lod, 0.0, f32(l.mip_levels - 1u));
-    let l0 = i32(floor(lod));
-    let l1 = min(l0 + 1, i32(l.mip_levels) - 1);
-    let v0 = bilinear_log_level(map, uv, l0);
-    let v1 = bilinear_log_level(map, uv, l1);
-    let t = lod - floor(lod);
-    let m = max(v0, v1);
-    return m + log((1.0 - t) * exp(v0 - m) + t * exp(v1 - m));
+    let t = mip_taps(l, s);
+    // A running log-sum-exp: m the largest tap so far, sum = Σ exp(tap − m).
+    var m = trilinear_log(map, l, mip_tap_uv(t, s.uv, 0u), t.lod);
+    var sum = 1.0;
+    for (var k = 1u; k < l.max_anisotropy; k++) {
+        let v = trilinear_log(map, l, mip_tap_uv(t, s.uv, k), t.lod);
+        let on = k < t.count;
+        let m2 = select(m, max(m, v), on);
+        sum = sum * exp(m - m2) + select(0.0, exp(v - m2), on);
+        m = m2;
+    }
+    return m + log(sum / f32(t.count));
 }
 
 // `sample_bilinear_log` on mip `level`.
 fn bilinear_log_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> f32 {
-    let size = vec2<f32>(textureDimensions(map, level));
+    let size = level_size(map, level);
     let f = uv * size - 0.5;
     let i = vec2<i32>(floor(f));
     let a = f - floor(f);
@@ -312,7 +396,7 @@ fn vis_pcss(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
 // then the light-bleeding reduction linstep(bleed, 1, p_max).
 
 fn vis_vsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    return vis_vsm_of(sample_map(map, l, s.uv), l, s);
+    return vis_vsm_of(sample_map(map, l, s), l, s);
 }
 
 // The bound from filtered moments `m` however they were filtered (the `sat` filter calls this
@@ -341,7 +425,7 @@ fn chebyshev_upper(mean: f32, mean_sq: f32, receiver: f32, floor: f32) -> f32 {
 }
 
 fn vis_evsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    return vis_evsm_of(sample_map(map, l, s.uv), l, s);
+    return vis_evsm_of(sample_map(map, l, s), l, s);
 }
 
 // The bounds from filtered moments `m` however they were filtered.
@@ -361,7 +445,7 @@ fn vis_evsm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
 // moment kept as its logarithm L, so the product is exp(L − c d) and never overflows.
 
 fn vis_esm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    return vis_esm_of_log(sample_map_log(map, l, s.uv), l, s);
+    return vis_esm_of_log(sample_map_log(map, l, s), l, s);
 }
 
 // The `sat` filter's table sums the moment scaled by exp(−c), m = E[exp(c (z − 1))]: its log
@@ -453,7 +537,7 @@ fn msm_intensity(b: vec4<f32>, d: f32, hausdorff: bool) -> f32 {
 }
 
 fn vis_msm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    return vis_msm_of(sample_map(map, l, s.uv), l, s);
+    return vis_msm_of(sample_map(map, l, s), l, s);
 }
 
 // Visibility from filtered (possibly quantized) moments `m` however they were filtered.
@@ -490,7 +574,7 @@ fn csm_sin_cos(k: u32, x: f32) -> vec2<f32> {
 
 // Terms 2·chunk + 1 and 2·chunk + 2 (those ≤ M) of the series at this receiver.
 fn csm_chunk(map: texture_2d<f32>, chunk: u32, l: Light, s: LightSample) -> f32 {
-    return csm_chunk_of(sample_map(map, l, s.uv), chunk, l, s);
+    return csm_chunk_of(sample_map(map, l, s), chunk, l, s);
 }
 
 // The same from the chunk's filtered basis values `v` however they were filtered.

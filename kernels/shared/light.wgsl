@@ -40,7 +40,7 @@ struct Light {
     mip_levels: u32,         // mips filter: levels in the map's chain (0: no mips)
     filter_lod: f32,         // mips filter: log2 of the filter width in texels
     filter_width: f32,       // sat filter: box width in texels (0: no sat)
-    _pad0: u32,
+    max_anisotropy: u32,     // mips filter: 0 fixed width; ≥ 1 per-pixel footprint, up to this many taps
     sat_offset: vec4<f32>,   // sat filter: the table's coding (SatCoding in src/sat.rs)
     sat_scale: vec4<f32>,
 }
@@ -51,6 +51,7 @@ struct LightSample {
     depth: f32,      // receiver's linear depth d
     view_z: f32,     // receiver's distance Z along the light axis
     inside: bool,    // inside the map and the depth range
+    footprint: vec4<f32>, // the pixel's footprint in the map, texels: axes (x, y) and (z, w); 0 unknown
 }
 
 // World width of the whole map at view distance z.
@@ -83,7 +84,16 @@ fn light_sample(l: Light, p: vec3<f32>, n: vec3<f32>) -> LightSample {
     s.depth = (s.view_z - l.near) / (l.far - l.near);
     s.inside = clip.w > 0.0 && all(s.uv >= vec2<f32>(0.0)) && all(s.uv <= vec2<f32>(1.0))
         && s.depth >= 0.0 && s.depth <= 1.0;
+    s.footprint = vec4<f32>(0.0);
     return s;
+}
+
+// The footprint in light l's map, in texels, of the pixel whose receiver p (normal n) moves by
+// dpdx and dpdy from one pixel to the next: the differences of the projected points.
+fn light_footprint(l: Light, s: LightSample, p: vec3<f32>, n: vec3<f32>, dpdx: vec3<f32>, dpdy: vec3<f32>) -> vec4<f32> {
+    let a = (light_sample(l, p + dpdx, n).uv - s.uv) * l.map_size;
+    let b = (light_sample(l, p + dpdy, n).uv - s.uv) * l.map_size;
+    return vec4<f32>(a, b);
 }
 
 // Linear depth → the depth buffer's value (for the hardware comparison sampler).

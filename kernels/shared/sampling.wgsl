@@ -29,9 +29,16 @@ fn sample_bilinear(map: texture_2d<f32>, uv: vec2<f32>) -> vec4<f32> {
     return bilinear_level(map, uv, 0);
 }
 
+// The size of mip `level`, max(1, size >> level), from level 0's: llvmpipe answers
+// textureDimensions(map, level) with one invocation's level when the invocations' levels differ
+// (per-pixel footprints), which sends the others' loads out of range.
+fn level_size(map: texture_2d<f32>, level: i32) -> vec2<f32> {
+    return vec2<f32>(max(textureDimensions(map) >> vec2<u32>(u32(level)), vec2<u32>(1u)));
+}
+
 // `sample_bilinear` on mip `level` (texel centres at (i + ½) / level size).
 fn bilinear_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> vec4<f32> {
-    let size = vec2<f32>(textureDimensions(map, level));
+    let size = level_size(map, level);
     let f = uv * size - 0.5;
     let i = vec2<i32>(floor(f));
     let a = f - floor(f);
@@ -43,16 +50,78 @@ fn bilinear_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> vec4<f32> 
     return mix(mix(t00, t10, a.x), mix(t01, t11, a.x), a.y);
 }
 
-// A light's filtered representation at uv: bilinear, or with the `mips` filter trilinear at
-// level log2(filter width) (clamped to the chain).
-fn sample_map(map: texture_2d<f32>, l: Light, uv: vec2<f32>) -> vec4<f32> {
-    if l.mip_levels <= 1u {
-        return sample_bilinear(map, uv);
-    }
-    let lod = clamp(l.filter_lod, 0.0, f32(l.mip_levels - 1u));
+// Trilinear sample of a mip chain at `lod` (clamped to the chain).
+fn trilinear(map: texture_2d<f32>, l: Light, uv: vec2<f32>, lod_in: f32) -> vec4<f32> {
+    let lod = clamp(lod_in, 0.0, f32(l.mip_levels - 1u));
     let l0 = i32(floor(lod));
     let l1 = min(l0 + 1, i32(l.mip_levels) - 1);
     return mix(bilinear_level(map, uv, l0), bilinear_level(map, uv, l1), lod - floor(lod));
+}
+
+// How a pixel's footprint is read from a mip chain: `count` trilinear taps at `lod`, spaced by
+// `step` (UV) along the footprint's major axis and centred on the receiver.
+struct MipTaps {
+    lod: f32,
+    count: u32,
+    step: vec2<f32>,
+}
+
+// With `max_anisotropy` 0 (or no footprint): one tap at log2(filter width). Otherwise the
+// footprint's axes a, b (texels) give major = max(|a|, |b|), minor = min; the width is
+// w = max(filter width, minor), the taps n = clamp(⌈major / w⌉, 1, max_anisotropy), each at
+// level log2(max(w, major / n)), spaced major / n apart along the major axis.
+fn mip_taps(l: Light, s: LightSample) -> MipTaps {
+    var t: MipTaps;
+    t.lod = l.filter_lod;
+    t.count = 1u;
+    t.step = vec2<f32>(0.0);
+    let la = length(s.footprint.xy);
+    let lb = length(s.footprint.zw);
+    let major = max(la, lb);
+    if l.max_anisotropy == 0u || !(major > 0.0) {
+        return t;
+    }
+    let axis = select(s.footprint.zw, s.footprint.xy, la >= lb);
+    let w = max(exp2(l.filter_lod), min(la, lb));
+    t.count = u32(clamp(ceil(major / w), 1.0, f32(l.max_anisotropy)));
+    let n = f32(t.count);
+    t.lod = log2(max(w, major / n));
+    t.step = axis / (n * l.map_size);
+    return t;
+}
+
+// The UV of tap k of `t` around uv.
+fn mip_tap_uv(t: MipTaps, uv: vec2<f32>, k: u32) -> vec2<f32> {
+    return uv + t.step * (f32(k) + 0.5 - 0.5 * f32(t.count));
+}
+
+// A light's filtered representation at a receiver: bilinear, or with the `mips` filter
+// trilinear at log2(filter width), or along the pixel's footprint (`mip_taps`). The loop runs
+// `max_anisotropy` times for every invocation and weights the taps past `count` by 0: no
+// invocation leaves the loop early (llvmpipe mis-fetches explicit levels under divergence).
+fn sample_map(map: texture_2d<f32>, l: Light, s: LightSample) -> vec4<f32> {
+    if l.mip_levels <= 1u {
+        return sample_bilinear(map, s.uv);
+    }
+    let t = mip_taps(l, s);
+    var sum = trilinear(map, l, mip_tap_uv(t, s.uv, 0u), t.lod);
+    for (var k = 1u; k < l.max_anisotropy; k++) {
+        let v = trilinear(map, l, mip_tap_uv(t, s.uv, k), t.lod);
+        sum += select(vec4<f32>(0.0), v, k < t.count);
+    }
+    return sum / f32(t.count);
+}
+
+// Trilinear sample of a map of logarithms at `lod`, as a logarithm.
+fn trilinear_log(map: texture_2d<f32>, l: Light, uv: vec2<f32>, lod_in: f32) -> f32 {
+    let lod = clamp(lod_in, 0.0, f32(l.mip_levels - 1u));
+    let l0 = i32(floor(lod));
+    let l1 = min(l0 + 1, i32(l.mip_levels) - 1);
+    let v0 = bilinear_log_level(map, uv, l0);
+    let v1 = bilinear_log_level(map, uv, l1);
+    let t = lod - floor(lod);
+    let m = max(v0, v1);
+    return m + log((1.0 - t) * exp(v0 - m) + t * exp(v1 - m));
 }
 
 // linstep(lo, hi, x): the light-bleeding reduction of VSM-family techniques.
@@ -66,24 +135,29 @@ fn sample_bilinear_log(map: texture_2d<f32>, uv: vec2<f32>) -> f32 {
     return bilinear_log_level(map, uv, 0);
 }
 
-// `sample_map` for a map of logarithms: the same weights applied to exp(v), as a logarithm.
-fn sample_map_log(map: texture_2d<f32>, l: Light, uv: vec2<f32>) -> f32 {
+// `sample_map` for a map of logarithms: the same weights applied to exp(v), as a logarithm
+// (taps combined around the largest so far, so nothing overflows).
+fn sample_map_log(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     if l.mip_levels <= 1u {
-        return sample_bilinear_log(map, uv);
+        return sample_bilinear_log(map, s.uv);
     }
-    let lod = clamp(l.filter_lod, 0.0, f32(l.mip_levels - 1u));
-    let l0 = i32(floor(lod));
-    let l1 = min(l0 + 1, i32(l.mip_levels) - 1);
-    let v0 = bilinear_log_level(map, uv, l0);
-    let v1 = bilinear_log_level(map, uv, l1);
-    let t = lod - floor(lod);
-    let m = max(v0, v1);
-    return m + log((1.0 - t) * exp(v0 - m) + t * exp(v1 - m));
+    let t = mip_taps(l, s);
+    // A running log-sum-exp: m the largest tap so far, sum = Σ exp(tap − m).
+    var m = trilinear_log(map, l, mip_tap_uv(t, s.uv, 0u), t.lod);
+    var sum = 1.0;
+    for (var k = 1u; k < l.max_anisotropy; k++) {
+        let v = trilinear_log(map, l, mip_tap_uv(t, s.uv, k), t.lod);
+        let on = k < t.count;
+        let m2 = select(m, max(m, v), on);
+        sum = sum * exp(m - m2) + select(0.0, exp(v - m2), on);
+        m = m2;
+    }
+    return m + log(sum / f32(t.count));
 }
 
 // `sample_bilinear_log` on mip `level`.
 fn bilinear_log_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> f32 {
-    let size = vec2<f32>(textureDimensions(map, level));
+    let size = level_size(map, level);
     let f = uv * size - 0.5;
     let i = vec2<i32>(floor(f));
     let a = f - floor(f);

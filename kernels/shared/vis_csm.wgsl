@@ -12,7 +12,7 @@
 
 // Terms 2·chunk + 1 and 2·chunk + 2 (those ≤ M) of the series at this receiver.
 fn csm_chunk(map: texture_2d<f32>, chunk: u32, l: Light, s: LightSample) -> f32 {
-    return csm_chunk_of(sample_map(map, l, s.uv), chunk, l, s);
+    return csm_chunk_of(sample_map(map, l, s), chunk, l, s);
 }
 
 // The same from the chunk's filtered basis values `v` however they were filtered.

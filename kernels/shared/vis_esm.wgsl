@@ -4,7 +4,7 @@
 // #import shared/sampling
 
 fn vis_esm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    return vis_esm_of_log(sample_map_log(map, l, s.uv), l, s);
+    return vis_esm_of_log(sample_map_log(map, l, s), l, s);
 }
 
 // The `sat` filter's table sums the moment scaled by exp(−c), m = E[exp(c (z − 1))]: its log

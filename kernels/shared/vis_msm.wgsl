@@ -58,7 +58,7 @@ fn msm_intensity(b: vec4<f32>, d: f32, hausdorff: bool) -> f32 {
 }
 
 fn vis_msm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    return vis_msm_of(sample_map(map, l, s.uv), l, s);
+    return vis_msm_of(sample_map(map, l, s), l, s);
 }
 
 // Visibility from filtered (possibly quantized) moments `m` however they were filtered.

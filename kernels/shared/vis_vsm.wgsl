@@ -5,7 +5,7 @@
 // #import shared/sampling
 
 fn vis_vsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    return vis_vsm_of(sample_map(map, l, s.uv), l, s);
+    return vis_vsm_of(sample_map(map, l, s), l, s);
 }
 
 // The bound from filtered moments `m` however they were filtered (the `sat` filter calls this

@@ -15,6 +15,8 @@ pub struct LightSample {
     pub view_z: f64,
     /// Inside the map and depth range.
     pub inside: bool,
+    /// The pixel's footprint in the map, texels: axes `[0..2]` and `[2..4]` (0: unknown).
+    pub footprint: [f64; 4],
 }
 
 fn mat(m: &[[f32; 4]; 4]) -> DMat4 {
@@ -61,7 +63,29 @@ pub fn sample(l: &LightGpu, p: DVec3, n: DVec3) -> LightSample {
         depth,
         view_z,
         inside,
+        footprint: [0.0; 4],
     }
+}
+
+/// `light_footprint`: the differences, in texels, of the points `p + dpdx` and `p + dpdy`
+/// projected (with the same normal offset) from `s`, the projection of `p`.
+pub fn footprint(
+    l: &LightGpu,
+    s: &LightSample,
+    p: DVec3,
+    n: DVec3,
+    dpdx: DVec3,
+    dpdy: DVec3,
+) -> [f64; 4] {
+    let size = [f64::from(l.map_size[0]), f64::from(l.map_size[1])];
+    let a = sample(l, p + dpdx, n).uv;
+    let b = sample(l, p + dpdy, n).uv;
+    [
+        (a[0] - s.uv[0]) * size[0],
+        (a[1] - s.uv[1]) * size[1],
+        (b[0] - s.uv[0]) * size[0],
+        (b[1] - s.uv[1]) * size[1],
+    ]
 }
 
 /// `light_linear_to_ndc`.

@@ -2,6 +2,7 @@
 //! `kernels/shared/sampling.wgsl`.
 
 use super::Texels;
+use super::light::LightSample;
 use crate::technique::LightGpu;
 
 /// Weight of texel `i` of an `n_from`-texel axis in texel `j` of its `n_to`-texel reduction:
@@ -71,10 +72,56 @@ pub fn mip_chain(t: &Texels, log: bool) -> Vec<Texels> {
     levels
 }
 
-/// The `(weight, texel)` taps `sample_map` reads at `uv`: bilinear on level 0, or with a mip
-/// chain (`l.mip_levels > 1`) bilinear on the two levels around `l.filter_lod`.
-pub fn taps<'a>(levels: &'a [Texels], l: &LightGpu, uv: [f64; 2]) -> Vec<(f64, &'a [f64])> {
-    let bilinear = |t: &'a Texels, scale: f64| {
+/// How `sample_map` reads a footprint (`mip_taps` in `kernels/shared/sampling.wgsl`):
+/// `count` trilinear taps at `lod`, `step` (UV) apart along the major axis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MipTaps {
+    /// Level.
+    pub lod: f64,
+    /// Taps.
+    pub count: u32,
+    /// UV between taps.
+    pub step: [f64; 2],
+    /// `major / w` before the ceiling (a test skips receivers where it is near an integer,
+    /// where f32 and f64 may take different counts).
+    pub ratio: f64,
+}
+
+/// `mip_taps`: one tap at `log2(filter width)` with `max_anisotropy` 0 or no footprint; else
+/// `n = clamp(⌈major / w⌉, 1, max_anisotropy)` taps at `log2(max(w, major / n))`,
+/// `w = max(filter width, minor)`.
+pub fn mip_taps(l: &LightGpu, s: &LightSample) -> MipTaps {
+    let f = s.footprint;
+    let (la, lb) = (f[0].hypot(f[1]), f[2].hypot(f[3]));
+    let major = la.max(lb);
+    let mut t = MipTaps {
+        lod: f64::from(l.filter_lod),
+        count: 1,
+        step: [0.0; 2],
+        ratio: 1.0,
+    };
+    if l.max_anisotropy == 0 || major <= 0.0 {
+        return t;
+    }
+    let axis = if la >= lb { [f[0], f[1]] } else { [f[2], f[3]] };
+    let w = f64::from(l.filter_lod).exp2().max(la.min(lb));
+    t.ratio = major / w;
+    t.count = t.ratio.ceil().clamp(1.0, f64::from(l.max_anisotropy)) as u32;
+    let n = f64::from(t.count);
+    t.lod = w.max(major / n).log2();
+    t.step = [
+        axis[0] / (n * f64::from(l.map_size[0])),
+        axis[1] / (n * f64::from(l.map_size[1])),
+    ];
+    t
+}
+
+/// The `(weight, texel)` taps `sample_map` reads for receiver `s`: bilinear on level 0; with a
+/// SAT box, its texels; with a mip chain (`l.mip_levels > 1`) the [`mip_taps`], each bilinear
+/// on the two levels around its lod, weighted `1 / count`.
+pub fn taps<'a>(levels: &'a [Texels], l: &LightGpu, s: &LightSample) -> Vec<(f64, &'a [f64])> {
+    let uv = s.uv;
+    let bilinear = |t: &'a Texels, uv: [f64; 2], scale: f64| {
         let fx = uv[0] * t.width as f64 - 0.5;
         let fy = uv[1] * t.height as f64 - 0.5;
         let (x0, y0) = (fx.floor() as i64, fy.floor() as i64);
@@ -91,15 +138,22 @@ pub fn taps<'a>(levels: &'a [Texels], l: &LightGpu, uv: [f64; 2]) -> Vec<(f64, &
         return sat_taps(&levels[0], l, uv);
     }
     if l.mip_levels <= 1 || levels.len() <= 1 {
-        return bilinear(&levels[0], 1.0).to_vec();
+        return bilinear(&levels[0], uv, 1.0).to_vec();
     }
     let top = (l.mip_levels.min(levels.len() as u32) - 1) as f64;
-    let lod = f64::from(l.filter_lod).clamp(0.0, top);
+    let mt = mip_taps(l, s);
+    let lod = mt.lod.clamp(0.0, top);
     let l0 = lod.floor() as usize;
     let l1 = (l0 + 1).min(top as usize);
     let t = lod - lod.floor();
-    let mut v = bilinear(&levels[l0], 1.0 - t).to_vec();
-    v.extend(bilinear(&levels[l1], t));
+    let n = f64::from(mt.count);
+    let mut v = Vec::new();
+    for k in 0..mt.count {
+        let o = f64::from(k) + 0.5 - 0.5 * n;
+        let at = [uv[0] + mt.step[0] * o, uv[1] + mt.step[1] * o];
+        v.extend(bilinear(&levels[l0], at, (1.0 - t) / n));
+        v.extend(bilinear(&levels[l1], at, t / n));
+    }
     v
 }
 
@@ -126,9 +180,9 @@ pub fn sat_taps<'a>(t: &'a Texels, l: &LightGpu, uv: [f64; 2]) -> Vec<(f64, &'a 
     taps
 }
 
-/// `sample_map`: the filtered representation at `uv`.
-pub fn sample(levels: &[Texels], l: &LightGpu, uv: [f64; 2]) -> Vec<f64> {
-    let taps = taps(levels, l, uv);
+/// `sample_map`: the filtered representation for receiver `s`.
+pub fn sample(levels: &[Texels], l: &LightGpu, s: &LightSample) -> Vec<f64> {
+    let taps = taps(levels, l, s);
     (0..levels[0].channels)
         .map(|c| taps.iter().map(|(w, v)| w * v[c]).sum())
         .collect()

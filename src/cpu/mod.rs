@@ -10,6 +10,7 @@ pub mod linearize;
 pub mod mips;
 pub mod msm;
 pub mod sat;
+pub mod shade;
 pub mod vis_csm;
 pub mod vis_esm;
 pub mod vis_evsm;

@@ -23,7 +23,7 @@ pub fn series(basis: &[f64], l: &LightGpu, d: f64) -> f64 {
 /// CSM visibility: offset, scaled about ½, clamped (`levels`: the 2M-channel basis, or its
 /// mip chain).
 pub fn vis_csm(levels: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
-    let basis = super::mips::sample(levels, l, s.uv);
+    let basis = super::mips::sample(levels, l, s);
     let d = s.depth - f64::from(l.bias) - f64::from(l.csm_offset);
     (f64::from(l.csm_scale) * series(&basis, l, d) + 0.5).clamp(0.0, 1.0)
 }

@@ -25,7 +25,7 @@ pub fn warp(l: &LightGpu, s: &LightSample) -> [(f64, f64); 2] {
 
 /// EVSM2/EVSM4 visibility with bleeding reduction (`levels`: the map, or its mip chain).
 pub fn vis_evsm(levels: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
-    let m = super::mips::sample(levels, l, s.uv);
+    let m = super::mips::sample(levels, l, s);
     let [(pos, floor_pos), (neg, floor_neg)] = warp(l, s);
     let mut p = chebyshev_upper(m[0], m[1], pos, floor_pos);
     if l.moments == 4 {

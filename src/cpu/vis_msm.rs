@@ -64,7 +64,7 @@ pub fn intensity(b: [f64; 4], d: f64, hausdorff: bool) -> f64 {
 
 /// The filtered (possibly quantized) moments at `s`, dequantized and biased.
 pub fn biased_moments(levels: &[Texels], l: &LightGpu, s: &LightSample) -> [f64; 4] {
-    let m = super::mips::sample(levels, l, s.uv);
+    let m = super::mips::sample(levels, l, s);
     let mut b = [m[0], m[1], m[2], m[3]];
     if l.msm_flags & MSM_QUANTIZED != 0 {
         b = super::msm::dequantize(b);

@@ -370,8 +370,13 @@ fn filter(f: &Filter) -> Result<(), StageError> {
         range("filter_radius", radius, 0.0, f64::from(MAX_BLUR_RADIUS))?;
         range("filter_sigma", sigma, 0.1, 100.0)?;
     }
-    if let Filter::Mips { width } = *f {
+    if let Filter::Mips {
+        width,
+        max_anisotropy,
+    } = *f
+    {
         range("filter_width", width, 1.0, 65536.0)?;
+        range("max_anisotropy", max_anisotropy as f32, 0.0, 16.0)?;
     }
     if let Filter::Sat { width, .. } = *f {
         range("filter_width", width, 1.0, 1024.0)?;

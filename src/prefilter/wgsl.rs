@@ -200,6 +200,12 @@ pub fn host_block(technique: &Technique, group: u32, first_binding: u32) -> Resu
         "fn shadowgraph_light_visibility(l: Light, s: LightSample) -> f32 {{\n    {call}\n}}\n\
          fn shadowgraph_visibility(l: Light, p: vec3<f32>, n: vec3<f32>) -> f32 {{\n    \
          let s = light_sample(l, p, n);\n    \
+         return select(1.0, shadowgraph_light_visibility(l, s), s.inside);\n}}\n\
+         // With the pixel's footprint (e.g. dpdx(p), dpdy(p) in a fragment shader): mip lookups\n\
+         // with `max_anisotropy` ≥ 1 follow it; other lookups ignore it.\n\
+         fn shadowgraph_visibility_footprint(l: Light, p: vec3<f32>, n: vec3<f32>, dpdx: vec3<f32>, dpdy: vec3<f32>) -> f32 {{\n    \
+         var s = light_sample(l, p, n);\n    \
+         s.footprint = light_footprint(l, s, p, n, dpdx, dpdy);\n    \
          return select(1.0, shadowgraph_light_visibility(l, s), s.inside);\n}}\n"
     );
     Ok(s)

@@ -136,6 +136,8 @@ pub struct ShadowFile {
     pub filter_width: Option<Spanned<f64>>,
     /// SAT sums: `fixed` (u32 fixed point, exact window sums) or `float` (f32).
     pub sat_sums: Option<Spanned<String>>,
+    /// Mips: most taps along the pixel's footprint (0: fixed width).
+    pub max_anisotropy: Option<Spanned<i64>>,
     /// MSM reconstruction: `hamburger` or `hausdorff`.
     pub reconstruction: Option<Spanned<String>>,
     /// MSM moment bias α.

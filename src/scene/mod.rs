@@ -124,6 +124,9 @@ pub enum Filter {
     Mips {
         /// Filter width in level-0 texels (level `log2(width)` is sampled).
         width: f32,
+        /// 0: the width is fixed. ≥ 1: the pixel's footprint in the map widens it (its minor
+        /// axis) and up to this many trilinear taps follow its major axis.
+        max_anisotropy: u32,
     },
     /// A summed-area table (`src/sat.rs`), read as the mean over a `width`-texel square
     /// around the receiver with four lookups per channel and sub-texel edges.

@@ -284,6 +284,7 @@ const TECHNIQUE_KEYS: &[(&str, &[&str])] = &[
             KERNEL,
             WIDTH,
             SAT_SUMS,
+            ANISOTROPY,
             "bleed_reduction",
             "min_variance",
         ],
@@ -298,6 +299,7 @@ const TECHNIQUE_KEYS: &[(&str, &[&str])] = &[
             KERNEL,
             WIDTH,
             SAT_SUMS,
+            ANISOTROPY,
             "bleed_reduction",
             "min_variance",
             "exponent_pos",
@@ -313,6 +315,7 @@ const TECHNIQUE_KEYS: &[(&str, &[&str])] = &[
             KERNEL,
             WIDTH,
             SAT_SUMS,
+            ANISOTROPY,
             "bleed_reduction",
             "min_variance",
             "exponent_pos",
@@ -321,7 +324,9 @@ const TECHNIQUE_KEYS: &[(&str, &[&str])] = &[
     ),
     (
         "esm",
-        &[FILTER, RADIUS, SIGMA, KERNEL, WIDTH, SAT_SUMS, "exponent"],
+        &[
+            FILTER, RADIUS, SIGMA, KERNEL, WIDTH, SAT_SUMS, ANISOTROPY, "exponent",
+        ],
     ),
     (
         "msm",
@@ -333,6 +338,7 @@ const TECHNIQUE_KEYS: &[(&str, &[&str])] = &[
             KERNEL,
             WIDTH,
             SAT_SUMS,
+            ANISOTROPY,
             "reconstruction",
             "moment_bias",
             "bleed_reduction",
@@ -348,6 +354,7 @@ const TECHNIQUE_KEYS: &[(&str, &[&str])] = &[
             KERNEL,
             WIDTH,
             SAT_SUMS,
+            ANISOTROPY,
             "terms",
             "attenuation",
             "offset",
@@ -361,6 +368,7 @@ const SIGMA: &str = "filter_sigma";
 const KERNEL: &str = "filter_kernel";
 const WIDTH: &str = "filter_width";
 const SAT_SUMS: &str = "sat_sums";
+const ANISOTROPY: &str = "max_anisotropy";
 
 /// Storage formats of the two- and four-moment float techniques.
 const FLOAT_STORAGE: &[(&str, Storage)] = &[("f32", Storage::F32), ("f16", Storage::F16)];
@@ -442,6 +450,7 @@ fn present(s: &ShadowFile) -> Vec<(&'static str, Range<usize>)> {
         ("exponent_neg", sp(&s.exponent_neg)),
         ("filter_width", sp(&s.filter_width)),
         ("sat_sums", sp(&s.sat_sums)),
+        ("max_anisotropy", sp(&s.max_anisotropy)),
         ("reconstruction", sp(&s.reconstruction)),
         ("moment_bias", sp(&s.moment_bias)),
         ("terms", sp(&s.terms)),
@@ -659,10 +668,18 @@ fn prefilter(
     if kind != Kind::Sat {
         ctx.reject(&key(SAT_SUMS), &s.sat_sums, "needs `filter = \"sat\"`")?;
     }
+    if kind != Kind::Mips {
+        ctx.reject(
+            &key(ANISOTROPY),
+            &s.max_anisotropy,
+            "needs `filter = \"mips\"`",
+        )?;
+    }
     let filter = match kind {
         Kind::None => Filter::None,
         Kind::Mips => Filter::Mips {
             width: ctx.num_or(&key("filter_width"), &s.filter_width, 1.0, 65536.0, 1.0)?,
+            max_anisotropy: ctx.int_or(&key(ANISOTROPY), &s.max_anisotropy, 0, 16, 0)?,
         },
         Kind::Sat => Filter::Sat {
             width: ctx.num_or(&key("filter_width"), &s.filter_width, 1.0, 1024.0, 3.0)?,

@@ -76,7 +76,7 @@ pub fn vsm_tolerance(
     l: &shadowgraph::technique::LightGpu,
     s: &shadowgraph::cpu::light::LightSample,
 ) -> f64 {
-    let m = shadowgraph::cpu::mips::sample(moments, l, s.uv);
+    let m = shadowgraph::cpu::mips::sample(moments, l, s);
     let d = s.depth - f64::from(l.bias);
     let dp = chebyshev_tolerance(
         m[0],
@@ -95,7 +95,7 @@ pub fn evsm_tolerance(
     l: &shadowgraph::technique::LightGpu,
     s: &shadowgraph::cpu::light::LightSample,
 ) -> f64 {
-    let m = shadowgraph::cpu::mips::sample(moments, l, s.uv);
+    let m = shadowgraph::cpu::mips::sample(moments, l, s);
     let [(pos, floor_pos), (neg, floor_neg)] = shadowgraph::cpu::vis_evsm::warp(l, s);
     let ulp = 2f64.powi(-23);
     let e = |c: f32| (3.0 + 4.0 * f64::from(c)) * ulp + 8.0 * ulp + 4.0 * f64::from(c) * ulp;
@@ -122,7 +122,7 @@ pub fn esm_tolerance(
     s: &shadowgraph::cpu::light::LightSample,
     v: f64,
 ) -> f64 {
-    let taps: Vec<f64> = shadowgraph::cpu::mips::taps(logs, l, s.uv)
+    let taps: Vec<f64> = shadowgraph::cpu::mips::taps(logs, l, s)
         .iter()
         .map(|(_, t)| t[0])
         .collect();
@@ -153,7 +153,7 @@ pub fn esm_sat_tolerance(
     s: &shadowgraph::cpu::light::LightSample,
     v: f64,
 ) -> f64 {
-    let m = shadowgraph::cpu::mips::sample(moments, l, s.uv)[0].max(1e-37);
+    let m = shadowgraph::cpu::mips::sample(moments, l, s)[0].max(1e-37);
     let c = f64::from(l.exp_pos);
     let ulp = 2f64.powi(-23);
     let x = m.ln() + c - c * s.depth;
