@@ -15,5 +15,6 @@ pub mod render;
 pub mod sat;
 pub mod scene;
 pub mod technique;
+pub mod truth;
 
 pub use error::{Error, Result};
