@@ -4,6 +4,7 @@ pub mod cli;
 pub mod cpu;
 pub mod dump;
 pub mod error;
+pub mod evaluate;
 pub mod exec;
 pub mod filter;
 pub mod gpu;

@@ -96,8 +96,8 @@ pub struct Truth {
     pub height: u32,
     /// Number of lights.
     pub lights: usize,
-    /// Visibility in [0, 1]: `visibility[px * lights + l]` (1 where no sample's map covers the
-    /// point; meaningful where `mask` is set).
+    /// Visibility in [0, 1]: `visibility[px * lights + l]` (1 on the background and where no
+    /// sample's map covers the point; meaningful where `mask` is set).
     pub visibility: Vec<f32>,
     /// Relevant receivers ([`relevant`]), same indexing.
     pub mask: Vec<bool>,
@@ -210,7 +210,10 @@ pub fn area_light_truth(
         let samples = emitter::samples(light, &offsets, res, z_min);
         let counts = accumulate(renderer, device, queue, &geometry, light, &samples, res)?;
         for (px, &c) in counts.iter().enumerate() {
-            truth.visibility[px * lights + li] = c as f32 / samples.len() as f32;
+            // Background stays 1, as the renderer reports it.
+            if frame.position[4 * px + 3] != 0.0 {
+                truth.visibility[px * lights + li] = c as f32 / samples.len() as f32;
+            }
         }
         truth.resolution.push(res);
     }
