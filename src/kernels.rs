@@ -44,6 +44,7 @@ pub const SOURCES: &[Source] = sources![
     "sat_cols_reduce",
     "sat_cols",
     "sat_cols_f32",
+    "truth_accumulate",
     "shared/light",
     "shared/vertex",
     "shared/exp_params",

@@ -4,6 +4,7 @@ pub mod cli;
 pub mod cpu;
 pub mod dump;
 pub mod error;
+pub mod evaluate;
 pub mod exec;
 pub mod filter;
 pub mod gpu;
@@ -15,5 +16,6 @@ pub mod render;
 pub mod sat;
 pub mod scene;
 pub mod technique;
+pub mod truth;
 
 pub use error::{Error, Result};

@@ -72,6 +72,50 @@ enum Command {
         #[arg(long, value_delimiter = ',', num_args = 0.., default_missing_value = "3,5,9,17,33,65")]
         lookup: Option<Vec<u32>>,
     },
+    /// Sweep techniques and their accuracy knobs, time each on the GPU and measure its error
+    /// against ground truth: report.md/.csv/.json, pareto.svg, grid.png (+ grid.txt).
+    Evaluate {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// Techniques to sweep (default: all), e.g. `hard,pcf,vsm`.
+        #[arg(long, value_delimiter = ',')]
+        techniques: Option<Vec<String>>,
+        /// Output folder (created if missing).
+        #[arg(long, default_value = "evaluation")]
+        out: PathBuf,
+        /// A tiny sweep that runs in seconds (one size, one width, K = 16, small image).
+        #[arg(long)]
+        quick: bool,
+        /// Shadow-map sizes (default 512,1024,2048,4096; quick: 512).
+        #[arg(long, value_delimiter = ',')]
+        sizes: Option<Vec<u32>>,
+        /// Emitter samples K of the area-light truth (default 256; quick: 16).
+        #[arg(long)]
+        k: Option<u32>,
+        /// Shadow-map side of the truth's samples (default max(2048, 2 × the light's map)).
+        #[arg(long)]
+        truth_resolution: Option<u32>,
+        /// Timed frames per configuration (the median is reported).
+        #[arg(long, default_value_t = 5)]
+        repeat: u32,
+        /// Evaluate at this image size, WIDTHxHEIGHT (default: the scene's).
+        #[arg(long, value_parser = parse_size)]
+        image: Option<(u32, u32)>,
+    },
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once('x')
+        .ok_or_else(|| format!("`{s}`: expected WIDTHxHEIGHT, e.g. 160x120"))?;
+    let n = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|&v| v > 0)
+            .ok_or_else(|| format!("`{s}`: sides must be positive integers"))
+    };
+    Ok((n(w)?, n(h)?))
 }
 
 fn main() {
@@ -104,6 +148,29 @@ fn run(args: Args) -> Result<()> {
             );
         }
         Command::Info => print!("{}", Gpu::new()?.info_report()),
+        Command::Evaluate {
+            scene,
+            techniques,
+            out,
+            quick,
+            sizes,
+            k,
+            truth_resolution,
+            repeat,
+            image,
+        } => {
+            let opts = shadowgraph::evaluate::EvaluateOptions {
+                techniques,
+                quick,
+                sizes,
+                samples: k,
+                truth_resolution,
+                repeat: if quick { repeat.min(1) } else { repeat },
+                image,
+            };
+            let gpu = Gpu::new()?;
+            print!("{}", shadowgraph::evaluate::run(&gpu, &scene, &out, &opts)?);
+        }
         Command::Bench {
             sizes,
             repeat,

@@ -695,11 +695,36 @@ impl Renderer {
         depth: &wgpu::Texture,
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
-        let pipeline = self
-            .shadow_pipeline(device, light.shadow.slope_bias)?
-            .clone();
         let vp = (light.projection() * light.view()).to_cols_array();
-        let ubuf = uniform(device, "shadowgraph.light_view", bytemuck::cast_slice(&vp));
+        let label = format!("light{i}.shadow_raster");
+        let raster = ShadowRaster {
+            label: &label,
+            view_proj: vp,
+            slope_bias: light.shadow.slope_bias,
+        };
+        self.shadow_raster(device, enc, &raster, vbuf, count, depth, timer)
+    }
+
+    /// Records a depth-only raster pass of the scene's vertices `vbuf` (`count` vertices) into
+    /// `depth` (Depth32Float) with an explicit world → clip matrix: the pipeline and bias the
+    /// renderer's own shadow maps use (`truth` rasterizes its emitter samples with it).
+    #[expect(clippy::too_many_arguments, reason = "one raster pass's inputs")]
+    pub fn shadow_raster(
+        &mut self,
+        device: &wgpu::Device,
+        enc: &mut wgpu::CommandEncoder,
+        raster: &ShadowRaster,
+        vbuf: &wgpu::Buffer,
+        count: u32,
+        depth: &wgpu::Texture,
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
+        let pipeline = self.shadow_pipeline(device, raster.slope_bias)?.clone();
+        let ubuf = uniform(
+            device,
+            "shadowgraph.light_view",
+            bytemuck::cast_slice(&raster.view_proj),
+        );
         let bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("shadowgraph.shadow_depth"),
             layout: &pipeline.get_bind_group_layout(0),
@@ -709,10 +734,9 @@ impl Renderer {
             }],
         });
         let view = depth.create_view(&Default::default());
-        let label = format!("light{i}.shadow_raster");
-        let timestamp_writes = timer.and_then(|t| t.render_pass(&label));
+        let timestamp_writes = timer.and_then(|t| t.render_pass(raster.label));
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some(&label),
+            label: Some(raster.label),
             color_attachments: &[],
             depth_stencil_attachment: Some(clear_depth(&view)),
             timestamp_writes,
@@ -926,6 +950,17 @@ impl Renderer {
         drop(pass);
         Ok(Shaded { color, visibility })
     }
+}
+
+/// One depth-only raster pass for [`Renderer::shadow_raster`].
+#[derive(Clone, Copy, Debug)]
+pub struct ShadowRaster<'a> {
+    /// Pass label (and timer label).
+    pub label: &'a str,
+    /// World → clip, column-major (wgpu depth convention: 0 at near, 1 at far).
+    pub view_proj: [f32; 16],
+    /// Slope-scaled depth bias (`DepthBiasState::slope_scale`).
+    pub slope_bias: f32,
 }
 
 /// The shading pass's outputs.

@@ -317,7 +317,13 @@ fn technique(
                         prefilter.storage
                     ));
                 }
-                Ok(c.min(limit))
+                Ok(sat_clamp(
+                    warnings,
+                    field,
+                    c.min(limit),
+                    &prefilter.filter,
+                    false,
+                ))
             };
             Technique::Evsm {
                 prefilter,
@@ -334,7 +340,10 @@ fn technique(
         } => {
             filter(&f)?;
             range("exponent", exponent, 0.01, 1e4)?;
-            t
+            Technique::Esm {
+                filter: f,
+                exponent: sat_clamp(warnings, "exponent", exponent, &f, true),
+            }
         }
         Technique::Msm {
             prefilter,
@@ -363,6 +372,21 @@ fn technique(
         }
         _ => t,
     })
+}
+
+/// `c` clamped to what a summed-area table keeps accurate (`scene::sat_exponent_limit`), with
+/// a warning when it is clamped.
+fn sat_clamp(warnings: &mut Vec<String>, field: &str, c: f32, f: &Filter, esm: bool) -> f32 {
+    match crate::scene::sat_exponent_limit(f, esm) {
+        Some(limit) if c > limit => {
+            warnings.push(format!(
+                "`{field}` = {c} exceeds {limit:.2}, the largest a summed-area table of this \
+                 `filter_width` keeps accurate; clamped"
+            ));
+            limit
+        }
+        _ => c,
+    }
 }
 
 fn filter(f: &Filter) -> Result<(), StageError> {

@@ -1,0 +1,193 @@
+//! The report files: `report.md`, `report.csv`, `report.json`, and the figures (`pareto.svg`,
+//! `grid.png` with its legend `grid.txt`).
+
+use std::fmt::Write;
+use std::path::{Path, PathBuf};
+
+use super::{ErrorStats, Images, Report, Row, out_path};
+use crate::error::{Error, Result};
+
+/// Writes every output file into `dir`; returns their paths.
+pub fn write_all(dir: &Path, report: &Report, images: &Images) -> Result<Vec<PathBuf>> {
+    let mut written = Vec::new();
+    let mut put = |name: &str, bytes: &[u8]| -> Result<()> {
+        let path = out_path(dir, name)?;
+        std::fs::write(&path, bytes).map_err(|error| Error::Io {
+            path: path.clone(),
+            error,
+        })?;
+        written.push(path);
+        Ok(())
+    };
+    put("report.md", markdown(report).as_bytes())?;
+    put("report.csv", csv(report).as_bytes())?;
+    let json = serde_json::to_string_pretty(report)
+        .map_err(|e| Error::Invalid(format!("report.json: {e}")))?;
+    put("report.json", json.as_bytes())?;
+    put("pareto.svg", super::svg::pareto(report).as_bytes())?;
+    let (png, legend) = super::grid::grid(report, images)?;
+    put("grid.png", &png)?;
+    put("grid.txt", legend.as_bytes())?;
+    Ok(written)
+}
+
+fn ms(v: Option<f64>) -> String {
+    v.map_or_else(String::new, |v| format!("{v:.3}"))
+}
+
+/// The CSV columns of an error statistic, with a prefix.
+fn stats_header(prefix: &str) -> String {
+    [
+        "pixels",
+        "mean_abs",
+        "rmse",
+        "p99",
+        "max",
+        "over_0.05",
+        "over_0.2",
+    ]
+    .map(|c| format!("{prefix}_{c}"))
+    .join(",")
+}
+
+fn stats_cells(s: Option<&ErrorStats>) -> String {
+    match s {
+        Some(s) => format!(
+            "{},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6}",
+            s.pixels, s.mean_abs, s.rmse, s.p99, s.max, s.over_005, s.over_02
+        ),
+        None => ",,,,,,".into(),
+    }
+}
+
+/// One line per configuration; per-pass times as `name=ms` pairs separated by `;`.
+pub fn csv(report: &Report) -> String {
+    let mut s = format!(
+        "label,technique,shadow_map,storage,filter,box_width,raster_ms,kernels_ms,shade_ms,total_ms,gbuffer_ms,memory_bytes,{},{},passes\n",
+        stats_header("soft"),
+        stats_header("pcf")
+    );
+    for r in &report.rows {
+        let passes: Vec<String> = r
+            .passes
+            .iter()
+            .map(|(l, v)| format!("{l}={v:.4}"))
+            .collect();
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            r.label,
+            r.technique,
+            r.shadow_map,
+            r.storage,
+            r.filter,
+            r.box_width.map_or_else(String::new, |w| w.to_string()),
+            ms(r.raster_ms),
+            ms(r.kernels_ms),
+            ms(r.shade_ms),
+            ms(r.total_ms),
+            ms(r.gbuffer_ms),
+            r.memory_bytes,
+            stats_cells(Some(&r.soft)),
+            stats_cells(r.pcf.as_ref()),
+            passes.join(";")
+        );
+    }
+    s
+}
+
+fn mib(b: u64) -> String {
+    format!("{:.1}", b as f64 / (1024.0 * 1024.0))
+}
+
+/// The report: what was measured and how, then one table row per configuration.
+pub fn markdown(report: &Report) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "# Accuracy vs time: `{}`\n", report.scene);
+    let _ = writeln!(
+        s,
+        "Device: {}. Image {}×{}, {} relevant pixels (lit receivers: facing the light, inside its \
+         frustum and cone). Ground truth: the area light's emitter (a square of side `size` at \
+         the light's position, perpendicular to its direction) sampled at K = {} stratified \
+         points, one {:?}² hard shadow map each (`shadowgraph::truth`).\n",
+        report.device,
+        report.image.0,
+        report.image.1,
+        report.relevant_pixels,
+        report.truth_samples,
+        report.truth_resolution
+    );
+    if report.cpu_driver {
+        s.push_str(
+            "**Times are CPU-driver times** (a software Vulkan driver runs the kernels on the \
+             CPU): compare configurations with each other, not with a GPU.\n\n",
+        );
+    }
+    s.push_str(
+        "Columns: GPU time per part (median over the repeats, from timestamps): raster = shadow \
+         map, kernels = the graph (linearize, encode, filter), shade = the shading pass, total = \
+         their sum (the camera G-buffer is common to all and left out); memory = the plan's peak \
+         live textures plus the depth maps. *soft*: error against the area-light truth (the \
+         scene as it should look); *pcf*: error against brute-force box PCF of the \
+         configuration's own map with the same box width (what a prefiltered technique \
+         approximates), where the configuration filters with a box. Errors are |visibility − \
+         truth| over the relevant pixels: mean, RMSE, 99th percentile, max, and the shares of \
+         pixels off by more than 0.05 and 0.2.\n\n",
+    );
+    s.push_str(
+        "| configuration | raster ms | kernels ms | shade ms | total ms | MiB | soft mean | soft rmse | soft p99 | soft max | soft >0.05 | soft >0.2 | pcf mean | pcf p99 | pcf >0.05 |\n",
+    );
+    s.push_str("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+    for r in &report.rows {
+        let (pm, pp, po) =
+            r.pcf
+                .as_ref()
+                .map_or((String::new(), String::new(), String::new()), |p| {
+                    (
+                        format!("{:.4}", p.mean_abs),
+                        format!("{:.3}", p.p99),
+                        format!("{:.2}%", 100.0 * p.over_005),
+                    )
+                });
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.3} | {:.3} | {:.2}% | {:.2}% | {pm} | {pp} | {po} |",
+            r.label,
+            ms(r.raster_ms),
+            ms(r.kernels_ms),
+            ms(r.shade_ms),
+            ms(r.total_ms),
+            mib(r.memory_bytes),
+            r.soft.mean_abs,
+            r.soft.rmse,
+            r.soft.p99,
+            r.soft.max,
+            100.0 * r.soft.over_005,
+            100.0 * r.soft.over_02,
+        );
+    }
+    let front = super::svg::front(&report.rows);
+    if !front.is_empty() {
+        s.push_str("\nPareto front (total time vs soft mean error; no configuration is both faster and more accurate):\n\n");
+        for i in front {
+            let r: &Row = &report.rows[i];
+            let _ = writeln!(
+                s,
+                "- {}: {} ms, soft mean {:.4}",
+                r.label,
+                ms(r.total_ms),
+                r.soft.mean_abs
+            );
+        }
+    }
+    for (label, why) in &report.skipped {
+        let _ = writeln!(s, "\nSkipped {label}: {why}");
+    }
+    s.push_str(
+        "\nFigures: `pareto.svg` (total time, log scale, vs soft mean error; the front drawn), \
+         `grid.png` (light 0: the truth, then per configuration its visibility and its error \
+         map — red where brighter than the truth, blue where darker, full colour at |error| ≥ \
+         0.5, grey outside the relevant pixels), cells listed in `grid.txt`.\n",
+    );
+    s
+}

@@ -1,0 +1,248 @@
+//! The sweep: which configurations `shadowgraph evaluate` renders, built as a scene file would
+//! build them.
+
+use super::EvaluateOptions;
+use crate::error::{Error, Result};
+use crate::prefilter::PrefilterConfig;
+use crate::scene::{BlurKernel, Filter, PcfKernel, Scene, Storage, Technique};
+
+/// Technique names `--techniques` accepts, in sweep order.
+pub const TECHNIQUES: &[&str] = &[
+    "hard", "pcf", "pcss", "vsm", "evsm2", "evsm4", "esm", "msm", "csm",
+];
+
+/// A filter of a box `width` texels wide.
+pub type FilterOfWidth = fn(f32) -> Filter;
+
+/// The filters prefiltered techniques are swept with: a name and the filter of a box `width`
+/// texels wide. Adding a filter (e.g. `filter = "sat"`) is one line here.
+pub const FILTERS: &[(&str, FilterOfWidth)] = &[
+    ("blur", |width| Filter::Blur {
+        radius: 0.5 * (width - 1.0),
+        sigma: (0.25 * (width - 1.0)).max(0.5),
+        kernel: BlurKernel::Box,
+    }),
+    ("mips", |width| Filter::Mips {
+        width,
+        max_anisotropy: 0,
+    }),
+    ("sat", |width| Filter::Sat {
+        width,
+        variant: crate::sat::SatVariant::Fixed,
+    }),
+];
+
+/// One configuration of the sweep: a technique with its knobs on a map size.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Config {
+    /// Short unique label, e.g. `vsm f16 blur5 1024`.
+    pub label: String,
+    /// Technique and knobs (every light of the scene gets it).
+    pub technique: Technique,
+    /// Shadow-map side.
+    pub shadow_map: u32,
+    /// Width in texels of the box the technique filters with, when it has one (the PCF truth
+    /// then applies).
+    pub box_width: Option<f64>,
+}
+
+/// Configurations of the sweep for `scene` (every light gets each), filtered by
+/// `opts.techniques`. Unknown technique names are an error listing the known ones.
+pub fn sweep(scene: &Scene, opts: &EvaluateOptions) -> Result<Vec<Config>> {
+    let wanted: Vec<String> = match &opts.techniques {
+        None => TECHNIQUES.iter().map(|s| s.to_string()).collect(),
+        Some(list) => {
+            for t in list {
+                if !TECHNIQUES.contains(&t.as_str()) {
+                    return Err(Error::Invalid(format!(
+                        "unknown technique `{t}` in --techniques (known: {})",
+                        TECHNIQUES.join(", ")
+                    )));
+                }
+            }
+            list.clone()
+        }
+    };
+    let quick = opts.quick;
+    let sizes = opts.sizes.clone().unwrap_or_else(|| {
+        if quick {
+            vec![512]
+        } else {
+            vec![512, 1024, 2048, 4096]
+        }
+    });
+    if sizes.is_empty() || sizes.iter().any(|&s| !(1..=65536).contains(&s)) {
+        return Err(Error::Invalid(format!(
+            "--sizes must be map sides in [1, 65536], got {sizes:?}"
+        )));
+    }
+    let base = if sizes.contains(&1024) {
+        1024
+    } else {
+        sizes[0]
+    };
+    let widths: &[f32] = if quick { &[5.0] } else { &[3.0, 5.0, 9.0] };
+    let storages: &[Storage] = if quick {
+        &[Storage::F32]
+    } else {
+        &[Storage::F32, Storage::F16]
+    };
+    let mut out = Vec::new();
+    let mut push = |label: String, technique: Technique, size: u32, box_width: Option<f64>| {
+        out.push(Config {
+            label: format!("{label} {size}"),
+            technique,
+            shadow_map: size,
+            box_width,
+        });
+    };
+    let size_sweep = |t: &str| -> Vec<u32> {
+        if wanted.iter().any(|w| w == t) {
+            sizes.clone()
+        } else {
+            Vec::new()
+        }
+    };
+    for &size in &size_sweep("hard") {
+        push("hard".into(), Technique::Hard, size, None);
+    }
+    if wanted.iter().any(|w| w == "pcf") {
+        for r in if quick { vec![2] } else { vec![1, 2, 4] } {
+            let t = Technique::Pcf {
+                radius: r,
+                kernel: PcfKernel::Box,
+            };
+            let width = Some(f64::from(2 * r + 1));
+            let on: Vec<u32> = if r == 2 { sizes.clone() } else { vec![base] };
+            for size in on {
+                push(format!("pcf box{}", 2 * r + 1), t, size, width);
+            }
+        }
+    }
+    if scene.lights.iter().all(|l| l.size > 0.0) {
+        let pcss = scene
+            .lights
+            .iter()
+            .map(|l| l.shadow.technique)
+            .find(|t| matches!(t, Technique::Pcss { .. }))
+            .unwrap_or(Technique::Pcss {
+                blocker_samples: 16,
+                filter_samples: 32,
+                max_search: 0.1,
+            });
+        for &size in &size_sweep("pcss") {
+            push("pcss".into(), pcss, size, None);
+        }
+    }
+    for name in ["vsm", "evsm2", "evsm4", "esm", "msm", "csm"] {
+        if wanted.iter().any(|w| w == name) {
+            prefiltered_configs(name, quick, base, &sizes, widths, storages, &mut out)?;
+        }
+    }
+    Ok(out)
+}
+
+/// The prefiltered technique `name` with `storage`, `filter` and (CSM) `terms`, validated
+/// like a scene file (EVSM exponents clamped to the storage's limit, MSM's default bias for
+/// the storage).
+fn prefiltered(name: &str, storage: Storage, filter: Filter, terms: u32) -> Result<Technique> {
+    let config = match name {
+        "vsm" => PrefilterConfig::vsm(1),
+        "evsm2" => PrefilterConfig::evsm2(1),
+        "evsm4" => PrefilterConfig::evsm4(1),
+        "esm" => PrefilterConfig::esm(1),
+        "msm" => PrefilterConfig::msm(1),
+        _ => PrefilterConfig::csm(1, terms),
+    };
+    let config = if name == "esm" {
+        config.with_filter(filter)
+    } else {
+        config.with_storage(storage).with_filter(filter)
+    };
+    let (mut valid, _) = config.validated()?;
+    if let Technique::Msm { moment_bias, .. } = &mut valid.technique {
+        *moment_bias = crate::scene::default_moment_bias(storage);
+    }
+    Ok(valid.technique)
+}
+
+pub(super) fn storage_name(s: Storage) -> &'static str {
+    match s {
+        Storage::F32 => "f32",
+        Storage::F16 => "f16",
+        Storage::Unorm16 => "unorm16",
+    }
+}
+
+fn prefiltered_configs(
+    name: &str,
+    quick: bool,
+    base: u32,
+    sizes: &[u32],
+    widths: &[f32],
+    storages: &[Storage],
+    out: &mut Vec<Config>,
+) -> Result<()> {
+    let mut push = |label: String, t: Technique, size: u32, width: f32| {
+        out.push(Config {
+            label: format!("{label} {size}"),
+            technique: t,
+            shadow_map: size,
+            box_width: Some(f64::from(width)),
+        });
+    };
+    let mid = widths[widths.len() / 2];
+    // CSM: the knobs are swept at M = 8 (4 when quick); the other M with the first filter.
+    let (default_m, other_m): (u32, &[u32]) = match (name, quick) {
+        ("csm", true) => (4, &[]),
+        ("csm", false) => (8, &[2, 4, 16]),
+        _ => (0, &[]),
+    };
+    let prefix = |m: u32| {
+        if m > 0 {
+            format!("{name} M{m}")
+        } else {
+            name.to_string()
+        }
+    };
+    let mut storages = storages.to_vec();
+    if name == "esm" {
+        storages = vec![Storage::F32];
+    } else if name == "msm" && !quick {
+        storages.push(Storage::Unorm16);
+    }
+    for &storage in &storages {
+        for (fname, filter) in FILTERS {
+            // Widths are swept for f32; other storages at the middle width.
+            let ws: &[f32] = if storage == Storage::F32 {
+                widths
+            } else {
+                &[mid]
+            };
+            for &w in ws {
+                let t = prefiltered(name, storage, filter(w), default_m)?;
+                let label = format!("{} {} {fname}{w}", prefix(default_m), storage_name(storage));
+                push(label, t, base, w);
+            }
+        }
+    }
+    let (fname, filter) = FILTERS[0];
+    for &m in other_m {
+        for &storage in &storages {
+            let t = prefiltered(name, storage, filter(mid), m)?;
+            let label = format!("{} {} {fname}{mid}", prefix(m), storage_name(storage));
+            push(label, t, base, mid);
+        }
+    }
+    // Map sizes for the default configuration.
+    let t = prefiltered(name, Storage::F32, filter(mid), default_m)?;
+    for &size in sizes.iter().filter(|&&s| s != base) {
+        push(
+            format!("{} f32 {fname}{mid}", prefix(default_m)),
+            t,
+            size,
+            mid,
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,370 @@
+//! `shadowgraph evaluate`: every output file for a tiny sweep, the JSON finite and equal to the
+//! CSV, errors recomputed independently from a render and the truth, plausibility (hard vs
+//! a point light's truth, wide blur vs PCF), error statistics against a direct f64
+//! computation, and clear errors for bad input.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use rand::Rng;
+use shadowgraph::evaluate::{
+    Config, ErrorStats, EvaluateOptions, FILTERS, Report, evaluate, scene_for,
+};
+use shadowgraph::render::{RenderOptions, Renderer};
+use shadowgraph::scene::{Filter, PcfKernel, Scene, Technique};
+use shadowgraph::truth::{Emitter, TruthOptions, area_light_truth};
+
+fn scene_path(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name)
+}
+
+fn temp_dir(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("shadowgraph-eval-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn shadowgraph(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_shadowgraph"))
+        .args(args)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .expect("run shadowgraph")
+}
+
+/// Every number in a JSON value is finite (serde_json writes NaN and ±Inf as null, so a null
+/// where a number belongs also fails).
+fn assert_finite(v: &serde_json::Value, path: &str) {
+    match v {
+        serde_json::Value::Number(n) => {
+            assert!(n.as_f64().is_some_and(f64::is_finite), "{path}: {n}")
+        }
+        serde_json::Value::Array(a) => {
+            for (i, x) in a.iter().enumerate() {
+                assert_finite(x, &format!("{path}[{i}]"));
+            }
+        }
+        serde_json::Value::Object(o) => {
+            for (k, x) in o {
+                // Optional fields are null where they do not apply, never where a number is due.
+                if x.is_null() {
+                    assert!(
+                        k == "pcf" || k == "box_width",
+                        "{path}.{k} is null (a non-finite number?)"
+                    );
+                    continue;
+                }
+                assert_finite(x, &format!("{path}.{k}"));
+            }
+        }
+        _ => {}
+    }
+}
+
+/// The quick sweep through the binary: all six files, a PNG of the grid's size, an SVG with
+/// one point per configuration and the front, JSON whose numbers are finite and whose rows
+/// equal the CSV's (CSV errors are printed to 6 decimals: tolerance 5e-7; times to 3: 5e-4),
+/// and each total the sum of its parts.
+#[test]
+fn quick_sweep_writes_every_file_consistently() {
+    let out = temp_dir("quick");
+    let o = shadowgraph(&[
+        "evaluate",
+        scene_path("sphere_on_plane.toml").to_str().unwrap(),
+        "--quick",
+        "--techniques",
+        "hard,pcf,pcss,vsm,msm",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "evaluate failed: {stderr}");
+    for f in [
+        "report.md",
+        "report.csv",
+        "report.json",
+        "pareto.svg",
+        "grid.png",
+        "grid.txt",
+    ] {
+        let meta = std::fs::metadata(out.join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
+        assert!(meta.len() > 100, "{f} is nearly empty");
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap())
+            .expect("report.json parses");
+    assert_finite(&json, "report");
+    let report: Report = serde_json::from_value(json).expect("report.json has the Report shape");
+    // hard, pcf box5, pcss, vsm and msm with each filter, all at 512.
+    let expected = 3 + 2 * FILTERS.len();
+    assert_eq!(report.rows.len(), expected, "{:?}", report.skipped);
+    let csv = std::fs::read_to_string(out.join("report.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), report.rows.len());
+    for (r, cells) in report.rows.iter().zip(&rows) {
+        assert_eq!(cells[col("label")], r.label);
+        let num = |name: &str| cells[col(name)].parse::<f64>().unwrap();
+        for (name, v, tol) in [
+            ("soft_mean_abs", r.soft.mean_abs, 5e-7),
+            ("soft_rmse", r.soft.rmse, 5e-7),
+            ("soft_p99", r.soft.p99, 5e-7),
+            ("soft_max", r.soft.max, 5e-7),
+            ("soft_over_0.05", r.soft.over_005, 5e-7),
+            ("soft_over_0.2", r.soft.over_02, 5e-7),
+            ("total_ms", r.total_ms.unwrap(), 5e-4),
+            ("shade_ms", r.shade_ms.unwrap(), 5e-4),
+        ] {
+            assert!(
+                (num(name) - v).abs() <= tol,
+                "{}: {name} csv {} json {v}",
+                r.label,
+                num(name)
+            );
+        }
+        assert_eq!(num("memory_bytes") as u64, r.memory_bytes);
+        assert_eq!(r.pcf.is_some(), r.box_width.is_some(), "{}", r.label);
+        let parts = r.raster_ms.unwrap() + r.kernels_ms.unwrap() + r.shade_ms.unwrap();
+        assert!((parts - r.total_ms.unwrap()).abs() < 1e-9, "{}", r.label);
+        let shares = [r.soft.over_005, r.soft.over_02];
+        assert!(shares.iter().all(|s| (0.0..=1.0).contains(s)) && shares[1] <= shares[0]);
+        assert!(r.soft.mean_abs <= r.soft.rmse + 1e-12 && r.soft.rmse <= r.soft.max + 1e-12);
+        assert!(r.soft.pixels == report.relevant_pixels, "{}", r.label);
+    }
+    let svg = std::fs::read_to_string(out.join("pareto.svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+    assert_eq!(svg.matches("<circle").count(), report.rows.len());
+    assert!(svg.contains("stroke-dasharray"), "no Pareto front drawn");
+    let png = image::open(out.join("grid.png"))
+        .expect("grid.png decodes")
+        .to_rgb8();
+    // 160-wide quick image: cells 160×(120 + 12), 3 configurations (6 cells) per row.
+    let grid_rows = 1 + report.rows.len().div_ceil(3);
+    assert_eq!(png.dimensions(), (6 * 160, (grid_rows * 132) as u32));
+    let legend = std::fs::read_to_string(out.join("grid.txt")).unwrap();
+    assert_eq!(legend.lines().count(), 2 + 2 * report.rows.len());
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(md.contains("CPU-driver times") == report.cpu_driver);
+    for r in &report.rows {
+        assert!(
+            md.contains(&format!("| {} |", r.label)),
+            "{} not in report.md",
+            r.label
+        );
+    }
+}
+
+/// A scene whose light has size 0 (stacked.toml's spot): the area-light truth is the light's
+/// hard shadow. (1) With the truth at the map's own resolution, `hard` at that size is that
+/// very shadow map: its error must be exactly 0. (2) The report's statistics equal a direct
+/// f64 recomputation from an independent render and truth (tolerance 1e-12: the same sums in
+/// another order). (3) A wide blur (VSM, box 17) is worse against the hard truth than PCF 3×3,
+/// and PCF's error against its own box-PCF truth stays small (the GPU window is centred on the
+/// texel, the truth's box on the receiver: at most half a texel apart, so only edge pixels
+/// move, by at most 1/3 per texel column: mean below 0.01).
+#[test]
+fn errors_are_plausible_and_recomputable() {
+    let g = common::gpu();
+    let opts = EvaluateOptions {
+        image: Some((160, 120)),
+        samples: Some(4),
+        truth_resolution: Some(1024),
+        repeat: 1,
+        ..Default::default()
+    };
+    let scene: Scene = scene_for(&scene_path("stacked.toml"), &opts).expect("scene");
+    assert_eq!(scene.lights[0].size, 0.0);
+    let wide = FILTERS[0].1(17.0);
+    assert!(matches!(wide, Filter::Blur { .. }));
+    let vsm = match shadowgraph::prefilter::PrefilterConfig::vsm(1024)
+        .with_filter(wide)
+        .validated()
+    {
+        Ok((c, _)) => c.technique,
+        Err(e) => panic!("{e}"),
+    };
+    let configs = vec![
+        Config {
+            label: "hard 1024".into(),
+            technique: Technique::Hard,
+            shadow_map: 1024,
+            box_width: None,
+        },
+        Config {
+            label: "pcf box3 1024".into(),
+            technique: Technique::Pcf {
+                radius: 1,
+                kernel: PcfKernel::Box,
+            },
+            shadow_map: 1024,
+            box_width: Some(3.0),
+        },
+        Config {
+            label: "vsm f32 blur17 1024".into(),
+            technique: vsm,
+            shadow_map: 1024,
+            box_width: Some(17.0),
+        },
+    ];
+    let (report, images) = evaluate(&g, &scene, &configs, &opts).expect("evaluate");
+    let [hard, pcf, blur] = [&report.rows[0], &report.rows[1], &report.rows[2]];
+    eprintln!(
+        "hard {:?}\npcf {:?} / {:?}\nblur {:?} / {:?}",
+        hard.soft, pcf.soft, pcf.pcf, blur.soft, blur.pcf
+    );
+    assert!(report.relevant_pixels > 5000);
+    assert_eq!(
+        hard.soft.max, 0.0,
+        "hard differs from its own shadow map's truth"
+    );
+    assert!(blur.soft.mean_abs > 2.0 * pcf.soft.mean_abs);
+    assert!(blur.soft.over_02 > pcf.soft.over_02);
+    assert!(pcf.pcf.expect("pcf truth").mean_abs < 0.01);
+
+    // (2) Independent recomputation of the PCF row's soft error.
+    let mut renderer = Renderer::new(&g.device);
+    let truth = area_light_truth(
+        &mut renderer,
+        &g.device,
+        &g.queue,
+        &scene,
+        &TruthOptions {
+            emitter: Emitter::Stratified { k: 4, seed: 1 },
+            resolution: Some(1024),
+        },
+    )
+    .expect("truth");
+    let mut s = scene.clone();
+    s.lights[0].shadow.technique = configs[1].technique;
+    let frame = renderer
+        .render(
+            &g.device,
+            &g.queue,
+            &s,
+            RenderOptions {
+                aux: false,
+                repeat: 1,
+                dump: false,
+            },
+        )
+        .expect("render");
+    let errors: Vec<f64> = (0..truth.mask.len())
+        .filter(|&i| truth.mask[i])
+        .map(|i| (f64::from(frame.visibility[i]) - f64::from(truth.visibility[i])).abs())
+        .collect();
+    let mean = errors.iter().sum::<f64>() / errors.len() as f64;
+    let over = errors.iter().filter(|&&e| e > 0.05).count() as f64 / errors.len() as f64;
+    assert_eq!(errors.len(), pcf.soft.pixels);
+    assert!(
+        (mean - pcf.soft.mean_abs).abs() < 1e-12,
+        "{mean} vs {}",
+        pcf.soft.mean_abs
+    );
+    assert!((over - pcf.soft.over_005).abs() < 1e-12);
+    assert_eq!(images.visibility.len(), 3);
+    assert_eq!(images.truth.len(), 160 * 120);
+}
+
+/// `ErrorStats` against a direct computation on random data: mean, RMSE and shares by
+/// definition, the 99th percentile as the value at rank ⌈0.99 n⌉ of the sorted errors (the
+/// nearest-rank definition), max; masked-out values ignored. Tolerance 1e-12 (sums of ≤ 5000
+/// values in [0, 1] in another order).
+#[test]
+fn error_stats_match_direct_computation() {
+    let mut rng = common::rng(3);
+    for n in [1usize, 7, 100, 5000] {
+        let v: Vec<f32> = (0..n).map(|_| rng.random_range(0.0..1.0)).collect();
+        let t: Vec<f64> = (0..n).map(|_| rng.random_range(0.0..1.0)).collect();
+        let mut m: Vec<bool> = (0..n).map(|_| rng.random_bool(0.7)).collect();
+        m[0] = true;
+        let s = ErrorStats::new(&v, &t, &m);
+        let mut e: Vec<f64> = (0..n)
+            .filter(|&i| m[i])
+            .map(|i| (f64::from(v[i]) - t[i]).abs())
+            .collect();
+        let k = e.len();
+        let mean = e.iter().sum::<f64>() / k as f64;
+        let rmse = (e.iter().map(|x| x * x).sum::<f64>() / k as f64).sqrt();
+        e.sort_by(|a, b| b.partial_cmp(a).unwrap());
+        let rank = (0.99 * k as f64).ceil() as usize; // 1-based rank in ascending order
+        let p99 = e[k - rank];
+        assert_eq!(s.pixels, k);
+        for (what, got, want) in [
+            ("mean", s.mean_abs, mean),
+            ("rmse", s.rmse, rmse),
+            ("p99", s.p99, p99),
+            ("max", s.max, e[0]),
+            (
+                "over 0.05",
+                s.over_005,
+                e.iter().filter(|&&x| x > 0.05).count() as f64 / k as f64,
+            ),
+            (
+                "over 0.2",
+                s.over_02,
+                e.iter().filter(|&&x| x > 0.2).count() as f64 / k as f64,
+            ),
+        ] {
+            assert!((got - want).abs() < 1e-12, "n {n} {what}: {got} vs {want}");
+        }
+    }
+}
+
+/// Bad input is one clear line and exit status 1, never a panic.
+#[test]
+fn bad_input_is_a_clear_error() {
+    let out = temp_dir("bad");
+    let o = shadowgraph(&[
+        "evaluate",
+        scene_path("sphere_on_plane.toml").to_str().unwrap(),
+        "--quick",
+        "--techniques",
+        "hard,phong",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("unknown technique `phong`") && err.contains("vsm"),
+        "{err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    let o = shadowgraph(&[
+        "evaluate",
+        "no/such/scene.toml",
+        "--quick",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("no/such/scene.toml") && !err.contains("panicked"),
+        "{err}"
+    );
+    let o = shadowgraph(&[
+        "evaluate",
+        scene_path("pole.toml").to_str().unwrap(),
+        "--sizes",
+        "0",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("--sizes") && !err.contains("panicked"),
+        "{err}"
+    );
+    assert!(
+        !out.join("report.json").exists(),
+        "a failed run wrote a report"
+    );
+}
