@@ -97,6 +97,24 @@ fn pixel_reference(
             // Means of 0/1 taps in f32.
             _ => 1e-5,
         };
+        // The receiver's UV comes out of f32 projections (a few 2⁻²⁴ each way), which moves the
+        // filtered moments' bilinear weights; where neighbouring texels' moments differ by
+        // orders of magnitude (EVSM's exp(40 z')), that is visible: add twice the reference's
+        // change under ±4·2⁻²⁴ of UV.
+        let tolerance = if light.shadow.technique.filter().is_some() {
+            let d = 4.0 * 2f64.powi(-24);
+            let spread = [[d, 0.0], [-d, 0.0], [0.0, d], [0.0, -d]]
+                .iter()
+                .map(|[du, dv]| {
+                    let mut t = s;
+                    t.uv = [s.uv[0] + du, s.uv[1] + dv];
+                    (vis(&t) - v).abs()
+                })
+                .fold(0.0, f64::max);
+            tolerance + 2.0 * spread
+        } else {
+            tolerance
+        };
         // The GPU's footprint is a difference of f32 UVs times the map size: 2⁻²⁴ · 1024 ≈
         // 6·10⁻⁵ texels on an axis of a texel or more, so up to about 10⁻⁴ relative. It moves
         // the taps' level and spacing: add twice the reference's change under a ±2·10⁻⁴ scaling
