@@ -14,6 +14,7 @@ pub mod prefilter;
 pub mod render;
 pub mod sat;
 pub mod scene;
+pub mod stability;
 pub mod technique;
 
 pub use error::{Error, Result};
