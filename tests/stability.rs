@@ -99,12 +99,17 @@ fn case1_sat_window_sums() {
             find(&rows, &format!("{map} 2048²: window means"), "sat", storage);
         }
     }
-    find(
-        &rows,
-        "random 2048²: window means",
-        "64² lookups",
-        "fixed u32",
-    );
+    for map in ["const 0.999", "random"] {
+        let what = format!("{map} 2048²: table = integer reference");
+        let r = find(&rows, &what, "64² lookups", "fixed");
+        assert_eq!(r.error, 0.0, "{map}: the wrapping table is exact");
+        find(
+            &rows,
+            &format!("{map} 2048²: window means"),
+            "64² lookups",
+            "fixed u32",
+        );
+    }
 }
 
 /// VSM, EVSM2, EVSM4 (f32 and f16) over a zero-variance occluder.

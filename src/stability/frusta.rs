@@ -183,7 +183,7 @@ pub(crate) fn frusta_case(gpu: &Gpu) -> Result<Vec<Row>> {
                 "depth32float",
             );
             row.note = format!(
-                "one f32 step of the depth buffer = {:.2} × bias",
+                "one f32 step of the depth buffer = {:.1e} × bias",
                 step / f64::from(BIAS)
             );
             rows.push(row);
