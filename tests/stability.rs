@@ -6,7 +6,7 @@
 //! (`cargo test --release --test stability -- --nocapture`).
 //!
 //! Case 1 builds two tables at 8192² (1 GiB each, read back only at the windows' corners) and
-//! five at 2048²: about half a minute on lavapipe with 2 cores; the other cases take seconds.
+//! six at 2048²: 30–50 s on lavapipe with 2 cores; the other cases take about a second.
 
 mod common;
 
@@ -71,8 +71,8 @@ fn find<'a>(rows: &'a [Row], what: &str, technique: &str, storage: &str) -> &'a 
 /// SAT window sums of a constant 0.999 map and a random map: the fixed-point tables equal the
 /// wrapping-integer reference at every corner read and their window means are within
 /// ½/scale; the f32 tables within the scan's rounding model. At 8192² one table per map (the
-/// constant map's f32 table, the random map's fixed-point table: five tables of 1 GiB took
-/// 60–80 s on 2 shared cores), every table at 2048².
+/// constant map's f32 table, the random map's whole-map fixed-point table: all six tables of
+/// 1 GiB take 75–85 s on 2 shared cores), every table at 2048².
 #[test]
 fn case1_sat_window_sums() {
     let rows = run_case(1, |g| {
