@@ -347,9 +347,9 @@ pub fn f16_to_f32(h: u16) -> f32 {
     let bits = match (exp, mant) {
         (0, 0) => sign,
         (0, m) => {
-            // Subnormal: renormalize.
+            // Subnormal m·2⁻²⁴: shift the leading 1 up to bit 10 (the implicit bit).
             let shift = m.leading_zeros() - 21;
-            sign | ((113 - shift) << 23) | ((m << (shift + 1)) & 0x3ff) << 13
+            sign | ((113 - shift) << 23) | ((m << shift) & 0x3ff) << 13
         }
         (31, m) => sign | 0x7f80_0000 | (m << 13),
         (e, m) => sign | ((e + 112) << 23) | (m << 13),
@@ -387,4 +387,30 @@ pub fn read_float_texture(
         bytemuck::cast_slice(&raw).to_vec()
     };
     Ok((channels, values))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::f16_to_f32;
+
+    /// Every half against its definition: `m·2⁻²⁴` (subnormal), `(1 + m/1024)·2^(e − 15)`,
+    /// infinities and NaNs.
+    #[test]
+    fn f16_to_f32_is_exact_for_every_half() {
+        for h in 0..=u16::MAX {
+            let (e, m) = (i32::from((h >> 10) & 0x1f), f64::from(h & 0x3ff));
+            let sign = if h >> 15 == 1 { -1.0 } else { 1.0 };
+            let want = match e {
+                0 => sign * m * 2f64.powi(-24),
+                31 if m == 0.0 => sign * f64::INFINITY,
+                31 => f64::NAN,
+                _ => sign * (1.0 + m / 1024.0) * 2f64.powi(e - 15),
+            };
+            let got = f64::from(f16_to_f32(h));
+            assert!(
+                got == want || (got.is_nan() && want.is_nan()),
+                "{h:#06x}: {got} vs {want}"
+            );
+        }
+    }
 }

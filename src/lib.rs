@@ -15,6 +15,7 @@ pub mod prefilter;
 pub mod render;
 pub mod sat;
 pub mod scene;
+pub mod stability;
 pub mod technique;
 pub mod truth;
 

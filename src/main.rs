@@ -102,6 +102,13 @@ enum Command {
         #[arg(long, value_parser = parse_size)]
         image: Option<(u32, u32)>,
     },
+    /// Run the numerical-stability suite: each hard input through the real kernels against its
+    /// f64 reference and stated bound; exits non-zero when a check fails.
+    Stability {
+        /// Summed-area tables at 8192² (1 GiB each) instead of 2048².
+        #[arg(long)]
+        large: bool,
+    },
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -192,6 +199,18 @@ fn run(args: Args) -> Result<()> {
                     );
                 }
                 None => print!("{}", shadowgraph::bench::run(&gpu, &sizes, repeat)?),
+            }
+        }
+        Command::Stability { large } => {
+            let gpu = Gpu::new()?;
+            let opts = shadowgraph::stability::StabilityOptions { large };
+            let report = shadowgraph::stability::run(&gpu, &opts, &mut |case, name| {
+                eprintln!("stability: case {case}/7, {name}");
+            })?;
+            print!("{}", report.table());
+            let failed = report.failures().len();
+            if failed > 0 {
+                anyhow::bail!("{failed} stability check(s) failed");
             }
         }
     }

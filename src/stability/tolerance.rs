@@ -1,0 +1,102 @@
+//! Error models of the shading kernel's f32 visibility functions against their f64
+//! references, evaluated on the same filtered maps: how far apart the two may be.
+
+use std::f64::consts::PI;
+
+use super::check::U;
+use crate::cpu::Texels;
+use crate::cpu::light::LightSample;
+use crate::cpu::vis_msm::{biased_moments, intensity};
+use crate::technique::{LightGpu, MSM_HAUSDORFF, MSM_QUANTIZED};
+
+/// First-order bound on the f32 error of the one-tailed Chebyshev bound
+/// `p = σ² / (σ² + t²)`, `σ² = max(E[x²] − E[x]², floor)`, `t = r − E[x]`, when every input
+/// carries relative error `e`: the cancellation in σ² amplifies it by `E[x²] / σ²`.
+pub(crate) fn chebyshev(mean: f64, mean_sq: f64, receiver: f64, floor: f64, e: f64) -> f64 {
+    if receiver <= mean {
+        return 0.0;
+    }
+    let var = (mean_sq - mean * mean).max(floor);
+    let t = receiver - mean;
+    let dvar = e * (mean_sq.abs() + 2.0 * mean * mean);
+    let dt = e * (receiver.abs() + mean.abs());
+    (t * t * dvar + 2.0 * t.abs() * var * dt) / (var + t * t).powi(2)
+}
+
+/// VSM at `s`: the bilinear mix and the receiver's depth carry ~8 roundings; then the
+/// light-bleeding reduction divides by `1 − bleed`. Plus 1e-5 for the final arithmetic.
+pub(crate) fn vsm(maps: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
+    let m = crate::cpu::mips::sample(maps, l, s);
+    let d = s.depth - f64::from(l.bias);
+    let dp = chebyshev(m[0], m[1], d, f64::from(l.min_variance), 8.0 * U);
+    1e-5 + dp / (1.0 - f64::from(l.bleed))
+}
+
+/// EVSM at `s`: besides VSM's roundings, SPIR-V's `exp` is accurate to `(3 + 2|x|)` ULP
+/// (|x| ≤ c), and the receiver's depth error is amplified by `2c` through the warp.
+pub(crate) fn evsm(maps: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
+    let m = crate::cpu::mips::sample(maps, l, s);
+    let [(pos, floor_pos), (neg, floor_neg)] = crate::cpu::vis_evsm::warp(l, s, &m);
+    let ulp = 2.0 * U;
+    let e = |c: f32| {
+        let c = f64::from(c);
+        (3.0 + 2.0 * c) * ulp + 8.0 * ulp + 4.0 * c * ulp
+    };
+    let mut dp = chebyshev(m[0], m[1], pos, floor_pos, e(l.exp_pos));
+    if l.moments == 4 {
+        dp = dp.max(chebyshev(m[2], m[3], neg, floor_neg, e(l.exp_neg)));
+    }
+    1e-5 + dp / (1.0 - f64::from(l.bleed))
+}
+
+/// MSM at `s`: Cholesky in f32 is backward stable, so the GPU computes the exact answer for
+/// moments off by a few dozen roundings. The tolerance is twice the largest change of the f64
+/// reference over 16 such perturbations (32·u relative per moment, ±8·u on the depth; with
+/// quantized storage also 8·u·Σ|q| absolute per moment, the f32 dequantization `q·M` with
+/// entries of `M` below 1), plus 1e-4 for the final rational expression, over `1 − bleed`.
+pub(crate) fn msm(maps: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
+    let b = biased_moments(maps, l, s);
+    let dequantized = if l.msm_flags & MSM_QUANTIZED != 0 {
+        let q = crate::cpu::mips::sample(maps, l, s);
+        8.0 * U * q.iter().map(|v| v.abs()).sum::<f64>()
+    } else {
+        0.0
+    };
+    let d = s.depth - f64::from(l.bias);
+    let hausdorff = l.msm_flags & MSM_HAUSDORFF != 0;
+    let vis = |b: [f64; 4], d: f64| {
+        let v = 1.0 - intensity(b, d, hausdorff).clamp(0.0, 1.0);
+        if v.is_nan() { 1.0 } else { v }
+    };
+    let base = vis(b, d);
+    let e = 32.0 * U;
+    let mut worst: f64 = 0.0;
+    for k in 0..16u32 {
+        let sign = |bit: u32| if k >> bit & 1 == 1 { 1.0 } else { -1.0 };
+        let p: [f64; 4] = std::array::from_fn(|i| {
+            b[i] * (1.0 + sign(i as u32) * e) + sign(i as u32) * dequantized
+        });
+        let dd = d + sign(k % 4) * 8.0 * U;
+        worst = worst.max((vis(p, dd) - base).abs());
+    }
+    (1e-4 + 2.0 * worst) / (1.0 - f64::from(l.bleed))
+}
+
+/// CSM's term weights `w_k = (2 / c_k)·exp(−α (k/M)²)`, k = 1..=M.
+pub(crate) fn csm_weights(l: &LightGpu) -> Vec<f64> {
+    let m = f64::from(l.csm_terms);
+    (1..=l.csm_terms)
+        .map(|k| {
+            let kf = f64::from(k) / m;
+            2.0 / (PI * f64::from(2 * k - 1)) * (-f64::from(l.csm_attenuation) * kf * kf).exp()
+        })
+        .collect()
+}
+
+/// CSM: Vulkan specifies `sin`/`cos` to 2⁻¹¹ absolute on [−π, π] (the kernels reduce their
+/// arguments there), so term k may be off by `w_k·2·2⁻¹¹` in the receiver's factors; the sum
+/// is scaled by `scale`. Plus 1e-5 for the f32 sum.
+pub(crate) fn csm(l: &LightGpu) -> f64 {
+    let w: f64 = csm_weights(l).iter().sum();
+    1e-5 + f64::from(l.csm_scale) * w * 2.0 * 2f64.powi(-11)
+}
