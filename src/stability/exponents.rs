@@ -8,9 +8,10 @@
 //! refuse (beyond its range) the exponent; what the clamp prevents is shown by encoding with
 //! an unclamped exponent.
 //!
-//! The scene-level `filter = "sat"` coding is being added separately; this case applies
-//! `add_sat` to the encoded map directly. Once that lands, the SAT rows should run the
-//! scene's own coding through the scene path as well.
+//! The rows above apply `add_sat` to the encoded map directly; [`scene_sat_rows`] runs the
+//! scene path too: `filter = "sat"` scenes whose exponents the validator clamps to the table's
+//! limit (`scene::sat_exponent_limit`), rendered, their tables decoded texel by texel against
+//! the f64 encoding of the GPU's linear map within the coding's step, and their visibility.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -337,6 +338,112 @@ fn unclamped(gpu: &Gpu, exec: &mut Executor, raw: &[f32], storage: Storage, c: f
     ))
 }
 
+/// The scene path of `filter = "sat"`: EVSM4 (f32 and f16) and ESM with their default
+/// exponents (40, 5 and 80, which the validator clamps to the table's limit for a 9-texel box:
+/// ½ ln(2²²/100) = 5.3 and 4× that), a box over a plane at a grazing light so the map spans
+/// its depth range. The table decoded texel by texel (`sat::decode_table`, what the lookups
+/// integrate) equals the f64 encoding of the GPU's linear map within ½/scale per channel (plus
+/// SPIR-V's `exp` to (3 + 2|x|) ULP and 2⁻¹⁰ relative for f16 storage); visibility is finite
+/// and in [0, 1].
+pub(crate) fn scene_sat_rows(gpu: &Gpu) -> Result<Vec<Row>> {
+    let path = Path::new("stability.toml");
+    let mut rows = Vec::new();
+    for (name, shadow, storage) in [
+        (
+            "evsm4",
+            "technique = \"evsm4\"\nformat = \"f32\"",
+            Storage::F32,
+        ),
+        (
+            "evsm4",
+            "technique = \"evsm4\"\nformat = \"f16\"",
+            Storage::F16,
+        ),
+        ("esm", "technique = \"esm\"", Storage::F32),
+    ] {
+        let text = format!(
+            "[output]\nwidth = 64\nheight = 48\n\n[camera]\nposition = [0.0, 4.0, 7.5]\n\
+             target = [0.0, 0.0, 0.0]\nfov_y_degrees = 40.0\n\n[[light]]\nkind = \"directional\"\n\
+             position = [-5.0, 3.0, 3.0]\ntarget = [0.0, 0.0, 0.0]\nextent = 4.0\nnear = 1.0\n\
+             far = 14.0\nshadow_map = 128\n\n[light.shadow]\n{shadow}\nfilter = \"sat\"\n\
+             filter_width = 9.0\n\n[[object]]\nshape = \"plane\"\nsize = [8.0, 8.0]\n\n\
+             [[object]]\nshape = \"box\"\nsize = [1.0, 2.0, 1.0]\ntranslate = [0.0, 1.0, 0.0]\n"
+        );
+        let scene = Scene::parse(path, &text)?;
+        let light = &scene.lights[0];
+        let technique = light.shadow.technique;
+        let coding = crate::technique::sat_coding(light)?
+            .ok_or_else(|| Error::Invalid("sat filter without a coding".into()))?;
+        let mut renderer = crate::render::Renderer::new(&gpu.device);
+        let frame = renderer.render(
+            &gpu.device,
+            &gpu.queue,
+            &scene,
+            crate::render::RenderOptions {
+                aux: true,
+                repeat: 1,
+                dump: false,
+            },
+        )?;
+        let linear = frame.linear_maps[0]
+            .as_ref()
+            .ok_or_else(|| Error::Invalid("no linear map".into()))?;
+        let lin = Texels::from_f32(
+            linear.width as usize,
+            linear.height as usize,
+            1,
+            &linear.data,
+        );
+        let (want, exponent) = match technique {
+            Technique::Evsm {
+                exp_pos, exp_neg, ..
+            } => (
+                cpu::evsm::evsm(&lin, exp_pos.into(), exp_neg.into()),
+                exp_pos.max(exp_neg),
+            ),
+            Technique::Esm { exponent, .. } => {
+                (cpu::esm::esm_linear(&lin, exponent.into()), exponent)
+            }
+            _ => return Err(Error::Invalid("case 4 runs exponential techniques".into())),
+        };
+        let got = &frame.shade_maps[0];
+        let mut check = Check::new();
+        let f16 = if storage == Storage::F16 {
+            2f64.powi(-10)
+        } else {
+            0.0
+        };
+        let exp_ulp = (3.0 + 4.0 * f64::from(exponent)) * U * 2.0;
+        for (i, (g, w)) in got
+            .data
+            .chunks(got.channels)
+            .zip(want.data.chunks(want.channels))
+            .enumerate()
+        {
+            for c in 0..want.channels.min(got.channels) {
+                let step = 0.5 / f64::from(coding.scale[c]) * (1.0 + 2f64.powi(-20));
+                let bound = step + (exp_ulp + f16 + 4.0 * U) * w[c].abs();
+                check.compare(f64::from(g[c]), w[c], bound, || {
+                    format!("texel {i} channel {c}")
+                });
+            }
+        }
+        for (i, v) in frame.visibility.iter().enumerate() {
+            if !(v.is_finite() && (0.0..=1.0).contains(v)) {
+                check.problem(format!("visibility {v} at pixel {i}"));
+            }
+        }
+        let label = format!("{name} c={exponent:.2}");
+        rows.push(check.row(
+            4,
+            "scene filter = \"sat\" (exponent clamped to the table): decoded table vs f64",
+            &label,
+            &format!("{} → sat fixed u32", super::planar::storage_name(storage)),
+        ));
+    }
+    Ok(rows)
+}
+
 /// A one-light scene whose shadow table has `shadow`.
 fn scene_text(shadow: &str) -> String {
     format!(
@@ -442,6 +549,7 @@ pub(crate) fn exponent_case(gpu: &Gpu) -> Result<Vec<Row>> {
             |f| esm(f, c),
         )?);
     }
+    rows.extend(scene_sat_rows(gpu)?);
     rows.push(unclamped(gpu, &mut exec, &raw, Storage::F32, 45.0)?);
     rows.push(unclamped(gpu, &mut exec, &raw, Storage::F16, 5.6)?);
     rows.extend(validator_rows());
