@@ -554,7 +554,7 @@ fn soft_inputs(
         sm.channels,
         &sm.data,
     );
-    common::soft::SoftInputs::new(light, &level0, common::soft::trig_error(g))
+    common::soft::SoftInputs::new(light, &level0, common::soft_maps::trig_error(g))
 }
 
 /// How far two runs of a soft light may differ at pixel `px`: 1e-5 or twice the propagated

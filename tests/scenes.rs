@@ -109,7 +109,7 @@ fn pixel_reference(
 #[test]
 fn every_scene_renders_and_matches_the_references() {
     let g = common::gpu();
-    let e_trig = common::soft::trig_error(&g);
+    let e_trig = common::soft_maps::trig_error(&g);
     let mut renderer = Renderer::new(&g.device);
     for path in scenes() {
         let scene = Scene::load(&path).expect("scene loads");

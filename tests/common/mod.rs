@@ -2,6 +2,7 @@
 #![allow(dead_code, reason = "each test binary uses a subset")]
 
 pub mod soft;
+pub mod soft_maps;
 
 use rand::{Rng, SeedableRng, rngs::SmallRng};
 use shadowgraph::gpu::Gpu;

@@ -1,5 +1,5 @@
-//! Tolerances of the soft techniques (`cssm`, `vssm`, `msm_soft`) and the device's measured
-//! trigonometric error, shared by tests/soft.rs and tests/scenes.rs.
+//! Tolerances of the soft techniques (`cssm`, `vssm`, `msm_soft`) and the inputs of their f64
+//! references, shared by tests/soft.rs, tests/scenes.rs and tests/plugin.rs.
 //!
 //! A soft visibility is a chain: table means over the search square → blocker estimate →
 //! filter width → table means over it → visibility. The GPU's errors enter at the means (f32
@@ -9,18 +9,14 @@
 //! combination of the errors on the search step's inputs gives a range of blocker depths
 //! z_avg ± δz (the visibility is then re-evaluated, exactly, at the widths of z_avg ± δz), and
 //! every combination on the final step's inputs a range of visibilities (at five scales of the
-//! errors, see `combinations`); the tolerance is
-//! twice the largest change of each, plus 1e-5 (first-order propagation is not a bound on
-//! its own: the factor 2 covers curvature). A point where a perturbation flips whether the
+//! errors, see `combinations`); the tolerance is twice the largest change of each, plus 1e-5
+//! (first-order propagation is not a bound on its own: the factor 2 covers curvature). A point where a perturbation flips whether the
 //! search square holds blockers (a threshold, `BLOCKER_MIN_SHARE`) has no tolerance: `None`.
-
-use std::collections::HashMap;
 
 use shadowgraph::cpu::blocker::Blocker;
 use shadowgraph::cpu::light::LightSample;
 use shadowgraph::cpu::sat::Integral;
 use shadowgraph::cpu::{self, Texels};
-use shadowgraph::gpu::Gpu;
 use shadowgraph::sat::{SatCoding, SatVariant};
 use shadowgraph::technique::{LightGpu, MSM_HAUSDORFF, MSM_QUANTIZED};
 
@@ -348,96 +344,6 @@ pub fn cssm_tolerance(
     }
     .tolerance(v0)
     .map(|t| t + 2.0 * pow)
-}
-
-/// The device's largest error of CSM's `csm_sin_cos` against f64, measured by running the
-/// `csm` kernel (M = 16: every factor the shading can use) over 65 536 depths spread over
-/// [−0.25, 1.25] (receiver depths shifted by bias and offset stay inside). Asserts Vulkan's
-/// bound of 2⁻¹¹ on [−π, π]; returns twice the measured error (the sweep samples the
-/// functions, the factor covers depths between samples) plus 2⁻²⁴.
-pub fn trig_error(g: &Gpu) -> f64 {
-    use shadowgraph::graph::{Dispatch, Graph, Node, SizeRule, plan};
-    let (w, h) = (256u32, 256u32);
-    let z: Vec<f32> = (0..w * h)
-        .map(|i| -0.25 + 1.5 * i as f32 / (w * h - 1) as f32)
-        .collect();
-    let terms = 16u32;
-    let mut graph = Graph::default();
-    graph.import("in", wgpu::TextureFormat::R32Float, w, h, Some(0));
-    let mut outputs = Vec::new();
-    for chunk in 0..terms / 2 {
-        let out = format!("basis{chunk}");
-        graph.resource(
-            &out,
-            wgpu::TextureFormat::Rgba32Float,
-            SizeRule::Reduced {
-                of: "in".into(),
-                shift: 0,
-            },
-            Some(0),
-        );
-        graph.node(Node {
-            name: out.clone(),
-            kernel: "csm".into(),
-            inputs: vec![("src".into(), "in".into())],
-            outputs: vec![("dst".into(), out.clone())],
-            params: bytemuck::bytes_of(&shadowgraph::technique::CsmParams {
-                first_term: 2 * chunk + 1,
-                terms,
-                _pad: [0; 2],
-            })
-            .to_vec(),
-            dispatch: Dispatch::Texels(out.clone()),
-            light: Some(0),
-        });
-        outputs.push(out);
-    }
-    let names: Vec<&str> = outputs.iter().map(String::as_str).collect();
-    let p = plan(&graph, &names).expect("plan");
-    let input = g.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("test.trig"),
-        size: wgpu::Extent3d {
-            width: w,
-            height: h,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::R32Float,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
-    shadowgraph::gpu::write_texture(&g.queue, &input, bytemuck::cast_slice(&z));
-    let mut exec = shadowgraph::exec::Executor::new();
-    let imports = HashMap::from([("in".to_string(), input)]);
-    let mut enc = g.device.create_command_encoder(&Default::default());
-    let out = exec
-        .record(&g.device, &mut enc, &p, &imports, None)
-        .expect("record");
-    shadowgraph::gpu::submit_and_wait(&g.device, &g.queue, enc, "trig").expect("submit");
-    let mut worst: f64 = 0.0;
-    for (chunk, name) in outputs.iter().enumerate() {
-        let (_, data) =
-            shadowgraph::gpu::read_float_texture(&g.device, &g.queue, &out.textures[name], 0)
-                .expect("readback");
-        for (i, texel) in data.chunks(4).enumerate() {
-            let zi = f64::from(z[i]);
-            for j in 0..2 {
-                let k = 2 * chunk as u32 + 1 + j as u32;
-                let c = std::f64::consts::PI * f64::from(2 * k - 1);
-                let e_sin = (f64::from(texel[2 * j]) - (c * zi).sin()).abs();
-                let e_cos = (f64::from(texel[2 * j + 1]) - (c * zi).cos()).abs();
-                worst = worst.max(e_sin).max(e_cos);
-            }
-        }
-    }
-    // The depth itself is exact in f32 here; the reference's argument is the f32 value.
-    assert!(
-        worst <= 2f64.powi(-11),
-        "sin/cos error {worst:e} exceeds Vulkan's 2⁻¹¹"
-    );
-    2.0 * worst + ULP
 }
 
 /// A CSSM light's shade map (its tables' values side by side, `technique::map_channels`
