@@ -158,8 +158,13 @@ pub fn check_limits(device: &wgpu::Device, scene: &Scene) -> Result<()> {
 pub fn check_features(device: &wgpu::Device, lights: &[Light]) -> Result<()> {
     use crate::scene::{Storage, Technique};
     for (i, l) in lights.iter().enumerate() {
-        if let Technique::Msm { prefilter, .. } = l.shadow.technique {
-            if prefilter.storage == Storage::Unorm16
+        let storage = match l.shadow.technique {
+            Technique::Msm { prefilter, .. } => Some(prefilter.storage),
+            Technique::MsmSoft { soft, .. } => Some(soft.storage),
+            _ => None,
+        };
+        if let Some(storage) = storage {
+            if storage == Storage::Unorm16
                 && !device
                     .features()
                     .contains(wgpu::Features::TEXTURE_FORMAT_16BIT_NORM)
@@ -1069,7 +1074,8 @@ fn depth_only_view(t: &wgpu::Texture) -> wgpu::TextureView {
 pub struct ProbeMap<'a> {
     /// Side length of level 0.
     pub size: u32,
-    /// Texel format of `data` (a 32-bit float format).
+    /// Texel format of `data`: a 32-bit float format, or `Rgba32Uint` for a fixed-point
+    /// summed-area table, whose words `data` carries bit for bit (`f32::from_bits`).
     pub format: wgpu::TextureFormat,
     /// Mip levels in `data` (1 for a plain map).
     pub mips: u32,

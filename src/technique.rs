@@ -6,7 +6,7 @@ use std::fmt::Write;
 use crate::filter::{BlurMode, add_filter};
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
 use crate::sat::{SatCoding, SatVariant, add_sat, lookup_area};
-use crate::scene::{Filter, Light, LightKind, PcfKernel, Storage, Technique};
+use crate::scene::{Filter, Light, LightKind, PcfKernel, Prefilter, Soft, Storage, Technique};
 
 /// A light as the shading kernel reads it. Mirrors `struct Light` in
 /// `kernels/shared/light.wgsl` (a test checks the size against naga's layout).
@@ -41,7 +41,8 @@ pub struct LightGpu {
     pub normal_bias: f32,
     /// Spot: cos(fov/2); directional: −1.
     pub cos_outer: f32,
-    /// 0 hard, 1 pcf, 2 pcss, 3 vsm, 4 evsm, 5 esm, 6 msm, 7 csm.
+    /// 0 hard, 1 pcf, 2 pcss, 3 vsm, 4 evsm, 5 esm, 6 msm, 7 csm, 8 cssm, 9 vssm,
+    /// 10 msm_soft.
     pub technique: u32,
     /// PCF radius.
     pub radius: u32,
@@ -51,7 +52,7 @@ pub struct LightGpu {
     pub blocker_samples: u32,
     /// PCSS filter taps.
     pub filter_samples: u32,
-    /// PCSS search cap (UV).
+    /// PCSS and soft techniques: search cap (UV).
     pub max_search: f32,
     /// VSM light-bleeding reduction.
     pub bleed: f32,
@@ -88,6 +89,15 @@ pub struct LightGpu {
     pub sat_offset: [f32; 4],
     /// SAT filter: the table's per-channel scale ([`SatCoding::scale`]).
     pub sat_scale: [f32; 4],
+    /// CSSM: sharpening strength A of `v^p`, `p = 1 + A·exp(−B (d − z_avg))`.
+    pub sharpen: f32,
+    /// CSSM: sharpening falloff B, per linear depth unit.
+    pub sharpen_falloff: f32,
+    /// Soft techniques: cap on the search and filter widths in texels ([`soft_max_width`];
+    /// 0 otherwise).
+    pub max_width: f32,
+    /// Padding to the WGSL struct's 16-byte alignment.
+    pub _pad1: u32,
 }
 
 /// MSM flag: Hausdorff reconstruction.
@@ -120,9 +130,17 @@ impl LightGpu {
                 Technique::Esm { .. } => (5, 0, 0, 0, 0, 0.0),
                 Technique::Msm { .. } => (6, 0, 0, 0, 0, 0.0),
                 Technique::Csm { .. } => (7, 0, 0, 0, 0, 0.0),
+                Technique::Cssm { soft, .. } => (8, 0, 0, 0, 0, soft.max_search),
+                Technique::Vssm { soft, .. } => (9, 0, 0, 0, 0, soft.max_search),
+                Technique::MsmSoft { soft, .. } => (10, 0, 0, 0, 0, soft.max_search),
             };
         let (bleed, min_variance, exp_pos, exp_neg, moments) = match light.shadow.technique {
             Technique::Vsm {
+                bleed,
+                min_variance,
+                ..
+            }
+            | Technique::Vssm {
                 bleed,
                 min_variance,
                 ..
@@ -142,7 +160,9 @@ impl LightGpu {
                 if four { 4 } else { 2 },
             ),
             Technique::Esm { exponent, .. } => (0.0, 0.0, exponent, 0.0, 1),
-            Technique::Msm { bleed, .. } => (bleed, 0.0, 0.0, 0.0, 4),
+            Technique::Msm { bleed, .. } | Technique::MsmSoft { bleed, .. } => {
+                (bleed, 0.0, 0.0, 0.0, 4)
+            }
             _ => (0.0, 0.0, 0.0, 0.0, 0),
         };
         let (moment_bias, msm_flags) = match light.shadow.technique {
@@ -151,11 +171,13 @@ impl LightGpu {
                 hausdorff,
                 moment_bias,
                 ..
-            } => (
+            } => (moment_bias, msm_flags(hausdorff, prefilter.storage)),
+            Technique::MsmSoft {
+                soft,
+                hausdorff,
                 moment_bias,
-                u32::from(hausdorff) * MSM_HAUSDORFF
-                    + u32::from(msm_quantized(prefilter.storage)) * MSM_QUANTIZED,
-            ),
+                ..
+            } => (moment_bias, msm_flags(hausdorff, soft.storage)),
             _ => (0.0, 0),
         };
         let (csm_terms, csm_attenuation, csm_offset, csm_scale) = match light.shadow.technique {
@@ -165,8 +187,23 @@ impl LightGpu {
                 offset,
                 scale,
                 ..
+            }
+            | Technique::Cssm {
+                terms,
+                attenuation,
+                offset,
+                scale,
+                ..
             } => (terms, attenuation, offset, scale),
             _ => (0, 0.0, 0.0, 1.0),
+        };
+        let (sharpen, sharpen_falloff) = match light.shadow.technique {
+            Technique::Cssm {
+                sharpen,
+                sharpen_falloff,
+                ..
+            } => (sharpen, sharpen_falloff),
+            _ => (0.0, 0.0),
         };
         let (mip_levels, filter_lod, max_anisotropy) = match light.shadow.technique.filter() {
             Some(Filter::Mips {
@@ -221,17 +258,22 @@ impl LightGpu {
             max_anisotropy,
             sat_offset: [0.0; 4],
             sat_scale: [1.0; 4],
+            sharpen,
+            sharpen_falloff,
+            max_width: soft_max_width(light).unwrap_or(0.0),
+            _pad1: 0,
         }
         .with_sat(light)
     }
 
-    /// The SAT fields for `light` (left as they are without the `sat` filter or when its
-    /// coding is invalid, which [`sat_coding`] reports).
+    /// The SAT fields for `light` (left as they are without a summed-area table or when its
+    /// coding is invalid, which [`sat_coding`] reports). A soft technique's width is per
+    /// receiver: `filter_width` stays 0.
     fn with_sat(mut self, light: &Light) -> Self {
-        if let (Some(Filter::Sat { width, .. }), Ok(Some(c))) =
-            (light.shadow.technique.filter(), sat_coding(light))
-        {
-            self.filter_width = width;
+        if let Ok(Some(c)) = sat_coding(light) {
+            if let Some(Filter::Sat { width, .. }) = light.shadow.technique.filter() {
+                self.filter_width = width;
+            }
             self.sat_offset = c.offset;
             self.sat_scale = c.scale;
         }
@@ -239,21 +281,81 @@ impl LightGpu {
     }
 }
 
-/// The summed-area-table coding of light `light`'s representation when its filter is `sat`
-/// (`None` otherwise): the value range of every channel over linear depths in [0, 1], and
-/// the largest window the lookups touch ([`lookup_area`] of the filter width).
+/// The MSM flags of a reconstruction and storage.
+fn msm_flags(hausdorff: bool, storage: Storage) -> u32 {
+    u32::from(hausdorff) * MSM_HAUSDORFF + u32::from(msm_quantized(storage)) * MSM_QUANTIZED
+}
+
+/// The largest square a soft technique reads (blocker search or filter), in texels:
+/// `2·max_search·map_size`, clamped to `[1, map_size]` (a larger square is clamped to the map
+/// by the lookups anyway); `None` for other techniques. Per-receiver widths are clamped to it
+/// in `kernels/shared/blocker.wgsl`, and the fixed-point table is coded for it.
+pub fn soft_max_width(light: &Light) -> Option<f32> {
+    let soft = light.shadow.technique.soft()?;
+    Some(soft_width_cap(soft.max_search, light.shadow_map))
+}
+
+/// [`soft_max_width`] for a search cap `max_search` (UV) on a `map`² shadow map.
+pub fn soft_width_cap(max_search: f32, map: u32) -> f32 {
+    let n = map as f32;
+    (2.0 * max_search * n).clamp(1.0, n.max(1.0))
+}
+
+/// The window area a soft technique's fixed-point table is coded for: [`lookup_area`] of
+/// its width cap plus one texel (the rectangle's edges are formed in f32 from a per-receiver
+/// width).
+pub fn soft_lookup_area(max_search: f32, map: u32) -> u64 {
+    let w = soft_width_cap(max_search, map) + 1.0;
+    lookup_area(w, w)
+}
+
+/// The table variant of `light`'s summed-area table, if its technique reads one (the `sat`
+/// filter or a soft technique).
+pub fn sat_variant(light: &Light) -> Option<SatVariant> {
+    match (
+        light.shadow.technique.filter(),
+        light.shadow.technique.soft(),
+    ) {
+        (Some(Filter::Sat { variant, .. }), _) => Some(variant),
+        (_, Some(Soft { sums, .. })) => Some(sums),
+        _ => None,
+    }
+}
+
+/// The summed-area-table coding of light `light`'s representation when it is read through a
+/// table (the `sat` filter or a soft technique; `None` otherwise): the value range of every
+/// channel over linear depths in [0, 1], and the largest window the lookups touch
+/// ([`lookup_area`] of the filter width; for a soft technique of [`soft_max_width`] plus one
+/// texel, since its rectangle's edges are formed in f32 from a per-receiver width).
 ///
 /// Ranges: VSM and raw MSM moments [0, 1]; EVSM `±exp(±c z')` and their squares over
 /// z' ∈ [−1, 1] as `±max |v|` (offset 0); ESM (stored linearly for the table)
-/// `exp(c (z − 1)) ∈ [e^{−c}, 1]` as ±1; CSM's
-/// sines and cosines [−1, 1]; quantized MSM moments the range of the quantization over the
+/// `exp(c (z − 1)) ∈ [e^{−c}, 1]` as ±1; CSM's sines and cosines and CSSM's CSM-Z basis
+/// (z, z·sin, z·cos) [−1, 1]; quantized MSM moments the range of the quantization over the
 /// moment curve, sampled at 4097 depths and widened by 10⁻³ of the range (the curve is a
 /// quartic: sampling misses its extremes by far less).
 pub fn sat_coding(light: &Light) -> crate::error::Result<Option<SatCoding>> {
-    let Some(Filter::Sat { width, variant }) = light.shadow.technique.filter() else {
+    let area = match (light.shadow.technique.filter(), soft_max_width(light)) {
+        (Some(Filter::Sat { width, .. }), _) => lookup_area(width, width),
+        (_, Some(_)) => match light.shadow.technique.soft() {
+            Some(soft) => soft_lookup_area(soft.max_search, light.shadow_map),
+            None => return Ok(None),
+        },
+        _ => return Ok(None),
+    };
+    let Some(variant) = sat_variant(light) else {
         return Ok(None);
     };
-    let (lo, hi): ([f32; 4], [f32; 4]) = match light.shadow.technique {
+    let (lo, hi) = value_range(&light.shadow.technique);
+    Ok(Some(match variant {
+        SatVariant::Fixed => SatCoding::fixed(area, lo, hi)?,
+        SatVariant::Float => SatCoding::float(lo, hi)?,
+    }))
+}
+
+/// Per channel, the range of the values a technique's table sums (see [`sat_coding`]).
+fn value_range(technique: &Technique) -> ([f32; 4], [f32; 4]) {
+    match *technique {
         // Exponential moments span orders of magnitude, most of them close to 0: coded about 0
         // (range ±max|v|) every value keeps f32's relative precision through the lookups'
         // weighting, where a centred offset would leave the small ones an absolute error of
@@ -267,28 +369,30 @@ pub fn sat_coding(light: &Light) -> crate::error::Result<Option<SatCoding>> {
         }
         Technique::Esm { .. } => ([-1.0, 0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]),
         Technique::Msm { prefilter, .. } if msm_quantized(prefilter.storage) => {
-            let (mut lo, mut hi) = ([f64::MAX; 4], [f64::MIN; 4]);
-            for k in 0..=4096 {
-                let z = f64::from(k) / 4096.0;
-                let q = crate::cpu::msm::quantize([z, z * z, z.powi(3), z.powi(4)]);
-                for c in 0..4 {
-                    lo[c] = lo[c].min(q[c]);
-                    hi[c] = hi[c].max(q[c]);
-                }
-            }
-            let pad = |c: usize| 1e-3 * (hi[c] - lo[c]);
-            (
-                std::array::from_fn(|c| (lo[c] - pad(c)) as f32),
-                std::array::from_fn(|c| (hi[c] + pad(c)) as f32),
-            )
+            quantized_msm_range()
         }
-        Technique::Csm { .. } => ([-1.0; 4], [1.0; 4]),
+        Technique::MsmSoft { soft, .. } if msm_quantized(soft.storage) => quantized_msm_range(),
+        Technique::Csm { .. } | Technique::Cssm { .. } => ([-1.0; 4], [1.0; 4]),
         _ => ([0.0; 4], [1.0; 4]),
-    };
-    Ok(Some(match variant {
-        SatVariant::Fixed => SatCoding::fixed(lookup_area(width, width), lo, hi)?,
-        SatVariant::Float => SatCoding::float(lo, hi)?,
-    }))
+    }
+}
+
+/// The range of MSM's optimized quantization over the moment curve (see [`sat_coding`]).
+fn quantized_msm_range() -> ([f32; 4], [f32; 4]) {
+    let (mut lo, mut hi) = ([f64::MAX; 4], [f64::MIN; 4]);
+    for k in 0..=4096 {
+        let z = f64::from(k) / 4096.0;
+        let q = crate::cpu::msm::quantize([z, z * z, z.powi(3), z.powi(4)]);
+        for c in 0..4 {
+            lo[c] = lo[c].min(q[c]);
+            hi[c] = hi[c].max(q[c]);
+        }
+    }
+    let pad = |c: usize| 1e-3 * (hi[c] - lo[c]);
+    (
+        std::array::from_fn(|c| (lo[c] - pad(c)) as f32),
+        std::array::from_fn(|c| (hi[c] + pad(c)) as f32),
+    )
 }
 
 /// Parameters of `kernels/linearize.wgsl` (mirrors its `Params`).
@@ -367,8 +471,15 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
             ..
         } => one(depth, "texture_depth_2d"),
         Technique::Hard | Technique::Pcf { .. } | Technique::Pcss { .. } => one(linear, float),
-        Technique::Vsm { prefilter, .. } => {
-            let format = moments_format(prefilter.storage, 2);
+        Technique::Vsm {
+            prefilter: Prefilter { storage, .. },
+            ..
+        }
+        | Technique::Vssm {
+            soft: Soft { storage, .. },
+            ..
+        } => {
+            let format = moments_format(storage, 2);
             let moments = encode(graph, i, "vsm", "vsm", &linear, format, Vec::new());
             one(filtered(graph, i, light, &moments, BlurMode::Linear), float)
         }
@@ -395,10 +506,17 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
                 float,
             )
         }
-        Technique::Msm { prefilter, .. } => {
-            let format = moments_format(prefilter.storage, 4);
+        Technique::Msm {
+            prefilter: Prefilter { storage, .. },
+            ..
+        }
+        | Technique::MsmSoft {
+            soft: Soft { storage, .. },
+            ..
+        } => {
+            let format = moments_format(storage, 4);
             let params = bytemuck::bytes_of(&MsmParams {
-                quantized: u32::from(msm_quantized(prefilter.storage)),
+                quantized: u32::from(msm_quantized(storage)),
                 _pad: [0; 3],
             })
             .to_vec();
@@ -406,23 +524,20 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
             one(filtered(graph, i, light, &moments, BlurMode::Linear), float)
         }
         Technique::Csm {
-            prefilter, terms, ..
+            prefilter: Prefilter { storage, .. },
+            terms,
+            ..
+        } => ShadeInput {
+            maps: csm_nodes(graph, i, light, &linear, storage, terms),
+            wgsl_type: float,
+        },
+        Technique::Cssm {
+            soft: Soft { storage, .. },
+            terms,
+            ..
         } => {
-            let maps = (0..csm_maps(terms))
-                .map(|chunk| {
-                    let pairs = (terms - 2 * chunk).min(2);
-                    let format = moments_format(prefilter.storage, 2 * pairs);
-                    let params = bytemuck::bytes_of(&CsmParams {
-                        first_term: 2 * chunk + 1,
-                        terms,
-                        _pad: [0; 2],
-                    })
-                    .to_vec();
-                    let name = format!("csm{chunk}");
-                    let basis = encode(graph, i, "csm", &name, &linear, format, params);
-                    filtered(graph, i, light, &basis, BlurMode::Linear)
-                })
-                .collect();
+            let mut maps = csm_nodes(graph, i, light, &linear, storage, terms);
+            maps.extend(csm_z_nodes(graph, i, light, &linear, storage, terms));
             ShadeInput {
                 maps,
                 wgsl_type: float,
@@ -431,15 +546,72 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
     }
 }
 
-/// The filter of light `light`'s representation applied to `input`: the blur or mip chain of
-/// [`add_filter`], or the summed-area table of [`add_sat`] coded by [`sat_coding`] (whose
-/// errors `render::plan_lights` reports before any graph is built).
+/// The filtered CSM basis maps of light `i` (`light{i}.csm<chunk>`, two terms each).
+fn csm_nodes(
+    graph: &mut Graph,
+    i: usize,
+    light: &Light,
+    linear: &str,
+    storage: Storage,
+    terms: u32,
+) -> Vec<String> {
+    (0..csm_maps(terms))
+        .map(|chunk| {
+            let pairs = (terms - 2 * chunk).min(2);
+            let format = moments_format(storage, 2 * pairs);
+            let params = bytemuck::bytes_of(&CsmParams {
+                first_term: 2 * chunk + 1,
+                terms,
+                _pad: [0; 2],
+            })
+            .to_vec();
+            let name = format!("csm{chunk}");
+            let basis = encode(graph, i, "csm", &name, linear, format, params);
+            filtered(graph, i, light, &basis, BlurMode::Linear)
+        })
+        .collect()
+}
+
+/// The filtered CSM-Z maps of light `i` (`light{i}.csm_z<chunk>`, four channels of the
+/// sequence `[z, z·sin c₁z, z·cos c₁z, …]` each): the complementary basis the CSSM blocker
+/// search filters. Planned only for soft CSM.
+fn csm_z_nodes(
+    graph: &mut Graph,
+    i: usize,
+    light: &Light,
+    linear: &str,
+    storage: Storage,
+    terms: u32,
+) -> Vec<String> {
+    let channels = csm_z_channels(terms);
+    (0..csm_z_maps(terms))
+        .map(|chunk| {
+            let format = moments_format(storage, (channels - 4 * chunk).min(4));
+            let params = bytemuck::bytes_of(&CsmParams {
+                first_term: chunk,
+                terms,
+                _pad: [0; 2],
+            })
+            .to_vec();
+            let name = format!("csm_z{chunk}");
+            let basis = encode(graph, i, "csm_z", &name, linear, format, params);
+            filtered(graph, i, light, &basis, BlurMode::Linear)
+        })
+        .collect()
+}
+
+/// The filter of light `light`'s representation applied to `input`: the summed-area table of
+/// [`add_sat`] coded by [`sat_coding`] (the `sat` filter and the soft techniques; its errors
+/// `render::plan_lights` reports before any graph is built), else the blur or mip chain of
+/// [`add_filter`].
 fn filtered(graph: &mut Graph, i: usize, light: &Light, input: &str, mode: BlurMode) -> String {
-    match light.shadow.technique.filter() {
-        Some(Filter::Sat { .. }) => match sat_coding(light) {
+    if sat_variant(light).is_some() {
+        return match sat_coding(light) {
             Ok(Some(coding)) => add_sat(graph, i, input, &coding),
             _ => input.to_string(),
-        },
+        };
+    }
+    match light.shadow.technique.filter() {
         Some(filter) => add_filter(graph, i, input, &filter, mode),
         None => input.to_string(),
     }
@@ -467,11 +639,8 @@ pub fn map_channels(light: &Light) -> Vec<usize> {
 /// The WGSL type of a prefiltered technique's maps: `texture_2d<u32>` for a fixed-point
 /// summed-area table, else `texture_2d<f32>`.
 pub fn map_type(light: &Light) -> &'static str {
-    match light.shadow.technique.filter() {
-        Some(Filter::Sat {
-            variant: SatVariant::Fixed,
-            ..
-        }) => "texture_2d<u32>",
+    match sat_variant(light) {
+        Some(SatVariant::Fixed) => "texture_2d<u32>",
         _ => "texture_2d<f32>",
     }
 }
@@ -492,6 +661,16 @@ pub fn csm_maps(terms: u32) -> u32 {
     terms.div_ceil(2)
 }
 
+/// Channels of the CSM-Z representation with `terms` terms: z, then z·sin and z·cos per term.
+pub fn csm_z_channels(terms: u32) -> u32 {
+    2 * terms + 1
+}
+
+/// Four-channel CSM-Z maps CSSM with `terms` terms needs.
+pub fn csm_z_maps(terms: u32) -> u32 {
+    csm_z_channels(terms).div_ceil(4)
+}
+
 /// Parameters of `kernels/msm.wgsl` (mirrors its `Params`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
@@ -502,11 +681,12 @@ pub struct MsmParams {
     pub _pad: [u32; 3],
 }
 
-/// Parameters of `kernels/csm.wgsl` (mirrors its `Params`).
+/// Parameters of `kernels/csm.wgsl` and `kernels/csm_z.wgsl` (mirrors their `Params`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct CsmParams {
-    /// Term k of the map's first pair (channels sin, cos of c_k z, then of c_{k+1} z).
+    /// `csm`: term k of the map's first pair (channels sin, cos of c_k z, then of c_{k+1} z);
+    /// `csm_z`: the map's chunk j (channels 4j … 4j + 3 of the CSM-Z sequence).
     pub first_term: u32,
     /// Total terms M (a pair past M is written as zeros).
     pub terms: u32,
@@ -541,9 +721,10 @@ impl ExpParams {
     }
 }
 
-/// The texel format of a `channels`-moment representation (2 or 4) at `storage` precision.
+/// The texel format of a `channels`-channel representation (1–4) at `storage` precision.
 pub fn moments_format(storage: Storage, channels: u32) -> wgpu::TextureFormat {
     match (storage, channels) {
+        (Storage::F32, 1) => wgpu::TextureFormat::R32Float,
         (Storage::F32, 2) => wgpu::TextureFormat::Rg32Float,
         (Storage::F32, _) => wgpu::TextureFormat::Rgba32Float,
         // rg16float is no core storage format; rgba16float is.
@@ -597,6 +778,12 @@ pub struct ShadeInput {
 /// The modules light `light`'s visibility function needs, and the WGSL statements (ending in
 /// a `return`) that evaluate it with `l`, `s` in scope and its maps bound as `maps`.
 pub fn visibility_body(light: &Light, maps: &[String]) -> (Vec<&'static str>, String) {
+    if let Some(soft) = light.shadow.technique.soft() {
+        return (
+            vec![soft_module(&light.shadow.technique)],
+            soft_visibility_body(light, maps, soft.sums),
+        );
+    }
     if let Some(Filter::Sat { variant, .. }) = light.shadow.technique.filter() {
         let (module, body) = sat_visibility_body(light, maps, variant);
         return (vec![module, "shared/sat_lookup"], body);
@@ -641,6 +828,68 @@ fn sat_visibility_body(
     }
 }
 
+/// The module of a soft technique's visibility (it imports the table lookups and
+/// `shared/blocker`).
+fn soft_module(technique: &Technique) -> &'static str {
+    match technique {
+        Technique::Cssm { .. } => "shared/vis_cssm",
+        Technique::MsmSoft { .. } => "shared/vis_msm_soft",
+        _ => "shared/vis_vssm",
+    }
+}
+
+/// [`visibility_body`] of a soft technique: the table means over the blocker-search square,
+/// the blocker estimate, the means over the penumbra width, the visibility. Every lookup is
+/// made whatever the estimate (no branch before sampling; a square without blockers is
+/// resolved to 1 at the end). VSSM and soft MSM call their module's complete function; CSSM
+/// sums its basis maps (the first ⌈M/2⌉) and CSM-Z maps (the rest) here.
+fn soft_visibility_body(light: &Light, maps: &[String], variant: SatVariant) -> String {
+    let suffix = match variant {
+        SatVariant::Fixed => "fixed",
+        SatVariant::Float => "float",
+    };
+    let map = maps.first().map_or("", String::as_str);
+    let Technique::Cssm { terms, .. } = light.shadow.technique else {
+        let f = match light.shadow.technique {
+            Technique::MsmSoft { .. } => "vis_msm_soft",
+            _ => "vis_vssm",
+        };
+        return format!("return {f}_{suffix}({map}, l, s);");
+    };
+    let (basis, z) = maps.split_at((csm_maps(terms) as usize).min(maps.len()));
+    let sample = |m: &str, width: &str| format!("sat_sample_{suffix}({m}, l, s.uv, {width})");
+    let mut body =
+        String::from("let search = blocker_search_width(l, s);\n            var below = 0.0;");
+    for (chunk, m) in basis.iter().enumerate() {
+        let _ = write!(
+            body,
+            "\n            below += csm_chunk_of({}, {chunk}u, l, s);",
+            sample(m, "search")
+        );
+    }
+    body.push_str("\n            var zsum = 0.0;");
+    for (chunk, m) in z.iter().enumerate() {
+        let _ = write!(
+            body,
+            "\n            zsum += csm_z_chunk_of({}, {chunk}u, l, s);",
+            sample(m, "search")
+        );
+    }
+    body.push_str(
+        "\n            let b = cssm_blocker(below, zsum, l, s);\n            \
+         let width = blocker_filter_width(l, s, b.x);\n            var sum = 0.0;",
+    );
+    for (chunk, m) in basis.iter().enumerate() {
+        let _ = write!(
+            body,
+            "\n            sum += csm_chunk_of({}, {chunk}u, l, s);",
+            sample(m, "width")
+        );
+    }
+    body.push_str("\n            return cssm_resolve(sum, b, l, s);");
+    body
+}
+
 /// [`visibility_body`] without the `sat` filter.
 fn filtered_visibility_body(light: &Light, maps: &[String]) -> (&'static str, String) {
     let map = maps.first().map_or("", String::as_str);
@@ -667,6 +916,10 @@ fn filtered_visibility_body(light: &Light, maps: &[String]) -> (&'static str, St
             }
             body.push_str("\n            return csm_resolve(sum, l);");
             ("shared/vis_csm", body)
+        }
+        // Soft techniques are handled by `soft_visibility_body`.
+        Technique::Cssm { .. } | Technique::Vssm { .. } | Technique::MsmSoft { .. } => {
+            (soft_module(&light.shadow.technique), String::new())
         }
     }
 }

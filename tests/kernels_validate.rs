@@ -4,8 +4,9 @@
 use std::collections::BTreeSet;
 
 use shadowgraph::kernels::{self, SOURCES, struct_size};
+use shadowgraph::sat::SatVariant;
 use shadowgraph::scene::{
-    BlurKernel, Filter, Light, LightKind, PcfKernel, Prefilter, Shadow, Storage, Technique,
+    BlurKernel, Filter, Light, LightKind, PcfKernel, Prefilter, Shadow, Soft, Storage, Technique,
 };
 use shadowgraph::technique::{LightGpu, LinearizeParams, shading_block};
 
@@ -100,7 +101,55 @@ fn all_techniques() -> Vec<Technique> {
             offset: 0.05,
             scale: 2.0,
         },
+        Technique::Cssm {
+            soft: soft(Storage::F32, SatVariant::Fixed),
+            terms: 5,
+            attenuation: 1.0,
+            offset: 0.1,
+            scale: 2.0,
+            sharpen: 2.0,
+            sharpen_falloff: 50.0,
+        },
+        Technique::Cssm {
+            soft: soft(Storage::F16, SatVariant::Float),
+            terms: 2,
+            attenuation: 1.0,
+            offset: 0.1,
+            scale: 2.0,
+            sharpen: 0.0,
+            sharpen_falloff: 0.0,
+        },
+        Technique::Vssm {
+            soft: soft(Storage::F32, SatVariant::Fixed),
+            bleed: 0.2,
+            min_variance: 1e-5,
+        },
+        Technique::Vssm {
+            soft: soft(Storage::F16, SatVariant::Float),
+            bleed: 0.2,
+            min_variance: 1e-5,
+        },
+        Technique::MsmSoft {
+            soft: soft(Storage::Unorm16, SatVariant::Fixed),
+            hausdorff: true,
+            moment_bias: 6e-5,
+            bleed: 0.0,
+        },
+        Technique::MsmSoft {
+            soft: soft(Storage::F32, SatVariant::Float),
+            hausdorff: false,
+            moment_bias: 1e-5,
+            bleed: 0.0,
+        },
     ]
+}
+
+fn soft(storage: Storage, sums: SatVariant) -> Soft {
+    Soft {
+        storage,
+        sums,
+        max_search: 0.1,
+    }
 }
 
 #[test]
@@ -193,6 +242,15 @@ fn rust_mirrors_match_naga_layouts() {
         Some(size_of::<shadowgraph::render::FrameGpu>() as u32),
         "FrameGpu vs struct Frame"
     );
+    for kernel in ["csm", "csm_z"] {
+        let wgsl = kernels::resolve(kernel, None).unwrap();
+        let (m, _) = kernels::reflect(kernel, &wgsl).unwrap();
+        assert_eq!(
+            struct_size(&m, "Params"),
+            Some(size_of::<shadowgraph::technique::CsmParams>() as u32),
+            "CsmParams vs {kernel}'s Params"
+        );
+    }
     let lin = kernels::resolve("linearize", None).unwrap();
     let (m, _) = kernels::reflect("linearize", &lin).unwrap();
     assert_eq!(
@@ -227,6 +285,11 @@ fn storage_format_variants_validate() {
         ("blur", "rg32float", all),
         ("msm", "rgba32float", &["rgba16float", "rgba16unorm"][..]),
         ("csm", "rgba32float", &["rg32float", "rgba16float"][..]),
+        (
+            "csm_z",
+            "rgba32float",
+            &["r32float", "rg32float", "rgba16float"][..],
+        ),
         ("mips", "rgba32float", all),
     ] {
         let base = kernels::resolve(kernel, None).unwrap();

@@ -368,7 +368,13 @@ fn differences(a: &[f32], b: &[f32]) -> (usize, f32) {
 /// inputs; tolerance 0). Visibility through the exported WGSL and `PrefilterOutput::light`:
 /// that light's position, direction and map width come from inverting the host's matrices
 /// rather than from the scene, an ulp-level change that can flip a comparison exactly at a
-/// texel edge; so |Δ| ≤ 1e-5 at ≥ 99.9% of covered pixels and ≤ 1e-3 summed over all.
+/// texel edge; so |Δ| ≤ 1e-5 at ≥ 99.9% of covered pixels and ≤ 1e-3 summed over all. The
+/// soft techniques' f32 chains (blocker estimate → width → lookup) amplify such changes where
+/// they are ill-conditioned (soft MSM's reconstruction, measured: |Δ| up to 1e-3 at 0.55% of
+/// pixels): there each run may stand as far from the f64 reference as its propagated tolerance
+/// (tests/common/soft.rs, which models UV and depth errors of that size), so a pixel counts as
+/// off where |Δ| exceeds 1e-5 and twice that tolerance; pixels where the reference jumps or the
+/// blocker threshold could flip are not counted.
 #[test]
 fn stage_outputs_equal_the_renderers() {
     let g = common::gpu();
@@ -436,6 +442,7 @@ fn stage_outputs_equal_the_renderers() {
             );
 
             let vis = host_visibility(&g, &mut stage, &depth, &params, &frame, &scene);
+            let soft = soft_inputs(&g, &frame, light, li);
             let (mut covered, mut off, mut total) = (0, 0, 0.0f64);
             for (px, v) in vis.iter().enumerate() {
                 if frame.position[4 * px + 3] == 0.0 {
@@ -444,7 +451,11 @@ fn stage_outputs_equal_the_renderers() {
                 covered += 1;
                 let diff = f64::from((v - frame.visibility[px * lights + li]).abs());
                 total += diff;
-                if diff > 1e-5 {
+                let allowed = match &soft {
+                    Some(soft) => soft_allowance(soft, light, &frame, px),
+                    None => Some(1e-5),
+                };
+                if allowed.is_some_and(|a| diff > a) {
                     off += 1;
                 }
             }
@@ -554,4 +565,42 @@ fn kernels_are_timed_when_the_device_can() {
         timings.iter().all(|(_, ms)| ms.is_finite() && *ms >= 0.0),
         "{timings:?}"
     );
+}
+
+/// A soft light's f64 inputs from the renderer's shade map (`None` for other techniques).
+fn soft_inputs(
+    g: &Gpu,
+    frame: &Frame,
+    light: &shadowgraph::scene::Light,
+    li: usize,
+) -> Option<common::soft::SoftInputs> {
+    light.shadow.technique.soft()?;
+    let sm = &frame.shade_maps[li];
+    let level0 = shadowgraph::cpu::Texels::from_f32(
+        sm.width as usize,
+        sm.height as usize,
+        sm.channels,
+        &sm.data,
+    );
+    common::soft::SoftInputs::new(light, &level0, common::soft_maps::trig_error(g))
+}
+
+/// How far two runs of a soft light may differ at pixel `px`: 1e-5 or twice the propagated
+/// tolerance of the f64 reference, `None` where it jumps or the blocker threshold could flip.
+fn soft_allowance(
+    soft: &common::soft::SoftInputs,
+    light: &shadowgraph::scene::Light,
+    frame: &Frame,
+    px: usize,
+) -> Option<f64> {
+    let lg = shadowgraph::technique::LightGpu::new(light);
+    let p = &frame.position[4 * px..4 * px + 3];
+    let n = &frame.normal[4 * px..4 * px + 3];
+    let s = shadowgraph::cpu::light::sample(
+        &lg,
+        glam::DVec3::new(p[0].into(), p[1].into(), p[2].into()),
+        glam::DVec3::new(n[0].into(), n[1].into(), n[2].into()).normalize(),
+    );
+    let v = common::robust(&s, light.shadow_map as usize, |t| soft.reference(&lg, t))?;
+    soft.tolerance(&lg, &s, v).map(|t| (2.0 * t).max(1e-5))
 }

@@ -40,6 +40,13 @@ fn every_technique() -> Vec<Technique> {
             .with_storage(Storage::F16)
             .technique,
         PrefilterConfig::esm(64).with_filter(Filter::None).technique,
+        PrefilterConfig::cssm(64, 5, 0.5).technique,
+        PrefilterConfig::vssm(64, 0.5)
+            .with_soft(shadowgraph::sat::SatVariant::Float, 0.2)
+            .technique,
+        PrefilterConfig::msm_soft(64, 0.5)
+            .with_storage(Storage::Unorm16)
+            .technique,
     ]
 }
 
@@ -94,7 +101,16 @@ fn host_shader_including_the_library_validates() {
         "LightGpu vs the exported struct Light"
     );
     for name in [
-        "vis_hard", "vis_pcf", "vis_pcss", "vis_vsm", "vis_evsm", "vis_esm",
+        "vis_hard",
+        "vis_pcf",
+        "vis_pcss",
+        "vis_vsm",
+        "vis_evsm",
+        "vis_esm",
+        "vis_vssm_fixed",
+        "vis_vssm_float",
+        "vis_msm_soft_fixed",
+        "vis_msm_soft_float",
     ] {
         assert!(
             library.contains(&format!("//   fn {name}(")),
@@ -159,13 +175,16 @@ fn scene_with(technique: &str, keys: &str, light_size: f32) -> shadowgraph::Resu
 
 #[test]
 fn constructors_have_the_scene_defaults() {
-    for (name, config) in [
-        ("vsm", PrefilterConfig::vsm(64)),
-        ("evsm2", PrefilterConfig::evsm2(64)),
-        ("evsm4", PrefilterConfig::evsm4(64)),
-        ("esm", PrefilterConfig::esm(64)),
+    for (name, config, light_size) in [
+        ("vsm", PrefilterConfig::vsm(64), 0.0),
+        ("evsm2", PrefilterConfig::evsm2(64), 0.0),
+        ("evsm4", PrefilterConfig::evsm4(64), 0.0),
+        ("esm", PrefilterConfig::esm(64), 0.0),
+        ("cssm", PrefilterConfig::cssm(64, 8, 0.5), 0.5),
+        ("vssm", PrefilterConfig::vssm(64, 0.5), 0.5),
+        ("msm_soft", PrefilterConfig::msm_soft(64, 0.5), 0.5),
     ] {
-        let scene = scene_with(name, "", 0.0).expect("scene");
+        let scene = scene_with(name, "", light_size).expect("scene");
         let from_scene = PrefilterConfig::from_light(&scene.lights[0]);
         let (validated, _) = config.validated().expect("defaults are valid");
         assert_eq!(validated, from_scene, "{name}");
@@ -216,6 +235,15 @@ fn pcss() -> PrefilterConfig {
         },
         64,
     )
+}
+
+/// CSSM's config with sharpening strength `a` (moment bias as a scene's default for the
+/// storage).
+fn cssm_sharpen(mut c: PrefilterConfig, a: f32) -> PrefilterConfig {
+    if let Technique::Cssm { sharpen, .. } = &mut c.technique {
+        *sharpen = a;
+    }
+    c
 }
 
 #[test]
@@ -283,6 +311,34 @@ fn configs_follow_the_scene_rules() {
         ("pcf", "radius = 33", 0.0, PrefilterConfig::new(pcf33, 64)),
         ("pcss", "", 0.0, pcss()),
         ("pcss", "", 0.5, pcss()),
+        ("cssm", "", 0.0, PrefilterConfig::cssm(64, 8, 0.0)),
+        ("vssm", "", 0.5, PrefilterConfig::vssm(64, 0.5)),
+        (
+            "cssm",
+            "terms = 4\nsharpen = 100.5",
+            0.5,
+            cssm_sharpen(PrefilterConfig::cssm(64, 4, 0.5), 100.5),
+        ),
+        (
+            "cssm",
+            "terms = 4\nsharpen = 3.0",
+            0.5,
+            cssm_sharpen(PrefilterConfig::cssm(64, 4, 0.5), 3.0),
+        ),
+        (
+            "msm_soft",
+            "format = \"f16\"\nsat_sums = \"float\"\nmax_search = 0.3\nmoment_bias = 0.00001",
+            0.5,
+            PrefilterConfig::msm_soft(64, 0.5)
+                .with_storage(Storage::F16)
+                .with_soft(shadowgraph::sat::SatVariant::Float, 0.3),
+        ),
+        (
+            "vssm",
+            "max_search = 2.0",
+            0.5,
+            PrefilterConfig::vssm(64, 0.5).with_soft(shadowgraph::sat::SatVariant::Fixed, 2.0),
+        ),
     ];
     for (technique, keys, light_size, mut config) in cases {
         config.light_size = light_size;
@@ -334,6 +390,16 @@ fn settings_that_do_not_apply_are_named() {
     assert!(e.to_string().contains("filter"), "{e}");
     let e = PrefilterConfig::vsm(0).validated().unwrap_err();
     assert!(e.to_string().contains("size"), "{e}");
+    let e = PrefilterConfig::vsm(64)
+        .with_soft(shadowgraph::sat::SatVariant::Float, 0.1)
+        .validated()
+        .unwrap_err();
+    assert!(e.to_string().contains("sat_sums"), "{e}");
+    let e = PrefilterConfig::vssm(64, 0.5)
+        .with_blur(2.0)
+        .validated()
+        .unwrap_err();
+    assert!(e.to_string().contains("filter"), "{e}");
     // A scene's prefilter field set by hand is still checked.
     let mut c = PrefilterConfig::vsm(64);
     c.technique = Technique::Vsm {

@@ -982,3 +982,133 @@ fn max_anisotropy_key() {
         })
     );
 }
+
+#[test]
+fn soft_techniques_keys_defaults_and_errors() {
+    use shadowgraph::sat::SatVariant;
+    use shadowgraph::scene::{Soft, Storage};
+    let soft = |keys: &str, size: &str| {
+        scene_with(&[
+            ("technique = \"hard\"", keys),
+            ("far = 20.0", &format!("far = 20.0\n{size}")),
+        ])
+    };
+    // Each needs an area light, named at the light's `kind` when no `size` is given.
+    for t in ["cssm", "vssm", "msm_soft"] {
+        let text = scene_with(&[("technique = \"hard\"", &format!("technique = \"{t}\""))]);
+        let shown = expect(&text, "kind", &["light[0].size", t]);
+        assert!(shown.starts_with("inline.toml:13:"), "{shown}");
+        let text = soft(&format!("technique = \"{t}\""), "size = 0.0");
+        expect(&text, "size = 0.0", &["light[0].size", t]);
+    }
+    // Defaults: f32 representation, fixed-point sums, search cap 0.1; CSSM as CSM plus the
+    // sharpening; VSSM as VSM; soft MSM as MSM.
+    let defaults = Soft {
+        storage: Storage::F32,
+        sums: SatVariant::Fixed,
+        max_search: 0.1,
+    };
+    let s = parse(&soft("technique = \"cssm\"", "size = 0.5")).expect("cssm parses");
+    assert_eq!(
+        s.lights[0].shadow.technique,
+        Technique::Cssm {
+            soft: defaults,
+            terms: 8,
+            attenuation: 1.0,
+            offset: 0.0625,
+            scale: 2.0,
+            sharpen: shadowgraph::scene::DEFAULT_SHARPEN,
+            sharpen_falloff: shadowgraph::scene::DEFAULT_SHARPEN_FALLOFF,
+        }
+    );
+    let s = parse(&soft("technique = \"vssm\"", "size = 0.5")).expect("vssm parses");
+    assert_eq!(
+        s.lights[0].shadow.technique,
+        Technique::Vssm {
+            soft: defaults,
+            bleed: 0.2,
+            min_variance: 1e-5,
+        }
+    );
+    let keys = "technique = \"msm_soft\"\nformat = \"unorm16\"\nsat_sums = \"float\"\n\
+                max_search = 0.05\nreconstruction = \"hausdorff\"";
+    let s = parse(&soft(keys, "size = 0.5")).expect("msm_soft parses");
+    assert_eq!(
+        s.lights[0].shadow.technique,
+        Technique::MsmSoft {
+            soft: Soft {
+                storage: Storage::Unorm16,
+                sums: SatVariant::Float,
+                max_search: 0.05,
+            },
+            hausdorff: true,
+            moment_bias: 6e-5,
+            bleed: 0.0,
+        }
+    );
+    // Keys out of range, of another technique, or of a fixed filter name themselves.
+    for (keys, at, needles) in [
+        (
+            "technique = \"cssm\"\nsharpen = -1.0",
+            "sharpen",
+            &["light[0].shadow.sharpen", "-1"][..],
+        ),
+        (
+            "technique = \"cssm\"\nsharpen_falloff = 1e5",
+            "sharpen_falloff",
+            &["light[0].shadow.sharpen_falloff"],
+        ),
+        (
+            "technique = \"cssm\"\nterms = 17",
+            "terms",
+            &["light[0].shadow.terms"],
+        ),
+        (
+            "technique = \"vssm\"\nmax_search = 0.0",
+            "max_search",
+            &["light[0].shadow.max_search"],
+        ),
+        (
+            "technique = \"vssm\"\nsat_sums = \"double\"",
+            "sat_sums",
+            &["light[0].shadow.sat_sums", "\"fixed\""],
+        ),
+        (
+            "technique = \"vssm\"\nformat = \"unorm16\"",
+            "format",
+            &["light[0].shadow.format", "\"f16\""],
+        ),
+        (
+            "technique = \"vssm\"\nfilter = \"sat\"",
+            "filter",
+            &["light[0].shadow.filter", "\"vssm\""],
+        ),
+        (
+            "technique = \"msm_soft\"\nfilter_width = 4.0",
+            "filter_width",
+            &["light[0].shadow.filter_width", "\"msm_soft\""],
+        ),
+        (
+            "technique = \"csm\"\nsharpen = 1.0",
+            "sharpen",
+            &["light[0].shadow.sharpen", "\"csm\""],
+        ),
+    ] {
+        expect(&soft(keys, "size = 0.5"), at, needles);
+    }
+    // A search cap whose squares no fixed-point table can sum names `max_search`.
+    let text = soft(
+        "technique = \"vssm\"\nmax_search = 1.0",
+        "size = 0.5\nshadow_map = 60000",
+    );
+    expect(
+        &text,
+        "max_search",
+        &["light[0].shadow.max_search", "sat_sums"],
+    );
+    let text = soft(
+        "technique = \"vssm\"\nmax_search = 1.0\nsat_sums = \"float\"",
+        "size = 0.5\nshadow_map = 60000",
+    );
+    parse(&text).expect("f32 sums have no window limit");
+}

@@ -27,11 +27,13 @@ fn scenes() -> Vec<PathBuf> {
     v
 }
 
-/// Reference visibility of light `li` at pixel `px` and its tolerance, if robust.
+/// Reference visibility of light `li` at pixel `px` and its tolerance, if robust (soft
+/// techniques: also where the propagated errors could flip the blocker threshold).
 fn pixel_reference(
     scene: &Scene,
     frame: &shadowgraph::render::Frame,
     moments: &[Texels],
+    soft: Option<&common::soft::SoftInputs>,
     li: usize,
     px: usize,
 ) -> Option<(f64, f64)> {
@@ -61,6 +63,9 @@ fn pixel_reference(
         texels: &frame.shade_maps[li].data,
     };
     let vis = |t: &cpu::light::LightSample| {
+        if let Some(soft) = soft {
+            return soft.reference(&lg, t);
+        }
         if !t.inside {
             return 1.0;
         }
@@ -77,75 +82,90 @@ fn pixel_reference(
             Technique::Esm { .. } => cpu::vis_esm::vis_esm(moments, &lg, t),
             Technique::Msm { .. } => cpu::vis_msm::vis_msm(moments, &lg, t),
             Technique::Csm { .. } => cpu::vis_csm::vis_csm(moments, &lg, t),
+            Technique::Cssm { .. } | Technique::Vssm { .. } | Technique::MsmSoft { .. } => {
+                unreachable!("soft techniques use SoftInputs")
+            }
         }
     };
-    common::robust(&s, size, vis).map(|v| {
-        let tolerance = match light.shadow.technique {
-            // Vulkan allows 8-bit bilinear weights: each of four may be off by 2⁻⁸.
-            Technique::Pcf {
-                kernel: PcfKernel::Hardware,
-                ..
-            } => 1.0 / 64.0,
-            Technique::Vsm { .. } => common::vsm_tolerance(moments, &lg, &s),
-            Technique::Evsm { .. } => common::evsm_tolerance(moments, &lg, &s),
-            Technique::Esm { .. } if lg.filter_width > 0.0 => {
-                common::esm_sat_tolerance(moments, &lg, &s, v)
-            }
-            Technique::Esm { .. } => common::esm_tolerance(moments, &lg, &s, v),
-            Technique::Msm { .. } => common::msm_tolerance(moments, &lg, &s),
-            Technique::Csm { .. } => common::csm_tolerance(&lg),
-            // Means of 0/1 taps in f32.
-            _ => 1e-5,
-        };
-        // The receiver's UV comes out of f32 projections (a few 2⁻²⁴ each way), which moves the
-        // filtered moments' bilinear weights; where neighbouring texels' moments differ by
-        // orders of magnitude (EVSM's exp(40 z')), that is visible: add twice the reference's
-        // change under ±4·2⁻²⁴ of UV.
-        let tolerance = if light.shadow.technique.filter().is_some() {
-            let d = 4.0 * 2f64.powi(-24);
-            let spread = [[d, 0.0], [-d, 0.0], [0.0, d], [0.0, -d]]
-                .iter()
-                .map(|[du, dv]| {
-                    let mut t = s;
-                    t.uv = [s.uv[0] + du, s.uv[1] + dv];
-                    (vis(&t) - v).abs()
-                })
-                .fold(0.0, f64::max);
-            tolerance + 2.0 * spread
-        } else {
-            tolerance
-        };
-        // The GPU's footprint is a difference of f32 UVs times the map size: 2⁻²⁴ · 1024 ≈
-        // 6·10⁻⁵ texels on an axis of a texel or more, so up to about 10⁻⁴ relative. It moves
-        // the taps' level and spacing: add twice the reference's change under a ±2·10⁻⁴ scaling
-        // of the footprint, and 8 f32 roundings per tap for the taps' running mean.
-        let tolerance = if lg.max_anisotropy > 0 {
-            let spread = [1.0 - 2e-4, 1.0 + 2e-4]
-                .iter()
-                .map(|k| {
-                    let mut t = s;
-                    t.footprint = s.footprint.map(|f| f * k);
-                    (vis(&t) - v).abs()
-                })
-                .fold(0.0, f64::max);
-            let taps = f64::from(cpu::mips::mip_taps(&lg, &s).count);
-            // ESM's running log-sum-exp re-rounds the logarithm (|L| ≤ c) at every tap: 8 ULP
-            // of c, relative in the visibility.
-            let esm_logs = match light.shadow.technique {
-                Technique::Esm { exponent, .. } => 8.0 * 2f64.powi(-23) * f64::from(exponent) * v,
-                _ => 0.0,
+    common::robust(&s, size, vis)
+        .and_then(|v| match soft {
+            Some(soft) => soft.tolerance(&lg, &s, v).map(|t| (v, t)),
+            None => Some((v, 0.0)),
+        })
+        .map(|(v, soft_tolerance)| {
+            let tolerance = match light.shadow.technique {
+                // Vulkan allows 8-bit bilinear weights: each of four may be off by 2⁻⁸.
+                Technique::Pcf {
+                    kernel: PcfKernel::Hardware,
+                    ..
+                } => 1.0 / 64.0,
+                Technique::Vsm { .. } => common::vsm_tolerance(moments, &lg, &s),
+                Technique::Evsm { .. } => common::evsm_tolerance(moments, &lg, &s),
+                Technique::Esm { .. } if lg.filter_width > 0.0 => {
+                    common::esm_sat_tolerance(moments, &lg, &s, v)
+                }
+                Technique::Esm { .. } => common::esm_tolerance(moments, &lg, &s, v),
+                Technique::Msm { .. } => common::msm_tolerance(moments, &lg, &s),
+                Technique::Csm { .. } => common::csm_tolerance(&lg),
+                // Propagated through the chain (tests/common/soft.rs).
+                Technique::Cssm { .. } | Technique::Vssm { .. } | Technique::MsmSoft { .. } => {
+                    soft_tolerance
+                }
+                // Means of 0/1 taps in f32.
+                _ => 1e-5,
             };
-            tolerance + 2.0 * spread + taps * 8.0 * 2f64.powi(-23) * v + esm_logs
-        } else {
-            tolerance
-        };
-        (v, tolerance)
-    })
+            // The receiver's UV comes out of f32 projections (a few 2⁻²⁴ each way), which moves the
+            // filtered moments' bilinear weights; where neighbouring texels' moments differ by
+            // orders of magnitude (EVSM's exp(40 z')), that is visible: add twice the reference's
+            // change under ±4·2⁻²⁴ of UV.
+            let tolerance = if light.shadow.technique.filter().is_some() {
+                let d = 4.0 * 2f64.powi(-24);
+                let spread = [[d, 0.0], [-d, 0.0], [0.0, d], [0.0, -d]]
+                    .iter()
+                    .map(|[du, dv]| {
+                        let mut t = s;
+                        t.uv = [s.uv[0] + du, s.uv[1] + dv];
+                        (vis(&t) - v).abs()
+                    })
+                    .fold(0.0, f64::max);
+                tolerance + 2.0 * spread
+            } else {
+                tolerance
+            };
+            // The GPU's footprint is a difference of f32 UVs times the map size: 2⁻²⁴ · 1024 ≈
+            // 6·10⁻⁵ texels on an axis of a texel or more, so up to about 10⁻⁴ relative. It moves
+            // the taps' level and spacing: add twice the reference's change under a ±2·10⁻⁴ scaling
+            // of the footprint, and 8 f32 roundings per tap for the taps' running mean.
+            let tolerance = if lg.max_anisotropy > 0 {
+                let spread = [1.0 - 2e-4, 1.0 + 2e-4]
+                    .iter()
+                    .map(|k| {
+                        let mut t = s;
+                        t.footprint = s.footprint.map(|f| f * k);
+                        (vis(&t) - v).abs()
+                    })
+                    .fold(0.0, f64::max);
+                let taps = f64::from(cpu::mips::mip_taps(&lg, &s).count);
+                // ESM's running log-sum-exp re-rounds the logarithm (|L| ≤ c) at every tap: 8 ULP
+                // of c, relative in the visibility.
+                let esm_logs = match light.shadow.technique {
+                    Technique::Esm { exponent, .. } => {
+                        8.0 * 2f64.powi(-23) * f64::from(exponent) * v
+                    }
+                    _ => 0.0,
+                };
+                tolerance + 2.0 * spread + taps * 8.0 * 2f64.powi(-23) * v + esm_logs
+            } else {
+                tolerance
+            };
+            (v, tolerance)
+        })
 }
 
 #[test]
 fn every_scene_renders_and_matches_the_references() {
     let g = common::gpu();
+    let e_trig = common::soft_maps::trig_error(&g);
     let mut renderer = Renderer::new(&g.device);
     for path in scenes() {
         let scene = Scene::load(&path).expect("scene loads");
@@ -194,8 +214,9 @@ fn every_scene_renders_and_matches_the_references() {
                 Some(shadowgraph::scene::Filter::Mips { .. }) => {
                     cpu::mips::mip_chain(&level0, matches!(technique, Technique::Esm { .. }))
                 }
-                _ => vec![level0],
+                _ => vec![level0.clone()],
             };
+            let soft = common::soft::SoftInputs::new(&scene.lights[li], &level0, e_trig);
             let (mut gpu_v, mut ref_v, mut tol, mut covered) =
                 (Vec::new(), Vec::new(), Vec::new(), 0);
             for px in 0..(frame.width * frame.height) as usize {
@@ -203,7 +224,9 @@ fn every_scene_renders_and_matches_the_references() {
                     continue;
                 }
                 covered += 1;
-                if let Some((r, t)) = pixel_reference(&scene, &frame, &moments, li, px) {
+                if let Some((r, t)) =
+                    pixel_reference(&scene, &frame, &moments, soft.as_ref(), li, px)
+                {
                     gpu_v.push(frame.visibility[px * lights + li]);
                     ref_v.push(r);
                     tol.push(t);
@@ -311,6 +334,52 @@ fn check_prefilter_chain(scene: &Scene, frame: &shadowgraph::render::Frame, li: 
                     1e-6,
                 )
             }
+            // Soft techniques: the unfiltered representation, through a table.
+            Technique::Vssm { soft, .. } => (
+                Box::new(|t: &Texels| cpu::vsm::vsm(t)) as Box<dyn Fn(&Texels) -> Texels>,
+                2,
+                Filter::None,
+                soft.storage,
+                false,
+                1e-6,
+            ),
+            Technique::MsmSoft { soft, .. } => {
+                let quantized = shadowgraph::technique::msm_quantized(soft.storage);
+                let f = move |t: &Texels| cpu::msm::msm(t, quantized);
+                (
+                    Box::new(f) as Box<dyn Fn(&Texels) -> Texels>,
+                    4,
+                    Filter::None,
+                    soft.storage,
+                    false,
+                    1e-6,
+                )
+            }
+            // The CSM basis (2M channels) then the CSM-Z basis (2M + 1).
+            Technique::Cssm { soft, terms, .. } => {
+                let f = move |t: &Texels| {
+                    let (a, b) = (cpu::csm::csm(t, terms), cpu::csm_z::csm_z(t, terms));
+                    let data = a
+                        .data
+                        .chunks(a.channels)
+                        .zip(b.data.chunks(b.channels))
+                        .flat_map(|(x, y)| x.iter().chain(y).copied())
+                        .collect();
+                    Texels {
+                        channels: a.channels + b.channels,
+                        data,
+                        ..a
+                    }
+                };
+                (
+                    Box::new(f) as Box<dyn Fn(&Texels) -> Texels>,
+                    4 * terms as usize + 1,
+                    Filter::None,
+                    soft.storage,
+                    false,
+                    1e-6,
+                )
+            }
             _ => return,
         };
     let Some(linear) = &frame.linear_maps[li] else {
@@ -332,11 +401,28 @@ fn check_prefilter_chain(scene: &Scene, frame: &shadowgraph::render::Frame, li: 
         .flat_map(|c| c[..channels].to_vec())
         .collect();
     let got = &frame.shade_maps[li];
-    let got: Vec<f32> = got
-        .data
-        .chunks(got.channels)
-        .flat_map(|c| c[..channels].to_vec())
-        .collect();
+    let got: Vec<f32> = match scene.lights[li].shadow.technique {
+        // The tables' padding channels dropped.
+        Technique::Cssm { .. } => {
+            let map = Texels::from_f32(
+                got.width as usize,
+                got.height as usize,
+                got.channels,
+                &got.data,
+            );
+            let (a, b) = common::soft::split_cssm(&scene.lights[li], &map);
+            a.data
+                .chunks(a.channels)
+                .zip(b.data.chunks(b.channels))
+                .flat_map(|(x, y)| x.iter().chain(y).map(|&v| v as f32))
+                .collect()
+        }
+        _ => got
+            .data
+            .chunks(got.channels)
+            .flat_map(|c| c[..channels].to_vec())
+            .collect(),
+    };
     let (atol, rtol) = match storage {
         Storage::F32 => (1e-6, rtol),
         Storage::F16 => (1e-4, 3.0 * 2f64.powi(-10)),
@@ -344,9 +430,9 @@ fn check_prefilter_chain(scene: &Scene, frame: &shadowgraph::render::Frame, li: 
         // to 82: about 2·10⁻⁵).
         Storage::Unorm16 => (6e-5, 0.0),
     };
-    // CSM: Vulkan specifies sin/cos to 2⁻¹¹ absolute on [−π, π].
+    // CSM: Vulkan specifies sin/cos to 2⁻¹¹ absolute on [−π, π] (CSM-Z: times z ≤ 1).
     let atol = match scene.lights[li].shadow.technique {
-        Technique::Csm { .. } => atol + 2f64.powi(-11),
+        Technique::Csm { .. } | Technique::Cssm { .. } => atol + 2f64.powi(-11),
         _ => atol,
     };
     let what = format!("light {li} filtered map");
@@ -456,7 +542,99 @@ fn plan_contains_only_what_techniques_need() {
     }
 }
 
-/// Every technique (with each filter) on every bundled scene, at a reduced size: no NaN or Inf,
+/// The blocker kernels are planned only for lights that ask for soft shadows: every bundled
+/// and technique scene's lights, and one plan mixing CSM, CSSM, VSM, VSSM and MSM lights.
+/// A CSSM light plans its ⌈M/2⌉ basis maps and ⌈(2M + 1)/4⌉ CSM-Z maps, each encoded once
+/// and summed by five SAT passes, and nothing else; VSSM and soft MSM plan exactly the
+/// encoding of their hard counterparts and one table.
+#[test]
+fn blocker_kernels_are_planned_only_for_soft_lights() {
+    let mut lights: Vec<shadowgraph::scene::Light> = Vec::new();
+    for path in scenes() {
+        lights.extend(Scene::load(&path).expect("scene").lights);
+    }
+    let soft_scene = |name: &str| {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("scenes/techniques/{name}"));
+        Scene::load(path).expect("scene").lights.remove(0)
+    };
+    let mut csm = soft_scene("csm_sat.toml");
+    csm.shadow_map = 64;
+    lights.extend([
+        csm,
+        soft_scene("cssm.toml"),
+        soft_scene("vsm_sat.toml"),
+        soft_scene("vssm.toml"),
+        soft_scene("msm_sat.toml"),
+        soft_scene("msm_soft.toml"),
+    ]);
+    let sp = shadowgraph::render::plan_lights(&lights).expect("plan");
+    let sat = ["sat_rows", "sat_carry", "sat_cols_reduce", "sat_carry"];
+    for (i, l) in lights.iter().enumerate() {
+        let mut kernels: Vec<&str> = sp
+            .plan
+            .steps
+            .iter()
+            .filter(|s| s.node.light == Some(i))
+            .map(|s| s.node.kernel.as_str())
+            .collect();
+        let what = format!("light {i} ({})", l.shadow.technique.name());
+        let blocker = kernels.iter().filter(|k| **k == "csm_z").count();
+        let expected: Option<Vec<&str>> = match l.shadow.technique {
+            Technique::Cssm { soft, terms, .. } => {
+                let last = match soft.sums {
+                    shadowgraph::sat::SatVariant::Fixed => "sat_cols",
+                    shadowgraph::sat::SatVariant::Float => "sat_cols_f32",
+                };
+                let basis = shadowgraph::technique::csm_maps(terms) as usize;
+                let z = shadowgraph::technique::csm_z_maps(terms) as usize;
+                assert_eq!(blocker, z, "{what}: CSM-Z maps");
+                let mut v = vec!["linearize"];
+                for k in 0..basis + z {
+                    v.push(if k < basis { "csm" } else { "csm_z" });
+                    v.extend(sat);
+                    v.push(last);
+                }
+                Some(v)
+            }
+            Technique::Vssm { .. } | Technique::MsmSoft { .. } => {
+                let encode = if matches!(l.shadow.technique, Technique::Vssm { .. }) {
+                    "vsm"
+                } else {
+                    "msm"
+                };
+                let last = match l.shadow.technique.soft().map(|s| s.sums) {
+                    Some(shadowgraph::sat::SatVariant::Float) => "sat_cols_f32",
+                    _ => "sat_cols",
+                };
+                let mut v = vec!["linearize", encode];
+                v.extend(sat);
+                v.push(last);
+                Some(v)
+            }
+            _ => None,
+        };
+        match expected {
+            Some(mut e) => {
+                kernels.sort_unstable();
+                e.sort_unstable();
+                assert_eq!(kernels, e, "{what}");
+            }
+            None => assert_eq!(blocker, 0, "{what} plans blocker kernels"),
+        }
+    }
+    assert!(
+        lights
+            .iter()
+            .any(|l| matches!(l.shadow.technique, Technique::Csm { .. }))
+            && lights
+                .iter()
+                .any(|l| matches!(l.shadow.technique, Technique::Cssm { .. })),
+        "the mixed plan lacks CSM or CSSM"
+    );
+}
+
+/// Every technique (with each filter; the soft ones on a light 0.3 units wide where the scene's
+/// light has no size) on every bundled scene, at a reduced size: no NaN or Inf,
 /// visibility in [0, 1] and some shadow cast (some pixel below 0.95: a thin pole on a 512² map
 /// seen in 120×90 pixels casts little).
 #[test]
@@ -477,6 +655,11 @@ fn every_technique_renders_every_bundled_scene() {
         variant: shadowgraph::sat::SatVariant::Float,
     };
     let sat_limit = shadowgraph::scene::sat_exponent_limit(&sat, false).expect("sat limit");
+    let soft = |storage, sums| shadowgraph::scene::Soft {
+        storage,
+        sums,
+        max_search: shadowgraph::scene::DEFAULT_MAX_SEARCH,
+    };
     let techniques = [
         Technique::Hard,
         Technique::Pcf {
@@ -569,6 +752,26 @@ fn every_technique_renders_every_bundled_scene() {
             offset: 0.1,
             scale: 2.0,
         },
+        Technique::Cssm {
+            soft: soft(Storage::F32, shadowgraph::sat::SatVariant::Fixed),
+            terms: 3,
+            attenuation: 1.0,
+            offset: 0.5 / 3.0,
+            scale: 2.0,
+            sharpen: shadowgraph::scene::DEFAULT_SHARPEN,
+            sharpen_falloff: shadowgraph::scene::DEFAULT_SHARPEN_FALLOFF,
+        },
+        Technique::Vssm {
+            soft: soft(Storage::F16, shadowgraph::sat::SatVariant::Float),
+            bleed: 0.2,
+            min_variance: 1e-5,
+        },
+        Technique::MsmSoft {
+            soft: soft(Storage::F16, shadowgraph::sat::SatVariant::Fixed),
+            hausdorff: false,
+            moment_bias: 5e-4,
+            bleed: 0.0,
+        },
     ];
     let g = common::gpu();
     let mut renderer = Renderer::new(&g.device);
@@ -585,6 +788,10 @@ fn every_technique_renders_every_bundled_scene() {
             for l in &mut scene.lights {
                 l.shadow.technique = t;
                 l.shadow_map = l.shadow_map.min(512);
+                // PCSS and the soft techniques model an area light (scenes require a size).
+                if t.soft().is_some() && l.size <= 0.0 {
+                    l.size = 0.3;
+                }
             }
             let what = format!("{} with {}", path.display(), t.name());
             let frame = renderer

@@ -30,15 +30,25 @@
 //   fn vis_esm_of_log(log_moment: f32, l: Light, s: LightSample) -> f32
 //   fn vis_msm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
 //   fn vis_msm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32
+//   fn vis_vssm_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32
+//   fn vis_vssm_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
+//   fn vis_msm_soft_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32
+//   fn vis_msm_soft_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
 //
 // Names defined here (a host must not reuse them):
-//   CSM_PI GOLDEN_ANGLE Light LightSample MSM_B0 MipTaps bilinear_level bilinear_log_level
-//   chebyshev_upper csm_chunk csm_chunk_of csm_resolve csm_sin_cos level_size light_footprint
-//   light_linear_to_ndc light_linear_to_z light_map_width light_sample light_to_light linstep
-//   load_depth mip_tap_uv mip_taps msm_dequantize msm_intensity msm_quantize pcss_search_radius
-//   sample_bilinear sample_bilinear_log sample_map sample_map_log texel_of trilinear
-//   trilinear_log vis_esm vis_esm_of_log vis_esm_of_sat vis_evsm vis_evsm_of vis_hard vis_msm
-//   vis_msm_of vis_pcf vis_pcf_hardware vis_pcss vis_vsm vis_vsm_of vogel_disc
+//   BLOCKER_MIN_SHARE CSM_PI GOLDEN_ANGLE Light LightSample MSM_B0 MipTaps SAT_MIN_EXTENT
+//   SatNodes bilinear_level bilinear_log_level blocker_csm_z blocker_filter_width blocker_msm
+//   blocker_result blocker_search_width blocker_vsm blocker_width chebyshev_upper csm_chunk
+//   csm_chunk_of csm_resolve csm_sin_cos csm_weight csm_z_chunk_of cssm_blocker cssm_resolve
+//   cssm_sharpen level_size light_footprint light_linear_to_ndc light_linear_to_z
+//   light_map_width light_sample light_to_light linstep load_depth mip_tap_uv mip_taps
+//   msm_biased msm_dequantize msm_intensity msm_quantize msm_roots msm_soft_blocker
+//   msm_soft_resolve pcss_search_radius sample_bilinear sample_bilinear_log sample_map
+//   sample_map_log sat_mean_fixed sat_mean_float sat_node_f32 sat_node_u32 sat_nodes sat_rect
+//   sat_sample_fixed sat_sample_float texel_of trilinear trilinear_log vis_esm vis_esm_of_log
+//   vis_esm_of_sat vis_evsm vis_evsm_of vis_hard vis_msm vis_msm_of vis_msm_soft_fixed
+//   vis_msm_soft_float vis_pcf vis_pcf_hardware vis_pcss vis_vsm vis_vsm_of vis_vssm_fixed
+//   vis_vssm_float vogel_disc vssm_blocker vssm_resolve
 
 // Shared light description and light-space helpers (import-only module).
 //
@@ -62,12 +72,12 @@ struct Light {
     bias: f32,               // constant bias, linear depth units
     normal_bias: f32,        // normal offset, texels, scaled by (1 − N·L)
     cos_outer: f32,          // spot cone: cos(fov/2); directional: −1
-    technique: u32,          // 0 hard, 1 pcf, 2 pcss, 3 vsm, 4 evsm, 5 esm, 6 msm, 7 csm
+    technique: u32,          // 0 hard, 1 pcf, 2 pcss, 3 vsm, 4 evsm, 5 esm, 6 msm, 7 csm, 8 cssm, 9 vssm, 10 msm_soft
     radius: u32,             // pcf: window radius in texels
     kernel: u32,             // pcf: 0 box, 1 tent, 2 hardware 2×2
     blocker_samples: u32,    // pcss
     filter_samples: u32,     // pcss
-    max_search: f32,         // pcss: cap on the blocker-search radius, UV
+    max_search: f32,         // pcss, soft techniques: cap on the blocker-search radius, UV
     bleed: f32,              // vsm, evsm: light-bleeding reduction amount
     min_variance: f32,       // vsm, evsm: variance floor (depth units²)
     exp_pos: f32,            // evsm: positive exponent c⁺; esm: exponent c
@@ -83,8 +93,12 @@ struct Light {
     filter_lod: f32,         // mips filter: log2 of the filter width in texels
     filter_width: f32,       // sat filter: box width in texels (0: no sat)
     max_anisotropy: u32,     // mips filter: 0 fixed width; ≥ 1 per-pixel footprint, up to this many taps
-    sat_offset: vec4<f32>,   // sat filter: the table's coding (SatCoding in src/sat.rs)
+    sat_offset: vec4<f32>,   // sat filter, soft techniques: the table's coding (SatCoding in src/sat.rs)
     sat_scale: vec4<f32>,
+    sharpen: f32,            // cssm: sharpening strength A of v^p, p = 1 + A·exp(−B (d − z_avg))
+    sharpen_falloff: f32,    // cssm: sharpening falloff B, per linear depth unit
+    max_width: f32,          // soft techniques: cap on the search and filter widths, texels
+    _pad1: u32,
 }
 
 // Where a receiver lands in a light's shadow map.
@@ -496,21 +510,20 @@ fn msm_dequantize(q: vec4<f32>) -> vec4<f32> {
 // on [−1, 1], mapped to depth in [0, 1].
 const MSM_B0: vec4<f32> = vec4<f32>(0.5, 0.34375, 0.265625, 0.2265625);
 
-// Shadow intensity (share of the depth distribution in front of d) from biased moments b.
-fn msm_intensity(b: vec4<f32>, d: f32, hausdorff: bool) -> f32 {
+// The Hamburger reconstruction through d: (z₂, z₃, case) where z₂ ≤ z₃ are the other support
+// points of the three-point distribution that matches the biased moments b and has a point at
+// d (solve B c = (1, d, d²) by Cholesky, roots of c₃x² + c₂x + c₁). case 0: regular; 1: the
+// variance is (numerically) 0, a single point at b.x; 2: rank-deficient, two support points
+// (z₂, z₃ then meaningless).
+fn msm_roots(b: vec4<f32>, d: f32) -> vec3<f32> {
     let var1 = b.y - b.x * b.x;
     if !(var1 > 1e-12) {
-        return select(0.0, 1.0, d > b.x);
+        return vec3<f32>(0.0, 0.0, 1.0);
     }
     let l32 = (b.z - b.x * b.y) / var1;
     let d3 = b.w - b.y * b.y - l32 * l32 * var1;
     if !(d3 > 0.0) {
-        // Rank-deficient: two support points; Chebyshev's bound is the best statement left.
-        if d <= b.x {
-            return 0.0;
-        }
-        let t = d - b.x;
-        return t * t / (var1 + t * t);
+        return vec3<f32>(0.0, 0.0, 2.0);
     }
     // Forward substitution, scaling by the diagonal, back substitution.
     let y2 = d - b.x;
@@ -521,8 +534,25 @@ fn msm_intensity(b: vec4<f32>, d: f32, hausdorff: bool) -> f32 {
     let p = c2 / c3;
     let q = c1 / c3;
     let r = sqrt(max(0.25 * p * p - q, 0.0));
-    let z2 = -0.5 * p - r;
-    let z3 = -0.5 * p + r;
+    return vec3<f32>(-0.5 * p - r, -0.5 * p + r, 0.0);
+}
+
+// Shadow intensity (share of the depth distribution in front of d) from biased moments b.
+fn msm_intensity(b: vec4<f32>, d: f32, hausdorff: bool) -> f32 {
+    let roots = msm_roots(b, d);
+    if roots.z == 1.0 {
+        return select(0.0, 1.0, d > b.x);
+    }
+    if roots.z == 2.0 {
+        // Rank-deficient: two support points; Chebyshev's bound is the best statement left.
+        if d <= b.x {
+            return 0.0;
+        }
+        let t = d - b.x;
+        return t * t / (b.y - b.x * b.x + t * t);
+    }
+    let z2 = roots.x;
+    let z3 = roots.y;
     if hausdorff && (z2 < 0.0 || z3 > 1.0) {
         let free = ((b.z - b.y) * d + b.z - b.w) / ((b.y - b.x) * d + b.y - b.z);
         let w1 = select(0.0, 1.0, d > free);
@@ -542,13 +572,18 @@ fn vis_msm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     return vis_msm_of(sample_map(map, l, s), l, s);
 }
 
-// Visibility from filtered (possibly quantized) moments `m` however they were filtered.
-fn vis_msm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
+// Filtered (possibly quantized) moments `m` dequantized and biased toward MSM_B0.
+fn msm_biased(m: vec4<f32>, l: Light) -> vec4<f32> {
     var b = m;
     if (l.msm_flags & 2u) != 0u {
         b = msm_dequantize(b);
     }
-    b = mix(b, MSM_B0, l.moment_bias);
+    return mix(b, MSM_B0, l.moment_bias);
+}
+
+// Visibility from filtered (possibly quantized) moments `m` however they were filtered.
+fn vis_msm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
+    let b = msm_biased(m, l);
     let intensity = msm_intensity(b, s.depth - l.bias, (l.msm_flags & 1u) != 0u);
     let v = 1.0 - clamp(intensity, 0.0, 1.0);
     // NaN compares false both ways: a non-finite intensity reads as fully lit.
@@ -582,15 +617,13 @@ fn csm_chunk(map: texture_2d<f32>, chunk: u32, l: Light, s: LightSample) -> f32 
 // The same from the chunk's filtered basis values `v` however they were filtered.
 fn csm_chunk_of(v: vec4<f32>, chunk: u32, l: Light, s: LightSample) -> f32 {
     let d = s.depth - l.bias - l.csm_offset;
-    let m = f32(l.csm_terms);
     var sum = 0.0;
     for (var j = 0u; j < 2u; j++) {
         let k = 2u * chunk + 1u + j;
         if k > l.csm_terms {
             break;
         }
-        let kf = f32(k) / m;
-        let w = 2.0 / (CSM_PI * f32(2u * k - 1u)) * exp(-l.csm_attenuation * kf * kf);
+        let w = csm_weight(k, l);
         let basis = select(v.xy, v.zw, j == 1u);
         let sc = csm_sin_cos(k, d);
         sum += w * (sc.y * basis.x - sc.x * basis.y);
@@ -598,6 +631,352 @@ fn csm_chunk_of(v: vec4<f32>, chunk: u32, l: Light, s: LightSample) -> f32 {
     return sum;
 }
 
+// w_k = (2 / c_k) · exp(−α (k / M)²): the attenuated weight of term k.
+fn csm_weight(k: u32, l: Light) -> f32 {
+    let kf = f32(k) / f32(l.csm_terms);
+    return 2.0 / (CSM_PI * f32(2u * k - 1u)) * exp(-l.csm_attenuation * kf * kf);
+}
+
 fn csm_resolve(sum: f32, l: Light) -> f32 {
     return clamp(l.csm_scale * sum + 0.5, 0.0, 1.0);
+}
+// Convolution soft shadow maps (Annen et al. 2008; seed 000), every step a summed-area-table
+// lookup: over the blocker-search square, the CSM basis gives E[f] and the CSM-Z basis
+// E[f̄·z], hence the blocker share and z_avg (blocker_csm_z); the PCSS penumbra width
+// w = size·(Z − Z_b)/Z_b sets the square of the CSM lookup; its response is shifted, scaled
+// about ½ and clamped to [0, 1] as CSM's (csm_resolve: the clamp cuts the ringing), then
+// sharpened selectively, v^p with p = 1 + A·exp(−B (d − z_avg)): near contact (d ≈ z_avg),
+// where the smooth Fourier step leaks light and the penumbra is narrow, the darkening is
+// strongest; it fades as the receiver leaves its blockers. A square without blockers
+// (share < BLOCKER_MIN_SHARE) is lit.
+// The shading block (technique::visibility_body) sums `csm_chunk_of` over the light's basis
+// tables and `csm_z_chunk_of` over its CSM-Z tables at the search width, calls
+// `cssm_blocker`, sums the basis again at `blocker_filter_width(l, s, b.x)`, then calls
+// `cssm_resolve`.
+// The `sat` filter's lookups for the shading side (import-only module): a light's filtered
+// representation at a receiver as the mean over a square of `width` shadow-map texels centred
+// on it, from the light's summed-area table, four lookups per channel (sixteen with the
+// sub-texel edges) whatever the width. Any other rectangle, e.g. a per-pixel penumbra width,
+// goes through `sat_rect` with that width.
+// Summed-area-table lookups for the shading side (import-only module): the mean of the
+// representation over any axis-aligned rectangle, from a SAT built by the sat_* kernels.
+//
+// Coordinates are texel units: texel (i, j) covers [i, i + 1) × [j, j + 1), so a shadow-map
+// UV maps to uv · size. SAT texel (i, j) holds the sum over texels [0, i] × [0, j], which is
+// F(i + 1, j + 1) with F(x, y) the integral of the piecewise-constant map over [0, x] × [0, y].
+// Inside a texel F is bilinear in (x, y), so F at a fractional corner is the bilinear mix of
+// four SAT texels and the integral over the rectangle is exact for fractional edges. Each of
+// the 16 corner-pair boxes below is an integer-edged window sum: in fixed point it is taken
+// with wrapping u32 arithmetic and is exact while its true value fits in an i32 (the scale
+// rule of src/sat.rs, with the window one texel larger than the rectangle each way); only
+// then is it weighted in f32.
+//
+// A rectangle is ordered, clamped to the map and, where thinner than SAT_MIN_EXTENT, widened
+// to it inside the map (the mean then tends to the point value, never 0/0). Channels the
+// representation does not have hold 0 in the table and decode to `offset`.
+
+const SAT_MIN_EXTENT: f32 = 0.00390625; // 2⁻⁸ texel
+
+// The integer corner nodes of a clamped rectangle and their bilinear weights:
+// x = (i0, i0 + 1, i1, i1 + 1) with i0 = ⌊x0⌋, i1 = ⌊x1⌋ (clamped to the map),
+// wx = (1 − fract(x0), fract(x0), 1 − fract(x1), fract(x1)); the same for y.
+struct SatNodes {
+    x: vec4<i32>,
+    y: vec4<i32>,
+    wx: vec4<f32>,
+    wy: vec4<f32>,
+    area: f32,
+}
+
+fn sat_nodes(rect: vec4<f32>, size: vec2<u32>) -> SatNodes {
+    let s = vec2<f32>(size);
+    let lo0 = clamp(min(rect.xy, rect.zw), vec2<f32>(0.0), s);
+    let hi0 = clamp(max(rect.xy, rect.zw), vec2<f32>(0.0), s);
+    let lo = min(lo0, s - SAT_MIN_EXTENT);
+    let hi = max(hi0, lo + SAT_MIN_EXTENT);
+    let i0 = floor(lo);
+    let i1 = floor(hi);
+    let a0 = lo - i0;
+    let a1 = hi - i1;
+    let top = vec2<i32>(size);
+    var n: SatNodes;
+    n.x = min(vec4<i32>(i32(i0.x), i32(i0.x) + 1, i32(i1.x), i32(i1.x) + 1), vec4<i32>(top.x));
+    n.y = min(vec4<i32>(i32(i0.y), i32(i0.y) + 1, i32(i1.y), i32(i1.y) + 1), vec4<i32>(top.y));
+    n.wx = vec4<f32>(1.0 - a0.x, a0.x, 1.0 - a1.x, a1.x);
+    n.wy = vec4<f32>(1.0 - a0.y, a0.y, 1.0 - a1.y, a1.y);
+    n.area = (hi.x - lo.x) * (hi.y - lo.y);
+    return n;
+}
+
+// F(X, Y) at integer nodes: 0 on the top and left edges, else SAT texel (X − 1, Y − 1).
+fn sat_node_u32(sat: texture_2d<u32>, x: i32, y: i32) -> vec4<u32> {
+    if x == 0 || y == 0 {
+        return vec4<u32>(0u);
+    }
+    return textureLoad(sat, vec2<i32>(x - 1, y - 1), 0);
+}
+
+fn sat_node_f32(sat: texture_2d<f32>, x: i32, y: i32) -> vec4<f32> {
+    if x == 0 || y == 0 {
+        return vec4<f32>(0.0);
+    }
+    return textureLoad(sat, vec2<i32>(x - 1, y - 1), 0);
+}
+
+// Mean of the representation over `rect` = (x0, y0, x1, y1), texel units, from a fixed-point
+// SAT (rgba32uint) encoded with `offset` and `scale` (SatCoding in src/sat.rs).
+// With F at the left edge a mix over r and at the right edge over p (weights summing to 1),
+// F(x1) − F(x0) = Σ_r,p wx0_r·wx1_p·(F(X1_p) − F(X0_r)): a weighted sum of integer windows.
+fn sat_mean_fixed(sat: texture_2d<u32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
+    let n = sat_nodes(rect, textureDimensions(sat));
+    var f: array<vec4<u32>, 16>;
+    for (var j = 0; j < 4; j++) {
+        for (var i = 0; i < 4; i++) {
+            f[j * 4 + i] = sat_node_u32(sat, n.x[i], n.y[j]);
+        }
+    }
+    var sum = vec4<f32>(0.0);
+    for (var s = 0; s < 2; s++) {
+        for (var q = 2; q < 4; q++) {
+            for (var r = 0; r < 2; r++) {
+                for (var p = 2; p < 4; p++) {
+                    // Wrapping differences: exact whatever the SAT values are.
+                    let window = f[q * 4 + p] - f[q * 4 + r] - f[s * 4 + p] + f[s * 4 + r];
+                    let w = n.wx[r] * n.wx[p] * n.wy[s] * n.wy[q];
+                    sum += w * vec4<f32>(bitcast<vec4<i32>>(window));
+                }
+            }
+        }
+    }
+    return sum / (scale * n.area) + offset;
+}
+
+// The same from an f32 SAT (rgba32float) built with `offset` and `scale` (scale is 1 for the
+// f32 variant). Each window is a difference of f32 sums: its error grows with the sums at the
+// corners (about 2⁻²⁴ of the sum over [0, X] × [0, Y] each), not with the window.
+fn sat_mean_float(sat: texture_2d<f32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
+    let n = sat_nodes(rect, textureDimensions(sat));
+    var f: array<vec4<f32>, 16>;
+    for (var j = 0; j < 4; j++) {
+        for (var i = 0; i < 4; i++) {
+            f[j * 4 + i] = sat_node_f32(sat, n.x[i], n.y[j]);
+        }
+    }
+    var sum = vec4<f32>(0.0);
+    for (var s = 0; s < 2; s++) {
+        for (var q = 2; q < 4; q++) {
+            for (var r = 0; r < 2; r++) {
+                for (var p = 2; p < 4; p++) {
+                    let window = (f[q * 4 + p] - f[q * 4 + r]) - (f[s * 4 + p] - f[s * 4 + r]);
+                    sum += n.wx[r] * n.wx[p] * n.wy[s] * n.wy[q] * window;
+                }
+            }
+        }
+    }
+    return sum / (scale * n.area) + offset;
+}
+
+// The square of `width` texels centred on uv, in texel units (x0, y0, x1, y1).
+fn sat_rect(l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
+    let c = uv * l.map_size;
+    let h = vec2<f32>(0.5 * width);
+    return vec4<f32>(c - h, c + h);
+}
+
+// The mean over `sat_rect(l, uv, width)` from a fixed-point table (rgba32uint).
+fn sat_sample_fixed(map: texture_2d<u32>, l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
+    return sat_mean_fixed(map, sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
+}
+
+// The mean over `sat_rect(l, uv, width)` from an f32 table (rgba32float).
+fn sat_sample_float(map: texture_2d<f32>, l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
+    return sat_mean_float(map, sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
+}
+// The blocker search of the soft techniques (cssm, vssm, msm_soft) as filtered lookups
+// (import-only module): each technique reads the mean of its representation over the search
+// square from its summed-area table, turns it into the share of texels in front of the
+// receiver and their average depth z_avg, and reads the table again over the PCSS penumbra
+// width. No loop over texels: the cost is the same for any light size.
+//
+// Widths are in shadow-map texels, squares centred on the receiver:
+//   search  w_s = size·(Z − near)/Z at the near plane (the cone from the receiver to the light's
+//           width, where it is widest, as PCSS's search: vis_pcss.wgsl), / light_map_width(near);
+//   filter  w   = size·(Z − Z_b)/Z_b at the receiver (PCSS's penumbra, Fernando 2005), with
+//           Z_b = light_linear_to_z(z_avg), / light_map_width(Z);
+// both · map_size, at least 1 texel and at most l.max_width (2·max_search·map_size, the square
+// the fixed-point table is coded for). A NaN width (outside the map, where the result is
+// discarded) reads as 1 texel.
+
+// A search square whose estimated share of blockers is below this reads as lit, whatever the
+// lookup at the filter width gives (PCSS: no blocker tap). The estimates are smooth, so a
+// threshold keeps ringing (CSM-Z) and Chebyshev's tail (VSM) from turning into blockers.
+const BLOCKER_MIN_SHARE: f32 = 0.01;
+
+fn blocker_width(texels: f32, l: Light) -> f32 {
+    return min(select(1.0, texels, texels > 1.0), l.max_width);
+}
+
+fn blocker_search_width(l: Light, s: LightSample) -> f32 {
+    let world = l.size * (s.view_z - l.near) / s.view_z;
+    return blocker_width(world / light_map_width(l, l.near) * l.map_size.x, l);
+}
+
+fn blocker_filter_width(l: Light, s: LightSample, z_avg: f32) -> f32 {
+    let z_b = light_linear_to_z(l, z_avg);
+    let penumbra = l.size * (s.view_z - z_b) / z_b;
+    return blocker_width(penumbra / light_map_width(l, s.view_z) * l.map_size.x, l);
+}
+
+// (z_avg, share) from a blocker depth estimate `z` and share: z clamped to [0, d] (blockers
+// are in front of the receiver d).
+fn blocker_result(z: f32, share: f32, d: f32) -> vec2<f32> {
+    return vec2<f32>(clamp(z, 0.0, max(d, 0.0)), share);
+}
+
+// VSM moments m = (μ, E[z²]) over the search square, receiver depth d (Yang et al. 2010):
+// Chebyshev's one-tailed bound p on the share of texels at or behind d, and with those texels
+// taken at d, μ = p·d + (1 − p)·z_avg, so z_avg = (μ − p·d)/(1 − p). σ² is floored at `floor`.
+fn blocker_vsm(m: vec4<f32>, d: f32, floor: f32) -> vec2<f32> {
+    let variance = max(m.y - m.x * m.x, floor);
+    let t = d - m.x;
+    let p = select(1.0, variance / (variance + t * t), t > 0.0);
+    let share = 1.0 - p;
+    return blocker_result((m.x - p * d) / max(share, BLOCKER_MIN_SHARE), share, d);
+}
+
+// Biased MSM moments b over the search square, receiver depth d: the three-point distribution
+// through d that Hamburger MSM reconstructs (support d, z₂ ≤ z₃; msm_roots) carries the
+// blockers at the support points in front of d; z_avg is their weighted mean, the share their
+// weight. Weights from the Vandermonde system, w_i = E[Π_{j≠i} (z − z_j)] / Π_{j≠i} (z_i − z_j):
+// d ≤ z₂: none; z₂ < d ≤ z₃: z₂ alone, share w₂ (= MSM's shadow intensity); d > z₃: both,
+// share 1 − w₁ (= MSM's intensity) with w₃ = 1 − w₁ − w₂. Each support point is clamped to
+// [0, d] before averaging: as d crosses the value where z₃ passes through ±∞ (the roots
+// reorder), a point far outside [0, 1] carries a vanishing weight whose product with its depth
+// need not vanish; clamped, it does, and z_avg stays continuous. Degenerate moments: a single
+// point at μ, or (rank-deficient) the two-moment estimate.
+fn blocker_msm(b: vec4<f32>, d: f32) -> vec2<f32> {
+    let roots = msm_roots(b, d);
+    if roots.z == 1.0 {
+        return vec2<f32>(b.x, select(0.0, 1.0, d > b.x));
+    }
+    if roots.z == 2.0 {
+        return blocker_vsm(b, d, 0.0);
+    }
+    let z2 = roots.x;
+    let z3 = roots.y;
+    if d <= z2 {
+        return vec2<f32>(max(d, 0.0), 0.0);
+    }
+    if d <= z3 {
+        let w2 = (d * z3 - b.x * (d + z3) + b.y) / ((z3 - z2) * (d - z2));
+        return blocker_result(z2, w2, d);
+    }
+    let w1 = (z2 * z3 - b.x * (z2 + z3) + b.y) / ((d - z2) * (d - z3));
+    let w2 = (d * z3 - b.x * (d + z3) + b.y) / ((z3 - z2) * (d - z2));
+    let share = 1.0 - w1;
+    let z = w2 * clamp(z2, 0.0, d) + (share - w2) * clamp(z3, 0.0, d);
+    return blocker_result(z / max(share, BLOCKER_MIN_SHARE), share, d);
+}
+
+// The CSM-Z basis (Annen et al. 2008): with f̄(d, z) = 1 − f(d, z) the complementary test
+// (1 where z < d) in CSM's Fourier expansion,
+//   f̄(d, z)·z ≈ ½ z − Σ_k w_k [cos(c_k d)·z sin(c_k z) − sin(c_k d)·z cos(c_k z)],
+// linear in the images z, z·sin(c_k z), z·cos(c_k z), which `csm_z` writes in the order
+// [z, z·sin c₁z, z·cos c₁z, z·sin c₂z, …], four to a map. This is map `chunk`'s share of
+// E[f̄·z] from its filtered values v, at the shifted receiver depth CSM uses.
+fn csm_z_chunk_of(v: vec4<f32>, chunk: u32, l: Light, s: LightSample) -> f32 {
+    let d = s.depth - l.bias - l.csm_offset;
+    var sum = 0.0;
+    for (var c = 0u; c < 4u; c++) {
+        let i = 4u * chunk + c;
+        let k = (i + 1u) / 2u;
+        let sc = csm_sin_cos(max(k, 1u), d);
+        // Odd i: z·sin c_k z, weighted −w_k cos(c_k d); even i > 0: z·cos, weighted w_k sin.
+        var weight = select(csm_weight(max(k, 1u), l) * sc.x, -csm_weight(max(k, 1u), l) * sc.y,
+            (i & 1u) == 1u);
+        weight = select(weight, 0.5, i == 0u);
+        sum += select(0.0, weight * v[c], i <= 2u * l.csm_terms);
+    }
+    return sum;
+}
+
+// CSSM's blocker estimate from the search square's sums: `below` = Σ csm_chunk_of over the
+// basis maps = E[f] − ½ (unscaled), `zsum` = Σ csm_z_chunk_of over the CSM-Z maps = E[f̄·z].
+// Share E[f̄] = ½ − below, z_avg = E[f̄·z] / E[f̄] (seed 000: the denominator is 1 − the
+// filtered CSM test).
+fn blocker_csm_z(below: f32, zsum: f32, d: f32) -> vec2<f32> {
+    let share = 0.5 - below;
+    return blocker_result(zsum / max(share, BLOCKER_MIN_SHARE), share, d);
+}
+
+fn cssm_blocker(below: f32, zsum: f32, l: Light, s: LightSample) -> vec2<f32> {
+    return blocker_csm_z(below, zsum, s.depth - l.bias);
+}
+
+// v^p for v in [0, 1], p ≥ 1 (0 at v = 0, where log2 is −∞).
+fn cssm_sharpen(v: f32, p: f32) -> f32 {
+    return select(0.0, exp2(p * log2(v)), v > 0.0);
+}
+
+// The visibility from the basis sum at the filter width and the blocker estimate `b`.
+fn cssm_resolve(sum: f32, b: vec2<f32>, l: Light, s: LightSample) -> f32 {
+    let v = csm_resolve(sum, l);
+    let gap = max(s.depth - l.bias - b.x, 0.0);
+    let p = 1.0 + l.sharpen * exp(-l.sharpen_falloff * gap);
+    return select(1.0, cssm_sharpen(v, p), b.y >= BLOCKER_MIN_SHARE);
+}
+// Variance soft shadow maps (Yang et al. 2010) from a summed-area table of the VSM moments:
+// the moments over the blocker-search square give the blocker share and depth (blocker_vsm),
+// the PCSS penumbra width follows, and the VSM bound (vis_vsm_of: variance floor, bleed
+// reduction) is read from the moments over that width. Two table lookups per receiver; both
+// are made before the result is chosen (lit when the share is below BLOCKER_MIN_SHARE).
+// `vis_vssm_fixed` reads a fixed-point table (rgba32uint), `vis_vssm_float` an f32 one.
+
+fn vssm_blocker(m: vec4<f32>, l: Light, s: LightSample) -> vec2<f32> {
+    return blocker_vsm(m, s.depth - l.bias, l.min_variance);
+}
+
+// The visibility from the moments `m` at the filter width and the blocker estimate `b`.
+fn vssm_resolve(m: vec4<f32>, b: vec2<f32>, l: Light, s: LightSample) -> f32 {
+    return select(1.0, vis_vsm_of(m, l, s), b.y >= BLOCKER_MIN_SHARE);
+}
+
+fn vis_vssm_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32 {
+    let b = vssm_blocker(sat_sample_fixed(map, l, s.uv, blocker_search_width(l, s)), l, s);
+    let m = sat_sample_fixed(map, l, s.uv, blocker_filter_width(l, s, b.x));
+    return vssm_resolve(m, b, l, s);
+}
+
+fn vis_vssm_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
+    let b = vssm_blocker(sat_sample_float(map, l, s.uv, blocker_search_width(l, s)), l, s);
+    let m = sat_sample_float(map, l, s.uv, blocker_filter_width(l, s, b.x));
+    return vssm_resolve(m, b, l, s);
+}
+// Moment soft shadow maps (after Peters et al. 2016) from a summed-area table of the MSM
+// moments (raw or quantized): the biased moments over the blocker-search square give the
+// blocker share and depth from the Hamburger reconstruction (blocker_msm), the PCSS penumbra
+// width follows, and MSM's visibility (vis_msm_of: Hamburger or Hausdorff, bleed reduction) is
+// read from the moments over that width. Two table lookups per receiver, both made before the
+// result is chosen (lit when the share is below BLOCKER_MIN_SHARE).
+// `vis_msm_soft_fixed` reads a fixed-point table (rgba32uint), `vis_msm_soft_float` an f32 one.
+
+fn msm_soft_blocker(m: vec4<f32>, l: Light, s: LightSample) -> vec2<f32> {
+    return blocker_msm(msm_biased(m, l), s.depth - l.bias);
+}
+
+// The visibility from the moments `m` at the filter width and the blocker estimate `b`.
+fn msm_soft_resolve(m: vec4<f32>, b: vec2<f32>, l: Light, s: LightSample) -> f32 {
+    return select(1.0, vis_msm_of(m, l, s), b.y >= BLOCKER_MIN_SHARE);
+}
+
+fn vis_msm_soft_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32 {
+    let b = msm_soft_blocker(sat_sample_fixed(map, l, s.uv, blocker_search_width(l, s)), l, s);
+    let m = sat_sample_fixed(map, l, s.uv, blocker_filter_width(l, s, b.x));
+    return msm_soft_resolve(m, b, l, s);
+}
+
+fn vis_msm_soft_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
+    let b = msm_soft_blocker(sat_sample_float(map, l, s.uv, blocker_search_width(l, s)), l, s);
+    let m = sat_sample_float(map, l, s.uv, blocker_filter_width(l, s, b.x));
+    return msm_soft_resolve(m, b, l, s);
 }

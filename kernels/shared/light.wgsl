@@ -20,12 +20,12 @@ struct Light {
     bias: f32,               // constant bias, linear depth units
     normal_bias: f32,        // normal offset, texels, scaled by (1 − N·L)
     cos_outer: f32,          // spot cone: cos(fov/2); directional: −1
-    technique: u32,          // 0 hard, 1 pcf, 2 pcss, 3 vsm, 4 evsm, 5 esm, 6 msm, 7 csm
+    technique: u32,          // 0 hard, 1 pcf, 2 pcss, 3 vsm, 4 evsm, 5 esm, 6 msm, 7 csm, 8 cssm, 9 vssm, 10 msm_soft
     radius: u32,             // pcf: window radius in texels
     kernel: u32,             // pcf: 0 box, 1 tent, 2 hardware 2×2
     blocker_samples: u32,    // pcss
     filter_samples: u32,     // pcss
-    max_search: f32,         // pcss: cap on the blocker-search radius, UV
+    max_search: f32,         // pcss, soft techniques: cap on the blocker-search radius, UV
     bleed: f32,              // vsm, evsm: light-bleeding reduction amount
     min_variance: f32,       // vsm, evsm: variance floor (depth units²)
     exp_pos: f32,            // evsm: positive exponent c⁺; esm: exponent c
@@ -41,8 +41,12 @@ struct Light {
     filter_lod: f32,         // mips filter: log2 of the filter width in texels
     filter_width: f32,       // sat filter: box width in texels (0: no sat)
     max_anisotropy: u32,     // mips filter: 0 fixed width; ≥ 1 per-pixel footprint, up to this many taps
-    sat_offset: vec4<f32>,   // sat filter: the table's coding (SatCoding in src/sat.rs)
+    sat_offset: vec4<f32>,   // sat filter, soft techniques: the table's coding (SatCoding in src/sat.rs)
     sat_scale: vec4<f32>,
+    sharpen: f32,            // cssm: sharpening strength A of v^p, p = 1 + A·exp(−B (d − z_avg))
+    sharpen_falloff: f32,    // cssm: sharpening falloff B, per linear depth unit
+    max_width: f32,          // soft techniques: cap on the search and filter widths, texels
+    _pad1: u32,
 }
 
 // Where a receiver lands in a light's shadow map.

@@ -18,20 +18,24 @@ fn csm_chunk(map: texture_2d<f32>, chunk: u32, l: Light, s: LightSample) -> f32 
 // The same from the chunk's filtered basis values `v` however they were filtered.
 fn csm_chunk_of(v: vec4<f32>, chunk: u32, l: Light, s: LightSample) -> f32 {
     let d = s.depth - l.bias - l.csm_offset;
-    let m = f32(l.csm_terms);
     var sum = 0.0;
     for (var j = 0u; j < 2u; j++) {
         let k = 2u * chunk + 1u + j;
         if k > l.csm_terms {
             break;
         }
-        let kf = f32(k) / m;
-        let w = 2.0 / (CSM_PI * f32(2u * k - 1u)) * exp(-l.csm_attenuation * kf * kf);
+        let w = csm_weight(k, l);
         let basis = select(v.xy, v.zw, j == 1u);
         let sc = csm_sin_cos(k, d);
         sum += w * (sc.y * basis.x - sc.x * basis.y);
     }
     return sum;
+}
+
+// w_k = (2 / c_k) · exp(−α (k / M)²): the attenuated weight of term k.
+fn csm_weight(k: u32, l: Light) -> f32 {
+    let kf = f32(k) / f32(l.csm_terms);
+    return 2.0 / (CSM_PI * f32(2u * k - 1u)) * exp(-l.csm_attenuation * kf * kf);
 }
 
 fn csm_resolve(sum: f32, l: Light) -> f32 {

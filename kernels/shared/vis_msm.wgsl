@@ -15,21 +15,20 @@
 // on [−1, 1], mapped to depth in [0, 1].
 const MSM_B0: vec4<f32> = vec4<f32>(0.5, 0.34375, 0.265625, 0.2265625);
 
-// Shadow intensity (share of the depth distribution in front of d) from biased moments b.
-fn msm_intensity(b: vec4<f32>, d: f32, hausdorff: bool) -> f32 {
+// The Hamburger reconstruction through d: (z₂, z₃, case) where z₂ ≤ z₃ are the other support
+// points of the three-point distribution that matches the biased moments b and has a point at
+// d (solve B c = (1, d, d²) by Cholesky, roots of c₃x² + c₂x + c₁). case 0: regular; 1: the
+// variance is (numerically) 0, a single point at b.x; 2: rank-deficient, two support points
+// (z₂, z₃ then meaningless).
+fn msm_roots(b: vec4<f32>, d: f32) -> vec3<f32> {
     let var1 = b.y - b.x * b.x;
     if !(var1 > 1e-12) {
-        return select(0.0, 1.0, d > b.x);
+        return vec3<f32>(0.0, 0.0, 1.0);
     }
     let l32 = (b.z - b.x * b.y) / var1;
     let d3 = b.w - b.y * b.y - l32 * l32 * var1;
     if !(d3 > 0.0) {
-        // Rank-deficient: two support points; Chebyshev's bound is the best statement left.
-        if d <= b.x {
-            return 0.0;
-        }
-        let t = d - b.x;
-        return t * t / (var1 + t * t);
+        return vec3<f32>(0.0, 0.0, 2.0);
     }
     // Forward substitution, scaling by the diagonal, back substitution.
     let y2 = d - b.x;
@@ -40,8 +39,25 @@ fn msm_intensity(b: vec4<f32>, d: f32, hausdorff: bool) -> f32 {
     let p = c2 / c3;
     let q = c1 / c3;
     let r = sqrt(max(0.25 * p * p - q, 0.0));
-    let z2 = -0.5 * p - r;
-    let z3 = -0.5 * p + r;
+    return vec3<f32>(-0.5 * p - r, -0.5 * p + r, 0.0);
+}
+
+// Shadow intensity (share of the depth distribution in front of d) from biased moments b.
+fn msm_intensity(b: vec4<f32>, d: f32, hausdorff: bool) -> f32 {
+    let roots = msm_roots(b, d);
+    if roots.z == 1.0 {
+        return select(0.0, 1.0, d > b.x);
+    }
+    if roots.z == 2.0 {
+        // Rank-deficient: two support points; Chebyshev's bound is the best statement left.
+        if d <= b.x {
+            return 0.0;
+        }
+        let t = d - b.x;
+        return t * t / (b.y - b.x * b.x + t * t);
+    }
+    let z2 = roots.x;
+    let z3 = roots.y;
     if hausdorff && (z2 < 0.0 || z3 > 1.0) {
         let free = ((b.z - b.y) * d + b.z - b.w) / ((b.y - b.x) * d + b.y - b.z);
         let w1 = select(0.0, 1.0, d > free);
@@ -61,13 +77,18 @@ fn vis_msm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     return vis_msm_of(sample_map(map, l, s), l, s);
 }
 
-// Visibility from filtered (possibly quantized) moments `m` however they were filtered.
-fn vis_msm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
+// Filtered (possibly quantized) moments `m` dequantized and biased toward MSM_B0.
+fn msm_biased(m: vec4<f32>, l: Light) -> vec4<f32> {
     var b = m;
     if (l.msm_flags & 2u) != 0u {
         b = msm_dequantize(b);
     }
-    b = mix(b, MSM_B0, l.moment_bias);
+    return mix(b, MSM_B0, l.moment_bias);
+}
+
+// Visibility from filtered (possibly quantized) moments `m` however they were filtered.
+fn vis_msm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
+    let b = msm_biased(m, l);
     let intensity = msm_intensity(b, s.depth - l.bias, (l.msm_flags & 1u) != 0u);
     let v = 1.0 - clamp(intensity, 0.0, 1.0);
     // NaN compares false both ways: a non-finite intensity reads as fully lit.

@@ -161,8 +161,18 @@ pub fn taps<'a>(levels: &'a [Texels], l: &LightGpu, s: &LightSample) -> Vec<(f64
 /// the square of `l.filter_width` texels centred on `uv` overlaps, weighted by its overlap over
 /// the (clamped) square's area; the rectangle itself is formed in f32 as the shader forms it.
 pub fn sat_taps<'a>(t: &'a Texels, l: &LightGpu, uv: [f64; 2]) -> Vec<(f64, &'a [f64])> {
+    sat_taps_width(t, l, uv, l.filter_width)
+}
+
+/// [`sat_taps`] for a square of `width` texels (`sat_sample_*(map, l, uv, width)`).
+pub fn sat_taps_width<'a>(
+    t: &'a Texels,
+    l: &LightGpu,
+    uv: [f64; 2],
+    width: f32,
+) -> Vec<(f64, &'a [f64])> {
     let (cx, cy) = (uv[0] as f32 * l.map_size[0], uv[1] as f32 * l.map_size[1]);
-    let h = 0.5 * l.filter_width;
+    let h = 0.5 * width;
     let rect = [cx - h, cy - h, cx + h, cy + h];
     let [x0, y0, x1, y1] = super::sat::clamp_rect(rect, t.width, t.height).map(f64::from);
     let area = (x1 - x0) * (y1 - y0);

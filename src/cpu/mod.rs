@@ -1,8 +1,10 @@
 //! f64 CPU references, one per kernel or WGSL module and named after it, written in the
 //! shader's shape so the two read side by side. Tests compare the GPU against these.
 
+pub mod blocker;
 pub mod blur;
 pub mod csm;
+pub mod csm_z;
 pub mod esm;
 pub mod evsm;
 pub mod light;
@@ -12,13 +14,16 @@ pub mod msm;
 pub mod sat;
 pub mod shade;
 pub mod vis_csm;
+pub mod vis_cssm;
 pub mod vis_esm;
 pub mod vis_evsm;
 pub mod vis_hard;
 pub mod vis_msm;
+pub mod vis_msm_soft;
 pub mod vis_pcf;
 pub mod vis_pcss;
 pub mod vis_vsm;
+pub mod vis_vssm;
 pub mod vsm;
 
 /// A linear depth map on the CPU.

@@ -24,6 +24,21 @@ pub fn series(basis: &[f64], l: &LightGpu, d: f64) -> f64 {
 /// mip chain).
 pub fn vis_csm(levels: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
     let basis = super::mips::sample(levels, l, s);
-    let d = s.depth - f64::from(l.bias) - f64::from(l.csm_offset);
-    (f64::from(l.csm_scale) * series(&basis, l, d) + 0.5).clamp(0.0, 1.0)
+    resolve(series(&basis, l, shifted_depth(l, s)), l)
+}
+
+/// The receiver depth the series is evaluated at: `d − bias − offset`.
+pub fn shifted_depth(l: &LightGpu, s: &LightSample) -> f64 {
+    s.depth - f64::from(l.bias) - f64::from(l.csm_offset)
+}
+
+/// The series `sum` scaled about ½ and clamped (`csm_resolve`).
+pub fn resolve(sum: f64, l: &LightGpu) -> f64 {
+    (f64::from(l.csm_scale) * sum + 0.5).clamp(0.0, 1.0)
+}
+
+/// The attenuated weight of term k, `(2 / c_k)·exp(−α (k/M)²)` (`csm_weight`).
+pub fn weight(k: u32, l: &LightGpu) -> f64 {
+    let kf = f64::from(k) / f64::from(l.csm_terms);
+    2.0 / (PI * f64::from(2 * k - 1)) * (-f64::from(l.csm_attenuation) * kf * kf).exp()
 }

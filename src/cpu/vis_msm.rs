@@ -64,7 +64,11 @@ pub fn intensity(b: [f64; 4], d: f64, hausdorff: bool) -> f64 {
 
 /// The filtered (possibly quantized) moments at `s`, dequantized and biased.
 pub fn biased_moments(levels: &[Texels], l: &LightGpu, s: &LightSample) -> [f64; 4] {
-    let m = super::mips::sample(levels, l, s);
+    biased(&super::mips::sample(levels, l, s), l)
+}
+
+/// Filtered (possibly quantized) moments `m` dequantized and biased (`msm_biased`).
+pub fn biased(m: &[f64], l: &LightGpu) -> [f64; 4] {
     let mut b = [m[0], m[1], m[2], m[3]];
     if l.msm_flags & MSM_QUANTIZED != 0 {
         b = super::msm::dequantize(b);
@@ -75,7 +79,12 @@ pub fn biased_moments(levels: &[Texels], l: &LightGpu, s: &LightSample) -> [f64;
 
 /// MSM visibility (Hamburger or Hausdorff by `l.msm_flags`) with bleeding reduction.
 pub fn vis_msm(levels: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
-    let b = biased_moments(levels, l, s);
+    vis_msm_of(&super::mips::sample(levels, l, s), l, s)
+}
+
+/// MSM visibility from filtered moments `m` however they were filtered (`vis_msm_of`).
+pub fn vis_msm_of(m: &[f64], l: &LightGpu, s: &LightSample) -> f64 {
+    let b = biased(m, l);
     let i = intensity(
         b,
         s.depth - f64::from(l.bias),

@@ -7,7 +7,11 @@ use crate::technique::LightGpu;
 /// Chebyshev upper bound from the filtered moments (`levels`: the map, or its mip chain),
 /// with bleeding reduction.
 pub fn vis_vsm(levels: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
-    let m = super::mips::sample(levels, l, s);
+    vis_vsm_of(&super::mips::sample(levels, l, s), l, s)
+}
+
+/// The bound from filtered moments `m` however they were filtered (`vis_vsm_of`).
+pub fn vis_vsm_of(m: &[f64], l: &LightGpu, s: &LightSample) -> f64 {
     let d = s.depth - f64::from(l.bias);
     if d <= m[0] {
         return 1.0;

@@ -6,7 +6,8 @@ use glam::{Mat4, Vec3, Vec4};
 use super::StageError;
 use crate::filter::MAX_BLUR_RADIUS;
 use crate::scene::{
-    BlurKernel, Filter, Light, LightKind, Prefilter, Shadow, Storage, Technique, exponent_limit,
+    BlurKernel, DEFAULT_MAX_SEARCH, DEFAULT_SHARPEN, DEFAULT_SHARPEN_FALLOFF, Filter, Light,
+    LightKind, Prefilter, Shadow, Soft, Storage, Technique, exponent_limit,
 };
 use crate::technique::LightGpu;
 
@@ -44,6 +45,13 @@ const DEFAULT_BLUR: Filter = Filter::Blur {
 const DEFAULT_PREFILTER: Prefilter = Prefilter {
     storage: Storage::F32,
     filter: DEFAULT_BLUR,
+};
+
+/// A soft technique's table without `format`, `sat_sums` or `max_search` keys.
+const DEFAULT_SOFT: Soft = Soft {
+    storage: Storage::F32,
+    sums: crate::sat::SatVariant::Fixed,
+    max_search: DEFAULT_MAX_SEARCH,
 };
 
 impl PrefilterConfig {
@@ -141,6 +149,56 @@ impl PrefilterConfig {
         )
     }
 
+    /// Soft VSM (`vssm`) with a scene's defaults, for an area light `light_size` wide: f32
+    /// moments in a fixed-point table, search cap 0.1, bleed reduction 0.2, floor 1e-5.
+    pub fn vssm(size: u32, light_size: f32) -> Self {
+        let mut c = Self::new(
+            Technique::Vssm {
+                soft: DEFAULT_SOFT,
+                bleed: 0.2,
+                min_variance: 1e-5,
+            },
+            size,
+        );
+        c.light_size = light_size;
+        c
+    }
+
+    /// Soft MSM (`msm_soft`) with a scene's defaults: f32 raw moments in a fixed-point table,
+    /// Hamburger reconstruction, search cap 0.1.
+    pub fn msm_soft(size: u32, light_size: f32) -> Self {
+        let mut c = Self::new(
+            Technique::MsmSoft {
+                soft: DEFAULT_SOFT,
+                hausdorff: false,
+                moment_bias: crate::scene::default_moment_bias(Storage::F32),
+                bleed: 0.0,
+            },
+            size,
+        );
+        c.light_size = light_size;
+        c
+    }
+
+    /// Convolution soft shadow maps (`cssm`) with `terms` terms and a scene's defaults
+    /// (attenuation 1, offset ½/M, scale 2, the default sharpening, search cap 0.1).
+    pub fn cssm(size: u32, terms: u32, light_size: f32) -> Self {
+        let mut c = Self::new(
+            Technique::Cssm {
+                soft: DEFAULT_SOFT,
+                terms,
+                attenuation: 1.0,
+                offset: 0.5 / terms.max(1) as f32,
+                scale: 2.0,
+                sharpen: DEFAULT_SHARPEN,
+                sharpen_falloff: DEFAULT_SHARPEN_FALLOFF,
+            },
+            size,
+        );
+        c.light_size = light_size;
+        c
+    }
+
     /// The technique, map size and shading constants of a scene's light.
     pub fn from_light(light: &Light) -> Self {
         Self {
@@ -153,11 +211,17 @@ impl PrefilterConfig {
         }
     }
 
-    /// The same with moments stored at `storage` precision (VSM, EVSM, MSM, CSM; ESM is always
-    /// f32; `Unorm16` only for MSM).
+    /// The same with moments stored at `storage` precision (VSM, EVSM, MSM, CSM and the soft
+    /// techniques; ESM is always f32; `Unorm16` only for MSM and soft MSM).
     pub fn with_storage(mut self, storage: Storage) -> Self {
         match &mut self.technique {
             Technique::Msm { prefilter, .. } => prefilter.storage = storage,
+            Technique::MsmSoft { soft, .. } => soft.storage = storage,
+            Technique::Vssm { soft, .. } | Technique::Cssm { soft, .. }
+                if storage != Storage::Unorm16 =>
+            {
+                soft.storage = storage;
+            }
             Technique::Vsm { prefilter, .. }
             | Technique::Evsm { prefilter, .. }
             | Technique::Csm { prefilter, .. }
@@ -170,7 +234,8 @@ impl PrefilterConfig {
         self
     }
 
-    /// The same with `filter` over the representation (VSM, EVSM, ESM, MSM, CSM).
+    /// The same with `filter` over the representation (VSM, EVSM, ESM, MSM, CSM; the soft
+    /// techniques always read a summed-area table: see [`PrefilterConfig::with_soft`]).
     pub fn with_filter(mut self, filter: Filter) -> Self {
         match &mut self.technique {
             Technique::Vsm { prefilter, .. }
@@ -181,6 +246,21 @@ impl PrefilterConfig {
             }
             Technique::Esm { filter: f, .. } => *f = filter,
             _ => self.not_applicable = Some("filter"),
+        }
+        self
+    }
+
+    /// The same with a soft technique's table sums and search cap (`cssm`, `vssm`,
+    /// `msm_soft`; the storage is set by [`PrefilterConfig::with_storage`]).
+    pub fn with_soft(mut self, sums: crate::sat::SatVariant, max_search: f32) -> Self {
+        match &mut self.technique {
+            Technique::Cssm { soft, .. }
+            | Technique::Vssm { soft, .. }
+            | Technique::MsmSoft { soft, .. } => {
+                soft.sums = sums;
+                soft.max_search = max_search;
+            }
+            _ => self.not_applicable = Some("sat_sums"),
         }
         self
     }
@@ -278,12 +358,49 @@ fn technique(
             int_range("blocker_samples", blocker_samples, 1, 256)?;
             int_range("filter_samples", filter_samples, 1, 1024)?;
             range("max_search", max_search, 1e-4, 1.0)?;
-            if light_size <= 0.0 {
-                return Err(config_err(
-                    "size (light)",
-                    "technique \"pcss\" needs an area light width > 0".into(),
-                ));
-            }
+            area_light(&t, light_size)?;
+            t
+        }
+        Technique::Cssm {
+            soft,
+            terms,
+            attenuation,
+            offset,
+            scale,
+            sharpen,
+            sharpen_falloff,
+        } => {
+            range("max_search", soft.max_search, 1e-4, 1.0)?;
+            range("terms", terms as f32, 1.0, 16.0)?;
+            range("attenuation", attenuation, 0.0, 20.0)?;
+            range("offset", offset, 0.0, 0.5)?;
+            range("scale", scale, 1.0, 16.0)?;
+            range("sharpen", sharpen, 0.0, 100.0)?;
+            range("sharpen_falloff", sharpen_falloff, 0.0, 1e4)?;
+            area_light(&t, light_size)?;
+            t
+        }
+        Technique::Vssm {
+            soft,
+            bleed,
+            min_variance,
+        } => {
+            range("max_search", soft.max_search, 1e-4, 1.0)?;
+            range("bleed_reduction", bleed, 0.0, 0.99)?;
+            range("min_variance", min_variance, 0.0, 1.0)?;
+            area_light(&t, light_size)?;
+            t
+        }
+        Technique::MsmSoft {
+            soft,
+            moment_bias,
+            bleed,
+            ..
+        } => {
+            range("max_search", soft.max_search, 1e-4, 1.0)?;
+            range("moment_bias", moment_bias, 0.0, 0.5)?;
+            range("bleed_reduction", bleed, 0.0, 0.99)?;
+            area_light(&t, light_size)?;
             t
         }
         Technique::Vsm {
@@ -387,6 +504,17 @@ fn sat_clamp(warnings: &mut Vec<String>, field: &str, c: f32, f: &Filter, esm: b
         }
         _ => c,
     }
+}
+
+/// PCSS and the soft techniques need an area light (as a scene's `size` > 0).
+fn area_light(t: &Technique, light_size: f32) -> Result<(), StageError> {
+    if light_size <= 0.0 {
+        return Err(config_err(
+            "size (light)",
+            format!("technique \"{}\" needs an area light width > 0", t.name()),
+        ));
+    }
+    Ok(())
 }
 
 fn filter(f: &Filter) -> Result<(), StageError> {

@@ -110,7 +110,7 @@ pub struct ShadowFile {
     pub blocker_samples: Option<Spanned<i64>>,
     /// PCSS filter taps.
     pub filter_samples: Option<Spanned<i64>>,
-    /// PCSS cap on the blocker-search radius, in shadow-map UV.
+    /// PCSS and soft techniques: cap on the blocker-search radius, in shadow-map UV.
     pub max_search: Option<Spanned<f64>>,
     /// Storage of a prefiltered representation: `f32`, `f16` or `unorm16` (MSM).
     pub format: Option<Spanned<String>>,
@@ -150,6 +150,10 @@ pub struct ShadowFile {
     pub offset: Option<Spanned<f64>>,
     /// CSM response scale.
     pub scale: Option<Spanned<f64>>,
+    /// CSSM sharpening strength A.
+    pub sharpen: Option<Spanned<f64>>,
+    /// CSSM sharpening falloff B.
+    pub sharpen_falloff: Option<Spanned<f64>>,
 }
 
 /// `[[object]]`.

@@ -5,7 +5,10 @@ pub mod format;
 pub mod mesh;
 mod validate;
 
-pub use validate::{default_moment_bias, exponent_limit, sat_exponent_limit};
+pub use validate::{
+    DEFAULT_MAX_SEARCH, DEFAULT_SHARPEN, DEFAULT_SHARPEN_FALLOFF, default_moment_bias,
+    exponent_limit, sat_exponent_limit,
+};
 
 use std::path::{Path, PathBuf};
 
@@ -138,6 +141,19 @@ pub enum Filter {
     },
 }
 
+/// How a soft technique (`cssm`, `vssm`, `msm_soft`) stores its representation and reads it:
+/// always through a summed-area table, at a width per receiver.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Soft {
+    /// Storage precision of the representation the table sums.
+    pub storage: Storage,
+    /// How the table stores its sums.
+    pub sums: crate::sat::SatVariant,
+    /// Cap on the blocker-search half-width and on the filter's half-width, in shadow-map UV
+    /// (as PCSS's `max_search`); the fixed-point table is coded for squares of that size.
+    pub max_search: f32,
+}
+
 /// How a prefiltered technique stores and filters its representation.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Prefilter {
@@ -227,6 +243,51 @@ pub enum Technique {
         /// Scale of the response about ½ before the clamp to [0, 1].
         scale: f32,
     },
+    /// Convolution soft shadow maps (Annen et al. 2008): the CSM basis and the CSM-Z basis
+    /// (z, z·sin c_k z, z·cos c_k z) through summed-area tables; the average blocker depth over
+    /// the light cone's search square, the PCSS penumbra width, the CSM lookup at that width,
+    /// then the selective sharpening `v^p`, `p = 1 + A·exp(−B (d − z_avg))`.
+    Cssm {
+        /// Storage, table sums and search cap.
+        soft: Soft,
+        /// Number of terms M (1–16).
+        terms: u32,
+        /// Ringing attenuation α: term k weighted by exp(−α (k/M)²).
+        attenuation: f32,
+        /// Offset subtracted from the receiver depth.
+        offset: f32,
+        /// Scale of the response about ½ before the clamp to [0, 1].
+        scale: f32,
+        /// Sharpening strength A (0: none).
+        sharpen: f32,
+        /// Sharpening falloff B per linear depth unit of `d − z_avg`.
+        sharpen_falloff: f32,
+    },
+    /// Variance soft shadow maps (Yang et al. 2010): from the VSM moments over the search
+    /// square, the Chebyshev share p of lit texels and `z_avg = (μ − p·d)/(1 − p)`; then VSM
+    /// at the penumbra width.
+    Vssm {
+        /// Storage, table sums and search cap.
+        soft: Soft,
+        /// Light-bleeding reduction of the final bound.
+        bleed: f32,
+        /// Minimum variance.
+        min_variance: f32,
+    },
+    /// Moment soft shadow maps (after Peters et al. 2016): the blocker depth from the four
+    /// moments over the search square (the mean of the support points in front of the receiver
+    /// of the three-point distribution through d that Hamburger MSM reconstructs), then MSM at
+    /// the penumbra width.
+    MsmSoft {
+        /// Storage (f32 raw; f16 or unorm16 quantized), table sums and search cap.
+        soft: Soft,
+        /// Hausdorff rather than Hamburger reconstruction for the final visibility.
+        hausdorff: bool,
+        /// Moment bias α.
+        moment_bias: f32,
+        /// Light-bleeding reduction.
+        bleed: f32,
+    },
 }
 
 impl Technique {
@@ -238,6 +299,16 @@ impl Technique {
             | Technique::Msm { prefilter, .. }
             | Technique::Csm { prefilter, .. } => Some(prefilter.filter),
             Technique::Esm { filter, .. } => Some(filter),
+            _ => None,
+        }
+    }
+
+    /// The storage and table of a soft technique (`cssm`, `vssm`, `msm_soft`).
+    pub fn soft(&self) -> Option<Soft> {
+        match *self {
+            Technique::Cssm { soft, .. }
+            | Technique::Vssm { soft, .. }
+            | Technique::MsmSoft { soft, .. } => Some(soft),
             _ => None,
         }
     }
@@ -254,6 +325,9 @@ impl Technique {
             Technique::Esm { .. } => "esm",
             Technique::Msm { .. } => "msm",
             Technique::Csm { .. } => "csm",
+            Technique::Cssm { .. } => "cssm",
+            Technique::Vssm { .. } => "vssm",
+            Technique::MsmSoft { .. } => "msm_soft",
         }
     }
 }

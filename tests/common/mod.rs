@@ -1,6 +1,9 @@
 //! Helpers shared by the GPU tests.
 #![allow(dead_code, reason = "each test binary uses a subset")]
 
+pub mod soft;
+pub mod soft_maps;
+
 use rand::{Rng, SeedableRng, rngs::SmallRng};
 use shadowgraph::gpu::Gpu;
 

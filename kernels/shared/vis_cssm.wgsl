@@ -1,0 +1,34 @@
+// Convolution soft shadow maps (Annen et al. 2008; seed 000), every step a summed-area-table
+// lookup: over the blocker-search square, the CSM basis gives E[f] and the CSM-Z basis
+// E[f̄·z], hence the blocker share and z_avg (blocker_csm_z); the PCSS penumbra width
+// w = size·(Z − Z_b)/Z_b sets the square of the CSM lookup; its response is shifted, scaled
+// about ½ and clamped to [0, 1] as CSM's (csm_resolve: the clamp cuts the ringing), then
+// sharpened selectively, v^p with p = 1 + A·exp(−B (d − z_avg)): near contact (d ≈ z_avg),
+// where the smooth Fourier step leaks light and the penumbra is narrow, the darkening is
+// strongest; it fades as the receiver leaves its blockers. A square without blockers
+// (share < BLOCKER_MIN_SHARE) is lit.
+// The shading block (technique::visibility_body) sums `csm_chunk_of` over the light's basis
+// tables and `csm_z_chunk_of` over its CSM-Z tables at the search width, calls
+// `cssm_blocker`, sums the basis again at `blocker_filter_width(l, s, b.x)`, then calls
+// `cssm_resolve`.
+// #import shared/light
+// #import shared/sat_lookup
+// #import shared/blocker
+// #import shared/vis_csm
+
+fn cssm_blocker(below: f32, zsum: f32, l: Light, s: LightSample) -> vec2<f32> {
+    return blocker_csm_z(below, zsum, s.depth - l.bias);
+}
+
+// v^p for v in [0, 1], p ≥ 1 (0 at v = 0, where log2 is −∞).
+fn cssm_sharpen(v: f32, p: f32) -> f32 {
+    return select(0.0, exp2(p * log2(v)), v > 0.0);
+}
+
+// The visibility from the basis sum at the filter width and the blocker estimate `b`.
+fn cssm_resolve(sum: f32, b: vec2<f32>, l: Light, s: LightSample) -> f32 {
+    let v = csm_resolve(sum, l);
+    let gap = max(s.depth - l.bias - b.x, 0.0);
+    let p = 1.0 + l.sharpen * exp(-l.sharpen_falloff * gap);
+    return select(1.0, cssm_sharpen(v, p), b.y >= BLOCKER_MIN_SHARE);
+}

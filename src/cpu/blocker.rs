@@ -1,0 +1,144 @@
+//! Reference of `kernels/shared/blocker.wgsl`: the search and filter widths of the soft
+//! techniques and their blocker estimates from filtered means. The MSM estimate is computed
+//! independently of the shader's Cholesky steps: the Hankel system by Cramer's rule, the
+//! weights of the three-point distribution by Lagrange's formula.
+
+use std::f64::consts::PI;
+
+use super::light::{LightSample, linear_to_z, map_width};
+use crate::technique::LightGpu;
+
+/// `BLOCKER_MIN_SHARE`: a search square with a smaller blocker share reads as lit.
+pub const MIN_SHARE: f64 = 0.01;
+
+/// A blocker estimate: the average depth (linear) of the texels in front of the receiver and
+/// their share of the search square.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Blocker {
+    /// Average blocker depth z_avg, linear, in `[0, max(d, 0)]`.
+    pub depth: f64,
+    /// Estimated share of blockers.
+    pub share: f64,
+}
+
+impl Blocker {
+    /// Whether the search square holds blockers (share ≥ [`MIN_SHARE`]).
+    pub fn found(&self) -> bool {
+        self.share >= MIN_SHARE
+    }
+
+    /// Depth `z` clamped to `[0, max(d, 0)]` with `share` (`blocker_result`).
+    pub fn new(z: f64, share: f64, d: f64) -> Self {
+        Self {
+            depth: z.clamp(0.0, d.max(0.0)),
+            share,
+        }
+    }
+}
+
+/// `blocker_width`: at least 1 texel, at most `l.max_width`.
+fn width(texels: f64, l: &LightGpu) -> f64 {
+    let w = if texels > 1.0 { texels } else { 1.0 };
+    w.min(f64::from(l.max_width))
+}
+
+/// `blocker_search_width`: the light cone at the near plane, in texels.
+pub fn search_width(l: &LightGpu, s: &LightSample) -> f64 {
+    let near = f64::from(l.near);
+    let world = f64::from(l.size) * (s.view_z - near) / s.view_z;
+    width(world / map_width(l, near) * f64::from(l.map_size[0]), l)
+}
+
+/// `blocker_filter_width`: the PCSS penumbra at the receiver for blockers at `z_avg`.
+pub fn filter_width(l: &LightGpu, s: &LightSample, z_avg: f64) -> f64 {
+    let z_b = linear_to_z(l, z_avg);
+    let penumbra = f64::from(l.size) * (s.view_z - z_b) / z_b;
+    width(
+        penumbra / map_width(l, s.view_z) * f64::from(l.map_size[0]),
+        l,
+    )
+}
+
+/// `blocker_vsm`: Chebyshev's share p of texels at or behind `d`, the rest averaging
+/// `(μ − p·d)/(1 − p)`.
+pub fn vsm(m: &[f64], d: f64, floor: f64) -> Blocker {
+    let variance = (m[1] - m[0] * m[0]).max(floor);
+    let t = d - m[0];
+    let p = if t > 0.0 {
+        variance / (variance + t * t)
+    } else {
+        1.0
+    };
+    let share = 1.0 - p;
+    Blocker::new((m[0] - p * d) / share.max(MIN_SHARE), share, d)
+}
+
+fn det3(m: [[f64; 3]; 3]) -> f64 {
+    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+}
+
+/// `blocker_msm` from biased moments `b`: the support points in front of `d` of the
+/// three-point distribution through `d` that matches `b`, each clamped to `[0, d]`, weighted.
+pub fn msm(b: [f64; 4], d: f64) -> Blocker {
+    let var1 = b[1] - b[0] * b[0];
+    if var1 <= 1e-12 {
+        return Blocker::new(b[0], if d > b[0] { 1.0 } else { 0.0 }, d);
+    }
+    let h = [[1.0, b[0], b[1]], [b[0], b[1], b[2]], [b[1], b[2], b[3]]];
+    let det = det3(h);
+    if det <= 0.0 {
+        return vsm(&b, d, 0.0);
+    }
+    let rhs = [1.0, d, d * d];
+    let c: Vec<f64> = (0..3)
+        .map(|i| {
+            let mut m = h;
+            for (r, row) in m.iter_mut().enumerate() {
+                row[i] = rhs[r];
+            }
+            det3(m) / det
+        })
+        .collect();
+    let disc = (c[1] * c[1] - 4.0 * c[2] * c[0]).max(0.0).sqrt();
+    let (r1, r2) = ((-c[1] - disc) / (2.0 * c[2]), (-c[1] + disc) / (2.0 * c[2]));
+    let (z2, z3) = (r1.min(r2), r1.max(r2));
+    // Lagrange: w_i = E[Π_{j≠i} (z − z_j)] / Π_{j≠i} (z_i − z_j).
+    let expect = |a: f64, c: f64| b[1] - (a + c) * b[0] + a * c;
+    let w2 = expect(d, z3) / ((z2 - d) * (z2 - z3));
+    let w3 = expect(d, z2) / ((z3 - d) * (z3 - z2));
+    if d <= z2 {
+        Blocker::new(d, 0.0, d)
+    } else if d <= z3 {
+        Blocker::new(z2, w2, d)
+    } else {
+        let share = w2 + w3;
+        let clamped = |z: f64| z.clamp(0.0, d);
+        Blocker::new(
+            (w2 * clamped(z2) + w3 * clamped(z3)) / share.max(MIN_SHARE),
+            share,
+            d,
+        )
+    }
+}
+
+/// The CSM-Z series `E[f̄(d, z)·z]` from the filtered CSM-Z channels `zb` (`2M + 1`) at the
+/// shifted receiver depth `d` (the sum of `csm_z_chunk_of` over the maps).
+pub fn csm_z_series(zb: &[f64], l: &LightGpu, d: f64) -> f64 {
+    0.5 * zb[0]
+        - (1..=l.csm_terms)
+            .map(|k| {
+                let c = PI * f64::from(2 * k - 1);
+                let i = 2 * k as usize - 1;
+                super::vis_csm::weight(k, l) * ((c * d).cos() * zb[i] - (c * d).sin() * zb[i + 1])
+            })
+            .sum::<f64>()
+}
+
+/// `blocker_csm_z`: share `½ − below` (`below` = the CSM series = E[f] − ½), depth
+/// `zsum / share`.
+pub fn csm_z(below: f64, zsum: f64, d: f64) -> Blocker {
+    let share = 0.5 - below;
+    Blocker::new(zsum / share.max(MIN_SHARE), share, d)
+}

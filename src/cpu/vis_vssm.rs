@@ -1,0 +1,37 @@
+//! Reference of `kernels/shared/vis_vssm.wgsl`, in three steps so tests can perturb each:
+//! the moments over the search square, the blocker estimate, the visibility at the penumbra
+//! width. `moments` is the integral image of the per-texel representation the table sums (the
+//! shader's lookups integrate the same values exactly).
+
+use super::blocker::{self, Blocker};
+use super::light::LightSample;
+use super::sat::Integral;
+use crate::technique::LightGpu;
+
+/// The mean moments over the blocker-search square.
+pub fn search(moments: &Integral, l: &LightGpu, s: &LightSample) -> Vec<f64> {
+    moments.square_mean(l.map_size, s.uv, blocker::search_width(l, s))
+}
+
+/// `vssm_blocker`.
+pub fn blocker_of(m: &[f64], l: &LightGpu, s: &LightSample) -> Blocker {
+    blocker::vsm(m, s.depth - f64::from(l.bias), f64::from(l.min_variance))
+}
+
+/// The mean moments over the penumbra width of `b`.
+pub fn filtered(moments: &Integral, l: &LightGpu, s: &LightSample, b: Blocker) -> Vec<f64> {
+    moments.square_mean(l.map_size, s.uv, blocker::filter_width(l, s, b.depth))
+}
+
+/// The visibility for blocker estimate `b` (`vssm_resolve` after the second lookup).
+pub fn finish(moments: &Integral, l: &LightGpu, s: &LightSample, b: Blocker) -> f64 {
+    if !b.found() {
+        return 1.0;
+    }
+    super::vis_vsm::vis_vsm_of(&filtered(moments, l, s, b), l, s)
+}
+
+/// Soft VSM visibility.
+pub fn vis_vssm(moments: &Integral, l: &LightGpu, s: &LightSample) -> f64 {
+    finish(moments, l, s, blocker_of(&search(moments, l, s), l, s))
+}

@@ -1,0 +1,464 @@
+//! Tolerances of the soft techniques (`cssm`, `vssm`, `msm_soft`) and the inputs of their f64
+//! references, shared by tests/soft.rs, tests/scenes.rs and tests/plugin.rs.
+//!
+//! A soft visibility is a chain: table means over the search square → blocker estimate →
+//! filter width → table means over it → visibility. The GPU's errors enter at the means (f32
+//! weighting of exact fixed-point windows, or f32 differences of f32 sums), at the receiver's
+//! depth (the view transform in f32) and, for CSSM, at the receiver's Fourier factors (sin/cos).
+//! Each tolerance propagates them through the f64 reference by perturbation: every sign
+//! combination of the errors on the search step's inputs gives a range of blocker depths
+//! z_avg ± δz (the visibility is then re-evaluated, exactly, at the widths of z_avg ± δz), and
+//! every combination on the final step's inputs a range of visibilities (at five scales of the
+//! errors, see `combinations`); the tolerance is twice the largest change of each, plus 1e-5
+//! (first-order propagation is not a bound on its own: the factor 2 covers curvature). A point where a perturbation flips whether the
+//! search square holds blockers (a threshold, `BLOCKER_MIN_SHARE`) has no tolerance: `None`.
+
+use shadowgraph::cpu::blocker::Blocker;
+use shadowgraph::cpu::light::LightSample;
+use shadowgraph::cpu::sat::Integral;
+use shadowgraph::cpu::{self, Texels};
+use shadowgraph::sat::{SatCoding, SatVariant};
+use shadowgraph::technique::{LightGpu, MSM_HAUSDORFF, MSM_QUANTIZED};
+
+const ULP: f64 = 1.0 / 16_777_216.0; // 2⁻²⁴
+
+/// How far the GPU's table means can be from the exact integral of the table's values.
+#[derive(Clone, Copy, Debug)]
+pub struct TableError {
+    /// Per table channel, the largest |value − offset| in the map (what the lookups weight).
+    pub amp: [f64; 4],
+    /// An f32 table (else fixed point).
+    pub float: bool,
+    /// Map side in texels.
+    pub size: usize,
+}
+
+impl TableError {
+    /// For the texels `t` (the values a table sums, decoded) coded by `coding`.
+    pub fn new(t: &Texels, coding: &SatCoding) -> Self {
+        // Channel c of the representation lands in channel c mod 4 of its table.
+        let mut amp = [0.0f64; 4];
+        for texel in t.data.chunks(t.channels) {
+            for (c, v) in texel.iter().enumerate() {
+                let k = c % 4;
+                amp[k] = amp[k].max((v - f64::from(coding.offset[k])).abs());
+            }
+        }
+        Self {
+            amp,
+            float: coding.variant == SatVariant::Float,
+            size: t.width.max(t.height),
+        }
+    }
+
+    /// Absolute error bound of the mean of channel c over the `width`-texel square at `s`
+    /// (the square itself exact; the UV's error is applied separately, see [`UV_ERROR`]):
+    /// 16 weights and products, a 16-term sum and a division in f32 (40 roundings of the
+    /// largest |value − offset|); with f32 sums, each window is two f32 differences of strip
+    /// sums up to `(size + 2)·(⌈w⌉ + 2)` values, rounded relative to those strips, over the
+    /// clamped area.
+    pub fn mean(&self, l: &LightGpu, s: &LightSample, width: f64) -> [f64; 4] {
+        let n = self.size as f64;
+        let (cx, cy) = (
+            s.uv[0] as f32 * l.map_size[0],
+            s.uv[1] as f32 * l.map_size[1],
+        );
+        let h = 0.5 * width as f32;
+        let r = cpu::sat::clamp_rect([cx - h, cy - h, cx + h, cy + h], self.size, self.size)
+            .map(f64::from);
+        let area = (r[2] - r[0]) * (r[3] - r[1]);
+        self.amp.map(|a| {
+            let strips = if self.float {
+                3.0 * ULP * (n + 2.0) * (width.ceil() + 2.0) * a / area
+            } else {
+                0.0
+            };
+            40.0 * ULP * a + strips
+        })
+    }
+}
+
+/// The f32 error of the receiver's UV (the projection of the normal-offset point: a few
+/// roundings of clip coordinates of magnitude about 1, over w): it moves the squares, so the
+/// means are recomputed at the UV moved by ± this on both axes (the moments move together,
+/// which independent per-channel errors would not model).
+pub const UV_ERROR: f64 = 16.0 * ULP;
+
+/// The f32 error of the receiver's linear depth: the view transform (4 roundings of Z and
+/// near), over far − near.
+pub fn depth_error(l: &LightGpu, s: &LightSample) -> f64 {
+    8.0 * ULP * (s.view_z + f64::from(l.near)) / f64::from(l.far - l.near)
+}
+
+/// Every sign combination of `n` errors at each of five scales (1, ½, ¼, ⅛, 1⁄16 of the
+/// bound): `f(factors)` for `factors[i] = ±scale`. The blocker estimates are not monotone in
+/// their inputs near singular moments (MSM), so the corners of the error box alone can miss
+/// a flip that a smaller error causes.
+fn combinations(n: usize, mut f: impl FnMut(&[f64])) {
+    for scale in [1.0, 0.5, 0.25, 0.125, 0.0625] {
+        for k in 0..(1u32 << n) {
+            let signs: Vec<f64> = (0..n)
+                .map(|i| if k >> i & 1 == 1 { scale } else { -scale })
+                .collect();
+            f(&signs);
+        }
+    }
+}
+
+/// The perturbation tolerance of one soft visibility `v0` (see the module documentation).
+/// `search(δuv)`, `e_search`: the search step's inputs with the receiver's UV moved, and their
+/// errors; `blocker` their estimate (with the receiver depth moved); `finish(z)`: the exact
+/// visibility for blockers at depth z; `last(δuv)`, `e_last`, `visibility`: the final step's
+/// inputs (at the unperturbed blocker's width), errors and function of them (with the
+/// receiver depth moved).
+pub struct Chain<'a> {
+    /// Search-step inputs at the UV moved by the argument.
+    pub search: &'a dyn Fn([f64; 2]) -> Vec<f64>,
+    /// Their absolute errors.
+    pub e_search: Vec<f64>,
+    /// Blocker estimate of (inputs, depth offset).
+    pub blocker: &'a dyn Fn(&[f64], f64) -> Blocker,
+    /// Visibility for blockers at this depth (exact lookups at its filter width).
+    pub finish: &'a dyn Fn(f64) -> f64,
+    /// Final-step inputs at the UV moved by the argument.
+    pub last: &'a dyn Fn([f64; 2]) -> Vec<f64>,
+    /// Their absolute errors.
+    pub e_last: Vec<f64>,
+    /// Visibility of (inputs, depth offset).
+    pub visibility: &'a dyn Fn(&[f64], f64) -> f64,
+    /// The receiver depth's error.
+    pub e_depth: f64,
+}
+
+/// The receiver's UV and the four moved by ±[`UV_ERROR`] on both axes.
+const UV_MOVES: [[f64; 2]; 5] = [
+    [0.0, 0.0],
+    [UV_ERROR, UV_ERROR],
+    [UV_ERROR, -UV_ERROR],
+    [-UV_ERROR, UV_ERROR],
+    [-UV_ERROR, -UV_ERROR],
+];
+
+impl Chain<'_> {
+    /// The tolerance, or `None` where a perturbation flips the blocker threshold.
+    pub fn tolerance(&self, v0: f64) -> Option<f64> {
+        let search0 = (self.search)([0.0; 2]);
+        let b0 = (self.blocker)(&search0, 0.0);
+        let mut flips = false;
+        let mut dz: f64 = 0.0;
+        for moved in UV_MOVES {
+            let search = (self.search)(moved);
+            let n = search.len();
+            combinations(n + 1, |sg| {
+                let m: Vec<f64> = (0..n)
+                    .map(|i| search[i] + sg[i] * self.e_search[i])
+                    .collect();
+                let b = (self.blocker)(&m, sg[n] * self.e_depth);
+                flips |= b.found() != b0.found();
+                dz = dz.max((b.depth - b0.depth).abs());
+            });
+        }
+        if flips {
+            return None;
+        }
+        if !b0.found() {
+            return Some(1e-5);
+        }
+        let search = [b0.depth - dz, b0.depth + dz]
+            .iter()
+            .map(|&z| ((self.finish)(z) - v0).abs())
+            .fold(0.0, f64::max);
+        let mut last: f64 = 0.0;
+        for moved in UV_MOVES {
+            let inputs = (self.last)(moved);
+            let n = inputs.len();
+            combinations(n + 1, |sg| {
+                let m: Vec<f64> = (0..n).map(|i| inputs[i] + sg[i] * self.e_last[i]).collect();
+                let v = (self.visibility)(&m, sg[n] * self.e_depth);
+                last = last.max((v - v0).abs());
+            });
+        }
+        Some(1e-5 + 2.0 * (search + last))
+    }
+}
+
+/// `s` with its UV moved by `du`.
+pub fn shifted(s: &LightSample, du: [f64; 2]) -> LightSample {
+    let mut t = *s;
+    t.uv = [s.uv[0] + du[0], s.uv[1] + du[1]];
+    t
+}
+
+/// `s` with its depth moved by `dd`.
+pub fn moved(s: &LightSample, dd: f64) -> LightSample {
+    let mut t = *s;
+    t.depth += dd;
+    t
+}
+
+/// Soft VSM's tolerance at `s` over the table values `t` (see [`Chain`]).
+pub fn vssm_tolerance(
+    t: &Integral,
+    err: &TableError,
+    l: &LightGpu,
+    s: &LightSample,
+    v0: f64,
+) -> Option<f64> {
+    use cpu::vis_vssm as v;
+    let b0 = v::blocker_of(&v::search(t, l, s), l, s);
+    let es = err.mean(l, s, cpu::blocker::search_width(l, s));
+    let el = err.mean(l, s, cpu::blocker::filter_width(l, s, b0.depth));
+    Chain {
+        search: &|du| v::search(t, l, &shifted(s, du))[..2].to_vec(),
+        e_search: es[..2].to_vec(),
+        blocker: &|m, dd| v::blocker_of(m, l, &moved(s, dd)),
+        finish: &|z| v::finish(t, l, s, Blocker { depth: z, ..b0 }),
+        last: &|du| v::filtered(t, l, &shifted(s, du), b0)[..2].to_vec(),
+        e_last: el[..2].to_vec(),
+        visibility: &|m, dd| cpu::vis_vsm::vis_vsm_of(m, l, &moved(s, dd)),
+        e_depth: depth_error(l, s),
+    }
+    .tolerance(v0)
+}
+
+/// MSM's error in the moment domain: the table error carried through the dequantization
+/// (its matrix's absolute column sums), plus 32·2⁻²⁴ relative (the f32 Cholesky is backward
+/// stable: the GPU's answer is exact for moments that close, as in `msm_tolerance`).
+fn msm_moment_error(l: &LightGpu, m: &[f64], e: [f64; 4]) -> [f64; 4] {
+    let b = cpu::vis_msm::biased(m, l);
+    let carried: [f64; 4] = if l.msm_flags & MSM_QUANTIZED != 0 {
+        let zero = cpu::msm::dequantize([0.0; 4]);
+        let mut out = [0.0; 4];
+        for (j, ej) in e.iter().enumerate() {
+            let mut unit = [0.0; 4];
+            unit[j] = 1.0;
+            let col = cpu::msm::dequantize(unit);
+            for c in 0..4 {
+                out[c] += (col[c] - zero[c]).abs() * ej;
+            }
+        }
+        out
+    } else {
+        e
+    };
+    std::array::from_fn(|c| carried[c] + 32.0 * ULP * b[c].abs())
+}
+
+/// MSM's visibility from biased moments `b` (the tail of `vis_msm_of`).
+fn msm_visibility(l: &LightGpu, b: &[f64], d: f64) -> f64 {
+    let hausdorff = l.msm_flags & MSM_HAUSDORFF != 0;
+    let i = cpu::vis_msm::intensity([b[0], b[1], b[2], b[3]], d, hausdorff);
+    let v = 1.0 - i.clamp(0.0, 1.0);
+    let v = if v.is_nan() { 1.0 } else { v };
+    let bleed = f64::from(l.bleed);
+    ((v - bleed) / (1.0 - bleed)).clamp(0.0, 1.0)
+}
+
+/// Soft MSM's tolerance at `s` (see [`Chain`]), perturbing the biased moments.
+pub fn msm_soft_tolerance(
+    t: &Integral,
+    err: &TableError,
+    l: &LightGpu,
+    s: &LightSample,
+    v0: f64,
+) -> Option<f64> {
+    use cpu::vis_msm_soft as v;
+    let search0 = v::search(t, l, s);
+    let b0 = v::blocker_of(&search0, l, s);
+    let es = msm_moment_error(
+        l,
+        &search0,
+        err.mean(l, s, cpu::blocker::search_width(l, s)),
+    );
+    let width = cpu::blocker::filter_width(l, s, b0.depth);
+    let last0 = v::filtered(t, l, s, b0);
+    let el = msm_moment_error(l, &last0, err.mean(l, s, width));
+    let d = s.depth - f64::from(l.bias);
+    Chain {
+        search: &|du| cpu::vis_msm::biased(&v::search(t, l, &shifted(s, du)), l).to_vec(),
+        e_search: es.to_vec(),
+        blocker: &|b, dd| cpu::blocker::msm([b[0], b[1], b[2], b[3]], d + dd),
+        finish: &|z| v::finish(t, l, s, Blocker { depth: z, ..b0 }),
+        last: &|du| cpu::vis_msm::biased(&v::filtered(t, l, &shifted(s, du), b0), l).to_vec(),
+        e_last: el.to_vec(),
+        visibility: &|b, dd| msm_visibility(l, b, d + dd),
+        e_depth: depth_error(l, s),
+    }
+    .tolerance(v0)
+}
+
+/// CSSM's tolerance at `s` (see [`Chain`]). The series carry, per term, the error of the two
+/// receiver factors (`e_trig`, the device's sin/cos error, plus c_M times the depth error)
+/// against basis values of magnitude ≤ 1, and the error of the two means; E[z]'s mean error
+/// enters ½-weighted; a 2M-term f32 sum adds 4M roundings. The sharpened result `v^p` is
+/// `exp2(p·log2 v)`: log2 to 2⁻²¹ absolute (Vulkan, near 1; 3 ULP elsewhere is smaller here),
+/// exp2 to (3 + 2|x|) ULP.
+pub fn cssm_tolerance(
+    maps: cpu::vis_cssm::Maps,
+    err: (&TableError, &TableError),
+    e_trig: f64,
+    l: &LightGpu,
+    s: &LightSample,
+    v0: f64,
+) -> Option<f64> {
+    use cpu::vis_cssm as v;
+    let (below, zsum) = v::search(maps, l, s);
+    let b0 = v::blocker_of(below, zsum, l, s);
+    let terms = l.csm_terms;
+    let e_d = depth_error(l, s);
+    let e_factor = e_trig + std::f64::consts::PI * f64::from(2 * terms - 1) * e_d;
+    let series_error = |e_basis: [f64; 4]| {
+        let e = e_basis.iter().copied().fold(0.0, f64::max);
+        (1..=terms)
+            .map(|k| cpu::vis_csm::weight(k, l) * 2.0 * (e_factor + e))
+            .sum::<f64>()
+            + 8.0 * f64::from(terms) * ULP
+    };
+    let ws = cpu::blocker::search_width(l, s);
+    let e_below = series_error(err.0.mean(l, s, ws));
+    let ez = err.1.mean(l, s, ws);
+    let e_zsum = series_error(ez) + 0.5 * ez[0];
+    let width = cpu::blocker::filter_width(l, s, b0.depth);
+    let sum = v::filtered(maps, l, s, b0);
+    let e_sum = series_error(err.0.mean(l, s, width));
+    let pow = if b0.found() {
+        let p = v::exponent(l, s, b0);
+        let base = cpu::vis_csm::resolve(sum, l);
+        let x = p * base.max(f64::MIN_POSITIVE).log2();
+        v0 * (p * 2f64.powi(-21) * std::f64::consts::LN_2 + (3.0 + 2.0 * x.abs()) * 2.0 * ULP)
+    } else {
+        0.0
+    };
+    Chain {
+        search: &|du| {
+            let (below, zsum) = v::search(maps, l, &shifted(s, du));
+            vec![below, zsum]
+        },
+        e_search: vec![e_below, e_zsum],
+        blocker: &|m, dd| v::blocker_of(m[0], m[1], l, &moved(s, dd)),
+        finish: &|z| v::finish(maps, l, s, Blocker { depth: z, ..b0 }),
+        last: &|du| vec![v::filtered(maps, l, &shifted(s, du), b0)],
+        e_last: vec![e_sum],
+        visibility: &|m, dd| v::resolve(m[0], l, &moved(s, dd), b0),
+        e_depth: e_d,
+    }
+    .tolerance(v0)
+    .map(|t| t + 2.0 * pow)
+}
+
+/// A CSSM light's shade map (its tables' values side by side, `technique::map_channels`
+/// each, as `Frame::shade_maps` holds them) split into the CSM basis (2M channels) and the
+/// CSM-Z basis (2M + 1), padding dropped.
+pub fn split_cssm(light: &shadowgraph::scene::Light, map: &Texels) -> (Texels, Texels) {
+    let shadowgraph::scene::Technique::Cssm { terms, .. } = light.shadow.technique else {
+        panic!("not a CSSM light");
+    };
+    let stored = shadowgraph::technique::map_channels(light);
+    let basis_maps = shadowgraph::technique::csm_maps(terms) as usize;
+    // (first stored channel, logical channels) of every table, in binding order.
+    let mut first = 0;
+    let mut parts = Vec::new();
+    for (k, &n) in stored.iter().enumerate() {
+        let (j, total) = if k < basis_maps {
+            (k, 2 * terms as usize)
+        } else {
+            (
+                k - basis_maps,
+                shadowgraph::technique::csm_z_channels(terms) as usize,
+            )
+        };
+        parts.push((k < basis_maps, first, (total - 4 * j).min(4)));
+        first += n;
+    }
+    let pick = |basis: bool| {
+        let channels: usize = parts.iter().filter(|p| p.0 == basis).map(|p| p.2).sum();
+        let data = map
+            .data
+            .chunks(map.channels)
+            .flat_map(|texel| {
+                parts
+                    .iter()
+                    .filter(|p| p.0 == basis)
+                    .flat_map(move |&(_, at, n)| texel[at..at + n].iter().copied())
+            })
+            .collect();
+        Texels {
+            width: map.width,
+            height: map.height,
+            channels,
+            data,
+        }
+    };
+    (pick(true), pick(false))
+}
+
+/// What a soft light's f64 reference reads, prepared once per light from its shade map (the
+/// tables' values side by side, as `Frame::shade_maps` holds them): the integral images (CSSM:
+/// the basis, then the CSM-Z basis), their errors and the device's sin/cos error. `None` for
+/// a light whose technique is not soft.
+pub struct SoftInputs {
+    light: shadowgraph::scene::Light,
+    integrals: Vec<Integral>,
+    errors: Vec<TableError>,
+    e_trig: f64,
+}
+
+impl SoftInputs {
+    /// The inputs of `light` (a soft technique, else `None`) from its shade map `level0`.
+    pub fn new(light: &shadowgraph::scene::Light, level0: &Texels, e_trig: f64) -> Option<Self> {
+        use shadowgraph::scene::Technique;
+        let parts = match light.shadow.technique {
+            Technique::Cssm { .. } => {
+                let (basis, z) = split_cssm(light, level0);
+                vec![basis, z]
+            }
+            Technique::Vssm { .. } | Technique::MsmSoft { .. } => vec![level0.clone()],
+            _ => return None,
+        };
+        let coding = shadowgraph::technique::sat_coding(light)
+            .expect("valid coding")
+            .expect("soft techniques read tables");
+        Some(Self {
+            light: light.clone(),
+            errors: parts.iter().map(|t| TableError::new(t, &coding)).collect(),
+            integrals: parts.iter().map(Integral::new).collect(),
+            e_trig,
+        })
+    }
+
+    fn cssm(&self) -> cpu::vis_cssm::Maps<'_> {
+        cpu::vis_cssm::Maps {
+            basis: &self.integrals[0],
+            z: &self.integrals[1],
+        }
+    }
+
+    /// The f64 visibility at `s` (1 outside the map).
+    pub fn reference(&self, l: &LightGpu, s: &LightSample) -> f64 {
+        use shadowgraph::scene::Technique;
+        if !s.inside {
+            return 1.0;
+        }
+        match self.light.shadow.technique {
+            Technique::Cssm { .. } => cpu::vis_cssm::vis_cssm(self.cssm(), l, s),
+            Technique::MsmSoft { .. } => cpu::vis_msm_soft::vis_msm_soft(&self.integrals[0], l, s),
+            _ => cpu::vis_vssm::vis_vssm(&self.integrals[0], l, s),
+        }
+    }
+
+    /// The tolerance at `s` for reference value `v` (see [`Chain`]; 0 outside the map).
+    pub fn tolerance(&self, l: &LightGpu, s: &LightSample, v: f64) -> Option<f64> {
+        use shadowgraph::scene::Technique;
+        if !s.inside {
+            return Some(0.0);
+        }
+        let (i, e) = (&self.integrals, &self.errors);
+        match self.light.shadow.technique {
+            Technique::Cssm { .. } => {
+                cssm_tolerance(self.cssm(), (&e[0], &e[1]), self.e_trig, l, s, v)
+            }
+            Technique::MsmSoft { .. } => msm_soft_tolerance(&i[0], &e[0], l, s, v),
+            _ => vssm_tolerance(&i[0], &e[0], l, s, v),
+        }
+    }
+}
