@@ -8,7 +8,7 @@ use crate::scene::{BlurKernel, Filter, PcfKernel, Scene, Storage, Technique};
 
 /// Technique names `--techniques` accepts, in sweep order.
 pub const TECHNIQUES: &[&str] = &[
-    "hard", "pcf", "pcss", "vsm", "evsm2", "evsm4", "esm", "msm", "csm",
+    "hard", "pcf", "pcss", "vsm", "evsm2", "evsm4", "esm", "msm", "csm", "cssm", "vssm", "msm_soft",
 ];
 
 /// A filter of a box `width` texels wide.
@@ -132,6 +132,52 @@ pub fn sweep(scene: &Scene, opts: &EvaluateOptions) -> Result<Vec<Config>> {
             });
         for &size in &size_sweep("pcss") {
             push("pcss".into(), pcss, size, None);
+        }
+        // The soft techniques (every step a summed-area-table lookup), validated as a scene
+        // would be; their first variant on every size, the others at the base size.
+        let light_size = scene.lights[0].size;
+        for name in ["cssm", "vssm", "msm_soft"] {
+            if !wanted.iter().any(|w| w == name) {
+                continue;
+            }
+            let variants: Vec<(String, PrefilterConfig)> = match name {
+                "cssm" => (if quick { vec![8] } else { vec![8, 4, 16] })
+                    .into_iter()
+                    .map(|m| {
+                        (
+                            format!("cssm M{m}"),
+                            PrefilterConfig::cssm(1, m, light_size),
+                        )
+                    })
+                    .collect(),
+                "vssm" => vec![("vssm".into(), PrefilterConfig::vssm(1, light_size))],
+                _ => {
+                    let mut v = vec![(
+                        "msm_soft f32".to_string(),
+                        PrefilterConfig::msm_soft(1, light_size),
+                    )];
+                    if !quick {
+                        v.push((
+                            "msm_soft f16".into(),
+                            PrefilterConfig::msm_soft(1, light_size).with_storage(Storage::F16),
+                        ));
+                    }
+                    v
+                }
+            };
+            for (k, (label, config)) in variants.into_iter().enumerate() {
+                let (mut valid, _) = config.validated()?;
+                if let Technique::MsmSoft {
+                    soft, moment_bias, ..
+                } = &mut valid.technique
+                {
+                    *moment_bias = crate::scene::default_moment_bias(soft.storage);
+                }
+                let on = if k == 0 { sizes.clone() } else { vec![base] };
+                for size in on {
+                    push(label.clone(), valid.technique, size, None);
+                }
+            }
         }
     }
     for name in ["vsm", "evsm2", "evsm4", "esm", "msm", "csm"] {
