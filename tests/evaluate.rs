@@ -378,7 +378,7 @@ fn bad_input_is_a_clear_error() {
 /// per-pixel search it replaces with constant-time lookups), and its share of pixels off by
 /// more than 0.2 is below hard's. Measured (lavapipe): mean error hard 0.0097, PCSS 0.0055,
 /// cssm 0.0066 (0.68 × hard: the closest to its bound), vssm 0.0045, msm_soft 0.0030; off by
-/// > 0.2: hard 2.27%, PCSS 0.36%, cssm 1.48%, vssm 0.00%, msm_soft 0.03%
+/// more than 0.2: hard 2.27%, PCSS 0.36%, cssm 1.48%, vssm 0.00%, msm_soft 0.03%
 /// (`cargo test --release --test evaluate soft -- --nocapture`).
 #[test]
 fn soft_techniques_approach_the_area_light_truth() {
