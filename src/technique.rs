@@ -377,22 +377,26 @@ fn value_range(technique: &Technique) -> ([f32; 4], [f32; 4]) {
     }
 }
 
-/// The range of MSM's optimized quantization over the moment curve (see [`sat_coding`]).
+/// The range of MSM's optimized quantization over the moment curve (see [`sat_coding`]),
+/// computed once (every frame builds each light's `LightGpu`, which asks for it).
 fn quantized_msm_range() -> ([f32; 4], [f32; 4]) {
-    let (mut lo, mut hi) = ([f64::MAX; 4], [f64::MIN; 4]);
-    for k in 0..=4096 {
-        let z = f64::from(k) / 4096.0;
-        let q = crate::cpu::msm::quantize([z, z * z, z.powi(3), z.powi(4)]);
-        for c in 0..4 {
-            lo[c] = lo[c].min(q[c]);
-            hi[c] = hi[c].max(q[c]);
+    static RANGE: std::sync::OnceLock<([f32; 4], [f32; 4])> = std::sync::OnceLock::new();
+    *RANGE.get_or_init(|| {
+        let (mut lo, mut hi) = ([f64::MAX; 4], [f64::MIN; 4]);
+        for k in 0..=4096 {
+            let z = f64::from(k) / 4096.0;
+            let q = crate::cpu::msm::quantize([z, z * z, z.powi(3), z.powi(4)]);
+            for c in 0..4 {
+                lo[c] = lo[c].min(q[c]);
+                hi[c] = hi[c].max(q[c]);
+            }
         }
-    }
-    let pad = |c: usize| 1e-3 * (hi[c] - lo[c]);
-    (
-        std::array::from_fn(|c| (lo[c] - pad(c)) as f32),
-        std::array::from_fn(|c| (hi[c] + pad(c)) as f32),
-    )
+        let pad = |c: usize| 1e-3 * (hi[c] - lo[c]);
+        (
+            std::array::from_fn(|c| (lo[c] - pad(c)) as f32),
+            std::array::from_fn(|c| (hi[c] + pad(c)) as f32),
+        )
+    })
 }
 
 /// Parameters of `kernels/linearize.wgsl` (mirrors its `Params`).

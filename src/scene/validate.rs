@@ -660,32 +660,22 @@ fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
         }
         "msm" => {
             let prefilter = prefilter(ctx, i, s, MSM_STORAGE)?;
+            let (hausdorff, moment_bias, bleed) = msm_keys(ctx, i, s, prefilter.storage)?;
             Technique::Msm {
                 prefilter,
-                hausdorff: ctx.choice(
-                    &key("reconstruction"),
-                    &s.reconstruction,
-                    &RECONSTRUCTIONS,
-                    false,
-                )?,
-                moment_bias: ctx.num_or(
-                    &key("moment_bias"),
-                    &s.moment_bias,
-                    0.0,
-                    0.5,
-                    default_moment_bias(prefilter.storage),
-                )?,
-                bleed: ctx.num_or(&key("bleed_reduction"), &s.bleed_reduction, 0.0, 0.99, 0.0)?,
+                hausdorff,
+                moment_bias,
+                bleed,
             }
         }
         "cssm" => {
-            let terms = ctx.int_or(&key("terms"), &s.terms, 1, 16, 8)?;
+            let (terms, attenuation, offset, scale) = csm_keys(ctx, i, s)?;
             Technique::Cssm {
                 soft: soft(ctx, i, s, FLOAT_STORAGE)?,
                 terms,
-                attenuation: ctx.num_or(&key("attenuation"), &s.attenuation, 0.0, 20.0, 1.0)?,
-                offset: ctx.num_or(&key("offset"), &s.offset, 0.0, 0.5, 0.5 / terms as f32)?,
-                scale: ctx.num_or(&key("scale"), &s.scale, 1.0, 16.0, 2.0)?,
+                attenuation,
+                offset,
+                scale,
                 sharpen: ctx.num_or(&key("sharpen"), &s.sharpen, 0.0, 100.0, DEFAULT_SHARPEN)?,
                 sharpen_falloff: ctx.num_or(
                     &key("sharpen_falloff"),
@@ -703,32 +693,22 @@ fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
         },
         "msm_soft" => {
             let soft = soft(ctx, i, s, MSM_STORAGE)?;
+            let (hausdorff, moment_bias, bleed) = msm_keys(ctx, i, s, soft.storage)?;
             Technique::MsmSoft {
                 soft,
-                hausdorff: ctx.choice(
-                    &key("reconstruction"),
-                    &s.reconstruction,
-                    &RECONSTRUCTIONS,
-                    false,
-                )?,
-                moment_bias: ctx.num_or(
-                    &key("moment_bias"),
-                    &s.moment_bias,
-                    0.0,
-                    0.5,
-                    default_moment_bias(soft.storage),
-                )?,
-                bleed: ctx.num_or(&key("bleed_reduction"), &s.bleed_reduction, 0.0, 0.99, 0.0)?,
+                hausdorff,
+                moment_bias,
+                bleed,
             }
         }
         "csm" => {
-            let terms = ctx.int_or(&key("terms"), &s.terms, 1, 16, 8)?;
+            let (terms, attenuation, offset, scale) = csm_keys(ctx, i, s)?;
             Technique::Csm {
                 prefilter: prefilter(ctx, i, s, FLOAT_STORAGE)?,
                 terms,
-                attenuation: ctx.num_or(&key("attenuation"), &s.attenuation, 0.0, 20.0, 1.0)?,
-                offset: ctx.num_or(&key("offset"), &s.offset, 0.0, 0.5, 0.5 / terms as f32)?,
-                scale: ctx.num_or(&key("scale"), &s.scale, 1.0, 16.0, 2.0)?,
+                attenuation,
+                offset,
+                scale,
             }
         }
         _ => {
@@ -856,6 +836,40 @@ fn prefilter(
 
 /// The storage, table sums and search cap of a soft technique; its table is always a
 /// summed-area table read at a per-receiver width.
+/// MSM's reconstruction keys (`msm`, `msm_soft`): Hausdorff or not, the moment bias (default
+/// per `storage`) and the bleeding reduction.
+fn msm_keys(ctx: &Ctx, i: usize, s: &ShadowFile, storage: Storage) -> Result<(bool, f32, f32)> {
+    let key = |k: &str| format!("light[{i}].shadow.{k}");
+    Ok((
+        ctx.choice(
+            &key("reconstruction"),
+            &s.reconstruction,
+            &RECONSTRUCTIONS,
+            false,
+        )?,
+        ctx.num_or(
+            &key("moment_bias"),
+            &s.moment_bias,
+            0.0,
+            0.5,
+            default_moment_bias(storage),
+        )?,
+        ctx.num_or(&key("bleed_reduction"), &s.bleed_reduction, 0.0, 0.99, 0.0)?,
+    ))
+}
+
+/// CSM's series keys (`csm`, `cssm`): terms M, attenuation, offset (default ½/M) and scale.
+fn csm_keys(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<(u32, f32, f32, f32)> {
+    let key = |k: &str| format!("light[{i}].shadow.{k}");
+    let terms = ctx.int_or(&key("terms"), &s.terms, 1, 16, 8)?;
+    Ok((
+        terms,
+        ctx.num_or(&key("attenuation"), &s.attenuation, 0.0, 20.0, 1.0)?,
+        ctx.num_or(&key("offset"), &s.offset, 0.0, 0.5, 0.5 / terms as f32)?,
+        ctx.num_or(&key("scale"), &s.scale, 1.0, 16.0, 2.0)?,
+    ))
+}
+
 fn soft(ctx: &Ctx, i: usize, s: &ShadowFile, storages: &[(&str, Storage)]) -> Result<Soft> {
     let key = |k: &str| format!("light[{i}].shadow.{k}");
     Ok(Soft {
