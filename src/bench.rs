@@ -462,7 +462,9 @@ pub fn lookup_cost(gpu: &Gpu, widths: &[u32], repeat: u32) -> Result<Vec<LookupR
     }
     if !gpu.can_time() {
         return Err(Error::Invalid(
-            "this device cannot time kernels: it has no TIMESTAMP_QUERY feature".to_string(),
+            "this device cannot time kernels: it lacks TIMESTAMP_QUERY or \
+             TIMESTAMP_QUERY_INSIDE_ENCODERS"
+                .to_string(),
         ));
     }
     let base = crate::scene::Scene::parse(std::path::Path::new("vsm.toml"), LOOKUP_SCENE)?;
@@ -569,7 +571,9 @@ pub fn format_lookup_table(device: &str, cpu: bool, repeat: u32, rows: &[LookupR
 fn timer(device: &wgpu::Device, queue: &wgpu::Queue, passes: u32) -> Result<GpuTimer> {
     GpuTimer::new(device, queue, passes.max(1)).ok_or_else(|| {
         Error::Invalid(
-            "this device cannot time kernels: it has no TIMESTAMP_QUERY feature".to_string(),
+            "this device cannot time kernels: it lacks TIMESTAMP_QUERY or \
+             TIMESTAMP_QUERY_INSIDE_ENCODERS"
+                .to_string(),
         )
     })
 }
@@ -837,10 +841,12 @@ impl CopyBench {
 
     /// Records one copy pass, timed when `timer` is given.
     fn record(&self, enc: &mut wgpu::CommandEncoder, timer: Option<&mut GpuTimer>) {
-        let timestamp_writes = timer.and_then(|t| t.compute_pass(COPY));
+        if let Some(t) = timer {
+            t.begin(enc, COPY);
+        }
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("shadowgraph.bench.copy"),
-            timestamp_writes,
+            timestamp_writes: None,
         });
         pass.set_pipeline(&self.kernel.pipeline);
         pass.set_bind_group(0, &self.bind_group, &[]);

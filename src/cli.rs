@@ -114,12 +114,13 @@ fn write_aux(dir: &Path, scene: &Scene, frame: &Frame) -> Result<()> {
     )
 }
 
-/// Median of each pass's time over the frames, as a table.
+/// Median of each pass's time over the frames, as a table, with the frames' wall time.
 pub fn timing_table(gpu: &Gpu, frame: &Frame) -> String {
     let mut s = String::new();
     if !gpu.can_time() {
         s.push_str(
-            "timings: this device has no TIMESTAMP_QUERY feature, so GPU passes cannot be timed\n",
+            "timings: this device lacks TIMESTAMP_QUERY or TIMESTAMP_QUERY_INSIDE_ENCODERS, so \
+             GPU passes cannot be timed\n",
         );
         return s;
     }
@@ -128,7 +129,7 @@ pub fn timing_table(gpu: &Gpu, frame: &Frame) -> String {
     };
     let _ = writeln!(
         s,
-        "GPU time per pass, median of {} frame(s), on {}:",
+        "GPU time per pass (timestamps between passes), median of {} frame(s), on {}:",
         frame.timings.len(),
         gpu.describe()
     );
@@ -139,11 +140,23 @@ pub fn timing_table(gpu: &Gpu, frame: &Frame) -> String {
             .iter()
             .filter_map(|t| t.get(i).map(|x| x.1))
             .collect();
-        v.sort_by(f64::total_cmp);
-        let med = v[v.len() / 2];
+        let med = median(&mut v);
         total += med;
         let _ = writeln!(s, "  {label:<28} {med:>10.3} ms");
     }
     let _ = writeln!(s, "  {:<28} {total:>10.3} ms", "total");
+    let mut wall = frame.wall_ms.clone();
+    let _ = writeln!(
+        s,
+        "  {:<28} {:>10.3} ms  (submit to completion, median)",
+        "wall",
+        median(&mut wall)
+    );
     s
+}
+
+/// The median of `v` (the upper middle value for an even count); NaN when empty.
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
 }
