@@ -9,7 +9,7 @@ use wgpu::util::DeviceExt;
 
 use crate::error::{Error, Result};
 use crate::gpu::{read_buffer, scoped};
-use crate::graph::{Dispatch, Plan, Slot, block_count};
+use crate::graph::{Dispatch, Plan, Slot};
 use crate::kernels::{self, Reflection};
 pub use crate::timer::GpuTimer;
 
@@ -145,10 +145,7 @@ impl KernelCache {
         name: &str,
         generated: Option<&str>,
     ) -> Result<Arc<ComputeKernel>> {
-        let key = match generated {
-            Some(g) => format!("{name}\u{0}{g}"),
-            None => name.to_string(),
-        };
+        let key = generated_key(name, generated);
         if let Some(k) = self.kernels.get(&key) {
             return Ok(k.clone());
         }
@@ -156,6 +153,22 @@ impl KernelCache {
         let k = Arc::new(ComputeKernel::new(device, name, &wgsl)?);
         self.kernels.insert(key, k.clone());
         Ok(k)
+    }
+
+    /// Compiles `wgsl` as the pipeline [`KernelCache::get_generated`] returns for `name` and
+    /// `generated` from now on: a rewritten variant of the kernel with the same bindings, e.g.
+    /// the shading kernel with every texture fetch counted (`tests/cost.rs`).
+    pub fn insert_generated(
+        &mut self,
+        device: &wgpu::Device,
+        name: &str,
+        generated: Option<&str>,
+        wgsl: &str,
+    ) -> Result<()> {
+        let key = generated_key(name, generated);
+        let k = Arc::new(ComputeKernel::new(device, name, wgsl)?);
+        self.kernels.insert(key, k);
+        Ok(())
     }
 
     /// Number of pipelines created so far.
@@ -166,6 +179,14 @@ impl KernelCache {
     /// Whether no pipeline was created yet.
     pub fn is_empty(&self) -> bool {
         self.kernels.is_empty()
+    }
+}
+
+/// The cache key of kernel `name` with the `// #generated` block `generated`.
+fn generated_key(name: &str, generated: Option<&str>) -> String {
+    match generated {
+        Some(g) => format!("{name}\u{0}{g}"),
+        None => name.to_string(),
     }
 }
 
@@ -479,33 +500,14 @@ impl Executor {
                     message: format!("binding node `{}`: {message}", node.name),
                 },
             )?;
-            let groups = match &node.dispatch {
-                Dispatch::Groups(g) => *g,
-                // Recorded by `record_mip_chain` before this point.
-                Dispatch::MipChain => continue,
-                Dispatch::Texels(r) => {
-                    let t = &textures[r];
-                    kernel.groups_for(t.width(), t.height())
-                }
-                Dispatch::Blocks { of, x, y } => {
-                    let t = textures.get(of).ok_or_else(|| {
-                        Error::Invalid(format!(
-                            "node `{}` dispatches over `{of}`, which is not in the plan",
-                            node.name
-                        ))
-                    })?;
-                    [block_count(t.width(), *x), block_count(t.height(), *y), 1]
-                }
-                Dispatch::Axis { of, axis } => {
-                    let t = &textures[of];
-                    let (along, across) = if *axis == 0 {
-                        (t.width(), t.height())
-                    } else {
-                        (t.height(), t.width())
-                    };
-                    [kernel.groups_for(along, 1)[0], across, 1]
-                }
-            };
+            let wg = kernel.reflection.workgroup_size.unwrap_or([1, 1, 1]);
+            let size = |r: &str| textures.get(r).map(|t| (t.width(), t.height()));
+            let groups = node.dispatch.groups(wg, size).ok_or_else(|| {
+                Error::Invalid(format!(
+                    "node `{}` dispatches over a resource that is not in the plan",
+                    node.name
+                ))
+            })?;
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some(&node.name),
                 timestamp_writes: None,
@@ -558,25 +560,18 @@ impl Executor {
             .get_specialized(device, &node.kernel, &formats)?;
         let levels = dst.mip_level_count();
         let size = |l: u32| [(dst.width() >> l).max(1), (dst.height() >> l).max(1)];
-        // (read level, first written level); read level None = the `src` input.
-        let mut passes: Vec<(Option<u32>, u32)> = vec![(None, 0)];
-        let mut next = 2;
-        while next < levels {
-            let a = next.min(levels - 2);
-            passes.push((Some(a - 1), a));
-            next = a + 2;
-        }
+        let passes = crate::graph::mip_chain_passes(levels);
         let base: crate::filter::MipParams = bytemuck::try_pod_read_unaligned(
             &node.params[..std::mem::size_of::<crate::filter::MipParams>()],
         )
         .map_err(|e| pipeline_err(format!("bad params: {e}")))?;
         let align = u64::from(device.limits().min_uniform_buffer_offset_alignment).max(32);
         let mut bytes = vec![0u8; passes.len() * align as usize];
-        for (k, (read, a)) in passes.iter().enumerate() {
+        for (k, pass) in passes.iter().enumerate() {
             let p = crate::filter::MipParams {
-                src_size: read.map_or([src.width(), src.height()], size),
-                a_size: size(*a),
-                b_size: if a + 1 < levels { size(a + 1) } else { [0, 0] },
+                src_size: pass.read.map_or([src.width(), src.height()], size),
+                a_size: size(pass.a),
+                b_size: pass.b.map_or([0, 0], size),
                 ..base
             };
             let at = k * align as usize;
@@ -608,13 +603,13 @@ impl Executor {
             binding("params")?,
         );
         let mut groups = Vec::new();
-        for (k, (read, a)) in passes.iter().enumerate() {
-            let src_view = match read {
+        for (k, pass) in passes.iter().enumerate() {
+            let (a, b_level) = (pass.a, pass.b.unwrap_or(pass.a));
+            let src_view = match pass.read {
                 None => level_view(&src, 0),
-                Some(l) => level_view(&dst, *l),
+                Some(l) => level_view(&dst, l),
             };
-            let b_level = if a + 1 < levels { a + 1 } else { *a };
-            let (va, vb) = (level_view(&dst, *a), level_view(&dst, b_level));
+            let (va, vb) = (level_view(&dst, a), level_view(&dst, b_level));
             let entries = [
                 wgpu::BindGroupEntry {
                     binding: b_src,
@@ -650,7 +645,7 @@ impl Executor {
                 },
                 |message| pipeline_err(format!("binding level {a}: {message}")),
             )?;
-            let out = size(if a + 1 < levels { a + 1 } else { *a });
+            let out = size(b_level);
             groups.push((bg, kernel.groups_for(out[0], out[1])));
         }
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
