@@ -13,10 +13,10 @@
 //! on its compute threads. So a timestamp written before a compute pass was stamped at the next
 //! flush, *after* the dispatch, unless a barrier happened to flush in between; a pass's own
 //! begin/end pair read the gap between two flushes, near zero for every compute pass after the
-//! first (a 270 ms blur read 0.08 ms). The second write of a mark is such a flush: it stamps the
-//! first at the boundary, before any later work starts. On a GPU it is one more query write
-//! between passes (nanoseconds), and it is the same code path that the lavapipe test checks
-//! (`tests/timing.rs`).
+//! first (a blur of 40–270 ms per frame read 0.1 ms). The second write of a mark is such a
+//! flush: it stamps the first at the boundary, before any later work starts. On a GPU it is one
+//! more query write between passes (nanoseconds), and it is the same code path that the
+//! lavapipe test checks (`tests/timing.rs`).
 //!
 //! Writing on the encoder needs `TIMESTAMP_QUERY_INSIDE_ENCODERS` (Vulkan, DX12 and Metal on
 //! Apple GPUs offer it); a device without it cannot time. Timestamps inside a pass's descriptor

@@ -85,7 +85,19 @@ fn with_retries(what: &str, mut measure: impl FnMut() -> Result<(), String>) {
 }
 
 /// Checks the three configurations of one measurement: no blur, a small one, a large one.
-fn check(none: &Frames, small: &Frames, large: &Frames) -> Result<(), String> {
+///
+/// On a GPU (not CI's lavapipe) a 512² frame is microseconds of work against a submission of
+/// tens of microseconds, so its wall time says nothing about its passes: there the check is
+/// only that the costlier blur reads costlier.
+fn check(cpu: bool, none: &Frames, small: &Frames, large: &Frames) -> Result<(), String> {
+    if !cpu {
+        let (s, l) = (median(small.blur.clone()), median(large.blur.clone()));
+        return if l > s {
+            Ok(())
+        } else {
+            Err(format!("the large blur reads {l} ms, the small one {s} ms"))
+        };
+    }
     let mut misses = Vec::new();
     for (name, f) in [
         ("no blur", none),
@@ -128,6 +140,11 @@ fn check(none: &Frames, small: &Frames, large: &Frames) -> Result<(), String> {
     } else {
         Err(misses.join("; "))
     }
+}
+
+/// Whether the adapter is a CPU driver (lavapipe on CI), where a frame's wall time is its work.
+fn cpu(g: &Gpu) -> bool {
+    g.adapter.get_info().device_type == wgpu::DeviceType::Cpu
 }
 
 /// `scenes/techniques/vsm.toml` with its blur's radius set, or no filter for radius 0.
@@ -200,7 +217,7 @@ fn render_pass_times_add_up_to_the_wall_clock() {
     with_retries("render --timings", || {
         let f = interleaved(&mut scenes, |s| render_frame(&g, &mut renderer, s));
         assert!(f[1].blur.iter().all(|&b| b > 0.0), "blur passes are timed");
-        check(&f[0], &f[1], &f[2])
+        check(cpu(&g), &f[0], &f[1], &f[2])
     });
 }
 
@@ -275,6 +292,6 @@ fn stage_timings_add_up_to_the_wall_clock() {
     });
     with_retries("Prefilter::timings", || {
         let f = interleaved(&mut stages, |s| stage_frame(&g, s, &depth));
-        check(&f[0], &f[1], &f[2])
+        check(cpu(&g), &f[0], &f[1], &f[2])
     });
 }
