@@ -15,6 +15,10 @@ struct Params {
     weights: array<vec4<f32>, 9>,     // weight of offset i at weights[i / 4][i % 4], i = 0..=32
 }
 
+// Traffic (the cost model, src/graph/cost): each workgroup loads its line segment and a halo of
+// `radius` texels on either side.
+// #traffic src: WG_SIZE + 2 * min(params.radius, MAX_RADIUS) per group
+// #traffic dst: all
 @group(0) @binding(0) var src: texture_2d<f32>;
 @group(0) @binding(1) var dst: texture_storage_2d<rg32float, write>;
 @group(0) @binding(2) var<uniform> params: Params;

@@ -18,6 +18,11 @@ struct Params {
     _pad: u32,
 }
 
+// Traffic (the cost model, src/graph/cost): each dispatch reads the level above once and writes
+// its two levels.
+// #traffic src: all
+// #traffic dst_a: all
+// #traffic dst_b: all
 @group(0) @binding(0) var src: texture_2d<f32>;
 @group(0) @binding(1) var dst_a: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(2) var dst_b: texture_storage_2d<rgba32float, write>;

@@ -1,6 +1,6 @@
 //! The executor: records a [`Plan`] into a caller's command encoder, one compute pass per node,
-//! with a timestamp pair around each when the device allows. It borrows the device and never
-//! submits, so it runs the same inside shadowgraph's renderer and inside a host's frame.
+//! each node a span of the caller's [`GpuTimer`] when one is given. It borrows the device and
+//! never submits, so it runs the same inside shadowgraph's renderer and inside a host's frame.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -9,8 +9,9 @@ use wgpu::util::DeviceExt;
 
 use crate::error::{Error, Result};
 use crate::gpu::{read_buffer, scoped};
-use crate::graph::{Dispatch, Plan, Slot, block_count};
+use crate::graph::{Dispatch, Plan, Slot};
 use crate::kernels::{self, Reflection};
+pub use crate::timer::GpuTimer;
 
 /// A compute pipeline with the layouts reflected from its WGSL.
 pub struct ComputeKernel {
@@ -144,10 +145,7 @@ impl KernelCache {
         name: &str,
         generated: Option<&str>,
     ) -> Result<Arc<ComputeKernel>> {
-        let key = match generated {
-            Some(g) => format!("{name}\u{0}{g}"),
-            None => name.to_string(),
-        };
+        let key = generated_key(name, generated);
         if let Some(k) = self.kernels.get(&key) {
             return Ok(k.clone());
         }
@@ -155,6 +153,22 @@ impl KernelCache {
         let k = Arc::new(ComputeKernel::new(device, name, &wgsl)?);
         self.kernels.insert(key, k.clone());
         Ok(k)
+    }
+
+    /// Compiles `wgsl` as the pipeline [`KernelCache::get_generated`] returns for `name` and
+    /// `generated` from now on: a rewritten variant of the kernel with the same bindings, e.g.
+    /// the shading kernel with every texture fetch counted (`tests/cost.rs`).
+    pub fn insert_generated(
+        &mut self,
+        device: &wgpu::Device,
+        name: &str,
+        generated: Option<&str>,
+        wgsl: &str,
+    ) -> Result<()> {
+        let key = generated_key(name, generated);
+        let k = Arc::new(ComputeKernel::new(device, name, wgsl)?);
+        self.kernels.insert(key, k);
+        Ok(())
     }
 
     /// Number of pipelines created so far.
@@ -165,6 +179,14 @@ impl KernelCache {
     /// Whether no pipeline was created yet.
     pub fn is_empty(&self) -> bool {
         self.kernels.is_empty()
+    }
+}
+
+/// The cache key of kernel `name` with the `// #generated` block `generated`.
+fn generated_key(name: &str, generated: Option<&str>) -> String {
+    match generated {
+        Some(g) => format!("{name}\u{0}{g}"),
+        None => name.to_string(),
     }
 }
 
@@ -230,113 +252,6 @@ impl TexturePool {
     /// Textures held (in use by the last run or free).
     pub fn texture_count(&self) -> usize {
         self.free.values().map(Vec::len).sum()
-    }
-}
-
-/// Timestamp queries around passes, resolved after the work is submitted.
-pub struct GpuTimer {
-    query_set: wgpu::QuerySet,
-    resolve: wgpu::Buffer,
-    readback: wgpu::Buffer,
-    capacity: u32,
-    labels: Vec<String>,
-    period_ns: f64,
-}
-
-impl GpuTimer {
-    /// A timer for up to `passes` passes, or `None` when the device has no TIMESTAMP_QUERY.
-    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, passes: u32) -> Option<Self> {
-        if !device.features().contains(wgpu::Features::TIMESTAMP_QUERY) || passes == 0 {
-            return None;
-        }
-        let count = 2 * passes;
-        let bytes = u64::from(count) * 8;
-        Some(Self {
-            query_set: device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("shadowgraph.timer"),
-                ty: wgpu::QueryType::Timestamp,
-                count,
-            }),
-            resolve: device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("shadowgraph.timer.resolve"),
-                size: bytes,
-                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            }),
-            readback: device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("shadowgraph.timer.readback"),
-                size: bytes,
-                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-                mapped_at_creation: false,
-            }),
-            capacity: passes,
-            labels: Vec::new(),
-            period_ns: f64::from(queue.get_timestamp_period()),
-        })
-    }
-
-    /// Forgets the passes of the last frame.
-    pub fn reset(&mut self) {
-        self.labels.clear();
-    }
-
-    /// Query indices for the next pass named `label`, or `None` when the timer is full.
-    fn next(&mut self, label: &str) -> Option<(u32, u32)> {
-        let i = self.labels.len() as u32;
-        if i >= self.capacity {
-            log::warn!("timer full: pass `{label}` is not timed");
-            return None;
-        }
-        self.labels.push(label.to_string());
-        Some((2 * i, 2 * i + 1))
-    }
-
-    /// Timestamp writes for a compute pass named `label`.
-    pub fn compute_pass(&mut self, label: &str) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
-        let (a, b) = self.next(label)?;
-        Some(wgpu::ComputePassTimestampWrites {
-            query_set: &self.query_set,
-            beginning_of_pass_write_index: Some(a),
-            end_of_pass_write_index: Some(b),
-        })
-    }
-
-    /// Timestamp writes for a render pass named `label`.
-    pub fn render_pass(&mut self, label: &str) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
-        let (a, b) = self.next(label)?;
-        Some(wgpu::RenderPassTimestampWrites {
-            query_set: &self.query_set,
-            beginning_of_pass_write_index: Some(a),
-            end_of_pass_write_index: Some(b),
-        })
-    }
-
-    /// Records the query resolve; call after the last timed pass, before submitting.
-    pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
-        let n = self.labels.len() as u32 * 2;
-        if n == 0 {
-            return;
-        }
-        encoder.resolve_query_set(&self.query_set, 0..n, &self.resolve, 0);
-        encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.readback, 0, u64::from(n) * 8);
-    }
-
-    /// Milliseconds per timed pass, in recording order. Call after the submission completed.
-    pub fn read(&self, device: &wgpu::Device) -> Result<Vec<(String, f64)>> {
-        if self.labels.is_empty() {
-            return Ok(Vec::new());
-        }
-        let raw = read_buffer(device, &self.readback)?;
-        let ticks: &[u64] = bytemuck::cast_slice(&raw);
-        Ok(self
-            .labels
-            .iter()
-            .enumerate()
-            .map(|(i, l)| {
-                let dt = ticks[2 * i + 1].wrapping_sub(ticks[2 * i]);
-                (l.clone(), dt as f64 * self.period_ns * 1e-6)
-            })
-            .collect())
     }
 }
 
@@ -420,6 +335,7 @@ impl Executor {
     }
 
     /// Records `plan` into `encoder`. `imports` gives a texture for every imported resource.
+    /// With a `timer`, each node is a span named after it, and the last one ends with the plan.
     pub fn record(
         &mut self,
         device: &wgpu::Device,
@@ -503,8 +419,11 @@ impl Executor {
 
         for (si, step) in plan.steps.iter().enumerate() {
             let node = &step.node;
+            if let Some(t) = timer.as_deref_mut() {
+                t.begin(encoder, &node.name);
+            }
             if node.dispatch == Dispatch::MipChain {
-                self.record_mip_chain(device, encoder, node, &textures, timer.as_deref_mut())?;
+                self.record_mip_chain(device, encoder, node, &textures)?;
                 continue;
             }
             let formats: Vec<(String, wgpu::TextureFormat)> = node
@@ -581,43 +500,25 @@ impl Executor {
                     message: format!("binding node `{}`: {message}", node.name),
                 },
             )?;
-            let groups = match &node.dispatch {
-                Dispatch::Groups(g) => *g,
-                // Recorded by `record_mip_chain` before this point.
-                Dispatch::MipChain => continue,
-                Dispatch::Texels(r) => {
-                    let t = &textures[r];
-                    kernel.groups_for(t.width(), t.height())
-                }
-                Dispatch::Blocks { of, x, y } => {
-                    let t = textures.get(of).ok_or_else(|| {
-                        Error::Invalid(format!(
-                            "node `{}` dispatches over `{of}`, which is not in the plan",
-                            node.name
-                        ))
-                    })?;
-                    [block_count(t.width(), *x), block_count(t.height(), *y), 1]
-                }
-                Dispatch::Axis { of, axis } => {
-                    let t = &textures[of];
-                    let (along, across) = if *axis == 0 {
-                        (t.width(), t.height())
-                    } else {
-                        (t.height(), t.width())
-                    };
-                    [kernel.groups_for(along, 1)[0], across, 1]
-                }
-            };
-            let timestamp_writes = timer
-                .as_deref_mut()
-                .and_then(|t| t.compute_pass(&node.name));
+            let wg = kernel.reflection.workgroup_size.unwrap_or([1, 1, 1]);
+            let size = |r: &str| textures.get(r).map(|t| (t.width(), t.height()));
+            let groups = node.dispatch.groups(wg, size).ok_or_else(|| {
+                Error::Invalid(format!(
+                    "node `{}` dispatches over a resource that is not in the plan",
+                    node.name
+                ))
+            })?;
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some(&node.name),
-                timestamp_writes,
+                timestamp_writes: None,
             });
             pass.set_pipeline(&kernel.pipeline);
             pass.set_bind_group(0, &bind_group, &[]);
             pass.dispatch_workgroups(groups[0], groups[1], groups[2]);
+        }
+        // The last node ends here, not at whatever the caller records next.
+        if let Some(t) = timer {
+            t.end(encoder);
         }
         Ok(Outputs {
             textures,
@@ -637,7 +538,6 @@ impl Executor {
         encoder: &mut wgpu::CommandEncoder,
         node: &crate::graph::Node,
         textures: &HashMap<String, wgpu::Texture>,
-        timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         let pipeline_err = |message: String| Error::Pipeline {
             kernel: node.kernel.clone(),
@@ -660,25 +560,18 @@ impl Executor {
             .get_specialized(device, &node.kernel, &formats)?;
         let levels = dst.mip_level_count();
         let size = |l: u32| [(dst.width() >> l).max(1), (dst.height() >> l).max(1)];
-        // (read level, first written level); read level None = the `src` input.
-        let mut passes: Vec<(Option<u32>, u32)> = vec![(None, 0)];
-        let mut next = 2;
-        while next < levels {
-            let a = next.min(levels - 2);
-            passes.push((Some(a - 1), a));
-            next = a + 2;
-        }
+        let passes = crate::graph::mip_chain_passes(levels);
         let base: crate::filter::MipParams = bytemuck::try_pod_read_unaligned(
             &node.params[..std::mem::size_of::<crate::filter::MipParams>()],
         )
         .map_err(|e| pipeline_err(format!("bad params: {e}")))?;
         let align = u64::from(device.limits().min_uniform_buffer_offset_alignment).max(32);
         let mut bytes = vec![0u8; passes.len() * align as usize];
-        for (k, (read, a)) in passes.iter().enumerate() {
+        for (k, pass) in passes.iter().enumerate() {
             let p = crate::filter::MipParams {
-                src_size: read.map_or([src.width(), src.height()], size),
-                a_size: size(*a),
-                b_size: if a + 1 < levels { size(a + 1) } else { [0, 0] },
+                src_size: pass.read.map_or([src.width(), src.height()], size),
+                a_size: size(pass.a),
+                b_size: pass.b.map_or([0, 0], size),
                 ..base
             };
             let at = k * align as usize;
@@ -710,13 +603,13 @@ impl Executor {
             binding("params")?,
         );
         let mut groups = Vec::new();
-        for (k, (read, a)) in passes.iter().enumerate() {
-            let src_view = match read {
+        for (k, pass) in passes.iter().enumerate() {
+            let (a, b_level) = (pass.a, pass.b.unwrap_or(pass.a));
+            let src_view = match pass.read {
                 None => level_view(&src, 0),
-                Some(l) => level_view(&dst, *l),
+                Some(l) => level_view(&dst, l),
             };
-            let b_level = if a + 1 < levels { a + 1 } else { *a };
-            let (va, vb) = (level_view(&dst, *a), level_view(&dst, b_level));
+            let (va, vb) = (level_view(&dst, a), level_view(&dst, b_level));
             let entries = [
                 wgpu::BindGroupEntry {
                     binding: b_src,
@@ -752,13 +645,12 @@ impl Executor {
                 },
                 |message| pipeline_err(format!("binding level {a}: {message}")),
             )?;
-            let out = size(if a + 1 < levels { a + 1 } else { *a });
+            let out = size(b_level);
             groups.push((bg, kernel.groups_for(out[0], out[1])));
         }
-        let timestamp_writes = timer.and_then(|t| t.compute_pass(&node.name));
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some(&node.name),
-            timestamp_writes,
+            timestamp_writes: None,
         });
         pass.set_pipeline(&kernel.pipeline);
         for (bg, g) in &groups {

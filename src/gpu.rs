@@ -16,7 +16,7 @@ pub struct Gpu {
 }
 
 /// Features shadowgraph uses when offered; none is required.
-const WANTED_FEATURES: wgpu::Features = wgpu::Features::TIMESTAMP_QUERY
+const WANTED_FEATURES: wgpu::Features = crate::timer::TIMER_FEATURES
     .union(wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES)
     .union(wgpu::Features::FLOAT32_FILTERABLE)
     .union(wgpu::Features::SHADER_F64)
@@ -69,11 +69,11 @@ impl Gpu {
         )
     }
 
-    /// Whether GPU timestamps can be written around compute passes.
+    /// Whether GPU timestamps can be written between passes ([`crate::timer::GpuTimer`]).
     pub fn can_time(&self) -> bool {
         self.device
             .features()
-            .contains(wgpu::Features::TIMESTAMP_QUERY)
+            .contains(crate::timer::TIMER_FEATURES)
     }
 
     /// The facts `shadowgraph info` prints: adapter, backend, features and limits that matter.
@@ -89,6 +89,10 @@ impl Gpu {
         line("driver", format!("{} {}", i.driver, i.driver_info));
         for (name, feat) in [
             ("TIMESTAMP_QUERY", wgpu::Features::TIMESTAMP_QUERY),
+            (
+                "TIMESTAMP_QUERY_INSIDE_ENCODERS",
+                wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS,
+            ),
             (
                 "TIMESTAMP_QUERY_INSIDE_PASSES",
                 wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES,

@@ -17,6 +17,7 @@ pub mod sat;
 pub mod scene;
 pub mod stability;
 pub mod technique;
+pub mod timer;
 pub mod truth;
 
 pub use error::{Error, Result};

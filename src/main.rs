@@ -30,7 +30,7 @@ enum Command {
         /// Also write position, normal and per-light visibility as 32-bit float OpenEXR here.
         #[arg(long)]
         aux: Option<PathBuf>,
-        /// Print GPU time per node and for the shading pass.
+        /// Print GPU time per pass (timestamps between passes) and each frame's wall time.
         #[arg(long)]
         timings: bool,
         /// Frames to render (timings are medians over them).
@@ -59,7 +59,8 @@ enum Command {
     },
     /// Print the adapter, its backend, and the features and limits that matter.
     Info,
-    /// Time kernels by GPU timestamps against a copy kernel over the same bytes.
+    /// Time kernels by GPU timestamps against a texture copy of their output's format (and the
+    /// texture copies against a buffer copy), bytes from the plan's cost model.
     Bench {
         /// Square map sizes.
         #[arg(long, value_delimiter = ',', default_value = "512,1024,2048,4096")]

@@ -217,8 +217,12 @@ pub struct Frame {
     pub position: Vec<f32>,
     /// Normal + material per pixel (`aux` only).
     pub normal: Vec<f32>,
-    /// Per frame, milliseconds per timed pass (empty when the device cannot time).
+    /// Per frame, milliseconds per timed pass (empty when the device cannot time): GPU
+    /// timestamps at the boundaries between passes, so consecutive passes share their bounds.
     pub timings: Vec<Vec<(String, f64)>>,
+    /// Per frame, wall-clock milliseconds from submitting the frame's commands to their
+    /// completion (what the passes' times should add up to, less submission overhead).
+    pub wall_ms: Vec<f64>,
     /// Steps whose kernels reported replaced texels (non-finite depth), with the count.
     pub sanitized: Vec<(String, u32)>,
     /// Per light, the map its shading reads (level 0): raw depth, linear depth or a filtered
@@ -556,10 +560,11 @@ impl Renderer {
             .enumerate()
             .map(|(i, t)| (technique::depth_name(i), t.clone()))
             .collect();
-        let passes = 2 * scene.lights.len() as u32 + sp.plan.steps.len() as u32 + 2;
-        let mut timer = GpuTimer::new(device, queue, passes);
+        let spans = scene.lights.len() as u32 + sp.plan.steps.len() as u32 + 2;
+        let mut timer = GpuTimer::new(device, queue, spans);
         let repeat = opts.repeat.max(1);
         let mut timings = Vec::new();
+        let mut wall_ms = Vec::new();
         let mut last = None;
         for _ in 0..repeat {
             if let Some(t) = timer.as_mut() {
@@ -610,11 +615,13 @@ impl Renderer {
                 &maps,
                 timer.as_mut(),
             )?;
-            outputs.copy_stats(&mut enc);
-            if let Some(t) = timer.as_ref() {
+            if let Some(t) = timer.as_mut() {
                 t.resolve(&mut enc);
             }
+            outputs.copy_stats(&mut enc);
+            let submitted = std::time::Instant::now();
             submit_and_wait(device, queue, enc, "render")?;
+            wall_ms.push(submitted.elapsed().as_secs_f64() * 1e3);
             if let Some(t) = timer.as_ref() {
                 timings.push(t.read(device)?);
             }
@@ -637,6 +644,7 @@ impl Renderer {
             position: Vec::new(),
             normal: Vec::new(),
             timings,
+            wall_ms,
             sanitized,
             shade_maps: Vec::new(),
             shade_mips: Vec::new(),
@@ -739,12 +747,14 @@ impl Renderer {
             }],
         });
         let view = depth.create_view(&Default::default());
-        let timestamp_writes = timer.and_then(|t| t.render_pass(raster.label));
+        if let Some(t) = timer {
+            t.begin(enc, raster.label);
+        }
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(raster.label),
             color_attachments: &[],
             depth_stencil_attachment: Some(clear_depth(&view)),
-            timestamp_writes,
+            timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
         });
@@ -813,12 +823,14 @@ impl Renderer {
                 },
             })
         };
-        let timestamp_writes = timer.and_then(|t| t.render_pass("gbuffer"));
+        if let Some(t) = timer {
+            t.begin(enc, "gbuffer");
+        }
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("gbuffer"),
             color_attachments: &[clear(&pv), clear(&nv)],
             depth_stencil_attachment: Some(clear_depth(&dv)),
-            timestamp_writes,
+            timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
         });
@@ -943,10 +955,12 @@ impl Renderer {
             err,
         )?;
         let groups = kernel.groups_for(w, h);
-        let timestamp_writes = timer.and_then(|t| t.compute_pass("shade"));
+        if let Some(t) = timer {
+            t.begin(enc, "shade");
+        }
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("shade"),
-            timestamp_writes,
+            timestamp_writes: None,
         });
         pass.set_pipeline(&kernel.pipeline);
         pass.set_bind_group(0, &bg0, &[]);

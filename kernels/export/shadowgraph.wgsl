@@ -183,6 +183,7 @@ fn texel_of(uv: vec2<f32>, size: vec2<f32>) -> vec2<i32> {
 }
 
 // Linear depth at texel t, clamped to the edge.
+// #fetches load_depth: 1
 fn load_depth(map: texture_2d<f32>, t: vec2<i32>) -> f32 {
     let size = vec2<i32>(textureDimensions(map));
     return textureLoad(map, clamp(t, vec2<i32>(0), size - 1), 0).r;
@@ -191,6 +192,7 @@ fn load_depth(map: texture_2d<f32>, t: vec2<i32>) -> f32 {
 // Bilinear interpolation of all four channels at uv (texel centres at (i + ½) / size),
 // clamp-to-edge, from four loads: exact and filter-feature independent (f32 maps need not be
 // filterable).
+// #fetches sample_bilinear: 4
 fn sample_bilinear(map: texture_2d<f32>, uv: vec2<f32>) -> vec4<f32> {
     return bilinear_level(map, uv, 0);
 }
@@ -203,6 +205,7 @@ fn level_size(map: texture_2d<f32>, level: i32) -> vec2<f32> {
 }
 
 // `sample_bilinear` on mip `level` (texel centres at (i + ½) / level size).
+// #fetches bilinear_level: 4
 fn bilinear_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> vec4<f32> {
     let size = level_size(map, level);
     let f = uv * size - 0.5;
@@ -217,6 +220,7 @@ fn bilinear_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> vec4<f32> 
 }
 
 // Trilinear sample of a mip chain at `lod` (clamped to the chain).
+// #fetches trilinear: 8
 fn trilinear(map: texture_2d<f32>, l: Light, uv: vec2<f32>, lod_in: f32) -> vec4<f32> {
     let lod = clamp(lod_in, 0.0, f32(l.mip_levels - 1u));
     let l0 = i32(floor(lod));
@@ -265,6 +269,7 @@ fn mip_tap_uv(t: MipTaps, uv: vec2<f32>, k: u32) -> vec2<f32> {
 // trilinear at log2(filter width), or along the pixel's footprint (`mip_taps`). The loop runs
 // `max_anisotropy` times for every invocation and weights the taps past `count` by 0: no
 // invocation leaves the loop early (llvmpipe mis-fetches explicit levels under divergence).
+// #fetches sample_map: select(4, 8 * max(l.max_anisotropy, 1), l.mip_levels > 1)
 fn sample_map(map: texture_2d<f32>, l: Light, s: LightSample) -> vec4<f32> {
     if l.mip_levels <= 1u {
         return sample_bilinear(map, s.uv);
@@ -279,6 +284,7 @@ fn sample_map(map: texture_2d<f32>, l: Light, s: LightSample) -> vec4<f32> {
 }
 
 // Trilinear sample of a map of logarithms at `lod`, as a logarithm.
+// #fetches trilinear_log: 8
 fn trilinear_log(map: texture_2d<f32>, l: Light, uv: vec2<f32>, lod_in: f32) -> f32 {
     let lod = clamp(lod_in, 0.0, f32(l.mip_levels - 1u));
     let l0 = i32(floor(lod));
@@ -297,12 +303,14 @@ fn linstep(lo: f32, hi: f32, x: f32) -> f32 {
 
 // Bilinear interpolation of exp(v) for a map of logarithms v (channel 0), returned as a
 // logarithm: log Σ wᵢ exp(vᵢ), evaluated around the largest tap so nothing overflows.
+// #fetches sample_bilinear_log: 4
 fn sample_bilinear_log(map: texture_2d<f32>, uv: vec2<f32>) -> f32 {
     return bilinear_log_level(map, uv, 0);
 }
 
 // `sample_map` for a map of logarithms: the same weights applied to exp(v), as a logarithm
 // (taps combined around the largest so far, so nothing overflows).
+// #fetches sample_map_log: select(4, 8 * max(l.max_anisotropy, 1), l.mip_levels > 1)
 fn sample_map_log(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     if l.mip_levels <= 1u {
         return sample_bilinear_log(map, s.uv);
@@ -322,6 +330,7 @@ fn sample_map_log(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
 }
 
 // `sample_bilinear_log` on mip `level`.
+// #fetches bilinear_log_level: 4
 fn bilinear_log_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> f32 {
     let size = level_size(map, level);
     let f = uv * size - 0.5;
@@ -339,6 +348,7 @@ fn bilinear_log_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> f32 {
 }
 // Hard shadow test (Williams 1978): lit when d ≤ z_map + bias at the nearest texel.
 
+// #fetches vis_hard: 1
 fn vis_hard(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     let z = load_depth(map, texel_of(s.uv, l.map_size));
     return select(0.0, 1.0, s.depth <= z + l.bias);
@@ -346,6 +356,7 @@ fn vis_hard(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
 // Percentage-closer filtering (Reeves et al. 1987): the weighted mean of comparison results
 // over a (2r + 1)² window around the receiver's texel — never a filter of depths.
 
+// #fetches vis_pcf: (2 * l.radius + 1) * (2 * l.radius + 1)
 fn vis_pcf(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     let c = texel_of(s.uv, l.map_size);
     let r = i32(l.radius);
@@ -366,6 +377,7 @@ fn vis_pcf(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
 }
 
 // The hardware 2×2 comparison: bilinear weights of four comparisons against the raw depth map.
+// #fetches vis_pcf_hardware: 1
 fn vis_pcf_hardware(map: texture_depth_2d, cmp: sampler_comparison, l: Light, s: LightSample) -> f32 {
     let reference = light_linear_to_ndc(l, clamp(s.depth - l.bias, 0.0, 1.0));
     return textureSampleCompareLevel(map, cmp, s.uv, reference);
@@ -381,6 +393,7 @@ fn pcss_search_radius(l: Light, s: LightSample) -> f32 {
     return min(world / light_map_width(l, l.near), l.max_search);
 }
 
+// #fetches vis_pcss: l.blocker_samples + l.filter_samples
 fn vis_pcss(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     let search = pcss_search_radius(l, s);
     var sum = 0.0;
@@ -409,6 +422,7 @@ fn vis_pcss(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
 //   σ² = max(E[z²] − μ², min_variance),  p_max = σ² / (σ² + (d − μ)²) for d > μ, else 1,
 // then the light-bleeding reduction linstep(bleed, 1, p_max).
 
+// #fetches vis_vsm: sample_map
 fn vis_vsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     return vis_vsm_of(sample_map(map, l, s), l, s);
 }
@@ -440,6 +454,7 @@ fn chebyshev_upper(mean: f32, mean_sq: f32, receiver: f32, floor: f32) -> f32 {
     return variance / (variance + t * t);
 }
 
+// #fetches vis_evsm: sample_map
 fn vis_evsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     return vis_evsm_of(sample_map(map, l, s), l, s);
 }
@@ -460,6 +475,7 @@ fn vis_evsm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
 // Exponential shadow maps: visibility = clamp(E[exp(c z)] · exp(−c d), 0, 1), with the filtered
 // moment kept as its logarithm L, so the product is exp(L − c d) and never overflows.
 
+// #fetches vis_esm: sample_map_log
 fn vis_esm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     return vis_esm_of_log(sample_map_log(map, l, s), l, s);
 }
@@ -568,6 +584,7 @@ fn msm_intensity(b: vec4<f32>, d: f32, hausdorff: bool) -> f32 {
     return 1.0 - (z2 * z3 - b.x * (z2 + z3) + b.y) / ((d - z2) * (d - z3));
 }
 
+// #fetches vis_msm: sample_map
 fn vis_msm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     return vis_msm_of(sample_map(map, l, s), l, s);
 }
@@ -610,6 +627,7 @@ fn csm_sin_cos(k: u32, x: f32) -> vec2<f32> {
 }
 
 // Terms 2·chunk + 1 and 2·chunk + 2 (those ≤ M) of the series at this receiver.
+// #fetches csm_chunk: sample_map
 fn csm_chunk(map: texture_2d<f32>, chunk: u32, l: Light, s: LightSample) -> f32 {
     return csm_chunk_of(sample_map(map, l, s), chunk, l, s);
 }
@@ -709,6 +727,7 @@ fn sat_nodes(rect: vec4<f32>, size: vec2<u32>) -> SatNodes {
 }
 
 // F(X, Y) at integer nodes: 0 on the top and left edges, else SAT texel (X − 1, Y − 1).
+// #fetches sat_node_u32: 1
 fn sat_node_u32(sat: texture_2d<u32>, x: i32, y: i32) -> vec4<u32> {
     if x == 0 || y == 0 {
         return vec4<u32>(0u);
@@ -716,6 +735,7 @@ fn sat_node_u32(sat: texture_2d<u32>, x: i32, y: i32) -> vec4<u32> {
     return textureLoad(sat, vec2<i32>(x - 1, y - 1), 0);
 }
 
+// #fetches sat_node_f32: 1
 fn sat_node_f32(sat: texture_2d<f32>, x: i32, y: i32) -> vec4<f32> {
     if x == 0 || y == 0 {
         return vec4<f32>(0.0);
@@ -727,6 +747,7 @@ fn sat_node_f32(sat: texture_2d<f32>, x: i32, y: i32) -> vec4<f32> {
 // SAT (rgba32uint) encoded with `offset` and `scale` (SatCoding in src/sat.rs).
 // With F at the left edge a mix over r and at the right edge over p (weights summing to 1),
 // F(x1) − F(x0) = Σ_r,p wx0_r·wx1_p·(F(X1_p) − F(X0_r)): a weighted sum of integer windows.
+// #fetches sat_mean_fixed: 16
 fn sat_mean_fixed(sat: texture_2d<u32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
     let n = sat_nodes(rect, textureDimensions(sat));
     var f: array<vec4<u32>, 16>;
@@ -754,6 +775,7 @@ fn sat_mean_fixed(sat: texture_2d<u32>, rect: vec4<f32>, offset: vec4<f32>, scal
 // The same from an f32 SAT (rgba32float) built with `offset` and `scale` (scale is 1 for the
 // f32 variant). Each window is a difference of f32 sums: its error grows with the sums at the
 // corners (about 2⁻²⁴ of the sum over [0, X] × [0, Y] each), not with the window.
+// #fetches sat_mean_float: 16
 fn sat_mean_float(sat: texture_2d<f32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
     let n = sat_nodes(rect, textureDimensions(sat));
     var f: array<vec4<f32>, 16>;
@@ -784,11 +806,13 @@ fn sat_rect(l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
 }
 
 // The mean over `sat_rect(l, uv, width)` from a fixed-point table (rgba32uint).
+// #fetches sat_sample_fixed: 16
 fn sat_sample_fixed(map: texture_2d<u32>, l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
     return sat_mean_fixed(map, sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
 }
 
 // The mean over `sat_rect(l, uv, width)` from an f32 table (rgba32float).
+// #fetches sat_sample_float: 16
 fn sat_sample_float(map: texture_2d<f32>, l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
     return sat_mean_float(map, sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
 }
@@ -941,12 +965,14 @@ fn vssm_resolve(m: vec4<f32>, b: vec2<f32>, l: Light, s: LightSample) -> f32 {
     return select(1.0, vis_vsm_of(m, l, s), b.y >= BLOCKER_MIN_SHARE);
 }
 
+// #fetches vis_vssm_fixed: 2 * sat_sample_fixed
 fn vis_vssm_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32 {
     let b = vssm_blocker(sat_sample_fixed(map, l, s.uv, blocker_search_width(l, s)), l, s);
     let m = sat_sample_fixed(map, l, s.uv, blocker_filter_width(l, s, b.x));
     return vssm_resolve(m, b, l, s);
 }
 
+// #fetches vis_vssm_float: 2 * sat_sample_float
 fn vis_vssm_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     let b = vssm_blocker(sat_sample_float(map, l, s.uv, blocker_search_width(l, s)), l, s);
     let m = sat_sample_float(map, l, s.uv, blocker_filter_width(l, s, b.x));
@@ -969,12 +995,14 @@ fn msm_soft_resolve(m: vec4<f32>, b: vec2<f32>, l: Light, s: LightSample) -> f32
     return select(1.0, vis_msm_of(m, l, s), b.y >= BLOCKER_MIN_SHARE);
 }
 
+// #fetches vis_msm_soft_fixed: 2 * sat_sample_fixed
 fn vis_msm_soft_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32 {
     let b = msm_soft_blocker(sat_sample_fixed(map, l, s.uv, blocker_search_width(l, s)), l, s);
     let m = sat_sample_fixed(map, l, s.uv, blocker_filter_width(l, s, b.x));
     return msm_soft_resolve(m, b, l, s);
 }
 
+// #fetches vis_msm_soft_float: 2 * sat_sample_float
 fn vis_msm_soft_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     let b = msm_soft_blocker(sat_sample_float(map, l, s.uv, blocker_search_width(l, s)), l, s);
     let m = sat_sample_float(map, l, s.uv, blocker_filter_width(l, s, b.x));

@@ -73,6 +73,7 @@ fn msm_intensity(b: vec4<f32>, d: f32, hausdorff: bool) -> f32 {
     return 1.0 - (z2 * z3 - b.x * (z2 + z3) + b.y) / ((d - z2) * (d - z3));
 }
 
+// #fetches vis_msm: sample_map
 fn vis_msm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     return vis_msm_of(sample_map(map, l, s), l, s);
 }

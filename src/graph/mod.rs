@@ -2,6 +2,7 @@
 //! (format and size rule) and their parameters. [`plan()`] turns a graph and the outputs a
 //! scene asks for into an ordered, pruned [`Plan`] with resource lifetimes and texture reuse.
 
+pub mod cost;
 mod plan;
 pub mod print;
 
@@ -84,6 +85,67 @@ pub enum Dispatch {
     /// A mip-chain node: the executor records one dispatch per two levels of the output
     /// (its `dst` resource), each reading the level before (the `src` input for the first).
     MipChain,
+}
+
+impl Dispatch {
+    /// The workgroup count of the dispatch for a kernel of workgroup size `wg`, with `size`
+    /// giving each resource's size; `None` for a [`Dispatch::MipChain`] (several dispatches:
+    /// [`mip_chain_passes`]) or a resource `size` does not know.
+    pub fn groups(
+        &self,
+        wg: [u32; 3],
+        size: impl Fn(&str) -> Option<(u32, u32)>,
+    ) -> Option<[u32; 3]> {
+        Some(match self {
+            Dispatch::Groups(g) => *g,
+            Dispatch::MipChain => return None,
+            Dispatch::Texels(r) => {
+                let (w, h) = size(r)?;
+                [w.div_ceil(wg[0]), h.div_ceil(wg[1]), 1]
+            }
+            Dispatch::Blocks { of, x, y } => {
+                let (w, h) = size(of)?;
+                [block_count(w, *x), block_count(h, *y), 1]
+            }
+            Dispatch::Axis { of, axis } => {
+                let (w, h) = size(of)?;
+                let (along, across) = if *axis == 0 { (w, h) } else { (h, w) };
+                [along.div_ceil(wg[0]), across, 1]
+            }
+        })
+    }
+}
+
+/// One dispatch of a [`Dispatch::MipChain`] node (`kernels/mips.wgsl`): it reads level `read`
+/// of the output (`None`: the node's `src` input) and writes levels `a` and `b`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MipPass {
+    /// The level read (`None`: the `src` input).
+    pub read: Option<u32>,
+    /// The first level written.
+    pub a: u32,
+    /// The second level written (`None` when the chain has no level after `a`: a 1×1 map).
+    pub b: Option<u32>,
+}
+
+/// The dispatches of a mip chain of `levels` levels, two levels each. With an odd level count
+/// the last dispatch redoes the level before the last (identical values), so that every
+/// dispatch writes two levels.
+pub fn mip_chain_passes(levels: u32) -> Vec<MipPass> {
+    let levels = levels.max(1);
+    let pass = |read, a: u32| MipPass {
+        read,
+        a,
+        b: (a + 1 < levels).then_some(a + 1),
+    };
+    let mut passes = vec![pass(None, 0)];
+    let mut next = 2;
+    while next < levels {
+        let a = next.min(levels - 2);
+        passes.push(pass(Some(a - 1), a));
+        next = a + 2;
+    }
+    passes
 }
 
 /// One kernel invocation in the graph.
