@@ -56,6 +56,9 @@ pub struct EvaluateOptions {
     pub repeat: u32,
     /// Image size to evaluate at (default: the scene's; quick: scaled to ≤ 160 wide).
     pub image: Option<(u32, u32)>,
+    /// MSM moment biases: each `msm`/`msm_soft` configuration runs once per bias instead of
+    /// at its storage's default (`None`: the defaults).
+    pub moment_biases: Option<Vec<f32>>,
 }
 
 impl Default for EvaluateOptions {
@@ -68,6 +71,7 @@ impl Default for EvaluateOptions {
             truth_resolution: None,
             repeat: 5,
             image: None,
+            moment_biases: None,
         }
     }
 }

@@ -102,6 +102,9 @@ enum Command {
         /// Evaluate at this image size, WIDTHxHEIGHT (default: the scene's).
         #[arg(long, value_parser = parse_size)]
         image: Option<(u32, u32)>,
+        /// Run every MSM configuration at each of these moment biases (default: the storage's).
+        #[arg(long, value_delimiter = ',')]
+        moment_bias: Option<Vec<f32>>,
     },
     /// Run the numerical-stability suite: each hard input through the real kernels against its
     /// f64 reference and stated bound; exits non-zero when a check fails.
@@ -166,6 +169,7 @@ fn run(args: Args) -> Result<()> {
             truth_resolution,
             repeat,
             image,
+            moment_bias,
         } => {
             let opts = shadowgraph::evaluate::EvaluateOptions {
                 techniques,
@@ -175,6 +179,7 @@ fn run(args: Args) -> Result<()> {
                 truth_resolution,
                 repeat: if quick { repeat.min(1) } else { repeat },
                 image,
+                moment_biases: moment_bias,
             };
             let gpu = Gpu::new()?;
             print!("{}", shadowgraph::evaluate::run(&gpu, &scene, &out, &opts)?);

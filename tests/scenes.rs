@@ -310,7 +310,8 @@ fn check_prefilter_chain(scene: &Scene, frame: &shadowgraph::render::Frame, li: 
                 )
             }
             Technique::Msm { prefilter, .. } => {
-                let quantized = shadowgraph::technique::msm_quantized(prefilter.storage);
+                let quantized =
+                    shadowgraph::technique::msm_quantized(&scene.lights[li].shadow.technique);
                 let f = move |t: &Texels| cpu::msm::msm(t, quantized);
                 (
                     Box::new(f) as Box<dyn Fn(&Texels) -> Texels>,
@@ -344,7 +345,8 @@ fn check_prefilter_chain(scene: &Scene, frame: &shadowgraph::render::Frame, li: 
                 1e-6,
             ),
             Technique::MsmSoft { soft, .. } => {
-                let quantized = shadowgraph::technique::msm_quantized(soft.storage);
+                let quantized =
+                    shadowgraph::technique::msm_quantized(&scene.lights[li].shadow.technique);
                 let f = move |t: &Texels| cpu::msm::msm(t, quantized);
                 (
                     Box::new(f) as Box<dyn Fn(&Texels) -> Texels>,

@@ -7,7 +7,7 @@ mod validate;
 
 pub use validate::{
     DEFAULT_MAX_SEARCH, DEFAULT_SHARPEN, DEFAULT_SHARPEN_FALLOFF, default_moment_bias,
-    exponent_limit, sat_exponent_limit,
+    default_soft_moment_bias, exponent_limit, sat_exponent_limit,
 };
 
 use std::path::{Path, PathBuf};

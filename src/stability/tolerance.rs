@@ -6,7 +6,7 @@ use std::f64::consts::PI;
 use super::check::U;
 use crate::cpu::Texels;
 use crate::cpu::light::LightSample;
-use crate::cpu::vis_msm::{biased_moments, intensity};
+use crate::cpu::vis_msm::{bias_for, branch_spread, dequantized, intensity};
 use crate::technique::{LightGpu, MSM_HAUSDORFF, MSM_QUANTIZED};
 
 /// First-order bound on the f32 error of the one-tailed Chebyshev bound
@@ -49,15 +49,17 @@ pub(crate) fn evsm(maps: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
     1e-5 + dp / (1.0 - f64::from(l.bleed))
 }
 
-/// MSM at `s`: Cholesky in f32 is backward stable, so the GPU computes the exact answer for
-/// moments off by a few dozen roundings. The tolerance is twice the largest change of the f64
-/// reference over 16 such perturbations (32·u relative per moment, ±8·u on the depth; with
+/// MSM at `s`: the kernel's solve is backward stable in the stored moments (their
+/// covariances are formed once, the bias added as non-negative terms), so the GPU computes
+/// the exact answer for moments off by a few dozen roundings. The tolerance is twice the
+/// largest change of the f64 reference over 16 such perturbations of the dequantized moments
+/// before their projection and bias (32·u relative per moment, ±8·u on the depth; with
 /// quantized storage also 8·u·Σ|q| absolute per moment, the f32 dequantization `q·M` with
 /// entries of `M` below 1), plus 1e-4 for the final rational expression, over `1 − bleed`.
 pub(crate) fn msm(maps: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
-    let b = biased_moments(maps, l, s);
-    let dequantized = if l.msm_flags & MSM_QUANTIZED != 0 {
-        let q = crate::cpu::mips::sample(maps, l, s);
+    let q = crate::cpu::mips::sample(maps, l, s);
+    let b = dequantized(&q, l);
+    let dequantize_error = if l.msm_flags & MSM_QUANTIZED != 0 {
         8.0 * U * q.iter().map(|v| v.abs()).sum::<f64>()
     } else {
         0.0
@@ -65,7 +67,7 @@ pub(crate) fn msm(maps: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
     let d = s.depth - f64::from(l.bias);
     let hausdorff = l.msm_flags & MSM_HAUSDORFF != 0;
     let vis = |b: [f64; 4], d: f64| {
-        let v = 1.0 - intensity(b, d, hausdorff).clamp(0.0, 1.0);
+        let v = 1.0 - intensity(&bias_for(b, l), d, hausdorff).clamp(0.0, 1.0);
         if v.is_nan() { 1.0 } else { v }
     };
     let base = vis(b, d);
@@ -74,11 +76,14 @@ pub(crate) fn msm(maps: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
     for k in 0..16u32 {
         let sign = |bit: u32| if k >> bit & 1 == 1 { 1.0 } else { -1.0 };
         let p: [f64; 4] = std::array::from_fn(|i| {
-            b[i] * (1.0 + sign(i as u32) * e) + sign(i as u32) * dequantized
+            b[i] * (1.0 + sign(i as u32) * e) + sign(i as u32) * dequantize_error
         });
         let dd = d + sign(k % 4) * 8.0 * U;
         worst = worst.max((vis(p, dd) - base).abs());
     }
+    // Where a root sits at 0 or 1, rounding picks Hamburger's or Hausdorff's formula.
+    let spread = branch_spread(&bias_for(b, l), d, hausdorff, 1e-3);
+    worst = worst.max(spread);
     (1e-4 + 2.0 * worst) / (1.0 - f64::from(l.bleed))
 }
 

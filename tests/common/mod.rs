@@ -220,22 +220,24 @@ pub fn robust(
     Some(v)
 }
 
-/// Tolerance of MSM visibility at `s`: Cholesky in f32 is backward stable, so the GPU computes
-/// the exact answer for moments off by a few dozen roundings; the tolerance is twice the
-/// largest change of the f64 reference over 16 such perturbations (relative 32·2⁻²⁴ per
-/// moment, ±8·2⁻²⁴ on the receiver depth), plus 1e-4 for the final rational expression.
+/// Tolerance of MSM visibility at `s`: the kernel's solve is backward stable in the stored
+/// moments (their covariances are formed once, the bias added as non-negative terms), so the
+/// GPU computes the exact answer for moments off by a few dozen roundings; the tolerance is
+/// twice the largest change of the f64 reference over 16 such perturbations of the
+/// (dequantized) moments before their projection and bias (relative 32·2⁻²⁴ per moment,
+/// ±8·2⁻²⁴ on the receiver depth), plus 1e-4 for the final rational expression.
 pub fn msm_tolerance(
     moments: &[shadowgraph::cpu::Texels],
     l: &shadowgraph::technique::LightGpu,
     s: &shadowgraph::cpu::light::LightSample,
 ) -> f64 {
-    use shadowgraph::cpu::vis_msm::{biased_moments, intensity};
+    use shadowgraph::cpu::vis_msm::{bias_for, branch_spread, dequantized, intensity};
     use shadowgraph::technique::MSM_HAUSDORFF;
-    let b = biased_moments(moments, l, s);
+    let b = dequantized(&shadowgraph::cpu::mips::sample(moments, l, s), l);
     let d = s.depth - f64::from(l.bias);
     let hausdorff = l.msm_flags & MSM_HAUSDORFF != 0;
     let vis = |b: [f64; 4], d: f64| {
-        let v = 1.0 - intensity(b, d, hausdorff).clamp(0.0, 1.0);
+        let v = 1.0 - intensity(&bias_for(b, l), d, hausdorff).clamp(0.0, 1.0);
         if v.is_nan() { 1.0 } else { v }
     };
     let base = vis(b, d);
@@ -247,6 +249,9 @@ pub fn msm_tolerance(
         let dd = d + sign(k % 4) * 8.0 * 2f64.powi(-24);
         worst = worst.max((vis(p, dd) - base).abs());
     }
+    // Where a root sits at 0 or 1, rounding picks Hamburger's or Hausdorff's formula.
+    let spread = branch_spread(&bias_for(b, l), d, hausdorff, 1e-3);
+    worst = worst.max(spread);
     let bleed = f64::from(l.bleed);
     (1e-4 + 2.0 * worst) / (1.0 - bleed)
 }
