@@ -23,8 +23,12 @@ pub(super) fn parse(path: &Path, text: &str) -> Result<Scene> {
     };
     let locations = Locations::of(text);
     let file: SceneFile = toml::from_str(text).map_err(|e| {
-        let key = e.span().and_then(|s| locations.key_at(&s));
-        ctx.err(e.span(), locate::rewrite(e.message(), key))
+        // A key missing from the top level comes with an empty span at 0: the whole file.
+        let whole =
+            e.message().starts_with("missing field") && e.span().is_none_or(|s| s.is_empty());
+        let span = e.span().filter(|_| !whole);
+        let key = span.as_ref().and_then(|s| locations.key_at(s));
+        ctx.err(span, locate::rewrite(e.message(), key))
     })?;
     let width = ctx.int("output.width", &file.output.width, 1, MAX_SIDE)?;
     let height = ctx.int("output.height", &file.output.height, 1, MAX_SIDE)?;
