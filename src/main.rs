@@ -33,7 +33,7 @@ enum Command {
         /// Print GPU time per node and for the shading pass.
         #[arg(long)]
         timings: bool,
-        /// Frames to render (timings are medians over them), 1 to 10000.
+        /// Frames to render (timings are medians over them), 1 to 1000.
         #[arg(long, default_value_t = 1, value_parser = repeat_range())]
         repeat: u32,
     },
@@ -64,7 +64,7 @@ enum Command {
         /// Square map sizes.
         #[arg(long, value_delimiter = ',', default_value = "512,1024,2048,4096")]
         sizes: Vec<u32>,
-        /// Timed repetitions per kernel and size (the median is reported), 1 to 10000.
+        /// Timed repetitions per kernel and size (the median is reported), 1 to 1000.
         #[arg(long, default_value_t = 10, value_parser = repeat_range())]
         repeat: u32,
         /// Instead: the shading pass's cost as the filter widens, PCF against summed-area
@@ -95,7 +95,7 @@ enum Command {
         /// Shadow-map side of the truth's samples (default max(2048, 2 × the light's map)).
         #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
         truth_resolution: Option<u32>,
-        /// Timed frames per configuration (the median is reported), 1 to 10000.
+        /// Timed frames per configuration (the median is reported), 1 to 1000.
         #[arg(long, default_value_t = 5, value_parser = repeat_range())]
         repeat: u32,
         /// Evaluate at this image size, WIDTHxHEIGHT (default: the scene's).

@@ -1,5 +1,5 @@
 //! The scene fuzzer (`tests/fuzz_support`) in `cargo test`: 3000 mutated scenes from a fixed
-//! seed, loaded and planned in-process, every 40th accepted one rendered at 16×12 on the GPU.
+//! seed, loaded and planned in-process, every 80th accepted one rendered at 16×12 on the GPU.
 //! No case may panic, print an error of more than one line or without its line, accept a
 //! non-finite number, or render NaN. `cargo run --release --example fuzz_scenes` runs millions.
 
@@ -14,7 +14,7 @@ fn three_thousand_mutated_scenes() {
         seed: 0x5eed,
         first: 0,
         threads: 2,
-        render_every: 40,
+        render_every: 80,
         dir: dir.clone(),
         progress: 0,
     };
@@ -36,6 +36,6 @@ fn three_thousand_mutated_scenes() {
     // The mutations must reach both sides and the renderer, or the fuzzer tests nothing.
     assert_eq!(s.cases, 3000);
     assert!(s.accepted > 300 && s.refused > 1000, "{s:?}");
-    assert!(s.rendered >= 8, "{s:?}");
+    assert!(s.rendered >= 4, "{s:?}");
     std::fs::remove_dir_all(&dir).ok();
 }
