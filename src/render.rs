@@ -140,11 +140,11 @@ pub fn check_limits(device: &wgpu::Device, scene: &Scene) -> Result<()> {
 }
 
 /// [`check_limits`] for a render with `opts` (read-backs of `aux` and `dump` count too), and
-/// `opts.repeat` at most [`MAX_REPEAT`].
+/// `opts.repeat` at most [`MAX_FRAMES`].
 pub fn check_render(device: &wgpu::Device, scene: &Scene, opts: &RenderOptions) -> Result<()> {
-    if opts.repeat > MAX_REPEAT {
+    if opts.repeat > MAX_FRAMES {
         return Err(Error::Invalid(format!(
-            "repeat = {} is more than {MAX_REPEAT} frames",
+            "repeat = {} is more than {MAX_FRAMES} frames",
             opts.repeat
         )));
     }
@@ -159,10 +159,14 @@ pub fn check_render(device: &wgpu::Device, scene: &Scene, opts: &RenderOptions) 
     )
 }
 
-/// Most frames one render may repeat. Timings keep one row per frame, and on lavapipe (Mesa
+/// Most frames a command's `--repeat` may ask for. Timings keep one row per frame, and on lavapipe (Mesa
 /// 22.3.6) every dispatch of the shading kernel keeps about 235 KB that the driver does not
 /// return (traced in the README), so 1000 frames bound that to about 240 MB.
 pub const MAX_REPEAT: u32 = 1000;
+
+/// Most frames one [`Renderer::render`] call may run: [`MAX_REPEAT`] timed frames and as many
+/// warm-up frames (`evaluate` and `bench` add theirs to the timed ones).
+pub const MAX_FRAMES: u32 = 2 * MAX_REPEAT;
 
 /// Checks that the device offers the features the lights' techniques need.
 pub fn check_features(device: &wgpu::Device, lights: &[Light]) -> Result<()> {

@@ -237,6 +237,24 @@ fn assert_finite_scene(s: &Scene, what: &str) {
             .is_finite(),
         "{what}: camera matrix"
     );
+    // What the shading computes in f32: squared distances from every vertex to the eye and to
+    // every light, and every vertex in every light's clip space.
+    for o in &s.objects {
+        for &v in &o.mesh.positions {
+            assert!(
+                (v - c.position).length_squared().is_finite(),
+                "{what}: eye distance"
+            );
+            for l in &s.lights {
+                let clip = l.projection() * l.view() * v.extend(1.0);
+                assert!(
+                    (v - l.position).length_squared().is_finite() && clip.is_finite(),
+                    "{what}: a vertex seen from the light at {}",
+                    l.position
+                );
+            }
+        }
+    }
 }
 
 /// An error message: one line, numbers printed short (no run of more than 20 digits).
@@ -265,8 +283,8 @@ fn full_scene_is_valid_and_finite() {
 #[test]
 fn every_number_is_checked_as_f32() {
     let extremes = [
-        "1e39", "-1e39", "1e300", "1e-50", "-1e-50", "5e-324", "3.5e38", "nan", "inf", "-inf", "0",
-        "-1",
+        "1e39", "-1e39", "1e300", "1e20", "-3e38", "1e-50", "-1e-50", "5e-324", "3.5e38", "nan",
+        "inf", "-inf", "0", "-1",
     ];
     let lines: Vec<&str> = FULL.lines().collect();
     let mut refused = 0;

@@ -311,6 +311,11 @@ fn check_scene(s: &Scene) -> Result<(), String> {
             ));
         }
     }
+    let lights: Vec<(glam::Vec3, glam::Mat4)> = s
+        .lights
+        .iter()
+        .map(|l| (l.position, l.projection() * l.view()))
+        .collect();
     for (i, o) in s.objects.iter().enumerate() {
         let m = &o.mesh;
         if !o.color.is_finite() || m.positions.iter().any(|p| !p.is_finite()) {
@@ -324,6 +329,21 @@ fn check_scene(s: &Scene) -> Result<(), String> {
             .find(|n| !(n.is_finite() && (n.length() - 1.0).abs() < 1e-3))
         {
             return Err(format!("accepted object[{i}] with normal {n}"));
+        }
+        // What the shading computes in f32: squared distances to the eye and the lights, and
+        // every vertex in every light's clip space.
+        for &v in &m.positions {
+            if !(v - s.camera.position).length_squared().is_finite() {
+                return Err(format!(
+                    "object[{i}]: a vertex's distance to the eye overflows"
+                ));
+            }
+            for (k, (p, clip_of)) in lights.iter().enumerate() {
+                let clip = *clip_of * v.extend(1.0);
+                if !((v - *p).length_squared().is_finite() && clip.is_finite()) {
+                    return Err(format!("object[{i}] seen from light[{k}] overflows"));
+                }
+            }
         }
     }
     Ok(())
@@ -343,6 +363,11 @@ fn render_check(
     }
     let mut guard = g.lock().unwrap_or_else(|e| e.into_inner());
     let (gpu, renderer) = &mut *guard;
+    // Every scene's technique mix compiles pipelines of its own: start afresh now and then so
+    // that millions of cases keep a bounded cache.
+    if renderer.executor.kernels.len() > 200 {
+        *renderer = Renderer::new(&gpu.device);
+    }
     let opts = RenderOptions {
         aux: true,
         repeat: 1,
