@@ -545,6 +545,15 @@ fn numbers_in_messages_print_short() {
         ("intensity = 1.5", "intensity = 1e300", "1e300"),
         ("near = 1.0", "near = 1e-300", "1e-300"),
         ("bias = 0.003", "bias = -1e200", "-1e200"),
+        // Integers past i64 (found by the fuzzer, which saw them printed in full).
+        ("terms = 6", "terms = 10000000000000000000000", "1e22"),
+        ("shape = \"box\"", "shape = -100000000000000000000", "-1e20"),
+        // A mesh path with a line break stays one line.
+        (
+            "shape = \"cylinder\"\nradius = 0.3\nheight = 1.2",
+            "shape = \"mesh\"\npath = \"x\\ny.obj\"",
+            "x\\ny.obj` not found",
+        ),
     ] {
         let shown = parse(&FULL.replacen(from, to, 1))
             .expect_err(to)

@@ -43,6 +43,21 @@ pub fn fmt_list(xs: &[f64]) -> String {
     format!("[{}]", parts.join(", "))
 }
 
+/// A path as messages show it: control characters escaped, so a message stays one line.
+pub fn shown_path(path: &Path) -> String {
+    path.display()
+        .to_string()
+        .chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
+}
+
 pub(super) struct Ctx<'a> {
     pub path: &'a Path,
     pub text: &'a str,

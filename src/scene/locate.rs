@@ -167,8 +167,9 @@ fn expected_name(expected: &str) -> String {
 }
 
 fn found_name(found: &str) -> String {
+    // serde quotes the number in backticks, sometimes with a suffix (`` `1e22` as i128 ``).
     let number = |s: &str| {
-        let s = s.trim_matches('`');
+        let s = s.split('`').find(|p| !p.is_empty()).unwrap_or(s);
         match s.parse::<f64>() {
             Ok(x) if s.len() > 20 => fmt_num(x),
             _ => s.to_string(),
@@ -179,7 +180,13 @@ fn found_name(found: &str) -> String {
     } else if let Some(n) = found.strip_prefix("floating point ") {
         format!("a decimal number ({})", number(n))
     } else if let Some(n) = found.strip_prefix("integer ") {
-        format!("an integer ({})", number(n))
+        let big = n.ends_with("as i128") || n.ends_with("as u128");
+        let what = if big {
+            "an integer too large"
+        } else {
+            "an integer"
+        };
+        format!("{what} ({})", number(n))
     } else if let Some(b) = found.strip_prefix("boolean ") {
         format!("a boolean ({})", b.trim_matches('`'))
     } else if found == "map" {

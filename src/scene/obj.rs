@@ -6,6 +6,7 @@ use std::path::Path;
 
 use glam::Vec3;
 
+use super::ctx::shown_path;
 use super::mesh::Mesh;
 
 /// Largest mesh file read: a scene's triangle cap (`object::MAX_TRIANGLES`, 4 Mi) written as
@@ -28,7 +29,7 @@ pub fn load_obj(path: &Path) -> Result<LoadedMesh, String> {
     let text = read_text(path)?;
     let body = text.strip_prefix('\u{feff}').unwrap_or(&text);
     check_lines(body)
-        .map_err(|(line, what)| format!("`{}` line {line}: {what}", path.display()))?;
+        .map_err(|(line, what)| format!("`{}` line {line}: {what}", shown_path(path)))?;
     let opts = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
@@ -37,7 +38,7 @@ pub fn load_obj(path: &Path) -> Result<LoadedMesh, String> {
     let (models, _) = tobj::load_obj_buf(&mut body.as_bytes(), &opts, |_| {
         Err(tobj::LoadError::OpenFileFailed)
     })
-    .map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
+    .map_err(|e| format!("cannot read `{}`: {e}", shown_path(path)))?;
     let mut mesh = Mesh::default();
     let mut given = Vec::new();
     for model in models {
@@ -61,10 +62,10 @@ pub fn load_obj(path: &Path) -> Result<LoadedMesh, String> {
         }));
     }
     if mesh.indices.is_empty() {
-        return Err(format!("`{}` has no triangles", path.display()));
+        return Err(format!("`{}` has no triangles", shown_path(path)));
     }
     if mesh.positions.iter().any(|p| !p.is_finite()) {
-        return Err(format!("`{}` has a non-finite vertex", path.display()));
+        return Err(format!("`{}` has a non-finite vertex", shown_path(path)));
     }
     let faces = mesh.face_normals();
     let mut repaired = 0;
@@ -87,7 +88,7 @@ pub fn load_obj(path: &Path) -> Result<LoadedMesh, String> {
 
 /// The file as text: at most [`MAX_MESH_BYTES`], a regular file, UTF-8.
 fn read_text(path: &Path) -> Result<String, String> {
-    let shown = path.display();
+    let shown = shown_path(path);
     let meta = std::fs::metadata(path).map_err(|e| match e.kind() {
         std::io::ErrorKind::NotFound => format!("mesh file `{shown}` not found"),
         _ => format!("cannot read `{shown}`: {e}"),
