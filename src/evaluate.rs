@@ -221,6 +221,7 @@ pub fn scene_for(path: &Path, opts: &EvaluateOptions) -> Result<Scene> {
 /// `report.md`, `report.csv`, `report.json`, `pareto.svg`, `grid.png` and `grid.txt` to
 /// `out`. Returns a short summary.
 pub fn run(gpu: &Gpu, scene_path: &Path, out: &Path, opts: &EvaluateOptions) -> Result<String> {
+    check_options(opts)?;
     let scene = scene_for(scene_path, opts)?;
     let configs = sweep(&scene, opts)?;
     let (report, images) = evaluate(gpu, &scene, &configs, opts)?;
@@ -241,6 +242,30 @@ pub fn run(gpu: &Gpu, scene_path: &Path, out: &Path, opts: &EvaluateOptions) -> 
         s.push_str(&format!("wrote {}\n", f.display()));
     }
     Ok(s)
+}
+
+/// The options' counts, named as the command line spells them: `--repeat` in
+/// 1..=[`crate::render::MAX_REPEAT`] (`--quick` uses 1), `--truth-resolution` and `--k` at
+/// least 1.
+pub fn check_options(opts: &EvaluateOptions) -> Result<()> {
+    let max = crate::render::MAX_REPEAT;
+    if !(1..=max).contains(&opts.repeat) {
+        return Err(Error::Invalid(format!(
+            "--repeat {} is outside 1..={max}",
+            opts.repeat
+        )));
+    }
+    if opts.truth_resolution == Some(0) {
+        return Err(Error::Invalid(
+            "--truth-resolution 0: the truth's shadow maps need at least 1 texel".into(),
+        ));
+    }
+    if opts.samples == Some(0) {
+        return Err(Error::Invalid(
+            "--k 0: the truth needs at least one emitter sample".into(),
+        ));
+    }
+    Ok(())
 }
 
 /// Renders every configuration of `configs` on `scene` and measures it (see the module docs).
@@ -322,7 +347,9 @@ pub fn evaluate(
                     .push(light0(&frame.visibility, truth.lights));
                 report.rows.push(row);
             }
-            Err(e @ (Error::MissingFeature { .. } | Error::Limit { .. })) => {
+            Err(
+                e @ (Error::MissingFeature { .. } | Error::Limit { .. } | Error::SceneLimit { .. }),
+            ) => {
                 log::warn!("{}: skipped: {e}", c.label);
                 report.skipped.push((c.label.clone(), e.to_string()));
             }

@@ -190,6 +190,14 @@ fn generated_key(name: &str, generated: Option<&str>) -> String {
     }
 }
 
+/// The error for a kernel without a bind group (a plan naming a kernel the executor cannot bind).
+fn no_layout(kernel: &str) -> Error {
+    Error::Pipeline {
+        kernel: kernel.to_string(),
+        message: "the kernel declares no bind group".into(),
+    }
+}
+
 /// The WGSL name of a storage texel format.
 pub fn wgsl_storage_format(f: wgpu::TextureFormat) -> Result<&'static str> {
     use wgpu::TextureFormat as T;
@@ -344,6 +352,8 @@ impl Executor {
         imports: &HashMap<String, wgpu::Texture>,
         mut timer: Option<&mut GpuTimer>,
     ) -> Result<Outputs> {
+        // A plan's fields are public: check what the indexing below relies on first.
+        plan.check()?;
         // Textures of the previous run go back to the pool, then each slot takes one.
         for (slot, t) in self.in_use.drain(..) {
             self.pool.free.entry(slot).or_default().push(t);
@@ -486,12 +496,16 @@ impl Executor {
                     }),
                 });
             }
+            let layout = kernel
+                .layouts
+                .first()
+                .ok_or_else(|| no_layout(&kernel.name))?;
             let bind_group = scoped(
                 device,
                 || {
                     device.create_bind_group(&wgpu::BindGroupDescriptor {
                         label: Some(&node.name),
-                        layout: &kernel.layouts[0],
+                        layout,
                         entries: &entries,
                     })
                 },
@@ -634,12 +648,16 @@ impl Executor {
                     }),
                 },
             ];
+            let layout = kernel
+                .layouts
+                .first()
+                .ok_or_else(|| no_layout(&kernel.name))?;
             let bg = scoped(
                 device,
                 || {
                     device.create_bind_group(&wgpu::BindGroupDescriptor {
                         label: Some(&node.name),
-                        layout: &kernel.layouts[0],
+                        layout,
                         entries: &entries,
                     })
                 },

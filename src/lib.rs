@@ -11,6 +11,7 @@ pub mod gpu;
 pub mod graph;
 pub mod io;
 pub mod kernels;
+pub mod limits;
 pub mod prefilter;
 pub mod render;
 pub mod sat;

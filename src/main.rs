@@ -33,8 +33,8 @@ enum Command {
         /// Print GPU time per pass (timestamps between passes) and each frame's wall time.
         #[arg(long)]
         timings: bool,
-        /// Frames to render (timings are medians over them).
-        #[arg(long, default_value_t = 1)]
+        /// Frames to render (timings are medians over them), 1 to 1000.
+        #[arg(long, default_value_t = 1, value_parser = repeat_range())]
         repeat: u32,
     },
     /// Print the kernels a scene will run (per light), its resources and peak memory.
@@ -65,8 +65,8 @@ enum Command {
         /// Square map sizes.
         #[arg(long, value_delimiter = ',', default_value = "512,1024,2048,4096")]
         sizes: Vec<u32>,
-        /// Timed repetitions per kernel and size (the median is reported).
-        #[arg(long, default_value_t = 10)]
+        /// Timed repetitions per kernel and size (the median is reported), 1 to 1000.
+        #[arg(long, default_value_t = 10, value_parser = repeat_range())]
         repeat: u32,
         /// Instead: the shading pass's cost as the filter widens, PCF against summed-area
         /// tables, at these odd widths (texels).
@@ -94,10 +94,10 @@ enum Command {
         #[arg(long)]
         k: Option<u32>,
         /// Shadow-map side of the truth's samples (default max(2048, 2 × the light's map)).
-        #[arg(long)]
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
         truth_resolution: Option<u32>,
-        /// Timed frames per configuration (the median is reported).
-        #[arg(long, default_value_t = 5)]
+        /// Timed frames per configuration (the median is reported), 1 to 1000.
+        #[arg(long, default_value_t = 5, value_parser = repeat_range())]
         repeat: u32,
         /// Evaluate at this image size, WIDTHxHEIGHT (default: the scene's).
         #[arg(long, value_parser = parse_size)]
@@ -113,6 +113,11 @@ enum Command {
         #[arg(long)]
         large: bool,
     },
+}
+
+/// `--repeat` of every command: 1 to `render::MAX_REPEAT` frames (each keeps a row of timings).
+fn repeat_range() -> clap::builder::RangedI64ValueParser<u32> {
+    clap::value_parser!(u32).range(1..=i64::from(shadowgraph::render::MAX_REPEAT))
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -131,7 +136,23 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
 
 fn main() {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
-    if let Err(e) = run(Args::parse()) {
+    let args = match Args::try_parse() {
+        Ok(args) => args,
+        // A usage error is one line and status 1, as every other error (`--help` prints all).
+        Err(e)
+            if e.use_stderr()
+                && e.kind() != clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand =>
+        {
+            let text = e.to_string();
+            eprintln!(
+                "{}",
+                text.lines().next().unwrap_or("error: invalid arguments")
+            );
+            std::process::exit(1);
+        }
+        Err(e) => e.exit(),
+    };
+    if let Err(e) = run(args) {
         eprintln!("error: {e:#}");
         std::process::exit(1);
     }

@@ -132,27 +132,41 @@ pub fn plan_lights(lights: &[Light]) -> Result<ScenePlan> {
     })
 }
 
-/// Checks sizes against the device's limits, naming the offending key.
+/// Checks `scene` against the device's limits, features and the memory budget
+/// ([`crate::limits::memory_budget`]) for a default render, before anything is created;
+/// errors name the scene key that would fix them, with its line.
 pub fn check_limits(device: &wgpu::Device, scene: &Scene) -> Result<()> {
-    let max = device.limits().max_texture_dimension_2d;
-    let check = |what: String, v: u32| {
-        if v > max {
-            Err(Error::Limit {
-                what,
-                requested: u64::from(v),
-                limit: u64::from(max),
-            })
-        } else {
-            Ok(())
-        }
-    };
-    check("output.width".into(), scene.width)?;
-    check("output.height".into(), scene.height)?;
-    for (i, l) in scene.lights.iter().enumerate() {
-        check(format!("light[{i}].shadow_map"), l.shadow_map)?;
-    }
-    check_features(device, &scene.lights)
+    check_render(device, scene, &RenderOptions::default())
 }
+
+/// [`check_limits`] for a render with `opts` (read-backs of `aux` and `dump` count too), and
+/// `opts.repeat` at most [`MAX_FRAMES`].
+pub fn check_render(device: &wgpu::Device, scene: &Scene, opts: &RenderOptions) -> Result<()> {
+    if opts.repeat > MAX_FRAMES {
+        return Err(Error::Invalid(format!(
+            "repeat = {} is more than {MAX_FRAMES} frames",
+            opts.repeat
+        )));
+    }
+    let sp = plan_lights(&scene.lights)?;
+    crate::limits::check_scene(
+        scene,
+        &sp,
+        &device.limits(),
+        device.features(),
+        opts,
+        crate::limits::memory_budget()?,
+    )
+}
+
+/// Most frames a command's `--repeat` may ask for. Timings keep one row per frame, and on lavapipe (Mesa
+/// 22.3.6) every dispatch of the shading kernel keeps about 235 KB that the driver does not
+/// return (traced in the README), so 1000 frames bound that to about 240 MB.
+pub const MAX_REPEAT: u32 = 1000;
+
+/// Most frames one [`Renderer::render`] call may run: [`MAX_REPEAT`] timed frames and as many
+/// warm-up frames (`evaluate` and `bench` add theirs to the timed ones).
+pub const MAX_FRAMES: u32 = 2 * MAX_REPEAT;
 
 /// Checks that the device offers the features the lights' techniques need.
 pub fn check_features(device: &wgpu::Device, lights: &[Light]) -> Result<()> {
@@ -503,7 +517,7 @@ impl Renderer {
         scene: &Scene,
         opts: RenderOptions,
     ) -> Result<Frame> {
-        check_limits(device, scene)?;
+        check_render(device, scene, &opts)?;
         let mut sp = plan_lights(&scene.lights)?;
         if opts.dump {
             // Everything is read back after the frame: no resource may share a texture.

@@ -500,10 +500,12 @@ fn shadow_map_past_the_device_limit_is_a_clear_error() {
     scene.lights[0].shadow_map = max + 1;
     let mut renderer = Renderer::new(&g.device);
     match renderer.render(&g.device, &g.queue, &scene, RenderOptions::default()) {
-        Err(e @ Error::Limit { .. }) => {
+        Err(e @ Error::SceneLimit { .. }) => {
             let m = e.to_string();
             assert!(
-                m.contains("light[0].shadow_map") && m.contains(&max.to_string()),
+                m.starts_with("limit.toml:")
+                    && m.contains("light[0].shadow_map")
+                    && m.contains(&max.to_string()),
                 "{m}"
             );
         }
