@@ -318,7 +318,7 @@ fn errors_are_plausible_and_recomputable() {
     // against the GPU's image of the same frame, and the truth-shaded image against the GPU's
     // image of `hard` (equal to the truth here), both within one 8-bit step (f32 vs f64
     // arithmetic before the rounding store).
-    assert_same_image("pcf shaded", &images.shaded[1], &frame.rgba);
+    common::evaluate::assert_same_image("pcf shaded", &images.shaded[1], &frame.rgba);
     s.lights[0].shadow.technique = Technique::Hard;
     let hard_frame = renderer
         .render(
@@ -332,62 +332,7 @@ fn errors_are_plausible_and_recomputable() {
             },
         )
         .expect("render");
-    assert_same_image("truth-shaded", &images.truth_shaded, &hard_frame.rgba);
-}
-
-/// `rgb` (RGB8) equals `rgba` (RGBA8) within one step per channel; prints how many differ.
-fn assert_same_image(what: &str, rgb: &[u8], rgba: &[u8]) {
-    assert_eq!(rgb.len() / 3, rgba.len() / 4, "{what}: size");
-    let mut off = 0;
-    for (i, (a, b)) in rgb.chunks(3).zip(rgba.chunks(4)).enumerate() {
-        for k in 0..3 {
-            let d = (i32::from(a[k]) - i32::from(b[k])).abs();
-            assert!(
-                d <= 1,
-                "{what}: pixel {i} channel {k}: {} vs GPU {}",
-                a[k],
-                b[k]
-            );
-            off += usize::from(d == 1);
-        }
-    }
-    eprintln!("{what}: {off} of {} channels one step off", rgb.len());
-}
-
-/// The region of each pixel by the definition, written out plainly (0 outside, 1 penumbra,
-/// 2 umbra, 3 lit): a relevant pixel is penumbra when its truth is strictly inside
-/// (0.02, 0.98) or when some pixel within 2 in x and y is an edge pixel (relevant, with a
-/// relevant 4-neighbour on the other side of 0.5).
-fn regions_direct(t: &[f32], m: &[bool], w: i64, h: i64) -> Vec<u8> {
-    let at = |x: i64, y: i64| (y * w + x) as usize;
-    let inside = |x: i64, y: i64| x >= 0 && y >= 0 && x < w && y < h;
-    let edge = |x: i64, y: i64| {
-        let i = at(x, y);
-        m[i] && [(1, 0), (-1, 0), (0, 1), (0, -1)].iter().any(|(dx, dy)| {
-            let (u, v) = (x + dx, y + dy);
-            inside(u, v) && m[at(u, v)] && ((t[i] >= 0.5) != (t[at(u, v)] >= 0.5))
-        })
-    };
-    let mut out = vec![0u8; (w * h) as usize];
-    for y in 0..h {
-        for x in 0..w {
-            let i = at(x, y);
-            if !m[i] {
-                continue;
-            }
-            let band = (-2..=2)
-                .any(|dy| (-2..=2).any(|dx| inside(x + dx, y + dy) && edge(x + dx, y + dy)));
-            let v = f64::from(t[i]);
-            out[i] = if band || (v > 0.02 && v < 0.98) {
-                1
-            } else if v <= 0.02 {
-                2
-            } else {
-                3
-            };
-        }
-    }
-    out
+    common::evaluate::assert_same_image("truth-shaded", &images.truth_shaded, &hard_frame.rgba);
 }
 
 /// On `sphere_on_plane` (one spot light of size 0.5, K = 16, 160×120), the penumbra, umbra and
@@ -430,7 +375,7 @@ fn region_and_flip_errors_match_direct_computation() {
         config("vsm", vsm),
     ];
     let (report, images) = evaluate(&g, &scene, &configs, &opts).expect("evaluate");
-    let regions = regions_direct(&images.truth, &images.mask, 160, 120);
+    let regions = common::evaluate::regions_direct(&images.truth, &images.mask, 160, 120);
     let count = |k: u8| regions.iter().filter(|&&r| r == k).count();
     assert_eq!(report.region_pixels, [count(1), count(2), count(3)]);
     assert!(

@@ -146,6 +146,35 @@ fn mean_cell(s: &ErrorStats) -> String {
     }
 }
 
+/// The Pareto fronts, one list per metric.
+fn fronts_text(report: &Report) -> String {
+    let mut s = String::new();
+    for m in Metric::ALL {
+        let f = front(&report.rows, m);
+        if f.is_empty() {
+            continue;
+        }
+        let _ = writeln!(
+            s,
+            "\nPareto front of total time vs {} (no configuration is both faster and more \
+             accurate):\n",
+            m.name()
+        );
+        for i in f {
+            let r = &report.rows[i];
+            let _ = writeln!(
+                s,
+                "- {}: {} ms, {} {:.4}",
+                r.label,
+                ms(r.total_ms),
+                m.name(),
+                m.value(r)
+            );
+        }
+    }
+    s
+}
+
 /// The report: what was measured and how, then one table row per configuration.
 pub fn markdown(report: &Report) -> String {
     let mut s = String::new();
@@ -219,29 +248,7 @@ pub fn markdown(report: &Report) -> String {
             r.flip.mean_abs,
         );
     }
-    for m in Metric::ALL {
-        let f = front(&report.rows, m);
-        if f.is_empty() {
-            continue;
-        }
-        let _ = writeln!(
-            s,
-            "\nPareto front of total time vs {} (no configuration is both faster and more \
-             accurate):\n",
-            m.name()
-        );
-        for i in f {
-            let r = &report.rows[i];
-            let _ = writeln!(
-                s,
-                "- {}: {} ms, {} {:.4}",
-                r.label,
-                ms(r.total_ms),
-                m.name(),
-                m.value(r)
-            );
-        }
-    }
+    s.push_str(&fronts_text(report));
     for (label, why) in &report.skipped {
         let _ = writeln!(s, "\nSkipped {label}: {why}");
     }

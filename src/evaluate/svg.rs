@@ -204,6 +204,61 @@ where
         .y_label_area_size(70)
         .build_cartesian_2d(x, y)
         .map_err(plot_error)?;
+    axes(&mut chart, metric)?;
+    let rows = &report.rows;
+    let f = front(rows, metric);
+    // The front as a staircase (each step holds the best error until the next improvement),
+    // every configuration's point, a ring around each front point.
+    let stair: Vec<(f64, f64)> = f
+        .iter()
+        .enumerate()
+        .flat_map(|(k, &i)| {
+            let t = rows[i].total_ms.unwrap_or(0.0);
+            let before = (k > 0).then(|| (t, metric.value(&rows[f[k - 1]])));
+            before.into_iter().chain([(t, metric.value(&rows[i]))])
+        })
+        .collect();
+    chart
+        .draw_series(LineSeries::new(stair, RGBColor(0x99, 0, 0).stroke_width(2)))
+        .map_err(plot_error)?;
+    let dots = pts
+        .iter()
+        .map(|&(i, t, e)| Circle::new((t, e), 4, colour(&rows[i].technique).mix(0.85).filled()));
+    chart.draw_series(dots).map_err(plot_error)?;
+    let rings = f.iter().filter_map(|&i| {
+        let at = (rows[i].total_ms?, metric.value(&rows[i]));
+        Some(Circle::new(at, 7, BLACK.stroke_width(2)))
+    });
+    chart.draw_series(rings).map_err(plot_error)?;
+    // Pixel positions relative to `area` (the chart's are the backend's).
+    let base = area.get_base_pixel();
+    let at = |t: f64, e: f64| {
+        let (x, y) = chart.backend_coord(&(t, e));
+        (x - base.0, y - base.1)
+    };
+    let points: Vec<(i32, i32)> = pts.iter().map(|&(_, t, e)| at(t, e)).collect();
+    let labelled: Vec<((i32, i32), String)> = pts
+        .iter()
+        .filter(|p| f.contains(&p.0))
+        .map(|&(i, t, e)| (at(t, e), rows[i].label.clone()))
+        .collect();
+    let (xs, ys) = chart.plotting_area().get_pixel_range();
+    let bounds = (
+        xs.start - base.0,
+        ys.start - base.1,
+        xs.end - base.0,
+        ys.end - base.1,
+    );
+    draw_labels(&area, &labelled, &points, bounds)?;
+    draw_legend(&legend, report)
+}
+
+/// The grid, the ticks and the axes' names.
+fn axes<X, Y>(chart: &mut ChartContext<SVGBackend, Cartesian2d<X, Y>>, metric: Metric) -> Result<()>
+where
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
     chart
         .configure_mesh()
         .x_desc("total GPU time, ms (log scale): shadow raster + kernels + shading")
@@ -216,60 +271,17 @@ where
         .label_style(("sans-serif", 14))
         .axis_desc_style(("sans-serif", 15))
         .draw()
-        .map_err(plot_error)?;
-    let rows = &report.rows;
-    let f = front(rows, metric);
-    // The front as a staircase: each step holds the best error until the next faster-to-slower
-    // improvement.
-    let mut stair = Vec::new();
-    for (k, &i) in f.iter().enumerate() {
-        let (t, e) = (rows[i].total_ms.unwrap_or(0.0), metric.value(&rows[i]));
-        if k > 0 {
-            stair.push((t, metric.value(&rows[f[k - 1]])));
-        }
-        stair.push((t, e));
-    }
-    chart
-        .draw_series(LineSeries::new(stair, RGBColor(0x99, 0, 0).stroke_width(2)))
-        .map_err(plot_error)?;
-    chart
-        .draw_series(pts.iter().map(|&(i, t, e)| {
-            let c = colour(&rows[i].technique);
-            Circle::new((t, e), 4, c.mix(0.85).filled())
-        }))
-        .map_err(plot_error)?;
-    chart
-        .draw_series(f.iter().filter_map(|&i| {
-            let t = rows[i].total_ms?;
-            Some(Circle::new(
-                (t, metric.value(&rows[i])),
-                7,
-                BLACK.stroke_width(2),
-            ))
-        }))
-        .map_err(plot_error)?;
-    // Pixel positions relative to `area` (the chart's are the backend's).
-    let base = area.get_base_pixel();
-    let at = |t: f64, e: f64| {
-        let (x, y) = chart.backend_coord(&(t, e));
-        (x - base.0, y - base.1)
-    };
-    let points: Vec<(i32, i32)> = pts.iter().map(|&(_, t, e)| at(t, e)).collect();
-    let labelled: Vec<((i32, i32), String)> = f
-        .iter()
-        .filter_map(|&i| {
-            let t = rows[i].total_ms?;
-            Some((at(t, metric.value(&rows[i])), rows[i].label.clone()))
-        })
-        .collect();
-    let (x_px, y_px) = chart.plotting_area().get_pixel_range();
-    let bounds = (
-        x_px.start - base.0,
-        y_px.start - base.1,
-        x_px.end - base.0,
-        y_px.end - base.1,
-    );
-    for l in place_labels(&labelled, &points, bounds) {
+        .map_err(plot_error)
+}
+
+/// The front's labels, placed by [`place_labels`], with their leader lines.
+fn draw_labels(
+    area: &DrawingArea<SVGBackend, Shift>,
+    labelled: &[((i32, i32), String)],
+    points: &[(i32, i32)],
+    bounds: Rect,
+) -> Result<()> {
+    for l in place_labels(labelled, points, bounds) {
         if let Some(anchor) = l.leader {
             area.draw(&PathElement::new(
                 vec![anchor, l.line_end],
@@ -281,7 +293,7 @@ where
         area.draw(&Text::new(l.text, (l.x, l.y), style))
             .map_err(plot_error)?;
     }
-    draw_legend(&legend, report)
+    Ok(())
 }
 
 /// One technique per line, in the order they first appear.
