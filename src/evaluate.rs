@@ -37,7 +37,7 @@ mod sweep;
 
 pub use flip::{Shader, flip_map, flip_stats, to_unorm8};
 pub use stats::{EDGE_BAND, ErrorStats, PENUMBRA_HIGH, PENUMBRA_LOW, Region, Regions};
-pub use svg::{Metric, front};
+pub use svg::{Metric, front, pareto};
 use sweep::storage_name;
 pub use sweep::{Config, FILTERS, FilterOfWidth, TECHNIQUES, sweep};
 

@@ -14,8 +14,8 @@ use super::svg::{Metric, colour, front};
 use super::{ErrorStats, Images, Report, Row};
 use crate::error::Result;
 
-/// Crops are shown at least this many CSS pixels wide.
-const CROP_PX: usize = 168;
+/// Crops are shown about this many CSS pixels wide (an integer zoom: square pixels).
+const CROP_PX: usize = 150;
 
 const STYLE: &str = "body{font:14px/1.45 sans-serif;margin:24px;color:#222;max-width:1500px}\
 h1{font-size:22px}h2{font-size:18px;margin-top:32px}\
@@ -30,6 +30,9 @@ tr.front td{background:#fff4e0}.swatch{display:inline-block;width:10px;height:10
 border-radius:5px;margin-right:5px}\
 .plot img{max-width:100%;border:1px solid #ddd;margin:6px 0}\
 .crops{display:flex;flex-wrap:wrap;gap:10px}\
+.croprow{display:flex;gap:8px;overflow-x:auto;padding-bottom:6px}.croprow figure{flex:none}\
+.croprow figure:first-child{position:sticky;left:0;background:#fff;z-index:1;\
+padding-right:6px;border-right:1px solid #ccc}\
 figure{margin:0;font-size:11.5px;text-align:center}\
 figure img{display:block;image-rendering:pixelated;margin-bottom:2px}\
 figcaption{max-width:180px;overflow-wrap:anywhere}.note{color:#555}";
@@ -50,6 +53,18 @@ fn escape(s: &str) -> String {
         .replace('<', "&lt;")
         .replace('>', "&gt;")
         .replace('"', "&quot;")
+}
+
+/// Markdown's `*word*` as `<i>word</i>` (the text is shared with report.md).
+fn emphasis(s: &str) -> String {
+    s.split('*')
+        .enumerate()
+        .map(|(k, part)| match (k % 2, k) {
+            (1, _) => format!("<i>{part}"),
+            (0, 0) => part.to_string(),
+            _ => format!("</i>{part}"),
+        })
+        .collect()
 }
 
 fn data_uri(mime: &str, bytes: &[u8]) -> String {
@@ -98,7 +113,7 @@ pub fn html(report: &Report, images: &Images, plots: &[(Metric, String)]) -> Res
         } else {
             ""
         },
-        escape(&region_text(report))
+        emphasis(&escape(&region_text(report)))
     );
     s.push_str("<h2>Time against error: the Pareto fronts</h2>\n");
     for (m, svg) in plots {
@@ -289,10 +304,10 @@ fn crop_row(
     regions: &[u8],
 ) -> Result<()> {
     let w = images.width as usize;
-    let scale = CROP_PX.div_ceil(c.side);
+    let scale = (CROP_PX as f64 / c.side as f64).round().max(1.0) as usize;
     let _ = writeln!(
         s,
-        "<h3>Crop {} at ({}, {})</h3>\n<div class=\"crops\">",
+        "<h3>Crop {} at ({}, {})</h3>\n<div class=\"croprow\">",
         k + 1,
         c.x,
         c.y

@@ -157,23 +157,43 @@ pub fn pareto(report: &Report, metric: Metric) -> Result<String> {
         } else {
             let (t0, t1) = span(pts.iter().map(|p| p.1));
             let (e0, e1) = span(pts.iter().map(|p| p.2));
-            let x = (t0 / 1.3..t1 * 1.3).log_scale();
+            let (t0, t1) = (t0 / 1.3, t1 * 1.3);
+            let (bold, light) = log_ticks(t0, t1);
+            let x = (t0..t1)
+                .log_scale()
+                .with_key_points(bold)
+                .with_light_points(light);
             if e0 > 0.0 && e1 / e0 >= 10.0 {
-                draw(
-                    &root,
-                    report,
-                    metric,
-                    &pts,
-                    x,
-                    (e0 / 1.5..e1 * 1.5).log_scale(),
-                )?;
+                let (e0, e1) = (e0 / 1.5, e1 * 1.5);
+                let (bold, light) = log_ticks(e0, e1);
+                let y = (e0..e1)
+                    .log_scale()
+                    .with_key_points(bold)
+                    .with_light_points(light);
+                draw(&root, report, metric, &pts, x, y)?;
             } else {
+                // plotters' own linear ticks are 1-2-5 steps already.
                 draw(&root, report, metric, &pts, x, 0.0..(e1 * 1.1).max(1e-4))?;
             }
         }
         root.present().map_err(plot_error)?;
     }
     Ok(svg)
+}
+
+/// Ticks of a log axis over [lo, hi]: labelled at 1, 2 and 5 times each power of ten (every
+/// integer multiple when that gives fewer than three), grid lines at every integer multiple.
+fn log_ticks(lo: f64, hi: f64) -> (Vec<f64>, Vec<f64>) {
+    let multiples = |ms: &[f64]| -> Vec<f64> {
+        let (a, b) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+        (a..=b)
+            .flat_map(|k| ms.iter().map(move |m| m * 10f64.powi(k)))
+            .filter(|v| (lo..=hi).contains(v))
+            .collect()
+    };
+    let all = multiples(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]);
+    let bold = multiples(&[1.0, 2.0, 5.0]);
+    (if bold.len() >= 3 { bold } else { all.clone() }, all)
 }
 
 fn span(v: impl Iterator<Item = f64>) -> (f64, f64) {
@@ -420,5 +440,36 @@ fn tick(v: f64) -> String {
         s.trim_end_matches('0').trim_end_matches('.').to_string()
     } else {
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Eight labels on points crowded into a few pixels, in a plot 600×400: every label inside
+    /// the bounds and no two labels' boxes overlapping.
+    #[test]
+    fn crowded_labels_do_not_collide() {
+        let labels: Vec<((i32, i32), String)> = (0..8)
+            .map(|k| ((300 + 3 * k, 200 - 2 * k), format!("vsm f32 blur{k} 1024")))
+            .collect();
+        let points: Vec<(i32, i32)> = labels.iter().map(|l| l.0).collect();
+        let bounds = (0, 0, 600, 400);
+        let placed = place_labels(&labels, &points, bounds);
+        assert_eq!(placed.len(), labels.len());
+        let rects: Vec<Rect> = placed
+            .iter()
+            .map(|l| {
+                let (w, h) = label_size(&l.text);
+                (l.x, l.y, l.x + w, l.y + h)
+            })
+            .collect();
+        for (i, a) in rects.iter().enumerate() {
+            assert!(a.0 >= 0 && a.1 >= 0 && a.2 <= 600 && a.3 <= 400, "{a:?}");
+            for b in &rects[i + 1..] {
+                assert!(!overlaps(*a, *b), "{a:?} overlaps {b:?}");
+            }
+        }
     }
 }
