@@ -407,7 +407,7 @@ pub fn place_labels(
                     .iter()
                     .filter(|&&(qx, qy)| overlaps((qx - 4, qy - 4, qx + 4, qy + 4), rect))
                     .count() as i64;
-                let cost = 1000 * hits_label + 10 * hits_point + ring as i64;
+                let cost = 1000 * hits_label + 4 * hits_point + 15 * ring as i64;
                 if best.is_none_or(|b| cost < b.0) {
                     best = Some((cost, rect, ring > 0));
                 }
