@@ -74,7 +74,8 @@ enum Command {
         lookup: Option<Vec<u32>>,
     },
     /// Sweep techniques and their accuracy knobs, time each on the GPU and measure its error
-    /// against ground truth: report.md/.csv/.json, pareto.svg, grid.png (+ grid.txt).
+    /// against ground truth: report.html/.md/.csv/.json, pareto{,_penumbra,_flip}.svg, grid.png
+    /// (+ grid.txt).
     Evaluate {
         /// Scene file (TOML).
         scene: PathBuf,

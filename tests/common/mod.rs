@@ -1,6 +1,7 @@
 //! Helpers shared by the GPU tests.
 #![allow(dead_code, reason = "each test binary uses a subset")]
 
+pub mod evaluate;
 pub mod soft;
 pub mod soft_maps;
 
