@@ -412,6 +412,23 @@ fn cases() -> Vec<Case> {
             edit: |d, _| prim(d)["indices"] = json!(7),
             expect: &["invalid glTF", "indices"],
         },
+        // gltf-json 1.4.1 indexes `accessors` with POSITION before checking it (found by
+        // `examples/fuzz_scenes.rs`: a panic).
+        Case {
+            name: "dangling POSITION",
+            edit: |d, _| prim(d)["attributes"]["POSITION"] = json!(9),
+            expect: &[
+                "`meshes[0].primitives[0].attributes[\"POSITION\"]`",
+                "refers to accessor 9, but the file has 3 accessors",
+            ],
+        },
+        Case {
+            name: "no accessors",
+            edit: |d, _| {
+                d.as_object_mut().unwrap().remove("accessors");
+            },
+            expect: &["refers to accessor 0, but the file has 0 accessors"],
+        },
         Case {
             name: "no scene",
             edit: |d, _| {

@@ -34,7 +34,7 @@ pub fn load_gltf(path: &Path) -> Result<LoadedMesh, String> {
     let shown = shown_path(path);
     let bytes = read_file(path, "mesh file")?;
     check_glb_header(&bytes).map_err(|e| format!("`{shown}`: {e}"))?;
-    let doc = gltf::Gltf::from_slice(&bytes).map_err(|e| format!("`{shown}`: {}", brief(&e)))?;
+    let doc = parse(&bytes).map_err(|e| format!("`{shown}`: {e}"))?;
     let dir = path.parent().unwrap_or(Path::new("."));
     let buffers = load_buffers(&doc, dir).map_err(|e| format!("`{shown}`: {e}"))?;
     let (mesh, given) = flatten(&doc, &buffers).map_err(|e| format!("`{shown}`: {e}"))?;
@@ -42,6 +42,35 @@ pub fn load_gltf(path: &Path) -> Result<LoadedMesh, String> {
         return Err(format!("`{shown}` has no triangles in its scene"));
     }
     Ok(with_normals(mesh, &given))
+}
+
+/// The document, validated by the crate once the references its validation itself follows
+/// unchecked are known to exist: gltf-json 1.4.1 indexes `accessors` with a primitive's
+/// `POSITION` before it checks that index, and panics on a dangling one.
+fn parse(bytes: &[u8]) -> Result<gltf::Gltf, String> {
+    let raw = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| brief(&e))?;
+    let json = raw.document.into_json();
+    let positions = gltf::json::validation::Checked::Valid(gltf::Semantic::Positions);
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            match primitive.attributes.get(&positions) {
+                Some(a) if a.value() >= json.accessors.len() => {
+                    return Err(format!(
+                        "invalid glTF: `meshes[{m}].primitives[{p}].attributes[\"POSITION\"]` \
+                         refers to accessor {}, but the file has {} accessors",
+                        a.value(),
+                        json.accessors.len()
+                    ));
+                }
+                _ => {}
+            }
+        }
+    }
+    let document = gltf::Document::from_json(json).map_err(|e| brief(&e))?;
+    Ok(gltf::Gltf {
+        document,
+        blob: raw.blob,
+    })
 }
 
 /// A GLB's declared length must cover its 12-byte header (the `gltf` crate subtracts before it
