@@ -28,7 +28,6 @@ mod non_finite;
 mod planar;
 mod sat_windows;
 mod stages;
-mod tolerance;
 
 use std::fmt::Write;
 use std::time::Instant;
