@@ -9,7 +9,7 @@ use wgpu::util::DeviceExt;
 
 use crate::error::{Error, Result};
 use crate::gpu::{read_buffer, scoped};
-use crate::graph::{Dispatch, Plan, Slot, block_count};
+use crate::graph::{Dispatch, Plan, Slot};
 use crate::kernels::{self, Reflection};
 
 /// A compute pipeline with the layouts reflected from its WGSL.
@@ -581,33 +581,14 @@ impl Executor {
                     message: format!("binding node `{}`: {message}", node.name),
                 },
             )?;
-            let groups = match &node.dispatch {
-                Dispatch::Groups(g) => *g,
-                // Recorded by `record_mip_chain` before this point.
-                Dispatch::MipChain => continue,
-                Dispatch::Texels(r) => {
-                    let t = &textures[r];
-                    kernel.groups_for(t.width(), t.height())
-                }
-                Dispatch::Blocks { of, x, y } => {
-                    let t = textures.get(of).ok_or_else(|| {
-                        Error::Invalid(format!(
-                            "node `{}` dispatches over `{of}`, which is not in the plan",
-                            node.name
-                        ))
-                    })?;
-                    [block_count(t.width(), *x), block_count(t.height(), *y), 1]
-                }
-                Dispatch::Axis { of, axis } => {
-                    let t = &textures[of];
-                    let (along, across) = if *axis == 0 {
-                        (t.width(), t.height())
-                    } else {
-                        (t.height(), t.width())
-                    };
-                    [kernel.groups_for(along, 1)[0], across, 1]
-                }
-            };
+            let wg = kernel.reflection.workgroup_size.unwrap_or([1, 1, 1]);
+            let size = |r: &str| textures.get(r).map(|t| (t.width(), t.height()));
+            let groups = node.dispatch.groups(size, wg).ok_or_else(|| {
+                Error::Invalid(format!(
+                    "node `{}` dispatches over a resource that is not in the plan",
+                    node.name
+                ))
+            })?;
             let timestamp_writes = timer
                 .as_deref_mut()
                 .and_then(|t| t.compute_pass(&node.name));

@@ -81,9 +81,51 @@ pub enum Dispatch {
         /// 0 for rows (horizontal), 1 for columns (vertical).
         axis: u32,
     },
+    /// One invocation per column and one per row of this resource:
+    /// `[⌈max(width, height) / per_group⌉, 2, 1]`, workgroup row 0 over the columns and row 1
+    /// over the rows (work serial along each line, e.g. a summed-area table's carries).
+    Lines {
+        /// The resource whose size counts.
+        of: String,
+        /// Lines per workgroup (the kernel's workgroup size).
+        per_group: u32,
+    },
     /// A mip-chain node: the executor records one dispatch per two levels of the output
     /// (its `dst` resource), each reading the level before (the `src` input for the first).
     MipChain,
+}
+
+impl Dispatch {
+    /// Workgroup counts of a dispatch of a kernel whose workgroup is `workgroup`, with
+    /// `size(resource)` the planned `(width, height)` of a resource; `None` when a resource it
+    /// counts is unknown, or for [`Dispatch::MipChain`] (the executor records those).
+    pub fn groups(
+        &self,
+        size: impl Fn(&str) -> Option<(u32, u32)>,
+        workgroup: [u32; 3],
+    ) -> Option<[u32; 3]> {
+        Some(match self {
+            Self::Groups(g) => *g,
+            Self::Texels(r) => {
+                let (w, h) = size(r)?;
+                [w.div_ceil(workgroup[0]), h.div_ceil(workgroup[1]), 1]
+            }
+            Self::Blocks { of, x, y } => {
+                let (w, h) = size(of)?;
+                [block_count(w, *x), block_count(h, *y), 1]
+            }
+            Self::Axis { of, axis } => {
+                let (w, h) = size(of)?;
+                let (along, across) = if *axis == 0 { (w, h) } else { (h, w) };
+                [along.div_ceil(workgroup[0]), across, 1]
+            }
+            Self::Lines { of, per_group } => {
+                let (w, h) = size(of)?;
+                [block_count(w.max(h), *per_group), 2, 1]
+            }
+            Self::MipChain => return None,
+        })
+    }
 }
 
 /// One kernel invocation in the graph.

@@ -157,23 +157,8 @@ fn dispatch_groups(plan: &Plan, node: &crate::graph::Node, wg: [u32; 3]) -> [u32
                 1,
             ]
         }
-        Dispatch::Groups(g) => *g,
-        Dispatch::Blocks { of, x, y } => {
-            let (w, h) = size(of);
-            [
-                crate::graph::block_count(w, *x),
-                crate::graph::block_count(h, *y),
-                1,
-            ]
-        }
-        Dispatch::Texels(r) => {
-            let (w, h) = size(r);
-            [w.div_ceil(wg[0]), h.div_ceil(wg[1]), 1]
-        }
-        Dispatch::Axis { of, axis } => {
-            let (w, h) = size(of);
-            let (along, across) = if *axis == 0 { (w, h) } else { (h, w) };
-            [along.div_ceil(wg[0]), across, 1]
-        }
+        other => other
+            .groups(|r| plan.resource(r).map(|p| (p.width, p.height)), wg)
+            .unwrap_or([1, 1, 1]),
     }
 }
