@@ -608,10 +608,10 @@ impl Executor {
         })
     }
 
-    /// Records a [`Dispatch::MipChain`] node: one compute pass, one dispatch per two levels of
-    /// the output (`kernels/mips.wgsl`), each reading the level above through a one-level view.
-    /// With an odd level count the last dispatch redoes the level before the last (identical
-    /// values) so that every dispatch writes two levels.
+    /// Records a [`Dispatch::MipChain`] node: one compute pass with the dispatches of
+    /// [`crate::filter::mip_dispatches`] (`kernels/mips.wgsl`, up to six levels each), each
+    /// reading one level (the `src` input for the first, which also stores it as level 0)
+    /// through a one-level view and writing the levels after it through one-level views.
     fn record_mip_chain(
         &mut self,
         device: &wgpu::Device,
@@ -620,6 +620,7 @@ impl Executor {
         textures: &HashMap<String, wgpu::Texture>,
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
+        use crate::filter::{MIP_LEVELS_PER_DISPATCH, MipParams, mip_dispatches};
         let pipeline_err = |message: String| Error::Pipeline {
             kernel: node.kernel.clone(),
             message: format!("node `{}`: {message}", node.name),
@@ -632,34 +633,34 @@ impl Executor {
         };
         let src = slot(&node.inputs, "src")?;
         let dst = slot(&node.outputs, "dst")?;
-        let formats = [
-            ("dst_a".to_string(), dst.format()),
-            ("dst_b".to_string(), dst.format()),
-        ];
+        let dst_bindings: Vec<String> = (0..=MIP_LEVELS_PER_DISPATCH)
+            .map(|k| format!("dst{k}"))
+            .collect();
+        let formats: Vec<(String, wgpu::TextureFormat)> = dst_bindings
+            .iter()
+            .map(|b| (b.clone(), dst.format()))
+            .collect();
         let kernel = self
             .kernels
             .get_specialized(device, &node.kernel, &formats)?;
-        let levels = dst.mip_level_count();
-        let size = |l: u32| [(dst.width() >> l).max(1), (dst.height() >> l).max(1)];
-        // (read level, first written level); read level None = the `src` input.
-        let mut passes: Vec<(Option<u32>, u32)> = vec![(None, 0)];
-        let mut next = 2;
-        while next < levels {
-            let a = next.min(levels - 2);
-            passes.push((Some(a - 1), a));
-            next = a + 2;
-        }
-        let base: crate::filter::MipParams = bytemuck::try_pod_read_unaligned(
-            &node.params[..std::mem::size_of::<crate::filter::MipParams>()],
+        let base: MipParams = bytemuck::try_pod_read_unaligned(
+            node.params
+                .get(..std::mem::size_of::<MipParams>())
+                .ok_or_else(|| pipeline_err("params are not a MipParams".into()))?,
         )
         .map_err(|e| pipeline_err(format!("bad params: {e}")))?;
+        let dispatches = mip_dispatches(dst.width(), dst.height());
         let align = u64::from(device.limits().min_uniform_buffer_offset_alignment).max(32);
-        let mut bytes = vec![0u8; passes.len() * align as usize];
-        for (k, (read, a)) in passes.iter().enumerate() {
-            let p = crate::filter::MipParams {
-                src_size: read.map_or([src.width(), src.height()], size),
-                a_size: size(*a),
-                b_size: if a + 1 < levels { size(a + 1) } else { [0, 0] },
+        let mut bytes = vec![0u8; dispatches.len() * align as usize];
+        for (k, &(first, count)) in dispatches.iter().enumerate() {
+            let odd = |n: u32| n > 1 && n % 2 == 1;
+            let general = odd((dst.width() >> first).max(1)) || odd((dst.height() >> first).max(1));
+            let p = MipParams {
+                base: [dst.width(), dst.height()],
+                first,
+                count,
+                copy: u32::from(first == 0),
+                general: u32::from(general),
                 ..base
             };
             let at = k * align as usize;
@@ -684,44 +685,44 @@ impl Executor {
                 .map(|b| b.binding)
                 .ok_or_else(|| pipeline_err(format!("kernel has no binding `{name}`")))
         };
-        let (b_src, b_a, b_b, b_params) = (
-            binding("src")?,
-            binding("dst_a")?,
-            binding("dst_b")?,
-            binding("params")?,
-        );
         let mut groups = Vec::new();
-        for (k, (read, a)) in passes.iter().enumerate() {
-            let src_view = match read {
-                None => level_view(&src, 0),
-                Some(l) => level_view(&dst, *l),
+        for (k, &(first, count)) in dispatches.iter().enumerate() {
+            let src_view = if first == 0 {
+                level_view(&src, 0)
+            } else {
+                level_view(&dst, first)
             };
-            let b_level = if a + 1 < levels { a + 1 } else { *a };
-            let (va, vb) = (level_view(&dst, *a), level_view(&dst, b_level));
-            let entries = [
-                wgpu::BindGroupEntry {
-                    binding: b_src,
-                    resource: wgpu::BindingResource::TextureView(&src_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: b_a,
-                    resource: wgpu::BindingResource::TextureView(&va),
-                },
-                wgpu::BindGroupEntry {
-                    binding: b_b,
-                    resource: wgpu::BindingResource::TextureView(&vb),
-                },
-                wgpu::BindGroupEntry {
-                    binding: b_params,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &params,
-                        offset: k as u64 * align,
-                        size: wgpu::BufferSize::new(
-                            std::mem::size_of::<crate::filter::MipParams>() as u64,
-                        ),
-                    }),
-                },
-            ];
+            // dst0 is level 0 in the first dispatch; unused bindings repeat the last level
+            // written (never stored to: the kernel stores only levels 0 … count).
+            let last = first + count;
+            let views: Vec<wgpu::TextureView> = (0..=MIP_LEVELS_PER_DISPATCH)
+                .map(|j| {
+                    let level = match j {
+                        0 if first == 0 => 0,
+                        j if j >= 1 && j <= count => first + j,
+                        _ => last,
+                    };
+                    level_view(&dst, level)
+                })
+                .collect();
+            let mut entries = vec![wgpu::BindGroupEntry {
+                binding: binding("src")?,
+                resource: wgpu::BindingResource::TextureView(&src_view),
+            }];
+            for (name, view) in dst_bindings.iter().zip(&views) {
+                entries.push(wgpu::BindGroupEntry {
+                    binding: binding(name)?,
+                    resource: wgpu::BindingResource::TextureView(view),
+                });
+            }
+            entries.push(wgpu::BindGroupEntry {
+                binding: binding("params")?,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &params,
+                    offset: k as u64 * align,
+                    size: wgpu::BufferSize::new(std::mem::size_of::<MipParams>() as u64),
+                }),
+            });
             let bg = scoped(
                 device,
                 || {
@@ -731,10 +732,14 @@ impl Executor {
                         entries: &entries,
                     })
                 },
-                |message| pipeline_err(format!("binding level {a}: {message}")),
+                |message| pipeline_err(format!("binding level {first}: {message}")),
             )?;
-            let out = size(if a + 1 < levels { a + 1 } else { *a });
-            groups.push((bg, kernel.groups_for(out[0], out[1])));
+            let next = [
+                (dst.width() >> (first + 1)).max(1),
+                (dst.height() >> (first + 1)).max(1),
+            ];
+            let tile = crate::filter::MIP_TILE / 2;
+            groups.push((bg, [next[0].div_ceil(tile), next[1].div_ceil(tile)]));
         }
         let timestamp_writes = timer.and_then(|t| t.compute_pass(&node.name));
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {

@@ -533,6 +533,10 @@ fn mip_chain_matches_reference_and_ends_at_the_mean() {
         (1, 57, BlurMode::Linear),
         (1, 1, BlurMode::Linear),
         (130, 7, BlurMode::LogSumExp),
+        // Several workgroups through six levels in one dispatch, then the tail.
+        (512, 512, BlurMode::Linear),
+        (256, 256, BlurMode::LogSumExp),
+        (384, 160, BlurMode::Linear),
     ] {
         let lin = random_linear(&mut rng, w as usize, h as usize);
         let log = mode == BlurMode::LogSumExp;

@@ -148,12 +148,13 @@ fn kernel_needs(
 fn dispatch_groups(plan: &Plan, node: &crate::graph::Node, wg: [u32; 3]) -> [u32; 3] {
     let size = |r: &str| plan.resource(r).map_or((1, 1), |p| (p.width, p.height));
     match &node.dispatch {
-        // The largest of a mip chain's dispatches covers level 1 (level 0 for a 1×1 map).
+        // The largest of a mip chain's dispatches covers level 1 in tiles of 32² texels.
         Dispatch::MipChain => {
             let (w, h) = node.outputs.first().map_or((1, 1), |(_, r)| size(r));
+            let tile = crate::filter::MIP_TILE / 2;
             [
-                (w / 2).max(1).div_ceil(wg[0]),
-                (h / 2).max(1).div_ceil(wg[1]),
+                (w / 2).max(1).div_ceil(tile),
+                (h / 2).max(1).div_ceil(tile),
                 1,
             ]
         }
