@@ -93,6 +93,11 @@ pub const CASES: &[BenchCase] = &[
         build: |n| stage_graph(n, vsm(), "light0.vsm", "light0.vsm.blur_v"),
     },
     BenchCase {
+        name: "blur rg32f r32",
+        bytes_moved: |n| 2 * texels(n) * (8 + 8),
+        build: |n| stage_graph(n, vsm_blur(32.0), "light0.vsm", "light0.vsm.blur_v"),
+    },
+    BenchCase {
         name: "blur log r4",
         bytes_moved: |n| 2 * texels(n) * (4 + 4),
         build: |n| stage_graph(n, esm(), "light0.esm", "light0.esm.blur_v"),
@@ -150,10 +155,19 @@ fn blur4() -> Filter {
 }
 
 fn vsm() -> Technique {
+    vsm_blur(4.0)
+}
+
+/// VSM with a Gaussian blur of `radius` taps each side (σ = radius / 2).
+fn vsm_blur(radius: f32) -> Technique {
     Technique::Vsm {
         prefilter: Prefilter {
             storage: Storage::F32,
-            filter: blur4(),
+            filter: Filter::Blur {
+                radius,
+                sigma: radius / 2.0,
+                kernel: BlurKernel::Gaussian,
+            },
         },
         bleed: 0.2,
         min_variance: 1e-5,

@@ -3,8 +3,16 @@
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
 use crate::scene::{BlurKernel, Filter};
 
-/// Taps each side the blur kernel's workgroup tile can hold.
+/// Taps each side the blur kernel's weight table holds.
 pub const MAX_BLUR_RADIUS: u32 = 32;
+
+/// Texels of a line one `blur` or `blur_log` invocation writes (`PER` in
+/// `kernels/shared/blur_pass.wgsl`).
+pub const BLUR_PER_INVOCATION: u32 = 8;
+
+/// Invocations of a `blur` or `blur_log` workgroup (`WG_SIZE` in
+/// `kernels/shared/blur_pass.wgsl`): along a row, or across neighbouring columns.
+pub const BLUR_GROUP: u32 = 64;
 
 /// How the blur combines texels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -100,14 +108,25 @@ pub fn add_filter(
         );
         graph.node(Node {
             name: format!("{input}.{pass}"),
-            kernel: "blur".into(),
+            kernel: match mode {
+                BlurMode::Linear => "blur",
+                BlurMode::LogSumExp => "blur_log",
+            }
+            .into(),
             inputs: vec![("src".into(), src)],
             outputs: vec![("dst".into(), out.clone())],
             params: bytemuck::bytes_of(&BlurParams::new(axis, radius, sigma, kernel, mode))
                 .to_vec(),
-            dispatch: Dispatch::Axis {
+            // Rows: a workgroup per BLUR_GROUP · PER texels of a row; columns: a workgroup per
+            // BLUR_GROUP columns × PER rows.
+            dispatch: Dispatch::Blocks {
                 of: out.clone(),
-                axis,
+                x: if axis == 0 {
+                    BLUR_GROUP * BLUR_PER_INVOCATION
+                } else {
+                    BLUR_GROUP
+                },
+                y: if axis == 0 { 1 } else { BLUR_PER_INVOCATION },
             },
             light: Some(light),
         });

@@ -283,6 +283,7 @@ fn storage_format_variants_validate() {
     for (kernel, declared, formats) in [
         ("vsm", "rg32float", &["rg32float", "rgba16float"][..]),
         ("blur", "rg32float", all),
+        ("blur_log", "rg32float", &["r32float"][..]),
         ("msm", "rgba32float", &["rgba16float", "rgba16unorm"][..]),
         ("csm", "rgba32float", &["rg32float", "rgba16float"][..]),
         (
