@@ -8,6 +8,7 @@ use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
 use crate::error::{Error, Result};
+use crate::filter::{MIP_LEVELS_PER_DISPATCH, MipParams, mip_dispatches};
 use crate::gpu::{read_buffer, scoped};
 use crate::graph::{Dispatch, Plan, Slot};
 use crate::kernels::{self, Reflection};
@@ -609,9 +610,10 @@ impl Executor {
     }
 
     /// Records a [`Dispatch::MipChain`] node: one compute pass with the dispatches of
-    /// [`crate::filter::mip_dispatches`] (`kernels/mips.wgsl`, up to six levels each), each
-    /// reading one level (the `src` input for the first, which also stores it as level 0)
-    /// through a one-level view and writing the levels after it through one-level views.
+    /// [`crate::filter::mip_dispatches`] (`kernels/mips.wgsl` or `mips_log.wgsl`, up to six
+    /// levels each), each reading one level (the `src` input for the first, which also stores
+    /// it as level 0) through a one-level view and writing the levels after it through
+    /// one-level views.
     fn record_mip_chain(
         &mut self,
         device: &wgpu::Device,
@@ -620,125 +622,24 @@ impl Executor {
         textures: &HashMap<String, wgpu::Texture>,
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
-        use crate::filter::{MIP_LEVELS_PER_DISPATCH, MipParams, mip_dispatches};
-        let pipeline_err = |message: String| Error::Pipeline {
-            kernel: node.kernel.clone(),
-            message: format!("node `{}`: {message}", node.name),
-        };
-        let slot = |list: &[(String, String)], name: &str| {
-            list.iter()
-                .find(|(s, _)| s == name)
-                .map(|(_, r)| textures[r].clone())
-                .ok_or_else(|| pipeline_err(format!("binds nothing to `{name}`")))
-        };
-        let src = slot(&node.inputs, "src")?;
-        let dst = slot(&node.outputs, "dst")?;
-        let dst_bindings: Vec<String> = (0..=MIP_LEVELS_PER_DISPATCH)
-            .map(|k| format!("dst{k}"))
-            .collect();
-        let formats: Vec<(String, wgpu::TextureFormat)> = dst_bindings
-            .iter()
-            .map(|b| (b.clone(), dst.format()))
+        let mip = MipNode::new(node, textures)?;
+        let formats: Vec<(String, wgpu::TextureFormat)> = (0..=MIP_LEVELS_PER_DISPATCH)
+            .map(|k| (format!("dst{k}"), mip.dst.format()))
             .collect();
         let kernel = self
             .kernels
             .get_specialized(device, &node.kernel, &formats)?;
-        let base: MipParams = bytemuck::try_pod_read_unaligned(
-            node.params
-                .get(..std::mem::size_of::<MipParams>())
-                .ok_or_else(|| pipeline_err("params are not a MipParams".into()))?,
-        )
-        .map_err(|e| pipeline_err(format!("bad params: {e}")))?;
-        let dispatches = mip_dispatches(dst.width(), dst.height());
+        let dispatches = mip_dispatches(mip.dst.width(), mip.dst.height());
         let align = u64::from(device.limits().min_uniform_buffer_offset_alignment).max(32);
-        let mut bytes = vec![0u8; dispatches.len() * align as usize];
-        for (k, &(first, count)) in dispatches.iter().enumerate() {
-            let odd = |n: u32| n > 1 && n % 2 == 1;
-            let general = odd((dst.width() >> first).max(1)) || odd((dst.height() >> first).max(1));
-            let p = MipParams {
-                base: [dst.width(), dst.height()],
-                first,
-                count,
-                copy: u32::from(first == 0),
-                general: u32::from(general),
-                ..base
-            };
-            let at = k * align as usize;
-            bytes[at..at + std::mem::size_of_val(&p)].copy_from_slice(bytemuck::bytes_of(&p));
-        }
-        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(&node.name),
-            contents: &bytes,
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let level_view = |t: &wgpu::Texture, level: u32| {
-            t.create_view(&wgpu::TextureViewDescriptor {
-                base_mip_level: level,
-                mip_level_count: Some(1),
-                ..Default::default()
-            })
-        };
-        let binding = |name: &str| {
-            kernel
-                .reflection
-                .binding(name)
-                .map(|b| b.binding)
-                .ok_or_else(|| pipeline_err(format!("kernel has no binding `{name}`")))
-        };
+        let params = mip.params_buffer(device, &dispatches, align)?;
         let mut groups = Vec::new();
         for (k, &(first, count)) in dispatches.iter().enumerate() {
-            let src_view = if first == 0 {
-                level_view(&src, 0)
-            } else {
-                level_view(&dst, first)
-            };
-            // dst0 is level 0 in the first dispatch; unused bindings repeat the last level
-            // written (never stored to: the kernel stores only levels 0 … count).
-            let last = first + count;
-            let views: Vec<wgpu::TextureView> = (0..=MIP_LEVELS_PER_DISPATCH)
-                .map(|j| {
-                    let level = match j {
-                        0 if first == 0 => 0,
-                        j if j >= 1 && j <= count => first + j,
-                        _ => last,
-                    };
-                    level_view(&dst, level)
-                })
-                .collect();
-            let mut entries = vec![wgpu::BindGroupEntry {
-                binding: binding("src")?,
-                resource: wgpu::BindingResource::TextureView(&src_view),
-            }];
-            for (name, view) in dst_bindings.iter().zip(&views) {
-                entries.push(wgpu::BindGroupEntry {
-                    binding: binding(name)?,
-                    resource: wgpu::BindingResource::TextureView(view),
-                });
-            }
-            entries.push(wgpu::BindGroupEntry {
-                binding: binding("params")?,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &params,
-                    offset: k as u64 * align,
-                    size: wgpu::BufferSize::new(std::mem::size_of::<MipParams>() as u64),
-                }),
-            });
-            let bg = scoped(
-                device,
-                || {
-                    device.create_bind_group(&wgpu::BindGroupDescriptor {
-                        label: Some(&node.name),
-                        layout: &kernel.layouts[0],
-                        entries: &entries,
-                    })
-                },
-                |message| pipeline_err(format!("binding level {first}: {message}")),
-            )?;
-            let next = [
-                (dst.width() >> (first + 1)).max(1),
-                (dst.height() >> (first + 1)).max(1),
-            ];
+            let bg = mip.bind_group(device, &kernel, &params, k as u64 * align, first, count)?;
             let tile = crate::filter::MIP_TILE / 2;
+            let next = [
+                (mip.dst.width() >> (first + 1)).max(1),
+                (mip.dst.height() >> (first + 1)).max(1),
+            ];
             groups.push((bg, [next[0].div_ceil(tile), next[1].div_ceil(tile)]));
         }
         let timestamp_writes = timer.and_then(|t| t.compute_pass(&node.name));
@@ -752,5 +653,147 @@ impl Executor {
             pass.dispatch_workgroups(g[0], g[1], 1);
         }
         Ok(())
+    }
+}
+
+/// A mip-chain node's textures and the pieces of its dispatches.
+struct MipNode<'a> {
+    node: &'a crate::graph::Node,
+    src: wgpu::Texture,
+    dst: wgpu::Texture,
+}
+
+impl<'a> MipNode<'a> {
+    fn new(
+        node: &'a crate::graph::Node,
+        textures: &HashMap<String, wgpu::Texture>,
+    ) -> Result<Self> {
+        let find = |list: &[(String, String)], slot: &str| {
+            list.iter()
+                .find(|(s, _)| s == slot)
+                .and_then(|(_, r)| textures.get(r).cloned())
+                .ok_or_else(|| Self::error(node, format!("binds nothing to `{slot}`")))
+        };
+        Ok(Self {
+            node,
+            src: find(&node.inputs, "src")?,
+            dst: find(&node.outputs, "dst")?,
+        })
+    }
+
+    fn error(node: &crate::graph::Node, message: String) -> Error {
+        Error::Pipeline {
+            kernel: node.kernel.clone(),
+            message: format!("node `{}`: {message}", node.name),
+        }
+    }
+
+    /// One `MipParams` per dispatch, `align` bytes apart.
+    fn params_buffer(
+        &self,
+        device: &wgpu::Device,
+        dispatches: &[(u32, u32)],
+        align: u64,
+    ) -> Result<wgpu::Buffer> {
+        let size = std::mem::size_of::<MipParams>();
+        let base: MipParams = self
+            .node
+            .params
+            .get(..size)
+            .and_then(|b| bytemuck::try_pod_read_unaligned(b).ok())
+            .ok_or_else(|| Self::error(self.node, "params are not a MipParams".into()))?;
+        let (w, h) = (self.dst.width(), self.dst.height());
+        let odd = |n: u32| n > 1 && n % 2 == 1;
+        let mut bytes = vec![0u8; dispatches.len() * align as usize];
+        for (k, &(first, count)) in dispatches.iter().enumerate() {
+            let p = MipParams {
+                base: [w, h],
+                first,
+                count,
+                copy: u32::from(first == 0),
+                general: u32::from(odd((w >> first).max(1)) || odd((h >> first).max(1))),
+                ..base
+            };
+            let at = k * align as usize;
+            bytes[at..at + size].copy_from_slice(bytemuck::bytes_of(&p));
+        }
+        Ok(
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(&self.node.name),
+                contents: &bytes,
+                usage: wgpu::BufferUsages::UNIFORM,
+            }),
+        )
+    }
+
+    /// The bind group of the dispatch reading level `first` and writing `count` levels:
+    /// `dst0` is level 0 in the first dispatch; unused bindings repeat the last level written
+    /// (the kernel stores only levels 0 … count).
+    fn bind_group(
+        &self,
+        device: &wgpu::Device,
+        kernel: &ComputeKernel,
+        params: &wgpu::Buffer,
+        offset: u64,
+        first: u32,
+        count: u32,
+    ) -> Result<wgpu::BindGroup> {
+        let level_view = |t: &wgpu::Texture, level: u32| {
+            t.create_view(&wgpu::TextureViewDescriptor {
+                base_mip_level: level,
+                mip_level_count: Some(1),
+                ..Default::default()
+            })
+        };
+        let binding = |name: &str| {
+            kernel
+                .reflection
+                .binding(name)
+                .map(|b| b.binding)
+                .ok_or_else(|| Self::error(self.node, format!("kernel has no binding `{name}`")))
+        };
+        let src_view = match first {
+            0 => level_view(&self.src, 0),
+            l => level_view(&self.dst, l),
+        };
+        let views: Vec<(String, wgpu::TextureView)> = (0..=MIP_LEVELS_PER_DISPATCH)
+            .map(|j| {
+                let level = match j {
+                    0 if first == 0 => 0,
+                    j if (1..=count).contains(&j) => first + j,
+                    _ => first + count,
+                };
+                (format!("dst{j}"), level_view(&self.dst, level))
+            })
+            .collect();
+        let mut entries = vec![wgpu::BindGroupEntry {
+            binding: binding("src")?,
+            resource: wgpu::BindingResource::TextureView(&src_view),
+        }];
+        for (name, view) in &views {
+            entries.push(wgpu::BindGroupEntry {
+                binding: binding(name)?,
+                resource: wgpu::BindingResource::TextureView(view),
+            });
+        }
+        entries.push(wgpu::BindGroupEntry {
+            binding: binding("params")?,
+            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer: params,
+                offset,
+                size: wgpu::BufferSize::new(std::mem::size_of::<MipParams>() as u64),
+            }),
+        });
+        scoped(
+            device,
+            || {
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some(&self.node.name),
+                    layout: &kernel.layouts[0],
+                    entries: &entries,
+                })
+            },
+            |message| Self::error(self.node, format!("binding level {first}: {message}")),
+        )
     }
 }

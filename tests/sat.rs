@@ -286,6 +286,8 @@ fn wgsl_const(module: &naga::Module, name: &str) -> Option<u32> {
 
 #[test]
 fn sat_tile_and_params_match_the_wgsl() {
+    // A row workgroup of `sat_carries` covers one tile row: one invocation per row.
+    assert_eq!(SAT_LINES_PER_GROUP, SAT_TILE);
     for kernel in [
         "sat_tile_sums",
         "sat_tile_sums_f32",

@@ -73,14 +73,6 @@ pub enum Dispatch {
         /// Block height in texels (0: the whole height, one group).
         y: u32,
     },
-    /// One invocation per texel along `axis` (0 = x, 1 = y) of this resource, one workgroup
-    /// row per line across it: `[ceil(len / workgroup x), lines, 1]` (separable passes).
-    Axis {
-        /// The resource whose size counts.
-        of: String,
-        /// 0 for rows (horizontal), 1 for columns (vertical).
-        axis: u32,
-    },
     /// One invocation per column and one per row of this resource:
     /// `[⌈max(width, height) / per_group⌉, 2, 1]`, workgroup row 0 over the columns and row 1
     /// over the rows (work serial along each line, e.g. a summed-area table's carries).
@@ -113,11 +105,6 @@ impl Dispatch {
             Self::Blocks { of, x, y } => {
                 let (w, h) = size(of)?;
                 [block_count(w, *x), block_count(h, *y), 1]
-            }
-            Self::Axis { of, axis } => {
-                let (w, h) = size(of)?;
-                let (along, across) = if *axis == 0 { (w, h) } else { (h, w) };
-                [along.div_ceil(workgroup[0]), across, 1]
             }
             Self::Lines { of, per_group } => {
                 let (w, h) = size(of)?;
