@@ -76,7 +76,12 @@ fn run() -> Result<(), String> {
                     println!("{:>6}    {:<22} {:>10.2}", n, name, ms);
                 }
             }
-            let bytes = (case.bytes_moved)(n) as f64 / (f64::from(n) * f64::from(n));
+            let built = (case.build)(n);
+            let outputs: Vec<&str> = built.outputs.iter().map(String::as_str).collect();
+            let plan =
+                shadowgraph::graph::plan(&built.graph, &outputs).map_err(|e| e.to_string())?;
+            let bytes = shadowgraph::bench::plan_bytes(&plan).map_err(|e| e.to_string())?
+                / (f64::from(n) * f64::from(n));
             println!(
                 "{:>6}  {:<24} {:>10.2} {:>10.2} {:>8.2} {:>10.1}   ({format:?})",
                 n,

@@ -7,6 +7,10 @@
 // per-pixel MSM tolerances of tests/scenes.rs and the stability suite's case 3 fail; this
 // order keeps the sums the earlier kernel computed.)
 // #import shared/blur_pass
+// Traffic (the cost model, src/graph/cost): a row workgroup loads its WG_SIZE · PER texels and
+// a halo of r each side; a column workgroup WG_SIZE columns of PER + 2r texels each.
+// #traffic src: select(WG_SIZE * PER + 2 * min(params.radius, MAX_RADIUS), WG_SIZE * (PER + 2 * min(params.radius, MAX_RADIUS)), params.axis == 1) per group
+// #traffic dst: all
 
 @compute @workgroup_size(WG_SIZE)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {

@@ -9,6 +9,10 @@
 // The invocation reads its PER + 2r texels once into PER running sums, kept as named values (an
 // array indexed in a loop stays in memory on llvmpipe, three times slower).
 // #import shared/blur_pass
+// Traffic (the cost model, src/graph/cost): a row workgroup loads its WG_SIZE · PER texels and
+// a halo of r each side; a column workgroup WG_SIZE columns of PER + 2r texels each.
+// #traffic src: select(WG_SIZE * PER + 2 * min(params.radius, MAX_RADIUS), WG_SIZE * (PER + 2 * min(params.radius, MAX_RADIUS)), params.axis == 1) per group
+// #traffic dst: all
 
 const SPAN: f32 = 80.0;
 

@@ -1,6 +1,9 @@
 // The bandwidth yardstick for benchmarks: copies a buffer, 16 bytes per invocation.
 // Effective bandwidth counts one read and one write of every byte.
 
+// Traffic (the cost model, src/graph/cost): the yardstick: every byte read once and written once.
+// #traffic src: all
+// #traffic dst: all
 @group(0) @binding(0) var<storage, read> src: array<vec4<u32>>;
 @group(0) @binding(1) var<storage, read_write> dst: array<vec4<u32>>;
 

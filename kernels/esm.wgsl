@@ -5,6 +5,9 @@
 
 // #import shared/exp_params
 
+// Traffic (the cost model, src/graph/cost): one texel in, one out.
+// #traffic src: all
+// #traffic dst: all
 @group(0) @binding(0) var src: texture_2d<f32>;
 @group(0) @binding(1) var dst: texture_storage_2d<r32float, write>;
 @group(0) @binding(2) var<uniform> params: Params;

@@ -14,6 +14,11 @@ struct Params {
     _pad: u32,
 }
 
+// Traffic (the cost model, src/graph/cost): one texel in, one out; the counter is one atomic per
+// replaced texel.
+// #traffic src: all
+// #traffic dst: all
+// #traffic stats: none
 @group(0) @binding(0) var src: texture_2d<f32>;
 @group(0) @binding(1) var dst: texture_storage_2d<r32float, write>;
 @group(0) @binding(2) var<uniform> params: Params;

@@ -2,6 +2,16 @@
 // it covers (shared/mip_chain). The executor records the dispatches of a `Dispatch::MipChain`
 // node.
 // #import shared/mip_chain
+// Traffic (the cost model, src/graph/cost): each dispatch reads the level it reduces once and
+// writes each level it stores once (dst0 in the first dispatch only).
+// #traffic src: all
+// #traffic dst0: all
+// #traffic dst1: all
+// #traffic dst2: all
+// #traffic dst3: all
+// #traffic dst4: all
+// #traffic dst5: all
+// #traffic dst6: all
 
 const LOG_MODE: bool = false;
 

@@ -14,6 +14,9 @@ struct Params {
     _pad2: u32,
 }
 
+// Traffic (the cost model, src/graph/cost): one texel in, one out.
+// #traffic src: all
+// #traffic dst: all
 @group(0) @binding(0) var src: texture_2d<f32>;
 @group(0) @binding(1) var dst: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(2) var<uniform> params: Params;

@@ -11,6 +11,13 @@
 // with V(tx') = Σ_{ty' < ty} total(tx', ty') the tiles above, from the tiles' totals (their
 // last column of col_part), summed by the workgroup into workgroup memory first.
 // #import shared/sat_tile
+// Traffic (the cost model, src/graph/cost): every edge texel read once and every carry written
+// once. Not counted: the row workgroups' re-reads of the tiles' totals above them (at most
+// tiles_x · tiles_y / 2 texels, under 1/TILE² of the map's).
+// #traffic col_part: all
+// #traffic row_part: all
+// #traffic col_carry: all
+// #traffic row_carry: all
 
 @group(0) @binding(0) var col_part: texture_2d<u32>;
 @group(0) @binding(1) var row_part: texture_2d<u32>;

@@ -5,6 +5,9 @@
 // work-efficient choice (n − 1 adds, no barriers) and any length works.
 // #import shared/sat_scan
 
+// Traffic (the cost model, src/graph/cost): the block totals, read and written once.
+// #traffic src: all
+// #traffic dst: all
 @group(0) @binding(0) var src: texture_2d<u32>;
 @group(0) @binding(1) var dst: texture_storage_2d<rgba32uint, write>;
 @group(0) @binding(2) var<uniform> params: SatParams;

@@ -4,6 +4,12 @@
 // wrapping subtraction are exact (see src/sat.rs for the scale).
 // #import shared/sat_scan
 
+// Traffic (the cost model, src/graph/cost): reads the row scans again (the table's second read),
+// each texel's row carry and one column carry per block, and writes the table.
+// #traffic src: all
+// #traffic row_carry: 1 per texel of src
+// #traffic col_carry: 1 per group
+// #traffic dst: all
 @group(0) @binding(0) var src: texture_2d<u32>;
 @group(0) @binding(1) var row_carry: texture_2d<u32>;
 @group(0) @binding(2) var col_carry: texture_2d<u32>;

@@ -3,6 +3,11 @@
 // per block: width × ⌈height / BLOCK⌉. Only the up-sweep half of the scan tree is needed.
 // #import shared/sat_scan
 
+// Traffic (the cost model, src/graph/cost): reads the row scans (their first read) and, for each
+// texel, its row block's carry.
+// #traffic src: all
+// #traffic row_carry: 1 per texel of src
+// #traffic dst: all
 @group(0) @binding(0) var src: texture_2d<u32>;
 @group(0) @binding(1) var row_carry: texture_2d<u32>;
 @group(0) @binding(2) var dst: texture_storage_2d<rgba32uint, write>;

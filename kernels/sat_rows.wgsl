@@ -5,6 +5,11 @@
 // are added by later dispatches (sat_carry, then sat_cols_reduce and sat_cols).
 // #import shared/sat_scan
 
+// Traffic (the cost model, src/graph/cost): one read of the representation, one write of the block
+// scans and of the block totals.
+// #traffic src: all
+// #traffic dst: all
+// #traffic sums: all
 @group(0) @binding(0) var src: texture_2d<f32>;
 @group(0) @binding(1) var dst: texture_storage_2d<rgba32uint, write>;
 @group(0) @binding(2) var sums: texture_storage_2d<rgba32uint, write>;

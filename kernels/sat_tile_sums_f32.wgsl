@@ -6,6 +6,11 @@
 // The representation is read once; these two edges (2/TILE of the map) are all it writes.
 // Storage: rgba32uint by default; the executor re-declares them for the table's channels.
 // #import shared/sat_tile_sums
+// Traffic (the cost model, src/graph/cost): each workgroup loads its tile (clamped at the map's
+// edge) and writes its edges.
+// #traffic src: TILE * TILE per group
+// #traffic col_part: all
+// #traffic row_part: all
 
 @group(0) @binding(0) var src: texture_2d<f32>;
 @group(0) @binding(1) var col_part: texture_storage_2d<rgba32uint, write>;

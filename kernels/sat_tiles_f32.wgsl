@@ -5,6 +5,12 @@
 // is written once.
 // Storage: rgba32float by default; the executor re-declares `dst` for the table's channels.
 // #import shared/sat_tile_scan
+// Traffic (the cost model, src/graph/cost): each workgroup loads its tile (clamped at the map's
+// edge; the second sweep hits its cache), TILE carries of either kind, and writes the table.
+// #traffic src: TILE * TILE per group
+// #traffic col_carry: TILE per group
+// #traffic row_carry: TILE per group
+// #traffic dst: all
 
 @group(0) @binding(0) var src: texture_2d<f32>;
 @group(0) @binding(1) var col_carry: texture_2d<u32>;

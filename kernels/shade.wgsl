@@ -22,6 +22,14 @@ struct Frame {
     _pad6: f32,
 }
 
+// Traffic (the cost model, src/graph/cost): the G-buffer and outputs once per pixel; the maps are
+// fetched by the visibility functions (`// #fetches`).
+// #traffic g_position: all
+// #traffic g_normal: all
+// #traffic materials: all
+// #traffic lights: all
+// #traffic out_color: all
+// #traffic out_visibility: all
 @group(0) @binding(0) var g_position: texture_2d<f32>;
 @group(0) @binding(1) var g_normal: texture_2d<f32>;
 @group(0) @binding(2) var<storage, read> materials: array<vec4<f32>>;

@@ -5,6 +5,13 @@
 // #import shared/light
 // #import shared/sampling
 
+// Traffic (the cost model, src/graph/cost): the G-buffer once per pixel and one depth texel per
+// pixel (scattered).
+// #traffic g_position: all
+// #traffic g_normal: all
+// #traffic depth: WG_SIZE * WG_SIZE per group
+// #traffic sample_light: all
+// #traffic lit_count: all
 @group(0) @binding(0) var g_position: texture_2d<f32>;
 @group(0) @binding(1) var g_normal: texture_2d<f32>;
 @group(0) @binding(2) var depth: texture_depth_2d;

@@ -6,6 +6,10 @@
 // silhouette (a jump on one side only) does not inflate the variance of the surface beside it.
 // Storage: rg32float by default; the executor re-declares `dst` for f16 (rgba16float).
 
+// Traffic (the cost model, src/graph/cost): the derivatives read a texel's four neighbours: a tile
+// and a one-texel cross-shaped halo.
+// #traffic src: WG_SIZE * WG_SIZE + 4 * WG_SIZE per group
+// #traffic dst: all
 @group(0) @binding(0) var src: texture_2d<f32>;
 @group(0) @binding(1) var dst: texture_storage_2d<rg32float, write>;
 

@@ -5,11 +5,15 @@ use std::path::Path;
 
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
+use crate::graph::cost::fetches::Fetches;
 use crate::io::{deinterleave, write_exr, write_png};
+use crate::kernels;
 use crate::render::{Frame, RenderOptions, Renderer, plan_lights};
-use crate::scene::Scene;
+use crate::scene::{Light, Scene};
+use crate::technique;
 
-/// `shadowgraph plan`: the plan as text (or Graphviz with `dot`).
+/// `shadowgraph plan`: the plan as text (or Graphviz with `dot`), with each light's traffic
+/// per texel and its visibility function's fetches per pixel (no GPU needed).
 pub fn plan(scene: &Path, dot: bool) -> Result<String> {
     let scene = Scene::load(scene)?;
     let sp = plan_lights(&scene.lights)?;
@@ -17,10 +21,35 @@ pub fn plan(scene: &Path, dot: bool) -> Result<String> {
         return Ok(sp.plan.to_dot());
     }
     let labels: Vec<String> = scene.lights.iter().map(|l| l.label()).collect();
+    let fetches = shading_fetches(&scene.lights)?;
+    let per_light = (0..scene.lights.len())
+        .map(|i| {
+            let mut s = sp.plan.cost_text(i)?;
+            let name = scene.lights[i].shadow.technique.name();
+            let _ = writeln!(s, "    shade: {name} {} fetches/pixel", fetches[i]);
+            Ok(s)
+        })
+        .collect::<Result<Vec<String>>>()?;
     let mut s = warnings(&scene);
-    s.push_str(&sp.plan.to_text(&labels));
+    s.push_str(&sp.plan.to_text(&labels, &per_light));
     s.push_str("then: shade (one visibility function per light)\n");
     Ok(s)
+}
+
+/// Per light, the texture fetches per pixel of its visibility function in the shading kernel
+/// (the `// #fetches` declarations of `kernels/shared/`, composed as the scene's shading block
+/// calls them; see [`crate::graph::cost::fetches`]).
+pub fn shading_fetches(lights: &[Light]) -> Result<Vec<f64>> {
+    let wgsl = kernels::resolve("shade", Some(&technique::shading_block(lights)))?;
+    lights
+        .iter()
+        .enumerate()
+        .map(|(i, l)| {
+            let gpu = technique::LightGpu::new(l);
+            Fetches::new("shade", &wgsl, bytemuck::bytes_of(&gpu))?
+                .count(&format!("light{i}_visibility"))
+        })
+        .collect()
 }
 
 /// `shadowgraph render`: renders, writes the PNG (and EXRs with `aux`), returns a summary.
@@ -114,12 +143,13 @@ fn write_aux(dir: &Path, scene: &Scene, frame: &Frame) -> Result<()> {
     )
 }
 
-/// Median of each pass's time over the frames, as a table.
+/// Median of each pass's time over the frames, as a table, with the frames' wall time.
 pub fn timing_table(gpu: &Gpu, frame: &Frame) -> String {
     let mut s = String::new();
     if !gpu.can_time() {
         s.push_str(
-            "timings: this device has no TIMESTAMP_QUERY feature, so GPU passes cannot be timed\n",
+            "timings: this device lacks TIMESTAMP_QUERY or TIMESTAMP_QUERY_INSIDE_ENCODERS, so \
+             GPU passes cannot be timed\n",
         );
         return s;
     }
@@ -128,7 +158,7 @@ pub fn timing_table(gpu: &Gpu, frame: &Frame) -> String {
     };
     let _ = writeln!(
         s,
-        "GPU time per pass, median of {} frame(s), on {}:",
+        "GPU time per pass (timestamps between passes), median of {} frame(s), on {}:",
         frame.timings.len(),
         gpu.describe()
     );
@@ -139,11 +169,23 @@ pub fn timing_table(gpu: &Gpu, frame: &Frame) -> String {
             .iter()
             .filter_map(|t| t.get(i).map(|x| x.1))
             .collect();
-        v.sort_by(f64::total_cmp);
-        let med = v[v.len() / 2];
+        let med = median(&mut v);
         total += med;
         let _ = writeln!(s, "  {label:<28} {med:>10.3} ms");
     }
     let _ = writeln!(s, "  {:<28} {total:>10.3} ms", "total");
+    let mut wall = frame.wall_ms.clone();
+    let _ = writeln!(
+        s,
+        "  {:<28} {:>10.3} ms  (submit to completion, median)",
+        "wall",
+        median(&mut wall)
+    );
     s
+}
+
+/// The median of `v` (the upper middle value for an even count); NaN when empty.
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
 }

@@ -63,6 +63,18 @@ pub enum Error {
         /// What is wrong, naming the key.
         message: String,
     },
+    /// A scene needs more of the device than it offers (a texture side, bindings, a buffer, or
+    /// memory past the budget), found before anything was created; names the scene key that
+    /// would fix it, with its line.
+    #[error("{path}{location}: {message}")]
+    SceneLimit {
+        /// The scene file.
+        path: PathBuf,
+        /// `:line:column` of the key (or of its table), else empty.
+        location: String,
+        /// What is too large, the device's limit, and the key to change.
+        message: String,
+    },
     /// A mesh referenced by a scene could not be loaded.
     #[error("mesh `{path}`: {message}")]
     Mesh {
@@ -84,7 +96,6 @@ pub enum Error {
     /// What a host handed the plug-in stage is unusable (see [`crate::prefilter`]).
     #[error("plug-in stage: {0}")]
     Stage(#[from] crate::prefilter::StageError),
-    /// An argument is invalid (zero size, mismatched lengths, ...).
     /// The scene needs a device feature the adapter does not offer.
     #[error("{what} needs the device feature {feature}, which this adapter does not offer")]
     MissingFeature {
@@ -93,6 +104,7 @@ pub enum Error {
         /// The wgpu feature's name.
         feature: &'static str,
     },
+    /// An argument is invalid (zero size, mismatched lengths, ...).
     #[error("invalid argument: {0}")]
     Invalid(String),
     /// Reading or writing a file failed.

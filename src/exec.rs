@@ -1,6 +1,6 @@
 //! The executor: records a [`Plan`] into a caller's command encoder, one compute pass per node,
-//! with a timestamp pair around each when the device allows. It borrows the device and never
-//! submits, so it runs the same inside shadowgraph's renderer and inside a host's frame.
+//! each node a span of the caller's [`GpuTimer`] when one is given. It borrows the device and
+//! never submits, so it runs the same inside shadowgraph's renderer and inside a host's frame.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -12,6 +12,7 @@ use crate::filter::{MIP_LEVELS_PER_DISPATCH, MipParams, mip_dispatches};
 use crate::gpu::{read_buffer, scoped};
 use crate::graph::{Dispatch, Plan, Slot};
 use crate::kernels::{self, Reflection};
+pub use crate::timer::GpuTimer;
 
 /// A compute pipeline with the layouts reflected from its WGSL.
 pub struct ComputeKernel {
@@ -145,10 +146,7 @@ impl KernelCache {
         name: &str,
         generated: Option<&str>,
     ) -> Result<Arc<ComputeKernel>> {
-        let key = match generated {
-            Some(g) => format!("{name}\u{0}{g}"),
-            None => name.to_string(),
-        };
+        let key = generated_key(name, generated);
         if let Some(k) = self.kernels.get(&key) {
             return Ok(k.clone());
         }
@@ -156,6 +154,22 @@ impl KernelCache {
         let k = Arc::new(ComputeKernel::new(device, name, &wgsl)?);
         self.kernels.insert(key, k.clone());
         Ok(k)
+    }
+
+    /// Compiles `wgsl` as the pipeline [`KernelCache::get_generated`] returns for `name` and
+    /// `generated` from now on: a rewritten variant of the kernel with the same bindings, e.g.
+    /// the shading kernel with every texture fetch counted (`tests/cost.rs`).
+    pub fn insert_generated(
+        &mut self,
+        device: &wgpu::Device,
+        name: &str,
+        generated: Option<&str>,
+        wgsl: &str,
+    ) -> Result<()> {
+        let key = generated_key(name, generated);
+        let k = Arc::new(ComputeKernel::new(device, name, wgsl)?);
+        self.kernels.insert(key, k);
+        Ok(())
     }
 
     /// Number of pipelines created so far.
@@ -166,6 +180,22 @@ impl KernelCache {
     /// Whether no pipeline was created yet.
     pub fn is_empty(&self) -> bool {
         self.kernels.is_empty()
+    }
+}
+
+/// The cache key of kernel `name` with the `// #generated` block `generated`.
+fn generated_key(name: &str, generated: Option<&str>) -> String {
+    match generated {
+        Some(g) => format!("{name}\u{0}{g}"),
+        None => name.to_string(),
+    }
+}
+
+/// The error for a kernel without a bind group (a plan naming a kernel the executor cannot bind).
+fn no_layout(kernel: &str) -> Error {
+    Error::Pipeline {
+        kernel: kernel.to_string(),
+        message: "the kernel declares no bind group".into(),
     }
 }
 
@@ -231,113 +261,6 @@ impl TexturePool {
     /// Textures held (in use by the last run or free).
     pub fn texture_count(&self) -> usize {
         self.free.values().map(Vec::len).sum()
-    }
-}
-
-/// Timestamp queries around passes, resolved after the work is submitted.
-pub struct GpuTimer {
-    query_set: wgpu::QuerySet,
-    resolve: wgpu::Buffer,
-    readback: wgpu::Buffer,
-    capacity: u32,
-    labels: Vec<String>,
-    period_ns: f64,
-}
-
-impl GpuTimer {
-    /// A timer for up to `passes` passes, or `None` when the device has no TIMESTAMP_QUERY.
-    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, passes: u32) -> Option<Self> {
-        if !device.features().contains(wgpu::Features::TIMESTAMP_QUERY) || passes == 0 {
-            return None;
-        }
-        let count = 2 * passes;
-        let bytes = u64::from(count) * 8;
-        Some(Self {
-            query_set: device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("shadowgraph.timer"),
-                ty: wgpu::QueryType::Timestamp,
-                count,
-            }),
-            resolve: device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("shadowgraph.timer.resolve"),
-                size: bytes,
-                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            }),
-            readback: device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("shadowgraph.timer.readback"),
-                size: bytes,
-                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-                mapped_at_creation: false,
-            }),
-            capacity: passes,
-            labels: Vec::new(),
-            period_ns: f64::from(queue.get_timestamp_period()),
-        })
-    }
-
-    /// Forgets the passes of the last frame.
-    pub fn reset(&mut self) {
-        self.labels.clear();
-    }
-
-    /// Query indices for the next pass named `label`, or `None` when the timer is full.
-    fn next(&mut self, label: &str) -> Option<(u32, u32)> {
-        let i = self.labels.len() as u32;
-        if i >= self.capacity {
-            log::warn!("timer full: pass `{label}` is not timed");
-            return None;
-        }
-        self.labels.push(label.to_string());
-        Some((2 * i, 2 * i + 1))
-    }
-
-    /// Timestamp writes for a compute pass named `label`.
-    pub fn compute_pass(&mut self, label: &str) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
-        let (a, b) = self.next(label)?;
-        Some(wgpu::ComputePassTimestampWrites {
-            query_set: &self.query_set,
-            beginning_of_pass_write_index: Some(a),
-            end_of_pass_write_index: Some(b),
-        })
-    }
-
-    /// Timestamp writes for a render pass named `label`.
-    pub fn render_pass(&mut self, label: &str) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
-        let (a, b) = self.next(label)?;
-        Some(wgpu::RenderPassTimestampWrites {
-            query_set: &self.query_set,
-            beginning_of_pass_write_index: Some(a),
-            end_of_pass_write_index: Some(b),
-        })
-    }
-
-    /// Records the query resolve; call after the last timed pass, before submitting.
-    pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
-        let n = self.labels.len() as u32 * 2;
-        if n == 0 {
-            return;
-        }
-        encoder.resolve_query_set(&self.query_set, 0..n, &self.resolve, 0);
-        encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.readback, 0, u64::from(n) * 8);
-    }
-
-    /// Milliseconds per timed pass, in recording order. Call after the submission completed.
-    pub fn read(&self, device: &wgpu::Device) -> Result<Vec<(String, f64)>> {
-        if self.labels.is_empty() {
-            return Ok(Vec::new());
-        }
-        let raw = read_buffer(device, &self.readback)?;
-        let ticks: &[u64] = bytemuck::cast_slice(&raw);
-        Ok(self
-            .labels
-            .iter()
-            .enumerate()
-            .map(|(i, l)| {
-                let dt = ticks[2 * i + 1].wrapping_sub(ticks[2 * i]);
-                (l.clone(), dt as f64 * self.period_ns * 1e-6)
-            })
-            .collect())
     }
 }
 
@@ -421,6 +344,7 @@ impl Executor {
     }
 
     /// Records `plan` into `encoder`. `imports` gives a texture for every imported resource.
+    /// With a `timer`, each node is a span named after it, and the last one ends with the plan.
     pub fn record(
         &mut self,
         device: &wgpu::Device,
@@ -429,6 +353,8 @@ impl Executor {
         imports: &HashMap<String, wgpu::Texture>,
         mut timer: Option<&mut GpuTimer>,
     ) -> Result<Outputs> {
+        // A plan's fields are public: check what the indexing below relies on first.
+        plan.check()?;
         // Textures of the previous run go back to the pool, then each slot takes one.
         for (slot, t) in self.in_use.drain(..) {
             self.pool.free.entry(slot).or_default().push(t);
@@ -504,8 +430,11 @@ impl Executor {
 
         for (si, step) in plan.steps.iter().enumerate() {
             let node = &step.node;
+            if let Some(t) = timer.as_deref_mut() {
+                t.begin(encoder, &node.name);
+            }
             if node.dispatch == Dispatch::MipChain {
-                self.record_mip_chain(device, encoder, node, &textures, timer.as_deref_mut())?;
+                self.record_mip_chain(device, encoder, node, &textures)?;
                 continue;
             }
             let formats: Vec<(String, wgpu::TextureFormat)> = node
@@ -568,12 +497,16 @@ impl Executor {
                     }),
                 });
             }
+            let layout = kernel
+                .layouts
+                .first()
+                .ok_or_else(|| no_layout(&kernel.name))?;
             let bind_group = scoped(
                 device,
                 || {
                     device.create_bind_group(&wgpu::BindGroupDescriptor {
                         label: Some(&node.name),
-                        layout: &kernel.layouts[0],
+                        layout,
                         entries: &entries,
                     })
                 },
@@ -590,16 +523,17 @@ impl Executor {
                     node.name
                 ))
             })?;
-            let timestamp_writes = timer
-                .as_deref_mut()
-                .and_then(|t| t.compute_pass(&node.name));
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some(&node.name),
-                timestamp_writes,
+                timestamp_writes: None,
             });
             pass.set_pipeline(&kernel.pipeline);
             pass.set_bind_group(0, &bind_group, &[]);
             pass.dispatch_workgroups(groups[0], groups[1], groups[2]);
+        }
+        // The last node ends here, not at whatever the caller records next.
+        if let Some(t) = timer {
+            t.end(encoder);
         }
         Ok(Outputs {
             textures,
@@ -620,7 +554,6 @@ impl Executor {
         encoder: &mut wgpu::CommandEncoder,
         node: &crate::graph::Node,
         textures: &HashMap<String, wgpu::Texture>,
-        timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         let mip = MipNode::new(node, textures)?;
         let formats: Vec<(String, wgpu::TextureFormat)> = (0..=MIP_LEVELS_PER_DISPATCH)
@@ -642,10 +575,9 @@ impl Executor {
             ];
             groups.push((bg, [next[0].div_ceil(tile), next[1].div_ceil(tile)]));
         }
-        let timestamp_writes = timer.and_then(|t| t.compute_pass(&node.name));
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some(&node.name),
-            timestamp_writes,
+            timestamp_writes: None,
         });
         pass.set_pipeline(&kernel.pipeline);
         for (bg, g) in &groups {

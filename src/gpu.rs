@@ -1,5 +1,8 @@
 //! GPU context: adapter selection, device creation with the adapter's own limits, readback.
 
+use std::cell::RefCell;
+use std::collections::HashMap;
+use std::hash::{Hash, Hasher};
 use std::sync::Arc;
 
 use crate::error::{Error, Result};
@@ -16,7 +19,7 @@ pub struct Gpu {
 }
 
 /// Features shadowgraph uses when offered; none is required.
-const WANTED_FEATURES: wgpu::Features = wgpu::Features::TIMESTAMP_QUERY
+const WANTED_FEATURES: wgpu::Features = crate::timer::TIMER_FEATURES
     .union(wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES)
     .union(wgpu::Features::FLOAT32_FILTERABLE)
     .union(wgpu::Features::SHADER_F64)
@@ -50,9 +53,7 @@ impl Gpu {
                 adapter: info.name.clone(),
                 message: e.to_string(),
             })?;
-        // Errors are caught with error scopes where they can happen; anything that escapes is
-        // logged rather than aborting the process from inside wgpu.
-        device.on_uncaptured_error(Arc::new(|e| log::error!("uncaptured wgpu error: {e}")));
+        watch_uncaptured(&device);
         Ok(Self {
             adapter,
             device,
@@ -69,11 +70,11 @@ impl Gpu {
         )
     }
 
-    /// Whether GPU timestamps can be written around compute passes.
+    /// Whether GPU timestamps can be written between passes ([`crate::timer::GpuTimer`]).
     pub fn can_time(&self) -> bool {
         self.device
             .features()
-            .contains(wgpu::Features::TIMESTAMP_QUERY)
+            .contains(crate::timer::TIMER_FEATURES)
     }
 
     /// The facts `shadowgraph info` prints: adapter, backend, features and limits that matter.
@@ -89,6 +90,10 @@ impl Gpu {
         line("driver", format!("{} {}", i.driver, i.driver_info));
         for (name, feat) in [
             ("TIMESTAMP_QUERY", wgpu::Features::TIMESTAMP_QUERY),
+            (
+                "TIMESTAMP_QUERY_INSIDE_ENCODERS",
+                wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS,
+            ),
             (
                 "TIMESTAMP_QUERY_INSIDE_PASSES",
                 wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES,
@@ -166,7 +171,72 @@ async fn pick_adapter(instance: &wgpu::Instance) -> Result<wgpu::Adapter> {
         })
 }
 
-/// Runs `f` inside a validation error scope and turns a captured error into `make_err`.
+thread_local! {
+    /// wgpu errors raised outside any error scope (an allocation that ran out of memory, a lost
+    /// device), per watched device, until [`take_uncaptured`] hands them to the caller. wgpu
+    /// reports an error in the thread whose call failed, so each thread keeps its own: tests
+    /// and workers sharing a process never see each other's (device ids repeat across
+    /// instances in one process, so the key alone could not tell them apart).
+    static UNCAPTURED: RefCell<HashMap<u64, Vec<String>>> = RefCell::new(HashMap::new());
+}
+
+fn device_key(device: &wgpu::Device) -> u64 {
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    device.hash(&mut h);
+    h.finish()
+}
+
+fn push_uncaptured(key: u64, message: String) {
+    UNCAPTURED.with(|u| u.borrow_mut().entry(key).or_default().push(message));
+}
+
+/// Collects `device`'s uncaptured errors and its loss for [`take_uncaptured`], which
+/// [`scoped`], [`submit_and_wait`] and [`read_buffer`] call: an error wgpu raises outside a
+/// scope fails the next of those calls in the same thread instead of being logged while the
+/// work "succeeds". [`Gpu::new`] does this for its device; a host may call it for its own.
+pub fn watch_uncaptured(device: &wgpu::Device) {
+    let key = device_key(device);
+    UNCAPTURED.with(|u| u.borrow_mut().insert(key, Vec::new()));
+    device.on_uncaptured_error(Arc::new(move |e| {
+        push_uncaptured(key, one_line(&e.to_string()))
+    }));
+    device.set_device_lost_callback(move |reason, message| {
+        push_uncaptured(
+            key,
+            format!("device lost ({reason:?}): {}", one_line(&message)),
+        );
+    });
+}
+
+/// The errors `device` raised outside any scope since the last call, as one error.
+pub fn take_uncaptured(device: &wgpu::Device) -> Result<()> {
+    let key = device_key(device);
+    let errors = UNCAPTURED.with(|u| u.borrow_mut().remove(&key).unwrap_or_default());
+    match errors.as_slice() {
+        [] => Ok(()),
+        [first, rest @ ..] => Err(Error::Gpu {
+            stage: "device".into(),
+            message: if rest.is_empty() {
+                first.clone()
+            } else {
+                format!("{first} (and {} more)", rest.len())
+            },
+        }),
+    }
+}
+
+/// wgpu's multi-line error text as one line: its lines trimmed and joined with `: `.
+pub fn one_line(message: &str) -> String {
+    let parts: Vec<&str> = message
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect();
+    parts.join(": ")
+}
+
+/// Runs `f` inside a validation error scope and turns a captured error into `make_err` (one
+/// line); an earlier uncaptured error on the device comes first.
 pub fn scoped<T>(
     device: &wgpu::Device,
     f: impl FnOnce() -> T,
@@ -174,13 +244,16 @@ pub fn scoped<T>(
 ) -> Result<T> {
     let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let out = f();
-    match pollster::block_on(scope.pop()) {
+    let popped = pollster::block_on(scope.pop());
+    take_uncaptured(device)?;
+    match popped {
         None => Ok(out),
-        Some(e) => Err(make_err(e.to_string())),
+        Some(e) => Err(make_err(one_line(&e.to_string()))),
     }
 }
 
-/// Submits `encoder`, waits for completion, and reports any validation error as `stage`.
+/// Submits `encoder`, waits for completion, and reports any validation error (or any error the
+/// device raised outside a scope since the last check) as `stage`.
 pub fn submit_and_wait(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
@@ -194,8 +267,8 @@ pub fn submit_and_wait(
     scoped(device, || queue.submit([encoder.finish()]), gpu_err)?;
     device
         .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| gpu_err(e.to_string()))?;
-    Ok(())
+        .map_err(|e| gpu_err(one_line(&e.to_string())))?;
+    take_uncaptured(device)
 }
 
 /// Reads a whole buffer back (it must have `MAP_READ`); waits for the device.
@@ -218,6 +291,7 @@ pub fn read_buffer(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u
         stage: "readback".into(),
         message: e.to_string(),
     })?;
+    take_uncaptured(device)?;
     let data = buffer
         .get_mapped_range(..)
         .map_err(|e| Error::Gpu {

@@ -28,6 +28,8 @@ macro_rules! sources {
 /// Every WGSL file of the project; a test checks this against the `kernels/` folder.
 pub const SOURCES: &[Source] = sources![
     "copy",
+    "copy_texture",
+    "copy_texture_u32",
     "linearize",
     "shadow_depth",
     "gbuffer",

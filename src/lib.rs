@@ -11,12 +11,15 @@ pub mod gpu;
 pub mod graph;
 pub mod io;
 pub mod kernels;
+pub mod limits;
 pub mod prefilter;
 pub mod render;
 pub mod sat;
 pub mod scene;
 pub mod stability;
 pub mod technique;
+pub mod timer;
+pub mod tolerance;
 pub mod truth;
 
 pub use error::{Error, Result};

@@ -30,11 +30,11 @@ enum Command {
         /// Also write position, normal and per-light visibility as 32-bit float OpenEXR here.
         #[arg(long)]
         aux: Option<PathBuf>,
-        /// Print GPU time per node and for the shading pass.
+        /// Print GPU time per pass (timestamps between passes) and each frame's wall time.
         #[arg(long)]
         timings: bool,
-        /// Frames to render (timings are medians over them).
-        #[arg(long, default_value_t = 1)]
+        /// Frames to render (timings are medians over them), 1 to 1000.
+        #[arg(long, default_value_t = 1, value_parser = repeat_range())]
         repeat: u32,
     },
     /// Print the kernels a scene will run (per light), its resources and peak memory.
@@ -59,13 +59,14 @@ enum Command {
     },
     /// Print the adapter, its backend, and the features and limits that matter.
     Info,
-    /// Time kernels by GPU timestamps against a copy kernel over the same bytes.
+    /// Time kernels by GPU timestamps against a texture copy of their output's format (and the
+    /// texture copies against a buffer copy), bytes from the plan's cost model.
     Bench {
         /// Square map sizes.
         #[arg(long, value_delimiter = ',', default_value = "512,1024,2048,4096")]
         sizes: Vec<u32>,
-        /// Timed repetitions per kernel and size (the median is reported).
-        #[arg(long, default_value_t = 10)]
+        /// Timed repetitions per kernel and size (the median is reported), 1 to 1000.
+        #[arg(long, default_value_t = 10, value_parser = repeat_range())]
         repeat: u32,
         /// Instead: the shading pass's cost as the filter widens, PCF against summed-area
         /// tables, at these odd widths (texels).
@@ -73,7 +74,8 @@ enum Command {
         lookup: Option<Vec<u32>>,
     },
     /// Sweep techniques and their accuracy knobs, time each on the GPU and measure its error
-    /// against ground truth: report.md/.csv/.json, pareto.svg, grid.png (+ grid.txt).
+    /// against ground truth: report.html/.md/.csv/.json, pareto{,_penumbra,_flip}.svg, grid.png
+    /// (+ grid.txt).
     Evaluate {
         /// Scene file (TOML).
         scene: PathBuf,
@@ -93,14 +95,17 @@ enum Command {
         #[arg(long)]
         k: Option<u32>,
         /// Shadow-map side of the truth's samples (default max(2048, 2 × the light's map)).
-        #[arg(long)]
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
         truth_resolution: Option<u32>,
-        /// Timed frames per configuration (the median is reported).
-        #[arg(long, default_value_t = 5)]
+        /// Timed frames per configuration (the median is reported), 1 to 1000.
+        #[arg(long, default_value_t = 5, value_parser = repeat_range())]
         repeat: u32,
         /// Evaluate at this image size, WIDTHxHEIGHT (default: the scene's).
         #[arg(long, value_parser = parse_size)]
         image: Option<(u32, u32)>,
+        /// Run every MSM configuration at each of these moment biases (default: the storage's).
+        #[arg(long, value_delimiter = ',')]
+        moment_bias: Option<Vec<f32>>,
     },
     /// Run the numerical-stability suite: each hard input through the real kernels against its
     /// f64 reference and stated bound; exits non-zero when a check fails.
@@ -109,6 +114,11 @@ enum Command {
         #[arg(long)]
         large: bool,
     },
+}
+
+/// `--repeat` of every command: 1 to `render::MAX_REPEAT` frames (each keeps a row of timings).
+fn repeat_range() -> clap::builder::RangedI64ValueParser<u32> {
+    clap::value_parser!(u32).range(1..=i64::from(shadowgraph::render::MAX_REPEAT))
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -127,7 +137,23 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
 
 fn main() {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
-    if let Err(e) = run(Args::parse()) {
+    let args = match Args::try_parse() {
+        Ok(args) => args,
+        // A usage error is one line and status 1, as every other error (`--help` prints all).
+        Err(e)
+            if e.use_stderr()
+                && e.kind() != clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand =>
+        {
+            let text = e.to_string();
+            eprintln!(
+                "{}",
+                text.lines().next().unwrap_or("error: invalid arguments")
+            );
+            std::process::exit(1);
+        }
+        Err(e) => e.exit(),
+    };
+    if let Err(e) = run(args) {
         eprintln!("error: {e:#}");
         std::process::exit(1);
     }
@@ -165,6 +191,7 @@ fn run(args: Args) -> Result<()> {
             truth_resolution,
             repeat,
             image,
+            moment_bias,
         } => {
             let opts = shadowgraph::evaluate::EvaluateOptions {
                 techniques,
@@ -174,6 +201,7 @@ fn run(args: Args) -> Result<()> {
                 truth_resolution,
                 repeat: if quick { repeat.min(1) } else { repeat },
                 image,
+                moment_biases: moment_bias,
             };
             let gpu = Gpu::new()?;
             print!("{}", shadowgraph::evaluate::run(&gpu, &scene, &out, &opts)?);

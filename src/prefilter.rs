@@ -32,10 +32,11 @@ pub use config::{LightParams, PrefilterConfig};
 pub use error::StageError;
 
 use crate::error::{Error, Result};
-use crate::exec::{Executor, GpuTimer};
+use crate::exec::Executor;
 use crate::graph::{Graph, Plan, plan};
 use crate::scene::Light;
 use crate::technique::{self, LightGpu};
+use crate::timer::{GpuTimer, TIMER_FEATURES};
 
 /// Depth formats the `linearize` kernel reads (as unfilterable float, depth aspect only).
 pub const DEPTH_FORMATS: [wgpu::TextureFormat; 5] = [
@@ -171,7 +172,7 @@ impl Prefilter {
             &imports,
             self.timer.as_mut(),
         )?;
-        if let Some(t) = &self.timer {
+        if let Some(t) = self.timer.as_mut() {
             t.resolve(encoder);
         }
         let maps = self
@@ -220,12 +221,13 @@ impl Prefilter {
         wgsl::needs_comparison_sampler(&self.config.technique)
     }
 
-    /// Times each kernel from now on with GPU timestamps; an error when the device was created
-    /// without `TIMESTAMP_QUERY`.
+    /// Times each kernel from now on with GPU timestamps written between the stage's passes
+    /// ([`GpuTimer`]); an error when the device was created without `TIMESTAMP_QUERY` and
+    /// `TIMESTAMP_QUERY_INSIDE_ENCODERS`.
     pub fn enable_timing(&mut self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<()> {
-        let passes = self.planned.plan.steps.len().max(1) as u32;
-        let timer = GpuTimer::new(device, queue, passes).ok_or(StageError::MissingFeature {
-            feature: wgpu::Features::TIMESTAMP_QUERY,
+        let spans = self.planned.plan.steps.len().max(1) as u32;
+        let timer = GpuTimer::new(device, queue, spans).ok_or(StageError::MissingFeature {
+            feature: TIMER_FEATURES.difference(device.features()),
             needed_for: "per-kernel GPU timing",
         })?;
         self.timer = Some(timer);

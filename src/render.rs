@@ -132,27 +132,41 @@ pub fn plan_lights(lights: &[Light]) -> Result<ScenePlan> {
     })
 }
 
-/// Checks sizes against the device's limits, naming the offending key.
+/// Checks `scene` against the device's limits, features and the memory budget
+/// ([`crate::limits::memory_budget`]) for a default render, before anything is created;
+/// errors name the scene key that would fix them, with its line.
 pub fn check_limits(device: &wgpu::Device, scene: &Scene) -> Result<()> {
-    let max = device.limits().max_texture_dimension_2d;
-    let check = |what: String, v: u32| {
-        if v > max {
-            Err(Error::Limit {
-                what,
-                requested: u64::from(v),
-                limit: u64::from(max),
-            })
-        } else {
-            Ok(())
-        }
-    };
-    check("output.width".into(), scene.width)?;
-    check("output.height".into(), scene.height)?;
-    for (i, l) in scene.lights.iter().enumerate() {
-        check(format!("light[{i}].shadow_map"), l.shadow_map)?;
-    }
-    check_features(device, &scene.lights)
+    check_render(device, scene, &RenderOptions::default())
 }
+
+/// [`check_limits`] for a render with `opts` (read-backs of `aux` and `dump` count too), and
+/// `opts.repeat` at most [`MAX_FRAMES`].
+pub fn check_render(device: &wgpu::Device, scene: &Scene, opts: &RenderOptions) -> Result<()> {
+    if opts.repeat > MAX_FRAMES {
+        return Err(Error::Invalid(format!(
+            "repeat = {} is more than {MAX_FRAMES} frames",
+            opts.repeat
+        )));
+    }
+    let sp = plan_lights(&scene.lights)?;
+    crate::limits::check_scene(
+        scene,
+        &sp,
+        &device.limits(),
+        device.features(),
+        opts,
+        crate::limits::memory_budget()?,
+    )
+}
+
+/// Most frames a command's `--repeat` may ask for. Timings keep one row per frame, and on lavapipe (Mesa
+/// 22.3.6) every dispatch of the shading kernel keeps about 235 KB that the driver does not
+/// return (traced in the README), so 1000 frames bound that to about 240 MB.
+pub const MAX_REPEAT: u32 = 1000;
+
+/// Most frames one [`Renderer::render`] call may run: [`MAX_REPEAT`] timed frames and as many
+/// warm-up frames (`evaluate` and `bench` add theirs to the timed ones).
+pub const MAX_FRAMES: u32 = 2 * MAX_REPEAT;
 
 /// Checks that the device offers the features the lights' techniques need.
 pub fn check_features(device: &wgpu::Device, lights: &[Light]) -> Result<()> {
@@ -217,8 +231,12 @@ pub struct Frame {
     pub position: Vec<f32>,
     /// Normal + material per pixel (`aux` only).
     pub normal: Vec<f32>,
-    /// Per frame, milliseconds per timed pass (empty when the device cannot time).
+    /// Per frame, milliseconds per timed pass (empty when the device cannot time): GPU
+    /// timestamps at the boundaries between passes, so consecutive passes share their bounds.
     pub timings: Vec<Vec<(String, f64)>>,
+    /// Per frame, wall-clock milliseconds from submitting the frame's commands to their
+    /// completion (what the passes' times should add up to, less submission overhead).
+    pub wall_ms: Vec<f64>,
     /// Steps whose kernels reported replaced texels (non-finite depth), with the count.
     pub sanitized: Vec<(String, u32)>,
     /// Per light, the map its shading reads (level 0): raw depth, linear depth or a filtered
@@ -499,7 +517,7 @@ impl Renderer {
         scene: &Scene,
         opts: RenderOptions,
     ) -> Result<Frame> {
-        check_limits(device, scene)?;
+        check_render(device, scene, &opts)?;
         let mut sp = plan_lights(&scene.lights)?;
         if opts.dump {
             // Everything is read back after the frame: no resource may share a texture.
@@ -556,10 +574,11 @@ impl Renderer {
             .enumerate()
             .map(|(i, t)| (technique::depth_name(i), t.clone()))
             .collect();
-        let passes = 2 * scene.lights.len() as u32 + sp.plan.steps.len() as u32 + 2;
-        let mut timer = GpuTimer::new(device, queue, passes);
+        let spans = scene.lights.len() as u32 + sp.plan.steps.len() as u32 + 2;
+        let mut timer = GpuTimer::new(device, queue, spans);
         let repeat = opts.repeat.max(1);
         let mut timings = Vec::new();
+        let mut wall_ms = Vec::new();
         let mut last = None;
         for _ in 0..repeat {
             if let Some(t) = timer.as_mut() {
@@ -610,11 +629,13 @@ impl Renderer {
                 &maps,
                 timer.as_mut(),
             )?;
-            outputs.copy_stats(&mut enc);
-            if let Some(t) = timer.as_ref() {
+            if let Some(t) = timer.as_mut() {
                 t.resolve(&mut enc);
             }
+            outputs.copy_stats(&mut enc);
+            let submitted = std::time::Instant::now();
             submit_and_wait(device, queue, enc, "render")?;
+            wall_ms.push(submitted.elapsed().as_secs_f64() * 1e3);
             if let Some(t) = timer.as_ref() {
                 timings.push(t.read(device)?);
             }
@@ -637,6 +658,7 @@ impl Renderer {
             position: Vec::new(),
             normal: Vec::new(),
             timings,
+            wall_ms,
             sanitized,
             shade_maps: Vec::new(),
             shade_mips: Vec::new(),
@@ -739,12 +761,14 @@ impl Renderer {
             }],
         });
         let view = depth.create_view(&Default::default());
-        let timestamp_writes = timer.and_then(|t| t.render_pass(raster.label));
+        if let Some(t) = timer {
+            t.begin(enc, raster.label);
+        }
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(raster.label),
             color_attachments: &[],
             depth_stencil_attachment: Some(clear_depth(&view)),
-            timestamp_writes,
+            timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
         });
@@ -813,12 +837,14 @@ impl Renderer {
                 },
             })
         };
-        let timestamp_writes = timer.and_then(|t| t.render_pass("gbuffer"));
+        if let Some(t) = timer {
+            t.begin(enc, "gbuffer");
+        }
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("gbuffer"),
             color_attachments: &[clear(&pv), clear(&nv)],
             depth_stencil_attachment: Some(clear_depth(&dv)),
-            timestamp_writes,
+            timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
         });
@@ -943,10 +969,12 @@ impl Renderer {
             err,
         )?;
         let groups = kernel.groups_for(w, h);
-        let timestamp_writes = timer.and_then(|t| t.compute_pass("shade"));
+        if let Some(t) = timer {
+            t.begin(enc, "shade");
+        }
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("shade"),
-            timestamp_writes,
+            timestamp_writes: None,
         });
         pass.set_pipeline(&kernel.pipeline);
         pass.set_bind_group(0, &bg0, &[]);

@@ -167,17 +167,18 @@ impl LightGpu {
         };
         let (moment_bias, msm_flags) = match light.shadow.technique {
             Technique::Msm {
-                prefilter,
                 hausdorff,
                 moment_bias,
                 ..
-            } => (moment_bias, msm_flags(hausdorff, prefilter.storage)),
-            Technique::MsmSoft {
-                soft,
+            }
+            | Technique::MsmSoft {
                 hausdorff,
                 moment_bias,
                 ..
-            } => (moment_bias, msm_flags(hausdorff, soft.storage)),
+            } => (
+                moment_bias,
+                msm_flags(hausdorff, msm_quantized(&light.shadow.technique)),
+            ),
             _ => (0.0, 0),
         };
         let (csm_terms, csm_attenuation, csm_offset, csm_scale) = match light.shadow.technique {
@@ -281,9 +282,9 @@ impl LightGpu {
     }
 }
 
-/// The MSM flags of a reconstruction and storage.
-fn msm_flags(hausdorff: bool, storage: Storage) -> u32 {
-    u32::from(hausdorff) * MSM_HAUSDORFF + u32::from(msm_quantized(storage)) * MSM_QUANTIZED
+/// The MSM flags of a reconstruction and representation.
+fn msm_flags(hausdorff: bool, quantized: bool) -> u32 {
+    u32::from(hausdorff) * MSM_HAUSDORFF + u32::from(quantized) * MSM_QUANTIZED
 }
 
 /// The largest square a soft technique reads (blocker search or filter), in texels:
@@ -368,10 +369,9 @@ fn value_range(technique: &Technique) -> ([f32; 4], [f32; 4]) {
             (hi.map(|v| -v), hi)
         }
         Technique::Esm { .. } => ([-1.0, 0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]),
-        Technique::Msm { prefilter, .. } if msm_quantized(prefilter.storage) => {
+        Technique::Msm { .. } | Technique::MsmSoft { .. } if msm_quantized(technique) => {
             quantized_msm_range()
         }
-        Technique::MsmSoft { soft, .. } if msm_quantized(soft.storage) => quantized_msm_range(),
         Technique::Csm { .. } | Technique::Cssm { .. } => ([-1.0; 4], [1.0; 4]),
         _ => ([0.0; 4], [1.0; 4]),
     }
@@ -520,7 +520,7 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
         } => {
             let format = moments_format(storage, 4);
             let params = bytemuck::bytes_of(&MsmParams {
-                quantized: u32::from(msm_quantized(storage)),
+                quantized: u32::from(msm_quantized(&light.shadow.technique)),
                 _pad: [0; 3],
             })
             .to_vec();
@@ -654,10 +654,21 @@ pub fn mip_levels(width: u32, height: u32) -> u32 {
     32 - width.max(height).max(1).leading_zeros()
 }
 
-/// Whether MSM at `storage` keeps its moments through the optimized quantization (every
-/// 16-bit storage does; f32 keeps the raw powers).
-pub fn msm_quantized(storage: Storage) -> bool {
-    storage != Storage::F32
+/// Whether an MSM technique keeps its moments through the optimized quantization: every
+/// 16-bit storage does, and so does every summed-area table (`msm_soft`, `filter = "sat"`),
+/// whatever the storage. A table rounds each moment on its own to the coding's step (10⁻⁵ of
+/// the range for the default soft search cap on a 1024² map); in the raw basis that noise
+/// lands in the Hankel matrix's near-null directions, in the quantized basis it does not
+/// (README, "MSM moment bias": a 10× smaller error behind a flat occluder at the same bias).
+/// Other f32 maps keep the raw powers.
+pub fn msm_quantized(technique: &Technique) -> bool {
+    match technique {
+        Technique::Msm { prefilter, .. } => {
+            prefilter.storage != Storage::F32 || matches!(prefilter.filter, Filter::Sat { .. })
+        }
+        Technique::MsmSoft { .. } => true,
+        _ => false,
+    }
 }
 
 /// Four-channel basis maps CSM with `terms` terms needs (two channels per term).

@@ -379,11 +379,13 @@ fn blocker_estimates_match_reference() {
         2,
     );
 
-    // MSM: the biased moments ± the table error (raw f32 moments) and Cholesky's.
+    // MSM: the moments ± the table error (carried through the dequantization) and the solve's
+    // backward error, then projected and biased as the kernel does.
     let l = common::soft_maps::light(DIR, msm_soft(Storage::F32, false));
     let lg = LightGpu::new(&l);
     let coding = sat_coding(&l).expect("coding").expect("table");
-    let t = tables(&rounded(cpu::msm::msm(&lin, false)), &coding);
+    let quantized = shadowgraph::technique::msm_quantized(&l.shadow.technique);
+    let t = tables(&rounded(cpu::msm::msm(&lin, quantized)), &coding);
     let (integral, err) = (
         Integral::new(&t.decoded),
         TableError::new(&t.decoded, &coding),
@@ -399,10 +401,10 @@ fn blocker_estimates_match_reference() {
             let w = f64::from(q[i][2]);
             let e = err.mean(&lg, &s, w);
             let m = integral.square_mean(lg.map_size, s.uv, w);
-            let b = cpu::vis_msm::biased(&m, &lg);
+            let b = cpu::vis_msm::dequantized(&m, &lg);
             let p: [f64; 4] =
                 std::array::from_fn(|c| b[c] + sg[c] * (e[c] + 32.0 * 2f64.powi(-24) * b[c].abs()));
-            cpu::blocker::msm(p, s.depth)
+            cpu::blocker::msm(&cpu::vis_msm::bias_for(p, &lg), s.depth)
         },
         4,
     );

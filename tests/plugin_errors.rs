@@ -340,11 +340,28 @@ fn timing_without_timestamps_is_a_missing_feature() {
             feature,
             needed_for,
         })) => {
-            assert_eq!(feature, wgpu::Features::TIMESTAMP_QUERY);
+            assert_eq!(feature, shadowgraph::timer::TIMER_FEATURES);
             assert!(needed_for.contains("timing"));
         }
         Err(e) => panic!("{e}"),
         Ok(()) => panic!("timing enabled without TIMESTAMP_QUERY"),
+    }
+    // Pass timestamps alone are not enough: the timer writes between passes.
+    let (passes_only, queue) =
+        pollster::block_on(g.adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("pass timestamps only"),
+            required_features: wgpu::Features::TIMESTAMP_QUERY,
+            required_limits: g.adapter.limits(),
+            ..Default::default()
+        }))
+        .expect("a device with TIMESTAMP_QUERY (lavapipe has it)");
+    let mut stage = Prefilter::new(&passes_only, &PrefilterConfig::esm(64)).expect("stage");
+    match stage.enable_timing(&passes_only, &queue) {
+        Err(Error::Stage(StageError::MissingFeature { feature, .. })) => {
+            assert_eq!(feature, wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);
+        }
+        Err(e) => panic!("{e}"),
+        Ok(()) => panic!("timing enabled without TIMESTAMP_QUERY_INSIDE_ENCODERS"),
     }
 }
 

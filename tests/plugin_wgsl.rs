@@ -183,6 +183,7 @@ fn constructors_have_the_scene_defaults() {
         ("cssm", PrefilterConfig::cssm(64, 8, 0.5), 0.5),
         ("vssm", PrefilterConfig::vssm(64, 0.5), 0.5),
         ("msm_soft", PrefilterConfig::msm_soft(64, 0.5), 0.5),
+        ("msm", PrefilterConfig::msm(64), 0.0),
     ] {
         let scene = scene_with(name, "", light_size).expect("scene");
         let from_scene = PrefilterConfig::from_light(&scene.lights[0]);
@@ -330,8 +331,46 @@ fn configs_follow_the_scene_rules() {
             "format = \"f16\"\nsat_sums = \"float\"\nmax_search = 0.3\nmoment_bias = 0.00001",
             0.5,
             PrefilterConfig::msm_soft(64, 0.5)
+                .with_moment_bias(1e-5)
                 .with_storage(Storage::F16)
                 .with_soft(shadowgraph::sat::SatVariant::Float, 0.3),
+        ),
+        // MSM's bias follows the storage's default unless set, and is checked as the key is.
+        (
+            "msm",
+            "format = \"f16\"",
+            0.0,
+            PrefilterConfig::msm(64).with_storage(Storage::F16),
+        ),
+        (
+            "msm",
+            "format = \"unorm16\"",
+            0.0,
+            PrefilterConfig::msm(64).with_storage(Storage::Unorm16),
+        ),
+        (
+            "msm_soft",
+            "format = \"f16\"",
+            0.5,
+            PrefilterConfig::msm_soft(64, 0.5).with_storage(Storage::F16),
+        ),
+        (
+            "msm",
+            "moment_bias = 0.003",
+            0.0,
+            PrefilterConfig::msm(64).with_moment_bias(0.003),
+        ),
+        (
+            "msm",
+            "moment_bias = 0.6",
+            0.0,
+            PrefilterConfig::msm(64).with_moment_bias(0.6),
+        ),
+        (
+            "msm_soft",
+            "moment_bias = -0.001",
+            0.5,
+            PrefilterConfig::msm_soft(64, 0.5).with_moment_bias(-0.001),
         ),
         (
             "vssm",
@@ -388,6 +427,11 @@ fn settings_that_do_not_apply_are_named() {
         .validated()
         .unwrap_err();
     assert!(e.to_string().contains("filter"), "{e}");
+    let e = PrefilterConfig::vsm(64)
+        .with_moment_bias(1e-4)
+        .validated()
+        .unwrap_err();
+    assert!(e.to_string().contains("moment_bias"), "{e}");
     let e = PrefilterConfig::vsm(0).validated().unwrap_err();
     assert!(e.to_string().contains("size"), "{e}");
     let e = PrefilterConfig::vsm(64)

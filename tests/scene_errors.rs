@@ -1042,7 +1042,7 @@ fn soft_techniques_keys_defaults_and_errors() {
                 max_search: 0.05,
             },
             hausdorff: true,
-            moment_bias: 6e-5,
+            moment_bias: shadowgraph::scene::default_soft_moment_bias(Storage::Unorm16),
             bleed: 0.0,
         }
     );

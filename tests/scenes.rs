@@ -310,7 +310,8 @@ fn check_prefilter_chain(scene: &Scene, frame: &shadowgraph::render::Frame, li: 
                 )
             }
             Technique::Msm { prefilter, .. } => {
-                let quantized = shadowgraph::technique::msm_quantized(prefilter.storage);
+                let quantized =
+                    shadowgraph::technique::msm_quantized(&scene.lights[li].shadow.technique);
                 let f = move |t: &Texels| cpu::msm::msm(t, quantized);
                 (
                     Box::new(f) as Box<dyn Fn(&Texels) -> Texels>,
@@ -344,7 +345,8 @@ fn check_prefilter_chain(scene: &Scene, frame: &shadowgraph::render::Frame, li: 
                 1e-6,
             ),
             Technique::MsmSoft { soft, .. } => {
-                let quantized = shadowgraph::technique::msm_quantized(soft.storage);
+                let quantized =
+                    shadowgraph::technique::msm_quantized(&scene.lights[li].shadow.technique);
                 let f = move |t: &Texels| cpu::msm::msm(t, quantized);
                 (
                     Box::new(f) as Box<dyn Fn(&Texels) -> Texels>,
@@ -498,10 +500,12 @@ fn shadow_map_past_the_device_limit_is_a_clear_error() {
     scene.lights[0].shadow_map = max + 1;
     let mut renderer = Renderer::new(&g.device);
     match renderer.render(&g.device, &g.queue, &scene, RenderOptions::default()) {
-        Err(e @ Error::Limit { .. }) => {
+        Err(e @ Error::SceneLimit { .. }) => {
             let m = e.to_string();
             assert!(
-                m.contains("light[0].shadow_map") && m.contains(&max.to_string()),
+                m.starts_with("limit.toml:")
+                    && m.contains("light[0].shadow_map")
+                    && m.contains(&max.to_string()),
                 "{m}"
             );
         }

@@ -230,3 +230,35 @@ fn case7_deep_and_shallow_frusta() {
         find(&rows, "depth-buffer step", light, "depth32float");
     }
 }
+
+/// MSM with the receiver 10⁻⁵–10⁻¹ behind a flat occluder, at the default moment biases:
+/// within 0.01 (f32), 0.03 (unorm16), 0.05 (soft MSM's tables) or 0.25 (f16) of exact MSM on
+/// the point mass.
+#[test]
+fn case8_msm_behind_a_flat_occluder() {
+    let rows = run_case(8, stability::msm_contact_case);
+    for (technique, storage) in [
+        ("msm hamburger", "f32"),
+        ("msm hamburger", "f16"),
+        ("msm_soft", "f32"),
+        ("msm_soft", "f16"),
+    ] {
+        let r = find(&rows, "behind a flat occluder", technique, storage);
+        assert_eq!(r.verdict, Verdict::Pass, "{technique} {storage}");
+        assert!(
+            r.values > 150,
+            "{technique} {storage}: {} receivers",
+            r.values
+        );
+    }
+    let g = common::gpu();
+    if g.device
+        .features()
+        .contains(wgpu::Features::TEXTURE_FORMAT_16BIT_NORM)
+    {
+        for technique in ["msm hamburger", "msm_soft"] {
+            let r = find(&rows, "behind a flat occluder", technique, "unorm16");
+            assert_eq!(r.verdict, Verdict::Pass, "{technique} unorm16");
+        }
+    }
+}

@@ -36,19 +36,19 @@
 //   fn vis_msm_soft_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
 //
 // Names defined here (a host must not reuse them):
-//   BLOCKER_MIN_SHARE CSM_PI GOLDEN_ANGLE Light LightSample MSM_B0 MipTaps SAT_MIN_EXTENT
-//   SatNodes bilinear_level bilinear_log_level blocker_csm_z blocker_filter_width blocker_msm
-//   blocker_result blocker_search_width blocker_vsm blocker_width chebyshev_upper csm_chunk
-//   csm_chunk_of csm_resolve csm_sin_cos csm_weight csm_z_chunk_of cssm_blocker cssm_resolve
-//   cssm_sharpen level_size light_footprint light_linear_to_ndc light_linear_to_z
-//   light_map_width light_sample light_to_light linstep load_depth mip_tap_uv mip_taps
-//   msm_biased msm_dequantize msm_intensity msm_quantize msm_roots msm_soft_blocker
-//   msm_soft_resolve pcss_search_radius sample_bilinear sample_bilinear_log sample_map
-//   sample_map_log sat_mean_fixed sat_mean_float sat_node_f32 sat_node_u32 sat_nodes sat_rect
-//   sat_sample_fixed sat_sample_float texel_of trilinear trilinear_log vis_esm vis_esm_of_log
-//   vis_esm_of_sat vis_evsm vis_evsm_of vis_hard vis_msm vis_msm_of vis_msm_soft_fixed
-//   vis_msm_soft_float vis_pcf vis_pcf_hardware vis_pcss vis_vsm vis_vsm_of vis_vssm_fixed
-//   vis_vssm_float vogel_disc vssm_blocker vssm_resolve
+//   BLOCKER_MIN_SHARE CSM_PI GOLDEN_ANGLE Light LightSample MSM_B0 MSM_B0_COV MSM_B0_SCHUR
+//   MipTaps MsmMoments SAT_MIN_EXTENT SatNodes bilinear_level bilinear_log_level blocker_csm_z
+//   blocker_filter_width blocker_msm blocker_result blocker_search_width blocker_vsm
+//   blocker_width chebyshev_upper csm_chunk csm_chunk_of csm_resolve csm_sin_cos csm_weight
+//   csm_z_chunk_of cssm_blocker cssm_resolve cssm_sharpen level_size light_footprint
+//   light_linear_to_ndc light_linear_to_z light_map_width light_sample light_to_light linstep
+//   load_depth mip_tap_uv mip_taps msm_biased msm_dequantize msm_expect msm_intensity
+//   msm_moments msm_quantize msm_roots msm_soft_blocker msm_soft_resolve pcss_search_radius
+//   sample_bilinear sample_bilinear_log sample_map sample_map_log sat_mean_fixed sat_mean_float
+//   sat_node_f32 sat_node_u32 sat_nodes sat_rect sat_sample_fixed sat_sample_float texel_of
+//   trilinear trilinear_log vis_esm vis_esm_of_log vis_esm_of_sat vis_evsm vis_evsm_of vis_hard
+//   vis_msm vis_msm_of vis_msm_soft_fixed vis_msm_soft_float vis_pcf vis_pcf_hardware vis_pcss
+//   vis_vsm vis_vsm_of vis_vssm_fixed vis_vssm_float vogel_disc vssm_blocker vssm_resolve
 
 // Shared light description and light-space helpers (import-only module).
 //
@@ -183,6 +183,7 @@ fn texel_of(uv: vec2<f32>, size: vec2<f32>) -> vec2<i32> {
 }
 
 // Linear depth at texel t, clamped to the edge.
+// #fetches load_depth: 1
 fn load_depth(map: texture_2d<f32>, t: vec2<i32>) -> f32 {
     let size = vec2<i32>(textureDimensions(map));
     return textureLoad(map, clamp(t, vec2<i32>(0), size - 1), 0).r;
@@ -191,6 +192,7 @@ fn load_depth(map: texture_2d<f32>, t: vec2<i32>) -> f32 {
 // Bilinear interpolation of all four channels at uv (texel centres at (i + ½) / size),
 // clamp-to-edge, from four loads: exact and filter-feature independent (f32 maps need not be
 // filterable).
+// #fetches sample_bilinear: 4
 fn sample_bilinear(map: texture_2d<f32>, uv: vec2<f32>) -> vec4<f32> {
     return bilinear_level(map, uv, 0);
 }
@@ -203,6 +205,7 @@ fn level_size(map: texture_2d<f32>, level: i32) -> vec2<f32> {
 }
 
 // `sample_bilinear` on mip `level` (texel centres at (i + ½) / level size).
+// #fetches bilinear_level: 4
 fn bilinear_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> vec4<f32> {
     let size = level_size(map, level);
     let f = uv * size - 0.5;
@@ -217,6 +220,7 @@ fn bilinear_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> vec4<f32> 
 }
 
 // Trilinear sample of a mip chain at `lod` (clamped to the chain).
+// #fetches trilinear: 8
 fn trilinear(map: texture_2d<f32>, l: Light, uv: vec2<f32>, lod_in: f32) -> vec4<f32> {
     let lod = clamp(lod_in, 0.0, f32(l.mip_levels - 1u));
     let l0 = i32(floor(lod));
@@ -265,6 +269,7 @@ fn mip_tap_uv(t: MipTaps, uv: vec2<f32>, k: u32) -> vec2<f32> {
 // trilinear at log2(filter width), or along the pixel's footprint (`mip_taps`). The loop runs
 // `max_anisotropy` times for every invocation and weights the taps past `count` by 0: no
 // invocation leaves the loop early (llvmpipe mis-fetches explicit levels under divergence).
+// #fetches sample_map: select(4, 8 * max(l.max_anisotropy, 1), l.mip_levels > 1)
 fn sample_map(map: texture_2d<f32>, l: Light, s: LightSample) -> vec4<f32> {
     if l.mip_levels <= 1u {
         return sample_bilinear(map, s.uv);
@@ -279,6 +284,7 @@ fn sample_map(map: texture_2d<f32>, l: Light, s: LightSample) -> vec4<f32> {
 }
 
 // Trilinear sample of a map of logarithms at `lod`, as a logarithm.
+// #fetches trilinear_log: 8
 fn trilinear_log(map: texture_2d<f32>, l: Light, uv: vec2<f32>, lod_in: f32) -> f32 {
     let lod = clamp(lod_in, 0.0, f32(l.mip_levels - 1u));
     let l0 = i32(floor(lod));
@@ -297,12 +303,14 @@ fn linstep(lo: f32, hi: f32, x: f32) -> f32 {
 
 // Bilinear interpolation of exp(v) for a map of logarithms v (channel 0), returned as a
 // logarithm: log Σ wᵢ exp(vᵢ), evaluated around the largest tap so nothing overflows.
+// #fetches sample_bilinear_log: 4
 fn sample_bilinear_log(map: texture_2d<f32>, uv: vec2<f32>) -> f32 {
     return bilinear_log_level(map, uv, 0);
 }
 
 // `sample_map` for a map of logarithms: the same weights applied to exp(v), as a logarithm
 // (taps combined around the largest so far, so nothing overflows).
+// #fetches sample_map_log: select(4, 8 * max(l.max_anisotropy, 1), l.mip_levels > 1)
 fn sample_map_log(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     if l.mip_levels <= 1u {
         return sample_bilinear_log(map, s.uv);
@@ -322,6 +330,7 @@ fn sample_map_log(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
 }
 
 // `sample_bilinear_log` on mip `level`.
+// #fetches bilinear_log_level: 4
 fn bilinear_log_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> f32 {
     let size = level_size(map, level);
     let f = uv * size - 0.5;
@@ -339,6 +348,7 @@ fn bilinear_log_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> f32 {
 }
 // Hard shadow test (Williams 1978): lit when d ≤ z_map + bias at the nearest texel.
 
+// #fetches vis_hard: 1
 fn vis_hard(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     let z = load_depth(map, texel_of(s.uv, l.map_size));
     return select(0.0, 1.0, s.depth <= z + l.bias);
@@ -346,6 +356,7 @@ fn vis_hard(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
 // Percentage-closer filtering (Reeves et al. 1987): the weighted mean of comparison results
 // over a (2r + 1)² window around the receiver's texel — never a filter of depths.
 
+// #fetches vis_pcf: (2 * l.radius + 1) * (2 * l.radius + 1)
 fn vis_pcf(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     let c = texel_of(s.uv, l.map_size);
     let r = i32(l.radius);
@@ -366,6 +377,7 @@ fn vis_pcf(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
 }
 
 // The hardware 2×2 comparison: bilinear weights of four comparisons against the raw depth map.
+// #fetches vis_pcf_hardware: 1
 fn vis_pcf_hardware(map: texture_depth_2d, cmp: sampler_comparison, l: Light, s: LightSample) -> f32 {
     let reference = light_linear_to_ndc(l, clamp(s.depth - l.bias, 0.0, 1.0));
     return textureSampleCompareLevel(map, cmp, s.uv, reference);
@@ -381,6 +393,7 @@ fn pcss_search_radius(l: Light, s: LightSample) -> f32 {
     return min(world / light_map_width(l, l.near), l.max_search);
 }
 
+// #fetches vis_pcss: l.blocker_samples + l.filter_samples
 fn vis_pcss(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     let search = pcss_search_radius(l, s);
     var sum = 0.0;
@@ -409,6 +422,7 @@ fn vis_pcss(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
 //   σ² = max(E[z²] − μ², min_variance),  p_max = σ² / (σ² + (d − μ)²) for d > μ, else 1,
 // then the light-bleeding reduction linstep(bleed, 1, p_max).
 
+// #fetches vis_vsm: sample_map
 fn vis_vsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     return vis_vsm_of(sample_map(map, l, s), l, s);
 }
@@ -440,6 +454,7 @@ fn chebyshev_upper(mean: f32, mean_sq: f32, receiver: f32, floor: f32) -> f32 {
     return variance / (variance + t * t);
 }
 
+// #fetches vis_evsm: sample_map
 fn vis_evsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     return vis_evsm_of(sample_map(map, l, s), l, s);
 }
@@ -460,6 +475,7 @@ fn vis_evsm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
 // Exponential shadow maps: visibility = clamp(E[exp(c z)] · exp(−c d), 0, 1), with the filtered
 // moment kept as its logarithm L, so the product is exp(L − c d) and never overflows.
 
+// #fetches vis_esm: sample_map_log
 fn vis_esm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     return vis_esm_of_log(sample_map_log(map, l, s), l, s);
 }
@@ -480,6 +496,15 @@ fn vis_esm_of_log(log_moment: f32, l: Light, s: LightSample) -> f32 {
 // other support points of the distribution through d that matches b', and the fraction of it
 // in front of d is the shadow intensity (three cases by where d lies). Hausdorff: the same when
 // z₂, z₃ lie in [0, 1], else the four-point solution supported on [0, 1].
+//
+// f32: the Cholesky pivots are the covariances of (z, z²) under b' (Var z, and Var z² less
+// its regression on z). Formed from b' they cancel ~1-sized terms down to ~α-sized ones, and
+// the mix's own roundings land in them too. Here the covariances of the stored moments are
+// formed once (raw f32 moments projected onto valid ones first), the bias is added as a
+// mixture's covariance, a sum of non-negative terms, and each pivot is floored at α times
+// b₀'s, which no distribution's biased moments go below. Measured behind flat occluders at
+// α = 10⁻⁴ (README, "MSM moment bias"): the largest error against exact arithmetic 0.016
+// where the mix-then-Cholesky form gave 0.053 (raw f32 moments).
 // Degenerate moments (bias 0 on a flat map) fall back to the two-moment Chebyshev bound or the
 // step at the mean instead of dividing by zero.
 // The optimized 16-bit moment quantization of Peters & Klein (2015), section 4.3, and its
@@ -509,37 +534,95 @@ fn msm_dequantize(q: vec4<f32>) -> vec4<f32> {
 // Moments of {0, ½, 1} with weights (3/16, 10/16, 3/16): Peters' b₀ = (0, 0.375, 0, 0.375)
 // on [−1, 1], mapped to depth in [0, 1].
 const MSM_B0: vec4<f32> = vec4<f32>(0.5, 0.34375, 0.265625, 0.2265625);
+// Its covariances (Var z, Cov(z, z²), Var z²) and the Schur complement
+// Var z² − Cov(z, z²)²/Var z, exact in f32.
+const MSM_B0_COV: vec3<f32> = vec3<f32>(0.09375, 0.09375, 0.1083984375);
+const MSM_B0_SCHUR: f32 = 0.0146484375;
+
+// Biased moments as the reconstruction reads them: the raw moments (for Hausdorff's closed
+// form) and the mean, second moment and covariances of (z, z²).
+struct MsmMoments {
+    // (1 − α)·m + α·b₀.
+    b: vec4<f32>,
+    // Var z, Cov(z, z²), Var z² of the biased distribution.
+    cov: vec3<f32>,
+    // b'.yzw − b'.xyz and 1 − b'.x (Hausdorff), mixed from the data's and b₀'s differences
+    // rather than differenced after the mix (near z = 1 they are α-sized).
+    diff: vec3<f32>,
+    below_one: f32,
+    // The bias α.
+    alpha: f32,
+}
+
+// Data moments `m` (dequantized) biased by `alpha` toward MSM_B0, see the header. `project`:
+// raw moments, whose roundings are independent per channel, are first projected onto valid
+// ones (Var z, Var z² ≥ 0, |Cov(z, z²)| ≤ √(Var z·Var z²)); quantized ones are not: their
+// errors come through the dequantization's matrix, whose design keeps them out of the
+// near-null directions, and a clamp per entry would undo that.
+fn msm_moments(m: vec4<f32>, alpha: f32, project: bool) -> MsmMoments {
+    var c = vec3<f32>(m.y - m.x * m.x, m.z - m.x * m.y, m.w - m.y * m.y);
+    if project {
+        c.x = max(c.x, 0.0);
+        c.z = max(c.z, 0.0);
+        let limit = sqrt(c.x * c.z);
+        c.y = clamp(c.y, -limit, limit);
+    }
+    // A mixture's covariance: the parts' covariances plus that of their means,
+    // (1 − α)·C(m) + α·C(b₀) + α(1 − α)·e eᵀ, e the difference of the means of (z, z²).
+    let w = 1.0 - alpha;
+    let e = m.xy - MSM_B0.xy;
+    var out: MsmMoments;
+    out.b = w * m + alpha * MSM_B0;
+    out.cov = w * c + alpha * MSM_B0_COV + (alpha * w) * vec3<f32>(e.x * e.x, e.x * e.y, e.y * e.y);
+    out.alpha = alpha;
+    out.diff = w * (m.yzw - m.xyz) + alpha * (MSM_B0.yzw - MSM_B0.xyz);
+    out.below_one = w * (1.0 - m.x) + alpha * (1.0 - MSM_B0.x);
+    return out;
+}
 
 // The Hamburger reconstruction through d: (z₂, z₃, case) where z₂ ≤ z₃ are the other support
-// points of the three-point distribution that matches the biased moments b and has a point at
-// d (solve B c = (1, d, d²) by Cholesky, roots of c₃x² + c₂x + c₁). case 0: regular; 1: the
-// variance is (numerically) 0, a single point at b.x; 2: rank-deficient, two support points
-// (z₂, z₃ then meaningless).
-fn msm_roots(b: vec4<f32>, d: f32) -> vec3<f32> {
-    let var1 = b.y - b.x * b.x;
+// points of the three-point distribution that matches the biased moments and has a point at
+// d (solve B c = (1, d, d²) by B = L·diag(1, Var z, s)·Lᵀ, L = [[1], [μ, 1], [E z², ℓ, 1]],
+// ℓ = Cov(z, z²)/Var z, s = Var z² − ℓ·Cov(z, z²); roots of c₃x² + c₂x + c₁). The pivots
+// Var z and s are at least α times b₀'s (B ⪰ α·B₀ for the moments of any distribution), and
+// are floored there. case 0: regular; 1: the variance is (numerically) 0, a single point at
+// the mean; 2: rank-deficient, two support points (z₂, z₃ then meaningless).
+fn msm_roots(mm: MsmMoments, d: f32) -> vec3<f32> {
+    let var1 = max(mm.cov.x, mm.alpha * MSM_B0_COV.x);
     if !(var1 > 1e-12) {
         return vec3<f32>(0.0, 0.0, 1.0);
     }
-    let l32 = (b.z - b.x * b.y) / var1;
-    let d3 = b.w - b.y * b.y - l32 * l32 * var1;
+    let l32 = mm.cov.y / var1;
+    let d3 = max(mm.cov.z - l32 * mm.cov.y, mm.alpha * MSM_B0_SCHUR);
     if !(d3 > 0.0) {
         return vec3<f32>(0.0, 0.0, 2.0);
     }
     // Forward substitution, scaling by the diagonal, back substitution.
+    let b = mm.b;
     let y2 = d - b.x;
     let y3 = d * d - b.y - l32 * y2;
     let c3 = y3 / d3;
     let c2 = y2 / var1 - l32 * c3;
     let c1 = 1.0 - b.x * c2 - b.y * c3;
-    let p = c2 / c3;
-    let q = c1 / c3;
-    let r = sqrt(max(0.25 * p * p - q, 0.0));
-    return vec3<f32>(-0.5 * p - r, -0.5 * p + r, 0.0);
+    // The root of larger magnitude without cancellation, the other from Vieta's product
+    // c₁/c₃: −p/2 ± √(p²/4 − q) loses the smaller root when the other is far away (c₃ → 0,
+    // as behind a flat occluder), and with it the weights, which cancel against it.
+    let t = -0.5 * (c2 + select(-1.0, 1.0, c2 >= 0.0) * sqrt(max(c2 * c2 - 4.0 * c3 * c1, 0.0)));
+    let r1 = t / c3;
+    let r2 = c1 / t;
+    return vec3<f32>(min(r1, r2), max(r1, r2), 0.0);
 }
 
-// Shadow intensity (share of the depth distribution in front of d) from biased moments b.
-fn msm_intensity(b: vec4<f32>, d: f32, hausdorff: bool) -> f32 {
-    let roots = msm_roots(b, d);
+// E[(z − x)(z − y)] under the biased moments: (μ − x)(μ − y) + Var z, free of the
+// cancellation in E z² − (x + y)·μ + x·y.
+fn msm_expect(mm: MsmMoments, x: f32, y: f32) -> f32 {
+    return (mm.b.x - x) * (mm.b.x - y) + mm.cov.x;
+}
+
+// Shadow intensity (share of the depth distribution in front of d) from biased moments.
+fn msm_intensity(mm: MsmMoments, d: f32, hausdorff: bool) -> f32 {
+    let b = mm.b;
+    let roots = msm_roots(mm, d);
     if roots.z == 1.0 {
         return select(0.0, 1.0, d > b.x);
     }
@@ -549,42 +632,48 @@ fn msm_intensity(b: vec4<f32>, d: f32, hausdorff: bool) -> f32 {
             return 0.0;
         }
         let t = d - b.x;
-        return t * t / (b.y - b.x * b.x + t * t);
+        return t * t / (mm.cov.x + t * t);
     }
     let z2 = roots.x;
     let z3 = roots.y;
     if hausdorff && (z2 < 0.0 || z3 > 1.0) {
-        let free = ((b.z - b.y) * d + b.z - b.w) / ((b.y - b.x) * d + b.y - b.z);
+        // Peters & Klein's four-point solution on [0, 1], in the differences D = mm.diff:
+        // free = ((b₃ − b₂)d + b₃ − b₄)/((b₂ − b₁)d + b₂ − b₃), and b₃ − b₁ − (free + 1)(b₂ − b₁)
+        // = D₁ − free·D₀.
+        let g = mm.diff;
+        let free = (g.y * d - g.z) / (g.x * d - g.y);
         let w1 = select(0.0, 1.0, d > free);
-        return (b.y - b.x + (b.z - b.x - (free + 1.0) * (b.y - b.x)) * (free - w1 - d)
-            / (d * (d - free))) / (free - w1) + 1.0 - b.x;
+        return (g.x + (g.y - free * g.x) * (free - w1 - d) / (d * (d - free))) / (free - w1)
+            + mm.below_one;
     }
     if d <= z2 {
         return 0.0;
     }
     if d <= z3 {
-        return (d * z3 - b.x * (d + z3) + b.y) / ((z3 - z2) * (d - z2));
+        return msm_expect(mm, d, z3) / ((z3 - z2) * (d - z2));
     }
-    return 1.0 - (z2 * z3 - b.x * (z2 + z3) + b.y) / ((d - z2) * (d - z3));
+    return 1.0 - msm_expect(mm, z2, z3) / ((d - z2) * (d - z3));
 }
 
+// #fetches vis_msm: sample_map
 fn vis_msm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     return vis_msm_of(sample_map(map, l, s), l, s);
 }
 
 // Filtered (possibly quantized) moments `m` dequantized and biased toward MSM_B0.
-fn msm_biased(m: vec4<f32>, l: Light) -> vec4<f32> {
+fn msm_biased(m: vec4<f32>, l: Light) -> MsmMoments {
+    let quantized = (l.msm_flags & 2u) != 0u;
     var b = m;
-    if (l.msm_flags & 2u) != 0u {
+    if quantized {
         b = msm_dequantize(b);
     }
-    return mix(b, MSM_B0, l.moment_bias);
+    return msm_moments(b, l.moment_bias, !quantized);
 }
 
 // Visibility from filtered (possibly quantized) moments `m` however they were filtered.
 fn vis_msm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
-    let b = msm_biased(m, l);
-    let intensity = msm_intensity(b, s.depth - l.bias, (l.msm_flags & 1u) != 0u);
+    let mm = msm_biased(m, l);
+    let intensity = msm_intensity(mm, s.depth - l.bias, (l.msm_flags & 1u) != 0u);
     let v = 1.0 - clamp(intensity, 0.0, 1.0);
     // NaN compares false both ways: a non-finite intensity reads as fully lit.
     return linstep(l.bleed, 1.0, select(1.0, v, v == v));
@@ -610,6 +699,7 @@ fn csm_sin_cos(k: u32, x: f32) -> vec2<f32> {
 }
 
 // Terms 2·chunk + 1 and 2·chunk + 2 (those ≤ M) of the series at this receiver.
+// #fetches csm_chunk: sample_map
 fn csm_chunk(map: texture_2d<f32>, chunk: u32, l: Light, s: LightSample) -> f32 {
     return csm_chunk_of(sample_map(map, l, s), chunk, l, s);
 }
@@ -709,6 +799,7 @@ fn sat_nodes(rect: vec4<f32>, size: vec2<u32>) -> SatNodes {
 }
 
 // F(X, Y) at integer nodes: 0 on the top and left edges, else SAT texel (X − 1, Y − 1).
+// #fetches sat_node_u32: 1
 fn sat_node_u32(sat: texture_2d<u32>, x: i32, y: i32) -> vec4<u32> {
     if x == 0 || y == 0 {
         return vec4<u32>(0u);
@@ -716,6 +807,7 @@ fn sat_node_u32(sat: texture_2d<u32>, x: i32, y: i32) -> vec4<u32> {
     return textureLoad(sat, vec2<i32>(x - 1, y - 1), 0);
 }
 
+// #fetches sat_node_f32: 1
 fn sat_node_f32(sat: texture_2d<f32>, x: i32, y: i32) -> vec4<f32> {
     if x == 0 || y == 0 {
         return vec4<f32>(0.0);
@@ -727,6 +819,7 @@ fn sat_node_f32(sat: texture_2d<f32>, x: i32, y: i32) -> vec4<f32> {
 // SAT (rgba32uint) encoded with `offset` and `scale` (SatCoding in src/sat.rs).
 // With F at the left edge a mix over r and at the right edge over p (weights summing to 1),
 // F(x1) − F(x0) = Σ_r,p wx0_r·wx1_p·(F(X1_p) − F(X0_r)): a weighted sum of integer windows.
+// #fetches sat_mean_fixed: 16
 fn sat_mean_fixed(sat: texture_2d<u32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
     let n = sat_nodes(rect, textureDimensions(sat));
     var f: array<vec4<u32>, 16>;
@@ -754,6 +847,7 @@ fn sat_mean_fixed(sat: texture_2d<u32>, rect: vec4<f32>, offset: vec4<f32>, scal
 // The same from an f32 SAT (rgba32float) built with `offset` and `scale` (scale is 1 for the
 // f32 variant). Each window is a difference of f32 sums: its error grows with the sums at the
 // corners (about 2⁻²⁴ of the sum over [0, X] × [0, Y] each), not with the window.
+// #fetches sat_mean_float: 16
 fn sat_mean_float(sat: texture_2d<f32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
     let n = sat_nodes(rect, textureDimensions(sat));
     var f: array<vec4<f32>, 16>;
@@ -784,11 +878,13 @@ fn sat_rect(l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
 }
 
 // The mean over `sat_rect(l, uv, width)` from a fixed-point table (rgba32uint).
+// #fetches sat_sample_fixed: 16
 fn sat_sample_fixed(map: texture_2d<u32>, l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
     return sat_mean_fixed(map, sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
 }
 
 // The mean over `sat_rect(l, uv, width)` from an f32 table (rgba32float).
+// #fetches sat_sample_float: 16
 fn sat_sample_float(map: texture_2d<f32>, l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
     return sat_mean_float(map, sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
 }
@@ -844,7 +940,7 @@ fn blocker_vsm(m: vec4<f32>, d: f32, floor: f32) -> vec2<f32> {
     return blocker_result((m.x - p * d) / max(share, BLOCKER_MIN_SHARE), share, d);
 }
 
-// Biased MSM moments b over the search square, receiver depth d: the three-point distribution
+// Biased MSM moments over the search square, receiver depth d: the three-point distribution
 // through d that Hamburger MSM reconstructs (support d, z₂ ≤ z₃; msm_roots) carries the
 // blockers at the support points in front of d; z_avg is their weighted mean, the share their
 // weight. Weights from the Vandermonde system, w_i = E[Π_{j≠i} (z − z_j)] / Π_{j≠i} (z_i − z_j):
@@ -854,8 +950,9 @@ fn blocker_vsm(m: vec4<f32>, d: f32, floor: f32) -> vec2<f32> {
 // reorder), a point far outside [0, 1] carries a vanishing weight whose product with its depth
 // need not vanish; clamped, it does, and z_avg stays continuous. Degenerate moments: a single
 // point at μ, or (rank-deficient) the two-moment estimate.
-fn blocker_msm(b: vec4<f32>, d: f32) -> vec2<f32> {
-    let roots = msm_roots(b, d);
+fn blocker_msm(mm: MsmMoments, d: f32) -> vec2<f32> {
+    let b = mm.b;
+    let roots = msm_roots(mm, d);
     if roots.z == 1.0 {
         return vec2<f32>(b.x, select(0.0, 1.0, d > b.x));
     }
@@ -867,12 +964,11 @@ fn blocker_msm(b: vec4<f32>, d: f32) -> vec2<f32> {
     if d <= z2 {
         return vec2<f32>(max(d, 0.0), 0.0);
     }
+    let w2 = msm_expect(mm, d, z3) / ((z3 - z2) * (d - z2));
     if d <= z3 {
-        let w2 = (d * z3 - b.x * (d + z3) + b.y) / ((z3 - z2) * (d - z2));
         return blocker_result(z2, w2, d);
     }
-    let w1 = (z2 * z3 - b.x * (z2 + z3) + b.y) / ((d - z2) * (d - z3));
-    let w2 = (d * z3 - b.x * (d + z3) + b.y) / ((z3 - z2) * (d - z2));
+    let w1 = msm_expect(mm, z2, z3) / ((d - z2) * (d - z3));
     let share = 1.0 - w1;
     let z = w2 * clamp(z2, 0.0, d) + (share - w2) * clamp(z3, 0.0, d);
     return blocker_result(z / max(share, BLOCKER_MIN_SHARE), share, d);
@@ -941,12 +1037,14 @@ fn vssm_resolve(m: vec4<f32>, b: vec2<f32>, l: Light, s: LightSample) -> f32 {
     return select(1.0, vis_vsm_of(m, l, s), b.y >= BLOCKER_MIN_SHARE);
 }
 
+// #fetches vis_vssm_fixed: 2 * sat_sample_fixed
 fn vis_vssm_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32 {
     let b = vssm_blocker(sat_sample_fixed(map, l, s.uv, blocker_search_width(l, s)), l, s);
     let m = sat_sample_fixed(map, l, s.uv, blocker_filter_width(l, s, b.x));
     return vssm_resolve(m, b, l, s);
 }
 
+// #fetches vis_vssm_float: 2 * sat_sample_float
 fn vis_vssm_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     let b = vssm_blocker(sat_sample_float(map, l, s.uv, blocker_search_width(l, s)), l, s);
     let m = sat_sample_float(map, l, s.uv, blocker_filter_width(l, s, b.x));
@@ -969,12 +1067,14 @@ fn msm_soft_resolve(m: vec4<f32>, b: vec2<f32>, l: Light, s: LightSample) -> f32
     return select(1.0, vis_msm_of(m, l, s), b.y >= BLOCKER_MIN_SHARE);
 }
 
+// #fetches vis_msm_soft_fixed: 2 * sat_sample_fixed
 fn vis_msm_soft_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32 {
     let b = msm_soft_blocker(sat_sample_fixed(map, l, s.uv, blocker_search_width(l, s)), l, s);
     let m = sat_sample_fixed(map, l, s.uv, blocker_filter_width(l, s, b.x));
     return msm_soft_resolve(m, b, l, s);
 }
 
+// #fetches vis_msm_soft_float: 2 * sat_sample_float
 fn vis_msm_soft_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     let b = msm_soft_blocker(sat_sample_float(map, l, s.uv, blocker_search_width(l, s)), l, s);
     let m = sat_sample_float(map, l, s.uv, blocker_filter_width(l, s, b.x));

@@ -53,7 +53,7 @@ fn blocker_vsm(m: vec4<f32>, d: f32, floor: f32) -> vec2<f32> {
     return blocker_result((m.x - p * d) / max(share, BLOCKER_MIN_SHARE), share, d);
 }
 
-// Biased MSM moments b over the search square, receiver depth d: the three-point distribution
+// Biased MSM moments over the search square, receiver depth d: the three-point distribution
 // through d that Hamburger MSM reconstructs (support d, z₂ ≤ z₃; msm_roots) carries the
 // blockers at the support points in front of d; z_avg is their weighted mean, the share their
 // weight. Weights from the Vandermonde system, w_i = E[Π_{j≠i} (z − z_j)] / Π_{j≠i} (z_i − z_j):
@@ -63,8 +63,9 @@ fn blocker_vsm(m: vec4<f32>, d: f32, floor: f32) -> vec2<f32> {
 // reorder), a point far outside [0, 1] carries a vanishing weight whose product with its depth
 // need not vanish; clamped, it does, and z_avg stays continuous. Degenerate moments: a single
 // point at μ, or (rank-deficient) the two-moment estimate.
-fn blocker_msm(b: vec4<f32>, d: f32) -> vec2<f32> {
-    let roots = msm_roots(b, d);
+fn blocker_msm(mm: MsmMoments, d: f32) -> vec2<f32> {
+    let b = mm.b;
+    let roots = msm_roots(mm, d);
     if roots.z == 1.0 {
         return vec2<f32>(b.x, select(0.0, 1.0, d > b.x));
     }
@@ -76,12 +77,11 @@ fn blocker_msm(b: vec4<f32>, d: f32) -> vec2<f32> {
     if d <= z2 {
         return vec2<f32>(max(d, 0.0), 0.0);
     }
+    let w2 = msm_expect(mm, d, z3) / ((z3 - z2) * (d - z2));
     if d <= z3 {
-        let w2 = (d * z3 - b.x * (d + z3) + b.y) / ((z3 - z2) * (d - z2));
         return blocker_result(z2, w2, d);
     }
-    let w1 = (z2 * z3 - b.x * (z2 + z3) + b.y) / ((d - z2) * (d - z3));
-    let w2 = (d * z3 - b.x * (d + z3) + b.y) / ((z3 - z2) * (d - z2));
+    let w1 = msm_expect(mm, z2, z3) / ((d - z2) * (d - z3));
     let share = 1.0 - w1;
     let z = w2 * clamp(z2, 0.0, d) + (share - w2) * clamp(z3, 0.0, d);
     return blocker_result(z / max(share, BLOCKER_MIN_SHARE), share, d);

@@ -17,6 +17,7 @@ fn texel_of(uv: vec2<f32>, size: vec2<f32>) -> vec2<i32> {
 }
 
 // Linear depth at texel t, clamped to the edge.
+// #fetches load_depth: 1
 fn load_depth(map: texture_2d<f32>, t: vec2<i32>) -> f32 {
     let size = vec2<i32>(textureDimensions(map));
     return textureLoad(map, clamp(t, vec2<i32>(0), size - 1), 0).r;
@@ -25,6 +26,7 @@ fn load_depth(map: texture_2d<f32>, t: vec2<i32>) -> f32 {
 // Bilinear interpolation of all four channels at uv (texel centres at (i + ½) / size),
 // clamp-to-edge, from four loads: exact and filter-feature independent (f32 maps need not be
 // filterable).
+// #fetches sample_bilinear: 4
 fn sample_bilinear(map: texture_2d<f32>, uv: vec2<f32>) -> vec4<f32> {
     return bilinear_level(map, uv, 0);
 }
@@ -37,6 +39,7 @@ fn level_size(map: texture_2d<f32>, level: i32) -> vec2<f32> {
 }
 
 // `sample_bilinear` on mip `level` (texel centres at (i + ½) / level size).
+// #fetches bilinear_level: 4
 fn bilinear_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> vec4<f32> {
     let size = level_size(map, level);
     let f = uv * size - 0.5;
@@ -51,6 +54,7 @@ fn bilinear_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> vec4<f32> 
 }
 
 // Trilinear sample of a mip chain at `lod` (clamped to the chain).
+// #fetches trilinear: 8
 fn trilinear(map: texture_2d<f32>, l: Light, uv: vec2<f32>, lod_in: f32) -> vec4<f32> {
     let lod = clamp(lod_in, 0.0, f32(l.mip_levels - 1u));
     let l0 = i32(floor(lod));
@@ -99,6 +103,7 @@ fn mip_tap_uv(t: MipTaps, uv: vec2<f32>, k: u32) -> vec2<f32> {
 // trilinear at log2(filter width), or along the pixel's footprint (`mip_taps`). The loop runs
 // `max_anisotropy` times for every invocation and weights the taps past `count` by 0: no
 // invocation leaves the loop early (llvmpipe mis-fetches explicit levels under divergence).
+// #fetches sample_map: select(4, 8 * max(l.max_anisotropy, 1), l.mip_levels > 1)
 fn sample_map(map: texture_2d<f32>, l: Light, s: LightSample) -> vec4<f32> {
     if l.mip_levels <= 1u {
         return sample_bilinear(map, s.uv);
@@ -113,6 +118,7 @@ fn sample_map(map: texture_2d<f32>, l: Light, s: LightSample) -> vec4<f32> {
 }
 
 // Trilinear sample of a map of logarithms at `lod`, as a logarithm.
+// #fetches trilinear_log: 8
 fn trilinear_log(map: texture_2d<f32>, l: Light, uv: vec2<f32>, lod_in: f32) -> f32 {
     let lod = clamp(lod_in, 0.0, f32(l.mip_levels - 1u));
     let l0 = i32(floor(lod));
@@ -131,12 +137,14 @@ fn linstep(lo: f32, hi: f32, x: f32) -> f32 {
 
 // Bilinear interpolation of exp(v) for a map of logarithms v (channel 0), returned as a
 // logarithm: log Σ wᵢ exp(vᵢ), evaluated around the largest tap so nothing overflows.
+// #fetches sample_bilinear_log: 4
 fn sample_bilinear_log(map: texture_2d<f32>, uv: vec2<f32>) -> f32 {
     return bilinear_log_level(map, uv, 0);
 }
 
 // `sample_map` for a map of logarithms: the same weights applied to exp(v), as a logarithm
 // (taps combined around the largest so far, so nothing overflows).
+// #fetches sample_map_log: select(4, 8 * max(l.max_anisotropy, 1), l.mip_levels > 1)
 fn sample_map_log(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     if l.mip_levels <= 1u {
         return sample_bilinear_log(map, s.uv);
@@ -156,6 +164,7 @@ fn sample_map_log(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
 }
 
 // `sample_bilinear_log` on mip `level`.
+// #fetches bilinear_log_level: 4
 fn bilinear_log_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> f32 {
     let size = level_size(map, level);
     let f = uv * size - 0.5;

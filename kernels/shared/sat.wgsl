@@ -49,6 +49,7 @@ fn sat_nodes(rect: vec4<f32>, size: vec2<u32>) -> SatNodes {
 }
 
 // F(X, Y) at integer nodes: 0 on the top and left edges, else SAT texel (X − 1, Y − 1).
+// #fetches sat_node_u32: 1
 fn sat_node_u32(sat: texture_2d<u32>, x: i32, y: i32) -> vec4<u32> {
     if x == 0 || y == 0 {
         return vec4<u32>(0u);
@@ -56,6 +57,7 @@ fn sat_node_u32(sat: texture_2d<u32>, x: i32, y: i32) -> vec4<u32> {
     return textureLoad(sat, vec2<i32>(x - 1, y - 1), 0);
 }
 
+// #fetches sat_node_f32: 1
 fn sat_node_f32(sat: texture_2d<f32>, x: i32, y: i32) -> vec4<f32> {
     if x == 0 || y == 0 {
         return vec4<f32>(0.0);
@@ -67,6 +69,7 @@ fn sat_node_f32(sat: texture_2d<f32>, x: i32, y: i32) -> vec4<f32> {
 // SAT (rgba32uint) encoded with `offset` and `scale` (SatCoding in src/sat.rs).
 // With F at the left edge a mix over r and at the right edge over p (weights summing to 1),
 // F(x1) − F(x0) = Σ_r,p wx0_r·wx1_p·(F(X1_p) − F(X0_r)): a weighted sum of integer windows.
+// #fetches sat_mean_fixed: 16
 fn sat_mean_fixed(sat: texture_2d<u32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
     let n = sat_nodes(rect, textureDimensions(sat));
     var f: array<vec4<u32>, 16>;
@@ -94,6 +97,7 @@ fn sat_mean_fixed(sat: texture_2d<u32>, rect: vec4<f32>, offset: vec4<f32>, scal
 // The same from an f32 SAT (rgba32float) built with `offset` and `scale` (scale is 1 for the
 // f32 variant). Each window is a difference of f32 sums: its error grows with the sums at the
 // corners (about 2⁻²⁴ of the sum over [0, X] × [0, Y] each), not with the window.
+// #fetches sat_mean_float: 16
 fn sat_mean_float(sat: texture_2d<f32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
     let n = sat_nodes(rect, textureDimensions(sat));
     var f: array<vec4<f32>, 16>;

@@ -14,11 +14,13 @@ fn sat_rect(l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
 }
 
 // The mean over `sat_rect(l, uv, width)` from a fixed-point table (rgba32uint).
+// #fetches sat_sample_fixed: 16
 fn sat_sample_fixed(map: texture_2d<u32>, l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
     return sat_mean_fixed(map, sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
 }
 
 // The mean over `sat_rect(l, uv, width)` from an f32 table (rgba32float).
+// #fetches sat_sample_float: 16
 fn sat_sample_float(map: texture_2d<f32>, l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
     return sat_mean_float(map, sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
 }

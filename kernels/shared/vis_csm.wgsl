@@ -11,6 +11,7 @@
 // #import shared/csm_basis
 
 // Terms 2·chunk + 1 and 2·chunk + 2 (those ≤ M) of the series at this receiver.
+// #fetches csm_chunk: sample_map
 fn csm_chunk(map: texture_2d<f32>, chunk: u32, l: Light, s: LightSample) -> f32 {
     return csm_chunk_of(sample_map(map, l, s), chunk, l, s);
 }

@@ -3,6 +3,7 @@
 // #import shared/light
 // #import shared/sampling
 
+// #fetches vis_esm: sample_map_log
 fn vis_esm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     return vis_esm_of_log(sample_map_log(map, l, s), l, s);
 }

@@ -16,6 +16,7 @@ fn chebyshev_upper(mean: f32, mean_sq: f32, receiver: f32, floor: f32) -> f32 {
     return variance / (variance + t * t);
 }
 
+// #fetches vis_evsm: sample_map
 fn vis_evsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     return vis_evsm_of(sample_map(map, l, s), l, s);
 }

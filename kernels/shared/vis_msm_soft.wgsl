@@ -19,12 +19,14 @@ fn msm_soft_resolve(m: vec4<f32>, b: vec2<f32>, l: Light, s: LightSample) -> f32
     return select(1.0, vis_msm_of(m, l, s), b.y >= BLOCKER_MIN_SHARE);
 }
 
+// #fetches vis_msm_soft_fixed: 2 * sat_sample_fixed
 fn vis_msm_soft_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32 {
     let b = msm_soft_blocker(sat_sample_fixed(map, l, s.uv, blocker_search_width(l, s)), l, s);
     let m = sat_sample_fixed(map, l, s.uv, blocker_filter_width(l, s, b.x));
     return msm_soft_resolve(m, b, l, s);
 }
 
+// #fetches vis_msm_soft_float: 2 * sat_sample_float
 fn vis_msm_soft_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     let b = msm_soft_blocker(sat_sample_float(map, l, s.uv, blocker_search_width(l, s)), l, s);
     let m = sat_sample_float(map, l, s.uv, blocker_filter_width(l, s, b.x));

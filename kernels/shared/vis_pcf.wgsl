@@ -3,6 +3,7 @@
 // #import shared/light
 // #import shared/sampling
 
+// #fetches vis_pcf: (2 * l.radius + 1) * (2 * l.radius + 1)
 fn vis_pcf(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     let c = texel_of(s.uv, l.map_size);
     let r = i32(l.radius);
@@ -23,6 +24,7 @@ fn vis_pcf(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
 }
 
 // The hardware 2×2 comparison: bilinear weights of four comparisons against the raw depth map.
+// #fetches vis_pcf_hardware: 1
 fn vis_pcf_hardware(map: texture_depth_2d, cmp: sampler_comparison, l: Light, s: LightSample) -> f32 {
     let reference = light_linear_to_ndc(l, clamp(s.depth - l.bias, 0.0, 1.0));
     return textureSampleCompareLevel(map, cmp, s.uv, reference);

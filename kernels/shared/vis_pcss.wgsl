@@ -11,6 +11,7 @@ fn pcss_search_radius(l: Light, s: LightSample) -> f32 {
     return min(world / light_map_width(l, l.near), l.max_search);
 }
 
+// #fetches vis_pcss: l.blocker_samples + l.filter_samples
 fn vis_pcss(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     let search = pcss_search_radius(l, s);
     var sum = 0.0;

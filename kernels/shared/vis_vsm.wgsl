@@ -4,6 +4,7 @@
 // #import shared/light
 // #import shared/sampling
 
+// #fetches vis_vsm: sample_map
 fn vis_vsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     return vis_vsm_of(sample_map(map, l, s), l, s);
 }

@@ -18,12 +18,14 @@ fn vssm_resolve(m: vec4<f32>, b: vec2<f32>, l: Light, s: LightSample) -> f32 {
     return select(1.0, vis_vsm_of(m, l, s), b.y >= BLOCKER_MIN_SHARE);
 }
 
+// #fetches vis_vssm_fixed: 2 * sat_sample_fixed
 fn vis_vssm_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32 {
     let b = vssm_blocker(sat_sample_fixed(map, l, s.uv, blocker_search_width(l, s)), l, s);
     let m = sat_sample_fixed(map, l, s.uv, blocker_filter_width(l, s, b.x));
     return vssm_resolve(m, b, l, s);
 }
 
+// #fetches vis_vssm_float: 2 * sat_sample_float
 fn vis_vssm_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     let b = vssm_blocker(sat_sample_float(map, l, s.uv, blocker_search_width(l, s)), l, s);
     let m = sat_sample_float(map, l, s.uv, blocker_filter_width(l, s, b.x));

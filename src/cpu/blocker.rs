@@ -1,7 +1,7 @@
 //! Reference of `kernels/shared/blocker.wgsl`: the search and filter widths of the soft
 //! techniques and their blocker estimates from filtered means. The MSM estimate is computed
-//! independently of the shader's Cholesky steps: the Hankel system by Cramer's rule, the
-//! weights of the three-point distribution by Lagrange's formula.
+//! independently of the shader's steps: the Hankel system by `cpu::vis_msm`'s Cholesky of the
+//! raw moments, the weights of the three-point distribution by Lagrange's formula.
 
 use std::f64::consts::PI;
 
@@ -73,41 +73,19 @@ pub fn vsm(m: &[f64], d: f64, floor: f64) -> Blocker {
     Blocker::new((m[0] - p * d) / share.max(MIN_SHARE), share, d)
 }
 
-fn det3(m: [[f64; 3]; 3]) -> f64 {
-    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
-}
-
-/// `blocker_msm` from biased moments `b`: the support points in front of `d` of the
-/// three-point distribution through `d` that matches `b`, each clamped to `[0, d]`, weighted.
-pub fn msm(b: [f64; 4], d: f64) -> Blocker {
-    let var1 = b[1] - b[0] * b[0];
-    if var1 <= 1e-12 {
-        return Blocker::new(b[0], if d > b[0] { 1.0 } else { 0.0 }, d);
-    }
-    let h = [[1.0, b[0], b[1]], [b[0], b[1], b[2]], [b[1], b[2], b[3]]];
-    let det = det3(h);
-    if det <= 0.0 {
-        return vsm(&b, d, 0.0);
-    }
-    let rhs = [1.0, d, d * d];
-    let c: Vec<f64> = (0..3)
-        .map(|i| {
-            let mut m = h;
-            for (r, row) in m.iter_mut().enumerate() {
-                row[i] = rhs[r];
-            }
-            det3(m) / det
-        })
-        .collect();
-    let disc = (c[1] * c[1] - 4.0 * c[2] * c[0]).max(0.0).sqrt();
-    let (r1, r2) = ((-c[1] - disc) / (2.0 * c[2]), (-c[1] + disc) / (2.0 * c[2]));
-    let (z2, z3) = (r1.min(r2), r1.max(r2));
+/// `blocker_msm` from biased moments `m`: the support points in front of `d` of the
+/// three-point distribution through `d` that matches them, each clamped to `[0, d]`, weighted.
+pub fn msm(m: &super::vis_msm::Biased, d: f64) -> Blocker {
+    use super::vis_msm::{Roots, expect, roots};
+    let b = m.b;
+    let (z2, z3) = match roots(m, d) {
+        Roots::Point => return Blocker::new(b[0], if d > b[0] { 1.0 } else { 0.0 }, d),
+        Roots::RankDeficient => return vsm(&b, d, 0.0),
+        Roots::Regular(z2, z3) => (z2, z3),
+    };
     // Lagrange: w_i = E[Π_{j≠i} (z − z_j)] / Π_{j≠i} (z_i − z_j).
-    let expect = |a: f64, c: f64| b[1] - (a + c) * b[0] + a * c;
-    let w2 = expect(d, z3) / ((z2 - d) * (z2 - z3));
-    let w3 = expect(d, z2) / ((z3 - d) * (z3 - z2));
+    let w2 = expect(b, d, z3) / ((z2 - d) * (z2 - z3));
+    let w3 = expect(b, d, z2) / ((z3 - d) * (z3 - z2));
     if d <= z2 {
         Blocker::new(d, 0.0, d)
     } else if d <= z3 {

@@ -14,7 +14,7 @@ pub fn search(moments: &Integral, l: &LightGpu, s: &LightSample) -> Vec<f64> {
 
 /// `msm_soft_blocker`.
 pub fn blocker_of(m: &[f64], l: &LightGpu, s: &LightSample) -> Blocker {
-    blocker::msm(super::vis_msm::biased(m, l), s.depth - f64::from(l.bias))
+    blocker::msm(&super::vis_msm::biased(m, l), s.depth - f64::from(l.bias))
 }
 
 /// The mean moments over the penumbra width of `b`.

@@ -166,13 +166,7 @@ pub fn sweep(scene: &Scene, opts: &EvaluateOptions) -> Result<Vec<Config>> {
                 }
             };
             for (k, (label, config)) in variants.into_iter().enumerate() {
-                let (mut valid, _) = config.validated()?;
-                if let Technique::MsmSoft {
-                    soft, moment_bias, ..
-                } = &mut valid.technique
-                {
-                    *moment_bias = crate::scene::default_moment_bias(soft.storage);
-                }
+                let (valid, _) = config.validated()?;
                 let on = if k == 0 { sizes.clone() } else { vec![base] };
                 for size in on {
                     push(label.clone(), valid.technique, size, None);
@@ -185,12 +179,50 @@ pub fn sweep(scene: &Scene, opts: &EvaluateOptions) -> Result<Vec<Config>> {
             prefiltered_configs(name, quick, base, &sizes, widths, storages, &mut out)?;
         }
     }
+    match &opts.moment_biases {
+        Some(biases) => with_moment_biases(out, biases),
+        None => Ok(out),
+    }
+}
+
+/// Every `msm` and `msm_soft` configuration once per moment bias in `biases` (label suffix
+/// `bias<α>`), instead of at its storage's default; the others as they are. Each bias is
+/// checked against the scene key's range.
+fn with_moment_biases(configs: Vec<Config>, biases: &[f32]) -> Result<Vec<Config>> {
+    if let Some(a) = biases.iter().find(|a| !(0.0..=0.5).contains(*a)) {
+        return Err(Error::Invalid(format!(
+            "--moment-bias: {a} is outside [0, 0.5]"
+        )));
+    }
+    let mut out = Vec::new();
+    for c in configs {
+        if !matches!(
+            c.technique,
+            Technique::Msm { .. } | Technique::MsmSoft { .. }
+        ) {
+            out.push(c);
+            continue;
+        }
+        for &a in biases {
+            let mut technique = c.technique;
+            if let Technique::Msm { moment_bias, .. } | Technique::MsmSoft { moment_bias, .. } =
+                &mut technique
+            {
+                *moment_bias = a;
+            }
+            out.push(Config {
+                label: format!("{} bias{a:e}", c.label),
+                technique,
+                ..c.clone()
+            });
+        }
+    }
     Ok(out)
 }
 
 /// The prefiltered technique `name` with `storage`, `filter` and (CSM) `terms`, validated
 /// like a scene file (EVSM exponents clamped to the storage's limit, MSM's default bias for
-/// the storage).
+/// the storage: `PrefilterConfig::with_storage`).
 fn prefiltered(name: &str, storage: Storage, filter: Filter, terms: u32) -> Result<Technique> {
     let config = match name {
         "vsm" => PrefilterConfig::vsm(1),
@@ -205,10 +237,7 @@ fn prefiltered(name: &str, storage: Storage, filter: Filter, terms: u32) -> Resu
     } else {
         config.with_storage(storage).with_filter(filter)
     };
-    let (mut valid, _) = config.validated()?;
-    if let Technique::Msm { moment_bias, .. } = &mut valid.technique {
-        *moment_bias = crate::scene::default_moment_bias(storage);
-    }
+    let (valid, _) = config.validated()?;
     Ok(valid.technique)
 }
 

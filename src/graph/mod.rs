@@ -2,6 +2,8 @@
 //! (format and size rule) and their parameters. [`plan()`] turns a graph and the outputs a
 //! scene asks for into an ordered, pruned [`Plan`] with resource lifetimes and texture reuse.
 
+mod check;
+pub mod cost;
 mod plan;
 pub mod print;
 
@@ -258,6 +260,10 @@ pub enum GraphError {
     /// The needed part of the graph has a cycle.
     #[error("cycle through nodes {}", .0.join(" → "))]
     Cycle(Vec<String>),
+    /// A plan (built or edited by hand) breaks what the executor relies on: a slot or a
+    /// resource out of range, mismatched, or missing (see [`Plan::check`]).
+    #[error("malformed plan: {0}")]
+    BadPlan(String),
     /// A size rule refers to a missing resource or to itself.
     #[error("size of `{resource}`: {message}")]
     BadSize {

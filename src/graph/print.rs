@@ -3,6 +3,8 @@
 use std::fmt::Write;
 
 use super::Plan;
+use super::cost;
+use crate::error::Result;
 
 /// `1.5 MiB`-style byte counts.
 pub fn human_bytes(b: u64) -> String {
@@ -22,8 +24,9 @@ pub fn human_bytes(b: u64) -> String {
 
 impl Plan {
     /// The text `shadowgraph plan` prints: per light, the ordered nodes and the resources they
-    /// touch (format, size, bytes), then memory totals.
-    pub fn to_text(&self, light_labels: &[String]) -> String {
+    /// touch (format, size, bytes), then `per_light[i]` (e.g. [`Plan::cost_text`]) where given;
+    /// then memory totals.
+    pub fn to_text(&self, light_labels: &[String], per_light: &[String]) -> String {
         let mut s = String::new();
         for (li, label) in light_labels.iter().enumerate() {
             let _ = writeln!(s, "light {li}: {label}");
@@ -77,6 +80,9 @@ impl Plan {
                     human_bytes(r.bytes)
                 );
             }
+            if let Some(extra) = per_light.get(li) {
+                s.push_str(extra);
+            }
         }
         let imported: u64 = self
             .resources
@@ -93,6 +99,46 @@ impl Plan {
             human_bytes(imported)
         );
         s
+    }
+
+    /// Light `light`'s traffic per texel of its map ([`cost`]): per node its dispatches and
+    /// the bytes it reads and writes, then
+    /// `total: N dispatches, X B/texel (one read + one write of the result: Y B/texel)`, where
+    /// the second figure is one read of the rasterized depth and one write of the maps the
+    /// shading reads, what a single fused kernel would move.
+    pub fn cost_text(&self, light: usize) -> Result<String> {
+        let nodes = cost::light_traffic(self, light)?;
+        let texels = cost::map_texels(self, light);
+        let mut s = String::new();
+        if nodes.is_empty() {
+            return Ok(s);
+        }
+        let side = texels.sqrt();
+        let _ = writeln!(s, "    traffic per texel of the {side}² map:");
+        let (mut dispatches, mut bytes) = (0, 0.0);
+        let width = nodes.iter().map(|(n, _)| n.name.len()).max().unwrap_or(0);
+        for (node, t) in &nodes {
+            let _ = writeln!(
+                s,
+                "      {:<width$} {:>3} dispatch{} reads {:>7.2} B, writes {:>7.2} B",
+                node.name,
+                t.dispatches,
+                if t.dispatches == 1 { ", " } else { "es," },
+                t.read / texels,
+                t.written / texels,
+            );
+            dispatches += t.dispatches;
+            bytes += t.bytes();
+        }
+        let _ = writeln!(
+            s,
+            "    total: {dispatches} dispatch{}, {:.2} B/texel (one read + one write of the \
+             result: {:.2} B/texel)",
+            if dispatches == 1 { "" } else { "es" },
+            bytes / texels,
+            cost::ideal_bytes(self, light)
+        );
+        Ok(s)
     }
 
     /// Graphviz: resources as boxes, nodes as ellipses, one cluster per light.

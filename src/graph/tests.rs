@@ -280,7 +280,7 @@ fn block_sizes_round_up_per_axis() {
 #[test]
 fn text_and_dot_name_every_step() {
     let p = plan(&chain(), &["c"]).unwrap();
-    let t = p.to_text(&["test light".into()]);
+    let t = p.to_text(&["test light".into()], &[]);
     for n in ["make_a", "make_b", "make_c", "R32Float", "peak live"] {
         assert!(t.contains(n), "{n} missing from\n{t}");
     }

@@ -33,6 +33,9 @@ pub struct PrefilterConfig {
     pub light_size: f32,
     /// A `with_*` call that did not apply to the technique (reported by validation).
     not_applicable: Option<&'static str>,
+    /// Whether [`PrefilterConfig::with_moment_bias`] set MSM's bias (else it follows the
+    /// storage's default, as in a scene file).
+    moment_bias_set: bool,
 }
 
 /// The blur a scene gets without filter keys: radius 2, sigma 1, Gaussian.
@@ -64,6 +67,7 @@ impl PrefilterConfig {
             normal_bias: 1.0,
             light_size: 0.0,
             not_applicable: None,
+            moment_bias_set: false,
         }
     }
 
@@ -164,14 +168,15 @@ impl PrefilterConfig {
         c
     }
 
-    /// Soft MSM (`msm_soft`) with a scene's defaults: f32 raw moments in a fixed-point table,
-    /// Hamburger reconstruction, search cap 0.1.
+    /// Soft MSM (`msm_soft`) with a scene's defaults: f32 moments (summed quantized, as every
+    /// MSM table) in a fixed-point table, Hamburger reconstruction, search cap 0.1, the soft
+    /// moment bias of f32.
     pub fn msm_soft(size: u32, light_size: f32) -> Self {
         let mut c = Self::new(
             Technique::MsmSoft {
                 soft: DEFAULT_SOFT,
                 hausdorff: false,
-                moment_bias: crate::scene::default_moment_bias(Storage::F32),
+                moment_bias: crate::scene::default_soft_moment_bias(Storage::F32),
                 bleed: 0.0,
             },
             size,
@@ -208,15 +213,34 @@ impl PrefilterConfig {
             normal_bias: light.shadow.normal_bias,
             light_size: light.size,
             not_applicable: None,
+            moment_bias_set: true,
         }
     }
 
     /// The same with moments stored at `storage` precision (VSM, EVSM, MSM, CSM and the soft
-    /// techniques; ESM is always f32; `Unorm16` only for MSM and soft MSM).
+    /// techniques; ESM is always f32; `Unorm16` only for MSM and soft MSM). MSM's moment bias
+    /// becomes the storage's default unless [`PrefilterConfig::with_moment_bias`] set it.
     pub fn with_storage(mut self, storage: Storage) -> Self {
+        let keep = self.moment_bias_set;
         match &mut self.technique {
-            Technique::Msm { prefilter, .. } => prefilter.storage = storage,
-            Technique::MsmSoft { soft, .. } => soft.storage = storage,
+            Technique::Msm {
+                prefilter,
+                moment_bias,
+                ..
+            } => {
+                prefilter.storage = storage;
+                if !keep {
+                    *moment_bias = crate::scene::default_moment_bias(storage);
+                }
+            }
+            Technique::MsmSoft {
+                soft, moment_bias, ..
+            } => {
+                soft.storage = storage;
+                if !keep {
+                    *moment_bias = crate::scene::default_soft_moment_bias(storage);
+                }
+            }
             Technique::Vssm { soft, .. } | Technique::Cssm { soft, .. }
                 if storage != Storage::Unorm16 =>
             {
@@ -281,6 +305,20 @@ impl PrefilterConfig {
         self
     }
 
+    /// The same with MSM's moment bias α (`msm`, `msm_soft`; the scene key `moment_bias`,
+    /// checked by validation against the same range [0, 0.5]). Without it, α is the default
+    /// of the storage (`scene::default_moment_bias`, `default_soft_moment_bias`).
+    pub fn with_moment_bias(mut self, alpha: f32) -> Self {
+        match &mut self.technique {
+            Technique::Msm { moment_bias, .. } | Technique::MsmSoft { moment_bias, .. } => {
+                *moment_bias = alpha;
+                self.moment_bias_set = true;
+            }
+            _ => self.not_applicable = Some("moment_bias"),
+        }
+        self
+    }
+
     /// The same with constant bias `bias` (linear depth units).
     pub fn with_bias(mut self, bias: f32) -> Self {
         self.bias = bias;
@@ -308,6 +346,8 @@ impl PrefilterConfig {
         range("normal_bias", self.normal_bias, 0.0, 100.0)?;
         range("size (light)", self.light_size, 0.0, 1e6)?;
         let mut out = *self;
+        // The bias is settled now: a later `with_storage` keeps it, as it keeps a light's.
+        out.moment_bias_set = true;
         let mut warnings = Vec::new();
         out.technique = technique(self.technique, self.light_size, &mut warnings)?;
         Ok((out, warnings))

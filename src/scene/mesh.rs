@@ -1,8 +1,6 @@
-//! Triangle meshes: the built-in shapes and OBJ loading.
+//! Triangle meshes: the built-in shapes, transforms and normal repair (OBJ files: `obj`).
 
-use std::path::Path;
-
-use glam::{Mat3, Mat4, Vec3};
+use glam::{DMat3, DVec3, Mat4, Vec3};
 
 /// Indexed triangles with per-vertex normals.
 #[derive(Clone, Debug, Default)]
@@ -28,22 +26,73 @@ pub struct Vertex {
 }
 
 impl Mesh {
-    /// The mesh under `m` (normals by the inverse transpose).
+    /// The mesh under `m`, computed in f64. Normals go through the cofactor matrix (the inverse
+    /// transpose times the determinant, so no division: a scale of 10⁻⁶ on one axis still gives
+    /// unit normals); a normal that comes out zero or not finite is left zero for
+    /// [`Mesh::repair_normals`].
     pub fn transformed(&self, m: Mat4) -> Mesh {
-        let nm = Mat3::from_mat4(m).inverse().transpose();
+        let m = m.as_dmat4();
+        let [a, b, c] = [
+            m.x_axis.truncate(),
+            m.y_axis.truncate(),
+            m.z_axis.truncate(),
+        ];
+        let cofactor = DMat3::from_cols(b.cross(c), c.cross(a), a.cross(b));
+        let sign = if a.dot(b.cross(c)) < 0.0 { -1.0 } else { 1.0 };
         Mesh {
             positions: self
                 .positions
                 .iter()
-                .map(|&p| m.transform_point3(p))
+                .map(|&p| m.transform_point3(p.as_dvec3()).as_vec3())
                 .collect(),
             normals: self
                 .normals
                 .iter()
-                .map(|&n| (nm * n).normalize_or_zero())
+                .map(|&n| {
+                    (sign * (cofactor * n.as_dvec3()))
+                        .try_normalize()
+                        .map_or(Vec3::ZERO, |n| n.as_vec3())
+                })
                 .collect(),
             indices: self.indices.clone(),
         }
+    }
+
+    /// Replaces every normal that is not a finite unit vector by the area-weighted normal of
+    /// the faces around its vertex; returns how many were replaced.
+    pub fn repair_normals(&mut self) -> usize {
+        let bad: Vec<usize> = (0..self.normals.len())
+            .filter(|&i| {
+                let n = self.normals[i];
+                !(n.is_finite() && (n.length() - 1.0).abs() < 1e-3)
+            })
+            .collect();
+        if !bad.is_empty() {
+            let faces = self.face_normals();
+            for &i in &bad {
+                self.normals[i] = faces[i];
+            }
+        }
+        bad.len()
+    }
+
+    /// Per vertex, the area-weighted normal of the faces around it (summed in f64); +Y for a
+    /// vertex of degenerate faces only.
+    pub fn face_normals(&self) -> Vec<Vec3> {
+        let mut n = vec![DVec3::ZERO; self.positions.len()];
+        for t in self.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| i as usize);
+            let p = [a, b, c].map(|i| self.positions[i].as_dvec3());
+            let face = (p[1] - p[0]).cross(p[2] - p[0]);
+            if face.is_finite() {
+                for i in [a, b, c] {
+                    n[i] += face;
+                }
+            }
+        }
+        n.into_iter()
+            .map(|v| v.try_normalize().map_or(Vec3::Y, |n| n.as_vec3()))
+            .collect()
     }
 
     /// Unindexed vertices tagged with `material`.
@@ -179,59 +228,4 @@ pub fn cylinder(radius: f32, height: f32, segments: u32) -> Mesh {
         }
     }
     m
-}
-
-/// Loads a Wavefront OBJ (triangulated); computes smooth normals when the file has none.
-pub fn load_obj(path: &Path) -> Result<Mesh, String> {
-    if !path.is_file() {
-        return Err(format!("mesh file `{}` not found", path.display()));
-    }
-    let opts = tobj::LoadOptions {
-        triangulate: true,
-        single_index: true,
-        ..Default::default()
-    };
-    let (models, _) = tobj::load_obj(path, &opts)
-        .map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
-    let mut mesh = Mesh::default();
-    for model in models {
-        let mm = &model.mesh;
-        let base = mesh.positions.len() as u32;
-        let pos: Vec<Vec3> = mm
-            .positions
-            .chunks_exact(3)
-            .map(|p| Vec3::new(p[0], p[1], p[2]))
-            .collect();
-        if pos.iter().any(|p| !p.is_finite()) {
-            return Err(format!("`{}` has a non-finite vertex", path.display()));
-        }
-        let normals = if mm.normals.len() == mm.positions.len() {
-            mm.normals
-                .chunks_exact(3)
-                .map(|n| Vec3::new(n[0], n[1], n[2]).normalize_or_zero())
-                .collect()
-        } else {
-            smooth_normals(&pos, &mm.indices)
-        };
-        mesh.positions.extend(pos);
-        mesh.normals.extend(normals);
-        mesh.indices.extend(mm.indices.iter().map(|i| i + base));
-    }
-    if mesh.indices.is_empty() {
-        return Err(format!("`{}` has no triangles", path.display()));
-    }
-    Ok(mesh)
-}
-
-/// Area-weighted vertex normals.
-fn smooth_normals(pos: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
-    let mut n = vec![Vec3::ZERO; pos.len()];
-    for t in indices.chunks_exact(3) {
-        let [a, b, c] = [t[0], t[1], t[2]].map(|i| i as usize);
-        let face = (pos[b] - pos[a]).cross(pos[c] - pos[a]);
-        for i in [a, b, c] {
-            n[i] += face;
-        }
-    }
-    n.into_iter().map(|v| v.normalize_or(Vec3::Y)).collect()
 }

@@ -1,15 +1,24 @@
 //! Scenes: the validated model, loaded from TOML (see `format`) with errors that name the file,
 //! the key and the line.
 
+mod ctx;
 pub mod format;
+pub mod locate;
 pub mod mesh;
+pub mod obj;
+mod object;
+mod parse;
 mod validate;
 
+pub use ctx::{COLOR_LIMIT, COORD_LIMIT, LENGTH_RANGE, ROTATION_LIMIT, fmt_num};
+pub use locate::Locations;
+pub use object::{MAX_TRIANGLES, WORLD_LIMIT};
 pub use validate::{
     DEFAULT_MAX_SEARCH, DEFAULT_SHARPEN, DEFAULT_SHARPEN_FALLOFF, default_moment_bias,
-    exponent_limit, sat_exponent_limit,
+    default_soft_moment_bias, exponent_limit, sat_exponent_limit,
 };
 
+use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Vec3};
@@ -38,7 +47,12 @@ pub struct Scene {
     pub objects: Vec<Object>,
     /// Values validation changed (e.g. exponents clamped to the storage's safe limit).
     pub warnings: Vec<String>,
+    /// Where each key was written, for errors found later (device limits, memory).
+    pub locations: Locations,
 }
+
+/// Largest scene file read (the bundled ones are 1–3 KiB); reading stops past it.
+pub const MAX_SCENE_BYTES: u64 = 1 << 20;
 
 /// A perspective camera.
 #[derive(Clone, Debug)]
@@ -426,19 +440,44 @@ pub struct Object {
 }
 
 impl Scene {
-    /// Reads and validates a scene file; meshes are loaded relative to it.
+    /// Reads and validates a scene file (at most [`MAX_SCENE_BYTES`], UTF-8); meshes are loaded
+    /// relative to it.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|error| Error::Io {
+        let io = |error| Error::Io {
             path: path.to_path_buf(),
             error,
+        };
+        let whole = |message: String| Error::Scene {
+            path: path.to_path_buf(),
+            location: String::new(),
+            message,
+        };
+        if std::fs::metadata(path).map_err(io)?.is_dir() {
+            return Err(whole("is a directory, not a scene file".into()));
+        }
+        let mut bytes = Vec::new();
+        std::fs::File::open(path)
+            .and_then(|f| f.take(MAX_SCENE_BYTES + 1).read_to_end(&mut bytes))
+            .map_err(io)?;
+        if bytes.len() as u64 > MAX_SCENE_BYTES {
+            return Err(whole(format!(
+                "larger than {} KiB, the most a scene file may be",
+                MAX_SCENE_BYTES >> 10
+            )));
+        }
+        let text = String::from_utf8(bytes).map_err(|e| {
+            whole(format!(
+                "not a text file (invalid UTF-8 at byte {})",
+                e.utf8_error().valid_up_to()
+            ))
         })?;
         Self::parse(path, &text)
     }
 
     /// Parses scene text; `path` names the file in errors and anchors relative mesh paths.
     pub fn parse(path: &Path, text: &str) -> Result<Self> {
-        validate::parse(path, text)
+        parse::parse(path, text.strip_prefix('\u{feff}').unwrap_or(text))
     }
 
     /// All objects' triangles as one vertex list (material = object index).

@@ -1,292 +1,14 @@
-//! Turns the spanned TOML (`format`) into the validated model, naming key and line on errors.
+//! A light's `[light.shadow]` table: the technique, the keys each technique accepts, their
+//! ranges and defaults.
 
 use std::ops::Range;
-use std::path::Path;
 
-use glam::{EulerRot, Mat4, Quat, Vec3};
 use toml::Spanned;
 
-use super::format::{LightFile, Num, ObjectFile, SceneFile, ShadowFile, V3};
-use super::{
-    BlurKernel, Camera, Filter, Light, LightKind, Mesh, Object, PcfKernel, Prefilter, Scene,
-    Shadow, Soft, Storage, Technique, mesh,
-};
-use crate::error::{Error, Result};
-
-/// Largest output or shadow-map side accepted before the device is even asked.
-const MAX_SIDE: i64 = 1 << 16;
-
-struct Ctx<'a> {
-    path: &'a Path,
-    text: &'a str,
-    warnings: std::cell::RefCell<Vec<String>>,
-}
-
-impl Ctx<'_> {
-    fn location(&self, span: Option<Range<usize>>) -> String {
-        let Some(span) = span else {
-            return String::new();
-        };
-        let before = &self.text[..span.start.min(self.text.len())];
-        let line = before.matches('\n').count() + 1;
-        let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
-        format!(":{line}:{col}")
-    }
-
-    fn err(&self, span: Option<Range<usize>>, message: impl Into<String>) -> Error {
-        Error::Scene {
-            path: self.path.to_path_buf(),
-            location: self.location(span),
-            message: message.into(),
-        }
-    }
-
-    fn vec3(&self, key: &str, v: &V3) -> Result<Vec3> {
-        let [x, y, z] = *v.get_ref();
-        if ![x, y, z].iter().all(|c| c.is_finite()) {
-            return Err(self.err(
-                Some(v.span()),
-                format!("`{key}` must be finite, got {:?}", [x, y, z]),
-            ));
-        }
-        Ok(Vec3::new(x as f32, y as f32, z as f32))
-    }
-
-    fn vec3_or(&self, key: &str, v: &Option<V3>, default: Vec3) -> Result<Vec3> {
-        v.as_ref().map_or(Ok(default), |v| self.vec3(key, v))
-    }
-
-    /// A finite number inside `[lo, hi]` (use infinities for open ends).
-    fn num(&self, key: &str, v: &Spanned<f64>, lo: f64, hi: f64) -> Result<f32> {
-        let x = *v.get_ref();
-        if !x.is_finite() || x < lo || x > hi {
-            return Err(self.err(
-                Some(v.span()),
-                format!("`{key}` = {x} is outside [{lo}, {hi}]"),
-            ));
-        }
-        Ok(x as f32)
-    }
-
-    fn num_or(&self, key: &str, v: &Option<Spanned<f64>>, lo: f64, hi: f64, d: f32) -> Result<f32> {
-        v.as_ref().map_or(Ok(d), |v| self.num(key, v, lo, hi))
-    }
-
-    fn int(&self, key: &str, v: &Spanned<i64>, lo: i64, hi: i64) -> Result<u32> {
-        let x = *v.get_ref();
-        if x < lo || x > hi {
-            return Err(self.err(
-                Some(v.span()),
-                format!("`{key}` = {x} is outside [{lo}, {hi}]"),
-            ));
-        }
-        Ok(x as u32)
-    }
-
-    fn int_or(&self, key: &str, v: &Option<Spanned<i64>>, lo: i64, hi: i64, d: u32) -> Result<u32> {
-        v.as_ref().map_or(Ok(d), |v| self.int(key, v, lo, hi))
-    }
-
-    fn required<'v, T>(&self, key: &str, v: &'v Option<T>, at: Range<usize>) -> Result<&'v T> {
-        v.as_ref()
-            .ok_or_else(|| self.err(Some(at), format!("missing key `{key}`")))
-    }
-
-    fn reject<T>(&self, key: &str, v: &Option<Spanned<T>>, why: &str) -> Result<()> {
-        match v {
-            Some(v) => Err(self.err(Some(v.span()), format!("`{key}` {why}"))),
-            None => Ok(()),
-        }
-    }
-}
-
-pub(super) fn parse(path: &Path, text: &str) -> Result<Scene> {
-    let ctx = Ctx {
-        path,
-        text,
-        warnings: Default::default(),
-    };
-    let file: SceneFile =
-        toml::from_str(text).map_err(|e| ctx.err(e.span(), e.message().trim()))?;
-    let width = ctx.int("output.width", &file.output.width, 1, MAX_SIDE)?;
-    let height = ctx.int("output.height", &file.output.height, 1, MAX_SIDE)?;
-    let background = ctx.vec3_or(
-        "output.background",
-        &file.output.background,
-        Vec3::new(0.55, 0.62, 0.72),
-    )?;
-    let ambient = ctx.vec3_or("ambient", &file.ambient, Vec3::splat(0.12))?;
-    let camera = camera(&ctx, &file)?;
-    if file.lights.is_empty() {
-        return Err(ctx.err(None, "the scene has no `[[light]]`"));
-    }
-    let lights = file
-        .lights
-        .iter()
-        .enumerate()
-        .map(|(i, l)| light(&ctx, i, l))
-        .collect::<Result<Vec<_>>>()?;
-    let objects = file
-        .objects
-        .iter()
-        .enumerate()
-        .map(|(i, o)| object(&ctx, i, o))
-        .collect::<Result<Vec<_>>>()?;
-    if objects.is_empty() {
-        return Err(ctx.err(None, "the scene has no `[[object]]`"));
-    }
-    Ok(Scene {
-        path: path.to_path_buf(),
-        width,
-        height,
-        background,
-        ambient,
-        camera,
-        lights,
-        objects,
-        warnings: ctx.warnings.into_inner(),
-    })
-}
-
-fn camera(ctx: &Ctx, file: &SceneFile) -> Result<Camera> {
-    let c = &file.camera;
-    let position = ctx.vec3("camera.position", &c.position)?;
-    let target = ctx.vec3("camera.target", &c.target)?;
-    let up = ctx.vec3_or("camera.up", &c.up, Vec3::Y)?;
-    let fov_y_degrees = ctx.num("camera.fov_y_degrees", &c.fov_y_degrees, 1.0, 170.0)?;
-    let forward = target - position;
-    if forward.length() < 1e-6 {
-        return Err(ctx.err(
-            Some(c.target.span()),
-            "`camera.target` equals `camera.position`",
-        ));
-    }
-    if forward.normalize().cross(up).length() < 1e-4 {
-        // Without an `up` key (default +Y), the target sets the view direction: point there.
-        let span = c.up.as_ref().map_or(c.target.span(), |u| u.span());
-        return Err(ctx.err(Some(span), "`camera.up` is parallel to the view direction"));
-    }
-    Ok(Camera {
-        position,
-        target,
-        up,
-        fov_y_degrees,
-    })
-}
-
-fn light(ctx: &Ctx, i: usize, l: &LightFile) -> Result<Light> {
-    let key = |k: &str| format!("light[{i}].{k}");
-    let kind = match l.kind.get_ref().as_str() {
-        "directional" => {
-            ctx.reject(
-                &key("fov_degrees"),
-                &l.fov_degrees,
-                "applies to spot lights only",
-            )?;
-            let e = ctx.required(&key("extent"), &l.extent, l.kind.span())?;
-            LightKind::Directional {
-                extent: ctx.num(&key("extent"), e, 1e-3, 1e6)?,
-            }
-        }
-        "spot" => {
-            ctx.reject(
-                &key("extent"),
-                &l.extent,
-                "applies to directional lights only",
-            )?;
-            let f = ctx.required(&key("fov_degrees"), &l.fov_degrees, l.kind.span())?;
-            LightKind::Spot {
-                fov_degrees: ctx.num(&key("fov_degrees"), f, 1.0, 170.0)?,
-            }
-        }
-        other => {
-            return Err(ctx.err(
-                Some(l.kind.span()),
-                format!(
-                    "`{}` = \"{other}\": unknown light kind (expected \"directional\" or \"spot\")",
-                    key("kind")
-                ),
-            ));
-        }
-    };
-    let position = ctx.vec3(&key("position"), &l.position)?;
-    let target = ctx.vec3(&key("target"), &l.target)?;
-    if (target - position).length() < 1e-6 {
-        return Err(ctx.err(
-            Some(l.target.span()),
-            format!("`{}` equals its position", key("target")),
-        ));
-    }
-    let near = ctx.num_or(&key("near"), &l.near, 1e-6, 1e7, 0.1)?;
-    let far = ctx.num_or(&key("far"), &l.far, 1e-6, 1e7, 50.0)?;
-    if far <= near {
-        let span = l.far.as_ref().or(l.near.as_ref()).map(|s| s.span());
-        return Err(ctx.err(
-            span,
-            format!(
-                "`{}` ({far}) must exceed `{}` ({near})",
-                key("far"),
-                key("near")
-            ),
-        ));
-    }
-    let size = ctx.num_or(&key("size"), &l.size, 0.0, 1e6, 0.0)?;
-    let color = ctx.vec3_or(&key("color"), &l.color, Vec3::ONE)?;
-    let intensity = ctx.num_or(&key("intensity"), &l.intensity, 0.0, 1e6, 1.0)?;
-    let shadow_map = ctx.int_or(&key("shadow_map"), &l.shadow_map, 1, MAX_SIDE, 1024)?;
-    let shadow = match &l.shadow {
-        Some(s) => shadow(ctx, i, s)?,
-        None => Shadow {
-            technique: Technique::Hard,
-            bias: 0.002,
-            slope_bias: 1.0,
-            normal_bias: 1.0,
-        },
-    };
-    let soft =
-        matches!(shadow.technique, Technique::Pcss { .. }) || shadow.technique.soft().is_some();
-    if soft && size <= 0.0 {
-        let span = l.size.as_ref().map(|s| s.span()).or(Some(l.kind.span()));
-        return Err(ctx.err(
-            span,
-            format!(
-                "technique \"{}\" needs `{}` > 0 (the area light's width)",
-                shadow.technique.name(),
-                key("size")
-            ),
-        ));
-    }
-    if let Some(soft) = shadow.technique.soft() {
-        let area = crate::technique::soft_lookup_area(soft.max_search, shadow_map);
-        if soft.sums == crate::sat::SatVariant::Fixed && area > crate::sat::MAX_FIXED_AREA {
-            let span = l
-                .shadow
-                .as_ref()
-                .and_then(|s| s.max_search.as_ref())
-                .map(|v| v.span());
-            return Err(ctx.err(
-                span.or(l.shadow_map.as_ref().map(|v| v.span())),
-                format!(
-                    "`{}` = {} on a {shadow_map}² map reads squares of {area} texels, more than a \
-                     fixed-point table can sum; lower it or set `sat_sums = \"float\"`",
-                    key("shadow.max_search"),
-                    soft.max_search
-                ),
-            ));
-        }
-    }
-    Ok(Light {
-        kind,
-        position,
-        target,
-        near,
-        far,
-        size,
-        radiance: color * intensity,
-        shadow_map,
-        shadow,
-    })
-}
+use super::ctx::Ctx;
+use super::format::ShadowFile;
+use super::{BlurKernel, Filter, PcfKernel, Prefilter, Shadow, Soft, Storage, Technique};
+use crate::error::Result;
 
 /// The technique-specific keys each technique accepts (the common ones — technique, bias,
 /// slope_bias, normal_bias — are always allowed).
@@ -451,15 +173,29 @@ pub const DEFAULT_SHARPEN_FALLOFF: f32 = 10.0;
 /// Default `max_search` (shadow-map UV) of PCSS and the soft techniques.
 pub const DEFAULT_MAX_SEARCH: f32 = 0.1;
 
-/// Default MSM moment bias per storage: Peters & Klein's 6·10⁻⁵ for 16-bit normalized
-/// quantized moments; larger for f16 (11-bit mantissa); for f32 raw moments enough to keep the
-/// Hankel matrix positive definite under f32 shading arithmetic on flat regions (the stability
-/// suite's zero-variance cases).
+/// Default MSM moment bias α per storage, from the measured sweep of bias against error
+/// (README, "MSM moment bias"; `cargo run --release --example msm_bias_sweep`): the smallest
+/// bias of the sweep whose largest error behind a flat occluder is at most half the stability
+/// suite's bound (case 8: 0.01 for f32, 0.03 for unorm16, 0.25 for f16 moments, whose 11-bit
+/// significand leaves them 2⁻¹² of their range). Against the area-light truth they cost f32
+/// and unorm16 at most 3% of the mean error of 10⁻⁵ on `sphere_on_plane` and `pole`; f16 9%
+/// of its best.
 pub fn default_moment_bias(storage: Storage) -> f32 {
     match storage {
-        Storage::F32 => 1e-5,
-        Storage::Unorm16 => 6e-5,
-        Storage::F16 => 5e-4,
+        Storage::F32 => 5e-4,
+        Storage::Unorm16 => 1e-3,
+        Storage::F16 => 3e-3,
+    }
+}
+
+/// Default moment bias of soft MSM (`msm_soft`) per storage, chosen as
+/// [`default_moment_bias`] against case 8's bound for summed-area tables (0.05; f16 0.25).
+/// The table sums quantized moments whatever the storage (`technique::msm_quantized`).
+pub fn default_soft_moment_bias(storage: Storage) -> f32 {
+    match storage {
+        Storage::F32 => 2e-4,
+        Storage::Unorm16 => 3e-4,
+        Storage::F16 => 3e-3,
     }
 }
 
@@ -543,35 +279,7 @@ fn present(s: &ShadowFile) -> Vec<(&'static str, Range<usize>)> {
     .collect()
 }
 
-impl Ctx<'_> {
-    /// The option named by a string key, with `default` when absent.
-    fn choice<T: Copy>(
-        &self,
-        key: &str,
-        v: &Option<Spanned<String>>,
-        options: &[(&str, T)],
-        default: T,
-    ) -> Result<T> {
-        let Some(v) = v else { return Ok(default) };
-        options
-            .iter()
-            .find(|(name, _)| *name == v.get_ref())
-            .map(|(_, t)| *t)
-            .ok_or_else(|| {
-                let names: Vec<String> = options.iter().map(|(n, _)| format!("\"{n}\"")).collect();
-                self.err(
-                    Some(v.span()),
-                    format!(
-                        "`{key}` = \"{}\": expected one of {}",
-                        v.get_ref(),
-                        names.join(", ")
-                    ),
-                )
-            })
-    }
-}
-
-fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
+pub(super) fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
     let key = |k: &str| format!("light[{i}].shadow.{k}");
     let name = s.technique.get_ref().as_str();
     let Some((_, allowed)) = TECHNIQUE_KEYS.iter().find(|(t, _)| *t == name) else {
@@ -582,7 +290,7 @@ fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
         return Err(ctx.err(
             Some(s.technique.span()),
             format!(
-                "`{}` = \"{name}\": unknown technique (this build knows {})",
+                "`{}` = {name:?}: unknown technique (this build knows {})",
                 key("technique"),
                 known.join(", ")
             ),
@@ -660,7 +368,8 @@ fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
         }
         "msm" => {
             let prefilter = prefilter(ctx, i, s, MSM_STORAGE)?;
-            let (hausdorff, moment_bias, bleed) = msm_keys(ctx, i, s, prefilter.storage)?;
+            let (hausdorff, moment_bias, bleed) =
+                msm_keys(ctx, i, s, default_moment_bias(prefilter.storage))?;
             Technique::Msm {
                 prefilter,
                 hausdorff,
@@ -693,7 +402,8 @@ fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
         },
         "msm_soft" => {
             let soft = soft(ctx, i, s, MSM_STORAGE)?;
-            let (hausdorff, moment_bias, bleed) = msm_keys(ctx, i, s, soft.storage)?;
+            let (hausdorff, moment_bias, bleed) =
+                msm_keys(ctx, i, s, default_soft_moment_bias(soft.storage))?;
             Technique::MsmSoft {
                 soft,
                 hausdorff,
@@ -837,8 +547,8 @@ fn prefilter(
 /// The storage, table sums and search cap of a soft technique; its table is always a
 /// summed-area table read at a per-receiver width.
 /// MSM's reconstruction keys (`msm`, `msm_soft`): Hausdorff or not, the moment bias (default
-/// per `storage`) and the bleeding reduction.
-fn msm_keys(ctx: &Ctx, i: usize, s: &ShadowFile, storage: Storage) -> Result<(bool, f32, f32)> {
+/// `bias`) and the bleeding reduction.
+fn msm_keys(ctx: &Ctx, i: usize, s: &ShadowFile, bias: f32) -> Result<(bool, f32, f32)> {
     let key = |k: &str| format!("light[{i}].shadow.{k}");
     Ok((
         ctx.choice(
@@ -847,13 +557,7 @@ fn msm_keys(ctx: &Ctx, i: usize, s: &ShadowFile, storage: Storage) -> Result<(bo
             &RECONSTRUCTIONS,
             false,
         )?,
-        ctx.num_or(
-            &key("moment_bias"),
-            &s.moment_bias,
-            0.0,
-            0.5,
-            default_moment_bias(storage),
-        )?,
+        ctx.num_or(&key("moment_bias"), &s.moment_bias, 0.0, 0.5, bias)?,
         ctx.num_or(&key("bleed_reduction"), &s.bleed_reduction, 0.0, 0.99, 0.0)?,
     ))
 }
@@ -890,109 +594,5 @@ fn soft(ctx: &Ctx, i: usize, s: &ShadowFile, storages: &[(&str, Storage)]) -> Re
             1.0,
             DEFAULT_MAX_SEARCH,
         )?,
-    })
-}
-
-fn num3(ctx: &Ctx, key: &str, v: &Spanned<Num>, len2_ok: bool) -> Result<Vec<f32>> {
-    let vals = match v.get_ref() {
-        Num::One(x) => vec![*x],
-        Num::Many(xs) => xs.clone(),
-    };
-    let ok_len = matches!(vals.len(), 1 | 3) || (len2_ok && vals.len() == 2);
-    if !ok_len || vals.iter().any(|x| !x.is_finite() || *x <= 0.0) {
-        return Err(ctx.err(
-            Some(v.span()),
-            format!(
-                "`{key}` must be one positive number or a list of positive numbers, got {vals:?}"
-            ),
-        ));
-    }
-    Ok(vals.iter().map(|&x| x as f32).collect())
-}
-
-fn object(ctx: &Ctx, i: usize, o: &ObjectFile) -> Result<Object> {
-    let key = |k: &str| format!("object[{i}].{k}");
-    let at = o.shape.span();
-    let positive = |k: &str, v: &Option<Spanned<f64>>| -> Result<f32> {
-        ctx.num(&key(k), ctx.required(&key(k), v, at.clone())?, 1e-6, 1e7)
-    };
-    let local: Mesh = match o.shape.get_ref().as_str() {
-        "plane" => {
-            let s = num3(
-                ctx,
-                &key("size"),
-                ctx.required(&key("size"), &o.size, at.clone())?,
-                true,
-            )?;
-            let (sx, sz) = match s.as_slice() {
-                [a] => (*a, *a),
-                [a, b] => (*a, *b),
-                _ => {
-                    return Err(ctx.err(
-                        o.size.as_ref().map(|s| s.span()),
-                        format!("`{}` of a plane is `[x, z]` or one number", key("size")),
-                    ));
-                }
-            };
-            mesh::plane(sx, sz)
-        }
-        "box" => {
-            let s = num3(
-                ctx,
-                &key("size"),
-                ctx.required(&key("size"), &o.size, at.clone())?,
-                false,
-            )?;
-            let v = if s.len() == 1 {
-                Vec3::splat(s[0])
-            } else {
-                Vec3::new(s[0], s[1], s[2])
-            };
-            mesh::cuboid(v)
-        }
-        "sphere" => mesh::sphere(positive("radius", &o.radius)?, 48, 24),
-        "cylinder" => mesh::cylinder(
-            positive("radius", &o.radius)?,
-            positive("height", &o.height)?,
-            48,
-        ),
-        "mesh" => {
-            let p = ctx.required(&key("path"), &o.path, at.clone())?;
-            let dir = ctx.path.parent().unwrap_or(Path::new("."));
-            let file = dir.join(p.get_ref());
-            mesh::load_obj(&file)
-                .map_err(|e| ctx.err(Some(p.span()), format!("`{}`: {e}", key("path"))))?
-        }
-        other => {
-            return Err(ctx.err(Some(at), format!(
-                "`{}` = \"{other}\": unknown shape (expected \"plane\", \"box\", \"sphere\", \"cylinder\" or \"mesh\")",
-                key("shape")
-            )));
-        }
-    };
-    let translate = ctx.vec3_or(&key("translate"), &o.translate, Vec3::ZERO)?;
-    let rot = ctx.vec3_or(&key("rotate_degrees"), &o.rotate_degrees, Vec3::ZERO)?;
-    let scale = match &o.scale {
-        None => Vec3::ONE,
-        Some(s) => {
-            let v = num3(ctx, &key("scale"), s, false)?;
-            if v.len() == 1 {
-                Vec3::splat(v[0])
-            } else {
-                Vec3::new(v[0], v[1], v[2])
-            }
-        }
-    };
-    let rotation = Quat::from_euler(
-        EulerRot::ZYX,
-        rot.z.to_radians(),
-        rot.y.to_radians(),
-        rot.x.to_radians(),
-    );
-    let transform = Mat4::from_scale_rotation_translation(scale, rotation, translate);
-    let color = ctx.vec3_or(&key("color"), &o.color, Vec3::splat(0.8))?;
-    Ok(Object {
-        mesh: local.transformed(transform),
-        color,
     })
 }

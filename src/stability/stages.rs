@@ -80,8 +80,8 @@ fn model(t: &Technique) -> Option<Model> {
             let f = move |z: &Texels| cpu::esm::esm(z, exponent.into());
             m(Box::new(f), (0.0, 2.0 * U), false, Some(exponent.into()))
         }
-        Technique::Msm { prefilter, .. } => {
-            let q = msm_quantized(prefilter.storage);
+        Technique::Msm { .. } => {
+            let q = msm_quantized(t);
             let f = move |z: &Texels| cpu::msm::msm(z, q);
             let tol = if q { (3e-5, 0.0) } else { (1e-7, 4.0 * U) };
             m(Box::new(f), tol, false, None)

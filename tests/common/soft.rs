@@ -18,7 +18,7 @@ use shadowgraph::cpu::light::LightSample;
 use shadowgraph::cpu::sat::Integral;
 use shadowgraph::cpu::{self, Texels};
 use shadowgraph::sat::{SatCoding, SatVariant};
-use shadowgraph::technique::{LightGpu, MSM_HAUSDORFF, MSM_QUANTIZED};
+use shadowgraph::technique::{LightGpu, MSM_QUANTIZED};
 
 const ULP: f64 = 1.0 / 16_777_216.0; // 2⁻²⁴
 
@@ -222,10 +222,11 @@ pub fn vssm_tolerance(
 }
 
 /// MSM's error in the moment domain: the table error carried through the dequantization
-/// (its matrix's absolute column sums), plus 32·2⁻²⁴ relative (the f32 Cholesky is backward
-/// stable: the GPU's answer is exact for moments that close, as in `msm_tolerance`).
+/// (its matrix's absolute column sums), plus 32·2⁻²⁴ relative (the kernel's solve is backward
+/// stable in the moments: the GPU's answer is exact for moments that close, as in
+/// `msm_tolerance`). Perturbed moments are then projected and biased, as the kernel does.
 fn msm_moment_error(l: &LightGpu, m: &[f64], e: [f64; 4]) -> [f64; 4] {
-    let b = cpu::vis_msm::biased(m, l);
+    let b = cpu::vis_msm::dequantized(m, l);
     let carried: [f64; 4] = if l.msm_flags & MSM_QUANTIZED != 0 {
         let zero = cpu::msm::dequantize([0.0; 4]);
         let mut out = [0.0; 4];
@@ -244,17 +245,12 @@ fn msm_moment_error(l: &LightGpu, m: &[f64], e: [f64; 4]) -> [f64; 4] {
     std::array::from_fn(|c| carried[c] + 32.0 * ULP * b[c].abs())
 }
 
-/// MSM's visibility from biased moments `b` (the tail of `vis_msm_of`).
-fn msm_visibility(l: &LightGpu, b: &[f64], d: f64) -> f64 {
-    let hausdorff = l.msm_flags & MSM_HAUSDORFF != 0;
-    let i = cpu::vis_msm::intensity([b[0], b[1], b[2], b[3]], d, hausdorff);
-    let v = 1.0 - i.clamp(0.0, 1.0);
-    let v = if v.is_nan() { 1.0 } else { v };
-    let bleed = f64::from(l.bleed);
-    ((v - bleed) / (1.0 - bleed)).clamp(0.0, 1.0)
+/// The biased moments of dequantized moments `b` (a slice of four).
+fn msm_bias(l: &LightGpu, b: &[f64]) -> cpu::vis_msm::Biased {
+    cpu::vis_msm::bias_for([b[0], b[1], b[2], b[3]], l)
 }
 
-/// Soft MSM's tolerance at `s` (see [`Chain`]), perturbing the biased moments.
+/// Soft MSM's tolerance at `s` (see [`Chain`]), perturbing the dequantized moments.
 pub fn msm_soft_tolerance(
     t: &Integral,
     err: &TableError,
@@ -275,13 +271,13 @@ pub fn msm_soft_tolerance(
     let el = msm_moment_error(l, &last0, err.mean(l, s, width));
     let d = s.depth - f64::from(l.bias);
     Chain {
-        search: &|du| cpu::vis_msm::biased(&v::search(t, l, &shifted(s, du)), l).to_vec(),
+        search: &|du| cpu::vis_msm::dequantized(&v::search(t, l, &shifted(s, du)), l).to_vec(),
         e_search: es.to_vec(),
-        blocker: &|b, dd| cpu::blocker::msm([b[0], b[1], b[2], b[3]], d + dd),
+        blocker: &|b, dd| cpu::blocker::msm(&msm_bias(l, b), d + dd),
         finish: &|z| v::finish(t, l, s, Blocker { depth: z, ..b0 }),
-        last: &|du| cpu::vis_msm::biased(&v::filtered(t, l, &shifted(s, du), b0), l).to_vec(),
+        last: &|du| cpu::vis_msm::dequantized(&v::filtered(t, l, &shifted(s, du), b0), l).to_vec(),
         e_last: el.to_vec(),
-        visibility: &|b, dd| msm_visibility(l, b, d + dd),
+        visibility: &|b, dd| cpu::vis_msm::visibility(&msm_bias(l, b), d + dd, l),
         e_depth: depth_error(l, s),
     }
     .tolerance(v0)

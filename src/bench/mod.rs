@@ -1,0 +1,572 @@
+//! Kernel microbenchmarks: every graph kernel timed by GPU timestamps at a set of square sizes,
+//! against a roofline per format: a texture copy kernel of each format a kernel reads or writes
+//! (`kernels/copy_texture.wgsl`, the map kernels' 16×16 workgroups), beside the storage-buffer
+//! copy (`kernels/copy.wgsl`, the device's practical bandwidth).
+//!
+//! Each kernel is one [`BenchCase`] in [`CASES`]: the graph that runs it. The bytes a case
+//! moves are the cost model's ([`crate::graph::cost`]): every dispatch's reads and writes,
+//! halos, second reads and mip levels included, not one read and one write per texel. Its
+//! ratio is its GB/s over the texture copy of its output's format, at the same size. The
+//! harness plans the graph, fills every imported texture with random values, records it with
+//! [`Executor::record`] under a [`crate::exec::GpuTimer`], and keeps the median over the timed
+//! runs (after [`WARMUP`] untimed ones) of the summed node times.
+
+mod copy;
+mod harness;
+mod lookup;
+
+use std::collections::HashMap;
+use std::fmt::Write;
+
+use glam::Vec3;
+
+pub use self::copy::{COPY, COPY_FORMATS, format_name};
+use self::harness::{gb_per_s, time_graph};
+pub use self::lookup::{LOOKUP_WIDTHS, LookupRow, format_lookup_table, lookup_cost};
+use crate::error::{Error, Result};
+use crate::exec::Executor;
+use crate::gpu::Gpu;
+use crate::graph::{Graph, Plan, cost};
+use crate::sat::{self, SatCoding, SatVariant};
+use crate::scene::{BlurKernel, Filter, Light, LightKind, Prefilter, Shadow, Storage, Technique};
+use crate::technique;
+
+/// Untimed runs before the timed ones (pipeline warm-up, lazy clears, caches).
+pub const WARMUP: u32 = 2;
+
+/// One kernel measured at one size.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BenchRow {
+    /// Kernel name ([`BenchCase::name`], `copy buffer` or `copy texture`).
+    pub kernel: String,
+    /// Format of the kernel's output (of a texture copy's source; `-` for the buffer copy).
+    pub format: String,
+    /// Side of the square map, texels.
+    pub size: u32,
+    /// Bytes read plus bytes written per run (the cost model's, all dispatches).
+    pub bytes_moved: f64,
+    /// Median GPU time per run over the timed runs, milliseconds (all nodes of the run).
+    pub median_ms: f64,
+    /// Effective bandwidth: `bytes_moved / median time`, GB/s (10⁹ bytes per second).
+    pub gbps: f64,
+    /// `gbps` over the yardstick's GB/s at the same size.
+    pub ratio: f64,
+    /// The yardstick: `copy texture <format>` for a kernel, `copy buffer` for a texture copy
+    /// (empty for the buffer copy itself).
+    pub yardstick: String,
+}
+
+/// The graph a case runs and the outputs that keep its nodes alive.
+pub struct BenchGraph {
+    /// The graph; its imports are R32Float textures the harness fills with random depths.
+    pub graph: Graph,
+    /// Resources requested from [`graph::plan`].
+    pub outputs: Vec<String>,
+}
+
+/// One kernel to benchmark: adding a kernel to the benchmark is one entry of [`CASES`].
+pub struct BenchCase {
+    /// Name in the report.
+    pub name: &'static str,
+    /// The graph at size `n`.
+    pub build: fn(u32) -> BenchGraph,
+}
+
+/// Every benchmarked graph kernel.
+pub const CASES: &[BenchCase] = &[
+    BenchCase {
+        name: "linearize",
+        build: linearize_graph,
+    },
+    BenchCase {
+        name: "vsm",
+        build: |n| stage_graph(n, vsm(), "light0.linear", "light0.vsm"),
+    },
+    BenchCase {
+        name: "evsm4",
+        build: |n| stage_graph(n, evsm4(), "light0.linear", "light0.evsm"),
+    },
+    BenchCase {
+        name: "esm",
+        build: |n| stage_graph(n, esm(), "light0.linear", "light0.esm"),
+    },
+    BenchCase {
+        name: "blur rg32f r4",
+        build: |n| stage_graph(n, vsm(), "light0.vsm", "light0.vsm.blur_v"),
+    },
+    BenchCase {
+        name: "blur rg32f r32",
+        build: |n| stage_graph(n, vsm_blur(32.0), "light0.vsm", "light0.vsm.blur_v"),
+    },
+    BenchCase {
+        name: "blur log r4",
+        build: |n| stage_graph(n, esm(), "light0.esm", "light0.esm.blur_v"),
+    },
+    BenchCase {
+        name: "msm",
+        build: |n| stage_graph(n, msm(Storage::F32), "light0.linear", "light0.msm"),
+    },
+    BenchCase {
+        name: "msm f16 quantized",
+        build: |n| stage_graph(n, msm(Storage::F16), "light0.linear", "light0.msm"),
+    },
+    BenchCase {
+        name: "csm (2 terms)",
+        build: |n| stage_graph(n, csm(), "light0.linear", "light0.csm0"),
+    },
+    BenchCase {
+        name: "mips rgba32f",
+        build: |n| stage_graph(n, msm_mips(), "light0.msm", "light0.msm.mips"),
+    },
+    BenchCase {
+        name: "sat fixed",
+        build: |n| sat_graph(n, SatVariant::Fixed),
+    },
+    BenchCase {
+        name: "sat float",
+        build: |n| sat_graph(n, SatVariant::Float),
+    },
+    // The first design, timed beside the tiled passes until their comparison is recorded.
+    BenchCase {
+        name: "sat fixed (5-pass, old)",
+        build: |n| sat_graph_with(n, SatVariant::Fixed, sat::five_pass::add_sat_five_pass),
+    },
+];
+
+fn texels(n: u32) -> u64 {
+    u64::from(n) * u64::from(n)
+}
+
+fn blur4() -> Filter {
+    Filter::Blur {
+        radius: 4.0,
+        sigma: 2.0,
+        kernel: BlurKernel::Gaussian,
+    }
+}
+
+fn vsm() -> Technique {
+    vsm_blur(4.0)
+}
+
+/// VSM with a Gaussian blur of `radius` taps each side (σ = radius / 2).
+fn vsm_blur(radius: f32) -> Technique {
+    Technique::Vsm {
+        prefilter: Prefilter {
+            storage: Storage::F32,
+            filter: Filter::Blur {
+                radius,
+                sigma: radius / 2.0,
+                kernel: BlurKernel::Gaussian,
+            },
+        },
+        bleed: 0.2,
+        min_variance: 1e-5,
+    }
+}
+
+fn evsm4() -> Technique {
+    Technique::Evsm {
+        prefilter: Prefilter {
+            storage: Storage::F32,
+            filter: blur4(),
+        },
+        four: true,
+        exp_pos: 40.0,
+        exp_neg: 5.0,
+        bleed: 0.0,
+        min_variance: 1e-4,
+    }
+}
+
+fn msm(storage: Storage) -> Technique {
+    Technique::Msm {
+        prefilter: Prefilter {
+            storage,
+            filter: blur4(),
+        },
+        hausdorff: false,
+        moment_bias: crate::scene::default_moment_bias(storage),
+        bleed: 0.0,
+    }
+}
+
+fn msm_mips() -> Technique {
+    Technique::Msm {
+        prefilter: Prefilter {
+            storage: Storage::F32,
+            filter: Filter::Mips {
+                width: 1.0,
+                max_anisotropy: 0,
+            },
+        },
+        hausdorff: false,
+        moment_bias: 1e-5,
+        bleed: 0.0,
+    }
+}
+
+fn csm() -> Technique {
+    Technique::Csm {
+        prefilter: Prefilter {
+            storage: Storage::F32,
+            filter: blur4(),
+        },
+        terms: 2,
+        attenuation: 1.0,
+        offset: 0.25,
+        scale: 2.0,
+    }
+}
+
+fn esm() -> Technique {
+    Technique::Esm {
+        filter: blur4(),
+        exponent: 80.0,
+    }
+}
+
+/// The stages of a light's shipped graph between `input` (made an import, its producers
+/// dropped by the planner) and `output`: one kernel or a filter's passes, timed alone.
+fn stage_graph(n: u32, technique: Technique, input: &str, output: &str) -> BenchGraph {
+    let mut graph = Graph::default();
+    technique::add_light_nodes(&mut graph, 0, &bench_light(n, technique));
+    for r in graph.resources.iter_mut().filter(|r| r.name == input) {
+        r.imported = true;
+    }
+    graph
+        .nodes
+        .retain(|node| node.outputs.iter().all(|(_, r)| r != input));
+    BenchGraph {
+        graph,
+        outputs: vec![output.to_string()],
+    }
+}
+
+/// The SAT passes of [`sat::add_sat`] over an imported `n`² VSM-shaped (Rg32Float) map; fixed
+/// point for lookups of up to 64 × 64 texels of values in [0, 1].
+fn sat_graph(n: u32, variant: SatVariant) -> BenchGraph {
+    sat_graph_with(n, variant, sat::add_sat)
+}
+
+/// [`sat_graph`] with another builder of the table's passes (the five-pass baseline).
+fn sat_graph_with(
+    n: u32,
+    variant: SatVariant,
+    add: fn(&mut Graph, usize, &str, &SatCoding) -> String,
+) -> BenchGraph {
+    let mut graph = Graph::default();
+    let input = graph.import("light0.vsm", wgpu::TextureFormat::Rg32Float, n, n, Some(0));
+    let (lo, hi) = ([0.0; 4], [1.0; 4]);
+    let coding = match variant {
+        SatVariant::Fixed => SatCoding::fixed(sat::lookup_area(64.0, 64.0), lo, hi),
+        SatVariant::Float => SatCoding::float(lo, hi),
+    };
+    // The arguments are valid constants; a unit scale would only change the values summed,
+    // not the work timed.
+    let coding = coding.unwrap_or(SatCoding {
+        variant,
+        offset: [0.5; 4],
+        scale: [1.0; 4],
+        limit: [1.0; 4],
+    });
+    let output = add(&mut graph, 0, &input, &coding);
+    BenchGraph {
+        graph,
+        outputs: vec![output],
+    }
+}
+
+/// The shipped node of [`technique::add_light_nodes`] for a spot light (the perspective path,
+/// the more expensive one), reading a Depth32Float import as the renderer's does.
+fn linearize_graph(n: u32) -> BenchGraph {
+    let light = bench_light(n, Technique::Hard);
+    let mut graph = Graph::default();
+    technique::add_light_nodes(&mut graph, 0, &light);
+    BenchGraph {
+        graph,
+        outputs: vec![technique::linear_name(0)],
+    }
+}
+
+/// A spot light with an `n`² map and `technique`.
+fn bench_light(n: u32, technique: Technique) -> Light {
+    Light {
+        kind: LightKind::Spot { fov_degrees: 60.0 },
+        position: Vec3::new(0.0, 10.0, 0.0),
+        target: Vec3::ZERO,
+        near: 0.1,
+        far: 100.0,
+        size: 0.0,
+        radiance: Vec3::ONE,
+        shadow_map: n,
+        shadow: Shadow {
+            technique,
+            bias: 0.0,
+            slope_bias: 0.0,
+            normal_bias: 0.0,
+        },
+    }
+}
+
+/// Bytes `plan` moves per run: the cost model's reads and writes of every node.
+pub fn plan_bytes(plan: &Plan) -> Result<f64> {
+    plan.steps
+        .iter()
+        .map(|s| Ok(cost::node_traffic(plan, &s.node)?.bytes()))
+        .sum()
+}
+
+/// A kernel or texture-copy row from a timed plan.
+fn row(name: &str, format: String, n: u32, plan: &Plan, ms: f64) -> Result<BenchRow> {
+    let bytes = plan_bytes(plan)?;
+    Ok(BenchRow {
+        kernel: name.to_string(),
+        format,
+        size: n,
+        bytes_moved: bytes,
+        median_ms: ms,
+        gbps: gb_per_s(bytes, ms),
+        ratio: f64::NAN,
+        yardstick: String::new(),
+    })
+}
+
+/// Times, at every size in `sizes` (`repeat` timed runs each), the buffer copy of an
+/// rgba32-sized map, the texture copy of every format of [`COPY_FORMATS`] (ratio to the
+/// buffer copy), then every case of [`CASES`] (ratio to the texture copy of its output's
+/// format).
+pub fn measure(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    sizes: &[u32],
+    repeat: u32,
+) -> Result<Vec<BenchRow>> {
+    check_args(device, sizes, repeat)?;
+    harness::timer(device, queue, 1)?;
+    let mut executor = Executor::new();
+    let mut rows = Vec::new();
+    for &n in sizes {
+        let buffer = texels(n) * 16;
+        let ms = copy::time_buffer_copy(device, queue, &mut executor.kernels, buffer, repeat)?;
+        let buffer_gbps = gb_per_s(2.0 * buffer as f64, ms);
+        rows.push(BenchRow {
+            kernel: "copy buffer".into(),
+            format: "-".into(),
+            size: n,
+            bytes_moved: 2.0 * buffer as f64,
+            median_ms: ms,
+            gbps: buffer_gbps,
+            ratio: 1.0,
+            yardstick: String::new(),
+        });
+        let mut copies: HashMap<wgpu::TextureFormat, f64> = HashMap::new();
+        for &format in COPY_FORMATS {
+            let built = copy::copy_texture_graph(n, format);
+            let (plan, ms) = time_graph(
+                device,
+                queue,
+                &mut executor,
+                &built.graph,
+                &built.outputs,
+                repeat,
+            )?;
+            let mut r = row("copy texture", format_name(format), n, &plan, ms)?;
+            r.ratio = r.gbps / buffer_gbps;
+            r.yardstick = "copy buffer".into();
+            copies.insert(format, r.gbps);
+            rows.push(r);
+        }
+        for case in CASES {
+            let built = (case.build)(n);
+            let (plan, ms) = time_graph(
+                device,
+                queue,
+                &mut executor,
+                &built.graph,
+                &built.outputs,
+                repeat,
+            )?;
+            let output = built.outputs.first().and_then(|o| plan.resource(o));
+            let format = output.map(|r| r.resource.format).ok_or_else(|| {
+                Error::Invalid(format!("benchmark `{}` plans no output", case.name))
+            })?;
+            let copy_gbps = copies.get(&format).copied().ok_or_else(|| {
+                Error::Invalid(format!(
+                    "benchmark `{}` writes {}, which has no texture copy row (COPY_FORMATS)",
+                    case.name,
+                    format_name(format)
+                ))
+            })?;
+            let mut r = row(case.name, format_name(format), n, &plan, ms)?;
+            r.ratio = r.gbps / copy_gbps;
+            r.yardstick = format!("copy texture {}", r.format);
+            rows.push(r);
+        }
+    }
+    Ok(rows)
+}
+
+/// Runs [`measure`] on `gpu` and formats the report.
+pub fn run(gpu: &Gpu, sizes: &[u32], repeat: u32) -> Result<String> {
+    let rows = measure(&gpu.device, &gpu.queue, sizes, repeat)?;
+    let cpu = gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu;
+    Ok(format_table(&gpu.describe(), cpu, repeat, &rows))
+}
+
+/// The report: a header naming the device and the method, then one line per row.
+pub fn format_table(device: &str, cpu: bool, repeat: u32, rows: &[BenchRow]) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "kernel benchmark on {device}");
+    let _ = writeln!(
+        s,
+        "GPU timestamps between passes, median of {repeat} run(s) after {WARMUP} warm-up run(s).\n\
+         MiB moved: the cost model's bytes (every dispatch's reads and writes, halos and second\n\
+         reads included, as `shadowgraph plan` prints them); GB/s = bytes / time; x = GB/s over\n\
+         the yardstick's: for a kernel the texture copy of its output's format (16x16\n\
+         workgroups, one load and one store per texel), for a texture copy the buffer copy."
+    );
+    if cpu {
+        let _ = writeln!(
+            s,
+            "NOTE: this adapter is a CPU device (software Vulkan): times and GB/s are CPU \
+             numbers,\nonly the ratios are meaningful."
+        );
+    }
+    let _ = writeln!(
+        s,
+        "{:>6}  {:<18} {:<12} {:>10} {:>10} {:>9} {:>7}  yardstick",
+        "size", "kernel", "format", "MiB moved", "median ms", "GB/s", "x"
+    );
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "{:>6}  {:<18} {:<12} {:>10.2} {:>10.3} {:>9.2} {:>7.2}  {}",
+            r.size,
+            r.kernel,
+            r.format,
+            r.bytes_moved / (1024.0 * 1024.0),
+            r.median_ms,
+            r.gbps,
+            r.ratio,
+            r.yardstick
+        );
+    }
+    s
+}
+
+fn check_args(device: &wgpu::Device, sizes: &[u32], repeat: u32) -> Result<()> {
+    if sizes.is_empty() {
+        return Err(Error::Invalid("no benchmark sizes given".into()));
+    }
+    if repeat == 0 {
+        return Err(Error::Invalid("repeat must be at least 1".into()));
+    }
+    let max = device.limits().max_texture_dimension_2d;
+    for &n in sizes {
+        if n == 0 {
+            return Err(Error::Invalid("benchmark size 0".into()));
+        }
+        if n > max {
+            return Err(Error::Limit {
+                what: "benchmark size".into(),
+                requested: u64::from(n),
+                limit: u64::from(max),
+            });
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn gpu() -> Gpu {
+        match Gpu::new() {
+            Ok(g) => g,
+            Err(e) => panic!("GPU tests need an adapter (lavapipe on CI): {e}"),
+        }
+    }
+
+    /// Per size: the buffer copy, a texture copy per format, then every case, each case's
+    /// ratio taken to the copy of its output's format and its bytes the cost model's.
+    #[test]
+    fn measure_reports_copies_then_each_case_per_size() {
+        let gpu = gpu();
+        let rows = measure(&gpu.device, &gpu.queue, &[32, 48], 2).unwrap();
+        let names: Vec<(&str, u32)> = rows.iter().map(|r| (r.kernel.as_str(), r.size)).collect();
+        let mut want = Vec::new();
+        for n in [32, 48] {
+            want.push(("copy buffer", n));
+            want.extend(COPY_FORMATS.iter().map(|_| ("copy texture", n)));
+            want.extend(CASES.iter().map(|c| (c.name, n)));
+        }
+        assert_eq!(names, want);
+        for r in &rows {
+            assert!(r.median_ms > 0.0 && r.gbps.is_finite(), "{r:?}");
+            let Some(case) = CASES.iter().find(|c| c.name == r.kernel) else {
+                continue;
+            };
+            let built = (case.build)(r.size);
+            let outputs: Vec<&str> = built.outputs.iter().map(String::as_str).collect();
+            let plan = crate::graph::plan(&built.graph, &outputs).unwrap();
+            assert_eq!(r.bytes_moved, plan_bytes(&plan).unwrap(), "{r:?}");
+            let copy = rows
+                .iter()
+                .find(|c| c.size == r.size && c.kernel == "copy texture" && c.format == r.format)
+                .unwrap();
+            assert_eq!(r.yardstick, format!("copy texture {}", r.format));
+            assert!((r.ratio - r.gbps / copy.gbps).abs() < 1e-12, "{r:?}");
+        }
+        let text = format_table("test device", true, 2, &rows);
+        assert!(text.contains("only the ratios") && text.contains("copy texture rg32float"));
+    }
+
+    /// The bytes of a SAT are its three passes' (two reads of the representation, one write
+    /// of the table, the tiles' edges and carries), the five-pass baseline's as before, a
+    /// blur's both passes with their halos.
+    #[test]
+    fn case_bytes_follow_the_cost_model() {
+        let n = 512;
+        let bytes = |name: &str| {
+            let case = CASES.iter().find(|c| c.name == name).unwrap();
+            let built = (case.build)(n);
+            let outputs: Vec<&str> = built.outputs.iter().map(String::as_str).collect();
+            plan_bytes(&crate::graph::plan(&built.graph, &outputs).unwrap()).unwrap()
+                / f64::from(n * n)
+        };
+        // rg32float moments in twice (2 × 8) and an rg32uint table out (8); a 64² tile's last
+        // row and column (2 × 8/64), read and written again as carries, and read once more.
+        assert_eq!(bytes("sat fixed"), 8.0 + 8.0 + 8.0 + 4.0 * 2.0 * 8.0 / 64.0);
+        // The first design: rg32float moments in (8), row scans out (16) and a block total per
+        // row (1/32), their carries (2 × 2/32), the row scans again with a row carry per texel
+        // (32) and column totals (1/32), the scans a third time with carries (32 + 1/32) and
+        // the rgba32uint table (16).
+        assert_eq!(
+            bytes("sat fixed (5-pass, old)"),
+            8.0 + 16.0 + 32.0 + 32.0 + 16.0 + 7.0 / 32.0
+        );
+        // Two passes of radius 4, 8 B out each: a row workgroup reads its 512 texels and 4 on
+        // either side (520/512 × 8 B), a column workgroup 64 columns of 8 + 8 texels (2 × 8 B).
+        assert_eq!(
+            bytes("blur rg32f r4"),
+            520.0 / 512.0 * 8.0 + 8.0 + 16.0 + 8.0
+        );
+        // Depth (4 B) in, linear depth (4 B) out.
+        assert_eq!(bytes("linearize"), 8.0);
+    }
+
+    #[test]
+    fn bad_arguments_are_errors() {
+        let gpu = gpu();
+        let (d, q) = (&gpu.device, &gpu.queue);
+        assert!(matches!(measure(d, q, &[], 1), Err(Error::Invalid(_))));
+        assert!(matches!(measure(d, q, &[64], 0), Err(Error::Invalid(_))));
+        assert!(matches!(measure(d, q, &[0], 1), Err(Error::Invalid(_))));
+        assert!(matches!(
+            measure(d, q, &[u32::MAX], 1),
+            Err(Error::Limit { .. })
+        ));
+    }
+}

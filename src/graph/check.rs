@@ -1,0 +1,109 @@
+//! What the executor relies on in a [`Plan`]: its fields are public, so a plan built or edited
+//! by hand is checked before it is recorded, and a malformed one is a [`GraphError::BadPlan`]
+//! rather than a panic on an index.
+
+use std::collections::HashSet;
+
+use super::{Dispatch, GraphError, Plan};
+
+impl Plan {
+    /// Checks every index and name the executor follows: resource slots in range and matching
+    /// their slot's format and size, slots of a size and format it can allocate, unique
+    /// resource names, every node's inputs, outputs and dispatch naming planned resources,
+    /// mip-chain nodes with their bindings and parameters, and outputs that exist.
+    pub fn check(&self) -> Result<(), GraphError> {
+        let bad = |message: String| Err(GraphError::BadPlan(message));
+        for (i, s) in self.slots.iter().enumerate() {
+            let full = 32 - s.width.max(s.height).max(1).leading_zeros();
+            if s.width == 0 || s.height == 0 || s.mips == 0 || s.mips > full {
+                return bad(format!(
+                    "slot {i} is {}×{} with {} mip level(s)",
+                    s.width, s.height, s.mips
+                ));
+            }
+            if crate::exec::wgsl_storage_format(s.format).is_err() {
+                return bad(format!(
+                    "slot {i} has format {:?}, not a storage format",
+                    s.format
+                ));
+            }
+        }
+        let mut names = HashSet::new();
+        for r in &self.resources {
+            let name = &r.resource.name;
+            if !names.insert(name.as_str()) {
+                return bad(format!("resource `{name}` is listed twice"));
+            }
+            if let Some(s) = r.slot {
+                let Some(slot) = self.slots.get(s) else {
+                    return bad(format!(
+                        "resource `{name}` lives in slot {s}, but the plan has {} slot(s)",
+                        self.slots.len()
+                    ));
+                };
+                if (slot.format, slot.width, slot.height, slot.mips)
+                    != (r.resource.format, r.width, r.height, r.resource.mips)
+                {
+                    return bad(format!("resource `{name}` does not match its slot {s}"));
+                }
+            }
+        }
+        let known = |r: &str| names.contains(r);
+        for (i, step) in self.steps.iter().enumerate() {
+            let n = &step.node;
+            if let Some((_, r)) = n.inputs.iter().chain(&n.outputs).find(|(_, r)| !known(r)) {
+                return bad(format!(
+                    "step {i} (`{}`) uses `{r}`, which is not in the plan",
+                    n.name
+                ));
+            }
+            let of = match &n.dispatch {
+                Dispatch::Texels(r) => Some(r),
+                Dispatch::Blocks { of, .. } => Some(of),
+                Dispatch::Lines { of, per_group } => {
+                    if *per_group == 0 {
+                        return bad(format!(
+                            "step {i} (`{}`) dispatches lines with 0 per workgroup",
+                            n.name
+                        ));
+                    }
+                    Some(of)
+                }
+                Dispatch::Groups(_) => None,
+                Dispatch::MipChain => {
+                    self.check_mip_chain(n)?;
+                    None
+                }
+            };
+            if let Some(r) = of.filter(|r| !known(r)) {
+                return bad(format!(
+                    "step {i} (`{}`) dispatches over `{r}`, which is not in the plan",
+                    n.name
+                ));
+            }
+        }
+        if let Some(o) = self.outputs.iter().find(|o| !known(o)) {
+            return bad(format!("output `{o}` is not in the plan"));
+        }
+        Ok(())
+    }
+
+    fn check_mip_chain(&self, n: &super::Node) -> Result<(), GraphError> {
+        let has = |list: &[(String, String)], slot: &str| list.iter().any(|(s, _)| s == slot);
+        if !has(&n.inputs, "src") || !has(&n.outputs, "dst") {
+            return Err(GraphError::BadPlan(format!(
+                "mip-chain node `{}` needs a `src` input and a `dst` output",
+                n.name
+            )));
+        }
+        let need = std::mem::size_of::<crate::filter::MipParams>();
+        if n.params.len() < need {
+            return Err(GraphError::BadPlan(format!(
+                "mip-chain node `{}` has {} parameter bytes, {need} needed",
+                n.name,
+                n.params.len()
+            )));
+        }
+        Ok(())
+    }
+}

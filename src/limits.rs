@@ -1,0 +1,252 @@
+//! What kernels and plans need of a device (bindings per stage, workgroup sizes and memory,
+//! dispatch sizes), read from the WGSL by reflection and compared with `wgpu::Limits` before
+//! anything is created; [`scene`] adds what a frame needs (buffers, the shading pass, memory
+//! against a budget) and names the scene key that would fix it.
+
+pub mod scene;
+
+use std::collections::HashMap;
+
+pub use scene::{
+    DEFAULT_MEMORY_BUDGET, MEMORY_BUDGET_ENV, Memory, check_scene, memory_budget, parse_bytes,
+    render_memory,
+};
+
+use crate::error::{Error, Result};
+use crate::graph::{Dispatch, Node, Plan};
+use crate::kernels;
+
+/// One thing a kernel needs of the device, and the device's limit on it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Need {
+    /// What is counted, e.g. `sampled textures`.
+    pub what: &'static str,
+    /// The `wgpu::Limits` field that bounds it.
+    pub limit_name: &'static str,
+    /// How many the kernel needs.
+    pub requested: u64,
+    /// How many the device allows.
+    pub limit: u64,
+}
+
+impl Need {
+    fn new(what: &'static str, limit_name: &'static str, requested: u64, limit: u32) -> Self {
+        Self {
+            what,
+            limit_name,
+            requested,
+            limit: u64::from(limit),
+        }
+    }
+
+    /// Whether the need exceeds the limit.
+    pub fn over(&self) -> bool {
+        self.requested > self.limit
+    }
+
+    /// `what (limit_name)`.
+    pub fn describe(&self) -> String {
+        format!("{} ({})", self.what, self.limit_name)
+    }
+}
+
+/// A plan step that needs more than the device allows.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct StepOver {
+    /// The node's name (`light0.blur_x`).
+    pub node: String,
+    /// The light the node works for.
+    pub light: Option<usize>,
+    /// `kernel `blur`: workgroup memory in bytes (max_compute_workgroup_storage_size)` or
+    /// `node `…`: workgroups per dimension (…)`.
+    pub what: String,
+    /// Whether the size of the map (not the technique's kernel) is what is too large.
+    pub dispatch: bool,
+    /// What it needs.
+    pub requested: u64,
+    /// What the device allows.
+    pub limit: u64,
+}
+
+/// What the compute kernel `module` (reflected as `refl`) needs, against `l`.
+pub fn kernel_needs(
+    module: &naga::Module,
+    refl: &kernels::Reflection,
+    l: &wgpu::Limits,
+) -> Result<Vec<Need>> {
+    use wgpu::BindingType as B;
+    use wgpu::BufferBindingType as Buf;
+    let count = |f: fn(&B) -> bool| refl.bindings.iter().filter(|b| f(&b.ty)).count() as u64;
+    let wg = refl.workgroup_size.unwrap_or([1, 1, 1]).map(u64::from);
+    let mut layouter = naga::proc::Layouter::default();
+    layouter
+        .update(module.to_ctx())
+        .map_err(|e| Error::Invalid(format!("workgroup memory layout: {e}")))?;
+    let shared: u64 = module
+        .global_variables
+        .iter()
+        .filter(|(_, g)| g.space == naga::AddressSpace::WorkGroup)
+        .map(|(_, g)| u64::from(layouter[g.ty].size))
+        .sum();
+    let storage = |t: &B| {
+        matches!(
+            t,
+            B::Buffer {
+                ty: Buf::Storage { .. },
+                ..
+            }
+        )
+    };
+    let uniform = |t: &B| {
+        matches!(
+            t,
+            B::Buffer {
+                ty: Buf::Uniform,
+                ..
+            }
+        )
+    };
+    Ok(vec![
+        Need::new(
+            "workgroup width",
+            "max_compute_workgroup_size_x",
+            wg[0],
+            l.max_compute_workgroup_size_x,
+        ),
+        Need::new(
+            "workgroup height",
+            "max_compute_workgroup_size_y",
+            wg[1],
+            l.max_compute_workgroup_size_y,
+        ),
+        Need::new(
+            "workgroup depth",
+            "max_compute_workgroup_size_z",
+            wg[2],
+            l.max_compute_workgroup_size_z,
+        ),
+        Need::new(
+            "invocations per workgroup",
+            "max_compute_invocations_per_workgroup",
+            wg.iter().product(),
+            l.max_compute_invocations_per_workgroup,
+        ),
+        Need::new(
+            "workgroup memory in bytes",
+            "max_compute_workgroup_storage_size",
+            shared,
+            l.max_compute_workgroup_storage_size,
+        ),
+        Need::new(
+            "storage textures",
+            "max_storage_textures_per_shader_stage",
+            count(|t| matches!(t, B::StorageTexture { .. })),
+            l.max_storage_textures_per_shader_stage,
+        ),
+        Need::new(
+            "storage buffers",
+            "max_storage_buffers_per_shader_stage",
+            count(storage),
+            l.max_storage_buffers_per_shader_stage,
+        ),
+        Need::new(
+            "sampled textures",
+            "max_sampled_textures_per_shader_stage",
+            count(|t| matches!(t, B::Texture { .. })),
+            l.max_sampled_textures_per_shader_stage,
+        ),
+        Need::new(
+            "samplers",
+            "max_samplers_per_shader_stage",
+            count(|t| matches!(t, B::Sampler(_))),
+            l.max_samplers_per_shader_stage,
+        ),
+        Need::new(
+            "uniform buffers",
+            "max_uniform_buffers_per_shader_stage",
+            count(uniform),
+            l.max_uniform_buffers_per_shader_stage,
+        ),
+        Need::new(
+            "bind groups",
+            "max_bind_groups",
+            refl.group_count().into(),
+            l.max_bind_groups,
+        ),
+    ])
+}
+
+/// The first of kernel `name`'s needs (WGSL `wgsl`) past `l`, if any.
+pub fn kernel_over(name: &str, wgsl: &str, l: &wgpu::Limits) -> Result<Option<Need>> {
+    let (module, refl) = kernels::reflect(name, wgsl)?;
+    Ok(kernel_needs(&module, &refl, l)?
+        .into_iter()
+        .find(Need::over))
+}
+
+/// The first step of `plan` whose kernel or dispatch exceeds `l`, if any.
+pub fn plan_over(plan: &Plan, l: &wgpu::Limits) -> Result<Option<StepOver>> {
+    let mut workgroups: HashMap<&str, [u32; 3]> = HashMap::new();
+    for step in &plan.steps {
+        let node = &step.node;
+        let name = node.kernel.as_str();
+        if !workgroups.contains_key(name) {
+            let wgsl = kernels::resolve(name, None)?;
+            let (module, refl) = kernels::reflect(name, &wgsl)?;
+            if let Some(n) = kernel_needs(&module, &refl, l)?
+                .into_iter()
+                .find(Need::over)
+            {
+                return Ok(Some(StepOver {
+                    node: node.name.clone(),
+                    light: node.light,
+                    what: format!("kernel `{name}`: {}", n.describe()),
+                    dispatch: false,
+                    requested: n.requested,
+                    limit: n.limit,
+                }));
+            }
+            workgroups.insert(name, refl.workgroup_size.unwrap_or([1, 1, 1]));
+        }
+        let wg = workgroups.get(name).copied().unwrap_or([1, 1, 1]);
+        let max = l.max_compute_workgroups_per_dimension;
+        if let Some(g) = dispatch_groups(plan, node, wg)
+            .into_iter()
+            .find(|&g| g > max)
+        {
+            return Ok(Some(StepOver {
+                node: node.name.clone(),
+                light: node.light,
+                what: format!(
+                    "node `{}`: workgroups per dimension (max_compute_workgroups_per_dimension)",
+                    node.name
+                ),
+                dispatch: true,
+                requested: g.into(),
+                limit: max.into(),
+            }));
+        }
+    }
+    Ok(None)
+}
+
+/// Workgroup counts of a node's dispatch (as the executor computes them; for a mip chain its
+/// largest dispatch, the first: tiles of level 1, or of level 0 for a 1×1 map).
+pub fn dispatch_groups(plan: &Plan, node: &Node, wg: [u32; 3]) -> [u32; 3] {
+    let size = |r: &str| plan.resource(r).map(|p| (p.width, p.height));
+    let wg = wg.map(|w| w.max(1));
+    if node.dispatch == Dispatch::MipChain {
+        let (w, h) = node
+            .outputs
+            .first()
+            .and_then(|(_, r)| size(r))
+            .unwrap_or((1, 1));
+        let tile = crate::filter::MIP_TILE / 2;
+        return [
+            (w / 2).max(1).div_ceil(tile),
+            (h / 2).max(1).div_ceil(tile),
+            1,
+        ];
+    }
+    node.dispatch.groups(size, wg).unwrap_or([1, 1, 1])
+}

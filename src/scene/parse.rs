@@ -1,0 +1,214 @@
+//! Turns the spanned TOML (`format`) into the validated model, naming key and line on errors:
+//! the file, `[output]`, `[camera]` and each `[[light]]` (its `[light.shadow]` in `validate`,
+//! objects in `object`).
+
+use std::path::Path;
+
+use glam::Vec3;
+
+use super::ctx::{Ctx, fmt_num};
+use super::format::{LightFile, SceneFile};
+use super::locate::{self, Locations};
+use super::{Camera, Light, LightKind, Scene, Shadow, Technique, object, validate};
+use crate::error::Result;
+
+/// Largest output or shadow-map side accepted before the device is even asked.
+pub(super) const MAX_SIDE: i64 = 1 << 16;
+
+pub(super) fn parse(path: &Path, text: &str) -> Result<Scene> {
+    let ctx = Ctx {
+        path,
+        text,
+        warnings: Default::default(),
+    };
+    let locations = Locations::of(text);
+    let file: SceneFile = toml::from_str(text).map_err(|e| {
+        // A key missing from the top level comes with an empty span at 0: the whole file.
+        let whole =
+            e.message().starts_with("missing field") && e.span().is_none_or(|s| s.is_empty());
+        let span = e.span().filter(|_| !whole);
+        let key = span.as_ref().and_then(|s| locations.key_at(s));
+        ctx.err(span, locate::rewrite(e.message(), key))
+    })?;
+    let width = ctx.int("output.width", &file.output.width, 1, MAX_SIDE)?;
+    let height = ctx.int("output.height", &file.output.height, 1, MAX_SIDE)?;
+    let background = ctx.color_or(
+        "output.background",
+        &file.output.background,
+        Vec3::new(0.55, 0.62, 0.72),
+    )?;
+    let ambient = ctx.color_or("ambient", &file.ambient, Vec3::splat(0.12))?;
+    let camera = camera(&ctx, &file)?;
+    if file.lights.is_empty() {
+        return Err(ctx.err(None, "the scene has no `[[light]]`"));
+    }
+    let lights = file
+        .lights
+        .iter()
+        .enumerate()
+        .map(|(i, l)| light(&ctx, i, l))
+        .collect::<Result<Vec<_>>>()?;
+    let mut objects = Vec::with_capacity(file.objects.len());
+    let mut triangles = 0;
+    for (i, o) in file.objects.iter().enumerate() {
+        let object = object::object(&ctx, i, o)?;
+        triangles += object.mesh.indices.len() / 3;
+        object::check_triangles(&ctx, i, o, triangles)?;
+        objects.push(object);
+    }
+    if objects.is_empty() {
+        return Err(ctx.err(None, "the scene has no `[[object]]`"));
+    }
+    Ok(Scene {
+        path: path.to_path_buf(),
+        width,
+        height,
+        background,
+        ambient,
+        camera,
+        lights,
+        objects,
+        warnings: ctx.warnings.into_inner(),
+        locations,
+    })
+}
+
+fn camera(ctx: &Ctx, file: &SceneFile) -> Result<Camera> {
+    let c = &file.camera;
+    let position = ctx.coord("camera.position", &c.position)?;
+    let target = ctx.coord("camera.target", &c.target)?;
+    let up = ctx.coord_or("camera.up", &c.up, Vec3::Y)?;
+    let fov_y_degrees = ctx.num("camera.fov_y_degrees", &c.fov_y_degrees, 1.0, 170.0)?;
+    let forward = target - position;
+    if forward.length() < 1e-6 {
+        return Err(ctx.err(
+            Some(c.target.span()),
+            "`camera.target` equals `camera.position`",
+        ));
+    }
+    if forward.normalize().cross(up).length() < 1e-4 {
+        // Without an `up` key (default +Y), the target sets the view direction: point there.
+        let span = c.up.as_ref().map_or(c.target.span(), |u| u.span());
+        return Err(ctx.err(Some(span), "`camera.up` is parallel to the view direction"));
+    }
+    Ok(Camera {
+        position,
+        target,
+        up,
+        fov_y_degrees,
+    })
+}
+
+fn light(ctx: &Ctx, i: usize, l: &LightFile) -> Result<Light> {
+    let key = |k: &str| format!("light[{i}].{k}");
+    let kind = match l.kind.get_ref().as_str() {
+        "directional" => {
+            ctx.reject(
+                &key("fov_degrees"),
+                &l.fov_degrees,
+                "applies to spot lights only",
+            )?;
+            let e = ctx.required(&key("extent"), &l.extent, l.kind.span())?;
+            LightKind::Directional {
+                extent: ctx.num(&key("extent"), e, 1e-3, 1e6)?,
+            }
+        }
+        "spot" => {
+            ctx.reject(
+                &key("extent"),
+                &l.extent,
+                "applies to directional lights only",
+            )?;
+            let f = ctx.required(&key("fov_degrees"), &l.fov_degrees, l.kind.span())?;
+            LightKind::Spot {
+                fov_degrees: ctx.num(&key("fov_degrees"), f, 1.0, 170.0)?,
+            }
+        }
+        other => {
+            return Err(ctx.err(
+                Some(l.kind.span()),
+                format!(
+                    "`{}` = {other:?}: unknown light kind (expected \"directional\" or \"spot\")",
+                    key("kind")
+                ),
+            ));
+        }
+    };
+    let position = ctx.coord(&key("position"), &l.position)?;
+    let target = ctx.coord(&key("target"), &l.target)?;
+    if (target - position).length() < 1e-6 {
+        return Err(ctx.err(
+            Some(l.target.span()),
+            format!("`{}` equals its position", key("target")),
+        ));
+    }
+    let near = ctx.num_or(&key("near"), &l.near, 1e-6, 1e7, 0.1)?;
+    let far = ctx.num_or(&key("far"), &l.far, 1e-6, 1e7, 50.0)?;
+    if far <= near {
+        let span = l.far.as_ref().or(l.near.as_ref()).map(|s| s.span());
+        return Err(ctx.err(
+            span,
+            format!(
+                "`{}` ({far}) must exceed `{}` ({near})",
+                key("far"),
+                key("near")
+            ),
+        ));
+    }
+    let size = ctx.num_or(&key("size"), &l.size, 0.0, 1e6, 0.0)?;
+    let color = ctx.color_or(&key("color"), &l.color, Vec3::ONE)?;
+    let intensity = ctx.num_or(&key("intensity"), &l.intensity, 0.0, 1e6, 1.0)?;
+    let shadow_map = ctx.int_or(&key("shadow_map"), &l.shadow_map, 1, MAX_SIDE, 1024)?;
+    let shadow = match &l.shadow {
+        Some(s) => validate::shadow(ctx, i, s)?,
+        None => Shadow {
+            technique: Technique::Hard,
+            bias: 0.002,
+            slope_bias: 1.0,
+            normal_bias: 1.0,
+        },
+    };
+    let soft =
+        matches!(shadow.technique, Technique::Pcss { .. }) || shadow.technique.soft().is_some();
+    if soft && size <= 0.0 {
+        let span = l.size.as_ref().map(|s| s.span()).or(Some(l.kind.span()));
+        return Err(ctx.err(
+            span,
+            format!(
+                "technique \"{}\" needs `{}` > 0 (the area light's width)",
+                shadow.technique.name(),
+                key("size")
+            ),
+        ));
+    }
+    if let Some(soft) = shadow.technique.soft() {
+        let area = crate::technique::soft_lookup_area(soft.max_search, shadow_map);
+        if soft.sums == crate::sat::SatVariant::Fixed && area > crate::sat::MAX_FIXED_AREA {
+            let span = l
+                .shadow
+                .as_ref()
+                .and_then(|s| s.max_search.as_ref())
+                .map(|v| v.span());
+            return Err(ctx.err(
+                span.or(l.shadow_map.as_ref().map(|v| v.span())),
+                format!(
+                    "`{}` = {} on a {shadow_map}² map reads squares of {area} texels, more than a \
+                     fixed-point table can sum; lower it or set `sat_sums = \"float\"`",
+                    key("shadow.max_search"),
+                    fmt_num(f64::from(soft.max_search))
+                ),
+            ));
+        }
+    }
+    Ok(Light {
+        kind,
+        position,
+        target,
+        near,
+        far,
+        size,
+        radiance: color * intensity,
+        shadow_map,
+        shadow,
+    })
+}

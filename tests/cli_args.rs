@@ -1,0 +1,121 @@
+//! Unbounded command-line inputs are refused up front, the same way by every command: `--repeat`
+//! is 1 to 1000 for `render`, `evaluate` and `bench`; `evaluate --truth-resolution 0` says what
+//! is wrong; `plan /dev/zero` stops reading. Each is one line and status 1, within seconds (no
+//! GPU work starts).
+
+use std::path::Path;
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+/// Runs the CLI, killing it after 60 s (a refusal must come long before).
+fn shadowgraph(args: &[&str]) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_shadowgraph"))
+        .args(args)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run shadowgraph");
+    let start = Instant::now();
+    while child.try_wait().expect("wait").is_none() {
+        if start.elapsed() > Duration::from_secs(60) {
+            let _ = child.kill();
+            panic!("`shadowgraph {}` still running after 60 s", args.join(" "));
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    child.wait_with_output().expect("output")
+}
+
+fn scene() -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes/sphere_on_plane.toml")
+        .display()
+        .to_string()
+}
+
+/// Status 1 and one line on stderr containing every needle.
+#[track_caller]
+fn refused(args: &[&str], needles: &[&str]) {
+    let o = shadowgraph(args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    let what = args.join(" ");
+    assert_eq!(o.status.code(), Some(1), "`{what}`: {err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "`{what}`: {err}");
+    for n in needles {
+        assert!(err.contains(n), "`{what}`: `{n}` missing from {err}");
+    }
+}
+
+#[test]
+fn repeat_is_bounded_the_same_way_everywhere() {
+    let s = scene();
+    let out = std::env::temp_dir().join(format!("shadowgraph-args-{}", std::process::id()));
+    let out = out.to_str().unwrap();
+    for repeat in ["0", "1001", "4294967295"] {
+        refused(
+            &["render", &s, "-o", "/dev/null", "--repeat", repeat],
+            &["--repeat", "1..=1000"],
+        );
+        refused(
+            &["evaluate", &s, "--out", out, "--repeat", repeat],
+            &["--repeat", "1..=1000"],
+        );
+        refused(
+            &["bench", "--sizes", "64", "--repeat", repeat],
+            &["--repeat", "1..=1000"],
+        );
+        refused(
+            &["bench", "--lookup", "--repeat", repeat],
+            &["--repeat", "1..=1000"],
+        );
+    }
+}
+
+#[test]
+fn truth_resolution_zero_says_so() {
+    let s = scene();
+    let out = std::env::temp_dir().join(format!("shadowgraph-truth-{}", std::process::id()));
+    let o = shadowgraph(&[
+        "evaluate",
+        &s,
+        "--out",
+        out.to_str().unwrap(),
+        "--truth-resolution",
+        "0",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("--truth-resolution") && !err.contains("device allows"),
+        "{err}"
+    );
+}
+
+#[cfg(unix)]
+#[test]
+fn plan_of_an_endless_file_stops() {
+    refused(&["plan", "/dev/zero"], &["/dev/zero", "KiB"]);
+}
+
+/// The library refuses what the command line cannot pass: a render of more frames than
+/// `MAX_REPEAT`, an evaluation of `repeat` 0 or `truth_resolution` 0.
+#[test]
+fn library_entry_points_check_the_same_bounds() {
+    let mut opts = shadowgraph::evaluate::EvaluateOptions {
+        repeat: 0,
+        ..Default::default()
+    };
+    let shown = shadowgraph::evaluate::check_options(&opts)
+        .unwrap_err()
+        .to_string();
+    assert!(shown.contains("--repeat 0"), "{shown}");
+    opts.repeat = 1;
+    opts.truth_resolution = Some(0);
+    let shown = shadowgraph::evaluate::check_options(&opts)
+        .unwrap_err()
+        .to_string();
+    assert!(shown.contains("--truth-resolution 0"), "{shown}");
+    opts.truth_resolution = None;
+    shadowgraph::evaluate::check_options(&opts).expect("defaults are valid");
+}

@@ -1,0 +1,421 @@
+//! The cost model (`shadowgraph plan`'s traffic and fetches) against hand counts, and its
+//! declarations against the code they describe: every compute kernel declares what each of
+//! its bindings moves, every fetching function declares its fetches, and the shading kernel,
+//! rewritten so that every texture fetch adds one to a per-pixel counter, fetches exactly what
+//! the declarations say. Structural costs are exact, so the tolerances are float rounding.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use shadowgraph::graph::cost::{self, fetches::Fetches};
+use shadowgraph::render::{RenderOptions, Renderer, plan_lights};
+use shadowgraph::scene::Scene;
+use shadowgraph::{kernels, technique};
+
+fn scene_path(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name)
+}
+
+fn scene(name: &str) -> Scene {
+    Scene::load(scene_path(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+/// One node of a hand count: name suffix, dispatches, bytes read and written per texel.
+type Row = (&'static str, u32, f64, f64);
+
+/// Checks light 0's traffic in `scene` against `rows` (in plan order) and the totals.
+fn assert_traffic(name: &str, rows: &[Row], total: f64, ideal: f64) {
+    let s = scene(name);
+    let plan = plan_lights(&s.lights).expect("plan").plan;
+    let texels = cost::map_texels(&plan, 0);
+    let nodes = cost::light_traffic(&plan, 0).expect("traffic");
+    let got: Vec<(String, u32, f64, f64)> = nodes
+        .iter()
+        .map(|(n, t)| {
+            (
+                n.name.clone(),
+                t.dispatches,
+                t.read / texels,
+                t.written / texels,
+            )
+        })
+        .collect();
+    assert_eq!(got.len(), rows.len(), "{name}: nodes {got:#?}");
+    for (g, r) in got.iter().zip(rows) {
+        // Dyadic fractions of the map's texels: exact in f64.
+        let same = g.0.ends_with(r.0) && g.1 == r.1 && g.2 == r.2 && g.3 == r.3;
+        assert!(same, "{name}: got {g:?}, hand count {r:?}");
+    }
+    let sum: f64 = got.iter().map(|g| g.2 + g.3).sum();
+    assert_eq!(sum, total, "{name}: total B/texel");
+    assert_eq!(
+        cost::ideal_bytes(&plan, 0),
+        ideal,
+        "{name}: one read + one write"
+    );
+}
+
+/// `vsm.toml`: a 512² map, f32 moments, a Gaussian blur of radius 3.
+#[test]
+fn vsm_with_blur_moves_what_the_hand_count_says() {
+    assert_traffic(
+        "techniques/vsm.toml",
+        &[
+            // depth32float in, r32float out.
+            ("linearize", 1, 4.0, 4.0),
+            // 16×16 workgroups load their tile and the 4×16 texels of its cross-shaped
+            // halo (the four neighbours of the derivatives): 320/256 × 4 B; rg32float out.
+            ("vsm", 1, 5.0, 8.0),
+            // A row workgroup loads 64 × 8 texels of a row and 3 more on either side:
+            // 518/512 × 8 B.
+            ("blur_h", 1, 8.09375, 8.0),
+            // A column workgroup loads 64 columns of 8 + 2 × 3 texels: 896/512 × 8 B.
+            ("blur_v", 1, 14.0, 8.0),
+        ],
+        // 8 + 13 + 16.09375 + 22
+        59.09375,
+        // one read of the depth (4 B) + one write of the blurred moments (8 B)
+        12.0,
+    );
+}
+
+/// `vsm_mips.toml`: a 512² map, a mip chain of 10 levels, up to six per dispatch.
+#[test]
+fn vsm_with_mips_moves_every_level() {
+    let level = |k: i32| 8.0 / 4f64.powi(k); // rg32float bytes of level k per level-0 texel
+    assert_traffic(
+        "techniques/vsm_mips.toml",
+        &[
+            ("linearize", 1, 4.0, 4.0),
+            ("vsm", 1, 5.0, 8.0),
+            // Dispatch 1 reads the moments and writes levels 0–6; dispatch 2 reads level 6
+            // and writes levels 7–9.
+            ("vsm.mips", 2, 8.0 + level(6), (0..10).map(level).sum()),
+        ],
+        21.0 + 8.0 + level(6) + (0..10).map(level).sum::<f64>(),
+        4.0 + (0..10).map(level).sum::<f64>(),
+    );
+}
+
+/// A summed-area table at 512² of a representation of `src` bytes per texel into a table of
+/// `table` bytes per texel, in 64 × 64 tiles (8 × 8 of them): the three passes.
+fn sat_rows(src: f64, table: f64) -> [Row; 3] {
+    // A tile's last row and last column (pass 1), and as many carries (pass 2): each one
+    // table texel per 64 map texels, twice.
+    let edges = 2.0 * table / 64.0;
+    [
+        // Read the representation, write the tiles' edge sums.
+        ("sat.tile_sums", 1, src, edges),
+        // Read the edge sums, write the carries.
+        ("sat.carries", 1, edges, edges),
+        // Read the representation again and 64 carries of either kind per tile (the same
+        // bytes as the carries); write the table.
+        ("sat", 1, src + edges, table),
+    ]
+}
+
+/// `msm_sat.toml`: a 512² map, 16-bit quantized moments (rgba16float), a fixed-point table.
+#[test]
+fn msm_with_sat_moves_what_the_hand_count_says() {
+    let mut rows = vec![("linearize", 1, 4.0, 4.0), ("msm", 1, 4.0, 8.0)];
+    rows.extend(sat_rows(8.0, 16.0));
+    // 8 + 12 + (8.5 + 1 + 24.5) of the table
+    assert_traffic("techniques/msm_sat.toml", &rows, 54.0, 4.0 + 16.0);
+}
+
+/// `cssm.toml`: M = 8 terms at 512²: four CSM maps (rgba32float), five CSM-Z maps (four
+/// rgba32float, the 17th channel alone in r32float), each with its table.
+#[test]
+fn cssm_moves_what_the_hand_count_says() {
+    let mut rows: Vec<Row> = vec![("linearize", 1, 4.0, 4.0)];
+    for chunk in 0..4 {
+        rows.push((["csm0", "csm1", "csm2", "csm3"][chunk], 1, 4.0, 16.0));
+        rows.extend(sat_rows(16.0, 16.0));
+    }
+    for chunk in 0..5 {
+        let bytes = if chunk < 4 { 16.0 } else { 4.0 };
+        let name = ["csm_z0", "csm_z1", "csm_z2", "csm_z3", "csm_z4"][chunk];
+        rows.push((name, 1, 4.0, bytes));
+        rows.extend(sat_rows(bytes, bytes));
+    }
+    // linearize 8; per rgba map 20 + 50; the r32float map 8 + 12.5.
+    let total = 8.0 + 8.0 * 70.0 + 20.5;
+    // One read of the depth, one write of eight rgba tables and one r32uint table.
+    assert_traffic("techniques/cssm.toml", &rows, total, 4.0 + 8.0 * 16.0 + 4.0);
+}
+
+/// The hand counts of the shading fetches: one bilinear lookup (4 loads) for VSM with a blur,
+/// one table lookup (16 loads: the 4 × 4 texels around the rectangle's corners) for MSM with
+/// a table, and for CSSM with M = 8 the ⌈M/2⌉ = 4 CSM and ⌈(2M + 1)/4⌉ = 5 CSM-Z tables over
+/// the search square plus the 4 CSM tables over the filter square: 13 × 16 = 208; PCSS 16
+/// blocker + 32 filter taps; anisotropic mips 8 taps of 8 loads (trilinear).
+#[test]
+fn shading_fetches_match_the_hand_counts() {
+    for (name, fetches) in [
+        ("techniques/vsm.toml", 4.0),
+        ("techniques/msm_sat.toml", 16.0),
+        ("techniques/cssm.toml", 208.0),
+        ("sphere_on_plane.toml", 48.0),
+        ("techniques/vsm_mips_aniso.toml", 64.0),
+    ] {
+        let s = scene(name);
+        let got = shadowgraph::cli::shading_fetches(&s.lights).expect("fetches");
+        assert_eq!(got, [fetches], "{name}");
+    }
+}
+
+/// `plan` prints each node's traffic, the closing total and the shading fetches.
+#[test]
+fn plan_prints_traffic_and_fetches() {
+    let text = shadowgraph::cli::plan(&scene_path("techniques/vsm.toml"), false).expect("plan");
+    for needle in [
+        "traffic per texel of the 512² map:",
+        "reads    5.00 B, writes    8.00 B",
+        "total: 4 dispatches, 59.09 B/texel (one read + one write of the result: 12.00 B/texel)",
+        "shade: vsm 4 fetches/pixel",
+    ] {
+        assert!(text.contains(needle), "`{needle}` missing:\n{text}");
+    }
+}
+
+/// The resolved WGSL of kernel `name` (the shading kernel with a block of every technique).
+fn resolved(name: &str) -> String {
+    let generated = (name == "shade").then(|| {
+        let s = scene("two_lights.toml");
+        technique::shading_block(&s.lights)
+    });
+    kernels::resolve(name, generated.as_deref()).expect("resolve")
+}
+
+/// Every compute kernel in `kernels/` declares every texture and storage buffer it binds, so
+/// a kernel added without its `// #traffic` lines fails here, naming the binding.
+#[test]
+fn every_compute_kernel_declares_its_traffic() {
+    let mut checked = Vec::new();
+    let mut failures = Vec::new();
+    for s in kernels::SOURCES.iter().filter(|s| !s.name.contains('/')) {
+        let (_, reflection) = kernels::reflect(s.name, &resolved(s.name)).expect("reflect");
+        if !reflection.stages.contains(wgpu::ShaderStages::COMPUTE) {
+            continue;
+        }
+        match cost::check_declarations(s.name, s.text, &reflection) {
+            Ok(_) => checked.push(s.name),
+            Err(e) => failures.push(e.to_string()),
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    assert!(checked.len() >= 17, "{checked:?}");
+    // Negative control: the blur without its `src` line is named.
+    let blur = kernels::source("blur").expect("blur");
+    let (_, reflection) = kernels::reflect("blur", &resolved("blur")).expect("reflect");
+    let stripped: String = blur
+        .lines()
+        .filter(|l| !l.starts_with("// #traffic src"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let e = cost::check_declarations("blur", &stripped, &reflection).unwrap_err();
+    assert!(e.to_string().contains("binding `src`"), "{e}");
+}
+
+/// Lights that exercise every declaration's fields: PCF radius 2, PCSS 16 + 32, anisotropic
+/// mips of 4 taps, a table.
+fn test_lights() -> Vec<Vec<u8>> {
+    [
+        "bunny.toml",
+        "sphere_on_plane.toml",
+        "techniques/vsm_mips_aniso.toml",
+    ]
+    .iter()
+    .flat_map(|n| scene(n).lights)
+    .map(|l| bytemuck::bytes_of(&technique::LightGpu::new(&l)).to_vec())
+    .collect()
+}
+
+/// Every function of the exported library (every `shared/vis_*` module and what it imports)
+/// that fetches has a `// #fetches` declaration, and each declaration of a function that does
+/// not loop equals the sum of its own loads and its callees' declarations.
+#[test]
+fn every_fetching_function_declares_its_fetches() {
+    let library = shadowgraph::prefilter::wgsl::library().expect("library");
+    let mut consistent = 0;
+    for light in test_lights() {
+        let mut f = Fetches::new("library", &library, &light).expect("declarations");
+        for name in f.functions() {
+            let declared = f.count_declared(&name).unwrap_or_else(|e| panic!("{e}"));
+            if f.declared().contains(&name) {
+                if let Some(from_body) = f.count_from_body(&name).expect("body") {
+                    assert_eq!(
+                        declared, from_body,
+                        "`{name}`: declaration against its body"
+                    );
+                    consistent += 1;
+                }
+            }
+        }
+    }
+    assert!(
+        consistent > 30,
+        "{consistent} declarations checked against their bodies"
+    );
+    // Negative control: without its declaration, `load_depth` is named.
+    let stripped = library.replace("// #fetches load_depth: 1\n", "");
+    assert_ne!(stripped, library);
+    let light = &test_lights()[0];
+    let mut f = Fetches::new("library", &stripped, light).expect("declarations");
+    let e = f.count_declared("load_depth").unwrap_err().to_string();
+    assert!(e.contains("load_depth"), "{e}");
+}
+
+/// Counting helpers: one per return type of a fetch in the shading kernel.
+const COUNTERS: &str = "
+var<private> sg_fetches: u32;
+fn sg_count_vec4f(v: vec4<f32>) -> vec4<f32> { sg_fetches += 1u; return v; }
+fn sg_count_vec4u(v: vec4<u32>) -> vec4<u32> { sg_fetches += 1u; return v; }
+fn sg_count_f32(v: f32) -> f32 { sg_fetches += 1u; return v; }
+";
+
+/// `wgsl` (the resolved shading kernel) with every `textureLoad`, `textureSample*` and
+/// `textureGather*` call wrapped in a counter, the counter reset before each light's
+/// visibility and stored in that light's visibility output instead.
+fn count_fetches(wgsl: &str) -> String {
+    let module = naga::front::wgsl::parse_str(wgsl).expect("parse");
+    let info = naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::all(),
+    )
+    .validate(&module)
+    .expect("validate");
+    let mut wraps = Vec::new();
+    let mut collect = |f: &naga::Function, fi: &naga::valid::FunctionInfo| {
+        for (h, e) in f.expressions.iter() {
+            if !matches!(
+                e,
+                naga::Expression::ImageLoad { .. } | naga::Expression::ImageSample { .. }
+            ) {
+                continue;
+            }
+            // naga's span is the callee's name: extend it to the closing parenthesis.
+            let name = f.expressions.get_span(h).to_range().expect("span");
+            let range = name.start..call_end(wgsl, name.end);
+            let counter = match fi[h].ty.inner_with(&module.types) {
+                naga::TypeInner::Vector { scalar, .. } if scalar.kind == naga::ScalarKind::Uint => {
+                    "sg_count_vec4u"
+                }
+                naga::TypeInner::Vector { .. } => "sg_count_vec4f",
+                _ => "sg_count_f32",
+            };
+            wraps.push((range, counter));
+        }
+    };
+    for (h, f) in module.functions.iter() {
+        collect(f, &info[h]);
+    }
+    for (i, ep) in module.entry_points.iter().enumerate() {
+        collect(&ep.function, info.get_entry_point(i));
+    }
+    wraps.sort_by_key(|(r, _)| std::cmp::Reverse(r.start));
+    let mut out = wgsl.to_string();
+    for (r, counter) in &wraps {
+        assert!(
+            wgsl[r.clone()].starts_with("texture"),
+            "{}",
+            &wgsl[r.clone()]
+        );
+        out.insert(r.end, ')');
+        out.insert_str(r.start, &format!("{counter}("));
+    }
+    let reset = "let v = select(light_visibility(";
+    let store = "out_visibility[base + i] = v;";
+    assert!(
+        out.contains(reset) && out.contains(store),
+        "shade.wgsl changed: update"
+    );
+    out = out.replace(reset, &format!("sg_fetches = 0u;\n        {reset}"));
+    out = out.replace(store, "out_visibility[base + i] = f32(sg_fetches);");
+    format!("{COUNTERS}{out}")
+}
+
+/// One past the `)` closing the argument list that opens at `at`.
+fn call_end(text: &str, at: usize) -> usize {
+    assert_eq!(&text[at..at + 1], "(", "a call's arguments follow its name");
+    let mut depth = 0;
+    for (i, c) in text[at..].char_indices() {
+        match c {
+            '(' => depth += 1,
+            ')' if depth == 1 => return at + i + 1,
+            ')' => depth -= 1,
+            _ => {}
+        }
+    }
+    panic!("unclosed call at {at}")
+}
+
+/// Every bundled and technique scene rendered with the counting shading kernel: per light, no
+/// pixel fetches more than the declared count and some pixel fetches exactly that (PCSS
+/// without a blocker stops after its search; a table lookup at the map's edge skips texels).
+#[test]
+fn counted_fetches_match_the_declarations() {
+    let g = common::gpu();
+    let mut names: Vec<String> = std::fs::read_dir(scene_path("techniques"))
+        .expect("scenes")
+        .map(|e| {
+            format!(
+                "techniques/{}",
+                e.expect("entry").file_name().to_string_lossy()
+            )
+        })
+        .collect();
+    names.extend(
+        [
+            "bunny",
+            "sphere_on_plane",
+            "pole",
+            "stacked",
+            "grazing",
+            "two_lights",
+        ]
+        .map(|n| format!("{n}.toml")),
+    );
+    names.sort();
+    let mut renderer = Renderer::new(&g.device);
+    let mut checked = 0;
+    for name in &names {
+        let mut s = scene(name);
+        if shadowgraph::render::check_features(&g.device, &s.lights).is_err() {
+            continue;
+        }
+        (s.width, s.height) = (96, 72);
+        let block = technique::shading_block(&s.lights);
+        let wgsl = kernels::resolve("shade", Some(&block)).expect("shade");
+        renderer
+            .executor
+            .kernels
+            .insert_generated(&g.device, "shade", Some(&block), &count_fetches(&wgsl))
+            .expect("counting kernel");
+        let frame = renderer
+            .render(&g.device, &g.queue, &s, RenderOptions::default())
+            .expect("render");
+        let declared = shadowgraph::cli::shading_fetches(&s.lights).expect("declared");
+        let lights = s.lights.len();
+        for (l, &d) in declared.iter().enumerate() {
+            let counts: Vec<f32> = frame
+                .visibility
+                .iter()
+                .skip(l)
+                .step_by(lights)
+                .copied()
+                .collect();
+            let most = counts.iter().copied().fold(0.0, f32::max);
+            assert_eq!(
+                f64::from(most),
+                d,
+                "{name} light {l}: most fetches of a pixel"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked >= 25, "{checked} lights checked");
+}

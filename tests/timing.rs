@@ -1,0 +1,297 @@
+//! Per-pass GPU times are true: they add up to the frame's wall-clock time, and a pass made
+//! costlier reads costlier. Run on lavapipe in CI, where timestamps are CPU time and where a
+//! timestamp written before a compute pass used to be stamped after it (see `src/timer.rs`):
+//! the old per-pass timestamp pairs read a 40 ms blur as 0.08 ms, and these tests fail on them.
+//!
+//! No absolute figure is asserted: every comparison is between measurements of the same run,
+//! each a median over frames, and a measurement that misses is taken again (the 2 CPU cores
+//! are shared with other jobs) before the test fails with every attempt's figures.
+
+mod common;
+
+use std::path::Path;
+use std::time::Instant;
+
+use shadowgraph::gpu::{Gpu, submit_and_wait};
+use shadowgraph::prefilter::{LightParams, Prefilter, PrefilterConfig};
+use shadowgraph::render::{RenderOptions, Renderer};
+use shadowgraph::scene::{Filter, Scene};
+
+/// Measurements taken before a test gives up.
+const ATTEMPTS: usize = 3;
+/// Timed frames per measurement, after one dropped warm-up frame (first-use compiles).
+const FRAMES: usize = 3;
+/// The sum of a frame's pass times is within this share of its wall time. The wall time also
+/// holds the submission and the driver's command translation (about 1 ms on lavapipe against
+/// frames of 60–500 ms), so a true timer sits near 1.0; the old one read 0.45–0.6 with a blur.
+const SUM_TOLERANCE: f64 = 0.25;
+/// Blur radii: the large blur's taps are 49 against 7, so its passes cost 4× or more.
+const SMALL_RADIUS: u32 = 3;
+const LARGE_RADIUS: u32 = 24;
+
+/// One configuration's frames: per frame, the sum of its pass times, the sum of its blur
+/// passes' times and its wall time (ms).
+#[derive(Debug)]
+struct Frames {
+    sum: Vec<f64>,
+    blur: Vec<f64>,
+    wall: Vec<f64>,
+}
+
+impl Frames {
+    fn new() -> Self {
+        Self {
+            sum: Vec::new(),
+            blur: Vec::new(),
+            wall: Vec::new(),
+        }
+    }
+
+    fn push(&mut self, passes: &[(String, f64)], wall: f64) {
+        self.sum.push(passes.iter().map(|(_, ms)| ms).sum());
+        let blur = passes.iter().filter(|(n, _)| n.contains("blur"));
+        self.blur.push(blur.map(|(_, ms)| ms).sum());
+        self.wall.push(wall);
+    }
+
+    /// The median over frames of (sum of pass times) / (wall time).
+    fn sum_over_wall(&self) -> f64 {
+        median(
+            self.sum
+                .iter()
+                .zip(&self.wall)
+                .map(|(s, w)| s / w)
+                .collect(),
+        )
+    }
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Runs `measure` until it returns `Ok`, at most [`ATTEMPTS`] times; fails with every
+/// attempt's message.
+fn with_retries(what: &str, mut measure: impl FnMut() -> Result<(), String>) {
+    let mut misses = Vec::new();
+    for _ in 0..ATTEMPTS {
+        match measure() {
+            Ok(()) => return,
+            Err(m) => misses.push(m),
+        }
+    }
+    panic!("{what}: {ATTEMPTS} attempts missed:\n{}", misses.join("\n"));
+}
+
+/// Checks the three configurations of one measurement: no blur, a small one, a large one.
+///
+/// On a GPU (not CI's lavapipe) a 512² frame is microseconds of work against a submission of
+/// tens of microseconds, so its wall time says nothing about its passes: there the check is
+/// only that the costlier blur reads costlier.
+fn check(cpu: bool, none: &Frames, small: &Frames, large: &Frames) -> Result<(), String> {
+    if !cpu {
+        let (s, l) = (median(small.blur.clone()), median(large.blur.clone()));
+        return if l > s {
+            Ok(())
+        } else {
+            Err(format!("the large blur reads {l} ms, the small one {s} ms"))
+        };
+    }
+    let mut misses = Vec::new();
+    for (name, f) in [
+        ("no blur", none),
+        ("small blur", small),
+        ("large blur", large),
+    ] {
+        let r = f.sum_over_wall();
+        if (r - 1.0).abs() > SUM_TOLERANCE {
+            misses.push(format!(
+                "{name}: pass times sum to {r:.3} × the wall time ({f:?})"
+            ));
+        }
+    }
+    // What the blur really costs, from the wall clock alone: the frame with it less the frame
+    // without it (all else is the same plan).
+    let wall = |f: &Frames| median(f.wall.clone());
+    let (true_small, true_large) = (wall(small) - wall(none), wall(large) - wall(none));
+    if true_large < 4.0 * true_small {
+        misses.push(format!(
+            "premise: the large blur should cost ≥ 4× the small one by the wall clock, got \
+             {true_large:.1} ms against {true_small:.1} ms"
+        ));
+    }
+    let (read_small, read_large) = (median(small.blur.clone()), median(large.blur.clone()));
+    eprintln!(
+        "sum/wall: {:.3} {:.3} {:.3}; blur read {read_small:.2} → {read_large:.2} ms; \
+         by the wall clock {true_small:.1} → {true_large:.1} ms",
+        none.sum_over_wall(),
+        small.sum_over_wall(),
+        large.sum_over_wall()
+    );
+    if read_large < 2.0 * read_small {
+        misses.push(format!(
+            "the large blur reads {read_large:.2} ms, less than 2× the small one's \
+             {read_small:.2} ms (wall clock: {true_large:.1} against {true_small:.1} ms)"
+        ));
+    }
+    if misses.is_empty() {
+        Ok(())
+    } else {
+        Err(misses.join("; "))
+    }
+}
+
+/// Whether the adapter is a CPU driver (lavapipe on CI), where a frame's wall time is its work.
+fn cpu(g: &Gpu) -> bool {
+    g.adapter.get_info().device_type == wgpu::DeviceType::Cpu
+}
+
+/// `scenes/techniques/vsm.toml` with its blur's radius set, or no filter for radius 0.
+fn vsm_scene(radius: u32) -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/techniques/vsm.toml");
+    let text = std::fs::read_to_string(&path).expect("vsm.toml");
+    let filter = "filter_radius = 3\nfilter_sigma = 1.5\n";
+    assert!(
+        text.contains(filter),
+        "vsm.toml's blur changed: update this test"
+    );
+    let edited = match radius {
+        0 => text
+            .replace(filter, "")
+            .replace("filter = \"blur\"", "filter = \"none\""),
+        r => text.replace(
+            filter,
+            &format!(
+                "filter_radius = {r}\nfilter_sigma = {}\n",
+                f64::from(r) / 2.0
+            ),
+        ),
+    };
+    Scene::parse(&path, &edited).expect("edited vsm scene")
+}
+
+/// One frame of each configuration per round, so that all see the same load; the first
+/// round is dropped (first-use compiles).
+fn interleaved<C>(
+    configs: &mut [C],
+    mut frame: impl FnMut(&mut C) -> (Vec<(String, f64)>, f64),
+) -> Vec<Frames> {
+    let mut frames: Vec<Frames> = configs.iter().map(|_| Frames::new()).collect();
+    for round in 0..=FRAMES {
+        for (c, f) in configs.iter_mut().zip(&mut frames) {
+            let (passes, wall) = frame(c);
+            if round > 0 {
+                f.push(&passes, wall);
+            }
+        }
+    }
+    frames
+}
+
+/// One frame of `scene`: its pass times and its wall time.
+fn render_frame(g: &Gpu, renderer: &mut Renderer, scene: &Scene) -> (Vec<(String, f64)>, f64) {
+    let mut frame = renderer
+        .render(
+            &g.device,
+            &g.queue,
+            scene,
+            RenderOptions {
+                repeat: 1,
+                ..Default::default()
+            },
+        )
+        .expect("render");
+    let passes = frame.timings.pop().expect("timed");
+    (passes, frame.wall_ms[0])
+}
+
+/// The renderer's per-pass times (shadow raster, every node, G-buffer, shading) sum to each
+/// frame's wall time within ±25%, and the blur's passes read ≥ 2× more when they cost ≥ 4×.
+#[test]
+fn render_pass_times_add_up_to_the_wall_clock() {
+    let g = common::gpu();
+    assert!(g.can_time(), "lavapipe offers the timer's features");
+    let mut scenes = [0, SMALL_RADIUS, LARGE_RADIUS].map(vsm_scene);
+    let mut renderer = Renderer::new(&g.device);
+    with_retries("render --timings", || {
+        let f = interleaved(&mut scenes, |s| render_frame(&g, &mut renderer, s));
+        assert!(f[1].blur.iter().all(|&b| b > 0.0), "blur passes are timed");
+        check(cpu(&g), &f[0], &f[1], &f[2])
+    });
+}
+
+/// A depth texture cleared to a middle depth: the stage's kernels cost the same whatever the
+/// depths, and the clear is submitted apart from the timed frames.
+fn cleared_depth(g: &Gpu, size: u32) -> wgpu::Texture {
+    let depth = g.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("timing.depth"),
+        size: wgpu::Extent3d {
+            width: size,
+            height: size,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Depth32Float,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    });
+    let view = depth.create_view(&Default::default());
+    let mut enc = g.device.create_command_encoder(&Default::default());
+    drop(enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("timing.clear"),
+        color_attachments: &[],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: &view,
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(0.5),
+                store: wgpu::StoreOp::Store,
+            }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    }));
+    submit_and_wait(&g.device, &g.queue, enc, "clear").expect("clear");
+    depth
+}
+
+/// One frame of `stage` over `depth`: its `Prefilter::timings` and the wall time of a
+/// submission holding only its work.
+fn stage_frame(g: &Gpu, stage: &mut Prefilter, depth: &wgpu::Texture) -> (Vec<(String, f64)>, f64) {
+    let light = LightParams::orthographic(glam::Mat4::IDENTITY, 5.0, 1.0, 20.0);
+    let mut enc = g.device.create_command_encoder(&Default::default());
+    stage
+        .record(&g.device, &mut enc, depth, &light)
+        .expect("record");
+    let submitted = Instant::now();
+    submit_and_wait(&g.device, &g.queue, enc, "stage").expect("submit");
+    let wall = submitted.elapsed().as_secs_f64() * 1e3;
+    (stage.timings(&g.device).expect("timings"), wall)
+}
+
+/// The plug-in stage's `Prefilter::timings` sum to the wall time of a submission holding only
+/// the stage's work within ±25%, and its blur reads ≥ 2× more when it costs ≥ 4×.
+#[test]
+fn stage_timings_add_up_to_the_wall_clock() {
+    let g = common::gpu();
+    let size = 512;
+    let depth = cleared_depth(&g, size);
+    let mut stages = [
+        PrefilterConfig::vsm(size).with_filter(Filter::None),
+        PrefilterConfig::vsm(size).with_blur(SMALL_RADIUS as f32),
+        PrefilterConfig::vsm(size).with_blur(LARGE_RADIUS as f32),
+    ]
+    .map(|c| {
+        let mut stage = Prefilter::new(&g.device, &c).expect("stage");
+        stage.enable_timing(&g.device, &g.queue).expect("timing");
+        stage
+    });
+    with_retries("Prefilter::timings", || {
+        let f = interleaved(&mut stages, |s| stage_frame(&g, s, &depth));
+        check(cpu(&g), &f[0], &f[1], &f[2])
+    });
+}
