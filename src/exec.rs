@@ -8,6 +8,7 @@ use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
 use crate::error::{Error, Result};
+use crate::filter::{MIP_LEVELS_PER_DISPATCH, MipParams, mip_dispatches};
 use crate::gpu::{read_buffer, scoped};
 use crate::graph::{Dispatch, Plan, Slot};
 use crate::kernels::{self, Reflection};
@@ -516,7 +517,7 @@ impl Executor {
             )?;
             let wg = kernel.reflection.workgroup_size.unwrap_or([1, 1, 1]);
             let size = |r: &str| textures.get(r).map(|t| (t.width(), t.height()));
-            let groups = node.dispatch.groups(wg, size).ok_or_else(|| {
+            let groups = node.dispatch.groups(size, wg).ok_or_else(|| {
                 Error::Invalid(format!(
                     "node `{}` dispatches over a resource that is not in the plan",
                     node.name
@@ -542,10 +543,11 @@ impl Executor {
         })
     }
 
-    /// Records a [`Dispatch::MipChain`] node: one compute pass, one dispatch per two levels of
-    /// the output (`kernels/mips.wgsl`), each reading the level above through a one-level view.
-    /// With an odd level count the last dispatch redoes the level before the last (identical
-    /// values) so that every dispatch writes two levels.
+    /// Records a [`Dispatch::MipChain`] node: one compute pass with the dispatches of
+    /// [`crate::filter::mip_dispatches`] (`kernels/mips.wgsl` or `mips_log.wgsl`, up to six
+    /// levels each), each reading one level (the `src` input for the first, which also stores
+    /// it as level 0) through a one-level view and writing the levels after it through
+    /// one-level views.
     fn record_mip_chain(
         &mut self,
         device: &wgpu::Device,
@@ -553,49 +555,121 @@ impl Executor {
         node: &crate::graph::Node,
         textures: &HashMap<String, wgpu::Texture>,
     ) -> Result<()> {
-        let pipeline_err = |message: String| Error::Pipeline {
-            kernel: node.kernel.clone(),
-            message: format!("node `{}`: {message}", node.name),
-        };
-        let slot = |list: &[(String, String)], name: &str| {
-            list.iter()
-                .find(|(s, _)| s == name)
-                .map(|(_, r)| textures[r].clone())
-                .ok_or_else(|| pipeline_err(format!("binds nothing to `{name}`")))
-        };
-        let src = slot(&node.inputs, "src")?;
-        let dst = slot(&node.outputs, "dst")?;
-        let formats = [
-            ("dst_a".to_string(), dst.format()),
-            ("dst_b".to_string(), dst.format()),
-        ];
+        let mip = MipNode::new(node, textures)?;
+        let formats: Vec<(String, wgpu::TextureFormat)> = (0..=MIP_LEVELS_PER_DISPATCH)
+            .map(|k| (format!("dst{k}"), mip.dst.format()))
+            .collect();
         let kernel = self
             .kernels
             .get_specialized(device, &node.kernel, &formats)?;
-        let levels = dst.mip_level_count();
-        let size = |l: u32| [(dst.width() >> l).max(1), (dst.height() >> l).max(1)];
-        let passes = crate::graph::mip_chain_passes(levels);
-        let base: crate::filter::MipParams = bytemuck::try_pod_read_unaligned(
-            &node.params[..std::mem::size_of::<crate::filter::MipParams>()],
-        )
-        .map_err(|e| pipeline_err(format!("bad params: {e}")))?;
+        let dispatches = mip_dispatches(mip.dst.width(), mip.dst.height());
         let align = u64::from(device.limits().min_uniform_buffer_offset_alignment).max(32);
-        let mut bytes = vec![0u8; passes.len() * align as usize];
-        for (k, pass) in passes.iter().enumerate() {
-            let p = crate::filter::MipParams {
-                src_size: pass.read.map_or([src.width(), src.height()], size),
-                a_size: size(pass.a),
-                b_size: pass.b.map_or([0, 0], size),
+        let params = mip.params_buffer(device, &dispatches, align)?;
+        let mut groups = Vec::new();
+        for (k, &(first, count)) in dispatches.iter().enumerate() {
+            let bg = mip.bind_group(device, &kernel, &params, k as u64 * align, first, count)?;
+            let tile = crate::filter::MIP_TILE / 2;
+            let next = [
+                (mip.dst.width() >> (first + 1)).max(1),
+                (mip.dst.height() >> (first + 1)).max(1),
+            ];
+            groups.push((bg, [next[0].div_ceil(tile), next[1].div_ceil(tile)]));
+        }
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(&node.name),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&kernel.pipeline);
+        for (bg, g) in &groups {
+            pass.set_bind_group(0, bg, &[]);
+            pass.dispatch_workgroups(g[0], g[1], 1);
+        }
+        Ok(())
+    }
+}
+
+/// A mip-chain node's textures and the pieces of its dispatches.
+struct MipNode<'a> {
+    node: &'a crate::graph::Node,
+    src: wgpu::Texture,
+    dst: wgpu::Texture,
+}
+
+impl<'a> MipNode<'a> {
+    fn new(
+        node: &'a crate::graph::Node,
+        textures: &HashMap<String, wgpu::Texture>,
+    ) -> Result<Self> {
+        let find = |list: &[(String, String)], slot: &str| {
+            list.iter()
+                .find(|(s, _)| s == slot)
+                .and_then(|(_, r)| textures.get(r).cloned())
+                .ok_or_else(|| Self::error(node, format!("binds nothing to `{slot}`")))
+        };
+        Ok(Self {
+            node,
+            src: find(&node.inputs, "src")?,
+            dst: find(&node.outputs, "dst")?,
+        })
+    }
+
+    fn error(node: &crate::graph::Node, message: String) -> Error {
+        Error::Pipeline {
+            kernel: node.kernel.clone(),
+            message: format!("node `{}`: {message}", node.name),
+        }
+    }
+
+    /// One `MipParams` per dispatch, `align` bytes apart.
+    fn params_buffer(
+        &self,
+        device: &wgpu::Device,
+        dispatches: &[(u32, u32)],
+        align: u64,
+    ) -> Result<wgpu::Buffer> {
+        let size = std::mem::size_of::<MipParams>();
+        let base: MipParams = self
+            .node
+            .params
+            .get(..size)
+            .and_then(|b| bytemuck::try_pod_read_unaligned(b).ok())
+            .ok_or_else(|| Self::error(self.node, "params are not a MipParams".into()))?;
+        let (w, h) = (self.dst.width(), self.dst.height());
+        let odd = |n: u32| n > 1 && n % 2 == 1;
+        let mut bytes = vec![0u8; dispatches.len() * align as usize];
+        for (k, &(first, count)) in dispatches.iter().enumerate() {
+            let p = MipParams {
+                base: [w, h],
+                first,
+                count,
+                copy: u32::from(first == 0),
+                general: u32::from(odd((w >> first).max(1)) || odd((h >> first).max(1))),
                 ..base
             };
             let at = k * align as usize;
-            bytes[at..at + std::mem::size_of_val(&p)].copy_from_slice(bytemuck::bytes_of(&p));
+            bytes[at..at + size].copy_from_slice(bytemuck::bytes_of(&p));
         }
-        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(&node.name),
-            contents: &bytes,
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
+        Ok(
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(&self.node.name),
+                contents: &bytes,
+                usage: wgpu::BufferUsages::UNIFORM,
+            }),
+        )
+    }
+
+    /// The bind group of the dispatch reading level `first` and writing `count` levels:
+    /// `dst0` is level 0 in the first dispatch; unused bindings repeat the last level written
+    /// (the kernel stores only levels 0 … count).
+    fn bind_group(
+        &self,
+        device: &wgpu::Device,
+        kernel: &ComputeKernel,
+        params: &wgpu::Buffer,
+        offset: u64,
+        first: u32,
+        count: u32,
+    ) -> Result<wgpu::BindGroup> {
         let level_view = |t: &wgpu::Texture, level: u32| {
             t.create_view(&wgpu::TextureViewDescriptor {
                 base_mip_level: level,
@@ -608,73 +682,50 @@ impl Executor {
                 .reflection
                 .binding(name)
                 .map(|b| b.binding)
-                .ok_or_else(|| pipeline_err(format!("kernel has no binding `{name}`")))
+                .ok_or_else(|| Self::error(self.node, format!("kernel has no binding `{name}`")))
         };
-        let (b_src, b_a, b_b, b_params) = (
-            binding("src")?,
-            binding("dst_a")?,
-            binding("dst_b")?,
-            binding("params")?,
-        );
-        let mut groups = Vec::new();
-        for (k, pass) in passes.iter().enumerate() {
-            let (a, b_level) = (pass.a, pass.b.unwrap_or(pass.a));
-            let src_view = match pass.read {
-                None => level_view(&src, 0),
-                Some(l) => level_view(&dst, l),
-            };
-            let (va, vb) = (level_view(&dst, a), level_view(&dst, b_level));
-            let entries = [
-                wgpu::BindGroupEntry {
-                    binding: b_src,
-                    resource: wgpu::BindingResource::TextureView(&src_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: b_a,
-                    resource: wgpu::BindingResource::TextureView(&va),
-                },
-                wgpu::BindGroupEntry {
-                    binding: b_b,
-                    resource: wgpu::BindingResource::TextureView(&vb),
-                },
-                wgpu::BindGroupEntry {
-                    binding: b_params,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &params,
-                        offset: k as u64 * align,
-                        size: wgpu::BufferSize::new(
-                            std::mem::size_of::<crate::filter::MipParams>() as u64,
-                        ),
-                    }),
-                },
-            ];
-            let layout = kernel
-                .layouts
-                .first()
-                .ok_or_else(|| no_layout(&kernel.name))?;
-            let bg = scoped(
-                device,
-                || {
-                    device.create_bind_group(&wgpu::BindGroupDescriptor {
-                        label: Some(&node.name),
-                        layout,
-                        entries: &entries,
-                    })
-                },
-                |message| pipeline_err(format!("binding level {a}: {message}")),
-            )?;
-            let out = size(b_level);
-            groups.push((bg, kernel.groups_for(out[0], out[1])));
+        let src_view = match first {
+            0 => level_view(&self.src, 0),
+            l => level_view(&self.dst, l),
+        };
+        let views: Vec<(String, wgpu::TextureView)> = (0..=MIP_LEVELS_PER_DISPATCH)
+            .map(|j| {
+                let level = match j {
+                    0 if first == 0 => 0,
+                    j if (1..=count).contains(&j) => first + j,
+                    _ => first + count,
+                };
+                (format!("dst{j}"), level_view(&self.dst, level))
+            })
+            .collect();
+        let mut entries = vec![wgpu::BindGroupEntry {
+            binding: binding("src")?,
+            resource: wgpu::BindingResource::TextureView(&src_view),
+        }];
+        for (name, view) in &views {
+            entries.push(wgpu::BindGroupEntry {
+                binding: binding(name)?,
+                resource: wgpu::BindingResource::TextureView(view),
+            });
         }
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(&node.name),
-            timestamp_writes: None,
+        entries.push(wgpu::BindGroupEntry {
+            binding: binding("params")?,
+            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer: params,
+                offset,
+                size: wgpu::BufferSize::new(std::mem::size_of::<MipParams>() as u64),
+            }),
         });
-        pass.set_pipeline(&kernel.pipeline);
-        for (bg, g) in &groups {
-            pass.set_bind_group(0, bg, &[]);
-            pass.dispatch_workgroups(g[0], g[1], 1);
-        }
-        Ok(())
+        scoped(
+            device,
+            || {
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some(&self.node.name),
+                    layout: &kernel.layouts[0],
+                    entries: &entries,
+                })
+            },
+            |message| Self::error(self.node, format!("binding level {first}: {message}")),
+        )
     }
 }

@@ -110,7 +110,7 @@ enum Command {
     /// Run the numerical-stability suite: each hard input through the real kernels against its
     /// f64 reference and stated bound; exits non-zero when a check fails.
     Stability {
-        /// Summed-area tables at 8192² (1 GiB each) instead of 2048².
+        /// Summed-area tables at 8192² (256 MiB each) instead of 2048².
         #[arg(long)]
         large: bool,
     },
