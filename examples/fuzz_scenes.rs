@@ -1,7 +1,7 @@
 //! The scene fuzzer at scale: mutated scene files (values, types, keys, sections, meshes and
-//! malformed OBJ files, damaged text) loaded and planned in-process on every core, a sample of
+//! malformed OBJ and glTF files, damaged text) loaded and planned in-process on every core, a sample of
 //! the accepted ones rendered at 16×12. Exits 1 if any case failed; failing inputs are written
-//! to `<dir>/failures/case-<n>.{toml,obj,txt}` and reproduce with `--first <n> --cases 1`.
+//! to `<dir>/failures/case-<n>.{toml,obj,gltf,glb,txt}` and reproduce with `--first <n> --cases 1`.
 //!
 //!     cargo run --release --example fuzz_scenes -- --cases 1000000
 
@@ -60,7 +60,7 @@ fn main() {
     let s = fuzz_support::run(&opts, gpu);
     println!(
         "{} cases in {:.1} s on {threads} thread(s) (seed {:#x}, cases {}..{}): {} accepted, {} refused, \
-         {} rendered ({} refused by device limits), {} failed",
+         {} rendered ({} refused by device limits), {} failed; mutated glTF files: {} accepted, {} refused",
         s.cases,
         s.elapsed.as_secs_f64(),
         args.seed,
@@ -70,7 +70,9 @@ fn main() {
         s.refused,
         s.rendered,
         s.render_refused,
-        s.failures.len()
+        s.failures.len(),
+        s.gltf_accepted,
+        s.gltf_refused
     );
     for (i, what) in s.failures.iter().take(50) {
         println!("  case {i}: {what}");

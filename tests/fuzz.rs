@@ -37,5 +37,6 @@ fn three_thousand_mutated_scenes() {
     assert_eq!(s.cases, 3000);
     assert!(s.accepted > 300 && s.refused > 1000, "{s:?}");
     assert!(s.rendered >= 4, "{s:?}");
+    assert!(s.gltf_accepted >= 2 && s.gltf_refused >= 60, "{s:?}");
     std::fs::remove_dir_all(&dir).ok();
 }

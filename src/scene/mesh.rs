@@ -1,6 +1,6 @@
 //! Triangle meshes: the built-in shapes, transforms and normal repair (OBJ files: `obj`).
 
-use glam::{DMat3, DVec3, Mat4, Vec3};
+use glam::{DMat3, DMat4, DVec3, Mat4, Vec3};
 
 /// Indexed triangles with per-vertex normals.
 #[derive(Clone, Debug, Default)]
@@ -31,7 +31,11 @@ impl Mesh {
     /// unit normals); a normal that comes out zero or not finite is left zero for
     /// [`Mesh::repair_normals`].
     pub fn transformed(&self, m: Mat4) -> Mesh {
-        let m = m.as_dmat4();
+        self.transformed_f64(m.as_dmat4())
+    }
+
+    /// [`Mesh::transformed`] under an f64 matrix (glTF node transforms are composed in f64).
+    pub fn transformed_f64(&self, m: DMat4) -> Mesh {
         let [a, b, c] = [
             m.x_axis.truncate(),
             m.y_axis.truncate(),

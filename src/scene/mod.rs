@@ -3,8 +3,10 @@
 
 mod ctx;
 pub mod format;
+pub mod gltf;
 pub mod locate;
 pub mod mesh;
+pub mod mesh_file;
 pub mod obj;
 mod object;
 mod parse;

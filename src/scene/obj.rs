@@ -1,26 +1,13 @@
 //! Wavefront OBJ meshes: read with a size cap, checked line by line (so a malformed file is an
 //! error naming its line), then triangulated by `tobj`.
 
-use std::io::Read;
 use std::path::Path;
 
 use glam::Vec3;
 
 use super::ctx::shown_path;
 use super::mesh::Mesh;
-
-/// Largest mesh file read: a scene's triangle cap (`object::MAX_TRIANGLES`, 4 Mi) written as
-/// OBJ is about 160 MiB; the bundled bunny is 110 KiB. Reading stops past it.
-pub const MAX_MESH_BYTES: u64 = 256 << 20;
-
-/// A loaded mesh and how many of its normals were repaired.
-#[derive(Clone, Debug)]
-pub struct LoadedMesh {
-    /// The triangles, normals unit length.
-    pub mesh: Mesh,
-    /// Normals the file gave as zero or non-finite, replaced by the faces' normal.
-    pub repaired_normals: usize,
-}
+use super::mesh_file::{LoadedMesh, read_file, with_normals};
 
 /// Loads a Wavefront OBJ (triangulated); smooth normals when the file has none, and the faces'
 /// normal wherever the file's is zero or not finite. Errors name the file and, for malformed
@@ -67,49 +54,16 @@ pub fn load_obj(path: &Path) -> Result<LoadedMesh, String> {
     if mesh.positions.iter().any(|p| !p.is_finite()) {
         return Err(format!("`{}` has a non-finite vertex", shown_path(path)));
     }
-    let faces = mesh.face_normals();
-    let mut repaired = 0;
-    mesh.normals = given
-        .iter()
-        .zip(&faces)
-        .map(|(n, f)| match n.and_then(|n| n.try_normalize()) {
-            Some(n) => n,
-            None => {
-                repaired += usize::from(n.is_some());
-                *f
-            }
-        })
-        .collect();
-    Ok(LoadedMesh {
-        mesh,
-        repaired_normals: repaired,
-    })
+    Ok(with_normals(mesh, &given))
 }
 
-/// The file as text: at most [`MAX_MESH_BYTES`], a regular file, UTF-8.
+/// The file as text: at most [`super::mesh_file::MAX_MESH_BYTES`], a regular file, UTF-8.
 fn read_text(path: &Path) -> Result<String, String> {
-    let shown = shown_path(path);
-    let meta = std::fs::metadata(path).map_err(|e| match e.kind() {
-        std::io::ErrorKind::NotFound => format!("mesh file `{shown}` not found"),
-        _ => format!("cannot read `{shown}`: {e}"),
-    })?;
-    if meta.is_dir() {
-        return Err(format!("`{shown}` is a directory, not a mesh file"));
-    }
-    let file = std::fs::File::open(path).map_err(|e| format!("cannot read `{shown}`: {e}"))?;
-    let mut bytes = Vec::new();
-    file.take(MAX_MESH_BYTES + 1)
-        .read_to_end(&mut bytes)
-        .map_err(|e| format!("cannot read `{shown}`: {e}"))?;
-    if bytes.len() as u64 > MAX_MESH_BYTES {
-        return Err(format!(
-            "`{shown}` is larger than {} MiB, the most a mesh file may be",
-            MAX_MESH_BYTES >> 20
-        ));
-    }
+    let bytes = read_file(path, "mesh file")?;
     String::from_utf8(bytes).map_err(|e| {
         format!(
-            "`{shown}` is not a text file (invalid UTF-8 at byte {})",
+            "`{}` is not a text file (invalid UTF-8 at byte {})",
+            shown_path(path),
             e.utf8_error().valid_up_to()
         )
     })

@@ -9,7 +9,7 @@ use toml::Spanned;
 
 use super::ctx::{Ctx, LENGTH_RANGE, ROTATION_LIMIT, fmt_list, fmt_num};
 use super::format::{Num, ObjectFile};
-use super::{Mesh, Object, mesh, obj};
+use super::{Mesh, Object, mesh, mesh_file};
 use crate::error::Result;
 
 /// Largest coordinate of a vertex after its object's transform, in world units (ten times
@@ -156,7 +156,7 @@ fn shape(ctx: &Ctx, i: usize, o: &ObjectFile) -> Result<Mesh> {
         _ => {
             let p = ctx.required(&key("path"), &o.path, at.clone())?;
             let dir = ctx.path.parent().unwrap_or(Path::new("."));
-            let loaded = obj::load_obj(&dir.join(p.get_ref()))
+            let loaded = mesh_file::load(&dir.join(p.get_ref()))
                 .map_err(|e| ctx.err(Some(p.span()), format!("`{}`: {e}", key("path"))))?;
             if loaded.repaired_normals > 0 {
                 ctx.warn(

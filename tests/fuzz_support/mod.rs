@@ -1,13 +1,15 @@
 //! A mutation fuzzer of scene files, shared by `tests/fuzz.rs` (a few thousand cases) and
 //! `examples/fuzz_scenes.rs` (millions). Each case mutates one of the bundled scenes as TOML
-//! (values, types, keys, sections, meshes; sometimes the text itself), then loads and plans
-//! it in-process. It asserts: no panic; a refused scene is one line naming the file, with a
-//! line number unless the fault is the whole file's; an accepted scene has finite numbers and
-//! unit normals; and a sample of accepted scenes, rendered at 16×12, gives finite visibility
-//! in [0, 1] and finite normals (or a one-line device-limit error).
+//! (values, types, keys, sections, meshes, mutated OBJ and glTF files; sometimes the text
+//! itself), then loads and plans it in-process. It asserts: no panic; a refused scene is one
+//! line naming the file, with a line number unless the fault is the whole file's; an accepted
+//! scene has finite numbers and unit normals; and a sample of accepted scenes, rendered at
+//! 16×12, gives finite visibility in [0, 1] and finite normals (or a one-line device-limit
+//! error).
 #![allow(dead_code, reason = "the test and the example use different parts")]
 
 pub mod mutate;
+pub mod mutate_gltf;
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
@@ -56,6 +58,10 @@ pub struct Summary {
     pub rendered: u64,
     /// Renders refused with a device-limit error.
     pub render_refused: u64,
+    /// Cases with a mutated glTF file whose scene was accepted.
+    pub gltf_accepted: u64,
+    /// Cases with a mutated glTF file whose scene was refused with a good error.
+    pub gltf_refused: u64,
     /// Failures: `(case, what)`; the inputs are written to `dir/failures`.
     pub failures: Vec<(u64, String)>,
     /// Wall time.
@@ -76,7 +82,8 @@ struct Shared<'a> {
     accepted: AtomicU64,
 }
 
-/// The seeds: every bundled scene, mesh paths pointed at the fuzzer's own small mesh.
+/// The seeds: every bundled scene, mesh paths pointed at the fuzzer's own small mesh of the
+/// same kind (OBJ or glTF).
 pub fn seeds() -> Vec<Table> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
     let mut files = Vec::new();
@@ -94,8 +101,13 @@ pub fn seeds() -> Vec<Table> {
             let mut t: Table = toml::from_str(&std::fs::read_to_string(f).unwrap()).unwrap();
             if let Some(Value::Array(objects)) = t.get_mut("object") {
                 for o in objects.iter_mut().filter_map(Value::as_table_mut) {
-                    if o.contains_key("path") {
-                        o.insert("path".into(), Value::String("fuzz.obj".into()));
+                    let gltf = o.get("path").and_then(Value::as_str).map(|p| {
+                        let p = p.to_ascii_lowercase();
+                        p.ends_with(".gltf") || p.ends_with(".glb")
+                    });
+                    if let Some(gltf) = gltf {
+                        let fuzz = if gltf { "fuzz.gltf" } else { "fuzz.obj" };
+                        o.insert("path".into(), Value::String(fuzz.into()));
                     }
                 }
             }
@@ -104,19 +116,32 @@ pub fn seeds() -> Vec<Table> {
         .collect()
 }
 
-/// Case `i`: the scene text and, for some cases, an OBJ text for `case.obj`.
-pub fn case(seeds: &[Table], seed: u64, i: u64) -> (String, Option<String>) {
+/// The mesh files a case may write beside its scene.
+const CASE_MESHES: [&str; 3] = ["case.obj", "case.gltf", "case.glb"];
+
+/// A mesh file a case writes beside its scene: its name and bytes.
+pub type MeshFile = (&'static str, Vec<u8>);
+
+/// Case `i`: the scene text and, for some cases, a mutated mesh file (`case.obj`, `case.gltf`
+/// or `case.glb`) that its last object loads.
+pub fn case(seeds: &[Table], seed: u64, i: u64) -> (String, Option<MeshFile>) {
     let mut rng = SmallRng::seed_from_u64(seed ^ i.wrapping_mul(0x9e37_79b9_7f4a_7c15));
     let mut t = seeds.choose(&mut rng).cloned().unwrap_or_default();
-    let obj = rng.random_bool(0.1).then(|| {
+    let mesh = rng.random_bool(0.14).then(|| {
+        // Two in three OBJ, one in three glTF (text or binary).
+        let (name, bytes) = if rng.random_range(0..3) < 2 {
+            ("case.obj", mutate::mutate_obj(&mut rng).into_bytes())
+        } else {
+            mutate_gltf::mutate_gltf(&mut rng)
+        };
         if let Some(Value::Array(objects)) = t.get_mut("object") {
             if let Some(o) = objects.last_mut().and_then(Value::as_table_mut) {
                 o.retain(|k, _| !matches!(k, "size" | "radius" | "height"));
                 o.insert("shape".into(), Value::String("mesh".into()));
-                o.insert("path".into(), Value::String("case.obj".into()));
+                o.insert("path".into(), Value::String(name.into()));
             }
         }
-        mutate::mutate_obj(&mut rng)
+        (name, bytes)
     });
     let mutations = [1, 1, 1, 1, 1, 2, 2, 3, 4, 6];
     for _ in 0..*mutations.choose(&mut rng).unwrap_or(&1) {
@@ -126,7 +151,7 @@ pub fn case(seeds: &[Table], seed: u64, i: u64) -> (String, Option<String>) {
     if rng.random_bool(0.08) {
         mutate::damage_text(&mut text, &mut rng);
     }
-    (text, obj)
+    (text, mesh)
 }
 
 /// Runs the cases on `opts.threads` threads; `gpu` renders the sample when given.
@@ -160,23 +185,32 @@ fn worker(sh: &Shared, t: usize) {
     let dir = opts.dir.join(format!("worker{t}"));
     std::fs::create_dir_all(dir.join("dir.obj")).expect("fuzz folder");
     std::fs::write(dir.join("fuzz.obj"), mutate::GOOD_OBJ).expect("fuzz mesh");
+    std::fs::write(dir.join("fuzz.gltf"), mutate_gltf::good_gltf()).expect("fuzz glTF");
     let scene_path = dir.join("case.toml");
     let threads = opts.threads.max(1) as u64;
     let mut i = opts.first + t as u64;
     let mut local = Summary::default();
     while i < opts.first + opts.cases {
-        let (text, obj) = case(&sh.seeds, opts.seed, i);
-        if let Some(obj) = &obj {
-            std::fs::write(dir.join("case.obj"), obj).expect("case mesh");
+        let (text, mesh) = case(&sh.seeds, opts.seed, i);
+        // Only this case's mesh may exist, so that a failure reproduces alone: a mutated
+        // path may name any of them.
+        for name in CASE_MESHES {
+            let _ = std::fs::remove_file(dir.join(name));
         }
+        if let Some((name, bytes)) = &mesh {
+            std::fs::write(dir.join(name), bytes).expect("case mesh");
+        }
+        let gltf = mesh.as_ref().is_some_and(|(name, _)| *name != "case.obj");
         local.cases += 1;
         let verdict = match check(&scene_path, &text) {
             Ok(Outcome::Refused) => {
                 local.refused += 1;
+                local.gltf_refused += u64::from(gltf);
                 Ok(())
             }
             Ok(Outcome::Accepted(scene)) => {
                 local.accepted += 1;
+                local.gltf_accepted += u64::from(gltf);
                 let n = sh.accepted.fetch_add(1, Ordering::Relaxed);
                 match &sh.gpu {
                     Some(g) if opts.render_every > 0 && n.is_multiple_of(opts.render_every) => {
@@ -188,7 +222,7 @@ fn worker(sh: &Shared, t: usize) {
             Err(e) => Err(e),
         };
         if let Err(what) = verdict {
-            save_failure(opts, i, &text, obj.as_deref(), &what);
+            save_failure(opts, i, &text, mesh.as_ref(), &what);
             local.failures.push((i, what));
         }
         let done = sh.done.fetch_add(1, Ordering::Relaxed) + 1;
@@ -203,15 +237,18 @@ fn worker(sh: &Shared, t: usize) {
     s.refused += local.refused;
     s.rendered += local.rendered;
     s.render_refused += local.render_refused;
+    s.gltf_accepted += local.gltf_accepted;
+    s.gltf_refused += local.gltf_refused;
     s.failures.extend(local.failures);
 }
 
-fn save_failure(opts: &Options, i: u64, text: &str, obj: Option<&str>, what: &str) {
+fn save_failure(opts: &Options, i: u64, text: &str, mesh: Option<&MeshFile>, what: &str) {
     let d = opts.dir.join("failures");
     let _ = std::fs::create_dir_all(&d);
     let _ = std::fs::write(d.join(format!("case-{i}.toml")), text);
-    if let Some(obj) = obj {
-        let _ = std::fs::write(d.join(format!("case-{i}.obj")), obj);
+    if let Some((name, bytes)) = mesh {
+        let ext = name.rsplit('.').next().unwrap_or("mesh");
+        let _ = std::fs::write(d.join(format!("case-{i}.{ext}")), bytes);
     }
     let _ = std::fs::write(d.join(format!("case-{i}.txt")), what);
 }

@@ -1,4 +1,5 @@
-//! TOML-aware mutations of scene files and line-aware mutations of OBJ meshes.
+//! TOML-aware mutations of scene files and line-aware mutations of OBJ meshes (glTF files:
+//! `mutate_gltf`).
 
 use rand::Rng;
 use rand::rngs::SmallRng;
@@ -197,12 +198,23 @@ const WORDS: &[&str] = &[
     "missing.obj",
     "dir.obj",
     "../m.obj",
+    "fuzz.gltf",
+    "x.glb",
     "/",
     ".",
 ];
 
-/// The mesh files the fuzzer's folder holds (see `write_meshes`).
-pub const MESH_PATHS: &[&str] = &["fuzz.obj", "case.obj", "missing.obj", "dir.obj"];
+/// The mesh files the fuzzer's folder holds (written by `worker`).
+pub const MESH_PATHS: &[&str] = &[
+    "fuzz.obj",
+    "case.obj",
+    "missing.obj",
+    "dir.obj",
+    "fuzz.gltf",
+    "case.gltf",
+    "case.glb",
+    "missing.glb",
+];
 
 /// A random number value: an extreme, or a random one (uniform or log-uniform, either sign).
 pub fn number(rng: &mut SmallRng) -> Value {
