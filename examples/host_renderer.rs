@@ -8,6 +8,7 @@
 use anyhow::{Context, Result};
 use glam::{Mat4, Vec3};
 use shadowgraph::prefilter::{LightParams, Prefilter, PrefilterConfig};
+use shadowgraph::timer::TIMER_FEATURES;
 use wgpu::util::DeviceExt;
 
 const PANEL: (u32, u32) = (384, 288);
@@ -73,7 +74,7 @@ fn main() -> Result<()> {
     for config in &configs {
         // The stage: pipelines once; its WGSL and layout go into the host's own pipeline.
         let mut stage = Prefilter::new(&device, config)?;
-        if device.features().contains(wgpu::Features::TIMESTAMP_QUERY) {
+        if device.features().contains(TIMER_FEATURES) {
             stage.enable_timing(&device, &queue)?;
         }
         let maps_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -155,7 +156,8 @@ async fn device() -> Result<(wgpu::Device, wgpu::Queue)> {
         .request_adapter(&Default::default())
         .await
         .context("no GPU adapter (without a GPU: apt-get install mesa-vulkan-drivers)")?;
-    let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
+    // Per-kernel timing writes timestamps between passes: both timer features or none.
+    let features = adapter.features() & TIMER_FEATURES;
     Ok(adapter
         .request_device(&wgpu::DeviceDescriptor {
             label: Some("host"),

@@ -10,33 +10,44 @@
 //! shadow* ([`crate::truth::pcf::pcf_box`] over the configuration's own rasterized linear map
 //! with the same box width, at the same receivers and bias): this isolates what the
 //! representation costs (light bleeding, ringing, quantization) from the difference between a
-//! box filter and a penumbra. Errors are taken over the truth's relevant pixels only.
+//! box filter and a penumbra. Errors are taken over the truth's relevant pixels only, as a
+//! whole and split into the truth's penumbra, umbra and lit regions ([`Regions`]: where
+//! techniques differ, light leaking, false shadow).
+//!
+//! **Perceptual error**: FLIP of the shaded image against the *truth-shaded* image (the same
+//! shading with the truth's visibility), over the whole image (the `flip` module).
+//!
+//! **Pareto fronts** ([`front`]) of total time against each [`Metric`]: the mean error, the
+//! penumbra's mean error and FLIP.
 //!
 //! **Times** are medians over the repeats of the renderer's GPU timestamps; a configuration's
 //! total is its shadow raster, its graph kernels and its shading pass (the camera G-buffer is
 //! the same for every configuration and reported apart). **Memory** is the plan's peak of live
 //! textures plus the rasterized depth maps.
 
+mod crops;
+mod flip;
 mod grid;
+mod html;
+mod measure;
 mod output;
+mod stats;
 mod svg;
 mod sweep;
 
+pub use flip::{Shader, flip_map, flip_stats, to_unorm8};
+pub use stats::{EDGE_BAND, ErrorStats, PENUMBRA_HIGH, PENUMBRA_LOW, Region, Regions};
+pub use svg::{Metric, front, pareto};
 use sweep::storage_name;
 pub use sweep::{Config, FILTERS, FilterOfWidth, TECHNIQUES, sweep};
 
 use std::path::{Path, PathBuf};
 
-use glam::DVec3;
-
-use crate::cpu::Map;
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
-use crate::render::{FloatMap, Frame, RenderOptions, Renderer, plan_lights};
-use crate::scene::{Filter, Scene, Technique};
-use crate::technique::LightGpu;
-use crate::truth::pcf::{Receiver, pcf_box};
-use crate::truth::{Emitter, Truth, TruthOptions, area_light_truth};
+use crate::render::Renderer;
+use crate::scene::Scene;
+use crate::truth::{Emitter, TruthOptions, area_light_truth};
 
 /// What the sweep covers and how it is measured.
 #[derive(Clone, Debug)]
@@ -76,53 +87,6 @@ impl Default for EvaluateOptions {
     }
 }
 
-/// Error statistics of one visibility image against a truth, over the relevant pixels.
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct ErrorStats {
-    /// Pixels measured.
-    pub pixels: usize,
-    /// Mean |v − truth|.
-    pub mean_abs: f64,
-    /// Root mean square error.
-    pub rmse: f64,
-    /// 99th percentile of |v − truth|.
-    pub p99: f64,
-    /// Largest |v − truth|.
-    pub max: f64,
-    /// Share of pixels with |v − truth| > 0.05.
-    pub over_005: f64,
-    /// Share of pixels with |v − truth| > 0.2.
-    pub over_02: f64,
-}
-
-impl ErrorStats {
-    /// Statistics of `values` against `truth` where `mask` is set.
-    pub fn new(values: &[f32], truth: &[f64], mask: &[bool]) -> Self {
-        let mut e: Vec<f64> = values
-            .iter()
-            .zip(truth)
-            .zip(mask)
-            .filter(|(_, m)| **m)
-            .map(|((&v, &t), _)| (f64::from(v) - t).abs())
-            .collect();
-        let n = e.len();
-        if n == 0 {
-            return Self::default();
-        }
-        e.sort_by(f64::total_cmp);
-        let share = |x: f64| e.iter().filter(|&&v| v > x).count() as f64 / n as f64;
-        Self {
-            pixels: n,
-            mean_abs: e.iter().sum::<f64>() / n as f64,
-            rmse: (e.iter().map(|v| v * v).sum::<f64>() / n as f64).sqrt(),
-            p99: e[((0.99 * n as f64).ceil() as usize).clamp(1, n) - 1],
-            max: e[n - 1],
-            over_005: share(0.05),
-            over_02: share(0.2),
-        }
-    }
-}
-
 /// Measurements of one configuration.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Row {
@@ -154,6 +118,15 @@ pub struct Row {
     pub memory_bytes: u64,
     /// Error against the area-light truth.
     pub soft: ErrorStats,
+    /// The same over the truth's penumbra (see [`Regions`]).
+    pub penumbra: ErrorStats,
+    /// The same over the truth's umbra: light where there should be none.
+    pub umbra: ErrorStats,
+    /// The same over the truth's lit pixels: shadow where there should be none.
+    pub lit: ErrorStats,
+    /// FLIP of the shaded image against the truth-shaded image, over every pixel (`mean_abs`
+    /// is FLIP's mean; see the `flip` module).
+    pub flip: ErrorStats,
     /// Error against the box-PCF truth of the configuration's own map, where it applies.
     pub pcf: Option<ErrorStats>,
 }
@@ -175,6 +148,8 @@ pub struct Report {
     pub truth_resolution: Vec<u32>,
     /// Relevant pixels (over all lights).
     pub relevant_pixels: usize,
+    /// Of those, pixels in the truth's penumbra, umbra and lit regions ([`Regions`]).
+    pub region_pixels: [usize; 3],
     /// Configurations skipped, with the reason.
     pub skipped: Vec<(String, String)>,
     /// One row per configuration, in sweep order.
@@ -194,6 +169,12 @@ pub struct Images {
     pub mask: Vec<bool>,
     /// Per row of the report, light 0's rendered visibility.
     pub visibility: Vec<Vec<f32>>,
+    /// Light 0's region per pixel.
+    pub regions: Vec<Region>,
+    /// The image shaded with the truth's visibility (RGB8, every light).
+    pub truth_shaded: Vec<u8>,
+    /// Per row, the image shaded with its visibility (RGB8), by the same shading.
+    pub shaded: Vec<Vec<u8>>,
 }
 
 /// The scene as evaluated: `opts.image`, or in quick mode at most 160 pixels wide.
@@ -297,25 +278,30 @@ pub fn evaluate(
             scene.path.display()
         )));
     }
-    let truth64: Vec<f64> = truth.visibility.iter().map(|&v| f64::from(v)).collect();
+    let reference = measure::Reference::new(scene, truth);
     let info = gpu.adapter.get_info();
+    let t = &reference.truth;
     let mut report = Report {
         scene: scene.path.display().to_string(),
         device: gpu.describe(),
         cpu_driver: info.device_type == wgpu::DeviceType::Cpu,
         image: (scene.width, scene.height),
-        truth_samples: truth.samples,
-        truth_resolution: truth.resolution.clone(),
+        truth_samples: t.samples,
+        truth_resolution: t.resolution.clone(),
         relevant_pixels: relevant,
+        region_pixels: reference.region_pixels(),
         skipped: Vec::new(),
         rows: Vec::new(),
     };
     let mut images = Images {
-        width: truth.width,
-        height: truth.height,
-        truth: light0(&truth.visibility, truth.lights),
-        mask: light0(&truth.mask, truth.lights),
+        width: t.width,
+        height: t.height,
+        truth: light0(&t.visibility, t.lights),
+        mask: light0(&t.mask, t.lights),
         visibility: Vec::new(),
+        regions: light0(&reference.regions.region, t.lights),
+        truth_shaded: Vec::new(),
+        shaded: Vec::new(),
     };
     let mut linear = std::collections::HashMap::new();
     for c in configs {
@@ -328,24 +314,18 @@ pub fn evaluate(
         let linear = match linear.entry(c.shadow_map) {
             std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
             std::collections::hash_map::Entry::Vacant(e) => {
-                e.insert(linear_maps(&mut renderer, gpu, &s, c.shadow_map)?)
+                e.insert(measure::linear_maps(&mut renderer, gpu, &s, c.shadow_map)?)
             }
         };
-        match measure(
-            &mut renderer,
-            gpu,
-            &s,
-            c,
-            linear,
-            &truth,
-            &truth64,
-            opts.repeat,
-        ) {
-            Ok((row, frame)) => {
-                images
-                    .visibility
-                    .push(light0(&frame.visibility, truth.lights));
-                report.rows.push(row);
+        match measure::measure(&mut renderer, gpu, &s, c, linear, &reference, opts.repeat) {
+            Ok(m) => {
+                let lights = reference.truth.lights;
+                images.visibility.push(light0(&m.frame.visibility, lights));
+                if images.truth_shaded.is_empty() {
+                    images.truth_shaded = m.truth_shaded;
+                }
+                images.shaded.push(m.shaded);
+                report.rows.push(m.row);
             }
             Err(
                 e @ (Error::MissingFeature { .. } | Error::Limit { .. } | Error::SceneLimit { .. }),
@@ -374,184 +354,6 @@ fn progress(len: u64) -> indicatif::ProgressBar {
 
 fn light0<T: Copy>(v: &[T], lights: usize) -> Vec<T> {
     v.iter().step_by(lights.max(1)).copied().collect()
-}
-
-/// Renders one configuration (`repeat` timed frames) and measures it.
-#[expect(clippy::too_many_arguments, reason = "one measurement's inputs")]
-fn measure(
-    renderer: &mut Renderer,
-    gpu: &Gpu,
-    scene: &Scene,
-    c: &Config,
-    linear: &[FloatMap],
-    truth: &Truth,
-    truth64: &[f64],
-    repeat: u32,
-) -> Result<(Row, Frame)> {
-    let frame = renderer.render(
-        &gpu.device,
-        &gpu.queue,
-        scene,
-        RenderOptions {
-            aux: true,
-            // One more frame than timed: the first also pays for first-use work (software
-            // drivers compile shaders at their first dispatch), so its times are dropped.
-            repeat: repeat.max(1) + 1,
-            dump: false,
-        },
-    )?;
-    if frame.visibility.len() != truth.visibility.len() {
-        return Err(Error::Invalid("truth and render differ in size".into()));
-    }
-    let soft = ErrorStats::new(&frame.visibility, truth64, &truth.mask);
-    let pcf = match c.box_width {
-        Some(w) => Some(pcf_stats(scene, &frame, linear, truth, w)?),
-        None => None,
-    };
-    let passes = median_passes(frame.timings.get(1..).unwrap_or_default());
-    let sum = |f: &dyn Fn(&str) -> bool| -> Option<f64> {
-        (!passes.is_empty()).then(|| passes.iter().filter(|(l, _)| f(l)).map(|p| p.1).sum())
-    };
-    let raster_ms = sum(&|l| l.ends_with(".shadow_raster"));
-    let gbuffer_ms = sum(&|l| l == "gbuffer");
-    let shade_ms = sum(&|l| l == "shade");
-    let kernels_ms = sum(&|l| !l.ends_with(".shadow_raster") && l != "gbuffer" && l != "shade");
-    let total_ms = match (raster_ms, kernels_ms, shade_ms) {
-        (Some(a), Some(b), Some(c)) => Some(a + b + c),
-        _ => None,
-    };
-    let plan = plan_lights(&scene.lights)?;
-    let depth: u64 = scene
-        .lights
-        .iter()
-        .map(|l| u64::from(l.shadow_map).pow(2) * 4)
-        .sum();
-    let (storage, filter) = match c.technique {
-        Technique::Vsm { prefilter, .. }
-        | Technique::Evsm { prefilter, .. }
-        | Technique::Msm { prefilter, .. }
-        | Technique::Csm { prefilter, .. } => (
-            storage_name(prefilter.storage).to_string(),
-            filter_name(prefilter.filter),
-        ),
-        Technique::Esm { filter, .. } => ("f32".to_string(), filter_name(filter)),
-        _ => (String::new(), String::new()),
-    };
-    let row = Row {
-        label: c.label.clone(),
-        technique: c.technique.name().to_string(),
-        shadow_map: c.shadow_map,
-        storage,
-        filter,
-        box_width: c.box_width,
-        passes,
-        raster_ms,
-        kernels_ms,
-        shade_ms,
-        total_ms,
-        gbuffer_ms,
-        memory_bytes: plan.plan.peak_live_bytes() + depth,
-        soft,
-        pcf,
-    };
-    Ok((row, frame))
-}
-
-fn filter_name(f: Filter) -> String {
-    match f {
-        Filter::None => "none",
-        Filter::Blur { .. } => "blur",
-        Filter::Mips { .. } => "mips",
-        Filter::Sat { .. } => "sat",
-    }
-    .to_string()
-}
-
-/// Median of each pass over the frames (passes in the first frame's order).
-fn median_passes(frames: &[Vec<(String, f64)>]) -> Vec<(String, f64)> {
-    let Some(first) = frames.first() else {
-        return Vec::new();
-    };
-    first
-        .iter()
-        .enumerate()
-        .map(|(i, (label, _))| {
-            let mut v: Vec<f64> = frames
-                .iter()
-                .filter_map(|f| f.get(i).map(|x| x.1))
-                .collect();
-            v.sort_by(f64::total_cmp);
-            (label.clone(), v[v.len() / 2])
-        })
-        .collect()
-}
-
-/// Each light's linear depth map at `size`: the shade map of a `hard` render (the plan's
-/// output, so no later kernel reused its texture). Rasterization does not depend on the
-/// technique, so this is the map every configuration of that size rasterized.
-fn linear_maps(
-    renderer: &mut Renderer,
-    gpu: &Gpu,
-    scene: &Scene,
-    size: u32,
-) -> Result<Vec<FloatMap>> {
-    let mut s = scene.clone();
-    for l in &mut s.lights {
-        l.shadow.technique = Technique::Hard;
-        l.shadow_map = size;
-    }
-    let opts = RenderOptions {
-        aux: true,
-        repeat: 1,
-        dump: false,
-    };
-    Ok(renderer
-        .render(&gpu.device, &gpu.queue, &s, opts)?
-        .shade_maps)
-}
-
-/// Error against the box-PCF truth over each light's linear map `linear` (1 where the
-/// receiver leaves the map, as the shading returns).
-fn pcf_stats(
-    scene: &Scene,
-    frame: &Frame,
-    linear: &[FloatMap],
-    truth: &Truth,
-    width: f64,
-) -> Result<ErrorStats> {
-    let lights = scene.lights.len();
-    let mut reference = vec![1.0; frame.visibility.len()];
-    for (li, light) in scene.lights.iter().enumerate() {
-        let Some(linear) = linear.get(li) else {
-            return Err(Error::Invalid(format!(
-                "light {li} has no linear map to take the PCF truth over"
-            )));
-        };
-        let map = Map {
-            size: linear.width as usize,
-            texels: &linear.data,
-        };
-        let g = LightGpu::new(light);
-        for px in 0..(frame.width * frame.height) as usize {
-            let i = px * lights + li;
-            if !truth.mask[i] {
-                continue;
-            }
-            let at = |d: &[f32]| {
-                DVec3::new(d[4 * px].into(), d[4 * px + 1].into(), d[4 * px + 2].into())
-            };
-            let (p, n) = (at(&frame.position), at(&frame.normal).normalize_or_zero());
-            let s = crate::cpu::light::sample(&g, p, n);
-            if s.inside {
-                let r = Receiver {
-                    uv: s.uv,
-                    depth: s.depth,
-                };
-                reference[i] = pcf_box(&map, &r, width, f64::from(light.shadow.bias));
-            }
-        }
-    }
-    Ok(ErrorStats::new(&frame.visibility, &reference, &truth.mask))
 }
 
 /// Output folder helper: creates `dir` and names `file` in it.

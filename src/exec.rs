@@ -8,11 +8,9 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-// `record_mip_chain` creates its parameters with `create_buffer_init`.
-use wgpu::util::DeviceExt;
-
 use crate::created;
 use crate::error::{Error, Result};
+use crate::filter::{MIP_LEVELS_PER_DISPATCH, MipParams, mip_dispatches};
 use crate::gpu::{read_buffer, scoped};
 use crate::graph::{Dispatch, Plan, Slot};
 use crate::kernels::{self, Reflection};
@@ -383,16 +381,15 @@ struct Prepared {
     outputs: Outputs,
     /// Every step's parameters, and per step its `(offset, size)` there.
     params: (wgpu::Buffer, Vec<(u64, u64)>),
-    /// Per step: its pipeline, bind group and workgroups (`None`: a mip chain, which
-    /// [`Executor::record_mip_chain`] binds itself).
-    steps: Vec<Option<PreparedStep>>,
+    /// Per step: its pipeline and dispatches.
+    steps: Vec<PreparedStep>,
 }
 
-/// One node's pipeline, bind group and dispatch size.
+/// One node's pipeline and its dispatches in one pass, each a bind group and workgroups (a
+/// mip chain: one per group of levels).
 struct PreparedStep {
     kernel: Arc<ComputeKernel>,
-    bind_group: wgpu::BindGroup,
-    groups: [u32; 3],
+    dispatches: Vec<(wgpu::BindGroup, [u32; 3])>,
 }
 
 impl Executor {
@@ -442,7 +439,7 @@ impl Executor {
             Some(p) if same_plan => self.rebind_imports(device, p, imports)?,
             _ => self.prepare_run(device, plan, imports)?,
         };
-        let result = self.encode(device, encoder, &prepared, timer.as_deref_mut());
+        let result = self.encode(encoder, &prepared, timer.as_deref_mut());
         let outputs = prepared.outputs.clone();
         self.prepared = Some(prepared);
         result?;
@@ -456,7 +453,6 @@ impl Executor {
     /// Records the passes of a prepared plan.
     fn encode(
         &mut self,
-        device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         prepared: &Prepared,
         mut timer: Option<&mut GpuTimer>,
@@ -467,17 +463,15 @@ impl Executor {
             if let Some(t) = timer.as_deref_mut() {
                 t.begin(encoder, &node.name);
             }
-            let Some(bound) = bound else {
-                self.record_mip_chain(device, encoder, node, &prepared.outputs.textures)?;
-                continue;
-            };
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some(&node.name),
                 timestamp_writes: None,
             });
             pass.set_pipeline(&bound.kernel.pipeline);
-            pass.set_bind_group(0, &bound.bind_group, &[]);
-            pass.dispatch_workgroups(bound.groups[0], bound.groups[1], bound.groups[2]);
+            for (bind_group, g) in &bound.dispatches {
+                pass.set_bind_group(0, bind_group, &[]);
+                pass.dispatch_workgroups(g[0], g[1], g[2]);
+            }
         }
         Ok(())
     }
@@ -534,17 +528,7 @@ impl Executor {
         let (params, params_at) = params_buffer(device, plan);
         let mut bound = Vec::new();
         for (si, step) in plan.steps.iter().enumerate() {
-            bound.push(match step.node.dispatch {
-                Dispatch::MipChain => None,
-                _ => Some(self.bind_step(
-                    device,
-                    &step.node,
-                    &outputs,
-                    si,
-                    &params,
-                    params_at[si],
-                )?),
-            });
+            bound.push(self.bind_step(device, &step.node, &outputs, si, &params, params_at[si])?);
         }
         let imports = plan
             .resources
@@ -586,22 +570,17 @@ impl Executor {
                 .inputs
                 .iter()
                 .any(|(_, r)| prepared.imports.iter().any(|(name, _)| name == r));
-            if reads_import && prepared.steps[si].is_some() {
+            if reads_import {
                 let (params, at) = &prepared.params;
-                prepared.steps[si] = Some(self.bind_step(
-                    device,
-                    &step.node,
-                    &prepared.outputs,
-                    si,
-                    params,
-                    at[si],
-                )?);
+                prepared.steps[si] =
+                    self.bind_step(device, &step.node, &prepared.outputs, si, params, at[si])?;
             }
         }
         Ok(prepared)
     }
 
-    /// A node's pipeline, bind group and workgroups; `params_at` is its slice of `params`.
+    /// A node's pipeline and dispatches (a mip chain's by [`Executor::bind_mip_chain`]);
+    /// `params_at` is its slice of `params`.
     fn bind_step(
         &mut self,
         device: &wgpu::Device,
@@ -611,6 +590,9 @@ impl Executor {
         params: &wgpu::Buffer,
         (offset, size): (u64, u64),
     ) -> Result<PreparedStep> {
+        if node.dispatch == Dispatch::MipChain {
+            return self.bind_mip_chain(device, node, &outputs.textures);
+        }
         let textures = &outputs.textures;
         let formats: Vec<(String, wgpu::TextureFormat)> = node
             .outputs
@@ -682,7 +664,7 @@ impl Executor {
         )?;
         let wg = kernel.reflection.workgroup_size.unwrap_or([1, 1, 1]);
         let size = |r: &str| textures.get(r).map(|t| (t.width(), t.height()));
-        let groups = node.dispatch.groups(wg, size).ok_or_else(|| {
+        let groups = node.dispatch.groups(size, wg).ok_or_else(|| {
             Error::Invalid(format!(
                 "node `{}` dispatches over a resource that is not in the plan",
                 node.name
@@ -690,145 +672,45 @@ impl Executor {
         })?;
         Ok(PreparedStep {
             kernel,
-            bind_group,
-            groups,
+            dispatches: vec![(bind_group, groups)],
         })
     }
 
-    /// Records a [`Dispatch::MipChain`] node: one compute pass, one dispatch per two levels of
-    /// the output (`kernels/mips.wgsl`), each reading the level above through a one-level view.
-    /// With an odd level count the last dispatch redoes the level before the last (identical
-    /// values) so that every dispatch writes two levels.
-    fn record_mip_chain(
+    /// Binds a [`Dispatch::MipChain`] node: one compute pass with the dispatches of
+    /// [`crate::filter::mip_dispatches`] (`kernels/mips.wgsl` or `mips_log.wgsl`, up to six
+    /// levels each), each reading one level (the `src` input for the first, which also stores
+    /// it as level 0) through a one-level view and writing the levels after it through
+    /// one-level views.
+    fn bind_mip_chain(
         &mut self,
         device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
         node: &crate::graph::Node,
         textures: &HashMap<String, wgpu::Texture>,
-    ) -> Result<()> {
-        let pipeline_err = |message: String| Error::Pipeline {
-            kernel: node.kernel.clone(),
-            message: format!("node `{}`: {message}", node.name),
-        };
-        let slot = |list: &[(String, String)], name: &str| {
-            list.iter()
-                .find(|(s, _)| s == name)
-                .map(|(_, r)| textures[r].clone())
-                .ok_or_else(|| pipeline_err(format!("binds nothing to `{name}`")))
-        };
-        let src = slot(&node.inputs, "src")?;
-        let dst = slot(&node.outputs, "dst")?;
-        let formats = [
-            ("dst_a".to_string(), dst.format()),
-            ("dst_b".to_string(), dst.format()),
-        ];
+    ) -> Result<PreparedStep> {
+        let mip = MipNode::new(node, textures)?;
+        let formats: Vec<(String, wgpu::TextureFormat)> = (0..=MIP_LEVELS_PER_DISPATCH)
+            .map(|k| (format!("dst{k}"), mip.dst.format()))
+            .collect();
         let kernel = self
             .kernels
             .get_specialized(device, &node.kernel, &formats)?;
-        let levels = dst.mip_level_count();
-        let size = |l: u32| [(dst.width() >> l).max(1), (dst.height() >> l).max(1)];
-        let passes = crate::graph::mip_chain_passes(levels);
-        let base: crate::filter::MipParams = bytemuck::try_pod_read_unaligned(
-            &node.params[..std::mem::size_of::<crate::filter::MipParams>()],
-        )
-        .map_err(|e| pipeline_err(format!("bad params: {e}")))?;
+        let dispatches = mip_dispatches(mip.dst.width(), mip.dst.height());
         let align = u64::from(device.limits().min_uniform_buffer_offset_alignment).max(32);
-        let mut bytes = vec![0u8; passes.len() * align as usize];
-        for (k, pass) in passes.iter().enumerate() {
-            let p = crate::filter::MipParams {
-                src_size: pass.read.map_or([src.width(), src.height()], size),
-                a_size: size(pass.a),
-                b_size: pass.b.map_or([0, 0], size),
-                ..base
-            };
-            let at = k * align as usize;
-            bytes[at..at + std::mem::size_of_val(&p)].copy_from_slice(bytemuck::bytes_of(&p));
-        }
-        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(&node.name),
-            contents: &bytes,
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let level_view = |t: &wgpu::Texture, level: u32| {
-            t.create_view(&wgpu::TextureViewDescriptor {
-                base_mip_level: level,
-                mip_level_count: Some(1),
-                ..Default::default()
-            })
-        };
-        let binding = |name: &str| {
-            kernel
-                .reflection
-                .binding(name)
-                .map(|b| b.binding)
-                .ok_or_else(|| pipeline_err(format!("kernel has no binding `{name}`")))
-        };
-        let (b_src, b_a, b_b, b_params) = (
-            binding("src")?,
-            binding("dst_a")?,
-            binding("dst_b")?,
-            binding("params")?,
-        );
-        let mut groups = Vec::new();
-        for (k, pass) in passes.iter().enumerate() {
-            let (a, b_level) = (pass.a, pass.b.unwrap_or(pass.a));
-            let src_view = match pass.read {
-                None => level_view(&src, 0),
-                Some(l) => level_view(&dst, l),
-            };
-            let (va, vb) = (level_view(&dst, a), level_view(&dst, b_level));
-            let entries = [
-                wgpu::BindGroupEntry {
-                    binding: b_src,
-                    resource: wgpu::BindingResource::TextureView(&src_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: b_a,
-                    resource: wgpu::BindingResource::TextureView(&va),
-                },
-                wgpu::BindGroupEntry {
-                    binding: b_b,
-                    resource: wgpu::BindingResource::TextureView(&vb),
-                },
-                wgpu::BindGroupEntry {
-                    binding: b_params,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &params,
-                        offset: k as u64 * align,
-                        size: wgpu::BufferSize::new(
-                            std::mem::size_of::<crate::filter::MipParams>() as u64,
-                        ),
-                    }),
-                },
+        let params = mip.params_buffer(device, &dispatches, align)?;
+        let mut bound = Vec::new();
+        for (k, &(first, count)) in dispatches.iter().enumerate() {
+            let bg = mip.bind_group(device, &kernel, &params, k as u64 * align, first, count)?;
+            let tile = crate::filter::MIP_TILE / 2;
+            let next = [
+                (mip.dst.width() >> (first + 1)).max(1),
+                (mip.dst.height() >> (first + 1)).max(1),
             ];
-            let layout = kernel
-                .layouts
-                .first()
-                .ok_or_else(|| no_layout(&kernel.name))?;
-            let bg = scoped(
-                device,
-                || {
-                    device.create_bind_group(&wgpu::BindGroupDescriptor {
-                        label: Some(&node.name),
-                        layout,
-                        entries: &entries,
-                    })
-                },
-                |message| pipeline_err(format!("binding level {a}: {message}")),
-            )?;
-            let out = size(b_level);
-            groups.push((bg, kernel.groups_for(out[0], out[1])));
+            bound.push((bg, [next[0].div_ceil(tile), next[1].div_ceil(tile), 1]));
         }
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(&node.name),
-            timestamp_writes: None,
-        });
-        pass.set_pipeline(&kernel.pipeline);
-        for (bg, g) in &groups {
-            pass.set_bind_group(0, bg, &[]);
-            pass.dispatch_workgroups(g[0], g[1], 1);
-        }
-        Ok(())
+        Ok(PreparedStep {
+            kernel,
+            dispatches: bound,
+        })
     }
 }
 
@@ -928,4 +810,153 @@ fn aspect_view(t: &wgpu::Texture) -> wgpu::TextureView {
             ..Default::default()
         },
     )
+}
+
+/// A mip-chain node's textures and the pieces of its dispatches.
+struct MipNode<'a> {
+    node: &'a crate::graph::Node,
+    src: wgpu::Texture,
+    dst: wgpu::Texture,
+}
+
+impl<'a> MipNode<'a> {
+    fn new(
+        node: &'a crate::graph::Node,
+        textures: &HashMap<String, wgpu::Texture>,
+    ) -> Result<Self> {
+        let find = |list: &[(String, String)], slot: &str| {
+            list.iter()
+                .find(|(s, _)| s == slot)
+                .and_then(|(_, r)| textures.get(r).cloned())
+                .ok_or_else(|| Self::error(node, format!("binds nothing to `{slot}`")))
+        };
+        Ok(Self {
+            node,
+            src: find(&node.inputs, "src")?,
+            dst: find(&node.outputs, "dst")?,
+        })
+    }
+
+    fn error(node: &crate::graph::Node, message: String) -> Error {
+        Error::Pipeline {
+            kernel: node.kernel.clone(),
+            message: format!("node `{}`: {message}", node.name),
+        }
+    }
+
+    /// One `MipParams` per dispatch, `align` bytes apart.
+    fn params_buffer(
+        &self,
+        device: &wgpu::Device,
+        dispatches: &[(u32, u32)],
+        align: u64,
+    ) -> Result<wgpu::Buffer> {
+        let size = std::mem::size_of::<MipParams>();
+        let base: MipParams = self
+            .node
+            .params
+            .get(..size)
+            .and_then(|b| bytemuck::try_pod_read_unaligned(b).ok())
+            .ok_or_else(|| Self::error(self.node, "params are not a MipParams".into()))?;
+        let (w, h) = (self.dst.width(), self.dst.height());
+        let odd = |n: u32| n > 1 && n % 2 == 1;
+        let mut bytes = vec![0u8; dispatches.len() * align as usize];
+        for (k, &(first, count)) in dispatches.iter().enumerate() {
+            let p = MipParams {
+                base: [w, h],
+                first,
+                count,
+                copy: u32::from(first == 0),
+                general: u32::from(odd((w >> first).max(1)) || odd((h >> first).max(1))),
+                ..base
+            };
+            let at = k * align as usize;
+            bytes[at..at + size].copy_from_slice(bytemuck::bytes_of(&p));
+        }
+        Ok(created::buffer_init(
+            device,
+            &wgpu::util::BufferInitDescriptor {
+                label: Some(&self.node.name),
+                contents: &bytes,
+                usage: wgpu::BufferUsages::UNIFORM,
+            },
+        ))
+    }
+
+    /// The bind group of the dispatch reading level `first` and writing `count` levels:
+    /// `dst0` is level 0 in the first dispatch; unused bindings repeat the last level written
+    /// (the kernel stores only levels 0 … count).
+    fn bind_group(
+        &self,
+        device: &wgpu::Device,
+        kernel: &ComputeKernel,
+        params: &wgpu::Buffer,
+        offset: u64,
+        first: u32,
+        count: u32,
+    ) -> Result<wgpu::BindGroup> {
+        let level_view = |t: &wgpu::Texture, level: u32| {
+            created::view(
+                t,
+                &wgpu::TextureViewDescriptor {
+                    base_mip_level: level,
+                    mip_level_count: Some(1),
+                    ..Default::default()
+                },
+            )
+        };
+        let binding = |name: &str| {
+            kernel
+                .reflection
+                .binding(name)
+                .map(|b| b.binding)
+                .ok_or_else(|| Self::error(self.node, format!("kernel has no binding `{name}`")))
+        };
+        let src_view = match first {
+            0 => level_view(&self.src, 0),
+            l => level_view(&self.dst, l),
+        };
+        let views: Vec<(String, wgpu::TextureView)> = (0..=MIP_LEVELS_PER_DISPATCH)
+            .map(|j| {
+                let level = match j {
+                    0 if first == 0 => 0,
+                    j if (1..=count).contains(&j) => first + j,
+                    _ => first + count,
+                };
+                (format!("dst{j}"), level_view(&self.dst, level))
+            })
+            .collect();
+        let mut entries = vec![wgpu::BindGroupEntry {
+            binding: binding("src")?,
+            resource: wgpu::BindingResource::TextureView(&src_view),
+        }];
+        for (name, view) in &views {
+            entries.push(wgpu::BindGroupEntry {
+                binding: binding(name)?,
+                resource: wgpu::BindingResource::TextureView(view),
+            });
+        }
+        entries.push(wgpu::BindGroupEntry {
+            binding: binding("params")?,
+            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer: params,
+                offset,
+                size: wgpu::BufferSize::new(std::mem::size_of::<MipParams>() as u64),
+            }),
+        });
+        scoped(
+            device,
+            || {
+                created::bind_group(
+                    device,
+                    &wgpu::BindGroupDescriptor {
+                        label: Some(&self.node.name),
+                        layout: &kernel.layouts[0],
+                        entries: &entries,
+                    },
+                )
+            },
+            |message| Self::error(self.node, format!("binding level {first}: {message}")),
+        )
+    }
 }

@@ -3,8 +3,16 @@
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
 use crate::scene::{BlurKernel, Filter};
 
-/// Taps each side the blur kernel's workgroup tile can hold.
+/// Taps each side the blur kernel's weight table holds.
 pub const MAX_BLUR_RADIUS: u32 = 32;
+
+/// Texels of a line one `blur` or `blur_log` invocation writes (`PER` in
+/// `kernels/shared/blur_pass.wgsl`).
+pub const BLUR_PER_INVOCATION: u32 = 8;
+
+/// Invocations of a `blur` or `blur_log` workgroup (`WG_SIZE` in
+/// `kernels/shared/blur_pass.wgsl`): along a row, or across neighbouring columns.
+pub const BLUR_GROUP: u32 = 64;
 
 /// How the blur combines texels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -100,14 +108,25 @@ pub fn add_filter(
         );
         graph.node(Node {
             name: format!("{input}.{pass}"),
-            kernel: "blur".into(),
+            kernel: match mode {
+                BlurMode::Linear => "blur",
+                BlurMode::LogSumExp => "blur_log",
+            }
+            .into(),
             inputs: vec![("src".into(), src)],
             outputs: vec![("dst".into(), out.clone())],
             params: bytemuck::bytes_of(&BlurParams::new(axis, radius, sigma, kernel, mode))
                 .to_vec(),
-            dispatch: Dispatch::Axis {
+            // Rows: a workgroup per BLUR_GROUP · PER texels of a row; columns: a workgroup per
+            // BLUR_GROUP columns × PER rows.
+            dispatch: Dispatch::Blocks {
                 of: out.clone(),
-                axis,
+                x: if axis == 0 {
+                    BLUR_GROUP * BLUR_PER_INVOCATION
+                } else {
+                    BLUR_GROUP
+                },
+                y: if axis == 0 { 1 } else { BLUR_PER_INVOCATION },
             },
             light: Some(light),
         });
@@ -116,25 +135,66 @@ pub fn add_filter(
     src
 }
 
-/// Parameters of `kernels/mips.wgsl` (mirrors its `Params`); the executor fills in the sizes
-/// of each dispatch's levels, the graph only the mode.
+/// Parameters of `kernels/mips.wgsl` (mirrors its `Params`); the executor fills in each
+/// dispatch's levels ([`mip_dispatches`]), the graph only the mode.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct MipParams {
-    /// Size of the level read.
-    pub src_size: [u32; 2],
-    /// Size of the first level written.
-    pub a_size: [u32; 2],
-    /// Size of the second level written.
-    pub b_size: [u32; 2],
-    /// 0 linear average, 1 log-sum-exp.
+    /// Size of level 0.
+    pub base: [u32; 2],
+    /// The level a dispatch reads, `s`.
+    pub first: u32,
+    /// Levels it writes after `s` (0 only for a 1×1 map, whose chain is level 0).
+    pub count: u32,
+    /// 0 linear average, 1 log-sum-exp (for the record: the kernel, `mips` or `mips_log`,
+    /// decides).
     pub mode: u32,
+    /// 1: the dispatch also stores the level it reads as level 0 (the first dispatch).
+    pub copy: u32,
+    /// 1: the level read has an odd side > 1 (a fractional reduction; `count` is 1).
+    pub general: u32,
     /// Padding.
     pub _pad: u32,
 }
 
-/// Adds the mip-chain node over `input`: `<input>.mips`, a copy of `input` at level 0 and
-/// area-weighted reductions below it, down to 1×1.
+/// Levels one `mips` dispatch writes at most (its `dst1` … `dst6`).
+pub const MIP_LEVELS_PER_DISPATCH: u32 = 6;
+
+/// Level-0 texels per axis a `mips` workgroup reduces when the level halves (`TILE` × 2).
+pub const MIP_TILE: u32 = 64;
+
+/// The dispatches of the full mip chain of a `width × height` map: `(first, count)` pairs,
+/// each reading level `first` and writing the `count` levels after it. A dispatch writes up to
+/// [`MIP_LEVELS_PER_DISPATCH`] levels, each an exact halving (or a side of 1 kept), which a
+/// workgroup does from its own texels; a level with an odd side > 1 (a fractional reduction)
+/// gets a dispatch of one level. A 1×1 map is one dispatch writing no level after level 0. A
+/// 4096² chain is `[(0, 6), (6, 6)]`.
+pub fn mip_dispatches(width: u32, height: u32) -> Vec<(u32, u32)> {
+    let levels = crate::technique::mip_levels(width, height);
+    let size = |l: u32| [(width >> l).max(1), (height >> l).max(1)];
+    let halves = |l: u32| size(l).iter().all(|&n| n == 1 || n % 2 == 0);
+    if levels <= 1 {
+        return vec![(0, 0)];
+    }
+    let mut out = Vec::new();
+    let mut first = 0;
+    while first + 1 < levels {
+        let mut count = 1;
+        while halves(first)
+            && count < MIP_LEVELS_PER_DISPATCH
+            && first + count + 1 < levels
+            && halves(first + count)
+        {
+            count += 1;
+        }
+        out.push((first, count));
+        first += count;
+    }
+    out
+}
+
+/// Adds the mip-chain node over `input`: `<input>.mips`, `input` at level 0 and area-weighted
+/// reductions below it, down to 1×1, in the dispatches of [`mip_dispatches`].
 fn add_mips(
     graph: &mut Graph,
     light: usize,
@@ -157,7 +217,11 @@ fn add_mips(
     };
     graph.node(Node {
         name: format!("{input}.mips"),
-        kernel: "mips".into(),
+        kernel: match mode {
+            BlurMode::Linear => "mips",
+            BlurMode::LogSumExp => "mips_log",
+        }
+        .into(),
         inputs: vec![("src".into(), input.to_string())],
         outputs: vec![("dst".into(), out.clone())],
         params: bytemuck::bytes_of(&params).to_vec(),
@@ -165,4 +229,55 @@ fn add_mips(
         light: Some(light),
     });
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mip_dispatches_cover_every_level_once() {
+        assert_eq!(mip_dispatches(4096, 4096), [(0, 6), (6, 6)]);
+        assert_eq!(mip_dispatches(8192, 8192), [(0, 6), (6, 6), (12, 1)]);
+        assert_eq!(mip_dispatches(1, 1), [(0, 0)]);
+        // 1000×37 (odd: a dispatch of one level): levels 500×18, 250×9 (odd), 125×4 (odd),
+        // 62×2, then 31×1, 15×1, 7×1, 3×1, each odd, down to 1×1.
+        assert_eq!(
+            mip_dispatches(1000, 37),
+            [
+                (0, 1),
+                (1, 1),
+                (2, 1),
+                (3, 1),
+                (4, 1),
+                (5, 1),
+                (6, 1),
+                (7, 1),
+                (8, 1)
+            ]
+        );
+        for (w, h) in [
+            (1000, 37),
+            (61, 61),
+            (1, 57),
+            (130, 7),
+            (4096, 4096),
+            (3, 2100),
+        ] {
+            let levels = crate::technique::mip_levels(w, h);
+            let d = mip_dispatches(w, h);
+            let mut next = 0;
+            for &(first, count) in &d {
+                assert_eq!(first, next, "{w}x{h}: {d:?}");
+                assert!((1..=MIP_LEVELS_PER_DISPATCH).contains(&count));
+                // A dispatch only halves (or keeps a side of 1), but for a one-level one.
+                for l in (first..first + count).skip(usize::from(count == 1)) {
+                    let n = [(w >> l).max(1), (h >> l).max(1)];
+                    assert!(n.iter().all(|&n| n == 1 || n % 2 == 0), "{w}x{h} level {l}");
+                }
+                next = first + count;
+            }
+            assert_eq!(next + 1, levels, "{w}x{h}: {d:?}");
+        }
+    }
 }

@@ -408,6 +408,8 @@ pub fn float_channels(format: wgpu::TextureFormat) -> Option<usize> {
         T::Rg16Unorm => Some(2),
         T::Rgba32Float | T::Rgba16Float | T::Rgba16Unorm => Some(4),
         // Summed-area tables and their intermediates: raw words read as i32 (dumps only).
+        T::R32Uint => Some(1),
+        T::Rg32Uint => Some(2),
         T::Rgba32Uint => Some(4),
         _ => None,
     }
@@ -453,7 +455,12 @@ pub fn read_float_texture(
         raw.chunks_exact(2)
             .map(|b| f32::from(u16::from_le_bytes([b[0], b[1]])) / 65535.0)
             .collect()
-    } else if format == wgpu::TextureFormat::Rgba32Uint {
+    } else if matches!(
+        format,
+        wgpu::TextureFormat::R32Uint
+            | wgpu::TextureFormat::Rg32Uint
+            | wgpu::TextureFormat::Rgba32Uint
+    ) {
         raw.chunks_exact(4)
             .map(|b| i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f32)
             .collect()

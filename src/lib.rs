@@ -20,6 +20,7 @@ pub mod scene;
 pub mod stability;
 pub mod technique;
 pub mod timer;
+pub mod tolerance;
 pub mod truth;
 
 pub use error::{Error, Result};

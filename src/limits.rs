@@ -13,7 +13,7 @@ pub use scene::{
 };
 
 use crate::error::{Error, Result};
-use crate::graph::{Dispatch, Node, Plan, block_count};
+use crate::graph::{Dispatch, Node, Plan};
 use crate::kernels;
 
 /// One thing a kernel needs of the device, and the device's limit on it.
@@ -230,33 +230,23 @@ pub fn plan_over(plan: &Plan, l: &wgpu::Limits) -> Result<Option<StepOver>> {
     Ok(None)
 }
 
-/// Workgroup counts of a node's dispatch (as the executor computes them).
+/// Workgroup counts of a node's dispatch (as the executor computes them; for a mip chain its
+/// largest dispatch, the first: tiles of level 1, or of level 0 for a 1×1 map).
 pub fn dispatch_groups(plan: &Plan, node: &Node, wg: [u32; 3]) -> [u32; 3] {
-    let size = |r: &str| plan.resource(r).map_or((1, 1), |p| (p.width, p.height));
+    let size = |r: &str| plan.resource(r).map(|p| (p.width, p.height));
     let wg = wg.map(|w| w.max(1));
-    match &node.dispatch {
-        // The largest of a mip chain's dispatches covers level 1 (level 0 for a 1×1 map).
-        Dispatch::MipChain => {
-            let (w, h) = node.outputs.first().map_or((1, 1), |(_, r)| size(r));
-            [
-                (w / 2).max(1).div_ceil(wg[0]),
-                (h / 2).max(1).div_ceil(wg[1]),
-                1,
-            ]
-        }
-        Dispatch::Groups(g) => *g,
-        Dispatch::Blocks { of, x, y } => {
-            let (w, h) = size(of);
-            [block_count(w, *x), block_count(h, *y), 1]
-        }
-        Dispatch::Texels(r) => {
-            let (w, h) = size(r);
-            [w.div_ceil(wg[0]), h.div_ceil(wg[1]), 1]
-        }
-        Dispatch::Axis { of, axis } => {
-            let (w, h) = size(of);
-            let (along, across) = if *axis == 0 { (w, h) } else { (h, w) };
-            [along.div_ceil(wg[0]), across, 1]
-        }
+    if node.dispatch == Dispatch::MipChain {
+        let (w, h) = node
+            .outputs
+            .first()
+            .and_then(|(_, r)| size(r))
+            .unwrap_or((1, 1));
+        let tile = crate::filter::MIP_TILE / 2;
+        return [
+            (w / 2).max(1).div_ceil(tile),
+            (h / 2).max(1).div_ceil(tile),
+            1,
+        ];
     }
+    node.dispatch.groups(size, wg).unwrap_or([1, 1, 1])
 }

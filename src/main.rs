@@ -78,7 +78,8 @@ enum Command {
         light_sizes: Vec<f32>,
     },
     /// Sweep techniques and their accuracy knobs, time each on the GPU and measure its error
-    /// against ground truth: report.md/.csv/.json, pareto.svg, grid.png (+ grid.txt).
+    /// against ground truth: report.html/.md/.csv/.json, pareto{,_penumbra,_flip}.svg, grid.png
+    /// (+ grid.txt).
     Evaluate {
         /// Scene file (TOML).
         scene: PathBuf,
@@ -113,7 +114,7 @@ enum Command {
     /// Run the numerical-stability suite: each hard input through the real kernels against its
     /// f64 reference and stated bound; exits non-zero when a check fails.
     Stability {
-        /// Summed-area tables at 8192² (1 GiB each) instead of 2048².
+        /// Summed-area tables at 8192² (256 MiB each) instead of 2048².
         #[arg(long)]
         large: bool,
     },

@@ -10,7 +10,7 @@ use std::process::Command;
 
 use rand::Rng;
 use shadowgraph::evaluate::{
-    Config, ErrorStats, EvaluateOptions, FILTERS, Report, evaluate, scene_for,
+    Config, ErrorStats, EvaluateOptions, FILTERS, Metric, Report, evaluate, front, scene_for,
 };
 use shadowgraph::render::{RenderOptions, Renderer};
 use shadowgraph::scene::{Filter, PcfKernel, Scene, Technique};
@@ -87,7 +87,10 @@ fn quick_sweep_writes_every_file_consistently() {
         "report.md",
         "report.csv",
         "report.json",
+        "report.html",
         "pareto.svg",
+        "pareto_penumbra.svg",
+        "pareto_flip.svg",
         "grid.png",
         "grid.txt",
     ] {
@@ -112,6 +115,12 @@ fn quick_sweep_writes_every_file_consistently() {
         assert_eq!(cells[col("label")], r.label);
         let num = |name: &str| cells[col(name)].parse::<f64>().unwrap();
         for (name, v, tol) in [
+            ("penumbra_mean_abs", r.penumbra.mean_abs, 5e-7),
+            ("penumbra_p99", r.penumbra.p99, 5e-7),
+            ("umbra_mean_abs", r.umbra.mean_abs, 5e-7),
+            ("lit_mean_abs", r.lit.mean_abs, 5e-7),
+            ("flip_mean_abs", r.flip.mean_abs, 5e-7),
+            ("flip_max", r.flip.max, 5e-7),
             ("soft_mean_abs", r.soft.mean_abs, 5e-7),
             ("soft_rmse", r.soft.rmse, 5e-7),
             ("soft_p99", r.soft.p99, 5e-7),
@@ -136,11 +145,38 @@ fn quick_sweep_writes_every_file_consistently() {
         assert!(shares.iter().all(|s| (0.0..=1.0).contains(s)) && shares[1] <= shares[0]);
         assert!(r.soft.mean_abs <= r.soft.rmse + 1e-12 && r.soft.rmse <= r.soft.max + 1e-12);
         assert!(r.soft.pixels == report.relevant_pixels, "{}", r.label);
+        // The regions partition the relevant pixels.
+        let regions = [r.penumbra.pixels, r.umbra.pixels, r.lit.pixels];
+        assert_eq!(regions, report.region_pixels, "{}", r.label);
+        assert_eq!(regions.iter().sum::<usize>(), report.relevant_pixels);
+        assert_eq!(r.flip.pixels, (report.image.0 * report.image.1) as usize);
     }
-    let svg = std::fs::read_to_string(out.join("pareto.svg")).unwrap();
-    assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
-    assert_eq!(svg.matches("<circle").count(), report.rows.len());
-    assert!(svg.contains("stroke-dasharray"), "no Pareto front drawn");
+    assert!(
+        report.region_pixels.iter().all(|&n| n > 0),
+        "{:?}",
+        report.region_pixels
+    );
+    // Each plot: one point per configuration, a ring per front point, a legend swatch per
+    // technique and for the front; labels on the front's points and on no other.
+    let techniques: std::collections::BTreeSet<&str> =
+        report.rows.iter().map(|r| r.technique.as_str()).collect();
+    for m in Metric::ALL {
+        let svg = std::fs::read_to_string(out.join(m.file())).unwrap();
+        assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+        let on = front(&report.rows, m);
+        assert!(!on.is_empty());
+        assert_eq!(
+            svg.matches("<circle").count(),
+            report.rows.len() + on.len() + techniques.len() + 1,
+            "{}",
+            m.file()
+        );
+        for (i, r) in report.rows.iter().enumerate() {
+            // plotters writes a text element's content on a line of its own.
+            let labelled = svg.contains(&format!(">\n{}\n</text>", r.label));
+            assert_eq!(labelled, on.contains(&i), "{}: {}", m.file(), r.label);
+        }
+    }
     let png = image::open(out.join("grid.png"))
         .expect("grid.png decodes")
         .to_rgb8();
@@ -227,6 +263,14 @@ fn errors_are_plausible_and_recomputable() {
     assert!(blur.soft.mean_abs > 2.0 * pcf.soft.mean_abs);
     assert!(blur.soft.over_02 > pcf.soft.over_02);
     assert!(pcf.pcf.expect("pcf truth").mean_abs < 0.01);
+    // Hard shadows equal to the truth: every region's error and FLIP exactly 0, the two shaded
+    // images identical; the blur is worse in the penumbra and perceptually.
+    for e in [hard.penumbra, hard.umbra, hard.lit, hard.flip] {
+        assert_eq!(e.max, 0.0, "{e:?}");
+    }
+    assert_eq!(images.shaded[0], images.truth_shaded);
+    assert!(blur.penumbra.mean_abs > 2.0 * pcf.penumbra.mean_abs);
+    assert!(blur.flip.mean_abs > pcf.flip.mean_abs);
 
     // (2) Independent recomputation of the PCF row's soft error.
     let mut renderer = Renderer::new(&g.device);
@@ -270,6 +314,112 @@ fn errors_are_plausible_and_recomputable() {
     assert!((over - pcf.soft.over_005).abs() < 1e-12);
     assert_eq!(images.visibility.len(), 3);
     assert_eq!(images.truth.len(), 160 * 120);
+    // The shaded images are the renderer's shading: the CPU port shading PCF's visibility
+    // against the GPU's image of the same frame, and the truth-shaded image against the GPU's
+    // image of `hard` (equal to the truth here), both within one 8-bit step (f32 vs f64
+    // arithmetic before the rounding store).
+    common::evaluate::assert_same_image("pcf shaded", &images.shaded[1], &frame.rgba);
+    s.lights[0].shadow.technique = Technique::Hard;
+    let hard_frame = renderer
+        .render(
+            &g.device,
+            &g.queue,
+            &s,
+            RenderOptions {
+                aux: false,
+                repeat: 1,
+                dump: false,
+            },
+        )
+        .expect("render");
+    common::evaluate::assert_same_image("truth-shaded", &images.truth_shaded, &hard_frame.rgba);
+}
+
+/// On `sphere_on_plane` (one spot light of size 0.5, K = 16, 160×120), the penumbra, umbra and
+/// lit errors of hard, PCF 5×5 and VSM blur 5 equal a direct f64 recomputation from the
+/// returned images by the written-out definition (`regions_direct`; tolerance 1e-12: the same
+/// sums in another order), and FLIP equals a direct call of the FLIP library on the returned
+/// shaded images, averaged in f64 (same map: 1e-12).
+#[test]
+fn region_and_flip_errors_match_direct_computation() {
+    let g = common::gpu();
+    let opts = EvaluateOptions {
+        image: Some((160, 120)),
+        samples: Some(16),
+        truth_resolution: Some(1024),
+        repeat: 1,
+        ..Default::default()
+    };
+    let scene: Scene = scene_for(&scene_path("sphere_on_plane.toml"), &opts).expect("scene");
+    assert_eq!(scene.lights.len(), 1, "the images hold light 0 only");
+    let vsm = match shadowgraph::prefilter::PrefilterConfig::vsm(512)
+        .with_filter(FILTERS[0].1(5.0))
+        .validated()
+    {
+        Ok((c, _)) => c.technique,
+        Err(e) => panic!("{e}"),
+    };
+    let config = |label: &str, technique| Config {
+        label: label.into(),
+        technique,
+        shadow_map: 512,
+        box_width: None,
+    };
+    let pcf = Technique::Pcf {
+        radius: 2,
+        kernel: PcfKernel::Box,
+    };
+    let configs = [
+        config("hard", Technique::Hard),
+        config("pcf", pcf),
+        config("vsm", vsm),
+    ];
+    let (report, images) = evaluate(&g, &scene, &configs, &opts).expect("evaluate");
+    let regions = common::evaluate::regions_direct(&images.truth, &images.mask, 160, 120);
+    let count = |k: u8| regions.iter().filter(|&&r| r == k).count();
+    assert_eq!(report.region_pixels, [count(1), count(2), count(3)]);
+    assert!(
+        count(1) > 300 && count(2) > 300 && count(3) > 3000,
+        "{:?}",
+        report.region_pixels
+    );
+    for (k, r) in report.rows.iter().enumerate() {
+        let v = &images.visibility[k];
+        for (region, stats) in [(1, r.penumbra), (2, r.umbra), (3, r.lit)] {
+            let e: Vec<f64> = (0..v.len())
+                .filter(|&i| regions[i] == region)
+                .map(|i| (f64::from(v[i]) - f64::from(images.truth[i])).abs())
+                .collect();
+            let mean = e.iter().sum::<f64>() / e.len() as f64;
+            let max = e.iter().copied().fold(0.0, f64::max);
+            assert_eq!(stats.pixels, e.len(), "{} region {region}", r.label);
+            assert!(
+                (stats.mean_abs - mean).abs() < 1e-12,
+                "{} region {region}: {} vs {mean}",
+                r.label,
+                stats.mean_abs
+            );
+            assert_eq!(stats.max, max, "{} region {region}", r.label);
+        }
+        let reference = nv_flip::FlipImageRgb8::with_data(160, 120, &images.truth_shaded);
+        let test = nv_flip::FlipImageRgb8::with_data(160, 120, &images.shaded[k]);
+        let map = nv_flip::flip(reference, test, nv_flip::DEFAULT_PIXELS_PER_DEGREE).to_vec();
+        let mean = map.iter().map(|&x| f64::from(x)).sum::<f64>() / map.len() as f64;
+        assert!(
+            (r.flip.mean_abs - mean).abs() < 1e-12,
+            "{}: FLIP {} vs {mean}",
+            r.label,
+            r.flip.mean_abs
+        );
+        eprintln!(
+            "{}: penumbra {:.4} umbra {:.4} lit {:.4} FLIP {:.4}",
+            r.label, r.penumbra.mean_abs, r.umbra.mean_abs, r.lit.mean_abs, r.flip.mean_abs
+        );
+    }
+    // Soft shadows from PCF beat hard shadows in the penumbra and by FLIP.
+    let [hard, pcf] = [&report.rows[0], &report.rows[1]];
+    assert!(pcf.penumbra.mean_abs < hard.penumbra.mean_abs);
+    assert!(pcf.flip.mean_abs < hard.flip.mean_abs);
 }
 
 /// `ErrorStats` against a direct computation on random data: mean, RMSE and shares by

@@ -283,6 +283,7 @@ fn storage_format_variants_validate() {
     for (kernel, declared, formats) in [
         ("vsm", "rg32float", &["rg32float", "rgba16float"][..]),
         ("blur", "rg32float", all),
+        ("blur_log", "rg32float", &["r32float"][..]),
         ("msm", "rgba32float", &["rgba16float", "rgba16unorm"][..]),
         ("csm", "rgba32float", &["rg32float", "rgba16float"][..]),
         (
@@ -291,11 +292,27 @@ fn storage_format_variants_validate() {
             &["r32float", "rg32float", "rgba16float"][..],
         ),
         ("mips", "rgba32float", all),
+        ("mips_log", "rgba32float", &["r32float"][..]),
+        ("sat_tile_sums", "rgba32uint", &["r32uint", "rg32uint"][..]),
+        (
+            "sat_tile_sums_f32",
+            "rgba32uint",
+            &["r32uint", "rg32uint"][..],
+        ),
+        ("sat_carries", "rgba32uint", &["r32uint", "rg32uint"][..]),
+        ("sat_tiles", "rgba32uint", &["r32uint", "rg32uint"][..]),
+        (
+            "sat_tiles_f32",
+            "rgba32float",
+            &["r32float", "rg32float"][..],
+        ),
     ] {
         let base = kernels::resolve(kernel, None).unwrap();
         for f in formats {
             let mut wgsl = base.clone();
-            for var in ["dst", "dst_a", "dst_b"] {
+            let mips = (0..7).map(|k| format!("dst{k}"));
+            let sat = ["col_part", "row_part", "col_carry", "row_carry"].map(String::from);
+            for var in ["dst".to_string()].into_iter().chain(mips).chain(sat) {
                 wgsl = wgsl.replace(
                     &format!("var {var}: texture_storage_2d<{declared},"),
                     &format!("var {var}: texture_storage_2d<{f},"),

@@ -165,11 +165,11 @@ fn malformed_plans_are_typed_errors() {
             }),
         ),
         (
-            "axis 7",
+            "lines with 0 per workgroup",
             Box::new(|p| {
-                p.steps[0].node.dispatch = Dispatch::Axis {
+                p.steps[0].node.dispatch = Dispatch::Lines {
                     of: p.resources[0].resource.name.clone(),
-                    axis: 7,
+                    per_group: 0,
                 }
             }),
         ),

@@ -312,14 +312,18 @@ fn sizes_and_kernels_past_the_device_limits_are_named() {
             ..g.adapter.limits()
         },
     );
-    let e = limit_error(&little_memory, &PrefilterConfig::vsm(64));
+    let table = PrefilterConfig::vsm(64).with_filter(shadowgraph::scene::Filter::Sat {
+        width: 3.0,
+        variant: shadowgraph::sat::SatVariant::Fixed,
+    });
+    let e = limit_error(&little_memory, &table);
     assert!(
-        e.contains("`blur`") && e.contains("max_compute_workgroup_storage_size"),
+        e.contains("`sat_tile_sums`") && e.contains("max_compute_workgroup_storage_size"),
         "{e}"
     );
-    // Unfiltered VSM runs no blur, so that device can run it.
-    let unfiltered = PrefilterConfig::vsm(64).with_filter(shadowgraph::scene::Filter::None);
-    Prefilter::new(&little_memory, &unfiltered).expect("no blur, no workgroup memory");
+    // The blur reads straight from the texture, no workgroup memory: that device runs it.
+    Prefilter::new(&little_memory, &PrefilterConfig::vsm(64))
+        .expect("blur without workgroup memory");
 
     let (no_compute, _) = device_with(&g, wgpu::Limits::downlevel_webgl2_defaults());
     let e = limit_error(&no_compute, &PrefilterConfig::vsm(64));

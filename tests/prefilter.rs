@@ -340,39 +340,43 @@ fn evsm_and_esm_encodings_match_reference() {
             "evsm at the f32 limit overflowed"
         );
     }
-    // ESM at c = 200 (exp(200) overflows f32): log-space blur keeps everything finite.
-    let params = bytemuck::bytes_of(&ExpParams::new(200.0, 0.0)).to_vec();
-    let (graph, out) = encode_graph(
-        "esm",
-        params,
-        w,
-        h,
-        wgpu::TextureFormat::R32Float,
-        Some(blur),
-        BlurMode::LogSumExp,
-    );
-    let gpu = run(
-        &g,
-        &graph,
-        &out,
-        upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin),
-    );
-    let expected = cpu::blur::blur_mode(
-        &cpu::esm::esm(&input, 200.0),
-        3.0,
-        1.5,
-        BlurKernel::Gaussian,
-        true,
-    );
-    // Each log-sum-exp: exp of (v − max) ∈ [−200, 0] at (3 + 2|x|) ULP relative, then log: the
-    // absolute error in L is ≲ 2 · 403 ULP of 1 plus the rounding of |L| ≤ 200.
-    common::assert_close(
-        "esm c=200 log-space blur",
-        &channels_of(&gpu, 1),
-        &expected.data,
-        2.0 * 403.0 * 2f64.powi(-23),
-        4.0 * 2f64.powi(-24),
-    );
+    // ESM at c = 40 (every window within `blur_log`'s span of 80: one exp per texel) and at
+    // c = 200 (exp(200) overflows f32; most windows span more than 80: one exp per tap around
+    // each output's maximum): log-space blur keeps everything finite.
+    for c in [40.0f32, 200.0] {
+        let params = bytemuck::bytes_of(&ExpParams::new(c, 0.0)).to_vec();
+        let (graph, out) = encode_graph(
+            "esm",
+            params,
+            w,
+            h,
+            wgpu::TextureFormat::R32Float,
+            Some(blur),
+            BlurMode::LogSumExp,
+        );
+        let gpu = run(
+            &g,
+            &graph,
+            &out,
+            upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin),
+        );
+        let expected = cpu::blur::blur_mode(
+            &cpu::esm::esm(&input, f64::from(c)),
+            3.0,
+            1.5,
+            BlurKernel::Gaussian,
+            true,
+        );
+        // Each log-sum-exp: exp of (v − max) ∈ [−c, 0] at (3 + 2|x|) ULP relative, then log:
+        // the absolute error in L is ≲ 2·(3 + 2c) ULP of 1 plus the rounding of |L| ≤ c.
+        common::assert_close(
+            &format!("esm c={c} log-space blur"),
+            &channels_of(&gpu, 1),
+            &expected.data,
+            2.0 * (3.0 + 2.0 * f64::from(c)) * 2f64.powi(-23),
+            4.0 * 2f64.powi(-24),
+        );
+    }
 }
 
 fn channels_of(t: &Texels, n: usize) -> Vec<f32> {
@@ -533,6 +537,10 @@ fn mip_chain_matches_reference_and_ends_at_the_mean() {
         (1, 57, BlurMode::Linear),
         (1, 1, BlurMode::Linear),
         (130, 7, BlurMode::LogSumExp),
+        // Several workgroups through six levels in one dispatch, then the tail.
+        (512, 512, BlurMode::Linear),
+        (256, 256, BlurMode::LogSumExp),
+        (384, 160, BlurMode::Linear),
     ] {
         let lin = random_linear(&mut rng, w as usize, h as usize);
         let log = mode == BlurMode::LogSumExp;

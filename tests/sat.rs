@@ -17,23 +17,21 @@ use shadowgraph::exec::{ComputeKernel, Executor};
 use shadowgraph::gpu::{Gpu, read_buffer, read_texture, submit_and_wait, write_texture};
 use shadowgraph::graph::{Graph, plan, texel_bytes};
 use shadowgraph::kernels;
+use shadowgraph::sat::five_pass::{SAT_BLOCK, SAT_CARRY_LINES, add_sat_five_pass};
 use shadowgraph::sat::{
-    SAT_BLOCK, SAT_CARRY_LINES, SatCoding, SatParams, SatVariant, add_sat, lookup_area,
+    SAT_LINES_PER_GROUP, SAT_TILE, SatCoding, SatParams, SatVariant, add_sat, float_sum_depth,
+    format_channels, lookup_area,
 };
 use wgpu::util::DeviceExt;
 
 /// f32's unit roundoff (round to nearest; Vulkan's f32 add, sub and mul are correctly rounded).
 const U: f64 = 1.0 / (1u64 << 24) as f64;
 
-/// Largest depth of the GPU's summation tree for one f32 table texel of a `w × h` map, per
-/// axis, with n = ⌈side / SAT_BLOCK⌉ blocks a line: the in-block prefix (3 serial adds in an
-/// invocation, 16 on a Blelloch path over 256 invocations, 1 to add the prefix: 20) or the block
-/// carry (block total 3 + 8, then n − 1 serial adds) plus adding it: max(20, 10 + n) + 1 along
-/// rows, the same again on top of the row prefix along columns. Every f32 table texel is within
-/// γ_d ≈ d·U of Σ|values| over its rectangle (d ≤ 42 for maps up to 1024²).
+/// Largest depth of the GPU's summation tree for one f32 table texel of a `w × h` map
+/// (`sat::float_sum_depth`, derived from the kernels' order of additions): every f32 table
+/// texel is within γ_d ≈ d·U of Σ|values| over its rectangle.
 fn scan_depth(w: usize, h: usize) -> f64 {
-    let axis = |side: usize| (20.max(10 + side.div_ceil(SAT_BLOCK as usize)) + 1) as f64;
-    axis(w) + axis(h) + 1.0
+    f64::from(float_sum_depth(w as u32, h as u32))
 }
 
 /// A random representation: `channels` f32 values per texel in `[lo, hi)`, never all zero.
@@ -78,21 +76,43 @@ struct Table {
 }
 
 impl Table {
-    fn fixed(&self) -> &[[u32; 4]] {
-        bytemuck::cast_slice(&self.bytes)
+    /// The words of every texel, widened to four (the channels the format lacks read 0).
+    fn fixed(&self) -> Vec<[u32; 4]> {
+        let t = &self.texture;
+        reference::widen(
+            bytemuck::cast_slice(&self.bytes),
+            (t.width() * t.height()) as usize,
+        )
     }
 
-    fn float(&self) -> &[f32] {
-        bytemuck::cast_slice(&self.bytes)
+    /// Four f32 values a texel, as [`Table::fixed`].
+    fn float(&self) -> Vec<f32> {
+        self.fixed()
+            .as_flattened()
+            .iter()
+            .map(|&b| f32::from_bits(b))
+            .collect()
     }
 }
 
+/// `add_sat`, or the five-pass baseline of `shadowgraph bench`.
+type AddSat = fn(&mut Graph, usize, &str, &SatCoding) -> String;
+
 /// Plans `add_sat` over `map` imported as `in`, runs it with every planned texture poisoned
-/// (all bits set: NaN for floats) so unwritten texels show, and reads the table back.
+/// (all bits set: NaN for floats) so unwritten texels show, and reads the table back; its
+/// format has the map's channels.
 fn build(g: &Gpu, exec: &mut Executor, map: &Map, coding: &SatCoding) -> Table {
+    let table = build_with(g, exec, map, coding, add_sat);
+    let channels = map.channels as u32;
+    assert_eq!(table.texture.format(), coding.variant.format(channels));
+    table
+}
+
+/// [`build`] with `add` in place of `add_sat`.
+fn build_with(g: &Gpu, exec: &mut Executor, map: &Map, coding: &SatCoding, add: AddSat) -> Table {
     let mut graph = Graph::default();
     graph.import("in", map.format(), map.w as u32, map.h as u32, Some(0));
-    let out = add_sat(&mut graph, 0, "in", coding);
+    let out = add(&mut graph, 0, "in", coding);
     let plan = plan(&graph, &[&out]).expect("plan");
     let input = g.device.create_texture(&wgpu::TextureDescriptor {
         label: Some("test.sat.input"),
@@ -160,7 +180,7 @@ fn check_fixed(
 ) {
     let input = map.texels();
     let expected = reference::sat_fixed(&input, coding);
-    let got = table.fixed();
+    let got = &table.fixed();
     if let Some(i) = (0..expected.len()).find(|&i| got[i] != expected[i]) {
         let mismatches = (0..expected.len())
             .filter(|&i| got[i] != expected[i])
@@ -227,8 +247,8 @@ fn check_float(what: &str, rng: &mut impl Rng, map: &Map, coding: &SatCoding, ta
     let got = table.float();
     let depth = scan_depth(map.w, map.h);
     let tol: Vec<f64> = abs.data.iter().map(|a| depth * U * a).collect();
-    common::assert_within(&format!("{what}: table"), got, &exact.data, &tol);
-    let gpu_table = Texels::from_f32(map.w, map.h, 4, got);
+    common::assert_within(&format!("{what}: table"), &got, &exact.data, &tol);
+    let gpu_table = Texels::from_f32(map.w, map.h, 4, &got);
     let mut gpu = Vec::new();
     let mut want = Vec::new();
     let mut tol = Vec::new();
@@ -265,7 +285,31 @@ fn wgsl_const(module: &naga::Module, name: &str) -> Option<u32> {
 }
 
 #[test]
-fn sat_block_and_params_match_the_wgsl() {
+fn sat_tile_and_params_match_the_wgsl() {
+    // A row workgroup of `sat_carries` covers one tile row: one invocation per row.
+    assert_eq!(SAT_LINES_PER_GROUP, SAT_TILE);
+    for kernel in [
+        "sat_tile_sums",
+        "sat_tile_sums_f32",
+        "sat_carries",
+        "sat_tiles",
+        "sat_tiles_f32",
+    ] {
+        let wgsl = kernels::resolve(kernel, None).unwrap();
+        let (module, r) = kernels::reflect(kernel, &wgsl).unwrap();
+        assert_eq!(
+            wgsl_const(&module, "TILE"),
+            Some(SAT_TILE),
+            "{kernel}: TILE"
+        );
+        let wg = r.workgroup_size.unwrap_or_default();
+        assert_eq!(wg, [SAT_LINES_PER_GROUP, 1, 1], "{kernel}: workgroup");
+        assert_eq!(
+            kernels::struct_size(&module, "SatParams"),
+            Some(size_of::<SatParams>() as u32),
+            "{kernel}: SatParams vs struct SatParams"
+        );
+    }
     for kernel in [
         "sat_rows",
         "sat_carry",
@@ -354,9 +398,10 @@ fn fixed_sat_wraps_yet_keeps_small_windows_exact() {
         .chain([[w - 33, h - 33, w, h]])
         .collect();
     let raw = reference::sat(&map.texels());
+    let words = table.fixed();
     for [x0, y0, x1, y1] in small {
         let area = ((x1 - x0) * (y1 - y0)) as f64;
-        let codes = reference::window_fixed(table.fixed(), w, x0, y0, x1, y1);
+        let codes = reference::window_fixed(&words, w, x0, y0, x1, y1);
         let sums = reference::window(&raw, x0, y0, x1, y1);
         for c in 0..2 {
             let d = reference::decode_window(f64::from(codes[c]), area, &coding, c);
@@ -414,9 +459,10 @@ fn constant_depth_0_999_map() {
     check_fixed("fixed constant", &mut rng, &map, &fixed, &table, None);
     // Every window holds exactly area × the code of 0.999.
     let code = reference::encode_fixed(0.999, &fixed, 0) as i32;
+    let words = table.fixed();
     for [x0, y0, x1, y1] in windows(&mut rng, w, h, 100) {
         let area = ((x1 - x0) * (y1 - y0)) as i64;
-        let got = reference::window_fixed(table.fixed(), w, x0, y0, x1, y1)[0];
+        let got = reference::window_fixed(&words, w, x0, y0, x1, y1)[0];
         assert_eq!(
             i64::from(got),
             area * i64::from(code),
@@ -713,4 +759,76 @@ fn largest_texture_dimension_each_way() {
         let table = build(&g, &mut exec, &map, &coding);
         check_float(&format!("float {w}x{h}"), &mut rng, &map, &coding, &table);
     }
+}
+
+/// The structural cost of a table: three dispatches; over them the map is read twice and the
+/// table written once, everything else (tile edges and carries, each written once and read
+/// once) 8/SAT_TILE of a table texel per texel; the table and its intermediates have the map's
+/// channels. Exact, from the plan's resources as the passes bind them.
+#[test]
+fn sat_reads_the_map_twice_and_writes_the_table_once() {
+    for (format, table_bytes) in [
+        (wgpu::TextureFormat::R32Float, 4u64),
+        (wgpu::TextureFormat::Rg32Float, 8),
+        (wgpu::TextureFormat::Rgba32Float, 16),
+    ] {
+        let n = 4096u32;
+        let mut graph = Graph::default();
+        graph.import("in", format, n, n, Some(0));
+        let coding = SatCoding::fixed(lookup_area(64.0, 64.0), [0.0; 4], [1.0; 4]).unwrap();
+        let out = add_sat(&mut graph, 0, "in", &coding);
+        let p = plan(&graph, &[&out]).unwrap();
+        assert_eq!(p.steps.len(), 3, "{format:?}: dispatches");
+        let bytes = |r: &str| p.resource(r).map_or(0, |r| r.bytes);
+        let texels = u64::from(n) * u64::from(n);
+        let (mut input, mut table, mut other) = (0, 0, 0);
+        for step in &p.steps {
+            for (_, r) in step.node.inputs.iter().chain(&step.node.outputs) {
+                match r.as_str() {
+                    "in" => input += bytes(r),
+                    r if r == out => table += bytes(r),
+                    r => other += bytes(r),
+                }
+            }
+        }
+        let input_texel = texel_bytes(format);
+        assert_eq!(
+            input,
+            2 * input_texel * texels,
+            "{format:?}: map read twice"
+        );
+        assert_eq!(
+            table,
+            table_bytes * texels,
+            "{format:?}: table written once"
+        );
+        assert_eq!(
+            other,
+            8 * table_bytes * texels / u64::from(SAT_TILE),
+            "{format:?}: edges and carries"
+        );
+        assert_eq!(
+            p.resource(&out).unwrap().resource.format,
+            SatVariant::Fixed.format(format_channels(format))
+        );
+    }
+}
+
+/// The five-pass baseline `shadowgraph bench` times against still builds the same table.
+#[test]
+fn five_pass_baseline_is_bit_identical_too() {
+    let g = common::gpu();
+    let mut exec = Executor::new();
+    let mut rng = common::rng(77);
+    let map = Map::random(&mut rng, 1500, 70, 2, 0.05, 1.0);
+    let coding = SatCoding::fixed(lookup_area(16.0, 16.0), [0.0; 4], [1.0; 4]).unwrap();
+    let table = build_with(&g, &mut exec, &map, &coding, add_sat_five_pass);
+    check_fixed(
+        "five-pass 1500x70",
+        &mut rng,
+        &map,
+        &coding,
+        &table,
+        Some(17),
+    );
 }

@@ -581,7 +581,13 @@ fn blocker_kernels_are_planned_only_for_soft_lights() {
         soft_scene("msm_soft.toml"),
     ]);
     let sp = shadowgraph::render::plan_lights(&lights).expect("plan");
-    let sat = ["sat_rows", "sat_carry", "sat_cols_reduce", "sat_carry"];
+    // A table's three passes, in the variant's kernels.
+    let sat = |sums| match sums {
+        shadowgraph::sat::SatVariant::Fixed => ["sat_tile_sums", "sat_carries", "sat_tiles"],
+        shadowgraph::sat::SatVariant::Float => {
+            ["sat_tile_sums_f32", "sat_carries", "sat_tiles_f32"]
+        }
+    };
     for (i, l) in lights.iter().enumerate() {
         let mut kernels: Vec<&str> = sp
             .plan
@@ -594,18 +600,13 @@ fn blocker_kernels_are_planned_only_for_soft_lights() {
         let blocker = kernels.iter().filter(|k| **k == "csm_z").count();
         let expected: Option<Vec<&str>> = match l.shadow.technique {
             Technique::Cssm { soft, terms, .. } => {
-                let last = match soft.sums {
-                    shadowgraph::sat::SatVariant::Fixed => "sat_cols",
-                    shadowgraph::sat::SatVariant::Float => "sat_cols_f32",
-                };
                 let basis = shadowgraph::technique::csm_maps(terms) as usize;
                 let z = shadowgraph::technique::csm_z_maps(terms) as usize;
                 assert_eq!(blocker, z, "{what}: CSM-Z maps");
                 let mut v = vec!["linearize"];
                 for k in 0..basis + z {
                     v.push(if k < basis { "csm" } else { "csm_z" });
-                    v.extend(sat);
-                    v.push(last);
+                    v.extend(sat(soft.sums));
                 }
                 Some(v)
             }
@@ -615,13 +616,9 @@ fn blocker_kernels_are_planned_only_for_soft_lights() {
                 } else {
                     "msm"
                 };
-                let last = match l.shadow.technique.soft().map(|s| s.sums) {
-                    Some(shadowgraph::sat::SatVariant::Float) => "sat_cols_f32",
-                    _ => "sat_cols",
-                };
+                let sums = l.shadow.technique.soft().map(|s| s.sums);
                 let mut v = vec!["linearize", encode];
-                v.extend(sat);
-                v.push(last);
+                v.extend(sat(sums.unwrap_or(shadowgraph::sat::SatVariant::Fixed)));
                 Some(v)
             }
             _ => None,

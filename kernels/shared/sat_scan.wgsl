@@ -1,8 +1,5 @@
-// Workgroup scans and the parameters of the summed-area-table kernels (import-only module).
-//
-// Values travel as vec4<u32> in both variants: u32 fixed point, added with two's-complement
-// wraparound (WGSL's u32 `+` wraps), or the bits of an f32, added as floats. 0u is the identity
-// of both (the bits of +0.0).
+// Workgroup scans of the five-pass summed-area-table kernels (import-only module; the
+// `sat_rows` … `sat_cols` baseline that `shadowgraph bench` times against the tiled kernels).
 //
 // A workgroup scans a block of BLOCK = WG_SIZE · ITEMS texels of a line: each invocation scans
 // its ITEMS consecutive texels in registers, the invocations' totals are scanned with
@@ -12,16 +9,7 @@
 // in all. No atomics and nothing waits on another workgroup: blocks meet only across
 // dispatches (no forward-progress assumption).
 
-// Keep in sync with `SatParams` in src/sat.rs.
-struct SatParams {
-    offset: vec4<f32>,   // subtracted from every value before scaling (centres the range)
-    scale: vec4<f32>,    // fixed: units per value unit (a power of two); float: 1
-    limit: vec4<f32>,    // |(v − offset)·scale| is clamped to this (keeps window sums in range)
-    channels: u32,       // channels of the representation that are used; the others are 0
-    float_sums: u32,     // 1: f32 variant (values are f32 bits), 0: u32 fixed point
-    axis: u32,           // sat_carry: 0 scans rows of block totals, 1 columns
-    _pad: u32,
-}
+// #import shared/sat_params
 
 // Keep in sync with `SAT_BLOCK` in src/sat.rs (BLOCK) and the kernels' dispatches.
 const WG_SIZE: u32 = 256u;
@@ -38,17 +26,6 @@ fn sat_add(a: vec4<u32>, b: vec4<u32>, float_sums: bool) -> vec4<u32> {
         return bitcast<vec4<u32>>(bitcast<vec4<f32>>(a) + bitcast<vec4<f32>>(b));
     }
     return a + b;
-}
-
-// A representation texel in the variant's domain: (v − offset)·scale, clamped to ±limit,
-// rounded to the nearest integer (ties to even) and wrapped into u32 for fixed point, or kept
-// as f32 bits; channels past `channels` are 0 (a texture without alpha reads alpha as 1).
-fn sat_encode(v: vec4<f32>, p: SatParams) -> vec4<u32> {
-    let x = clamp((v - p.offset) * p.scale, -p.limit, p.limit);
-    let used = vec4<u32>(0u, 1u, 2u, 3u) < vec4<u32>(p.channels);
-    let fixed = bitcast<vec4<u32>>(vec4<i32>(round(x)));
-    let e = select(fixed, bitcast<vec4<u32>>(x), p.float_sums != 0u);
-    return select(vec4<u32>(0u), e, used);
 }
 
 // Up-sweep over the invocations' values `x`: leaves the tree's partial sums in sh_scan, the

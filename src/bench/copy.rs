@@ -27,6 +27,8 @@ pub const COPY_FORMATS: &[wgpu::TextureFormat] = &[
     wgpu::TextureFormat::Rg32Float,
     wgpu::TextureFormat::Rgba16Float,
     wgpu::TextureFormat::Rgba32Float,
+    wgpu::TextureFormat::R32Uint,
+    wgpu::TextureFormat::Rg32Uint,
     wgpu::TextureFormat::Rgba32Uint,
 ];
 
@@ -42,7 +44,9 @@ pub fn format_name(format: wgpu::TextureFormat) -> String {
 /// format (a depth texture into `r32float`): the texture roofline of that format.
 pub(super) fn copy_texture_graph(n: u32, format: wgpu::TextureFormat) -> BenchGraph {
     let (kernel, out) = match format {
-        wgpu::TextureFormat::Rgba32Uint => ("copy_texture_u32", format),
+        wgpu::TextureFormat::R32Uint
+        | wgpu::TextureFormat::Rg32Uint
+        | wgpu::TextureFormat::Rgba32Uint => ("copy_texture_u32", format),
         wgpu::TextureFormat::Depth32Float => ("copy_texture", wgpu::TextureFormat::R32Float),
         f => ("copy_texture", f),
     };

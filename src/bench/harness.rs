@@ -121,8 +121,11 @@ pub(super) fn random_imports(
                     .collect();
                 Some(bytemuck::cast_slice(&halves).to_vec())
             }
-            wgpu::TextureFormat::Rgba32Uint => {
-                let words: Vec<u32> = random_bits(texels * 4, seed)
+            wgpu::TextureFormat::R32Uint
+            | wgpu::TextureFormat::Rg32Uint
+            | wgpu::TextureFormat::Rgba32Uint => {
+                let channels = graph::texel_bytes(format) as usize / 4;
+                let words: Vec<u32> = random_bits(texels * channels, seed)
                     .into_iter()
                     .map(|b| b as u32)
                     .collect();

@@ -28,7 +28,7 @@ pub struct LookupRow {
     pub sat_fixed_ms: f64,
     /// Shading pass, VSM through the f32 table, ms.
     pub sat_float_ms: f64,
-    /// Building the fixed-point table (its five passes), ms.
+    /// Building the fixed-point table (its passes), ms.
     pub sat_build_ms: f64,
 }
 

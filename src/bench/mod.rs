@@ -97,6 +97,10 @@ pub const CASES: &[BenchCase] = &[
         build: |n| stage_graph(n, vsm(), "light0.vsm", "light0.vsm.blur_v"),
     },
     BenchCase {
+        name: "blur rg32f r32",
+        build: |n| stage_graph(n, vsm_blur(32.0), "light0.vsm", "light0.vsm.blur_v"),
+    },
+    BenchCase {
         name: "blur log r4",
         build: |n| stage_graph(n, esm(), "light0.esm", "light0.esm.blur_v"),
     },
@@ -124,6 +128,11 @@ pub const CASES: &[BenchCase] = &[
         name: "sat float",
         build: |n| sat_graph(n, SatVariant::Float),
     },
+    // The first design, timed beside the tiled passes until their comparison is recorded.
+    BenchCase {
+        name: "sat fixed (5-pass, old)",
+        build: |n| sat_graph_with(n, SatVariant::Fixed, sat::five_pass::add_sat_five_pass),
+    },
 ];
 
 fn texels(n: u32) -> u64 {
@@ -139,10 +148,19 @@ fn blur4() -> Filter {
 }
 
 fn vsm() -> Technique {
+    vsm_blur(4.0)
+}
+
+/// VSM with a Gaussian blur of `radius` taps each side (σ = radius / 2).
+fn vsm_blur(radius: f32) -> Technique {
     Technique::Vsm {
         prefilter: Prefilter {
             storage: Storage::F32,
-            filter: blur4(),
+            filter: Filter::Blur {
+                radius,
+                sigma: radius / 2.0,
+                kernel: BlurKernel::Gaussian,
+            },
         },
         bleed: 0.2,
         min_variance: 1e-5,
@@ -230,6 +248,15 @@ fn stage_graph(n: u32, technique: Technique, input: &str, output: &str) -> Bench
 /// The SAT passes of [`sat::add_sat`] over an imported `n`² VSM-shaped (Rg32Float) map; fixed
 /// point for lookups of up to 64 × 64 texels of values in [0, 1].
 fn sat_graph(n: u32, variant: SatVariant) -> BenchGraph {
+    sat_graph_with(n, variant, sat::add_sat)
+}
+
+/// [`sat_graph`] with another builder of the table's passes (the five-pass baseline).
+fn sat_graph_with(
+    n: u32,
+    variant: SatVariant,
+    add: fn(&mut Graph, usize, &str, &SatCoding) -> String,
+) -> BenchGraph {
     let mut graph = Graph::default();
     let input = graph.import("light0.vsm", wgpu::TextureFormat::Rg32Float, n, n, Some(0));
     let (lo, hi) = ([0.0; 4], [1.0; 4]);
@@ -245,7 +272,7 @@ fn sat_graph(n: u32, variant: SatVariant) -> BenchGraph {
         scale: [1.0; 4],
         limit: [1.0; 4],
     });
-    let output = sat::add_sat(&mut graph, 0, &input, &coding);
+    let output = add(&mut graph, 0, &input, &coding);
     BenchGraph {
         graph,
         outputs: vec![output],
@@ -498,8 +525,9 @@ mod tests {
         assert!(text.contains("only the ratios") && text.contains("copy texture rg32float"));
     }
 
-    /// The bytes of a SAT are its five passes' (the issue's ≈ 72 B/texel for VSM moments was a
-    /// count without the row carries), a blur's both passes with their halos.
+    /// The bytes of a SAT are its three passes' (two reads of the representation, one write
+    /// of the table, the tiles' edges and carries), the five-pass baseline's as before, a
+    /// blur's both passes with their halos.
     #[test]
     fn case_bytes_follow_the_cost_model() {
         let n = 512;
@@ -510,15 +538,23 @@ mod tests {
             plan_bytes(&crate::graph::plan(&built.graph, &outputs).unwrap()).unwrap()
                 / f64::from(n * n)
         };
-        // rg32float moments in (8), row scans out (16) and a block total per row (1/32), their
-        // carries (2 × 2/32), the row scans again with a row carry per texel (32) and column
-        // totals (1/32), the scans a third time with carries (32 + 1/32) and the table (16).
+        // rg32float moments in twice (2 × 8) and an rg32uint table out (8); a 64² tile's last
+        // row and column (2 × 8/64), read and written again as carries, and read once more.
+        assert_eq!(bytes("sat fixed"), 8.0 + 8.0 + 8.0 + 4.0 * 2.0 * 8.0 / 64.0);
+        // The first design: rg32float moments in (8), row scans out (16) and a block total per
+        // row (1/32), their carries (2 × 2/32), the row scans again with a row carry per texel
+        // (32) and column totals (1/32), the scans a third time with carries (32 + 1/32) and
+        // the rgba32uint table (16).
         assert_eq!(
-            bytes("sat fixed"),
+            bytes("sat fixed (5-pass, old)"),
             8.0 + 16.0 + 32.0 + 32.0 + 16.0 + 7.0 / 32.0
         );
-        // Two passes of radius 4: (128 + 8)/128 × 8 B in, 8 B out.
-        assert_eq!(bytes("blur rg32f r4"), 2.0 * (136.0 / 128.0 * 8.0 + 8.0));
+        // Two passes of radius 4, 8 B out each: a row workgroup reads its 512 texels and 4 on
+        // either side (520/512 × 8 B), a column workgroup 64 columns of 8 + 8 texels (2 × 8 B).
+        assert_eq!(
+            bytes("blur rg32f r4"),
+            520.0 / 512.0 * 8.0 + 8.0 + 16.0 + 8.0
+        );
         // Depth (4 B) in, linear depth (4 B) out.
         assert_eq!(bytes("linearize"), 8.0);
     }

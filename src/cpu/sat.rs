@@ -83,6 +83,18 @@ pub fn sat_fixed(input: &Texels, coding: &SatCoding) -> Vec<[u32; 4]> {
     out
 }
 
+/// A table's raw words (`texels` texels, as many words each as the table's format has
+/// channels) widened to four words a texel, the channels it lacks 0: the shape of
+/// [`sat_fixed`] whatever the table's channel count.
+pub fn widen(words: &[u32], texels: usize) -> Vec<[u32; 4]> {
+    let stride = words.len() / texels.max(1);
+    words
+        .chunks(stride.max(1))
+        .take(texels)
+        .map(|t| std::array::from_fn(|c| t.get(c).copied().unwrap_or(0)))
+        .collect()
+}
+
 /// `F(X, Y)`, the sum over `[0, X) × [0, Y)`, from an inclusive table (0 on the top/left edge).
 fn node<T: Copy>(table: &[T], width: usize, x: usize, y: usize, zero: T) -> T {
     if x == 0 || y == 0 {

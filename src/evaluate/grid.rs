@@ -95,7 +95,7 @@ fn grey(v: f32) -> [f64; 3] {
 }
 
 /// Red where the rendering is brighter than the truth, blue where darker; grey outside the mask.
-fn error_colour(v: f32, t: f32, relevant: bool) -> [f64; 3] {
+pub(super) fn error_colour(v: f32, t: f32, relevant: bool) -> [f64; 3] {
     if !relevant {
         return [0.25, 0.25, 0.25];
     }

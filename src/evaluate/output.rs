@@ -1,10 +1,12 @@
-//! The report files: `report.md`, `report.csv`, `report.json`, and the figures (`pareto.svg`,
-//! `grid.png` with its legend `grid.txt`).
+//! The report files: `report.md`, `report.csv`, `report.json`, `report.html`, and the figures
+//! (`pareto.svg`, `pareto_penumbra.svg`, `pareto_flip.svg`, `grid.png` with its legend
+//! `grid.txt`).
 
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
-use super::{ErrorStats, Images, Report, Row, out_path};
+use super::svg::{Metric, front};
+use super::{EDGE_BAND, ErrorStats, Images, PENUMBRA_HIGH, PENUMBRA_LOW, Report, out_path};
 use crate::error::{Error, Result};
 
 /// Writes every output file into `dir`; returns their paths.
@@ -24,10 +26,19 @@ pub fn write_all(dir: &Path, report: &Report, images: &Images) -> Result<Vec<Pat
     let json = serde_json::to_string_pretty(report)
         .map_err(|e| Error::Invalid(format!("report.json: {e}")))?;
     put("report.json", json.as_bytes())?;
-    put("pareto.svg", super::svg::pareto(report).as_bytes())?;
+    let mut plots = Vec::new();
+    for m in Metric::ALL {
+        let svg = super::svg::pareto(report, m)?;
+        put(m.file(), svg.as_bytes())?;
+        plots.push((m, svg));
+    }
     let (png, legend) = super::grid::grid(report, images)?;
     put("grid.png", &png)?;
     put("grid.txt", legend.as_bytes())?;
+    put(
+        "report.html",
+        super::html::html(report, images, &plots)?.as_bytes(),
+    )?;
     Ok(written)
 }
 
@@ -63,8 +74,12 @@ fn stats_cells(s: Option<&ErrorStats>) -> String {
 /// One line per configuration; per-pass times as `name=ms` pairs separated by `;`.
 pub fn csv(report: &Report) -> String {
     let mut s = format!(
-        "label,technique,shadow_map,storage,filter,box_width,raster_ms,kernels_ms,shade_ms,total_ms,gbuffer_ms,memory_bytes,{},{},passes\n",
+        "label,technique,shadow_map,storage,filter,box_width,raster_ms,kernels_ms,shade_ms,total_ms,gbuffer_ms,memory_bytes,{},{},{},{},{},{},passes\n",
         stats_header("soft"),
+        stats_header("penumbra"),
+        stats_header("umbra"),
+        stats_header("lit"),
+        stats_header("flip"),
         stats_header("pcf")
     );
     for r in &report.rows {
@@ -75,7 +90,7 @@ pub fn csv(report: &Report) -> String {
             .collect();
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             r.label,
             r.technique,
             r.shadow_map,
@@ -89,6 +104,10 @@ pub fn csv(report: &Report) -> String {
             ms(r.gbuffer_ms),
             r.memory_bytes,
             stats_cells(Some(&r.soft)),
+            stats_cells(Some(&r.penumbra)),
+            stats_cells(Some(&r.umbra)),
+            stats_cells(Some(&r.lit)),
+            stats_cells(Some(&r.flip)),
             stats_cells(r.pcf.as_ref()),
             passes.join(";")
         );
@@ -98,6 +117,62 @@ pub fn csv(report: &Report) -> String {
 
 fn mib(b: u64) -> String {
     format!("{:.1}", b as f64 / (1024.0 * 1024.0))
+}
+
+/// How the regions and FLIP are defined, for the reports.
+pub fn region_text(report: &Report) -> String {
+    let [pen, umb, lit] = report.region_pixels;
+    format!(
+        "Regions of the truth (per light; {pen} penumbra, {umb} umbra, {lit} lit pixels): the \
+         *penumbra* is every relevant pixel whose truth is strictly between {PENUMBRA_LOW} and \
+         {PENUMBRA_HIGH}, or within {EDGE_BAND} pixels (a {w}×{w} square) of an edge pixel (a \
+         pixel whose truth and a relevant 4-neighbour's lie on opposite sides of 0.5), so a hard \
+         shadow's edge band counts too; the *umbra* is the rest with truth ≤ {PENUMBRA_LOW} \
+         (error there: light leaking, lost contact shadows); *lit* the rest with truth ≥ \
+         {PENUMBRA_HIGH} (error there: false shadow — acne, over-darkening, ringing). *FLIP*: \
+         NVIDIA's perceptual error (HPG 2020, 67 pixels per degree) of the shaded image against \
+         the truth-shaded image (the renderer's shading with the truth's visibility per light), \
+         mean over the whole image.",
+        w = 2 * EDGE_BAND + 1
+    )
+}
+
+/// A mean, or a dash where its region is empty.
+fn mean_cell(s: &ErrorStats) -> String {
+    if s.pixels == 0 {
+        "—".into()
+    } else {
+        format!("{:.4}", s.mean_abs)
+    }
+}
+
+/// The Pareto fronts, one list per metric.
+fn fronts_text(report: &Report) -> String {
+    let mut s = String::new();
+    for m in Metric::ALL {
+        let f = front(&report.rows, m);
+        if f.is_empty() {
+            continue;
+        }
+        let _ = writeln!(
+            s,
+            "\nPareto front of total time vs {} (no configuration is both faster and more \
+             accurate):\n",
+            m.name()
+        );
+        for i in f {
+            let r = &report.rows[i];
+            let _ = writeln!(
+                s,
+                "- {}: {} ms, {} {:.4}",
+                r.label,
+                ms(r.total_ms),
+                m.name(),
+                m.value(r)
+            );
+        }
+    }
+    s
 }
 
 /// The report: what was measured and how, then one table row per configuration.
@@ -132,12 +207,15 @@ pub fn markdown(report: &Report) -> String {
          configuration's own map with the same box width (what a prefiltered technique \
          approximates), where the configuration filters with a box. Errors are |visibility − \
          truth| over the relevant pixels: mean, RMSE, 99th percentile, max, and the shares of \
-         pixels off by more than 0.05 and 0.2.\n\n",
+         pixels off by more than 0.05 and 0.2; *penumbra*, *umbra*, *lit*: the soft mean over \
+         each region of the truth.\n\n",
     );
+    s.push_str(&region_text(report));
+    s.push_str("\n\n");
     s.push_str(
-        "| configuration | raster ms | kernels ms | shade ms | total ms | MiB | soft mean | soft rmse | soft p99 | soft max | soft >0.05 | soft >0.2 | pcf mean | pcf p99 | pcf >0.05 |\n",
+        "| configuration | raster ms | kernels ms | shade ms | total ms | MiB | soft mean | soft rmse | soft p99 | soft max | soft >0.05 | soft >0.2 | penumbra mean | umbra mean | lit mean | FLIP mean | pcf mean | pcf p99 | pcf >0.05 |\n",
     );
-    s.push_str("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+    s.push_str("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
     for r in &report.rows {
         let (pm, pp, po) =
             r.pcf
@@ -151,7 +229,7 @@ pub fn markdown(report: &Report) -> String {
                 });
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.3} | {:.3} | {:.2}% | {:.2}% | {pm} | {pp} | {po} |",
+            "| {} | {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.3} | {:.3} | {:.2}% | {:.2}% | {} | {} | {} | {:.4} | {pm} | {pp} | {po} |",
             r.label,
             ms(r.raster_ms),
             ms(r.kernels_ms),
@@ -164,30 +242,24 @@ pub fn markdown(report: &Report) -> String {
             r.soft.max,
             100.0 * r.soft.over_005,
             100.0 * r.soft.over_02,
+            mean_cell(&r.penumbra),
+            mean_cell(&r.umbra),
+            mean_cell(&r.lit),
+            r.flip.mean_abs,
         );
     }
-    let front = super::svg::front(&report.rows);
-    if !front.is_empty() {
-        s.push_str("\nPareto front (total time vs soft mean error; no configuration is both faster and more accurate):\n\n");
-        for i in front {
-            let r: &Row = &report.rows[i];
-            let _ = writeln!(
-                s,
-                "- {}: {} ms, soft mean {:.4}",
-                r.label,
-                ms(r.total_ms),
-                r.soft.mean_abs
-            );
-        }
-    }
+    s.push_str(&fronts_text(report));
     for (label, why) in &report.skipped {
         let _ = writeln!(s, "\nSkipped {label}: {why}");
     }
     s.push_str(
-        "\nFigures: `pareto.svg` (total time, log scale, vs soft mean error; the front drawn), \
-         `grid.png` (light 0: the truth, then per configuration its visibility and its error \
-         map — red where brighter than the truth, blue where darker, full colour at |error| ≥ \
-         0.5, grey outside the relevant pixels), cells listed in `grid.txt`.\n",
+        "\nFigures: `report.html` (the plots, a sortable table, and crops of the truth and of \
+         the front's configurations where their penumbrae differ most, with error maps), \
+         `pareto.svg`, `pareto_penumbra.svg` and `pareto_flip.svg` (total time, log scale, vs \
+         the soft mean, the penumbra mean and FLIP; the fronts drawn and labelled), `grid.png` \
+         (light 0: the truth, then per configuration its visibility and its error map — red \
+         where brighter than the truth, blue where darker, full colour at |error| ≥ 0.5, grey \
+         outside the relevant pixels), cells listed in `grid.txt`.\n",
     );
     s
 }

@@ -1,41 +1,102 @@
-//! `pareto.svg`, written by hand: total GPU time (log scale) against the mean error over the
-//! area-light truth, one labelled point per configuration, the Pareto front as a staircase.
+//! The Pareto plots (`pareto.svg`, `pareto_penumbra.svg`, `pareto_flip.svg`), drawn with
+//! `plotters`: total GPU time (log scale) against one error [`Metric`] (log scale when it spans
+//! a decade or more), one point per configuration coloured by technique with a legend, the
+//! Pareto front as a staircase, and only the front's points labelled, each label placed where
+//! it overlaps no other label (see [`place_labels`]).
 
-use std::fmt::Write;
+use plotters::coord::Shift;
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
+use plotters::prelude::*;
 
 use super::{Report, Row};
+use crate::error::{Error, Result};
 
-const W: f64 = 960.0;
-const H: f64 = 640.0;
-const LEFT: f64 = 70.0;
-const RIGHT: f64 = 30.0;
-const TOP: f64 = 40.0;
-const BOTTOM: f64 = 60.0;
+const W: u32 = 960;
+const H: u32 = 600;
+/// Width of the legend column at the right.
+const LEGEND: u32 = 130;
+/// Font size of the front's labels (plotters' size; the SVG's is this / 1.24).
+const LABEL_SIZE: f64 = 13.0;
 
-/// Colour per technique (by name), so families read at a glance.
-fn colour(technique: &str) -> &'static str {
-    match technique {
-        "hard" => "#444444",
-        "pcf" => "#1f77b4",
-        "pcss" => "#17becf",
-        "vsm" => "#2ca02c",
-        "evsm2" => "#bcbd22",
-        "evsm4" => "#8c564b",
-        "esm" => "#9467bd",
-        "msm" => "#d62728",
-        "csm" => "#ff7f0e",
-        _ => "#7f7f7f",
+/// What an accuracy axis measures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Metric {
+    /// Mean |error| against the area-light truth over the relevant pixels.
+    Mean,
+    /// Mean |error| over the truth's penumbra.
+    Penumbra,
+    /// Mean FLIP of the shaded image against the truth-shaded image.
+    Flip,
+}
+
+impl Metric {
+    /// Every metric, in report order.
+    pub const ALL: [Metric; 3] = [Metric::Mean, Metric::Penumbra, Metric::Flip];
+
+    /// The row's value of this metric.
+    pub fn value(self, r: &Row) -> f64 {
+        match self {
+            Metric::Mean => r.soft.mean_abs,
+            Metric::Penumbra => r.penumbra.mean_abs,
+            Metric::Flip => r.flip.mean_abs,
+        }
+    }
+
+    /// Short name, e.g. for a table heading.
+    pub fn name(self) -> &'static str {
+        match self {
+            Metric::Mean => "soft mean",
+            Metric::Penumbra => "penumbra mean",
+            Metric::Flip => "FLIP mean",
+        }
+    }
+
+    /// What the axis shows.
+    pub fn axis(self) -> &'static str {
+        match self {
+            Metric::Mean => "mean |visibility − truth| (relevant pixels)",
+            Metric::Penumbra => "mean |visibility − truth| over the penumbra",
+            Metric::Flip => "mean FLIP, shaded vs truth-shaded image",
+        }
+    }
+
+    /// The figure's file name.
+    pub fn file(self) -> &'static str {
+        match self {
+            Metric::Mean => "pareto.svg",
+            Metric::Penumbra => "pareto_penumbra.svg",
+            Metric::Flip => "pareto_flip.svg",
+        }
     }
 }
 
-/// Indices of the rows on the Pareto front of (total time, soft mean error), fastest first:
-/// a row is on it when no row is at most as slow and at most as wrong, and better in one.
-pub fn front(rows: &[Row]) -> Vec<usize> {
+/// Colour per technique (by name), so families read at a glance.
+pub fn colour(technique: &str) -> RGBColor {
+    match technique {
+        "hard" => RGBColor(0x44, 0x44, 0x44),
+        "pcf" => RGBColor(0x1f, 0x77, 0xb4),
+        "pcss" => RGBColor(0x17, 0xbe, 0xcf),
+        "vsm" => RGBColor(0x2c, 0xa0, 0x2c),
+        "evsm2" => RGBColor(0xbc, 0xbd, 0x22),
+        "evsm4" => RGBColor(0x8c, 0x56, 0x4b),
+        "esm" => RGBColor(0x94, 0x67, 0xbd),
+        "msm" => RGBColor(0xd6, 0x27, 0x28),
+        "csm" => RGBColor(0xff, 0x7f, 0x0e),
+        "cssm" => RGBColor(0xe3, 0x77, 0xc2),
+        "vssm" => RGBColor(0x00, 0x5f, 0x3f),
+        "msm_soft" => RGBColor(0x8b, 0x00, 0x00),
+        _ => RGBColor(0x7f, 0x7f, 0x7f),
+    }
+}
+
+/// Indices of the rows on the Pareto front of (total time, `metric`), fastest first: a row
+/// is on it when no row is at most as slow and at most as wrong, and better in one.
+pub fn front(rows: &[Row], metric: Metric) -> Vec<usize> {
     let mut timed: Vec<usize> = (0..rows.len())
         .filter(|&i| rows[i].total_ms.is_some())
         .collect();
+    let key = |i: usize| (rows[i].total_ms.unwrap_or(0.0), metric.value(&rows[i]));
     timed.sort_by(|&a, &b| {
-        let key = |i: usize| (rows[i].total_ms.unwrap_or(0.0), rows[i].soft.mean_abs);
         key(a)
             .partial_cmp(&key(b))
             .unwrap_or(std::cmp::Ordering::Equal)
@@ -43,171 +104,372 @@ pub fn front(rows: &[Row]) -> Vec<usize> {
     let mut out = Vec::new();
     let mut best = f64::INFINITY;
     for i in timed {
-        if rows[i].soft.mean_abs < best {
-            best = rows[i].soft.mean_abs;
+        if metric.value(&rows[i]) < best {
+            best = metric.value(&rows[i]);
             out.push(i);
         }
     }
     out
 }
 
-fn escape(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
+fn plot_error<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> Error {
+    Error::Invalid(format!("pareto plot: {e}"))
 }
 
-/// The figure.
-pub fn pareto(report: &Report) -> String {
-    let rows = &report.rows;
-    let pts: Vec<(usize, f64, f64)> = rows
+/// The figure of `metric` as SVG text.
+pub fn pareto(report: &Report, metric: Metric) -> Result<String> {
+    let pts: Vec<(usize, f64, f64)> = report
+        .rows
         .iter()
         .enumerate()
         .filter_map(|(i, r)| {
+            let e = metric.value(r);
             r.total_ms
-                .filter(|t| *t > 0.0)
-                .map(|t| (i, t, r.soft.mean_abs))
+                .filter(|t| *t > 0.0 && t.is_finite() && e.is_finite())
+                .map(|t| (i, t, e))
         })
         .collect();
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{W}" height="{H}" viewBox="0 0 {W} {H}" font-family="sans-serif">"#
-    );
-    let _ = writeln!(s, r#"<rect width="{W}" height="{H}" fill="white"/>"#);
-    let title = format!(
-        "{}: total GPU time vs mean |error| against the area-light truth{}",
-        report.scene,
-        if report.cpu_driver {
-            " (CPU-driver times)"
-        } else {
-            ""
-        }
-    );
-    let _ = writeln!(
-        s,
-        r#"<text x="{}" y="24" font-size="15" text-anchor="middle">{}</text>"#,
-        W / 2.0,
-        escape(&title)
-    );
-    if pts.is_empty() {
-        let _ = writeln!(
-            s,
-            r#"<text x="{}" y="{}" font-size="14" text-anchor="middle">no timestamps on this device: nothing to plot</text></svg>"#,
-            W / 2.0,
-            H / 2.0
-        );
-        return s;
-    }
-    let (mut t0, mut t1) = pts.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| {
-        (a.min(p.1), b.max(p.1))
-    });
-    t0 = 10f64.powf(t0.log10().floor());
-    t1 = 10f64.powf(t1.log10().ceil());
-    if t1 <= t0 {
-        t1 = t0 * 10.0;
-    }
-    let e1 = pts.iter().map(|p| p.2).fold(0.0, f64::max).max(1e-6) * 1.08;
-    let x =
-        |t: f64| LEFT + (t.log10() - t0.log10()) / (t1.log10() - t0.log10()) * (W - LEFT - RIGHT);
-    let y = |e: f64| H - BOTTOM - e / e1 * (H - TOP - BOTTOM);
-    axes(&mut s, t0, t1, e1, &x, &y);
-    let f = front(rows);
-    let mut path = String::new();
-    for (k, &i) in f.iter().enumerate() {
-        let (px, py) = (x(rows[i].total_ms.unwrap_or(t0)), y(rows[i].soft.mean_abs));
-        if k == 0 {
-            let _ = write!(path, "M{px:.1},{py:.1}");
-        } else {
-            let _ = write!(path, " H{px:.1} V{py:.1}");
-        }
-    }
-    let _ = writeln!(
-        s,
-        "<path d=\"{path}\" fill=\"none\" stroke=\"#d62728\" stroke-width=\"1.5\" stroke-dasharray=\"5,3\"/>"
-    );
-    for &(i, t, e) in &pts {
-        let r = &rows[i];
-        let on = f.contains(&i);
-        let _ = writeln!(
-            s,
-            "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"{}\" fill=\"{}\" stroke=\"black\" stroke-width=\"{}\"><title>{}</title></circle>",
-            x(t),
-            y(e),
-            if on { 5.0 } else { 3.5 },
-            colour(&r.technique),
-            if on { 1.2 } else { 0.3 },
-            escape(&r.label)
-        );
-        let _ = writeln!(
-            s,
-            r#"<text x="{:.1}" y="{:.1}" font-size="8" fill="{}">{}</text>"#,
-            x(t) + 5.0,
-            y(e) - 3.0,
-            colour(&r.technique),
-            escape(&r.label)
-        );
-    }
-    s.push_str("</svg>\n");
-    s
-}
-
-fn axes(s: &mut String, t0: f64, t1: f64, e1: f64, x: &dyn Fn(f64) -> f64, y: &dyn Fn(f64) -> f64) {
-    let (xl, xr, yb, yt) = (LEFT, W - RIGHT, H - BOTTOM, TOP);
-    let _ = writeln!(
-        s,
-        r#"<path d="M{xl},{yt} V{yb} H{xr}" fill="none" stroke="black"/>"#
-    );
-    let mut decade = t0;
-    while decade <= t1 * 1.0001 {
-        for m in [1.0, 2.0, 5.0] {
-            let t = decade * m;
-            if t > t1 * 1.0001 {
-                break;
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (W, H)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_error)?;
+        let title = format!(
+            "{}: total GPU time vs {}{}",
+            report.scene,
+            metric.name(),
+            if report.cpu_driver {
+                " (CPU-driver times)"
+            } else {
+                ""
             }
-            let px = x(t);
-            let _ = writeln!(
-                s,
-                "<line x1=\"{px:.1}\" y1=\"{yt}\" x2=\"{px:.1}\" y2=\"{yb}\" stroke=\"#dddddd\"/>"
-            );
-            let _ = writeln!(
-                s,
-                r#"<text x="{px:.1}" y="{}" font-size="11" text-anchor="middle">{}</text>"#,
-                yb + 16.0,
-                trim(t)
-            );
+        );
+        let root = root
+            .titled(&title, ("sans-serif", 20))
+            .map_err(plot_error)?;
+        if pts.is_empty() {
+            let style = ("sans-serif", 18).into_font().color(&BLACK);
+            root.draw(&Text::new(
+                "no timestamps on this device: nothing to plot",
+                (60, (H / 2) as i32),
+                style,
+            ))
+            .map_err(plot_error)?;
+        } else {
+            let (t0, t1) = span(pts.iter().map(|p| p.1));
+            let (e0, e1) = span(pts.iter().map(|p| p.2));
+            let (t0, t1) = (t0 / 1.3, t1 * 1.3);
+            let (bold, light) = log_ticks(t0, t1);
+            let x = (t0..t1)
+                .log_scale()
+                .with_key_points(bold)
+                .with_light_points(light);
+            if e0 > 0.0 && e1 / e0 >= 10.0 {
+                let (e0, e1) = (e0 / 1.5, e1 * 1.5);
+                let (bold, light) = log_ticks(e0, e1);
+                let y = (e0..e1)
+                    .log_scale()
+                    .with_key_points(bold)
+                    .with_light_points(light);
+                draw(&root, report, metric, &pts, x, y)?;
+            } else {
+                // plotters' own linear ticks are 1-2-5 steps already.
+                draw(&root, report, metric, &pts, x, 0.0..(e1 * 1.1).max(1e-4))?;
+            }
         }
-        decade *= 10.0;
+        root.present().map_err(plot_error)?;
     }
-    for k in 0..=5 {
-        let e = e1 * f64::from(k) / 5.0;
-        let py = y(e);
-        let _ = writeln!(
-            s,
-            "<line x1=\"{xl}\" y1=\"{py:.1}\" x2=\"{xr}\" y2=\"{py:.1}\" stroke=\"#dddddd\"/>"
-        );
-        let _ = writeln!(
-            s,
-            r#"<text x="{}" y="{:.1}" font-size="11" text-anchor="end">{e:.3}</text>"#,
-            xl - 6.0,
-            py + 4.0
-        );
-    }
-    let _ = writeln!(
-        s,
-        r#"<text x="{}" y="{}" font-size="13" text-anchor="middle">total GPU time, ms (log scale): shadow raster + kernels + shading</text>"#,
-        (xl + xr) / 2.0,
-        H - 18.0
-    );
-    let _ = writeln!(
-        s,
-        r#"<text x="18" y="{}" font-size="13" text-anchor="middle" transform="rotate(-90 18 {})">mean |visibility − truth|</text>"#,
-        (yt + yb) / 2.0,
-        (yt + yb) / 2.0
-    );
+    Ok(svg)
 }
 
-fn trim(t: f64) -> String {
-    let s = format!("{t:.3}");
-    s.trim_end_matches('0').trim_end_matches('.').to_string()
+/// Ticks of a log axis over [lo, hi]: labelled at 1, 2 and 5 times each power of ten (every
+/// integer multiple when that gives fewer than three), grid lines at every integer multiple.
+fn log_ticks(lo: f64, hi: f64) -> (Vec<f64>, Vec<f64>) {
+    let multiples = |ms: &[f64]| -> Vec<f64> {
+        let (a, b) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+        (a..=b)
+            .flat_map(|k| ms.iter().map(move |m| m * 10f64.powi(k)))
+            .filter(|v| (lo..=hi).contains(v))
+            .collect()
+    };
+    let all = multiples(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]);
+    let bold = multiples(&[1.0, 2.0, 5.0]);
+    (if bold.len() >= 3 { bold } else { all.clone() }, all)
+}
+
+fn span(v: impl Iterator<Item = f64>) -> (f64, f64) {
+    v.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+        (a.min(x), b.max(x))
+    })
+}
+
+/// Draws the chart on `root` with the x and y coordinates given (log or linear).
+fn draw<X, Y>(
+    root: &DrawingArea<SVGBackend, Shift>,
+    report: &Report,
+    metric: Metric,
+    pts: &[(usize, f64, f64)],
+    x: X,
+    y: Y,
+) -> Result<()>
+where
+    X: AsRangedCoord<Value = f64>,
+    Y: AsRangedCoord<Value = f64>,
+    X::CoordDescType: ValueFormatter<f64>,
+    Y::CoordDescType: ValueFormatter<f64>,
+{
+    let (area, legend) = root.split_horizontally(W - LEGEND);
+    let mut chart = ChartBuilder::on(&area)
+        .margin(10)
+        .x_label_area_size(46)
+        .y_label_area_size(70)
+        .build_cartesian_2d(x, y)
+        .map_err(plot_error)?;
+    axes(&mut chart, metric)?;
+    let rows = &report.rows;
+    let f = front(rows, metric);
+    // The front as a staircase (each step holds the best error until the next improvement),
+    // every configuration's point, a ring around each front point.
+    let stair: Vec<(f64, f64)> = f
+        .iter()
+        .enumerate()
+        .flat_map(|(k, &i)| {
+            let t = rows[i].total_ms.unwrap_or(0.0);
+            let before = (k > 0).then(|| (t, metric.value(&rows[f[k - 1]])));
+            before.into_iter().chain([(t, metric.value(&rows[i]))])
+        })
+        .collect();
+    chart
+        .draw_series(LineSeries::new(stair, RGBColor(0x99, 0, 0).stroke_width(2)))
+        .map_err(plot_error)?;
+    let dots = pts
+        .iter()
+        .map(|&(i, t, e)| Circle::new((t, e), 4, colour(&rows[i].technique).mix(0.85).filled()));
+    chart.draw_series(dots).map_err(plot_error)?;
+    let rings = f.iter().filter_map(|&i| {
+        let at = (rows[i].total_ms?, metric.value(&rows[i]));
+        Some(Circle::new(at, 7, BLACK.stroke_width(2)))
+    });
+    chart.draw_series(rings).map_err(plot_error)?;
+    // Pixel positions relative to `area` (the chart's are the backend's).
+    let base = area.get_base_pixel();
+    let at = |t: f64, e: f64| {
+        let (x, y) = chart.backend_coord(&(t, e));
+        (x - base.0, y - base.1)
+    };
+    let points: Vec<(i32, i32)> = pts.iter().map(|&(_, t, e)| at(t, e)).collect();
+    let labelled: Vec<((i32, i32), String)> = pts
+        .iter()
+        .filter(|p| f.contains(&p.0))
+        .map(|&(i, t, e)| (at(t, e), rows[i].label.clone()))
+        .collect();
+    let (xs, ys) = chart.plotting_area().get_pixel_range();
+    let bounds = (
+        xs.start - base.0,
+        ys.start - base.1,
+        xs.end - base.0,
+        ys.end - base.1,
+    );
+    draw_labels(&area, &labelled, &points, bounds)?;
+    draw_legend(&legend, report)
+}
+
+/// The grid, the ticks and the axes' names.
+fn axes<X, Y>(chart: &mut ChartContext<SVGBackend, Cartesian2d<X, Y>>, metric: Metric) -> Result<()>
+where
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    chart
+        .configure_mesh()
+        .x_desc("total GPU time, ms (log scale): shadow raster + kernels + shading")
+        .y_desc(metric.axis())
+        .x_labels(12)
+        .y_labels(10)
+        .x_label_formatter(&|v| tick(*v))
+        .y_label_formatter(&|v| tick(*v))
+        .light_line_style(RGBColor(0xee, 0xee, 0xee))
+        .label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 15))
+        .draw()
+        .map_err(plot_error)
+}
+
+/// The front's labels, placed by [`place_labels`], with their leader lines.
+fn draw_labels(
+    area: &DrawingArea<SVGBackend, Shift>,
+    labelled: &[((i32, i32), String)],
+    points: &[(i32, i32)],
+    bounds: Rect,
+) -> Result<()> {
+    for l in place_labels(labelled, points, bounds) {
+        if let Some(anchor) = l.leader {
+            area.draw(&PathElement::new(
+                vec![anchor, l.line_end],
+                RGBColor(0x88, 0x88, 0x88).stroke_width(1),
+            ))
+            .map_err(plot_error)?;
+        }
+        let style = ("sans-serif", LABEL_SIZE).into_font().color(&BLACK);
+        area.draw(&Text::new(l.text, (l.x, l.y), style))
+            .map_err(plot_error)?;
+    }
+    Ok(())
+}
+
+/// One technique per line, in the order they first appear.
+fn draw_legend(area: &DrawingArea<SVGBackend, Shift>, report: &Report) -> Result<()> {
+    let mut seen: Vec<&str> = Vec::new();
+    for r in &report.rows {
+        if !seen.contains(&r.technique.as_str()) {
+            seen.push(&r.technique);
+        }
+    }
+    let style = ("sans-serif", 15).into_font().color(&BLACK);
+    area.draw(&Text::new("technique", (10, 20), style.clone()))
+        .map_err(plot_error)?;
+    for (k, t) in seen.iter().enumerate() {
+        let y = 46 + 22 * k as i32;
+        area.draw(&Circle::new((16, y), 5, colour(t).filled()))
+            .map_err(plot_error)?;
+        area.draw(&Text::new(t.to_string(), (28, y - 7), style.clone()))
+            .map_err(plot_error)?;
+    }
+    let y = 46 + 22 * seen.len() as i32 + 8;
+    area.draw(&Circle::new((16, y), 7, BLACK.stroke_width(2)))
+        .map_err(plot_error)?;
+    area.draw(&Text::new("Pareto front", (28, y - 7), style))
+        .map_err(plot_error)?;
+    Ok(())
+}
+
+/// A placed label: text at (x, y) (its top-left), and a leader line from the point to it when
+/// it sits away from the point.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Label {
+    /// The text.
+    pub text: String,
+    /// Left edge, pixels.
+    pub x: i32,
+    /// Top edge, pixels.
+    pub y: i32,
+    /// The labelled point, when a leader line joins it to the label.
+    pub leader: Option<(i32, i32)>,
+    /// Where the leader line meets the label.
+    pub line_end: (i32, i32),
+}
+
+/// Estimated box of a label of `text` at `LABEL_SIZE` (sans-serif: about 0.6 em a character).
+fn label_size(text: &str) -> (i32, i32) {
+    let em = LABEL_SIZE / 1.24;
+    (
+        (0.6 * em * text.chars().count() as f64).ceil() as i32,
+        em.ceil() as i32 + 2,
+    )
+}
+
+type Rect = (i32, i32, i32, i32);
+
+fn overlaps(a: Rect, b: Rect) -> bool {
+    a.0 < b.2 && b.0 < a.2 && a.1 < b.3 && b.1 < a.3
+}
+
+/// Places each label near its point: the first of a ring of candidate positions (beside the
+/// point, then further out with a leader line) that stays inside `bounds` and overlaps no
+/// label placed before it, preferring the one that covers the fewest `points`. A label that
+/// fits nowhere is placed at its least crowded candidate.
+pub fn place_labels(
+    labels: &[((i32, i32), String)],
+    points: &[(i32, i32)],
+    bounds: Rect,
+) -> Vec<Label> {
+    let mut placed: Vec<Rect> = Vec::new();
+    let mut out = Vec::new();
+    for ((px, py), text) in labels {
+        let (w, h) = label_size(text);
+        let mut best: Option<(i64, Rect, bool)> = None;
+        for (ring, r) in [9, 26, 48, 74].into_iter().enumerate() {
+            for k in 0..12 {
+                let a = std::f64::consts::TAU * f64::from(k) / 12.0 - 0.5;
+                let (cx, cy) = (
+                    px + (f64::from(r) * a.cos()).round() as i32,
+                    py + (f64::from(r) * a.sin()).round() as i32,
+                );
+                // Anchor the box on the side facing away from the point.
+                let x = if cx >= *px { cx } else { cx - w };
+                let y = if cy >= *py { cy } else { cy - h };
+                let rect = (x, y, x + w, y + h);
+                if rect.0 < bounds.0 || rect.1 < bounds.1 || rect.2 > bounds.2 || rect.3 > bounds.3
+                {
+                    continue;
+                }
+                let hits_label = placed.iter().filter(|&&p| overlaps(p, rect)).count() as i64;
+                let hits_point = points
+                    .iter()
+                    .filter(|&&(qx, qy)| overlaps((qx - 4, qy - 4, qx + 4, qy + 4), rect))
+                    .count() as i64;
+                let cost = 1000 * hits_label + 4 * hits_point + 15 * ring as i64;
+                if best.is_none_or(|b| cost < b.0) {
+                    best = Some((cost, rect, ring > 0));
+                }
+            }
+        }
+        let Some((_, rect, leader)) = best else {
+            continue;
+        };
+        placed.push(rect);
+        let line_end = ((*px).clamp(rect.0, rect.2), (*py).clamp(rect.1, rect.3));
+        out.push(Label {
+            text: text.clone(),
+            x: rect.0,
+            y: rect.1,
+            leader: leader.then_some((*px, *py)),
+            line_end,
+        });
+    }
+    out
+}
+
+/// A tick label with three significant digits, trailing zeros dropped (`0.018`, `250`).
+fn tick(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return "0".into();
+    }
+    let decimals = (2 - v.abs().log10().floor() as i32).max(0) as usize;
+    let s = format!("{v:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Eight labels on points crowded into a few pixels, in a plot 600×400: every label inside
+    /// the bounds and no two labels' boxes overlapping.
+    #[test]
+    fn crowded_labels_do_not_collide() {
+        let labels: Vec<((i32, i32), String)> = (0..8)
+            .map(|k| ((300 + 3 * k, 200 - 2 * k), format!("vsm f32 blur{k} 1024")))
+            .collect();
+        let points: Vec<(i32, i32)> = labels.iter().map(|l| l.0).collect();
+        let bounds = (0, 0, 600, 400);
+        let placed = place_labels(&labels, &points, bounds);
+        assert_eq!(placed.len(), labels.len());
+        let rects: Vec<Rect> = placed
+            .iter()
+            .map(|l| {
+                let (w, h) = label_size(&l.text);
+                (l.x, l.y, l.x + w, l.y + h)
+            })
+            .collect();
+        for (i, a) in rects.iter().enumerate() {
+            assert!(a.0 >= 0 && a.1 >= 0 && a.2 <= 600 && a.3 <= 400, "{a:?}");
+            for b in &rects[i + 1..] {
+                assert!(!overlaps(*a, *b), "{a:?} overlaps {b:?}");
+            }
+        }
+    }
 }

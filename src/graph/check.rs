@@ -60,10 +60,10 @@ impl Plan {
             let of = match &n.dispatch {
                 Dispatch::Texels(r) => Some(r),
                 Dispatch::Blocks { of, .. } => Some(of),
-                Dispatch::Axis { of, axis } => {
-                    if *axis > 1 {
+                Dispatch::Lines { of, per_group } => {
+                    if *per_group == 0 {
                         return bad(format!(
-                            "step {i} (`{}`) dispatches along axis {axis}",
+                            "step {i} (`{}`) dispatches lines with 0 per workgroup",
                             n.name
                         ));
                     }

@@ -75,13 +75,14 @@ pub enum Dispatch {
         /// Block height in texels (0: the whole height, one group).
         y: u32,
     },
-    /// One invocation per texel along `axis` (0 = x, 1 = y) of this resource, one workgroup
-    /// row per line across it: `[ceil(len / workgroup x), lines, 1]` (separable passes).
-    Axis {
+    /// One invocation per column and one per row of this resource:
+    /// `[⌈max(width, height) / per_group⌉, 2, 1]`, workgroup row 0 over the columns and row 1
+    /// over the rows (work serial along each line, e.g. a summed-area table's carries).
+    Lines {
         /// The resource whose size counts.
         of: String,
-        /// 0 for rows (horizontal), 1 for columns (vertical).
-        axis: u32,
+        /// Lines per workgroup (the kernel's workgroup size).
+        per_group: u32,
     },
     /// A mip-chain node: the executor records one dispatch per two levels of the output
     /// (its `dst` resource), each reading the level before (the `src` input for the first).
@@ -89,64 +90,31 @@ pub enum Dispatch {
 }
 
 impl Dispatch {
-    /// The workgroup count of the dispatch for a kernel of workgroup size `wg`, with `size`
-    /// giving each resource's size; `None` for a [`Dispatch::MipChain`] (several dispatches:
-    /// [`mip_chain_passes`]) or a resource `size` does not know.
+    /// Workgroup counts of a dispatch of a kernel whose workgroup is `workgroup`, with
+    /// `size(resource)` the planned `(width, height)` of a resource; `None` when a resource it
+    /// counts is unknown, or for [`Dispatch::MipChain`] (the executor records those).
     pub fn groups(
         &self,
-        wg: [u32; 3],
         size: impl Fn(&str) -> Option<(u32, u32)>,
+        workgroup: [u32; 3],
     ) -> Option<[u32; 3]> {
         Some(match self {
-            Dispatch::Groups(g) => *g,
-            Dispatch::MipChain => return None,
-            Dispatch::Texels(r) => {
+            Self::Groups(g) => *g,
+            Self::Texels(r) => {
                 let (w, h) = size(r)?;
-                [w.div_ceil(wg[0]), h.div_ceil(wg[1]), 1]
+                [w.div_ceil(workgroup[0]), h.div_ceil(workgroup[1]), 1]
             }
-            Dispatch::Blocks { of, x, y } => {
+            Self::Blocks { of, x, y } => {
                 let (w, h) = size(of)?;
                 [block_count(w, *x), block_count(h, *y), 1]
             }
-            Dispatch::Axis { of, axis } => {
+            Self::Lines { of, per_group } => {
                 let (w, h) = size(of)?;
-                let (along, across) = if *axis == 0 { (w, h) } else { (h, w) };
-                [along.div_ceil(wg[0]), across, 1]
+                [block_count(w.max(h), *per_group), 2, 1]
             }
+            Self::MipChain => return None,
         })
     }
-}
-
-/// One dispatch of a [`Dispatch::MipChain`] node (`kernels/mips.wgsl`): it reads level `read`
-/// of the output (`None`: the node's `src` input) and writes levels `a` and `b`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct MipPass {
-    /// The level read (`None`: the `src` input).
-    pub read: Option<u32>,
-    /// The first level written.
-    pub a: u32,
-    /// The second level written (`None` when the chain has no level after `a`: a 1×1 map).
-    pub b: Option<u32>,
-}
-
-/// The dispatches of a mip chain of `levels` levels, two levels each. With an odd level count
-/// the last dispatch redoes the level before the last (identical values), so that every
-/// dispatch writes two levels.
-pub fn mip_chain_passes(levels: u32) -> Vec<MipPass> {
-    let levels = levels.max(1);
-    let pass = |read, a: u32| MipPass {
-        read,
-        a,
-        b: (a + 1 < levels).then_some(a + 1),
-    };
-    let mut passes = vec![pass(None, 0)];
-    let mut next = 2;
-    while next < levels {
-        let a = next.min(levels - 2);
-        passes.push(pass(Some(a - 1), a));
-        next = a + 2;
-    }
-    passes
 }
 
 /// One kernel invocation in the graph.

@@ -60,7 +60,7 @@ pub enum StageError {
         samples: u32,
     },
     /// The device was created without a feature that was asked for.
-    #[error("{needed_for} needs the device feature {feature:?}, which this device lacks")]
+    #[error("{needed_for} needs the device feature {feature}, which this device lacks")]
     MissingFeature {
         /// The feature.
         feature: wgpu::Features,

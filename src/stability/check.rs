@@ -6,7 +6,7 @@
 use super::{Row, Verdict};
 
 /// f32's unit roundoff (round to nearest).
-pub(crate) const U: f64 = 1.0 / (1u64 << 24) as f64;
+pub(crate) use crate::tolerance::U;
 
 /// Accumulates comparisons for one [`Row`].
 #[derive(Debug, Default)]

@@ -20,7 +20,6 @@ use super::Row;
 use super::check::{Check, Rng};
 use super::harness::{DIRECTIONAL, light, receiver, run_light, sample, shade};
 use super::planar::storage_name;
-use super::tolerance;
 use crate::cpu::{self, Texels};
 use crate::error::Result;
 use crate::exec::Executor;
@@ -28,6 +27,7 @@ use crate::gpu::Gpu;
 use crate::render::Renderer;
 use crate::scene::{BlurKernel, Filter, Prefilter, Storage, Technique};
 use crate::technique::{LightGpu, linear_name};
+use crate::tolerance;
 
 const MAP: u32 = 64;
 const TERMS: u32 = 16;

@@ -25,7 +25,7 @@ use crate::error::{Error, Result};
 use crate::exec::Executor;
 use crate::gpu::{Gpu, read_texture};
 use crate::graph::Graph;
-use crate::sat::{SAT_BLOCK, SatCoding, SatVariant, add_sat};
+use crate::sat::{SatCoding, SatVariant, add_sat, float_sum_depth};
 use crate::scene::{BlurKernel, Filter, Prefilter, Scene, Storage, Technique, exponent_limit};
 
 const MAP: u32 = 64;
@@ -219,7 +219,9 @@ pub(crate) fn sat_check(
     let mut exec = Executor::new();
     let ran = run_graph(gpu, &mut exec, &graph, &[&out], imports, false, Poison::All)?;
     let bytes = read_texture(&gpu.device, &gpu.queue, &ran.outputs.textures[&out], 0)?;
-    let words: &[u32] = bytemuck::cast_slice(&bytes);
+    // The table's words, each texel widened to 4 (the channels it lacks read 0).
+    let fixed = cpu::sat::widen(bytemuck::cast_slice(&bytes), w * h);
+    let words = fixed.as_flattened();
     let exact = cpu::sat::sat(texels);
     let k = texels.channels.min(4);
     let dev = |c: usize| {
@@ -243,11 +245,7 @@ pub(crate) fn sat_check(
         SatVariant::Float => float_table.data.iter().filter(|v| !v.is_finite()).count() as u64,
         SatVariant::Fixed => 0,
     };
-    let fixed: &[[u32; 4]] = bytemuck::cast_slice(&bytes);
-    let depth = {
-        let axis = |side: usize| (20.max(10 + side.div_ceil(SAT_BLOCK as usize)) + 1) as f64;
-        axis(w) + axis(h) + 1.0
-    };
+    let depth = f64::from(float_sum_depth(w as u32, h as u32));
     let mut check = Check::new();
     let mut rng = Rng::new(0x4E5A7);
     let mut wins = vec![
@@ -266,7 +264,7 @@ pub(crate) fn sat_check(
     for [x0, y0, x1, y1] in wins {
         let area = ((x1 - x0) * (y1 - y0)) as f64;
         let want = cpu::sat::window(&exact, x0, y0, x1, y1);
-        let codes = cpu::sat::window_fixed(fixed, w, x0, y0, x1, y1);
+        let codes = cpu::sat::window_fixed(&fixed, w, x0, y0, x1, y1);
         let floats = cpu::sat::window(&float_table, x0, y0, x1, y1);
         let corner_sum = |c: usize| -> f64 {
             [(x0, y0), (x1, y0), (x0, y1), (x1, y1)]

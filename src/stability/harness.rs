@@ -57,7 +57,7 @@ pub(crate) struct Ran {
 pub(crate) enum Poison<'a> {
     /// Every level of every planned texture.
     All,
-    /// Only these texels of level 0 of this resource (a 1 GiB table is not rewritten whole).
+    /// Only these texels of level 0 of this resource (a table of hundreds of MiB is not rewritten whole).
     Texels(&'a str, &'a [(u32, u32)]),
 }
 
@@ -133,15 +133,16 @@ impl Ran {
 }
 
 /// The 16-byte texels of `texture` (level 0) at `coords`, each copied alone into one buffer:
-/// reads a few thousand texels of a 1 GiB table without copying the table.
+/// reads a few thousand texels of a large table without copying the table.
 pub(crate) fn read_texels(
     gpu: &Gpu,
     texture: &wgpu::Texture,
     coords: &[(u32, u32)],
 ) -> Result<Vec<[u32; 4]>> {
-    if texel_bytes(texture.format()) != 16 || coords.is_empty() {
+    let bytes = texel_bytes(texture.format());
+    if ![4, 8, 16].contains(&bytes) || coords.is_empty() {
         return Err(Error::Invalid(format!(
-            "read_texels reads 16-byte texels at one or more places, not {:?}",
+            "read_texels reads 4-, 8- or 16-byte texels at one or more places, not {:?}",
             texture.format()
         )));
     }
@@ -177,7 +178,12 @@ pub(crate) fn read_texels(
     }
     submit_and_wait(&gpu.device, &gpu.queue, enc, "stability texel readback")?;
     let raw = read_buffer(&gpu.device, &buffer)?;
-    Ok(bytemuck::cast_slice::<u8, [u32; 4]>(&raw).to_vec())
+    // Each texel's words at the start of its 16 bytes; the channels a format lacks read 0.
+    let words = (bytes / 4) as usize;
+    Ok(bytemuck::cast_slice::<u8, [u32; 4]>(&raw)
+        .iter()
+        .map(|t| std::array::from_fn(|c| if c < words { t[c] } else { 0 }))
+        .collect())
 }
 
 /// Fills the texels of `texture` (level 0) at `coords` with all-ones bytes.

@@ -140,7 +140,7 @@ fn check_map(
             let (reference, tol) = if s.inside {
                 (
                     cpu::vis_msm::vis_msm(std::slice::from_ref(&levels[0]), &lg, &s),
-                    super::tolerance::msm(std::slice::from_ref(&levels[0]), &lg, &s),
+                    crate::tolerance::msm(std::slice::from_ref(&levels[0]), &lg, &s),
                 )
             } else {
                 (1.0, 0.0)

@@ -135,12 +135,12 @@ fn check_technique(
                 } else if lg.technique == 3 {
                     (
                         cpu::vis_vsm::vis_vsm(&levels, &lg, &s),
-                        super::tolerance::vsm(&levels, &lg, &s),
+                        crate::tolerance::vsm(&levels, &lg, &s),
                     )
                 } else {
                     (
                         cpu::vis_evsm::vis_evsm(&levels, &lg, &s),
-                        super::tolerance::evsm(&levels, &lg, &s),
+                        crate::tolerance::evsm(&levels, &lg, &s),
                     )
                 };
                 behind.compare(f64::from(v), reference, tol, at);

@@ -3,7 +3,7 @@
 //! The maps hold multiples of 2⁻²⁴ (the random map `k·2⁻²⁴`, `k < 2²⁴`; the constant
 //! `0.999f32`, which is one), so the f64 reference sums them *exactly* as integers (a 8192²
 //! sum is below 2⁵⁰). The GPU table is read back only at the corners of the windows checked
-//! (`read_texels`), never copied whole: an 8192² table is 1 GiB.
+//! (`read_texels`), never copied whole: an 8192² one-channel table is 256 MiB.
 //!
 //! Bounds: the fixed-point table is exact, so its texels must equal the wrapping-u32 prefix of
 //! the codes and every decoded window mean is within `½/scale` (rounding each code) plus
@@ -23,7 +23,7 @@ use crate::error::{Error, Result};
 use crate::exec::Executor;
 use crate::gpu::Gpu;
 use crate::graph::Graph;
-use crate::sat::{SAT_BLOCK, SatCoding, SatVariant, add_sat, lookup_area};
+use crate::sat::{SatCoding, SatVariant, add_sat, float_sum_depth, lookup_area};
 
 /// Units of the maps' values: every texel is an integer multiple of 2⁻²⁴.
 const UNIT: f64 = 1.0 / (1u64 << 24) as f64;
@@ -153,25 +153,22 @@ fn gpu_table(
         bytemuck::cast_slice(&map.values),
     );
     let imports = HashMap::from([("in".to_string(), input)]);
-    // A fresh executor: its 1 GiB textures go when it does.
+    // A fresh executor: its large textures go when it does.
     let mut exec = Executor::new();
     let poison = Poison::Texels(&out, coords);
     let ran = run_graph(gpu, &mut exec, &graph, &[&out], imports, false, poison)?;
     let texels = read_texels(gpu, &ran.outputs.textures[&out], coords)?;
-    // Free the 1 GiB textures now, not whenever wgpu next cleans up.
+    // Free the large textures now, not whenever wgpu next cleans up.
     for t in ran.outputs.textures.values() {
         t.destroy();
     }
     Ok(coords.iter().copied().zip(texels).collect())
 }
 
-/// Depth of the GPU's summation tree for one f32 table texel (as in `tests/sat.rs`): per axis
-/// the in-block prefix (3 serial adds, 16 on a Blelloch path over 256 invocations, 1 to add
-/// the prefix: 20) or the block carry (3 + 8 for the block total, then one add per block) plus
-/// adding it, `max(20, 10 + blocks) + 1`; rows, then columns on top, plus the encode.
+/// Depth of the GPU's summation tree for one f32 table texel of an `n`² map
+/// ([`float_sum_depth`]).
 fn scan_depth(n: usize) -> f64 {
-    let axis = (20.max(10 + n.div_ceil(SAT_BLOCK as usize)) + 1) as f64;
-    2.0 * axis + 1.0
+    f64::from(float_sum_depth(n as u32, n as u32))
 }
 
 /// The fixed-point table at the corners against the wrapping-u32 prefix of the codes, and the

@@ -1,6 +1,7 @@
 //! Helpers shared by the GPU tests.
-#![allow(dead_code, reason = "each test binary uses a subset")]
+#![allow(dead_code, unused_imports, reason = "each test binary uses a subset")]
 
+pub mod evaluate;
 pub mod soft;
 pub mod soft_maps;
 
@@ -58,118 +59,13 @@ pub fn assert_within(what: &str, gpu: &[f32], reference: &[f64], tolerance: &[f6
     );
 }
 
-/// First-order bound on the f32 error of the one-tailed Chebyshev bound
-/// `p = σ² / (σ² + t²)`, `σ² = max(E[x²] − E[x]², floor)`, `t = r − E[x]`, when every input
-/// carries relative error `e`: the cancellation in σ² amplifies it by `E[x²] / σ²`. The floor
-/// carries 2e (EVSM forms it from the squared filtered mean).
-pub fn chebyshev_tolerance(mean: f64, mean_sq: f64, receiver: f64, floor: f64, e: f64) -> f64 {
-    if receiver <= mean {
-        // p = 1 here; at the boundary p is continuous (σ² / σ²).
-        return 0.0;
-    }
-    let var = (mean_sq - mean * mean).max(floor);
-    let t = receiver - mean;
-    let dvar = e * (mean_sq.abs() + 2.0 * mean * mean) + 2.0 * e * floor;
-    let dt = e * (receiver.abs() + mean.abs());
-    (t * t * dvar + 2.0 * t.abs() * var * dt) / (var + t * t).powi(2)
-}
-
-/// Tolerance of VSM visibility at `s`: inputs carry ~8 roundings (bilinear mix, depth).
-pub fn vsm_tolerance(
-    moments: &[shadowgraph::cpu::Texels],
-    l: &shadowgraph::technique::LightGpu,
-    s: &shadowgraph::cpu::light::LightSample,
-) -> f64 {
-    let m = shadowgraph::cpu::mips::sample(moments, l, s);
-    let d = s.depth - f64::from(l.bias);
-    let dp = chebyshev_tolerance(
-        m[0],
-        m[1],
-        d,
-        f64::from(l.min_variance),
-        8.0 * 2f64.powi(-24),
-    );
-    1e-5 + dp / (1.0 - f64::from(l.bleed))
-}
-
-/// Tolerance of EVSM visibility at `s`: besides the roundings of VSM, SPIR-V's `exp` is
-/// accurate to (3 + 2|x|) ULP, and the receiver's depth error is amplified by 2c.
-pub fn evsm_tolerance(
-    moments: &[shadowgraph::cpu::Texels],
-    l: &shadowgraph::technique::LightGpu,
-    s: &shadowgraph::cpu::light::LightSample,
-) -> f64 {
-    let m = shadowgraph::cpu::mips::sample(moments, l, s);
-    let [(pos, floor_pos), (neg, floor_neg)] = shadowgraph::cpu::vis_evsm::warp(l, s, &m);
-    let ulp = 2f64.powi(-23);
-    let e = |c: f32| (3.0 + 4.0 * f64::from(c)) * ulp + 8.0 * ulp + 4.0 * f64::from(c) * ulp;
-    let mut dp = chebyshev_tolerance(m[0], m[1], pos, floor_pos, e(l.exp_pos));
-    if l.moments == 4 {
-        dp = dp.max(chebyshev_tolerance(
-            m[2],
-            m[3],
-            neg,
-            floor_neg,
-            e(l.exp_neg),
-        ));
-    }
-    1e-5 + dp / (1.0 - f64::from(l.bleed))
-}
-
-/// Tolerance of ESM visibility `v` at `s` over log map `logs`: the f32 arguments `L − c·d`
-/// (a few roundings of magnitudes up to |L| + c·d), the receiver's depth (view transform in
-/// f32: ~8 roundings of Z + near, over far − near, amplified by c), the inner exps and log of
-/// the log-space bilinear ((3 + 2|x|) ULP each) and the final exp, all relative to `v`.
-pub fn esm_tolerance(
-    logs: &[shadowgraph::cpu::Texels],
-    l: &shadowgraph::technique::LightGpu,
-    s: &shadowgraph::cpu::light::LightSample,
-    v: f64,
-) -> f64 {
-    let taps: Vec<f64> = shadowgraph::cpu::mips::taps(logs, l, s)
-        .iter()
-        .map(|(_, t)| t[0])
-        .collect();
-    let (lo, hi) = taps
-        .iter()
-        .fold((f64::MAX, f64::MIN), |(a, b), &t| (a.min(t), b.max(t)));
-    let cd = f64::from(l.exp_pos) * s.depth;
-    let ulp = 2f64.powi(-23);
-    let arg = (hi - cd).abs();
-    let depth = f64::from(l.exp_pos) * 4.0 * ulp * (s.view_z + f64::from(l.near))
-        / f64::from(l.far - l.near);
-    let rel = 8.0 * ulp * (hi.abs() + cd.abs())
-        + depth
-        + (3.0 + 2.0 * (hi - lo)) * ulp
-        + (3.0 + 2.0 * arg) * ulp
-        + 3.0 * ulp;
-    1e-6 + v * rel
-}
-
-/// Tolerance of ESM through a summed-area table at visibility `v` (`vis_esm_of_sat`): the
-/// table mean m in f32 from 16 weighted window sums (32 roundings of 2⁻²⁴ of m, the coding
-/// being about 0), SPIR-V's `log` (2⁻²¹ absolute near 1, else 3 ULP of |ln m|), the exponent
-/// x = ln m + c − c·d formed in f32 (4 ULP of c + c·d), `exp` to (3 + 2|x|) ULP, and the
-/// receiver depth's f32 rounding scaled by c (as in [`esm_tolerance`]).
-pub fn esm_sat_tolerance(
-    moments: &[shadowgraph::cpu::Texels],
-    l: &shadowgraph::technique::LightGpu,
-    s: &shadowgraph::cpu::light::LightSample,
-    v: f64,
-) -> f64 {
-    let m = shadowgraph::cpu::mips::sample(moments, l, s)[0].max(1e-37);
-    let c = f64::from(l.exp_pos);
-    let ulp = 2f64.powi(-23);
-    let x = m.ln() + c - c * s.depth;
-    let depth = c * 4.0 * ulp * (s.view_z + f64::from(l.near)) / f64::from(l.far - l.near);
-    let rel = 16.0 * ulp
-        + 2f64.powi(-21)
-        + 3.0 * ulp * m.ln().abs()
-        + 4.0 * ulp * (c + c * s.depth)
-        + (3.0 + 2.0 * x.abs()) * ulp
-        + depth;
-    1e-6 + v * rel
-}
+/// The f32-vs-f64 error models, from the library's one tolerance module
+/// (`shadowgraph::tolerance`), which the numerical-stability suite uses too.
+pub use shadowgraph::tolerance::{
+    chebyshev as chebyshev_tolerance, csm as csm_tolerance, esm as esm_tolerance,
+    esm_sat as esm_sat_tolerance, evsm as evsm_tolerance, msm as msm_tolerance,
+    vsm as vsm_tolerance,
+};
 
 /// A linear depth map with structure: a background and overlapping random rectangles, so
 /// windows see mixes of occluders (never all zeros).
@@ -218,55 +114,4 @@ pub fn robust(
         }
     }
     Some(v)
-}
-
-/// Tolerance of MSM visibility at `s`: the kernel's solve is backward stable in the stored
-/// moments (their covariances are formed once, the bias added as non-negative terms), so the
-/// GPU computes the exact answer for moments off by a few dozen roundings; the tolerance is
-/// twice the largest change of the f64 reference over 16 such perturbations of the
-/// (dequantized) moments before their projection and bias (relative 32·2⁻²⁴ per moment,
-/// ±8·2⁻²⁴ on the receiver depth), plus 1e-4 for the final rational expression.
-pub fn msm_tolerance(
-    moments: &[shadowgraph::cpu::Texels],
-    l: &shadowgraph::technique::LightGpu,
-    s: &shadowgraph::cpu::light::LightSample,
-) -> f64 {
-    use shadowgraph::cpu::vis_msm::{bias_for, branch_spread, dequantized, intensity};
-    use shadowgraph::technique::MSM_HAUSDORFF;
-    let b = dequantized(&shadowgraph::cpu::mips::sample(moments, l, s), l);
-    let d = s.depth - f64::from(l.bias);
-    let hausdorff = l.msm_flags & MSM_HAUSDORFF != 0;
-    let vis = |b: [f64; 4], d: f64| {
-        let v = 1.0 - intensity(&bias_for(b, l), d, hausdorff).clamp(0.0, 1.0);
-        if v.is_nan() { 1.0 } else { v }
-    };
-    let base = vis(b, d);
-    let e = 32.0 * 2f64.powi(-24);
-    let mut worst: f64 = 0.0;
-    for k in 0..16u32 {
-        let sign = |bit: u32| if k >> bit & 1 == 1 { 1.0 } else { -1.0 };
-        let p: [f64; 4] = std::array::from_fn(|i| b[i] * (1.0 + sign(i as u32) * e));
-        let dd = d + sign(k % 4) * 8.0 * 2f64.powi(-24);
-        worst = worst.max((vis(p, dd) - base).abs());
-    }
-    // Where a root sits at 0 or 1, rounding picks Hamburger's or Hausdorff's formula.
-    let spread = branch_spread(&bias_for(b, l), d, hausdorff, 1e-3);
-    worst = worst.max(spread);
-    let bleed = f64::from(l.bleed);
-    (1e-4 + 2.0 * worst) / (1.0 - bleed)
-}
-
-/// Tolerance of CSM visibility: Vulkan specifies `sin`/`cos` to 2⁻¹¹ absolute on [−π, π]
-/// (the kernels reduce their arguments there), so term k may be off by w_k · 2 · 2⁻¹¹ in the
-/// receiver's factors; the sum is scaled by `scale`. Plus 1e-5 for the f32 sum.
-pub fn csm_tolerance(l: &shadowgraph::technique::LightGpu) -> f64 {
-    let m = f64::from(l.csm_terms);
-    let weights: f64 = (1..=l.csm_terms)
-        .map(|k| {
-            let kf = f64::from(k) / m;
-            2.0 / (std::f64::consts::PI * f64::from(2 * k - 1))
-                * (-f64::from(l.csm_attenuation) * kf * kf).exp()
-        })
-        .sum();
-    1e-5 + f64::from(l.csm_scale) * weights * 2.0 * 2f64.powi(-11)
 }

@@ -195,7 +195,7 @@ pub fn tables(rep: &Texels, coding: &SatCoding) -> Tables {
         .collect();
     Tables {
         words,
-        format: coding.variant.format(),
+        format: coding.variant.format(4),
         decoded: Texels {
             width: w,
             height: h,

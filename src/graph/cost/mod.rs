@@ -17,8 +17,9 @@ pub mod fetches;
 use std::collections::HashMap;
 
 use self::declare::Pattern;
-use super::{Dispatch, Node, Plan, mip_chain_passes, texel_bytes};
+use super::{Dispatch, Node, Plan, texel_bytes};
 use crate::error::{Error, Result};
+use crate::filter::{MIP_LEVELS_PER_DISPATCH, mip_dispatches};
 use crate::kernels::{self, Reflection};
 
 /// What one node moves.
@@ -202,7 +203,7 @@ fn dispatches(
         })
     };
     let size = |r: &str| plan.resource(r).map(|p| (p.width, p.height));
-    if let Some(groups) = node.dispatch.groups(wg, size) {
+    if let Some(groups) = node.dispatch.groups(size, wg) {
         let mut map = HashMap::new();
         for (slot, r) in node.inputs.iter().chain(&node.outputs) {
             map.insert(slot.clone(), Some(bound(r, 0)?));
@@ -212,7 +213,9 @@ fn dispatches(
     if node.dispatch != Dispatch::MipChain {
         return Err("dispatches over a resource that is not in the plan".into());
     }
-    // As `Executor::record_mip_chain` binds them: `src`, then one-level views of `dst`.
+    // As `Executor::record_mip_chain` binds them: `src` (the input, then level `first` of
+    // `dst`), `dst0` (level 0, written by the first dispatch only) and `dst1` … `dst<count>`;
+    // the bindings past `count` repeat the last level and are not written.
     let slot = |list: &[(String, String)], name: &str| {
         list.iter()
             .find(|(s, _)| s == name)
@@ -220,24 +223,26 @@ fn dispatches(
             .ok_or_else(|| format!("binds nothing to `{name}`"))
     };
     let (src, dst) = (slot(&node.inputs, "src")?, slot(&node.outputs, "dst")?);
-    let levels = plan.resource(&dst).map_or(1, |p| p.resource.mips.max(1));
-    mip_chain_passes(levels)
+    let base = bound(&dst, 0)?;
+    let tile = crate::filter::MIP_TILE / 2;
+    mip_dispatches(base.width, base.height)
         .into_iter()
-        .map(|pass| {
-            let a = bound(&dst, pass.a)?;
-            let b = pass.b.map(|l| bound(&dst, l)).transpose()?;
-            let read = match pass.read {
-                None => bound(&src, 0)?,
-                Some(l) => bound(&dst, l)?,
+        .map(|(first, count)| {
+            let read = if first == 0 {
+                bound(&src, 0)?
+            } else {
+                bound(&dst, first)?
             };
-            let out = b.unwrap_or(a);
+            let mut map = HashMap::from([("src".to_string(), Some(read))]);
+            map.insert("dst0".into(), (first == 0).then_some(base));
+            for j in 1..=MIP_LEVELS_PER_DISPATCH {
+                let level = (j <= count).then(|| bound(&dst, first + j)).transpose()?;
+                map.insert(format!("dst{j}"), level);
+            }
+            let next = bound(&dst, (first + 1).min(first + count))?;
             Ok(Dispatched {
-                groups: [out.width.div_ceil(wg[0]), out.height.div_ceil(wg[1]), 1],
-                bound: HashMap::from([
-                    ("src".to_string(), Some(read)),
-                    ("dst_a".to_string(), Some(a)),
-                    ("dst_b".to_string(), b),
-                ]),
+                groups: [next.width.div_ceil(tile), next.height.div_ceil(tile), 1],
+                bound: map,
             })
         })
         .collect()

@@ -1,52 +1,119 @@
 //! Error models of the shading kernel's f32 visibility functions against their f64
-//! references, evaluated on the same filtered maps: how far apart the two may be.
+//! references, evaluated on the same filtered maps: how far apart the two may be. One module,
+//! used by the numerical-stability suite (`crate::stability`) and by the GPU tests
+//! (`tests/common`), so the bounds a test asserts are the bounds the suite reports.
+//!
+//! Where the two former copies of these models differed, every term either copy needed is
+//! kept: the variance floor's own error (EVSM forms it from the squared filtered mean, 2e), the
+//! `exp` of the squared moment's exponent (`3 + 4c` ULP rather than `3 + 2c`), and the f32
+//! dequantization of 16-bit MSM moments.
 
 use std::f64::consts::PI;
 
-use super::check::U;
 use crate::cpu::Texels;
 use crate::cpu::light::LightSample;
 use crate::cpu::vis_msm::{bias_for, branch_spread, dequantized, intensity};
 use crate::technique::{LightGpu, MSM_HAUSDORFF, MSM_QUANTIZED};
 
+/// The unit roundoff of f32, 2⁻²⁴.
+pub const U: f64 = 1.0 / (1u64 << 24) as f64;
+
 /// First-order bound on the f32 error of the one-tailed Chebyshev bound
 /// `p = σ² / (σ² + t²)`, `σ² = max(E[x²] − E[x]², floor)`, `t = r − E[x]`, when every input
-/// carries relative error `e`: the cancellation in σ² amplifies it by `E[x²] / σ²`.
-pub(crate) fn chebyshev(mean: f64, mean_sq: f64, receiver: f64, floor: f64, e: f64) -> f64 {
+/// carries relative error `e`: the cancellation in σ² amplifies it by `E[x²] / σ²`. The floor
+/// carries 2e (EVSM forms it from the squared filtered mean).
+pub fn chebyshev(mean: f64, mean_sq: f64, receiver: f64, floor: f64, e: f64) -> f64 {
     if receiver <= mean {
+        // p = 1 here; at the boundary p is continuous (σ² / σ²).
         return 0.0;
     }
     let var = (mean_sq - mean * mean).max(floor);
     let t = receiver - mean;
-    let dvar = e * (mean_sq.abs() + 2.0 * mean * mean);
+    let dvar = e * (mean_sq.abs() + 2.0 * mean * mean) + 2.0 * e * floor;
     let dt = e * (receiver.abs() + mean.abs());
     (t * t * dvar + 2.0 * t.abs() * var * dt) / (var + t * t).powi(2)
 }
 
 /// VSM at `s`: the bilinear mix and the receiver's depth carry ~8 roundings; then the
 /// light-bleeding reduction divides by `1 − bleed`. Plus 1e-5 for the final arithmetic.
-pub(crate) fn vsm(maps: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
+pub fn vsm(maps: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
     let m = crate::cpu::mips::sample(maps, l, s);
     let d = s.depth - f64::from(l.bias);
     let dp = chebyshev(m[0], m[1], d, f64::from(l.min_variance), 8.0 * U);
     1e-5 + dp / (1.0 - f64::from(l.bleed))
 }
 
-/// EVSM at `s`: besides VSM's roundings, SPIR-V's `exp` is accurate to `(3 + 2|x|)` ULP
-/// (|x| ≤ c), and the receiver's depth error is amplified by `2c` through the warp.
-pub(crate) fn evsm(maps: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
+/// EVSM at `s`: besides VSM's roundings, SPIR-V's `exp` is accurate to `(3 + 2|x|)` ULP, taken
+/// here at the squared moment's exponent (|x| ≤ 2c), and the receiver's depth error is
+/// amplified by `2c` through the warp.
+pub fn evsm(maps: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
     let m = crate::cpu::mips::sample(maps, l, s);
     let [(pos, floor_pos), (neg, floor_neg)] = crate::cpu::vis_evsm::warp(l, s, &m);
     let ulp = 2.0 * U;
     let e = |c: f32| {
         let c = f64::from(c);
-        (3.0 + 2.0 * c) * ulp + 8.0 * ulp + 4.0 * c * ulp
+        (3.0 + 4.0 * c) * ulp + 8.0 * ulp + 4.0 * c * ulp
     };
     let mut dp = chebyshev(m[0], m[1], pos, floor_pos, e(l.exp_pos));
     if l.moments == 4 {
         dp = dp.max(chebyshev(m[2], m[3], neg, floor_neg, e(l.exp_neg)));
     }
     1e-5 + dp / (1.0 - f64::from(l.bleed))
+}
+
+/// ESM visibility `v` at `s` over log map `logs`: the f32 arguments `L − c·d`
+/// (a few roundings of magnitudes up to |L| + c·d), the receiver's depth (view transform in
+/// f32: ~8 roundings of Z + near, over far − near, amplified by c), the inner exps and log of
+/// the log-space bilinear ((3 + 2|x|) ULP each) and the final exp, all relative to `v`.
+pub fn esm(
+    logs: &[crate::cpu::Texels],
+    l: &crate::technique::LightGpu,
+    s: &crate::cpu::light::LightSample,
+    v: f64,
+) -> f64 {
+    let taps: Vec<f64> = crate::cpu::mips::taps(logs, l, s)
+        .iter()
+        .map(|(_, t)| t[0])
+        .collect();
+    let (lo, hi) = taps
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), &t| (a.min(t), b.max(t)));
+    let cd = f64::from(l.exp_pos) * s.depth;
+    let ulp = 2f64.powi(-23);
+    let arg = (hi - cd).abs();
+    let depth = f64::from(l.exp_pos) * 4.0 * ulp * (s.view_z + f64::from(l.near))
+        / f64::from(l.far - l.near);
+    let rel = 8.0 * ulp * (hi.abs() + cd.abs())
+        + depth
+        + (3.0 + 2.0 * (hi - lo)) * ulp
+        + (3.0 + 2.0 * arg) * ulp
+        + 3.0 * ulp;
+    1e-6 + v * rel
+}
+
+/// ESM through a summed-area table at visibility `v` (`vis_esm_of_sat`): the
+/// table mean m in f32 from 16 weighted window sums (32 roundings of 2⁻²⁴ of m, the coding
+/// being about 0), SPIR-V's `log` (2⁻²¹ absolute near 1, else 3 ULP of |ln m|), the exponent
+/// x = ln m + c − c·d formed in f32 (4 ULP of c + c·d), `exp` to (3 + 2|x|) ULP, and the
+/// receiver depth's f32 rounding scaled by c (as in [`esm`]).
+pub fn esm_sat(
+    moments: &[crate::cpu::Texels],
+    l: &crate::technique::LightGpu,
+    s: &crate::cpu::light::LightSample,
+    v: f64,
+) -> f64 {
+    let m = crate::cpu::mips::sample(moments, l, s)[0].max(1e-37);
+    let c = f64::from(l.exp_pos);
+    let ulp = 2f64.powi(-23);
+    let x = m.ln() + c - c * s.depth;
+    let depth = c * 4.0 * ulp * (s.view_z + f64::from(l.near)) / f64::from(l.far - l.near);
+    let rel = 16.0 * ulp
+        + 2f64.powi(-21)
+        + 3.0 * ulp * m.ln().abs()
+        + 4.0 * ulp * (c + c * s.depth)
+        + (3.0 + 2.0 * x.abs()) * ulp
+        + depth;
+    1e-6 + v * rel
 }
 
 /// MSM at `s`: the kernel's solve is backward stable in the stored moments (their
@@ -56,7 +123,7 @@ pub(crate) fn evsm(maps: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
 /// before their projection and bias (32·u relative per moment, ±8·u on the depth; with
 /// quantized storage also 8·u·Σ|q| absolute per moment, the f32 dequantization `q·M` with
 /// entries of `M` below 1), plus 1e-4 for the final rational expression, over `1 − bleed`.
-pub(crate) fn msm(maps: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
+pub fn msm(maps: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
     let q = crate::cpu::mips::sample(maps, l, s);
     let b = dequantized(&q, l);
     let dequantize_error = if l.msm_flags & MSM_QUANTIZED != 0 {
@@ -88,7 +155,7 @@ pub(crate) fn msm(maps: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
 }
 
 /// CSM's term weights `w_k = (2 / c_k)·exp(−α (k/M)²)`, k = 1..=M.
-pub(crate) fn csm_weights(l: &LightGpu) -> Vec<f64> {
+pub fn csm_weights(l: &LightGpu) -> Vec<f64> {
     let m = f64::from(l.csm_terms);
     (1..=l.csm_terms)
         .map(|k| {
@@ -101,7 +168,7 @@ pub(crate) fn csm_weights(l: &LightGpu) -> Vec<f64> {
 /// CSM: Vulkan specifies `sin`/`cos` to 2⁻¹¹ absolute on [−π, π] (the kernels reduce their
 /// arguments there), so term k may be off by `w_k·2·2⁻¹¹` in the receiver's factors; the sum
 /// is scaled by `scale`. Plus 1e-5 for the f32 sum.
-pub(crate) fn csm(l: &LightGpu) -> f64 {
+pub fn csm(l: &LightGpu) -> f64 {
     let w: f64 = csm_weights(l).iter().sum();
     1e-5 + f64::from(l.csm_scale) * w * 2.0 * 2f64.powi(-11)
 }

@@ -1,29 +1,30 @@
-//! Summed-area tables (SAT) of a representation, built on the GPU from work-efficient parallel
-//! prefix scans, for box filters of any size at a constant cost per lookup.
+//! Summed-area tables (SAT) of a representation, built on the GPU in three passes over
+//! tiles, for box filters of any size at a constant cost per lookup.
 //!
-//! [`add_sat`] adds five passes to a [`Graph`]; every pass is a plain dispatch and no
-//! workgroup ever waits on another (no decoupled look-back, which needs forward-progress
-//! guarantees that Vulkan and WebGPU do not give):
+//! [`add_sat`] adds three passes to a [`Graph`] (after Nehab et al. 2011: read twice, write
+//! once, and no workgroup ever waits on another, so nothing needs the forward-progress
+//! guarantees that Vulkan and WebGPU do not give). The map is cut into tiles of [`SAT_TILE`]²
+//! texels, one workgroup each (64 invocations, each an 8×8 sub-block in registers):
 //!
-//! 1. `sat_rows`: encode each texel and scan each row in blocks of [`SAT_BLOCK`] texels, one
-//!    workgroup per block (4 texels per invocation scanned in registers, the invocations'
-//!    totals by Blelloch's up-sweep/down-sweep in workgroup memory); block totals to
-//!    `.row_sums`.
-//! 2. `sat_carry`: the exclusive prefix of each row's block totals (`.row_carry`), one
-//!    invocation per row ([`SAT_CARRY_LINES`] per workgroup), serially: a row has at most
-//!    ⌈32768 / [`SAT_BLOCK`]⌉ = 32 totals.
-//! 3. `sat_cols_reduce`: totals of blocks of [`SAT_BLOCK`] rows of the full row prefix
-//!    (`.rows` plus `.row_carry`, added on load) per column (`.col_sums`).
-//! 4. `sat_carry`: their exclusive prefix down each column (`.col_carry`).
-//! 5. `sat_cols` / `sat_cols_f32`: scan each column block of the full row prefix, add the
-//!    column carry, store the inclusive SAT.
+//! 1. `sat_tile_sums` / `sat_tile_sums_f32`: read and encode the tile; write the last row and the last column of the
+//!    tile's own table (`.col_part`, `width × ⌈height / SAT_TILE⌉`, and `.row_part`,
+//!    `⌈width / SAT_TILE⌉ × height`).
+//! 2. `sat_carries`: one invocation per column and one per row ([`Dispatch::Lines`]), the
+//!    exclusive prefix of those edges along the line: `.col_carry` (the map above the tile
+//!    row) and `.row_carry` (the map left of the tile column, every row above included: each
+//!    row workgroup first sums the totals of the tiles above its tile row).
+//! 3. `sat_tiles` / `sat_tiles_f32`: read and encode the tile again, scan it, add its column
+//!    and row carries, store the inclusive table.
 //!
-//! Traffic: the representation is read once, the block-local row scans are written once and
-//! read twice, the table is written once (plus the block totals, 1/[`SAT_BLOCK`] of that).
+//! Traffic per texel: the representation is read twice and the table written once, plus
+//! 8/[`SAT_TILE`] of a table texel for the edges and carries. The table and its intermediates
+//! have the representation's channels (1, 2 or 4: [`SatVariant::format`]).
+//! [`five_pass`] keeps the first design (five scan passes over 4-channel tables) as the
+//! benchmark's baseline.
 //!
 //! Two codings ([`SatVariant`]): **fixed** point, `e = round(clamp((v − offset)·scale, ±limit))`
-//! in wrapping u32 (`rgba32uint`), whose window sums are exact whatever the map size, and
-//! **float** (`rgba32float`), `(v − offset)·scale` summed in f32, whose window sums lose
+//! in wrapping u32, whose window sums are exact whatever the map size, and **float**,
+//! `(v − offset)·scale` summed in f32, whose window sums lose
 //! precision as the sums at their corners grow (fp32 has 24 significand bits).
 //!
 //! The scale rule of the fixed variant: a lookup's window of at most `A` texels (see
@@ -34,15 +35,17 @@
 //! makes `(v − offset)·scale` exact in f32. Each value then carries at most `½ / scale` of
 //! quantization error (plus 2⁻²⁴·|v − offset| from the subtraction), and so does every mean.
 
+pub mod five_pass;
+
 use crate::error::{Error, Result};
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
 
-/// Texels per scanned block, one workgroup each (`BLOCK` = `WG_SIZE · ITEMS` in
-/// `kernels/shared/sat_scan.wgsl`; a test checks them against each other).
-pub const SAT_BLOCK: u32 = 1024;
+/// Side of the square tile one workgroup of `sat_tile_sums` and `sat_tiles` owns (`TILE` in
+/// `kernels/shared/sat_tile.wgsl`; a test checks them against each other).
+pub const SAT_TILE: u32 = 64;
 
-/// Lines of block totals per `sat_carry` workgroup, one per invocation (its workgroup size).
-pub const SAT_CARRY_LINES: u32 = 64;
+/// Lines per `sat_carries` workgroup, one per invocation (its workgroup size).
+pub const SAT_LINES_PER_GROUP: u32 = 64;
 
 /// The largest `max_area` the fixed-point coding accepts: one unit per texel must fit an i32.
 pub const MAX_FIXED_AREA: u64 = (1 << 31) - 1;
@@ -50,32 +53,41 @@ pub const MAX_FIXED_AREA: u64 = (1 << 31) - 1;
 /// How the table stores its sums.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum SatVariant {
-    /// u32 fixed point with wraparound (`rgba32uint`): exact window sums.
+    /// u32 fixed point with wraparound (`r32uint` … `rgba32uint`): exact window sums.
     Fixed,
-    /// f32 (`rgba32float`): window sums lose precision with the magnitude of the corners.
+    /// f32 (`r32float` … `rgba32float`): window sums lose precision with the magnitude of the
+    /// corners.
     Float,
 }
 
 impl SatVariant {
-    /// The table's texel format.
-    pub fn format(self) -> wgpu::TextureFormat {
-        match self {
-            Self::Fixed => wgpu::TextureFormat::Rgba32Uint,
-            Self::Float => wgpu::TextureFormat::Rgba32Float,
+    /// The table's texel format for a representation of `channels` channels (1, 2, or 4 for
+    /// 3 or 4): `r32uint`, `rg32uint`, `rgba32uint` for fixed point, the `*32float` formats for
+    /// f32 sums.
+    pub fn format(self, channels: u32) -> wgpu::TextureFormat {
+        use wgpu::TextureFormat as T;
+        match (self, channels) {
+            (Self::Fixed, 1) => T::R32Uint,
+            (Self::Fixed, 2) => T::Rg32Uint,
+            (Self::Fixed, _) => T::Rgba32Uint,
+            (Self::Float, 1) => T::R32Float,
+            (Self::Float, 2) => T::Rg32Float,
+            (Self::Float, _) => T::Rgba32Float,
         }
     }
 
-    /// The kernel of the last pass (the only one whose output type differs).
-    fn last_kernel(self) -> &'static str {
+    /// The kernels of the first and the last pass (one per variant, so the variant's
+    /// arithmetic is a constant in them).
+    fn kernels(self) -> [&'static str; 2] {
         match self {
-            Self::Fixed => "sat_cols",
-            Self::Float => "sat_cols_f32",
+            Self::Fixed => ["sat_tile_sums", "sat_tiles"],
+            Self::Float => ["sat_tile_sums_f32", "sat_tiles_f32"],
         }
     }
 }
 
 /// Parameters of the `sat_*` kernels. Keep in sync with `SatParams` in
-/// `kernels/shared/sat_scan.wgsl`.
+/// `kernels/shared/sat_params.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct SatParams {
@@ -89,7 +101,7 @@ pub struct SatParams {
     pub channels: u32,
     /// 1 for the f32 variant, 0 for fixed point.
     pub float_sums: u32,
-    /// `sat_carry`: 0 scans along rows, 1 along columns.
+    /// The five-pass baseline's `sat_carry`: 0 scans along rows, 1 along columns (0 elsewhere).
     pub axis: u32,
     /// Padding.
     pub _pad: u32,
@@ -225,69 +237,114 @@ pub fn sat_name(input: &str) -> String {
     format!("{input}.sat")
 }
 
-/// Adds the five passes building the inclusive SAT of `input` (a float representation of
+/// Adds the three passes building the inclusive SAT of `input` (a float representation of
 /// `light`, 1–4 channels, any size) coded as `coding`; returns the table's resource,
-/// `<input>.sat` (`rgba32uint` or `rgba32float`, same size as `input`, always 4 channels).
+/// `<input>.sat`, the size of `input`, in [`SatVariant::format`] for the input's channels.
 ///
-/// Intermediates, all `rgba32uint` (the f32 variant carries f32 bits): `<input>.sat.rows`
-/// (block-local row scans, input size), `.row_sums` and `.row_carry`
-/// (`⌈width / SAT_BLOCK⌉ × height`), `.col_sums` and `.col_carry`
-/// (`width × ⌈height / SAT_BLOCK⌉`), sized by [`SizeRule`]s so the planner follows the input.
+/// Intermediates, in the table's channels as u32 (the f32 variant carries f32 bits):
+/// `<input>.sat.col_part` and `.col_carry` (`width × ⌈height / SAT_TILE⌉`), `.row_part` and
+/// `.row_carry` (`⌈width / SAT_TILE⌉ × height`), sized by [`SizeRule::Blocks`] so the planner
+/// follows the input.
 pub fn add_sat(graph: &mut Graph, light: usize, input: &str, coding: &SatCoding) -> String {
     let channels = graph.find(input).map_or(4, |r| format_channels(r.format));
     let name = sat_name(input);
-    let u32x4 = wgpu::TextureFormat::Rgba32Uint;
-    let same = SizeRule::Reduced {
-        of: input.to_string(),
-        shift: 0,
-    };
+    let words = SatVariant::Fixed.format(channels);
     let blocks = |x, y| SizeRule::Blocks {
         of: input.to_string(),
         x,
         y,
     };
     let mut res = |suffix: &str, size: SizeRule| {
-        graph.resource(format!("{name}.{suffix}"), u32x4, size, Some(light))
+        graph.resource(format!("{name}.{suffix}"), words, size, Some(light))
     };
-    let rows = res("rows", same.clone());
-    let row_sums = res("row_sums", blocks(SAT_BLOCK, 1));
-    let row_carry = res("row_carry", blocks(SAT_BLOCK, 1));
-    let col_sums = res("col_sums", blocks(1, SAT_BLOCK));
-    let col_carry = res("col_carry", blocks(1, SAT_BLOCK));
-    let out = graph.resource(name.clone(), coding.variant.format(), same, Some(light));
-
-    let names = SatNames {
-        input,
-        rows: &rows,
-        row_sums: &row_sums,
-        row_carry: &row_carry,
-        col_sums: &col_sums,
-        col_carry: &col_carry,
-        out: &out,
+    let col_part = res("col_part", blocks(1, SAT_TILE));
+    let row_part = res("row_part", blocks(SAT_TILE, 1));
+    let col_carry = res("col_carry", blocks(1, SAT_TILE));
+    let row_carry = res("row_carry", blocks(SAT_TILE, 1));
+    let same = SizeRule::Reduced {
+        of: input.to_string(),
+        shift: 0,
     };
-    for pass in passes(&names, coding.variant) {
-        graph.node(Node {
-            name: format!("{name}{}", pass.suffix),
-            kernel: pass.kernel.into(),
-            inputs: named(pass.inputs),
-            outputs: named(pass.outputs),
-            params: bytemuck::bytes_of(&coding.params(channels, pass.axis)).to_vec(),
-            dispatch: Dispatch::Blocks {
-                of: pass.blocks_of.to_string(),
-                x: pass.block[0],
-                y: pass.block[1],
+    let out = graph.resource(
+        name.clone(),
+        coding.variant.format(channels),
+        same,
+        Some(light),
+    );
+    let tiles = Dispatch::Blocks {
+        of: input.to_string(),
+        x: SAT_TILE,
+        y: SAT_TILE,
+    };
+    let params = bytemuck::bytes_of(&coding.params(channels, 0)).to_vec();
+    let passes = [
+        (
+            ".tile_sums",
+            coding.variant.kernels()[0],
+            vec![("src", input)],
+            vec![("col_part", col_part.as_str()), ("row_part", &row_part)],
+            tiles.clone(),
+        ),
+        (
+            ".carries",
+            "sat_carries",
+            vec![("col_part", col_part.as_str()), ("row_part", &row_part)],
+            vec![("col_carry", col_carry.as_str()), ("row_carry", &row_carry)],
+            Dispatch::Lines {
+                of: input.to_string(),
+                per_group: SAT_LINES_PER_GROUP,
             },
+        ),
+        (
+            "",
+            coding.variant.kernels()[1],
+            vec![
+                ("src", input),
+                ("col_carry", &col_carry),
+                ("row_carry", &row_carry),
+            ],
+            vec![("dst", out.as_str())],
+            tiles,
+        ),
+    ];
+    for (suffix, kernel, inputs, outputs, dispatch) in passes {
+        graph.node(Node {
+            name: format!("{name}{suffix}"),
+            kernel: kernel.into(),
+            inputs: named(inputs),
+            outputs: named(outputs),
+            params: params.clone(),
+            dispatch,
             light: Some(light),
         });
     }
     out
 }
 
+fn named(pairs: Vec<(&str, &str)>) -> Vec<(String, String)> {
+    pairs
+        .into_iter()
+        .map(|(b, r)| (b.to_string(), r.to_string()))
+        .collect()
+}
+
+/// The depth of the f32 table's summation tree for a `width × height` map: every f32 table
+/// texel is a sum of the scaled values over its rectangle in which no value passes through
+/// more than this many roundings, so it is within `d·2⁻²⁴·Σ|x|` of the exact sum. Per pass
+/// (see the kernels): the tile edges 28 (a sub-block's row sums 7, prefixed 7, across the
+/// sub-blocks 7, the sub-rows above 7); a column carry that many plus one per tile above, a
+/// row carry one more per tile above (the tiles' totals) and one per tile to the left; in the
+/// last pass the sub-block's table 14, the sums left of it 20 and above it 27, each added to
+/// its carry, and both sides added: `32 + tiles_x + tiles_y` bounds them all.
+pub fn float_sum_depth(width: u32, height: u32) -> u32 {
+    32 + width.div_ceil(SAT_TILE) + height.div_ceil(SAT_TILE)
+}
 /// The per-texel values a table holds, decoded: texel `(x, y)` of channel `c` is the 1×1
 /// window sum `S(x, y) − S(x − 1, y) − S(x, y − 1) + S(x − 1, y − 1)` (wrapping u32 read as
 /// i32 for the fixed variant, exact; f64 differences of the f32 sums for the float variant),
-/// divided by the scale, plus the offset. `table` holds the table's raw 32-bit words (4 per
-/// texel, row-major); the first `channels` channels are returned. For the fixed variant this is
+/// divided by the scale, plus the offset. `table` holds the table's raw 32-bit words,
+/// row-major, as many per texel as its format has channels (`table.len() / (width·height)`);
+/// the first `channels` channels are returned. For the fixed variant this is
 /// the quantized representation the lookups integrate, exactly.
 pub fn decode_table(
     table: &[u32],
@@ -296,7 +353,8 @@ pub fn decode_table(
     coding: &SatCoding,
     channels: usize,
 ) -> Vec<f32> {
-    let at = |x: usize, y: usize, c: usize| table[(y * width + x) * 4 + c];
+    let stride = table.len() / (width * height).max(1);
+    let at = |x: usize, y: usize, c: usize| table[(y * width + x) * stride + c];
     let mut out = Vec::with_capacity(width * height * channels);
     for y in 0..height {
         for x in 0..width {
@@ -336,92 +394,6 @@ pub fn decode_table(
         }
     }
     out
-}
-
-/// The resources of one table.
-struct SatNames<'a> {
-    input: &'a str,
-    rows: &'a str,
-    row_sums: &'a str,
-    row_carry: &'a str,
-    col_sums: &'a str,
-    col_carry: &'a str,
-    out: &'a str,
-}
-
-/// One pass of [`add_sat`]: a node named `<table><suffix>` with one workgroup per `block` of
-/// `blocks_of`.
-struct Pass<'a> {
-    suffix: &'a str,
-    kernel: &'a str,
-    inputs: Vec<(&'a str, &'a str)>,
-    outputs: Vec<(&'a str, &'a str)>,
-    axis: u32,
-    blocks_of: &'a str,
-    block: [u32; 2],
-}
-
-/// The five passes, in order (see the module documentation).
-fn passes<'a>(n: &SatNames<'a>, variant: SatVariant) -> [Pass<'a>; 5] {
-    let (b, lines) = (SAT_BLOCK, SAT_CARRY_LINES);
-    [
-        Pass {
-            suffix: ".rows",
-            kernel: "sat_rows",
-            inputs: vec![("src", n.input)],
-            outputs: vec![("dst", n.rows), ("sums", n.row_sums)],
-            axis: 0,
-            blocks_of: n.input,
-            block: [b, 1],
-        },
-        Pass {
-            suffix: ".row_carry",
-            kernel: "sat_carry",
-            inputs: vec![("src", n.row_sums)],
-            outputs: vec![("dst", n.row_carry)],
-            axis: 0,
-            blocks_of: n.row_sums,
-            block: [0, lines],
-        },
-        Pass {
-            suffix: ".col_sums",
-            kernel: "sat_cols_reduce",
-            inputs: vec![("src", n.rows), ("row_carry", n.row_carry)],
-            outputs: vec![("dst", n.col_sums)],
-            axis: 1,
-            blocks_of: n.input,
-            block: [1, b],
-        },
-        Pass {
-            suffix: ".col_carry",
-            kernel: "sat_carry",
-            inputs: vec![("src", n.col_sums)],
-            outputs: vec![("dst", n.col_carry)],
-            axis: 1,
-            blocks_of: n.col_sums,
-            block: [lines, 0],
-        },
-        Pass {
-            suffix: "",
-            kernel: variant.last_kernel(),
-            inputs: vec![
-                ("src", n.rows),
-                ("row_carry", n.row_carry),
-                ("col_carry", n.col_carry),
-            ],
-            outputs: vec![("dst", n.out)],
-            axis: 1,
-            blocks_of: n.input,
-            block: [1, b],
-        },
-    ]
-}
-
-fn named(pairs: Vec<(&str, &str)>) -> Vec<(String, String)> {
-    pairs
-        .into_iter()
-        .map(|(b, r)| (b.to_string(), r.to_string()))
-        .collect()
 }
 
 #[cfg(test)]
@@ -483,7 +455,7 @@ mod tests {
     }
 
     #[test]
-    fn sat_plans_five_passes_sized_by_blocks() {
+    fn sat_plans_three_passes_sized_by_tiles() {
         let mut g = Graph::default();
         g.import("in", wgpu::TextureFormat::Rg32Float, 3000, 37, Some(0));
         let coding = SatCoding::fixed(64, [0.0; 4], [1.0; 4]).unwrap();
@@ -491,41 +463,48 @@ mod tests {
         assert_eq!(out, "in.sat");
         let p = crate::graph::plan(&g, &[&out]).unwrap();
         let kernels: Vec<&str> = p.steps.iter().map(|s| s.node.kernel.as_str()).collect();
-        assert_eq!(
-            kernels,
-            [
-                "sat_rows",
-                "sat_carry",
-                "sat_cols_reduce",
-                "sat_carry",
-                "sat_cols"
-            ]
-        );
+        assert_eq!(kernels, ["sat_tile_sums", "sat_carries", "sat_tiles"]);
         let size = |n: &str| {
             let r = p.resource(n).unwrap();
             (r.width, r.height, r.resource.format)
         };
-        let u = wgpu::TextureFormat::Rgba32Uint;
+        let u = wgpu::TextureFormat::Rg32Uint;
         assert_eq!(size("in.sat"), (3000, 37, u));
-        assert_eq!(size("in.sat.rows"), (3000, 37, u));
-        assert_eq!(size("in.sat.row_carry"), (3, 37, u));
-        assert_eq!(size("in.sat.col_carry"), (3000, 1, u));
+        assert_eq!(size("in.sat.col_part"), (3000, 1, u));
+        assert_eq!(size("in.sat.row_carry"), (47, 37, u));
         let params: &SatParams = bytemuck::from_bytes(&p.steps[0].node.params);
         assert_eq!((params.channels, params.float_sums), (2, 0));
-
-        let mut g = Graph::default();
-        g.import("in", wgpu::TextureFormat::R32Float, 5, 5, Some(0));
-        let out = add_sat(
-            &mut g,
-            0,
-            "in",
-            &SatCoding::float([0.0; 4], [1.0; 4]).unwrap(),
-        );
-        let p = crate::graph::plan(&g, &[&out]).unwrap();
-        assert_eq!(p.steps[4].node.kernel, "sat_cols_f32");
+        let size = |r: &str| p.resource(r).map(|p| (p.width, p.height));
         assert_eq!(
-            p.resource(&out).unwrap().resource.format,
-            wgpu::TextureFormat::Rgba32Float
+            p.steps[0].node.dispatch.groups(size, [64, 1, 1]),
+            Some([47, 1, 1])
         );
+        assert_eq!(
+            p.steps[1].node.dispatch.groups(size, [64, 1, 1]),
+            Some([47, 2, 1])
+        );
+
+        for (format, channels, table) in [
+            (
+                wgpu::TextureFormat::R32Float,
+                1,
+                wgpu::TextureFormat::R32Float,
+            ),
+            (
+                wgpu::TextureFormat::Rgba16Float,
+                4,
+                wgpu::TextureFormat::Rgba32Float,
+            ),
+        ] {
+            let mut g = Graph::default();
+            g.import("in", format, 5, 5, Some(0));
+            let coding = SatCoding::float([0.0; 4], [1.0; 4]).unwrap();
+            let out = add_sat(&mut g, 0, "in", &coding);
+            let p = crate::graph::plan(&g, &[&out]).unwrap();
+            assert_eq!(p.steps[2].node.kernel, "sat_tiles_f32");
+            assert_eq!(p.resource(&out).unwrap().resource.format, table);
+            let params: &SatParams = bytemuck::from_bytes(&p.steps[2].node.params);
+            assert_eq!((params.channels, params.float_sums), (channels, 1));
+        }
     }
 }

@@ -1,0 +1,87 @@
+// One pass of a separable blur of a one-channel logarithmic representation (ESM's c·z; only
+// the first channel is read and written, so no exp is spent on the others): per texel
+// log Σ wᵢ exp(vᵢ) over its 2r + 1 neighbours along the axis (shared/blur_pass: PER outputs an
+// invocation). Each texel is exponentiated once, relative to the largest value the
+// invocation reads (its PER + 2r texels): `hi + log Σ w·exp(v − hi)`. Where those texels
+// span more than SPAN (exp(−SPAN) is still a normal f32, every bit kept), the invocation takes
+// each output's own window maximum instead, at one exp per tap: every exp ≤ 1, so nothing
+// that matters underflows at any c (ESM at c > SPAN across a depth edge).
+// The invocation reads its PER + 2r texels once into PER running sums, kept as named values (an
+// array indexed in a loop stays in memory on llvmpipe, three times slower).
+// #import shared/blur_pass
+// Traffic (the cost model, src/graph/cost): a row workgroup loads its WG_SIZE · PER texels and
+// a halo of r each side; a column workgroup WG_SIZE columns of PER + 2r texels each.
+// #traffic src: select(WG_SIZE * PER + 2 * min(params.radius, MAX_RADIUS), WG_SIZE * (PER + 2 * min(params.radius, MAX_RADIUS)), params.axis == 1) per group
+// #traffic dst: all
+
+const SPAN: f32 = 80.0;
+
+// The log-sum-exp of output k's window around its own maximum.
+fn log_sum_at(b: BlurLine, k: i32) -> f32 {
+    var m = -3.0e38;
+    for (var i = -b.r; i <= b.r; i++) {
+        m = max(m, tap(b, k + i).x);
+    }
+    var sum = 0.0;
+    for (var i = -b.r; i <= b.r; i++) {
+        sum += weight(i, b.r) * exp(tap(b, k + i).x - m);
+    }
+    return m + log(sum);
+}
+
+fn put_x(b: BlurLine, k: i32, v: f32) {
+    put(b, k, vec4<f32>(v, 0.0, 0.0, 0.0));
+}
+
+@compute @workgroup_size(WG_SIZE)
+fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    let b = blur_line(wg.xy, li);
+    if !blur_active(b) {
+        return;
+    }
+    var hi = -3.0e38;
+    var lo = 3.0e38;
+    for (var t = -b.r; t < i32(PER) + b.r; t++) {
+        let v = tap(b, t).x;
+        hi = max(hi, v);
+        lo = min(lo, v);
+    }
+    if hi - lo > SPAN {
+        put_x(b, 0, log_sum_at(b, 0));
+        put_x(b, 1, log_sum_at(b, 1));
+        put_x(b, 2, log_sum_at(b, 2));
+        put_x(b, 3, log_sum_at(b, 3));
+        put_x(b, 4, log_sum_at(b, 4));
+        put_x(b, 5, log_sum_at(b, 5));
+        put_x(b, 6, log_sum_at(b, 6));
+        put_x(b, 7, log_sum_at(b, 7));
+        return;
+    }
+    var s0 = 0.0;
+    var s1 = 0.0;
+    var s2 = 0.0;
+    var s3 = 0.0;
+    var s4 = 0.0;
+    var s5 = 0.0;
+    var s6 = 0.0;
+    var s7 = 0.0;
+    for (var t = -b.r; t < i32(PER) + b.r; t++) {
+        let v = exp(tap(b, t).x - hi);
+        s0 += weight(t - 0, b.r) * v;
+        s1 += weight(t - 1, b.r) * v;
+        s2 += weight(t - 2, b.r) * v;
+        s3 += weight(t - 3, b.r) * v;
+        s4 += weight(t - 4, b.r) * v;
+        s5 += weight(t - 5, b.r) * v;
+        s6 += weight(t - 6, b.r) * v;
+        s7 += weight(t - 7, b.r) * v;
+    }
+    put_x(b, 0, hi + log(s0));
+    put_x(b, 1, hi + log(s1));
+    put_x(b, 2, hi + log(s2));
+    put_x(b, 3, hi + log(s3));
+    put_x(b, 4, hi + log(s4));
+    put_x(b, 5, hi + log(s5));
+    put_x(b, 6, hi + log(s6));
+    put_x(b, 7, hi + log(s7));
+}

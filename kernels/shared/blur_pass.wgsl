@@ -1,0 +1,90 @@
+// One pass of a separable blur (import-only module of `blur` and `blur_log`): parameters,
+// bindings, and the line an invocation filters. Each invocation writes PER consecutive texels
+// of a line, reading its taps straight from the texture: no workgroup memory, so any radius up
+// to MAX_RADIUS fits (and llvmpipe, where a workgroup-memory access costs several texture
+// loads, runs it fast). Rows: a workgroup covers WG_SIZE · PER texels of one row; columns:
+// WG_SIZE neighbouring columns, PER rows each, so a workgroup's loads lie side by side. Edges
+// clamp (replicate the border texel), so the map edge keeps its shadow instead of fading
+// toward zero.
+// Storage: rg32float by default; the executor re-declares `dst` for the bound format.
+
+// Keep in sync with `BlurParams` in src/filter.rs.
+struct Params {
+    axis: u32,                        // 0 horizontal, 1 vertical
+    radius: u32,                      // taps each side, ≤ MAX_RADIUS
+    mode: u32,                        // 0 weighted sum; 1 log Σ w exp(v) (the kernel decides)
+    _pad: u32,
+    weights: array<vec4<f32>, 9>,     // weight of offset i at weights[i / 4][i % 4], i = 0..=32
+}
+
+@group(0) @binding(0) var src: texture_2d<f32>;
+@group(0) @binding(1) var dst: texture_storage_2d<rg32float, write>;
+@group(0) @binding(2) var<uniform> params: Params;
+
+// Keep in sync with `BLUR_PER_INVOCATION` and `BLUR_GROUP` in src/filter.rs.
+const PER: u32 = 8u;
+const WG_SIZE: u32 = 64u;
+const MAX_RADIUS: u32 = 32u;
+
+// The texels an invocation writes: `first` … `first + PER − 1` along line `line` of a map
+// `along` texels long and `across` lines wide; `r` taps each side.
+struct BlurLine {
+    first: i32,
+    line: u32,
+    along: i32,
+    across: u32,
+    r: i32,
+}
+
+// Rows: workgroup (x, y) covers texels [x·WG_SIZE·PER, …) of row y. Columns: workgroup (x, y)
+// covers columns x·WG_SIZE + li, rows [y·PER, (y + 1)·PER).
+fn blur_line(wg: vec2<u32>, li: u32) -> BlurLine {
+    let size = textureDimensions(src);
+    var b: BlurLine;
+    b.r = i32(min(params.radius, MAX_RADIUS));
+    if params.axis == 1u {
+        b.first = i32(wg.y * PER);
+        b.line = wg.x * WG_SIZE + li;
+        b.along = i32(size.y);
+        b.across = size.x;
+    } else {
+        b.first = i32((wg.x * WG_SIZE + li) * PER);
+        b.line = wg.y;
+        b.along = i32(size.x);
+        b.across = size.y;
+    }
+    return b;
+}
+
+// Whether the invocation has any texel to write.
+fn blur_active(b: BlurLine) -> bool {
+    return b.line < b.across && b.first < b.along;
+}
+
+// The weight of offset d (0 past the radius r ≤ MAX_RADIUS).
+fn weight(d: i32, r: i32) -> f32 {
+    let i = u32(min(abs(d), r));
+    return select(0.0, params.weights[i / 4u][i % 4u], abs(d) <= r);
+}
+
+// Texel `first + t` along the line, clamped to the map.
+fn tap(b: BlurLine, t: i32) -> vec4<f32> {
+    let c = u32(clamp(b.first + t, 0, b.along - 1));
+    if params.axis == 1u {
+        return textureLoad(src, vec2<u32>(b.line, c), 0);
+    }
+    return textureLoad(src, vec2<u32>(c, b.line), 0);
+}
+
+// Writes v as output k of the invocation (if inside the map).
+fn put(b: BlurLine, k: i32, v: vec4<f32>) {
+    let a = b.first + k;
+    if a >= b.along {
+        return;
+    }
+    if params.axis == 1u {
+        textureStore(dst, vec2<u32>(b.line, u32(a)), v);
+    } else {
+        textureStore(dst, vec2<u32>(u32(a), b.line), v);
+    }
+}

@@ -1,0 +1,261 @@
+//! One configuration's measurement: its render, its errors against the truth (whole, by
+//! region, perceptual) and against the PCF truth, its times and memory.
+
+use glam::DVec3;
+
+use super::flip::{Shader, flip_map, flip_stats};
+use super::stats::{ErrorStats, Region, Regions};
+use super::{Config, Row, storage_name};
+use crate::cpu::Map;
+use crate::error::{Error, Result};
+use crate::gpu::Gpu;
+use crate::render::{FloatMap, Frame, RenderOptions, Renderer, plan_lights};
+use crate::scene::{Filter, Scene, Technique};
+use crate::technique::LightGpu;
+use crate::truth::Truth;
+use crate::truth::pcf::{Receiver, pcf_box};
+
+/// What every configuration is measured against: the truth, its regions and its shading.
+pub struct Reference {
+    /// The area-light truth.
+    pub truth: Truth,
+    /// Its visibility in f64.
+    truth64: Vec<f64>,
+    /// Its penumbra, umbra and lit regions.
+    pub regions: Regions,
+    /// The masks of [`Region::Penumbra`], [`Region::Umbra`], [`Region::Lit`].
+    masks: [Vec<bool>; 3],
+    /// The scene's shading.
+    shader: Shader,
+}
+
+impl Reference {
+    /// The reference of `scene` from its `truth`.
+    pub fn new(scene: &Scene, truth: Truth) -> Self {
+        let regions = Regions::new(
+            &truth.visibility,
+            &truth.mask,
+            truth.width as usize,
+            truth.height as usize,
+            truth.lights,
+        );
+        let masks = [Region::Penumbra, Region::Umbra, Region::Lit].map(|r| regions.mask(r));
+        Self {
+            truth64: truth.visibility.iter().map(|&v| f64::from(v)).collect(),
+            truth,
+            regions,
+            masks,
+            shader: Shader::new(scene),
+        }
+    }
+
+    /// Pixels in the penumbra, umbra and lit regions.
+    pub fn region_pixels(&self) -> [usize; 3] {
+        self.masks
+            .each_ref()
+            .map(|m| m.iter().filter(|&&b| b).count())
+    }
+}
+
+/// One configuration measured: its row, its frame and both shaded images.
+pub struct Measured {
+    /// The report's row.
+    pub row: Row,
+    /// The last rendered frame.
+    pub frame: Frame,
+    /// The frame's G-buffer shaded with the frame's visibility (RGB8).
+    pub shaded: Vec<u8>,
+    /// The same G-buffer shaded with the truth's visibility (RGB8).
+    pub truth_shaded: Vec<u8>,
+}
+
+/// Renders one configuration (`repeat` timed frames) and measures it.
+pub fn measure(
+    renderer: &mut Renderer,
+    gpu: &Gpu,
+    scene: &Scene,
+    c: &Config,
+    linear: &[FloatMap],
+    reference: &Reference,
+    repeat: u32,
+) -> Result<Measured> {
+    let truth = &reference.truth;
+    let frame = renderer.render(
+        &gpu.device,
+        &gpu.queue,
+        scene,
+        RenderOptions {
+            aux: true,
+            // One more frame than timed: the first also pays for first-use work (software
+            // drivers compile shaders at their first dispatch), so its times are dropped.
+            repeat: repeat.max(1) + 1,
+            dump: false,
+        },
+    )?;
+    if frame.visibility.len() != truth.visibility.len() {
+        return Err(Error::Invalid("truth and render differ in size".into()));
+    }
+    let stats = |mask: &[bool]| ErrorStats::new(&frame.visibility, &reference.truth64, mask);
+    let soft = stats(&truth.mask);
+    let [penumbra, umbra, lit] = reference.masks.each_ref().map(|m| stats(m));
+    let shade = |v: &[f32]| reference.shader.image(&frame.position, &frame.normal, v);
+    let (shaded, truth_shaded) = (shade(&frame.visibility), shade(&truth.visibility));
+    let flip = flip_stats(&flip_map(&truth_shaded, &shaded, frame.width, frame.height));
+    let pcf = match c.box_width {
+        Some(w) => Some(pcf_stats(scene, &frame, linear, truth, w)?),
+        None => None,
+    };
+    let passes = median_passes(frame.timings.get(1..).unwrap_or_default());
+    let sum = |f: &dyn Fn(&str) -> bool| -> Option<f64> {
+        (!passes.is_empty()).then(|| passes.iter().filter(|(l, _)| f(l)).map(|p| p.1).sum())
+    };
+    let raster_ms = sum(&|l| l.ends_with(".shadow_raster"));
+    let gbuffer_ms = sum(&|l| l == "gbuffer");
+    let shade_ms = sum(&|l| l == "shade");
+    let kernels_ms = sum(&|l| !l.ends_with(".shadow_raster") && l != "gbuffer" && l != "shade");
+    let total_ms = match (raster_ms, kernels_ms, shade_ms) {
+        (Some(a), Some(b), Some(c)) => Some(a + b + c),
+        _ => None,
+    };
+    let plan = plan_lights(&scene.lights)?;
+    let depth: u64 = scene
+        .lights
+        .iter()
+        .map(|l| u64::from(l.shadow_map).pow(2) * 4)
+        .sum();
+    let (storage, filter) = match c.technique {
+        Technique::Vsm { prefilter, .. }
+        | Technique::Evsm { prefilter, .. }
+        | Technique::Msm { prefilter, .. }
+        | Technique::Csm { prefilter, .. } => (
+            storage_name(prefilter.storage).to_string(),
+            filter_name(prefilter.filter),
+        ),
+        Technique::Esm { filter, .. } => ("f32".to_string(), filter_name(filter)),
+        _ => (String::new(), String::new()),
+    };
+    let row = Row {
+        label: c.label.clone(),
+        technique: c.technique.name().to_string(),
+        shadow_map: c.shadow_map,
+        storage,
+        filter,
+        box_width: c.box_width,
+        passes,
+        raster_ms,
+        kernels_ms,
+        shade_ms,
+        total_ms,
+        gbuffer_ms,
+        memory_bytes: plan.plan.peak_live_bytes() + depth,
+        soft,
+        penumbra,
+        umbra,
+        lit,
+        flip,
+        pcf,
+    };
+    Ok(Measured {
+        row,
+        frame,
+        shaded,
+        truth_shaded,
+    })
+}
+
+fn filter_name(f: Filter) -> String {
+    match f {
+        Filter::None => "none",
+        Filter::Blur { .. } => "blur",
+        Filter::Mips { .. } => "mips",
+        Filter::Sat { .. } => "sat",
+    }
+    .to_string()
+}
+
+/// Median of each pass over the frames (passes in the first frame's order).
+fn median_passes(frames: &[Vec<(String, f64)>]) -> Vec<(String, f64)> {
+    let Some(first) = frames.first() else {
+        return Vec::new();
+    };
+    first
+        .iter()
+        .enumerate()
+        .map(|(i, (label, _))| {
+            let mut v: Vec<f64> = frames
+                .iter()
+                .filter_map(|f| f.get(i).map(|x| x.1))
+                .collect();
+            v.sort_by(f64::total_cmp);
+            (label.clone(), v[v.len() / 2])
+        })
+        .collect()
+}
+
+/// Each light's linear depth map at `size`: the shade map of a `hard` render (the plan's
+/// output, so no later kernel reused its texture). Rasterization does not depend on the
+/// technique, so this is the map every configuration of that size rasterized.
+pub fn linear_maps(
+    renderer: &mut Renderer,
+    gpu: &Gpu,
+    scene: &Scene,
+    size: u32,
+) -> Result<Vec<FloatMap>> {
+    let mut s = scene.clone();
+    for l in &mut s.lights {
+        l.shadow.technique = Technique::Hard;
+        l.shadow_map = size;
+    }
+    let opts = RenderOptions {
+        aux: true,
+        repeat: 1,
+        dump: false,
+    };
+    Ok(renderer
+        .render(&gpu.device, &gpu.queue, &s, opts)?
+        .shade_maps)
+}
+
+/// Error against the box-PCF truth over each light's linear map `linear` (1 where the
+/// receiver leaves the map, as the shading returns).
+fn pcf_stats(
+    scene: &Scene,
+    frame: &Frame,
+    linear: &[FloatMap],
+    truth: &Truth,
+    width: f64,
+) -> Result<ErrorStats> {
+    let lights = scene.lights.len();
+    let mut reference = vec![1.0; frame.visibility.len()];
+    for (li, light) in scene.lights.iter().enumerate() {
+        let Some(linear) = linear.get(li) else {
+            return Err(Error::Invalid(format!(
+                "light {li} has no linear map to take the PCF truth over"
+            )));
+        };
+        let map = Map {
+            size: linear.width as usize,
+            texels: &linear.data,
+        };
+        let g = LightGpu::new(light);
+        for px in 0..(frame.width * frame.height) as usize {
+            let i = px * lights + li;
+            if !truth.mask[i] {
+                continue;
+            }
+            let at = |d: &[f32]| {
+                DVec3::new(d[4 * px].into(), d[4 * px + 1].into(), d[4 * px + 2].into())
+            };
+            let (p, n) = (at(&frame.position), at(&frame.normal).normalize_or_zero());
+            let s = crate::cpu::light::sample(&g, p, n);
+            if s.inside {
+                let r = Receiver {
+                    uv: s.uv,
+                    depth: s.depth,
+                };
+                reference[i] = pcf_box(&map, &r, width, f64::from(light.shadow.bias));
+            }
+        }
+    }
+    Ok(ErrorStats::new(&frame.visibility, &reference, &truth.mask))
+}
