@@ -127,7 +127,7 @@ fn main() -> Result<()> {
         image::ColorType::Rgba8,
     )
     .with_context(|| format!("writing {out}"))?;
-    for (stage, _, _) in &panels {
+    for (stage, _, _) in &mut panels {
         let name = stage.config().technique.name();
         let times: Vec<String> = stage
             .timings(&device)?

@@ -85,30 +85,31 @@ fn cone(l: Light, p: vec3<f32>) -> f32 {
 
 @compute @workgroup_size(WG_SIZE, WG_SIZE)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    // Invocations past the image still run (clamped to its last texel) and store nothing, and
-    // background pixels still evaluate their lights: no invocation leaves the code path before
-    // the maps are sampled (see `technique::shading_block`).
-    let inside = all(id.xy < frame.size);
-    let xy = min(id.xy, frame.size - 1u);
+    if any(id.xy >= frame.size) {
+        return;
+    }
+    let xy = id.xy;
     let base = (xy.y * frame.size.x + xy.x) * frame.light_count;
     let gp = textureLoad(g_position, xy, 0);
-    let background = gp.w == 0.0;
+    if gp.w == 0.0 {
+        // Background: no receiver, nothing shadowed, no lookup.
+        for (var i = 0u; i < frame.light_count; i++) {
+            out_visibility[base + i] = 1.0;
+        }
+        textureStore(out_color, xy, vec4<f32>(linear_to_srgb(frame.background), 1.0));
+        return;
+    }
     let gn = textureLoad(g_normal, xy, 0);
-    let n = select(normalize(gn.xyz), vec3<f32>(0.0, 1.0, 0.0), background || dot(gn.xyz, gn.xyz) == 0.0);
+    let n = select(normalize(gn.xyz), vec3<f32>(0.0, 1.0, 0.0), dot(gn.xyz, gn.xyz) == 0.0);
     let albedo = materials[min(u32(gn.w), arrayLength(&materials) - 1u)].rgb;
     var radiance = frame.ambient * albedo;
     let dp = pixel_differentials(xy, gp.xyz, n);
     for (var i = 0u; i < frame.light_count; i++) {
         let l = lights[i];
-        let v = select(light_visibility(i, gp.xyz, n, dp.dpdx, dp.dpdy), 1.0, background);
-        if inside {
-            out_visibility[base + i] = v;
-        }
+        let v = light_visibility(i, gp.xyz, n, dp.dpdx, dp.dpdy);
+        out_visibility[base + i] = v;
         let ndl = max(dot(n, light_to_light(l, gp.xyz)), 0.0);
         radiance += albedo * l.radiance * (ndl * v * cone(l, gp.xyz));
     }
-    let color = select(radiance, frame.background, background);
-    if inside {
-        textureStore(out_color, xy, vec4<f32>(linear_to_srgb(color), 1.0));
-    }
+    textureStore(out_color, xy, vec4<f32>(linear_to_srgb(radiance), 1.0));
 }

@@ -1,12 +1,14 @@
 //! The executor: records a [`Plan`] into a caller's command encoder, one compute pass per node,
 //! each node a span of the caller's [`GpuTimer`] when one is given. It borrows the device and
 //! never submits, so it runs the same inside shadowgraph's renderer and inside a host's frame.
+//! What a plan needs (textures, the parameter and counter buffers, every node's bind group) is
+//! made on its first run and reused while the plan and its imported textures stay the same: a
+//! frame records passes and creates nothing.
 
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use wgpu::util::DeviceExt;
-
+use crate::created;
 use crate::error::{Error, Result};
 use crate::filter::{MIP_LEVELS_PER_DISPATCH, MipParams, mip_dispatches};
 use crate::gpu::{read_buffer, scoped};
@@ -34,32 +36,44 @@ impl ComputeKernel {
         let (layouts, pipeline) = scoped(
             device,
             || {
-                let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                    label: Some(&label),
-                    source: wgpu::ShaderSource::Wgsl(wgsl.into()),
-                });
+                let module = created::shader_module(
+                    device,
+                    wgpu::ShaderModuleDescriptor {
+                        label: Some(&label),
+                        source: wgpu::ShaderSource::Wgsl(wgsl.into()),
+                    },
+                );
                 let layouts: Vec<wgpu::BindGroupLayout> = (0..reflection.group_count())
                     .map(|g| {
-                        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                            label: Some(&label),
-                            entries: &reflection.layout_entries(g),
-                        })
+                        created::bind_group_layout(
+                            device,
+                            &wgpu::BindGroupLayoutDescriptor {
+                                label: Some(&label),
+                                entries: &reflection.layout_entries(g),
+                            },
+                        )
                     })
                     .collect();
                 let refs: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(Some).collect();
-                let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                    label: Some(&label),
-                    bind_group_layouts: &refs,
-                    immediate_size: 0,
-                });
-                let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(&label),
-                    layout: Some(&layout),
-                    module: &module,
-                    entry_point: Some("main"),
-                    compilation_options: Default::default(),
-                    cache: None,
-                });
+                let layout = created::pipeline_layout(
+                    device,
+                    &wgpu::PipelineLayoutDescriptor {
+                        label: Some(&label),
+                        bind_group_layouts: &refs,
+                        immediate_size: 0,
+                    },
+                );
+                let pipeline = created::compute_pipeline(
+                    device,
+                    &wgpu::ComputePipelineDescriptor {
+                        label: Some(&label),
+                        layout: Some(&layout),
+                        module: &module,
+                        entry_point: Some("main"),
+                        compilation_options: Default::default(),
+                        cache: None,
+                    },
+                );
                 (layouts, pipeline)
             },
             |message| Error::Pipeline {
@@ -156,6 +170,41 @@ impl KernelCache {
         Ok(k)
     }
 
+    /// The pipeline cached under `key`, compiled from the kernel `name` and the `// #generated`
+    /// block `generated()` makes on a miss: a variant looked up by a key its caller derives
+    /// from what the block depends on (the renderer's shading kernel,
+    /// [`crate::technique::shade_key`]) instead of generating and hashing the block's text.
+    pub fn get_keyed(
+        &mut self,
+        device: &wgpu::Device,
+        key: &str,
+        name: &str,
+        generated: impl FnOnce() -> String,
+    ) -> Result<Arc<ComputeKernel>> {
+        if let Some(k) = self.kernels.get(key) {
+            return Ok(k.clone());
+        }
+        let wgsl = kernels::resolve(name, Some(&generated()))?;
+        let k = Arc::new(ComputeKernel::new(device, name, &wgsl)?);
+        self.kernels.insert(key.to_string(), k.clone());
+        Ok(k)
+    }
+
+    /// Compiles `wgsl` as the pipeline [`KernelCache::get_keyed`] returns for `key` from now
+    /// on: a rewritten variant with the same bindings, e.g. the shading kernel with every
+    /// texture fetch counted (`tests/cost.rs`).
+    pub fn insert_keyed(
+        &mut self,
+        device: &wgpu::Device,
+        key: &str,
+        name: &str,
+        wgsl: &str,
+    ) -> Result<()> {
+        let k = Arc::new(ComputeKernel::new(device, name, wgsl)?);
+        self.kernels.insert(key.to_string(), k);
+        Ok(())
+    }
+
     /// Compiles `wgsl` as the pipeline [`KernelCache::get_generated`] returns for `name` and
     /// `generated` from now on: a rewritten variant of the kernel with the same bindings, e.g.
     /// the shading kernel with every texture fetch counted (`tests/cost.rs`).
@@ -239,23 +288,26 @@ impl TexturePool {
         if let Some(t) = self.free.get_mut(slot).and_then(Vec::pop) {
             return t;
         }
-        device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("shadowgraph.pool"),
-            size: wgpu::Extent3d {
-                width: slot.width,
-                height: slot.height,
-                depth_or_array_layers: 1,
+        created::texture(
+            device,
+            &wgpu::TextureDescriptor {
+                label: Some("shadowgraph.pool"),
+                size: wgpu::Extent3d {
+                    width: slot.width,
+                    height: slot.height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: slot.mips,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: slot.format,
+                usage: wgpu::TextureUsages::STORAGE_BINDING
+                    | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC
+                    | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
             },
-            mip_level_count: slot.mips,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: slot.format,
-            usage: wgpu::TextureUsages::STORAGE_BINDING
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC
-                | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        })
+        )
     }
 
     /// Textures held (in use by the last run or free).
@@ -265,6 +317,7 @@ impl TexturePool {
 }
 
 /// The textures a run produced, by resource name.
+#[derive(Clone)]
 pub struct Outputs {
     /// Texture of every planned resource, imports included.
     pub textures: HashMap<String, wgpu::Texture>,
@@ -283,7 +336,7 @@ impl Outputs {
     pub fn view(&self, name: &str) -> Result<wgpu::TextureView> {
         self.textures
             .get(name)
-            .map(|t| t.create_view(&Default::default()))
+            .map(|t| created::view(t, &Default::default()))
             .ok_or_else(|| Error::Invalid(format!("the plan has no resource `{name}`")))
     }
 
@@ -308,13 +361,35 @@ impl Outputs {
     }
 }
 
-/// Runs plans: owns pipelines and pooled textures, borrows everything else.
+/// Runs plans: owns pipelines, pooled textures and what the last plan's run needs; borrows
+/// everything else.
 #[derive(Default)]
 pub struct Executor {
     /// Compiled kernels.
     pub kernels: KernelCache,
     pool: TexturePool,
     in_use: Vec<(Slot, wgpu::Texture)>,
+    prepared: Option<Prepared>,
+}
+
+/// What a plan's run needs besides its passes, made once and reused while the plan and the
+/// imported textures stay the same.
+struct Prepared {
+    plan: Plan,
+    /// The imported textures bound, by resource name.
+    imports: Vec<(String, wgpu::Texture)>,
+    outputs: Outputs,
+    /// Every step's parameters, and per step its `(offset, size)` there.
+    params: (wgpu::Buffer, Vec<(u64, u64)>),
+    /// Per step: its pipeline and dispatches.
+    steps: Vec<PreparedStep>,
+}
+
+/// One node's pipeline and its dispatches in one pass, each a bind group and workgroups (a
+/// mip chain: one per group of levels).
+struct PreparedStep {
+    kernel: Arc<ComputeKernel>,
+    dispatches: Vec<(wgpu::BindGroup, [u32; 3])>,
 }
 
 impl Executor {
@@ -345,6 +420,8 @@ impl Executor {
 
     /// Records `plan` into `encoder`. `imports` gives a texture for every imported resource.
     /// With a `timer`, each node is a span named after it, and the last one ends with the plan.
+    /// The first run of a plan makes its textures, buffers and bind groups; later runs of the
+    /// same plan over the same imported textures reuse them and return the same textures.
     pub fn record(
         &mut self,
         device: &wgpu::Device,
@@ -355,6 +432,57 @@ impl Executor {
     ) -> Result<Outputs> {
         // A plan's fields are public: check what the indexing below relies on first.
         plan.check()?;
+        let same_plan = self.prepared.as_ref().is_some_and(|p| p.plan == *plan);
+        let prepared = match self.prepared.take() {
+            Some(p) if same_plan && p.imports_match(imports) => p,
+            // New imported textures (a host's depth map): the nodes reading them are bound anew.
+            Some(p) if same_plan => self.rebind_imports(device, p, imports)?,
+            _ => self.prepare_run(device, plan, imports)?,
+        };
+        let result = self.encode(encoder, &prepared, timer.as_deref_mut());
+        let outputs = prepared.outputs.clone();
+        self.prepared = Some(prepared);
+        result?;
+        // The last node ends here, not at whatever the caller records next.
+        if let Some(t) = timer {
+            t.end(encoder);
+        }
+        Ok(outputs)
+    }
+
+    /// Records the passes of a prepared plan.
+    fn encode(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        prepared: &Prepared,
+        mut timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
+        encoder.clear_buffer(&prepared.outputs.stats, 0, None);
+        for (step, bound) in prepared.plan.steps.iter().zip(&prepared.steps) {
+            let node = &step.node;
+            if let Some(t) = timer.as_deref_mut() {
+                t.begin(encoder, &node.name);
+            }
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(&node.name),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&bound.kernel.pipeline);
+            for (bind_group, g) in &bound.dispatches {
+                pass.set_bind_group(0, bind_group, &[]);
+                pass.dispatch_workgroups(g[0], g[1], g[2]);
+            }
+        }
+        Ok(())
+    }
+
+    /// Takes `plan`'s textures from the pool and makes its buffers and bind groups.
+    fn prepare_run(
+        &mut self,
+        device: &wgpu::Device,
+        plan: &Plan,
+        imports: &HashMap<String, wgpu::Texture>,
+    ) -> Result<Prepared> {
         // Textures of the previous run go back to the pool, then each slot takes one.
         for (slot, t) in self.in_use.drain(..) {
             self.pool.free.entry(slot).or_default().push(t);
@@ -370,191 +498,195 @@ impl Executor {
             .cloned()
             .zip(slot_textures.iter().cloned())
             .collect();
-
-        let mut textures = HashMap::new();
-        for r in &plan.resources {
-            let t = match r.slot {
-                Some(s) => slot_textures[s].clone(),
-                None => imports.get(&r.resource.name).cloned().ok_or_else(|| {
-                    Error::Invalid(format!(
-                        "imported resource `{}` was not provided",
-                        r.resource.name
-                    ))
-                })?,
-            };
-            if (t.width(), t.height()) != (r.width, r.height) {
-                return Err(Error::Invalid(format!(
-                    "`{}` is {}x{}, the plan expects {}x{}",
-                    r.resource.name,
-                    t.width(),
-                    t.height(),
-                    r.width,
-                    r.height
-                )));
-            }
-            textures.insert(r.resource.name.clone(), t);
-        }
-
+        let textures = plan_textures(plan, &slot_textures, imports)?;
         let steps = plan.steps.len().max(1) as u64;
-        let stats = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("shadowgraph.stats"),
-            size: steps * STATS_STRIDE,
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::COPY_SRC
-                | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let stats_readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("shadowgraph.stats.readback"),
-            size: steps * STATS_STRIDE,
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
-        encoder.clear_buffer(&stats, 0, None);
-
-        let align = u64::from(device.limits().min_uniform_buffer_offset_alignment).max(16);
-        let mut params_bytes = Vec::new();
-        let mut params_at = Vec::new();
-        for step in &plan.steps {
-            let at = (params_bytes.len() as u64).div_ceil(align) * align;
-            params_bytes.resize(at as usize, 0);
-            params_at.push((at, step.node.params.len().max(16) as u64));
-            params_bytes.extend_from_slice(&step.node.params);
-        }
-        params_bytes.resize(params_bytes.len().max(16).div_ceil(16) * 16 + 16, 0);
-        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("shadowgraph.params"),
-            contents: &params_bytes,
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-
-        for (si, step) in plan.steps.iter().enumerate() {
-            let node = &step.node;
-            if let Some(t) = timer.as_deref_mut() {
-                t.begin(encoder, &node.name);
-            }
-            if node.dispatch == Dispatch::MipChain {
-                self.record_mip_chain(device, encoder, node, &textures)?;
-                continue;
-            }
-            let formats: Vec<(String, wgpu::TextureFormat)> = node
-                .outputs
-                .iter()
-                .map(|(slot, r)| (slot.clone(), textures[r].format()))
-                .collect();
-            let kernel = self
-                .kernels
-                .get_specialized(device, &node.kernel, &formats)?;
-            let mut views: Vec<(u32, wgpu::TextureView)> = Vec::new();
-            let mut entries: Vec<wgpu::BindGroupEntry> = Vec::new();
-            for b in kernel.reflection.bindings.iter().filter(|b| b.group == 0) {
-                let bound = node
-                    .inputs
-                    .iter()
-                    .chain(&node.outputs)
-                    .find(|(slot, _)| *slot == b.name);
-                if let Some((_, res)) = bound {
-                    let view = textures[res].create_view(&wgpu::TextureViewDescriptor {
-                        aspect: if textures[res].format().is_depth_stencil_format() {
-                            wgpu::TextureAspect::DepthOnly
-                        } else {
-                            wgpu::TextureAspect::All
-                        },
-                        ..Default::default()
-                    });
-                    views.push((b.binding, view));
-                } else if b.name != "params" && b.name != "stats" {
-                    return Err(Error::Pipeline {
-                        kernel: node.kernel.clone(),
-                        message: format!("node `{}` binds nothing to `{}`", node.name, b.name),
-                    });
-                }
-            }
-            for (binding, view) in &views {
-                entries.push(wgpu::BindGroupEntry {
-                    binding: *binding,
-                    resource: wgpu::BindingResource::TextureView(view),
-                });
-            }
-            if let Some(b) = kernel.reflection.binding("params") {
-                let (offset, size) = params_at[si];
-                entries.push(wgpu::BindGroupEntry {
-                    binding: b.binding,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &params,
-                        offset,
-                        size: wgpu::BufferSize::new(size.div_ceil(16) * 16),
-                    }),
-                });
-            }
-            if let Some(b) = kernel.reflection.binding("stats") {
-                entries.push(wgpu::BindGroupEntry {
-                    binding: b.binding,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &stats,
-                        offset: si as u64 * STATS_STRIDE,
-                        size: wgpu::BufferSize::new(4),
-                    }),
-                });
-            }
-            let layout = kernel
-                .layouts
-                .first()
-                .ok_or_else(|| no_layout(&kernel.name))?;
-            let bind_group = scoped(
+        let counters = |label, usage| {
+            created::buffer(
                 device,
-                || {
-                    device.create_bind_group(&wgpu::BindGroupDescriptor {
-                        label: Some(&node.name),
-                        layout,
-                        entries: &entries,
-                    })
+                &wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size: steps * STATS_STRIDE,
+                    usage,
+                    mapped_at_creation: false,
                 },
-                |message| Error::Pipeline {
-                    kernel: node.kernel.clone(),
-                    message: format!("binding node `{}`: {message}", node.name),
-                },
-            )?;
-            let wg = kernel.reflection.workgroup_size.unwrap_or([1, 1, 1]);
-            let size = |r: &str| textures.get(r).map(|t| (t.width(), t.height()));
-            let groups = node.dispatch.groups(size, wg).ok_or_else(|| {
-                Error::Invalid(format!(
-                    "node `{}` dispatches over a resource that is not in the plan",
-                    node.name
-                ))
-            })?;
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some(&node.name),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&kernel.pipeline);
-            pass.set_bind_group(0, &bind_group, &[]);
-            pass.dispatch_workgroups(groups[0], groups[1], groups[2]);
-        }
-        // The last node ends here, not at whatever the caller records next.
-        if let Some(t) = timer {
-            t.end(encoder);
-        }
-        Ok(Outputs {
-            textures,
-            stats,
-            stats_readback,
+            )
+        };
+        let outputs = Outputs {
+            stats: counters(
+                "shadowgraph.stats",
+                wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_SRC
+                    | wgpu::BufferUsages::COPY_DST,
+            ),
+            stats_readback: counters(
+                "shadowgraph.stats.readback",
+                wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            ),
             steps: plan.steps.iter().map(|s| s.node.name.clone()).collect(),
+            textures,
+        };
+        let (params, params_at) = params_buffer(device, plan);
+        let mut bound = Vec::new();
+        for (si, step) in plan.steps.iter().enumerate() {
+            bound.push(self.bind_step(device, &step.node, &outputs, si, &params, params_at[si])?);
+        }
+        let imports = plan
+            .resources
+            .iter()
+            .filter(|r| r.slot.is_none())
+            .filter_map(|r| {
+                let t = imports.get(&r.resource.name)?;
+                Some((r.resource.name.clone(), t.clone()))
+            })
+            .collect();
+        Ok(Prepared {
+            plan: plan.clone(),
+            imports,
+            outputs,
+            params: (params, params_at),
+            steps: bound,
         })
     }
 
-    /// Records a [`Dispatch::MipChain`] node: one compute pass with the dispatches of
+    /// `prepared` over other imported textures: the same textures and buffers, the steps that
+    /// read an import bound anew.
+    fn rebind_imports(
+        &mut self,
+        device: &wgpu::Device,
+        mut prepared: Prepared,
+        imports: &HashMap<String, wgpu::Texture>,
+    ) -> Result<Prepared> {
+        let slots: Vec<wgpu::Texture> = self.in_use.iter().map(|(_, t)| t.clone()).collect();
+        prepared.outputs.textures = plan_textures(&prepared.plan, &slots, imports)?;
+        for (name, t) in &mut prepared.imports {
+            if let Some(new) = imports.get(name) {
+                *t = new.clone();
+            }
+        }
+        let plan = prepared.plan.clone();
+        for (si, step) in plan.steps.iter().enumerate() {
+            let reads_import = step
+                .node
+                .inputs
+                .iter()
+                .any(|(_, r)| prepared.imports.iter().any(|(name, _)| name == r));
+            if reads_import {
+                let (params, at) = &prepared.params;
+                prepared.steps[si] =
+                    self.bind_step(device, &step.node, &prepared.outputs, si, params, at[si])?;
+            }
+        }
+        Ok(prepared)
+    }
+
+    /// A node's pipeline and dispatches (a mip chain's by [`Executor::bind_mip_chain`]);
+    /// `params_at` is its slice of `params`.
+    fn bind_step(
+        &mut self,
+        device: &wgpu::Device,
+        node: &crate::graph::Node,
+        outputs: &Outputs,
+        si: usize,
+        params: &wgpu::Buffer,
+        (offset, size): (u64, u64),
+    ) -> Result<PreparedStep> {
+        if node.dispatch == Dispatch::MipChain {
+            return self.bind_mip_chain(device, node, &outputs.textures);
+        }
+        let textures = &outputs.textures;
+        let formats: Vec<(String, wgpu::TextureFormat)> = node
+            .outputs
+            .iter()
+            .map(|(slot, r)| (slot.clone(), textures[r].format()))
+            .collect();
+        let kernel = self
+            .kernels
+            .get_specialized(device, &node.kernel, &formats)?;
+        let mut views: Vec<(u32, wgpu::TextureView)> = Vec::new();
+        for b in kernel.reflection.bindings.iter().filter(|b| b.group == 0) {
+            let bound = node
+                .inputs
+                .iter()
+                .chain(&node.outputs)
+                .find(|(slot, _)| *slot == b.name);
+            if let Some((_, res)) = bound {
+                views.push((b.binding, aspect_view(&textures[res])));
+            } else if b.name != "params" && b.name != "stats" {
+                return Err(Error::Pipeline {
+                    kernel: node.kernel.clone(),
+                    message: format!("node `{}` binds nothing to `{}`", node.name, b.name),
+                });
+            }
+        }
+        let mut entries: Vec<wgpu::BindGroupEntry> = views
+            .iter()
+            .map(|(binding, view)| wgpu::BindGroupEntry {
+                binding: *binding,
+                resource: wgpu::BindingResource::TextureView(view),
+            })
+            .collect();
+        if let Some(b) = kernel.reflection.binding("params") {
+            entries.push(buffer_entry(
+                b.binding,
+                params,
+                offset,
+                size.div_ceil(16) * 16,
+            ));
+        }
+        if let Some(b) = kernel.reflection.binding("stats") {
+            entries.push(buffer_entry(
+                b.binding,
+                &outputs.stats,
+                si as u64 * STATS_STRIDE,
+                4,
+            ));
+        }
+        let layout = kernel
+            .layouts
+            .first()
+            .ok_or_else(|| no_layout(&kernel.name))?;
+        let bind_group = scoped(
+            device,
+            || {
+                created::bind_group(
+                    device,
+                    &wgpu::BindGroupDescriptor {
+                        label: Some(&node.name),
+                        layout,
+                        entries: &entries,
+                    },
+                )
+            },
+            |message| Error::Pipeline {
+                kernel: node.kernel.clone(),
+                message: format!("binding node `{}`: {message}", node.name),
+            },
+        )?;
+        let wg = kernel.reflection.workgroup_size.unwrap_or([1, 1, 1]);
+        let size = |r: &str| textures.get(r).map(|t| (t.width(), t.height()));
+        let groups = node.dispatch.groups(size, wg).ok_or_else(|| {
+            Error::Invalid(format!(
+                "node `{}` dispatches over a resource that is not in the plan",
+                node.name
+            ))
+        })?;
+        Ok(PreparedStep {
+            kernel,
+            dispatches: vec![(bind_group, groups)],
+        })
+    }
+
+    /// Binds a [`Dispatch::MipChain`] node: one compute pass with the dispatches of
     /// [`crate::filter::mip_dispatches`] (`kernels/mips.wgsl` or `mips_log.wgsl`, up to six
     /// levels each), each reading one level (the `src` input for the first, which also stores
     /// it as level 0) through a one-level view and writing the levels after it through
     /// one-level views.
-    fn record_mip_chain(
+    fn bind_mip_chain(
         &mut self,
         device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
         node: &crate::graph::Node,
         textures: &HashMap<String, wgpu::Texture>,
-    ) -> Result<()> {
+    ) -> Result<PreparedStep> {
         let mip = MipNode::new(node, textures)?;
         let formats: Vec<(String, wgpu::TextureFormat)> = (0..=MIP_LEVELS_PER_DISPATCH)
             .map(|k| (format!("dst{k}"), mip.dst.format()))
@@ -565,7 +697,7 @@ impl Executor {
         let dispatches = mip_dispatches(mip.dst.width(), mip.dst.height());
         let align = u64::from(device.limits().min_uniform_buffer_offset_alignment).max(32);
         let params = mip.params_buffer(device, &dispatches, align)?;
-        let mut groups = Vec::new();
+        let mut bound = Vec::new();
         for (k, &(first, count)) in dispatches.iter().enumerate() {
             let bg = mip.bind_group(device, &kernel, &params, k as u64 * align, first, count)?;
             let tile = crate::filter::MIP_TILE / 2;
@@ -573,19 +705,111 @@ impl Executor {
                 (mip.dst.width() >> (first + 1)).max(1),
                 (mip.dst.height() >> (first + 1)).max(1),
             ];
-            groups.push((bg, [next[0].div_ceil(tile), next[1].div_ceil(tile)]));
+            bound.push((bg, [next[0].div_ceil(tile), next[1].div_ceil(tile), 1]));
         }
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(&node.name),
-            timestamp_writes: None,
-        });
-        pass.set_pipeline(&kernel.pipeline);
-        for (bg, g) in &groups {
-            pass.set_bind_group(0, bg, &[]);
-            pass.dispatch_workgroups(g[0], g[1], 1);
-        }
-        Ok(())
+        Ok(PreparedStep {
+            kernel,
+            dispatches: bound,
+        })
     }
+}
+
+impl Prepared {
+    /// Whether `imports` holds the same texture for every import this run bound.
+    fn imports_match(&self, imports: &HashMap<String, wgpu::Texture>) -> bool {
+        self.imports
+            .iter()
+            .all(|(name, t)| imports.get(name) == Some(t))
+    }
+}
+
+/// The texture of every planned resource: its slot's, or the caller's for an import; sizes
+/// checked against the plan.
+fn plan_textures(
+    plan: &Plan,
+    slot_textures: &[wgpu::Texture],
+    imports: &HashMap<String, wgpu::Texture>,
+) -> Result<HashMap<String, wgpu::Texture>> {
+    let mut textures = HashMap::new();
+    for r in &plan.resources {
+        let t = match r.slot {
+            Some(s) => slot_textures[s].clone(),
+            None => imports.get(&r.resource.name).cloned().ok_or_else(|| {
+                Error::Invalid(format!(
+                    "imported resource `{}` was not provided",
+                    r.resource.name
+                ))
+            })?,
+        };
+        if (t.width(), t.height()) != (r.width, r.height) {
+            return Err(Error::Invalid(format!(
+                "`{}` is {}x{}, the plan expects {}x{}",
+                r.resource.name,
+                t.width(),
+                t.height(),
+                r.width,
+                r.height
+            )));
+        }
+        textures.insert(r.resource.name.clone(), t);
+    }
+    Ok(textures)
+}
+
+/// One uniform buffer of every step's parameters, each at an offset aligned for binding, and
+/// per step its `(offset, size)`.
+fn params_buffer(device: &wgpu::Device, plan: &Plan) -> (wgpu::Buffer, Vec<(u64, u64)>) {
+    let align = u64::from(device.limits().min_uniform_buffer_offset_alignment).max(16);
+    let mut bytes = Vec::new();
+    let mut at = Vec::new();
+    for step in &plan.steps {
+        let offset = (bytes.len() as u64).div_ceil(align) * align;
+        bytes.resize(offset as usize, 0);
+        at.push((offset, step.node.params.len().max(16) as u64));
+        bytes.extend_from_slice(&step.node.params);
+    }
+    bytes.resize(bytes.len().max(16).div_ceil(16) * 16 + 16, 0);
+    let buffer = created::buffer_init(
+        device,
+        &wgpu::util::BufferInitDescriptor {
+            label: Some("shadowgraph.params"),
+            contents: &bytes,
+            usage: wgpu::BufferUsages::UNIFORM,
+        },
+    );
+    (buffer, at)
+}
+
+/// A bind group entry of `size` bytes of `buffer` from `offset`.
+fn buffer_entry(
+    binding: u32,
+    buffer: &wgpu::Buffer,
+    offset: u64,
+    size: u64,
+) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry {
+        binding,
+        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer,
+            offset,
+            size: wgpu::BufferSize::new(size),
+        }),
+    }
+}
+
+/// A view of all of `t` (its depth aspect for a depth texture).
+fn aspect_view(t: &wgpu::Texture) -> wgpu::TextureView {
+    created::view(
+        t,
+        &wgpu::TextureViewDescriptor {
+            aspect: if t.format().is_depth_stencil_format() {
+                wgpu::TextureAspect::DepthOnly
+            } else {
+                wgpu::TextureAspect::All
+            },
+            ..Default::default()
+        },
+    )
 }
 
 /// A mip-chain node's textures and the pieces of its dispatches.
@@ -649,13 +873,14 @@ impl<'a> MipNode<'a> {
             let at = k * align as usize;
             bytes[at..at + size].copy_from_slice(bytemuck::bytes_of(&p));
         }
-        Ok(
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        Ok(created::buffer_init(
+            device,
+            &wgpu::util::BufferInitDescriptor {
                 label: Some(&self.node.name),
                 contents: &bytes,
                 usage: wgpu::BufferUsages::UNIFORM,
-            }),
-        )
+            },
+        ))
     }
 
     /// The bind group of the dispatch reading level `first` and writing `count` levels:
@@ -671,11 +896,14 @@ impl<'a> MipNode<'a> {
         count: u32,
     ) -> Result<wgpu::BindGroup> {
         let level_view = |t: &wgpu::Texture, level: u32| {
-            t.create_view(&wgpu::TextureViewDescriptor {
-                base_mip_level: level,
-                mip_level_count: Some(1),
-                ..Default::default()
-            })
+            created::view(
+                t,
+                &wgpu::TextureViewDescriptor {
+                    base_mip_level: level,
+                    mip_level_count: Some(1),
+                    ..Default::default()
+                },
+            )
         };
         let binding = |name: &str| {
             kernel
@@ -719,11 +947,14 @@ impl<'a> MipNode<'a> {
         scoped(
             device,
             || {
-                device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some(&self.node.name),
-                    layout: &kernel.layouts[0],
-                    entries: &entries,
-                })
+                created::bind_group(
+                    device,
+                    &wgpu::BindGroupDescriptor {
+                        label: Some(&self.node.name),
+                        layout: &kernel.layouts[0],
+                        entries: &entries,
+                    },
+                )
             },
             |message| Self::error(self.node, format!("binding level {first}: {message}")),
         )

@@ -2,6 +2,7 @@
 pub mod bench;
 pub mod cli;
 pub mod cpu;
+pub mod created;
 pub mod dump;
 pub mod error;
 pub mod evaluate;

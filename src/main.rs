@@ -72,6 +72,10 @@ enum Command {
         /// tables, at these odd widths (texels).
         #[arg(long, value_delimiter = ',', num_args = 0.., default_missing_value = "3,5,9,17,33,65")]
         lookup: Option<Vec<u32>>,
+        /// With `--lookup`: the light sizes (world units) at which PCSS and the soft techniques
+        /// are compared on `scenes/techniques/cssm.toml`.
+        #[arg(long, value_delimiter = ',', default_value = "0.25,0.5,1,2")]
+        light_sizes: Vec<f32>,
     },
     /// Sweep techniques and their accuracy knobs, time each on the GPU and measure its error
     /// against ground truth: report.html/.md/.csv/.json, pareto{,_penumbra,_flip}.svg, grid.png
@@ -210,6 +214,7 @@ fn run(args: Args) -> Result<()> {
             sizes,
             repeat,
             lookup,
+            light_sizes,
         } => {
             let gpu = Gpu::new()?;
             match lookup {
@@ -223,6 +228,17 @@ fn run(args: Args) -> Result<()> {
                             cpu,
                             repeat,
                             &rows
+                        )
+                    );
+                    let soft = shadowgraph::bench::soft_cost(&gpu, &light_sizes, repeat)?;
+                    print!(
+                        "\n{}",
+                        shadowgraph::bench::format_soft_table(
+                            &gpu.describe(),
+                            cpu,
+                            repeat,
+                            &light_sizes,
+                            &soft
                         )
                     );
                 }

@@ -106,6 +106,8 @@ pub struct Prefilter {
     executor: Executor,
     planned: Planned,
     timer: Option<GpuTimer>,
+    /// The last record's maps (with their views), handed out again while the textures stay.
+    maps: Vec<OutputMap>,
 }
 
 impl Prefilter {
@@ -129,6 +131,7 @@ impl Prefilter {
             executor,
             planned,
             timer: None,
+            maps: Vec::new(),
         })
     }
 
@@ -175,26 +178,43 @@ impl Prefilter {
         if let Some(t) = self.timer.as_mut() {
             t.resolve(encoder);
         }
-        let maps = self
-            .planned
-            .maps
-            .iter()
-            .map(|m| {
-                let texture = outputs.textures.get(&m.resource).cloned().ok_or_else(|| {
-                    Error::Invalid(format!("the plan produced no `{}`", m.resource))
-                })?;
-                Ok(OutputMap {
-                    resource: m.resource.clone(),
-                    wgsl_type: m.wgsl_type,
-                    view: depth_aspect_view(&texture),
-                    texture,
-                })
-            })
-            .collect::<Result<Vec<_>>>()?;
+        let maps = self.output_maps(&outputs.textures)?;
         Ok(PrefilterOutput {
             maps,
             light: light.light_gpu(&self.config, size),
         })
+    }
+
+    /// The maps of a record whose plan produced `textures`: the last record's (views
+    /// included) while the textures are the same, else made anew.
+    fn output_maps(&mut self, textures: &HashMap<String, wgpu::Texture>) -> Result<Vec<OutputMap>> {
+        let texture = |m: &MapInput| {
+            textures
+                .get(&m.resource)
+                .cloned()
+                .ok_or_else(|| Error::Invalid(format!("the plan produced no `{}`", m.resource)))
+        };
+        let same = self.maps.len() == self.planned.maps.len()
+            && self.maps.iter().zip(&self.planned.maps).all(|(o, m)| {
+                o.resource == m.resource && textures.get(&m.resource) == Some(&o.texture)
+            });
+        if !same {
+            self.maps = self
+                .planned
+                .maps
+                .iter()
+                .map(|m| {
+                    let texture = texture(m)?;
+                    Ok(OutputMap {
+                        resource: m.resource.clone(),
+                        wgsl_type: m.wgsl_type,
+                        view: depth_aspect_view(&texture),
+                        texture,
+                    })
+                })
+                .collect::<Result<Vec<_>>>()?;
+        }
+        Ok(self.maps.clone())
     }
 
     /// The host's WGSL: the technique's visibility function, its maps bound at
@@ -236,18 +256,24 @@ impl Prefilter {
 
     /// `(node, milliseconds)` per kernel of the last [`Prefilter::record`], e.g.
     /// `("vsm.blur_h", 0.21)`. Call after the host's submission of that encoder; it waits for
-    /// the queries' readback. Empty before timing is enabled.
-    pub fn timings(&self, device: &wgpu::Device) -> Result<Vec<(String, f64)>> {
-        let Some(timer) = &self.timer else {
+    /// the queries' readback (see [`Prefilter::poll_timings`] for a read that never waits).
+    /// Empty before timing is enabled.
+    pub fn timings(&mut self, device: &wgpu::Device) -> Result<Vec<(String, f64)>> {
+        let Some(timer) = &mut self.timer else {
             return Ok(Vec::new());
         };
-        // Node names are `light0.<node>`, like the resource names (`technique::depth_name`).
-        let prefix = "light0.";
-        Ok(timer
-            .read(device)?
-            .into_iter()
-            .map(|(name, ms)| (name.strip_prefix(prefix).unwrap_or(&name).to_string(), ms))
-            .collect())
+        Ok(strip_light(timer.read(device)?))
+    }
+
+    /// The timings of the newest recorded frame whose timestamps have arrived, without
+    /// waiting: call after submitting each encoder [`Prefilter::record`] recorded into; the
+    /// times of a frame arrive once the device has finished it, typically a frame later
+    /// (`None` until then, and before timing is enabled). Older unread frames are dropped.
+    pub fn poll_timings(&mut self, device: &wgpu::Device) -> Result<Option<Vec<(String, f64)>>> {
+        let Some(timer) = &mut self.timer else {
+            return Ok(None);
+        };
+        Ok(timer.collect(device)?.pop().map(strip_light))
     }
 
     /// The configuration in use (validated, exponents clamped).
@@ -284,6 +310,18 @@ impl Prefilter {
     pub fn pipeline_count(&self) -> usize {
         self.executor.kernels.len()
     }
+}
+
+/// Node names are `light0.<node>`, like the resource names (`technique::depth_name`): the
+/// light's prefix is dropped.
+fn strip_light(spans: Vec<(String, f64)>) -> Vec<(String, f64)> {
+    spans
+        .into_iter()
+        .map(|(name, ms)| match name.strip_prefix("light0.") {
+            Some(n) => (n.to_string(), ms),
+            None => (name, ms),
+        })
+        .collect()
 }
 
 /// Parameters to plan with before the first frame: pipelines do not depend on them.
@@ -364,12 +402,15 @@ fn check_depth(depth: &wgpu::Texture) -> Result<u32, StageError> {
 }
 
 fn depth_aspect_view(t: &wgpu::Texture) -> wgpu::TextureView {
-    t.create_view(&wgpu::TextureViewDescriptor {
-        aspect: if t.format().is_depth_stencil_format() {
-            wgpu::TextureAspect::DepthOnly
-        } else {
-            wgpu::TextureAspect::All
+    crate::created::view(
+        t,
+        &wgpu::TextureViewDescriptor {
+            aspect: if t.format().is_depth_stencil_format() {
+                wgpu::TextureAspect::DepthOnly
+            } else {
+                wgpu::TextureAspect::All
+            },
+            ..Default::default()
         },
-        ..Default::default()
-    })
+    )
 }

@@ -1,20 +1,21 @@
 //! The frame: per light a depth-only raster pass, the planned kernels, the camera G-buffer and
-//! the generated shading kernel. Also [`probe`], which evaluates visibility at given points
-//! on given maps (how tests compare the GPU to the f64 references).
+//! the generated shading kernel ([`Renderer`]). Also [`probe`], which evaluates visibility at
+//! given points on given maps (how tests compare the GPU to the f64 references).
 
-use std::collections::HashMap;
+mod probe;
+mod renderer;
+mod targets;
 
 use bytemuck::Zeroable;
-use glam::Vec3;
-use wgpu::util::DeviceExt;
 
+pub use self::probe::{ProbeMap, probe};
+pub use self::renderer::{Renderer, ShadowRaster};
 use crate::error::{Error, Result};
-use crate::exec::{Executor, GpuTimer};
-use crate::gpu::{read_buffer, read_texture, scoped, submit_and_wait, write_texture};
+use crate::exec::Outputs;
+use crate::gpu::read_texture;
 use crate::graph::{Graph, Plan, plan};
-use crate::kernels;
 use crate::scene::{Light, Scene};
-use crate::technique::{self, LightGpu};
+use crate::technique;
 
 /// Frame constants of `kernels/shade.wgsl` (mirrors its `Frame`).
 #[repr(C)]
@@ -350,694 +351,61 @@ pub fn read_sat_map(
     })
 }
 
-/// Renders scenes; holds pipelines and pooled textures across frames.
-pub struct Renderer {
-    /// The graph executor (kernel pipelines, texture pool).
-    pub executor: Executor,
-    shadow: HashMap<u32, wgpu::RenderPipeline>,
-    gbuffer: Option<(wgpu::RenderPipeline, wgpu::BindGroupLayout)>,
-    cmp_sampler: wgpu::Sampler,
-    /// The shading pass's outputs, kept while the image size and light count stay the same.
-    shade_targets: Option<((u32, u32, usize), Shaded)>,
-}
-
-const VERTEX_ATTRS: [wgpu::VertexAttribute; 3] =
-    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Uint32];
-
-fn vertex_layout() -> wgpu::VertexBufferLayout<'static> {
-    wgpu::VertexBufferLayout {
-        array_stride: std::mem::size_of::<crate::scene::Vertex>() as u64,
-        step_mode: wgpu::VertexStepMode::Vertex,
-        attributes: &VERTEX_ATTRS,
-    }
-}
-
-fn uniform(device: &wgpu::Device, label: &str, bytes: &[u8]) -> wgpu::Buffer {
-    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some(label),
-        contents: bytes,
-        usage: wgpu::BufferUsages::UNIFORM,
-    })
-}
-
-fn texture(
+/// Adds to `frame` what `opts` asks for besides the image: every resource of the plan
+/// (`dump`), the G-buffer and each light's maps (`aux`).
+#[expect(clippy::too_many_arguments, reason = "what a frame's read-backs need")]
+fn read_extras(
     device: &wgpu::Device,
-    label: &str,
-    (w, h): (u32, u32),
-    format: wgpu::TextureFormat,
-    usage: wgpu::TextureUsages,
-) -> wgpu::Texture {
-    device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d {
-            width: w,
-            height: h,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage,
-        view_formats: &[],
-    })
-}
-
-/// Usage of textures the renderer writes and later reads back or samples.
-const TARGET: wgpu::TextureUsages = wgpu::TextureUsages::RENDER_ATTACHMENT
-    .union(wgpu::TextureUsages::TEXTURE_BINDING)
-    .union(wgpu::TextureUsages::COPY_SRC)
-    .union(wgpu::TextureUsages::COPY_DST);
-
-impl Renderer {
-    /// A renderer for `device`.
-    pub fn new(device: &wgpu::Device) -> Self {
-        Self {
-            executor: Executor::new(),
-            shadow: HashMap::new(),
-            gbuffer: None,
-            shade_targets: None,
-            cmp_sampler: device.create_sampler(&wgpu::SamplerDescriptor {
-                label: Some("shadowgraph.cmp_sampler"),
-                mag_filter: wgpu::FilterMode::Linear,
-                min_filter: wgpu::FilterMode::Linear,
-                compare: Some(wgpu::CompareFunction::LessEqual),
-                ..Default::default()
-            }),
-        }
+    queue: &wgpu::Queue,
+    scene: &Scene,
+    sp: &ScenePlan,
+    outputs: &Outputs,
+    targets: &targets::Targets,
+    opts: RenderOptions,
+    mut frame: Frame,
+) -> Result<Frame> {
+    if opts.dump {
+        frame.resources = dump_resources(device, queue, &sp.plan, outputs)?;
     }
-
-    fn raster_pipeline(
-        device: &wgpu::Device,
-        name: &str,
-        fragment: Option<&[Option<wgpu::ColorTargetState>]>,
-        bias: wgpu::DepthBiasState,
-    ) -> Result<(wgpu::RenderPipeline, wgpu::BindGroupLayout)> {
-        let wgsl = kernels::resolve(name, None)?;
-        let (_, refl) = kernels::reflect(name, &wgsl)?;
-        let label = format!("shadowgraph.{name}");
-        scoped(
-            device,
-            || {
-                let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                    label: Some(&label),
-                    source: wgpu::ShaderSource::Wgsl(wgsl.as_str().into()),
-                });
-                let bgl = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                    label: Some(&label),
-                    entries: &refl.layout_entries(0),
-                });
-                let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                    label: Some(&label),
-                    bind_group_layouts: &[Some(&bgl)],
-                    immediate_size: 0,
-                });
-                let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                    label: Some(&label),
-                    layout: Some(&layout),
-                    vertex: wgpu::VertexState {
-                        module: &module,
-                        entry_point: Some("vs_main"),
-                        compilation_options: Default::default(),
-                        buffers: &[Some(vertex_layout())],
-                    },
-                    // Two-sided: planes and open meshes cast and receive from both sides.
-                    primitive: wgpu::PrimitiveState::default(),
-                    depth_stencil: Some(wgpu::DepthStencilState {
-                        format: wgpu::TextureFormat::Depth32Float,
-                        depth_write_enabled: Some(true),
-                        depth_compare: Some(wgpu::CompareFunction::Less),
-                        stencil: Default::default(),
-                        bias,
-                    }),
-                    multisample: Default::default(),
-                    fragment: fragment.map(|targets| wgpu::FragmentState {
-                        module: &module,
-                        entry_point: Some("fs_main"),
-                        compilation_options: Default::default(),
-                        targets,
-                    }),
-                    multiview_mask: None,
-                    cache: None,
-                });
-                (pipeline, bgl)
-            },
-            |message| Error::Pipeline {
-                kernel: name.to_string(),
-                message,
-            },
-        )
+    if !opts.aux {
+        return Ok(frame);
     }
-
-    fn shadow_pipeline(
-        &mut self,
-        device: &wgpu::Device,
-        slope: f32,
-    ) -> Result<&wgpu::RenderPipeline> {
-        // Slope-scaled bias is pipeline state: one pipeline per distinct value, made once.
-        match self.shadow.entry(slope.to_bits()) {
-            std::collections::hash_map::Entry::Occupied(e) => Ok(e.into_mut()),
-            std::collections::hash_map::Entry::Vacant(e) => {
-                let bias = wgpu::DepthBiasState {
-                    constant: 0,
-                    slope_scale: slope,
-                    clamp: 0.0,
-                };
-                let (p, _) = Self::raster_pipeline(device, "shadow_depth", None, bias)?;
-                Ok(e.insert(p))
-            }
-        }
-    }
-
-    /// Renders `scene` on `device`/`queue` and reads the frame back.
-    pub fn render(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        scene: &Scene,
-        opts: RenderOptions,
-    ) -> Result<Frame> {
-        check_render(device, scene, &opts)?;
-        let mut sp = plan_lights(&scene.lights)?;
-        if opts.dump {
-            // Everything is read back after the frame: no resource may share a texture.
-            sp.plan = sp.plan.unaliased();
-        }
-        let verts = scene.vertices();
-        let vbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("shadowgraph.vertices"),
-            contents: bytemuck::cast_slice(&verts),
-            usage: wgpu::BufferUsages::VERTEX,
-        });
-        let materials: Vec<[f32; 4]> = scene
-            .objects
+    frame.position = bytemuck::cast_slice(&read_texture(device, queue, &targets.gpos, 0)?).to_vec();
+    frame.normal = bytemuck::cast_slice(&read_texture(device, queue, &targets.gnorm, 0)?).to_vec();
+    for (i, input) in sp.shade_inputs.iter().enumerate() {
+        let coding = technique::sat_coding(&scene.lights[i])?;
+        let channels = technique::map_channels(&scene.lights[i]);
+        let maps = input
+            .maps
             .iter()
-            .map(|o| o.color.extend(1.0).to_array())
-            .collect();
-        let size = (scene.width, scene.height);
-        let gpos = texture(
-            device,
-            "shadowgraph.g_position",
-            size,
-            wgpu::TextureFormat::Rgba32Float,
-            TARGET,
-        );
-        let gnorm = texture(
-            device,
-            "shadowgraph.g_normal",
-            size,
-            wgpu::TextureFormat::Rgba32Float,
-            TARGET,
-        );
-        let cam_depth = texture(
-            device,
-            "shadowgraph.camera_depth",
-            size,
-            wgpu::TextureFormat::Depth32Float,
-            TARGET,
-        );
-        let depths: Vec<wgpu::Texture> = scene
-            .lights
-            .iter()
-            .map(|l| {
-                texture(
-                    device,
-                    "shadowgraph.shadow_map",
-                    (l.shadow_map, l.shadow_map),
-                    wgpu::TextureFormat::Depth32Float,
-                    TARGET,
-                )
+            .zip(channels)
+            .map(|(m, n)| match &coding {
+                Some(c) => read_sat_map(device, queue, m, &outputs.textures[m], c, n),
+                None => FloatMap::read(device, queue, m, &outputs.textures[m]),
             })
-            .collect();
-        let imports: HashMap<String, wgpu::Texture> = depths
-            .iter()
-            .enumerate()
-            .map(|(i, t)| (technique::depth_name(i), t.clone()))
-            .collect();
-        let spans = scene.lights.len() as u32 + sp.plan.steps.len() as u32 + 2;
-        let mut timer = GpuTimer::new(device, queue, spans);
-        let repeat = opts.repeat.max(1);
-        let mut timings = Vec::new();
-        let mut wall_ms = Vec::new();
-        let mut last = None;
-        for _ in 0..repeat {
-            if let Some(t) = timer.as_mut() {
-                t.reset();
-            }
-            let mut enc = device.create_command_encoder(&Default::default());
-            for (i, (l, depth)) in scene.lights.iter().zip(&depths).enumerate() {
-                self.shadow_pass(
-                    device,
-                    &mut enc,
-                    i,
-                    l,
-                    &vbuf,
-                    verts.len() as u32,
-                    depth,
-                    timer.as_mut(),
-                )?;
-            }
-            let outputs =
-                self.executor
-                    .record(device, &mut enc, &sp.plan, &imports, timer.as_mut())?;
-            self.gbuffer_pass(
-                device,
-                &mut enc,
-                scene,
-                &vbuf,
-                verts.len() as u32,
-                &gpos,
-                &gnorm,
-                &cam_depth,
-                timer.as_mut(),
-            )?;
-            let maps: Vec<wgpu::TextureView> = sp
-                .shade_inputs
+            .collect::<Result<Vec<_>>>()?;
+        frame.shade_maps.push(FloatMap::concat(maps)?);
+        let levels = input
+            .maps
+            .first()
+            .map_or(1, |m| outputs.textures[m].mip_level_count());
+        let mut mips = Vec::new();
+        for level in 1..levels {
+            let maps = input
+                .maps
                 .iter()
-                .flat_map(|s| &s.maps)
-                .map(|m| depth_only_view(&outputs.textures[m]))
-                .collect();
-            let frame = FrameGpu::new(scene, size.0, size.1);
-            let shaded = self.shade(
-                device,
-                &mut enc,
-                &scene.lights,
-                &frame,
-                &gpos,
-                &gnorm,
-                &materials,
-                &maps,
-                timer.as_mut(),
-            )?;
-            if let Some(t) = timer.as_mut() {
-                t.resolve(&mut enc);
-            }
-            outputs.copy_stats(&mut enc);
-            let submitted = std::time::Instant::now();
-            submit_and_wait(device, queue, enc, "render")?;
-            wall_ms.push(submitted.elapsed().as_secs_f64() * 1e3);
-            if let Some(t) = timer.as_ref() {
-                timings.push(t.read(device)?);
-            }
-            last = Some((outputs, shaded));
+                .map(|m| FloatMap::read_level(device, queue, m, &outputs.textures[m], level))
+                .collect::<Result<Vec<_>>>()?;
+            mips.push(FloatMap::concat(maps)?);
         }
-        let Some((outputs, shaded)) = last else {
-            return Err(Error::Invalid("no frame rendered".into()));
-        };
-        let sanitized = outputs.read_stats(device)?;
-        for (step, n) in &sanitized {
-            log::warn!("{step}: replaced {n} non-finite depth texel(s) with 1.0 (no occluder)");
-        }
-        let rgba = read_texture(device, queue, &shaded.color, 0)?;
-        let visibility = shaded.read_visibility(device, queue)?;
-        let mut frame = Frame {
-            width: size.0,
-            height: size.1,
-            rgba,
-            visibility,
-            position: Vec::new(),
-            normal: Vec::new(),
-            timings,
-            wall_ms,
-            sanitized,
-            shade_maps: Vec::new(),
-            shade_mips: Vec::new(),
-            linear_maps: Vec::new(),
-            resources: Vec::new(),
-        };
-        if opts.dump {
-            frame.resources = dump_resources(device, queue, &sp.plan, &outputs)?;
-        }
-        if opts.aux {
-            frame.position = bytemuck::cast_slice(&read_texture(device, queue, &gpos, 0)?).to_vec();
-            frame.normal = bytemuck::cast_slice(&read_texture(device, queue, &gnorm, 0)?).to_vec();
-            for (i, input) in sp.shade_inputs.iter().enumerate() {
-                let coding = technique::sat_coding(&scene.lights[i])?;
-                let channels = technique::map_channels(&scene.lights[i]);
-                let maps = input
-                    .maps
-                    .iter()
-                    .zip(channels)
-                    .map(|(m, n)| match &coding {
-                        Some(c) => read_sat_map(device, queue, m, &outputs.textures[m], c, n),
-                        None => FloatMap::read(device, queue, m, &outputs.textures[m]),
-                    })
-                    .collect::<Result<Vec<_>>>()?;
-                frame.shade_maps.push(FloatMap::concat(maps)?);
-                let levels = input
-                    .maps
-                    .first()
-                    .map_or(1, |m| outputs.textures[m].mip_level_count());
-                let mut mips = Vec::new();
-                for level in 1..levels {
-                    let maps = input
-                        .maps
-                        .iter()
-                        .map(|m| {
-                            FloatMap::read_level(device, queue, m, &outputs.textures[m], level)
-                        })
-                        .collect::<Result<Vec<_>>>()?;
-                    mips.push(FloatMap::concat(maps)?);
-                }
-                frame.shade_mips.push(mips);
-                let linear = technique::linear_name(i);
-                frame.linear_maps.push(match outputs.textures.get(&linear) {
-                    Some(t) => Some(FloatMap::read(device, queue, &linear, t)?),
-                    None => None,
-                });
-            }
-        }
-        Ok(frame)
-    }
-
-    #[expect(clippy::too_many_arguments, reason = "one raster pass's inputs")]
-    fn shadow_pass(
-        &mut self,
-        device: &wgpu::Device,
-        enc: &mut wgpu::CommandEncoder,
-        i: usize,
-        light: &Light,
-        vbuf: &wgpu::Buffer,
-        count: u32,
-        depth: &wgpu::Texture,
-        timer: Option<&mut GpuTimer>,
-    ) -> Result<()> {
-        let vp = (light.projection() * light.view()).to_cols_array();
-        let label = format!("light{i}.shadow_raster");
-        let raster = ShadowRaster {
-            label: &label,
-            view_proj: vp,
-            slope_bias: light.shadow.slope_bias,
-        };
-        self.shadow_raster(device, enc, &raster, vbuf, count, depth, timer)
-    }
-
-    /// Records a depth-only raster pass of the scene's vertices `vbuf` (`count` vertices) into
-    /// `depth` (Depth32Float) with an explicit world → clip matrix: the pipeline and bias the
-    /// renderer's own shadow maps use (`truth` rasterizes its emitter samples with it).
-    #[expect(clippy::too_many_arguments, reason = "one raster pass's inputs")]
-    pub fn shadow_raster(
-        &mut self,
-        device: &wgpu::Device,
-        enc: &mut wgpu::CommandEncoder,
-        raster: &ShadowRaster,
-        vbuf: &wgpu::Buffer,
-        count: u32,
-        depth: &wgpu::Texture,
-        timer: Option<&mut GpuTimer>,
-    ) -> Result<()> {
-        let pipeline = self.shadow_pipeline(device, raster.slope_bias)?.clone();
-        let ubuf = uniform(
-            device,
-            "shadowgraph.light_view",
-            bytemuck::cast_slice(&raster.view_proj),
-        );
-        let bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("shadowgraph.shadow_depth"),
-            layout: &pipeline.get_bind_group_layout(0),
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: ubuf.as_entire_binding(),
-            }],
+        frame.shade_mips.push(mips);
+        let linear = technique::linear_name(i);
+        frame.linear_maps.push(match outputs.textures.get(&linear) {
+            Some(t) => Some(FloatMap::read(device, queue, &linear, t)?),
+            None => None,
         });
-        let view = depth.create_view(&Default::default());
-        if let Some(t) = timer {
-            t.begin(enc, raster.label);
-        }
-        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some(raster.label),
-            color_attachments: &[],
-            depth_stencil_attachment: Some(clear_depth(&view)),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &bg, &[]);
-        pass.set_vertex_buffer(0, vbuf.slice(..));
-        pass.draw(0..count, 0..1);
-        Ok(())
     }
-
-    #[expect(clippy::too_many_arguments, reason = "one raster pass's inputs")]
-    fn gbuffer_pass(
-        &mut self,
-        device: &wgpu::Device,
-        enc: &mut wgpu::CommandEncoder,
-        scene: &Scene,
-        vbuf: &wgpu::Buffer,
-        count: u32,
-        gpos: &wgpu::Texture,
-        gnorm: &wgpu::Texture,
-        cam_depth: &wgpu::Texture,
-        timer: Option<&mut GpuTimer>,
-    ) -> Result<()> {
-        if self.gbuffer.is_none() {
-            let t = Some(wgpu::ColorTargetState {
-                format: wgpu::TextureFormat::Rgba32Float,
-                blend: None,
-                write_mask: wgpu::ColorWrites::ALL,
-            });
-            self.gbuffer = Some(Self::raster_pipeline(
-                device,
-                "gbuffer",
-                Some(&[t.clone(), t]),
-                Default::default(),
-            )?);
-        }
-        let Some((pipeline, bgl)) = &self.gbuffer else {
-            return Err(Error::Invalid("G-buffer pipeline missing".into()));
-        };
-        let vp = scene
-            .camera
-            .view_proj(scene.width as f32 / scene.height as f32)
-            .to_cols_array();
-        let ubuf = uniform(device, "shadowgraph.camera", bytemuck::cast_slice(&vp));
-        let bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("shadowgraph.gbuffer"),
-            layout: bgl,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: ubuf.as_entire_binding(),
-            }],
-        });
-        let (pv, nv, dv) = (
-            gpos.create_view(&Default::default()),
-            gnorm.create_view(&Default::default()),
-            cam_depth.create_view(&Default::default()),
-        );
-        let clear = |view| {
-            Some(wgpu::RenderPassColorAttachment {
-                view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            })
-        };
-        if let Some(t) = timer {
-            t.begin(enc, "gbuffer");
-        }
-        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("gbuffer"),
-            color_attachments: &[clear(&pv), clear(&nv)],
-            depth_stencil_attachment: Some(clear_depth(&dv)),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, &bg, &[]);
-        pass.set_vertex_buffer(0, vbuf.slice(..));
-        pass.draw(0..count, 0..1);
-        Ok(())
-    }
-
-    /// Records the shading kernel for `lights` over a G-buffer; `maps[i]` is light i's input.
-    #[expect(clippy::too_many_arguments, reason = "the shading pass's bindings")]
-    pub fn shade(
-        &mut self,
-        device: &wgpu::Device,
-        enc: &mut wgpu::CommandEncoder,
-        lights: &[Light],
-        frame: &FrameGpu,
-        gpos: &wgpu::Texture,
-        gnorm: &wgpu::Texture,
-        materials: &[[f32; 4]],
-        maps: &[wgpu::TextureView],
-        timer: Option<&mut GpuTimer>,
-    ) -> Result<Shaded> {
-        let block = technique::shading_block(lights);
-        let kernel = self
-            .executor
-            .kernels
-            .get_generated(device, "shade", Some(&block))?;
-        let (w, h) = (frame.size[0], frame.size[1]);
-        let key = (w, h, lights.len());
-        let targets = match &self.shade_targets {
-            Some((k, t)) if *k == key => t.clone(),
-            _ => {
-                let t = Shaded::new(device, key);
-                self.shade_targets = Some((key, t.clone()));
-                t
-            }
-        };
-        let Shaded { color, visibility } = targets;
-        let gpu_lights: Vec<LightGpu> = lights.iter().map(LightGpu::new).collect();
-        let storage = |label, bytes: &[u8]| {
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents: bytes,
-                usage: wgpu::BufferUsages::STORAGE,
-            })
-        };
-        let mat_buf = storage("shadowgraph.materials", bytemuck::cast_slice(materials));
-        let light_buf = storage("shadowgraph.lights", bytemuck::cast_slice(&gpu_lights));
-        let frame_buf = uniform(device, "shadowgraph.frame", bytemuck::bytes_of(frame));
-        let views = [
-            gpos.create_view(&Default::default()),
-            gnorm.create_view(&Default::default()),
-            color.create_view(&Default::default()),
-        ];
-        let err = |message: String| Error::Pipeline {
-            kernel: "shade".into(),
-            message,
-        };
-        let bg0 = scoped(
-            device,
-            || {
-                device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("shadowgraph.shade"),
-                    layout: &kernel.layouts[0],
-                    entries: &[
-                        wgpu::BindGroupEntry {
-                            binding: 0,
-                            resource: wgpu::BindingResource::TextureView(&views[0]),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 1,
-                            resource: wgpu::BindingResource::TextureView(&views[1]),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 2,
-                            resource: mat_buf.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 3,
-                            resource: light_buf.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 4,
-                            resource: frame_buf.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 5,
-                            resource: wgpu::BindingResource::TextureView(&views[2]),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 6,
-                            resource: visibility.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 7,
-                            resource: wgpu::BindingResource::Sampler(&self.cmp_sampler),
-                        },
-                    ],
-                })
-            },
-            err,
-        )?;
-        let entries: Vec<wgpu::BindGroupEntry> = maps
-            .iter()
-            .enumerate()
-            .map(|(i, v)| wgpu::BindGroupEntry {
-                binding: i as u32,
-                resource: wgpu::BindingResource::TextureView(v),
-            })
-            .collect();
-        let bg1 = scoped(
-            device,
-            || {
-                device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("shadowgraph.shade.maps"),
-                    layout: &kernel.layouts[1],
-                    entries: &entries,
-                })
-            },
-            err,
-        )?;
-        let groups = kernel.groups_for(w, h);
-        if let Some(t) = timer {
-            t.begin(enc, "shade");
-        }
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("shade"),
-            timestamp_writes: None,
-        });
-        pass.set_pipeline(&kernel.pipeline);
-        pass.set_bind_group(0, &bg0, &[]);
-        pass.set_bind_group(1, &bg1, &[]);
-        pass.dispatch_workgroups(groups[0], groups[1], 1);
-        drop(pass);
-        Ok(Shaded { color, visibility })
-    }
-}
-
-/// One depth-only raster pass for [`Renderer::shadow_raster`].
-#[derive(Clone, Copy, Debug)]
-pub struct ShadowRaster<'a> {
-    /// Pass label (and timer label).
-    pub label: &'a str,
-    /// World → clip, column-major (wgpu depth convention: 0 at near, 1 at far).
-    pub view_proj: [f32; 16],
-    /// Slope-scaled depth bias (`DepthBiasState::slope_scale`).
-    pub slope_bias: f32,
-}
-
-/// The shading pass's outputs.
-#[derive(Clone)]
-pub struct Shaded {
-    /// RGBA8 image (sRGB-encoded values).
-    pub color: wgpu::Texture,
-    /// Visibility per pixel per light.
-    pub visibility: wgpu::Buffer,
-}
-
-impl Shaded {
-    /// Targets for a `w × h` image and `lights` lights.
-    fn new(device: &wgpu::Device, (w, h, lights): (u32, u32, usize)) -> Self {
-        let color = texture(
-            device,
-            "shadowgraph.color",
-            (w, h),
-            wgpu::TextureFormat::Rgba8Unorm,
-            wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
-        );
-        let bytes = (u64::from(w) * u64::from(h) * lights.max(1) as u64 * 4).max(4);
-        let visibility = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("shadowgraph.visibility"),
-            size: bytes,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        Self { color, visibility }
-    }
-
-    /// Copies the visibility buffer back.
-    pub fn read_visibility(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Vec<f32>> {
-        let staging = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("shadowgraph.visibility.readback"),
-            size: self.visibility.size(),
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
-        let mut enc = device.create_command_encoder(&Default::default());
-        enc.copy_buffer_to_buffer(&self.visibility, 0, &staging, 0, self.visibility.size());
-        submit_and_wait(device, queue, enc, "visibility readback")?;
-        Ok(bytemuck::cast_slice(&read_buffer(device, &staging)?).to_vec())
-    }
+    Ok(frame)
 }
 
 /// Reads back every resource of `plan` (all mip levels) with its provenance.
@@ -1045,7 +413,7 @@ fn dump_resources(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     plan: &Plan,
-    outputs: &crate::exec::Outputs,
+    outputs: &Outputs,
 ) -> Result<Vec<DumpedResource>> {
     plan.resources
         .iter()
@@ -1072,173 +440,4 @@ fn dump_resources(
             })
         })
         .collect()
-}
-
-/// A depth attachment cleared to the far plane and kept.
-fn clear_depth(view: &wgpu::TextureView) -> wgpu::RenderPassDepthStencilAttachment<'_> {
-    wgpu::RenderPassDepthStencilAttachment {
-        view,
-        depth_ops: Some(wgpu::Operations {
-            load: wgpu::LoadOp::Clear(1.0),
-            store: wgpu::StoreOp::Store,
-        }),
-        stencil_ops: None,
-    }
-}
-
-fn depth_only_view(t: &wgpu::Texture) -> wgpu::TextureView {
-    t.create_view(&wgpu::TextureViewDescriptor {
-        aspect: if t.format().is_depth_stencil_format() {
-            wgpu::TextureAspect::DepthOnly
-        } else {
-            wgpu::TextureAspect::All
-        },
-        ..Default::default()
-    })
-}
-
-/// A map handed to [`probe`]: what the light's technique reads (linear depth as R32Float,
-/// moments as Rg32Float, …), never the raw depth of hardware PCF.
-pub struct ProbeMap<'a> {
-    /// Side length of level 0.
-    pub size: u32,
-    /// Texel format of `data`: a 32-bit float format, or `Rgba32Uint` for a fixed-point
-    /// summed-area table, whose words `data` carries bit for bit (`f32::from_bits`).
-    pub format: wgpu::TextureFormat,
-    /// Mip levels in `data` (1 for a plain map).
-    pub mips: u32,
-    /// Every level's texels, row-major, level 0 first (level `m` is `max(1, size >> m)` wide).
-    pub data: &'a [f32],
-}
-
-impl<'a> ProbeMap<'a> {
-    /// A linear depth map.
-    pub fn linear(size: u32, data: &'a [f32]) -> Self {
-        Self::new(size, wgpu::TextureFormat::R32Float, data)
-    }
-
-    /// A one-level map of `format`.
-    pub fn new(size: u32, format: wgpu::TextureFormat, data: &'a [f32]) -> Self {
-        Self {
-            size,
-            format,
-            mips: 1,
-            data,
-        }
-    }
-}
-
-/// Evaluates each light's visibility at `points` (position, unit normal) on the given maps
-/// with the real shading kernel. `maps` lists every light's maps in binding order (one per
-/// light; CSM: one per two terms). Returns `vis[point * lights + light]`.
-pub fn probe(
-    renderer: &mut Renderer,
-    device: &wgpu::Device,
-    queue: &wgpu::Queue,
-    lights: &[Light],
-    maps: &[ProbeMap],
-    points: &[(Vec3, Vec3)],
-) -> Result<Vec<f32>> {
-    let needed: usize = lights
-        .iter()
-        .enumerate()
-        .map(|(i, l)| {
-            technique::add_light_nodes(&mut Graph::default(), i, l)
-                .maps
-                .len()
-        })
-        .sum();
-    if maps.len() != needed || points.is_empty() {
-        return Err(Error::Invalid(format!(
-            "probe needs {needed} map(s) for these lights and at least one point"
-        )));
-    }
-    let w = (points.len() as u32).min(256);
-    let h = (points.len() as u32).div_ceil(w);
-    let mut pos = vec![[0.0f32; 4]; (w * h) as usize];
-    let mut nor = vec![[0.0f32; 4]; (w * h) as usize];
-    for (i, (p, n)) in points.iter().enumerate() {
-        pos[i] = p.extend(1.0).to_array();
-        nor[i] = n.extend(0.0).to_array();
-    }
-    let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
-    let gpos = texture(
-        device,
-        "shadowgraph.probe.position",
-        (w, h),
-        wgpu::TextureFormat::Rgba32Float,
-        usage,
-    );
-    let gnorm = texture(
-        device,
-        "shadowgraph.probe.normal",
-        (w, h),
-        wgpu::TextureFormat::Rgba32Float,
-        usage,
-    );
-    write_texture(queue, &gpos, bytemuck::cast_slice(&pos));
-    write_texture(queue, &gnorm, bytemuck::cast_slice(&nor));
-    let mut views = Vec::new();
-    for m in maps {
-        let channels = crate::gpu::float_channels(m.format).unwrap_or(0);
-        let side = |l: u32| (m.size >> l).max(1) as usize;
-        let texels: usize = (0..m.mips).map(|l| side(l) * side(l)).sum();
-        let is_f32 = crate::graph::texel_bytes(m.format) == 4 * channels as u64;
-        if !is_f32 || channels == 0 || m.mips == 0 || m.data.len() != texels * channels {
-            return Err(Error::Invalid(format!(
-                "a {0}x{0} {1:?} probe map of {3} level(s) needs {2} f32 values",
-                m.size,
-                m.format,
-                texels * channels.max(1),
-                m.mips
-            )));
-        }
-        let t = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("shadowgraph.probe.map"),
-            size: wgpu::Extent3d {
-                width: m.size,
-                height: m.size,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: m.mips,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: m.format,
-            usage,
-            view_formats: &[],
-        });
-        let mut at = 0;
-        for level in 0..m.mips {
-            let n = side(level) * side(level) * channels;
-            crate::gpu::write_texture_level(
-                queue,
-                &t,
-                level,
-                bytemuck::cast_slice(&m.data[at..at + n]),
-            );
-            at += n;
-        }
-        views.push(t.create_view(&Default::default()));
-    }
-    let frame = FrameGpu {
-        size: [w, h],
-        light_count: lights.len() as u32,
-        ..FrameGpu::zeroed()
-    };
-    let mut enc = device.create_command_encoder(&Default::default());
-    let shaded = renderer.shade(
-        device,
-        &mut enc,
-        lights,
-        &frame,
-        &gpos,
-        &gnorm,
-        &[[1.0; 4]],
-        &views,
-        None,
-    )?;
-    submit_and_wait(device, queue, enc, "probe")?;
-    let mut vis = shaded.read_visibility(device, queue)?;
-    vis.truncate(points.len() * lights.len());
-    Ok(vis)
 }

@@ -790,21 +790,41 @@ pub struct ShadeInput {
     pub wgsl_type: &'static str,
 }
 
-/// The modules light `light`'s visibility function needs, and the WGSL statements (ending in
-/// a `return`) that evaluate it with `l`, `s` in scope and its maps bound as `maps`.
-pub fn visibility_body(light: &Light, maps: &[String]) -> (Vec<&'static str>, String) {
+/// Light `light`'s visibility as the shading kernel and the plug-in's host block call it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct VisibilityBody {
+    /// The modules it needs (`shared/vis_*` and their helpers).
+    pub modules: Vec<&'static str>,
+    /// WGSL statements ending in a `return`, with `l: Light`, `s: LightSample` in scope and
+    /// the light's maps bound under the names given to [`visibility_body`].
+    pub body: String,
+    /// The `// #fetches` expression of a function made of `body` when its count cannot be
+    /// summed from the body's calls (it loops: CSSM's two passes over its basis tables).
+    pub fetches: Option<String>,
+}
+
+/// The modules, statements and fetch count of light `light`'s visibility with its maps bound
+/// as `maps`.
+pub fn visibility_body(light: &Light, maps: &[String]) -> VisibilityBody {
+    let simple = |modules: Vec<&'static str>, body: String| VisibilityBody {
+        modules,
+        body,
+        fetches: None,
+    };
     if let Some(soft) = light.shadow.technique.soft() {
-        return (
-            vec![soft_module(&light.shadow.technique)],
-            soft_visibility_body(light, maps, soft.sums),
-        );
+        let (body, fetches) = soft_visibility_body(light, maps, soft.sums);
+        return VisibilityBody {
+            modules: vec![soft_module(&light.shadow.technique)],
+            body,
+            fetches,
+        };
     }
     if let Some(Filter::Sat { variant, .. }) = light.shadow.technique.filter() {
         let (module, body) = sat_visibility_body(light, maps, variant);
-        return (vec![module, "shared/sat_lookup"], body);
+        return simple(vec![module, "shared/sat_lookup"], body);
     }
     let (module, body) = filtered_visibility_body(light, maps);
-    (vec![module], body)
+    simple(vec![module], body)
 }
 
 /// [`visibility_body`] with the `sat` filter: each map's rectangle mean, then the technique's
@@ -853,12 +873,16 @@ fn soft_module(technique: &Technique) -> &'static str {
     }
 }
 
-/// [`visibility_body`] of a soft technique: the table means over the blocker-search square,
-/// the blocker estimate, the means over the penumbra width, the visibility. Every lookup is
-/// made whatever the estimate (no branch before sampling; a square without blockers is
-/// resolved to 1 at the end). VSSM and soft MSM call their module's complete function; CSSM
-/// sums its basis maps (the first ⌈M/2⌉) and CSM-Z maps (the rest) here.
-fn soft_visibility_body(light: &Light, maps: &[String], variant: SatVariant) -> String {
+/// [`visibility_body`] of a soft technique and, where it loops, its fetch count: the table
+/// means over the blocker-search square, the blocker estimate, and only where that finds
+/// blockers the means over the penumbra width (`shared/blocker`'s two passes). VSSM and soft
+/// MSM call their module's complete function; CSSM sums its CSM-Z maps (the maps after the
+/// first ⌈M/2⌉) over the search square, then runs the two passes over its basis maps here.
+fn soft_visibility_body(
+    light: &Light,
+    maps: &[String],
+    variant: SatVariant,
+) -> (String, Option<String>) {
     let suffix = match variant {
         SatVariant::Fixed => "fixed",
         SatVariant::Float => "float",
@@ -869,40 +893,40 @@ fn soft_visibility_body(light: &Light, maps: &[String], variant: SatVariant) -> 
             Technique::MsmSoft { .. } => "vis_msm_soft",
             _ => "vis_vssm",
         };
-        return format!("return {f}_{suffix}({map}, l, s);");
+        return (format!("return {f}_{suffix}({map}, l, s);"), None);
     };
     let (basis, z) = maps.split_at((csm_maps(terms) as usize).min(maps.len()));
     let sample = |m: &str, width: &str| format!("sat_sample_{suffix}({m}, l, s.uv, {width})");
-    let mut body =
-        String::from("let search = blocker_search_width(l, s);\n            var below = 0.0;");
-    for (chunk, m) in basis.iter().enumerate() {
-        let _ = write!(
-            body,
-            "\n            below += csm_chunk_of({}, {chunk}u, l, s);",
-            sample(m, "search")
-        );
-    }
-    body.push_str("\n            var zsum = 0.0;");
+    let mut body = String::from(
+        "var look = soft_search(l, s);
+    var zsum = 0.0;",
+    );
     for (chunk, m) in z.iter().enumerate() {
         let _ = write!(
             body,
-            "\n            zsum += csm_z_chunk_of({}, {chunk}u, l, s);",
-            sample(m, "search")
+            "\n    zsum += csm_z_chunk_of({}, {chunk}u, l, s);",
+            sample(m, "look.width")
         );
     }
-    body.push_str(
-        "\n            let b = cssm_blocker(below, zsum, l, s);\n            \
-         let width = blocker_filter_width(l, s, b.x);\n            var sum = 0.0;",
-    );
+    body.push_str("\n    var sum = 0.0;\n    for (var k = 0u; k < 2u; k++) {\n        sum = 0.0;");
     for (chunk, m) in basis.iter().enumerate() {
         let _ = write!(
             body,
-            "\n            sum += csm_chunk_of({}, {chunk}u, l, s);",
-            sample(m, "width")
+            "\n        sum += csm_chunk_of({}, {chunk}u, l, s);",
+            sample(m, "look.width")
         );
     }
-    body.push_str("\n            return cssm_resolve(sum, b, l, s);");
-    body
+    body.push_str(
+        "\n        if k == 0u {\n            look = soft_blockers(cssm_blocker(sum, zsum, l, s), l, s);\n            \
+         if !look.blockers {\n                return 1.0;\n            }\n        }\n    }\n    \
+         return cssm_resolve(sum, look.blocker, l, s);",
+    );
+    let fetches = format!(
+        "{} * sat_sample_{suffix} + 2 * {} * sat_sample_{suffix}",
+        z.len(),
+        basis.len()
+    );
+    (body, Some(fetches))
 }
 
 /// [`visibility_body`] without the `sat` filter.
@@ -939,12 +963,52 @@ fn filtered_visibility_body(light: &Light, maps: &[String]) -> (&'static str, St
     }
 }
 
+/// The key of the shading kernel for `lights`: what [`shading_block`] reads of each light (its
+/// technique, the table it reads through, hardware PCF, whether it follows the pixel's
+/// footprint, CSM's terms, its maps' count and type), so that a scene of the same techniques
+/// finds its kernel without generating the block (`tests/reuse.rs` checks that lights with
+/// equal keys get equal blocks).
+pub fn shade_key(lights: &[Light]) -> String {
+    let mut key = String::from("shade");
+    for (i, light) in lights.iter().enumerate() {
+        let t = &light.shadow.technique;
+        let table = match sat_variant(light) {
+            Some(SatVariant::Fixed) => "u32",
+            Some(SatVariant::Float) => "f32",
+            None => "-",
+        };
+        let hardware = matches!(
+            t,
+            Technique::Pcf {
+                kernel: PcfKernel::Hardware,
+                ..
+            }
+        );
+        let footprint =
+            matches!(t.filter(), Some(Filter::Mips { max_anisotropy, .. }) if max_anisotropy > 0);
+        let terms = match *t {
+            Technique::Csm { terms, .. } | Technique::Cssm { terms, .. } => terms,
+            _ => 0,
+        };
+        let input = add_light_nodes(&mut Graph::default(), i, light);
+        let _ = write!(
+            key,
+            "|{} {table} {} {} {terms} {}x{}",
+            t.name(),
+            u8::from(hardware),
+            u8::from(footprint),
+            input.maps.len(),
+            input.wgsl_type
+        );
+    }
+    key
+}
+
 /// The `// #generated` block of `kernels/shade.wgsl` for these lights: imports of the
 /// techniques used, one group-1 binding per map (light by light, in [`ShadeInput::maps`]
 /// order), one visibility function per light and `light_visibility`, which dispatches on the
-/// light index. Every invocation evaluates its lights' visibility, also outside the map (then
-/// discarded by a `select`): llvmpipe (lavapipe) mis-fetches explicit mip levels when some
-/// invocations of a SIMD group have left the code path, so no path branches before sampling.
+/// light index. A receiver that faces away from a light reads 0 and one outside its map 1,
+/// without a lookup (`light_faces`, `LightSample::inside`).
 pub fn shading_block(lights: &[Light]) -> String {
     let mut imports: Vec<&str> = Vec::new();
     let mut bindings = String::new();
@@ -956,8 +1020,8 @@ pub fn shading_block(lights: &[Light]) -> String {
         let maps: Vec<String> = (0..input.maps.len())
             .map(|k| format!("light{i}_map{k}"))
             .collect();
-        let (modules, body) = visibility_body(light, &maps);
-        for module in modules {
+        let vis = visibility_body(light, &maps);
+        for module in vis.modules {
             if !imports.contains(&module) {
                 imports.push(module);
             }
@@ -970,9 +1034,13 @@ pub fn shading_block(lights: &[Light]) -> String {
             );
             binding += 1;
         }
+        if let Some(fetches) = &vis.fetches {
+            let _ = writeln!(functions, "// #fetches light{i}_visibility: {fetches}");
+        }
         let _ = writeln!(
             functions,
-            "fn light{i}_visibility(l: Light, s: LightSample) -> f32 {{\n    {body}\n}}"
+            "fn light{i}_visibility(l: Light, s: LightSample) -> f32 {{\n    {}\n}}",
+            vis.body
         );
         // Only anisotropic mip lookups read the footprint (two more projections per pixel).
         let footprint = match light.shadow.technique.filter() {
@@ -983,7 +1051,11 @@ pub fn shading_block(lights: &[Light]) -> String {
         };
         let _ = writeln!(
             cases,
-            "        case {i}u: {{\n            let l = lights[{i}];\n            var s = light_sample(l, p, n);{footprint}\n            return select(1.0, light{i}_visibility(l, s), s.inside);\n        }}"
+            "        case {i}u: {{\n            let l = lights[{i}];\n            \
+             if !light_faces(l, p, n) {{\n                return 0.0;\n            }}\n            \
+             var s = light_sample(l, p, n);\n            \
+             if !s.inside {{\n                return 1.0;\n            }}{footprint}\n            \
+             return light{i}_visibility(l, s);\n        }}"
         );
     }
     let mut s = String::new();

@@ -24,18 +24,54 @@
 //! begin timestamp and its first dispatch without `TIMESTAMP_QUERY_INSIDE_PASSES`, and an empty
 //! marker pass resolves to zero on Metal.
 
-use crate::error::Result;
-use crate::gpu::read_buffer;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU8, Ordering};
+
+use crate::created;
+use crate::error::{Error, Result};
 
 /// The features [`GpuTimer`] needs.
 pub const TIMER_FEATURES: wgpu::Features =
     wgpu::Features::TIMESTAMP_QUERY.union(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);
 
-/// Timestamps at pass boundaries, resolved after the work is submitted.
+/// Readback buffers the resolved timestamps rotate through: a frame's are mapped after its
+/// submission and read once the device is done with them, while the next frames resolve into
+/// the others, so no frame waits for its timestamps (three: one being written, one in flight,
+/// one being read).
+const RING: usize = 3;
+
+/// Where a readback buffer of the ring is.
+mod slot {
+    /// Free (nothing to read).
+    pub const IDLE: u8 = 0;
+    /// Holds a copy recorded into an encoder not yet known to be submitted.
+    pub const RECORDED: u8 = 1;
+    /// Mapping requested after the submission.
+    pub const MAPPING: u8 = 2;
+    /// Mapped: readable.
+    pub const MAPPED: u8 = 3;
+    /// The mapping failed (or was cancelled by reusing the slot).
+    pub const FAILED: u8 = 4;
+}
+
+/// One readback buffer of the ring and the spans of the frame it holds.
+struct Readback {
+    buffer: wgpu::Buffer,
+    state: Arc<AtomicU8>,
+    spans: Vec<(String, u32, u32)>,
+    /// Frame number (order of [`GpuTimer::resolve`] calls).
+    frame: u64,
+}
+
+/// Timestamps at pass boundaries, resolved into a ring of readback buffers and read back a
+/// frame or more later without waiting ([`GpuTimer::collect`]), or waited for when asked
+/// ([`GpuTimer::read`], [`GpuTimer::finish`]).
 pub struct GpuTimer {
     query_set: wgpu::QuerySet,
     resolve: wgpu::Buffer,
-    readback: wgpu::Buffer,
+    ring: Vec<Readback>,
+    /// Frames resolved so far; the next goes to `ring[frames % RING]`.
+    frames: u64,
     /// Marks the query set holds (two queries each).
     capacity: u32,
     /// Marks written since the last [`GpuTimer::reset`].
@@ -57,24 +93,42 @@ impl GpuTimer {
         // A span needs at most two marks of its own (begin, end).
         let capacity = 2 * spans;
         let bytes = u64::from(capacity) * 2 * 8;
+        let ring = (0..RING)
+            .map(|_| Readback {
+                buffer: created::buffer(
+                    device,
+                    &wgpu::BufferDescriptor {
+                        label: Some("shadowgraph.timer.readback"),
+                        size: bytes,
+                        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                        mapped_at_creation: false,
+                    },
+                ),
+                state: Arc::new(AtomicU8::new(slot::IDLE)),
+                spans: Vec::new(),
+                frame: 0,
+            })
+            .collect();
         Some(Self {
-            query_set: device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("shadowgraph.timer"),
-                ty: wgpu::QueryType::Timestamp,
-                count: capacity * 2,
-            }),
-            resolve: device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("shadowgraph.timer.resolve"),
-                size: bytes,
-                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            }),
-            readback: device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("shadowgraph.timer.readback"),
-                size: bytes,
-                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-                mapped_at_creation: false,
-            }),
+            query_set: created::query_set(
+                device,
+                &wgpu::QuerySetDescriptor {
+                    label: Some("shadowgraph.timer"),
+                    ty: wgpu::QueryType::Timestamp,
+                    count: capacity * 2,
+                },
+            ),
+            resolve: created::buffer(
+                device,
+                &wgpu::BufferDescriptor {
+                    label: Some("shadowgraph.timer.resolve"),
+                    size: bytes,
+                    usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                    mapped_at_creation: false,
+                },
+            ),
+            ring,
+            frames: 0,
             capacity,
             marks: 0,
             spans: Vec::new(),
@@ -82,7 +136,6 @@ impl GpuTimer {
             period_ns: f64::from(queue.get_timestamp_period()),
         })
     }
-
     /// The number of spans this timer can hold per frame.
     pub fn span_capacity(&self) -> u32 {
         self.capacity / 2
@@ -134,34 +187,134 @@ impl GpuTimer {
         }
     }
 
-    /// Ends the open span and records the query resolve; call after the last timed pass,
-    /// before submitting.
+    /// Ends the open span and records the query resolve and its copy into the next readback
+    /// buffer of the ring; call after the last timed pass, before submitting. A buffer still
+    /// holding an unread frame is taken back (that frame's times are dropped).
     pub fn resolve(&mut self, encoder: &mut wgpu::CommandEncoder) {
         self.end(encoder);
         let n = 2 * self.marks;
         if n == 0 {
             return;
         }
+        let frame = self.frames;
+        self.frames += 1;
+        let slot = &mut self.ring[(frame % RING as u64) as usize];
+        if slot.state.load(Ordering::Acquire) != slot::IDLE {
+            slot.buffer.unmap();
+            slot.state.store(slot::IDLE, Ordering::Release);
+        }
         encoder.resolve_query_set(&self.query_set, 0..n, &self.resolve, 0);
-        encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.readback, 0, u64::from(n) * 8);
+        encoder.copy_buffer_to_buffer(&self.resolve, 0, &slot.buffer, 0, u64::from(n) * 8);
+        slot.spans = std::mem::take(&mut self.spans);
+        slot.frame = frame;
+        slot.state.store(slot::RECORDED, Ordering::Release);
     }
 
-    /// Milliseconds per span, in the order they began. Call after the submission completed.
-    pub fn read(&self, device: &wgpu::Device) -> Result<Vec<(String, f64)>> {
-        if self.spans.is_empty() {
-            return Ok(Vec::new());
+    /// Requests the mapping of every frame resolved since the last call; call after the
+    /// encoders holding them were submitted. Never waits.
+    pub fn submitted(&mut self) {
+        for slot in &self.ring {
+            if slot.state.load(Ordering::Acquire) != slot::RECORDED {
+                continue;
+            }
+            slot.state.store(slot::MAPPING, Ordering::Release);
+            let state = slot.state.clone();
+            slot.buffer.map_async(wgpu::MapMode::Read, .., move |r| {
+                let to = if r.is_ok() {
+                    slot::MAPPED
+                } else {
+                    slot::FAILED
+                };
+                // Only a mapping still awaited completes (a reused slot was set back to IDLE).
+                let _ =
+                    state.compare_exchange(slot::MAPPING, to, Ordering::AcqRel, Ordering::Acquire);
+            });
         }
-        let raw = read_buffer(device, &self.readback)?;
-        let ticks: &[u64] = bytemuck::cast_slice(&raw);
-        // Only the first timestamp of each mark is a boundary.
-        let at = |m: u32| ticks[2 * m as usize];
-        Ok(self
-            .spans
-            .iter()
-            .map(|(l, a, b)| {
-                let dt = at(*b).wrapping_sub(at(*a));
-                (l.clone(), dt as f64 * self.period_ns * 1e-6)
+    }
+
+    /// Milliseconds per span of every frame whose timestamps have arrived, oldest first, each
+    /// frame's spans in the order they began; frames still in flight stay for a later call.
+    /// Requests mappings as [`GpuTimer::submitted`] does, polls the device without waiting.
+    pub fn collect(&mut self, device: &wgpu::Device) -> Result<Vec<Vec<(String, f64)>>> {
+        self.submitted();
+        device.poll(wgpu::PollType::Poll).map_err(poll_error)?;
+        self.take_mapped()
+    }
+
+    /// [`GpuTimer::collect`] after waiting for every frame submitted so far.
+    pub fn finish(&mut self, device: &wgpu::Device) -> Result<Vec<Vec<(String, f64)>>> {
+        self.submitted();
+        let waiting = |t: &Self| {
+            t.ring
+                .iter()
+                .any(|s| s.state.load(Ordering::Acquire) == slot::MAPPING)
+        };
+        if waiting(self) {
+            device
+                .poll(wgpu::PollType::wait_indefinitely())
+                .map_err(poll_error)?;
+        }
+        if waiting(self) {
+            return Err(Error::Gpu {
+                stage: "timer".into(),
+                message: "timestamps were not read back after the device went idle".into(),
+            });
+        }
+        self.take_mapped()
+    }
+
+    /// Milliseconds per span of the last frame resolved, in the order they began; waits for
+    /// it. Call after the submission completed. Earlier unread frames are dropped.
+    pub fn read(&mut self, device: &wgpu::Device) -> Result<Vec<(String, f64)>> {
+        Ok(self.finish(device)?.pop().unwrap_or_default())
+    }
+
+    /// Reads and frees every mapped slot, oldest frame first.
+    fn take_mapped(&mut self) -> Result<Vec<Vec<(String, f64)>>> {
+        let mut ready: Vec<usize> = (0..self.ring.len())
+            .filter(|&i| {
+                let s = self.ring[i].state.load(Ordering::Acquire);
+                s == slot::MAPPED || s == slot::FAILED
             })
-            .collect())
+            .collect();
+        ready.sort_by_key(|&i| self.ring[i].frame);
+        let mut frames = Vec::new();
+        for i in ready {
+            let slot = &mut self.ring[i];
+            if slot.state.load(Ordering::Acquire) == slot::FAILED {
+                slot.state.store(slot::IDLE, Ordering::Release);
+                return Err(Error::Gpu {
+                    stage: "timer".into(),
+                    message: "mapping the timestamps failed".into(),
+                });
+            }
+            let spans = {
+                let view = slot.buffer.get_mapped_range(..).map_err(|e| Error::Gpu {
+                    stage: "timer".into(),
+                    message: e.to_string(),
+                })?;
+                let ticks: &[u64] = bytemuck::cast_slice(&view);
+                // Only the first timestamp of each mark is a boundary.
+                let at = |m: u32| ticks[2 * m as usize];
+                slot.spans
+                    .iter()
+                    .map(|(l, a, b)| {
+                        let dt = at(*b).wrapping_sub(at(*a));
+                        (l.clone(), dt as f64 * self.period_ns * 1e-6)
+                    })
+                    .collect()
+            };
+            slot.buffer.unmap();
+            slot.state.store(slot::IDLE, Ordering::Release);
+            frames.push(spans);
+        }
+        Ok(frames)
+    }
+}
+
+fn poll_error(e: wgpu::PollError) -> Error {
+    Error::Gpu {
+        stage: "timer".into(),
+        message: crate::gpu::one_line(&e.to_string()),
     }
 }

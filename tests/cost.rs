@@ -327,7 +327,7 @@ fn count_fetches(wgsl: &str) -> String {
         out.insert(r.end, ')');
         out.insert_str(r.start, &format!("{counter}("));
     }
-    let reset = "let v = select(light_visibility(";
+    let reset = "let v = light_visibility(";
     let store = "out_visibility[base + i] = v;";
     assert!(
         out.contains(reset) && out.contains(store),
@@ -391,9 +391,7 @@ fn counted_fetches_match_the_declarations() {
         let block = technique::shading_block(&s.lights);
         let wgsl = kernels::resolve("shade", Some(&block)).expect("shade");
         renderer
-            .executor
-            .kernels
-            .insert_generated(&g.device, "shade", Some(&block), &count_fetches(&wgsl))
+            .insert_shade_kernel(&g.device, &s.lights, &count_fetches(&wgsl))
             .expect("counting kernel");
         let frame = renderer
             .render(&g.device, &g.queue, &s, RenderOptions::default())

@@ -43,6 +43,15 @@ fn pixel_reference(
     let n = &frame.normal[4 * px..4 * px + 3];
     let p = glam::DVec3::new(p[0].into(), p[1].into(), p[2].into());
     let n = glam::DVec3::new(n[0].into(), n[1].into(), n[2].into()).normalize();
+    // Facing away, the shading reads no map: 0 (`light_faces`). Within 10⁻⁵ of N·L = 0 the f32
+    // dot product may take either sign.
+    let ndl = cpu::light::facing(&lg, p, n);
+    if ndl.abs() < 1e-5 {
+        return None;
+    }
+    if ndl < 0.0 {
+        return Some((0.0, 0.0));
+    }
     let mut s = cpu::light::sample(&lg, p, n);
     if lg.max_anisotropy > 0 {
         // The pixel's footprint, as the shading kernel derives it from the camera's rays.

@@ -302,12 +302,13 @@ fn distance_to_pcss(g: &Gpu, renderer: &mut Renderer, scene: &Scene) -> Distance
         }
         let p = &frame.position[4 * px..4 * px + 3];
         let normal = &frame.normal[4 * px..4 * px + 3];
-        let s = cpu::light::sample(
-            &lg,
+        let (p, normal) = (
             DVec3::new(p[0].into(), p[1].into(), p[2].into()),
             DVec3::new(normal[0].into(), normal[1].into(), normal[2].into()).normalize(),
         );
-        if !s.inside {
+        let s = cpu::light::sample(&lg, p, normal);
+        // Receivers facing away read 0 by definition (`light_faces`): no estimate to compare.
+        if !s.inside || cpu::light::facing(&lg, p, normal) <= 0.0 {
             continue;
         }
         let pcss = cpu::vis_pcss::vis_pcss(&map, &lg, &s);

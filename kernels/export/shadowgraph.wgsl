@@ -3,8 +3,14 @@
 // test checks this file is current; `SHADOWGRAPH_BLESS=1` rewrites it).
 //
 // Usage, per light and shaded point p (world) with unit normal n:
-//   let s = light_sample(l, p, n);               // where p lands in the light's map
-//   let v = select(1.0, vis_vsm(map, l, s), s.inside);
+//   var v = 0.0;                                 // facing away: in its own shadow
+//   if light_faces(l, p, n) {
+//       let s = light_sample(l, p, n);           // where p lands in the light's map
+//       v = 1.0;                                 // outside the map: unshadowed
+//       if s.inside { v = vis_vsm(map, l, s); }
+//   }
+// (Branching costs nothing here: every function reads with textureLoad or an explicit level,
+// which WGSL allows in non-uniform control flow.)
 // `map` is the texture `Prefilter::record` returned for the technique (its
 // `PrefilterOutput::maps`, in order), bound as the type in the signature below; `l` is a
 // `Light`, filled byte for byte from `PrefilterOutput::light` (Rust `LightGpu`, bytemuck):
@@ -37,18 +43,19 @@
 //
 // Names defined here (a host must not reuse them):
 //   BLOCKER_MIN_SHARE CSM_PI GOLDEN_ANGLE Light LightSample MSM_B0 MSM_B0_COV MSM_B0_SCHUR
-//   MipTaps MsmMoments SAT_MIN_EXTENT SatNodes bilinear_level bilinear_log_level blocker_csm_z
-//   blocker_filter_width blocker_msm blocker_result blocker_search_width blocker_vsm
-//   blocker_width chebyshev_upper csm_chunk csm_chunk_of csm_resolve csm_sin_cos csm_weight
-//   csm_z_chunk_of cssm_blocker cssm_resolve cssm_sharpen level_size light_footprint
-//   light_linear_to_ndc light_linear_to_z light_map_width light_sample light_to_light linstep
-//   load_depth mip_tap_uv mip_taps msm_biased msm_dequantize msm_expect msm_intensity
-//   msm_moments msm_quantize msm_roots msm_soft_blocker msm_soft_resolve pcss_search_radius
+//   MipTaps MsmMoments SAT_MIN_EXTENT SatNodes SoftLookup bilinear_level bilinear_log_level
+//   blocker_csm_z blocker_filter_width blocker_msm blocker_result blocker_search_width
+//   blocker_vsm blocker_width chebyshev_upper csm_chunk csm_chunk_of csm_resolve csm_sin_cos
+//   csm_weight csm_z_chunk_of cssm_blocker cssm_resolve cssm_sharpen level_size light_faces
+//   light_footprint light_linear_to_ndc light_linear_to_z light_map_width light_sample
+//   light_to_light linstep load_depth mip_tap_uv mip_taps msm_biased msm_dequantize msm_expect
+//   msm_intensity msm_moments msm_quantize msm_roots msm_soft_blocker pcss_search_radius
 //   sample_bilinear sample_bilinear_log sample_map sample_map_log sat_mean_fixed sat_mean_float
-//   sat_node_f32 sat_node_u32 sat_nodes sat_rect sat_sample_fixed sat_sample_float texel_of
-//   trilinear trilinear_log vis_esm vis_esm_of_log vis_esm_of_sat vis_evsm vis_evsm_of vis_hard
-//   vis_msm vis_msm_of vis_msm_soft_fixed vis_msm_soft_float vis_pcf vis_pcf_hardware vis_pcss
-//   vis_vsm vis_vsm_of vis_vssm_fixed vis_vssm_float vogel_disc vssm_blocker vssm_resolve
+//   sat_node_f32 sat_node_u32 sat_nodes sat_rect sat_sample_fixed sat_sample_float soft_blockers
+//   soft_search texel_of trilinear trilinear_log vis_esm vis_esm_of_log vis_esm_of_sat vis_evsm
+//   vis_evsm_of vis_hard vis_msm vis_msm_of vis_msm_soft_fixed vis_msm_soft_float vis_pcf
+//   vis_pcf_hardware vis_pcss vis_vsm vis_vsm_of vis_vssm_fixed vis_vssm_float vogel_disc
+//   vssm_blocker
 
 // Shared light description and light-space helpers (import-only module).
 //
@@ -124,6 +131,13 @@ fn light_to_light(l: Light, p: vec3<f32>) -> vec3<f32> {
         return -l.direction;
     }
     return normalize(l.position - p);
+}
+
+// Whether a receiver p with unit normal n faces light l (N·L > 0). One that faces away is in
+// its own shadow: its visibility is 0, known without reading a map (and its N·L, hence its
+// light, is 0 whatever a map says), so the shading skips its lookups.
+fn light_faces(l: Light, p: vec3<f32>, n: vec3<f32>) -> bool {
+    return dot(n, light_to_light(l, p)) > 0.0;
 }
 
 // Projects p, first moved along n by normal_bias texels scaled by (1 − N·L).
@@ -266,19 +280,17 @@ fn mip_tap_uv(t: MipTaps, uv: vec2<f32>, k: u32) -> vec2<f32> {
 }
 
 // A light's filtered representation at a receiver: bilinear, or with the `mips` filter
-// trilinear at log2(filter width), or along the pixel's footprint (`mip_taps`). The loop runs
-// `max_anisotropy` times for every invocation and weights the taps past `count` by 0: no
-// invocation leaves the loop early (llvmpipe mis-fetches explicit levels under divergence).
+// trilinear at log2(filter width), or along the pixel's footprint (`mip_taps`): each pixel reads
+// its own tap count, so the declaration is the most a pixel reads (`max_anisotropy` taps).
 // #fetches sample_map: select(4, 8 * max(l.max_anisotropy, 1), l.mip_levels > 1)
 fn sample_map(map: texture_2d<f32>, l: Light, s: LightSample) -> vec4<f32> {
     if l.mip_levels <= 1u {
         return sample_bilinear(map, s.uv);
     }
     let t = mip_taps(l, s);
-    var sum = trilinear(map, l, mip_tap_uv(t, s.uv, 0u), t.lod);
-    for (var k = 1u; k < l.max_anisotropy; k++) {
-        let v = trilinear(map, l, mip_tap_uv(t, s.uv, k), t.lod);
-        sum += select(vec4<f32>(0.0), v, k < t.count);
+    var sum = vec4<f32>(0.0);
+    for (var k = 0u; k < t.count; k++) {
+        sum += trilinear(map, l, mip_tap_uv(t, s.uv, k), t.lod);
     }
     return sum / f32(t.count);
 }
@@ -319,11 +331,10 @@ fn sample_map_log(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     // A running log-sum-exp: m the largest tap so far, sum = Σ exp(tap − m).
     var m = trilinear_log(map, l, mip_tap_uv(t, s.uv, 0u), t.lod);
     var sum = 1.0;
-    for (var k = 1u; k < l.max_anisotropy; k++) {
+    for (var k = 1u; k < t.count; k++) {
         let v = trilinear_log(map, l, mip_tap_uv(t, s.uv, k), t.lod);
-        let on = k < t.count;
-        let m2 = select(m, max(m, v), on);
-        sum = sum * exp(m - m2) + select(0.0, exp(v - m2), on);
+        let m2 = max(m, v);
+        sum = sum * exp(m - m2) + exp(v - m2);
         m = m2;
     }
     return m + log(sum / f32(t.count));
@@ -739,10 +750,10 @@ fn csm_resolve(sum: f32, l: Light) -> f32 {
 // where the smooth Fourier step leaks light and the penumbra is narrow, the darkening is
 // strongest; it fades as the receiver leaves its blockers. A square without blockers
 // (share < BLOCKER_MIN_SHARE) is lit.
-// The shading block (technique::visibility_body) sums `csm_chunk_of` over the light's basis
-// tables and `csm_z_chunk_of` over its CSM-Z tables at the search width, calls
-// `cssm_blocker`, sums the basis again at `blocker_filter_width(l, s, b.x)`, then calls
-// `cssm_resolve`.
+// The shading block (technique::soft_visibility_body) sums `csm_z_chunk_of` over the light's
+// CSM-Z tables at the search width, then runs `blocker.wgsl`'s two passes over its basis
+// tables: `csm_chunk_of` summed at the search width gives `cssm_blocker`, and where that finds
+// blockers, summed again at `blocker_filter_width(l, s, b.x)`, `cssm_resolve`.
 // The `sat` filter's lookups for the shading side (import-only module): a light's filtered
 // representation at a receiver as the mean over a square of `width` shadow-map texels centred
 // on it, from the light's summed-area table, four lookups per channel (sixteen with the
@@ -903,8 +914,8 @@ fn sat_sample_float(map: texture_2d<f32>, l: Light, uv: vec2<f32>, width: f32) -
 // the fixed-point table is coded for). A NaN width (outside the map, where the result is
 // discarded) reads as 1 texel.
 
-// A search square whose estimated share of blockers is below this reads as lit, whatever the
-// lookup at the filter width gives (PCSS: no blocker tap). The estimates are smooth, so a
+// A search square whose estimated share of blockers is below this reads as lit, without a
+// lookup at the filter width (PCSS: no blocker tap). The estimates are smooth, so a
 // threshold keeps ringing (CSM-Z) and Chebyshev's tail (VSM) from turning into blockers.
 const BLOCKER_MIN_SHARE: f32 = 0.01;
 
@@ -921,6 +932,39 @@ fn blocker_filter_width(l: Light, s: LightSample, z_avg: f32) -> f32 {
     let z_b = light_linear_to_z(l, z_avg);
     let penumbra = l.size * (s.view_z - z_b) / z_b;
     return blocker_width(penumbra / light_map_width(l, s.view_z) * l.map_size.x, l);
+}
+
+// A soft technique's two table lookups as two passes of one loop: pass 0 reads the table over
+// the search square and estimates the blockers (soft_blockers); pass 1, made only where the
+// search found some (share ≥ BLOCKER_MIN_SHARE), reads it over the penumbra width; elsewhere
+// the receiver is lit after one lookup. A loop, not a second lookup in a branch: llvmpipe
+// (lavapipe) runs a loop-free branch body (a table lookup's loads) for its whole SIMD group
+// whatever its lanes decide, and leaves a loop after the trip in which no lane continues, so
+// only a loop lets a group without blockers skip the second lookup there (measured: 64 loads
+// under a branch never taken cost what they cost taken, 11.0 against 10.9 ms; a loop-bearing
+// body under a branch or loop never entered, 3 against 12 ms); a GPU runs either as a branch.
+struct SoftLookup {
+    width: f32,          // texels: the square the next pass reads
+    blocker: vec2<f32>,  // (z_avg, share) from the search (pass 1)
+    blockers: bool,      // whether the search found any (pass 1 is made)
+}
+
+// Pass 0: the search square.
+fn soft_search(l: Light, s: LightSample) -> SoftLookup {
+    var look: SoftLookup;
+    look.width = blocker_search_width(l, s);
+    look.blocker = vec2<f32>(0.0);
+    look.blockers = false;
+    return look;
+}
+
+// Pass 1 after the search's estimate b = (z_avg, share): the penumbra width of z_avg.
+fn soft_blockers(b: vec2<f32>, l: Light, s: LightSample) -> SoftLookup {
+    var look: SoftLookup;
+    look.width = blocker_filter_width(l, s, b.x);
+    look.blocker = b;
+    look.blockers = b.y >= BLOCKER_MIN_SHARE;
+    return look;
 }
 
 // (z_avg, share) from a blocker depth estimate `z` and share: z clamped to [0, d] (blockers
@@ -1014,69 +1058,98 @@ fn cssm_sharpen(v: f32, p: f32) -> f32 {
     return select(0.0, exp2(p * log2(v)), v > 0.0);
 }
 
-// The visibility from the basis sum at the filter width and the blocker estimate `b`.
+// The visibility from the basis sum at the filter width and the blocker estimate `b` (which
+// found blockers: share ≥ BLOCKER_MIN_SHARE).
 fn cssm_resolve(sum: f32, b: vec2<f32>, l: Light, s: LightSample) -> f32 {
     let v = csm_resolve(sum, l);
     let gap = max(s.depth - l.bias - b.x, 0.0);
     let p = 1.0 + l.sharpen * exp(-l.sharpen_falloff * gap);
-    return select(1.0, cssm_sharpen(v, p), b.y >= BLOCKER_MIN_SHARE);
+    return cssm_sharpen(v, p);
 }
 // Variance soft shadow maps (Yang et al. 2010) from a summed-area table of the VSM moments:
 // the moments over the blocker-search square give the blocker share and depth (blocker_vsm),
 // the PCSS penumbra width follows, and the VSM bound (vis_vsm_of: variance floor, bleed
-// reduction) is read from the moments over that width. Two table lookups per receiver; both
-// are made before the result is chosen (lit when the share is below BLOCKER_MIN_SHARE).
+// reduction) is read from the moments over that width. One table lookup per pass of
+// `blocker.wgsl`'s two-pass loop: a receiver whose search square holds no blockers (share below
+// BLOCKER_MIN_SHARE) is lit after the first.
 // `vis_vssm_fixed` reads a fixed-point table (rgba32uint), `vis_vssm_float` an f32 one.
 
 fn vssm_blocker(m: vec4<f32>, l: Light, s: LightSample) -> vec2<f32> {
     return blocker_vsm(m, s.depth - l.bias, l.min_variance);
 }
 
-// The visibility from the moments `m` at the filter width and the blocker estimate `b`.
-fn vssm_resolve(m: vec4<f32>, b: vec2<f32>, l: Light, s: LightSample) -> f32 {
-    return select(1.0, vis_vsm_of(m, l, s), b.y >= BLOCKER_MIN_SHARE);
-}
-
 // #fetches vis_vssm_fixed: 2 * sat_sample_fixed
 fn vis_vssm_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32 {
-    let b = vssm_blocker(sat_sample_fixed(map, l, s.uv, blocker_search_width(l, s)), l, s);
-    let m = sat_sample_fixed(map, l, s.uv, blocker_filter_width(l, s, b.x));
-    return vssm_resolve(m, b, l, s);
+    var look = soft_search(l, s);
+    var m = vec4<f32>(0.0);
+    for (var k = 0u; k < 2u; k++) {
+        m = sat_sample_fixed(map, l, s.uv, look.width);
+        if k == 0u {
+            look = soft_blockers(vssm_blocker(m, l, s), l, s);
+            if !look.blockers {
+                return 1.0;
+            }
+        }
+    }
+    return vis_vsm_of(m, l, s);
 }
 
 // #fetches vis_vssm_float: 2 * sat_sample_float
 fn vis_vssm_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    let b = vssm_blocker(sat_sample_float(map, l, s.uv, blocker_search_width(l, s)), l, s);
-    let m = sat_sample_float(map, l, s.uv, blocker_filter_width(l, s, b.x));
-    return vssm_resolve(m, b, l, s);
+    var look = soft_search(l, s);
+    var m = vec4<f32>(0.0);
+    for (var k = 0u; k < 2u; k++) {
+        m = sat_sample_float(map, l, s.uv, look.width);
+        if k == 0u {
+            look = soft_blockers(vssm_blocker(m, l, s), l, s);
+            if !look.blockers {
+                return 1.0;
+            }
+        }
+    }
+    return vis_vsm_of(m, l, s);
 }
 // Moment soft shadow maps (after Peters et al. 2016) from a summed-area table of the MSM
 // moments (raw or quantized): the biased moments over the blocker-search square give the
 // blocker share and depth from the Hamburger reconstruction (blocker_msm), the PCSS penumbra
 // width follows, and MSM's visibility (vis_msm_of: Hamburger or Hausdorff, bleed reduction) is
-// read from the moments over that width. Two table lookups per receiver, both made before the
-// result is chosen (lit when the share is below BLOCKER_MIN_SHARE).
+// read from the moments over that width. One table lookup per pass of `blocker.wgsl`'s two-pass
+// loop: a receiver whose search square holds no blockers (share below BLOCKER_MIN_SHARE) is
+// lit after the first.
 // `vis_msm_soft_fixed` reads a fixed-point table (rgba32uint), `vis_msm_soft_float` an f32 one.
 
 fn msm_soft_blocker(m: vec4<f32>, l: Light, s: LightSample) -> vec2<f32> {
     return blocker_msm(msm_biased(m, l), s.depth - l.bias);
 }
 
-// The visibility from the moments `m` at the filter width and the blocker estimate `b`.
-fn msm_soft_resolve(m: vec4<f32>, b: vec2<f32>, l: Light, s: LightSample) -> f32 {
-    return select(1.0, vis_msm_of(m, l, s), b.y >= BLOCKER_MIN_SHARE);
-}
-
 // #fetches vis_msm_soft_fixed: 2 * sat_sample_fixed
 fn vis_msm_soft_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32 {
-    let b = msm_soft_blocker(sat_sample_fixed(map, l, s.uv, blocker_search_width(l, s)), l, s);
-    let m = sat_sample_fixed(map, l, s.uv, blocker_filter_width(l, s, b.x));
-    return msm_soft_resolve(m, b, l, s);
+    var look = soft_search(l, s);
+    var m = vec4<f32>(0.0);
+    for (var k = 0u; k < 2u; k++) {
+        m = sat_sample_fixed(map, l, s.uv, look.width);
+        if k == 0u {
+            look = soft_blockers(msm_soft_blocker(m, l, s), l, s);
+            if !look.blockers {
+                return 1.0;
+            }
+        }
+    }
+    return vis_msm_of(m, l, s);
 }
 
 // #fetches vis_msm_soft_float: 2 * sat_sample_float
 fn vis_msm_soft_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    let b = msm_soft_blocker(sat_sample_float(map, l, s.uv, blocker_search_width(l, s)), l, s);
-    let m = sat_sample_float(map, l, s.uv, blocker_filter_width(l, s, b.x));
-    return msm_soft_resolve(m, b, l, s);
+    var look = soft_search(l, s);
+    var m = vec4<f32>(0.0);
+    for (var k = 0u; k < 2u; k++) {
+        m = sat_sample_float(map, l, s.uv, look.width);
+        if k == 0u {
+            look = soft_blockers(msm_soft_blocker(m, l, s), l, s);
+            if !look.blockers {
+                return 1.0;
+            }
+        }
+    }
+    return vis_msm_of(m, l, s);
 }

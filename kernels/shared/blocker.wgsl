@@ -16,8 +16,8 @@
 // #import shared/vis_csm
 // #import shared/vis_msm
 
-// A search square whose estimated share of blockers is below this reads as lit, whatever the
-// lookup at the filter width gives (PCSS: no blocker tap). The estimates are smooth, so a
+// A search square whose estimated share of blockers is below this reads as lit, without a
+// lookup at the filter width (PCSS: no blocker tap). The estimates are smooth, so a
 // threshold keeps ringing (CSM-Z) and Chebyshev's tail (VSM) from turning into blockers.
 const BLOCKER_MIN_SHARE: f32 = 0.01;
 
@@ -34,6 +34,39 @@ fn blocker_filter_width(l: Light, s: LightSample, z_avg: f32) -> f32 {
     let z_b = light_linear_to_z(l, z_avg);
     let penumbra = l.size * (s.view_z - z_b) / z_b;
     return blocker_width(penumbra / light_map_width(l, s.view_z) * l.map_size.x, l);
+}
+
+// A soft technique's two table lookups as two passes of one loop: pass 0 reads the table over
+// the search square and estimates the blockers (soft_blockers); pass 1, made only where the
+// search found some (share ≥ BLOCKER_MIN_SHARE), reads it over the penumbra width; elsewhere
+// the receiver is lit after one lookup. A loop, not a second lookup in a branch: llvmpipe
+// (lavapipe) runs a loop-free branch body (a table lookup's loads) for its whole SIMD group
+// whatever its lanes decide, and leaves a loop after the trip in which no lane continues, so
+// only a loop lets a group without blockers skip the second lookup there (measured: 64 loads
+// under a branch never taken cost what they cost taken, 11.0 against 10.9 ms; a loop-bearing
+// body under a branch or loop never entered, 3 against 12 ms); a GPU runs either as a branch.
+struct SoftLookup {
+    width: f32,          // texels: the square the next pass reads
+    blocker: vec2<f32>,  // (z_avg, share) from the search (pass 1)
+    blockers: bool,      // whether the search found any (pass 1 is made)
+}
+
+// Pass 0: the search square.
+fn soft_search(l: Light, s: LightSample) -> SoftLookup {
+    var look: SoftLookup;
+    look.width = blocker_search_width(l, s);
+    look.blocker = vec2<f32>(0.0);
+    look.blockers = false;
+    return look;
+}
+
+// Pass 1 after the search's estimate b = (z_avg, share): the penumbra width of z_avg.
+fn soft_blockers(b: vec2<f32>, l: Light, s: LightSample) -> SoftLookup {
+    var look: SoftLookup;
+    look.width = blocker_filter_width(l, s, b.x);
+    look.blocker = b;
+    look.blockers = b.y >= BLOCKER_MIN_SHARE;
+    return look;
 }
 
 // (z_avg, share) from a blocker depth estimate `z` and share: z clamped to [0, d] (blockers

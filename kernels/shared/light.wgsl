@@ -74,6 +74,13 @@ fn light_to_light(l: Light, p: vec3<f32>) -> vec3<f32> {
     return normalize(l.position - p);
 }
 
+// Whether a receiver p with unit normal n faces light l (N·L > 0). One that faces away is in
+// its own shadow: its visibility is 0, known without reading a map (and its N·L, hence its
+// light, is 0 whatever a map says), so the shading skips its lookups.
+fn light_faces(l: Light, p: vec3<f32>, n: vec3<f32>) -> bool {
+    return dot(n, light_to_light(l, p)) > 0.0;
+}
+
 // Projects p, first moved along n by normal_bias texels scaled by (1 − N·L).
 fn light_sample(l: Light, p: vec3<f32>, n: vec3<f32>) -> LightSample {
     let z0 = -(l.view * vec4<f32>(p, 1.0)).z;

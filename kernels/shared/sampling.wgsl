@@ -100,19 +100,17 @@ fn mip_tap_uv(t: MipTaps, uv: vec2<f32>, k: u32) -> vec2<f32> {
 }
 
 // A light's filtered representation at a receiver: bilinear, or with the `mips` filter
-// trilinear at log2(filter width), or along the pixel's footprint (`mip_taps`). The loop runs
-// `max_anisotropy` times for every invocation and weights the taps past `count` by 0: no
-// invocation leaves the loop early (llvmpipe mis-fetches explicit levels under divergence).
+// trilinear at log2(filter width), or along the pixel's footprint (`mip_taps`): each pixel reads
+// its own tap count, so the declaration is the most a pixel reads (`max_anisotropy` taps).
 // #fetches sample_map: select(4, 8 * max(l.max_anisotropy, 1), l.mip_levels > 1)
 fn sample_map(map: texture_2d<f32>, l: Light, s: LightSample) -> vec4<f32> {
     if l.mip_levels <= 1u {
         return sample_bilinear(map, s.uv);
     }
     let t = mip_taps(l, s);
-    var sum = trilinear(map, l, mip_tap_uv(t, s.uv, 0u), t.lod);
-    for (var k = 1u; k < l.max_anisotropy; k++) {
-        let v = trilinear(map, l, mip_tap_uv(t, s.uv, k), t.lod);
-        sum += select(vec4<f32>(0.0), v, k < t.count);
+    var sum = vec4<f32>(0.0);
+    for (var k = 0u; k < t.count; k++) {
+        sum += trilinear(map, l, mip_tap_uv(t, s.uv, k), t.lod);
     }
     return sum / f32(t.count);
 }
@@ -153,11 +151,10 @@ fn sample_map_log(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     // A running log-sum-exp: m the largest tap so far, sum = Σ exp(tap − m).
     var m = trilinear_log(map, l, mip_tap_uv(t, s.uv, 0u), t.lod);
     var sum = 1.0;
-    for (var k = 1u; k < l.max_anisotropy; k++) {
+    for (var k = 1u; k < t.count; k++) {
         let v = trilinear_log(map, l, mip_tap_uv(t, s.uv, k), t.lod);
-        let on = k < t.count;
-        let m2 = select(m, max(m, v), on);
-        sum = sum * exp(m - m2) + select(0.0, exp(v - m2), on);
+        let m2 = max(m, v);
+        sum = sum * exp(m - m2) + exp(v - m2);
         m = m2;
     }
     return m + log(sum / f32(t.count));

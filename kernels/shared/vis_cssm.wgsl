@@ -7,10 +7,10 @@
 // where the smooth Fourier step leaks light and the penumbra is narrow, the darkening is
 // strongest; it fades as the receiver leaves its blockers. A square without blockers
 // (share < BLOCKER_MIN_SHARE) is lit.
-// The shading block (technique::visibility_body) sums `csm_chunk_of` over the light's basis
-// tables and `csm_z_chunk_of` over its CSM-Z tables at the search width, calls
-// `cssm_blocker`, sums the basis again at `blocker_filter_width(l, s, b.x)`, then calls
-// `cssm_resolve`.
+// The shading block (technique::soft_visibility_body) sums `csm_z_chunk_of` over the light's
+// CSM-Z tables at the search width, then runs `blocker.wgsl`'s two passes over its basis
+// tables: `csm_chunk_of` summed at the search width gives `cssm_blocker`, and where that finds
+// blockers, summed again at `blocker_filter_width(l, s, b.x)`, `cssm_resolve`.
 // #import shared/light
 // #import shared/sat_lookup
 // #import shared/blocker
@@ -25,10 +25,11 @@ fn cssm_sharpen(v: f32, p: f32) -> f32 {
     return select(0.0, exp2(p * log2(v)), v > 0.0);
 }
 
-// The visibility from the basis sum at the filter width and the blocker estimate `b`.
+// The visibility from the basis sum at the filter width and the blocker estimate `b` (which
+// found blockers: share ≥ BLOCKER_MIN_SHARE).
 fn cssm_resolve(sum: f32, b: vec2<f32>, l: Light, s: LightSample) -> f32 {
     let v = csm_resolve(sum, l);
     let gap = max(s.depth - l.bias - b.x, 0.0);
     let p = 1.0 + l.sharpen * exp(-l.sharpen_falloff * gap);
-    return select(1.0, cssm_sharpen(v, p), b.y >= BLOCKER_MIN_SHARE);
+    return cssm_sharpen(v, p);
 }

@@ -14,6 +14,7 @@
 mod copy;
 mod harness;
 mod lookup;
+mod soft;
 
 use std::collections::HashMap;
 use std::fmt::Write;
@@ -23,6 +24,7 @@ use glam::Vec3;
 pub use self::copy::{COPY, COPY_FORMATS, format_name};
 use self::harness::{gb_per_s, time_graph};
 pub use self::lookup::{LOOKUP_WIDTHS, LookupRow, format_lookup_table, lookup_cost};
+pub use self::soft::{SOFT_LIGHT_SIZES, SOFT_TECHNIQUES, SoftRow, format_soft_table, soft_cost};
 use crate::error::{Error, Result};
 use crate::exec::Executor;
 use crate::gpu::Gpu;

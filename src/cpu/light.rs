@@ -42,6 +42,13 @@ pub fn to_light(l: &LightGpu, p: DVec3) -> DVec3 {
     }
 }
 
+/// `light_faces`: N·L of a receiver at `p` with unit normal `n`, which the shading compares with
+/// 0 (a receiver facing away reads 0 without a lookup). Returned rather than compared so that a
+/// test can set aside receivers where f32 and f64 may disagree on the sign.
+pub fn facing(l: &LightGpu, p: DVec3, n: DVec3) -> f64 {
+    n.dot(to_light(l, p))
+}
+
 /// `light_sample`: project `p` after the normal offset along `n`.
 pub fn sample(l: &LightGpu, p: DVec3, n: DVec3) -> LightSample {
     let view = mat(&l.view);

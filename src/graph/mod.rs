@@ -40,7 +40,7 @@ pub enum SizeRule {
 }
 
 /// A named, typed texture in the graph.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Resource {
     /// Unique name, `light<i>.<what>` by convention (e.g. `light0.linear`).
     pub name: String,
@@ -118,7 +118,7 @@ impl Dispatch {
 }
 
 /// One kernel invocation in the graph.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Node {
     /// Unique label, e.g. `light0.linearize`; pipelines and passes are labelled with it.
     pub name: String,

@@ -6,14 +6,14 @@ use std::collections::{BTreeSet, HashMap, HashSet};
 use super::{Graph, GraphError, Node, Resource, SizeRule, block_count, texel_bytes};
 
 /// One step of a plan: a node to run, in order.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Step {
     /// The node.
     pub node: Node,
 }
 
 /// A resource as the plan sees it: concrete size, lifetime and the texture slot it lives in.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct PlannedResource {
     /// The declared resource.
     pub resource: Resource,
@@ -45,7 +45,7 @@ pub struct Slot {
 }
 
 /// An ordered, pruned graph with lifetimes and texture assignment.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Plan {
     /// Nodes in execution order.
     pub steps: Vec<Step>,

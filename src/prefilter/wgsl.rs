@@ -58,8 +58,14 @@ const LIBRARY_HEADER: &str = "\
 // test checks this file is current; `SHADOWGRAPH_BLESS=1` rewrites it).
 //
 // Usage, per light and shaded point p (world) with unit normal n:
-//   let s = light_sample(l, p, n);               // where p lands in the light's map
-//   let v = select(1.0, vis_vsm(map, l, s), s.inside);
+//   var v = 0.0;                                 // facing away: in its own shadow
+//   if light_faces(l, p, n) {
+//       let s = light_sample(l, p, n);           // where p lands in the light's map
+//       v = 1.0;                                 // outside the map: unshadowed
+//       if s.inside { v = vis_vsm(map, l, s); }
+//   }
+// (Branching costs nothing here: every function reads with textureLoad or an explicit level,
+// which WGSL allows in non-uniform control flow.)
 // `map` is the texture `Prefilter::record` returned for the technique (its
 // `PrefilterOutput::maps`, in order), bound as the type in the signature below; `l` is a
 // `Light`, filled byte for byte from `PrefilterOutput::light` (Rust `LightGpu`, bytemuck):
@@ -104,6 +110,8 @@ struct Block {
     maps: Vec<(String, String)>,
     /// Statements ending in a `return`, with `l: Light` and `s: LightSample` in scope.
     body: String,
+    /// Their `// #fetches` expression where it cannot be summed from their calls.
+    fetches: Option<String>,
 }
 
 /// A light with `technique` (the visibility code depends on nothing else).
@@ -119,17 +127,18 @@ fn block_of(technique: &Technique) -> Result<Block> {
     let names: Vec<String> = (0..input.maps.len())
         .map(|k| format!("light0_map{k}"))
         .collect();
-    let (modules, body) = crate::technique::visibility_body(&light, &names);
-    if names.is_empty() || body.is_empty() {
-        return Err(malformed(&body));
+    let vis = crate::technique::visibility_body(&light, &names);
+    if names.is_empty() || vis.body.is_empty() {
+        return Err(malformed(&vis.body));
     }
     Ok(Block {
-        imports: modules.iter().map(|m| m.to_string()).collect(),
+        imports: vis.modules.iter().map(|m| m.to_string()).collect(),
         maps: names
             .into_iter()
             .map(|n| (n, input.wgsl_type.to_string()))
             .collect(),
-        body,
+        body: vis.body,
+        fetches: vis.fetches,
     })
 }
 
@@ -156,7 +165,8 @@ pub fn needs_comparison_sampler(technique: &Technique) -> Result<bool> {
 /// A host's WGSL for `technique`: [`technique_functions`], one binding per map at
 /// `@group(group) @binding(first_binding + k)` named `shadowgraph_map{k}` (then
 /// `shadowgraph_cmp_sampler` where [`needs_comparison_sampler`]), and
-/// `fn shadowgraph_visibility(l: Light, p: vec3<f32>, n: vec3<f32>) -> f32`, 1 outside the map.
+/// `fn shadowgraph_visibility(l: Light, p: vec3<f32>, n: vec3<f32>) -> f32`: 0 where the
+/// receiver faces away from the light, 1 outside the map, else the technique's visibility.
 pub fn host_block(technique: &Technique, group: u32, first_binding: u32) -> Result<String> {
     let block = block_of(technique)?;
     let mut s = String::new();
@@ -193,20 +203,26 @@ pub fn host_block(technique: &Technique, group: u32, first_binding: u32) -> Resu
             "@group({group}) @binding({binding}) var {HOST_CMP_SAMPLER}: sampler_comparison;"
         );
     }
-    // Evaluated also outside the map, then discarded: no invocation leaves before sampling
-    // (llvmpipe mis-fetches explicit mip levels under divergence; see `shading_block`).
+    if let Some(fetches) = &block.fetches {
+        let _ = writeln!(s, "// #fetches shadowgraph_light_visibility: {fetches}");
+    }
+    // As the renderer's shading block: no lookup facing away (0) or outside the map (1).
     let _ = write!(
         s,
         "fn shadowgraph_light_visibility(l: Light, s: LightSample) -> f32 {{\n    {call}\n}}\n\
          fn shadowgraph_visibility(l: Light, p: vec3<f32>, n: vec3<f32>) -> f32 {{\n    \
+         if !light_faces(l, p, n) {{\n        return 0.0;\n    }}\n    \
          let s = light_sample(l, p, n);\n    \
-         return select(1.0, shadowgraph_light_visibility(l, s), s.inside);\n}}\n\
+         if !s.inside {{\n        return 1.0;\n    }}\n    \
+         return shadowgraph_light_visibility(l, s);\n}}\n\
          // With the pixel's footprint (e.g. dpdx(p), dpdy(p) in a fragment shader): mip lookups\n\
          // with `max_anisotropy` ≥ 1 follow it; other lookups ignore it.\n\
          fn shadowgraph_visibility_footprint(l: Light, p: vec3<f32>, n: vec3<f32>, dpdx: vec3<f32>, dpdy: vec3<f32>) -> f32 {{\n    \
+         if !light_faces(l, p, n) {{\n        return 0.0;\n    }}\n    \
          var s = light_sample(l, p, n);\n    \
+         if !s.inside {{\n        return 1.0;\n    }}\n    \
          s.footprint = light_footprint(l, s, p, n, dpdx, dpdy);\n    \
-         return select(1.0, shadowgraph_light_visibility(l, s), s.inside);\n}}\n"
+         return shadowgraph_light_visibility(l, s);\n}}\n"
     );
     Ok(s)
 }

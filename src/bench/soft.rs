@@ -1,0 +1,184 @@
+//! The soft techniques' shading cost against PCSS as the penumbra widens: one scene, one map,
+//! one image, only the technique and the light's size changed.
+
+use std::fmt::Write;
+
+use super::WARMUP;
+use super::harness::median;
+use crate::error::{Error, Result};
+use crate::gpu::Gpu;
+use crate::render::{RenderOptions, Renderer};
+use crate::scene::Scene;
+
+/// The scene the soft-shadow benchmark shades: `scenes/techniques/cssm.toml` (a spot light over
+/// a floating sphere and a box on a plane; its depth range is fitted for CSSM), embedded so the
+/// benchmark runs from anywhere.
+const SOFT_SCENE: &str = include_str!("../../scenes/techniques/cssm.toml");
+
+/// Default light sizes of [`soft_cost`], world units (the scene's own is 0.5): the penumbra
+/// widens with the size.
+pub const SOFT_LIGHT_SIZES: &[f32] = &[0.25, 0.5, 1.0, 2.0];
+
+/// The configurations compared, in row order: a name and the scene's `[light.shadow]` table
+/// (the scene file's defaults apply to every other key). The first PCSS row is the yardstick.
+pub const SOFT_TECHNIQUES: &[(&str, &str)] = &[
+    ("hard", "technique = \"hard\""),
+    (
+        "pcss 16+32",
+        "technique = \"pcss\"\nblocker_samples = 16\nfilter_samples = 32",
+    ),
+    (
+        "pcss 64+64",
+        "technique = \"pcss\"\nblocker_samples = 64\nfilter_samples = 64",
+    ),
+    ("vssm", "technique = \"vssm\""),
+    ("msm_soft", "technique = \"msm_soft\""),
+    ("cssm M=8", "technique = \"cssm\"\nterms = 8"),
+];
+
+/// Index of the yardstick in [`SOFT_TECHNIQUES`]: PCSS with 16 blocker and 32 filter taps.
+const YARDSTICK: usize = 1;
+
+/// One technique of the soft-shadow benchmark.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SoftRow {
+    /// Its name in [`SOFT_TECHNIQUES`].
+    pub technique: String,
+    /// Its shading fetches per pixel (the declared count of a pixel that takes every lookup).
+    pub fetches: f64,
+    /// Per light size (in the order asked for), the shading pass's median GPU time, ms.
+    pub shade_ms: Vec<f64>,
+}
+
+/// The technique scene with `shadow` as its light's `[light.shadow]` table.
+fn scene_with(shadow: &str) -> Result<Scene> {
+    let start = SOFT_SCENE
+        .find("[light.shadow]")
+        .ok_or_else(|| Error::Invalid("the soft benchmark scene has no [light.shadow]".into()))?;
+    let end = SOFT_SCENE[start..]
+        .find("\n\n")
+        .map_or(SOFT_SCENE.len(), |e| start + e);
+    let text = format!(
+        "{}[light.shadow]\n{shadow}{}",
+        &SOFT_SCENE[..start],
+        &SOFT_SCENE[end..]
+    );
+    Scene::parse(std::path::Path::new("cssm.toml"), &text)
+}
+
+/// The declared shading fetches per pixel of the scene's one light.
+fn shading_fetches(scene: &Scene) -> Result<f64> {
+    let block = crate::technique::shading_block(&scene.lights);
+    let wgsl = crate::kernels::resolve("shade", Some(&block))?;
+    let light = crate::technique::LightGpu::new(&scene.lights[0]);
+    crate::graph::cost::fetches::Fetches::new("shade", &wgsl, bytemuck::bytes_of(&light))?
+        .count("light0_visibility")
+}
+
+/// The shading pass's cost of every configuration of [`SOFT_TECHNIQUES`] at each light size in
+/// `sizes`: the median over `repeat` frames (after [`WARMUP`] untimed ones) of the `shade`
+/// pass, frames interleaved across configurations (one frame of each in turn), so that a
+/// change of load on a shared machine reaches every configuration alike.
+pub fn soft_cost(gpu: &Gpu, sizes: &[f32], repeat: u32) -> Result<Vec<SoftRow>> {
+    if sizes.is_empty() || repeat == 0 {
+        return Err(Error::Invalid(
+            "soft benchmark needs light sizes and repeat ≥ 1".into(),
+        ));
+    }
+    if let Some(s) = sizes.iter().find(|s| !(s.is_finite() && **s > 0.0)) {
+        return Err(Error::Invalid(format!(
+            "soft benchmark light size {s}: sizes are positive world widths"
+        )));
+    }
+    if !gpu.can_time() {
+        return Err(Error::Invalid(
+            "this device cannot time kernels: it lacks TIMESTAMP_QUERY or \
+             TIMESTAMP_QUERY_INSIDE_ENCODERS"
+                .to_string(),
+        ));
+    }
+    let mut scenes = Vec::new();
+    for (_, shadow) in SOFT_TECHNIQUES {
+        let base = scene_with(shadow)?;
+        for &size in sizes {
+            let mut scene = base.clone();
+            scene.lights[0].size = size;
+            scenes.push(scene);
+        }
+    }
+    let mut renderer = Renderer::new(&gpu.device);
+    let mut times = vec![Vec::new(); scenes.len()];
+    let opts = RenderOptions {
+        repeat: 1,
+        ..Default::default()
+    };
+    for frame in 0..WARMUP + repeat {
+        for (scene, t) in scenes.iter().zip(&mut times) {
+            let f = renderer.render(&gpu.device, &gpu.queue, scene, opts)?;
+            let shade = f
+                .timings
+                .first()
+                .and_then(|passes| passes.iter().find(|(name, _)| name == "shade"))
+                .map(|(_, ms)| *ms)
+                .ok_or_else(|| Error::Invalid("the frame has no timed `shade` pass".into()))?;
+            if frame >= WARMUP {
+                t.push(shade);
+            }
+        }
+    }
+    let mut rows = Vec::new();
+    for (k, (name, _)) in SOFT_TECHNIQUES.iter().enumerate() {
+        let at = k * sizes.len();
+        rows.push(SoftRow {
+            technique: name.to_string(),
+            fetches: shading_fetches(&scenes[at])?,
+            shade_ms: times[at..at + sizes.len()]
+                .iter_mut()
+                .map(|t| median(t))
+                .collect(),
+        });
+    }
+    Ok(rows)
+}
+
+/// [`soft_cost`]'s report: one line per technique, its fetches per pixel, then per light size
+/// the shading pass's time and its ratio to PCSS 16+32's at that size (on a CPU adapter only
+/// the ratios mean anything).
+pub fn format_soft_table(
+    device: &str,
+    cpu: bool,
+    repeat: u32,
+    sizes: &[f32],
+    rows: &[SoftRow],
+) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "soft-shadow shading cost on {device}");
+    let _ = writeln!(
+        s,
+        "scenes/techniques/cssm.toml (200×150, 512² spot map), the light's size swept (wider \
+         penumbrae); GPU timestamps of the shade pass, median of {repeat} frame(s) after \
+         {WARMUP} warm-up frame(s), frames interleaved; (×) = over PCSS 16+32 at the same size."
+    );
+    if cpu {
+        let _ = writeln!(
+            s,
+            "NOTE: this adapter is a CPU device (software Vulkan): only the ratios mean anything."
+        );
+    }
+    let _ = write!(s, "{:<11} {:>10}", "technique", "fetches/px");
+    for size in sizes {
+        let _ = write!(s, "  {:>17}", format!("size {size}"));
+    }
+    let _ = writeln!(s);
+    let yardstick = rows.get(YARDSTICK);
+    for r in rows {
+        let _ = write!(s, "{:<11} {:>10}", r.technique, r.fetches);
+        for (i, ms) in r.shade_ms.iter().enumerate() {
+            let base = yardstick.and_then(|y| y.shade_ms.get(i)).copied();
+            let ratio = base.map_or(f64::NAN, |b| ms / b);
+            let _ = write!(s, "  {:>9.3} ({:>5.2})", ms, ratio);
+        }
+        let _ = writeln!(s);
+    }
+    s
+}

@@ -1,0 +1,245 @@
+//! [`probe`]: the real shading kernel evaluated at given points on given maps.
+
+use bytemuck::Zeroable;
+use glam::Vec3;
+
+use crate::created;
+use crate::error::{Error, Result};
+use crate::gpu::{read_buffer, submit_and_wait, write_texture};
+use crate::graph::Graph;
+use crate::scene::Light;
+use crate::technique;
+
+use super::FrameGpu;
+use super::renderer::{Renderer, ShadeInputs, record_shade};
+
+/// A map handed to [`probe`]: what the light's technique reads (linear depth as R32Float,
+/// moments as Rg32Float, …), never the raw depth of hardware PCF.
+pub struct ProbeMap<'a> {
+    /// Side length of level 0.
+    pub size: u32,
+    /// Texel format of `data`: a 32-bit float format, or `Rgba32Uint` for a fixed-point
+    /// summed-area table, whose words `data` carries bit for bit (`f32::from_bits`).
+    pub format: wgpu::TextureFormat,
+    /// Mip levels in `data` (1 for a plain map).
+    pub mips: u32,
+    /// Every level's texels, row-major, level 0 first (level `m` is `max(1, size >> m)` wide).
+    pub data: &'a [f32],
+}
+
+impl<'a> ProbeMap<'a> {
+    /// A linear depth map.
+    pub fn linear(size: u32, data: &'a [f32]) -> Self {
+        Self::new(size, wgpu::TextureFormat::R32Float, data)
+    }
+
+    /// A one-level map of `format`.
+    pub fn new(size: u32, format: wgpu::TextureFormat, data: &'a [f32]) -> Self {
+        Self {
+            size,
+            format,
+            mips: 1,
+            data,
+        }
+    }
+}
+
+/// Evaluates each light's visibility at `points` (position, unit normal) on the given maps
+/// with the real shading kernel. `maps` lists every light's maps in binding order (one per
+/// light; CSM: one per two terms). Returns `vis[point * lights + light]`.
+pub fn probe(
+    renderer: &mut Renderer,
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    lights: &[Light],
+    maps: &[ProbeMap],
+    points: &[(Vec3, Vec3)],
+) -> Result<Vec<f32>> {
+    let needed: usize = lights
+        .iter()
+        .enumerate()
+        .map(|(i, l)| {
+            technique::add_light_nodes(&mut Graph::default(), i, l)
+                .maps
+                .len()
+        })
+        .sum();
+    if maps.len() != needed || points.is_empty() {
+        return Err(Error::Invalid(format!(
+            "probe needs {needed} map(s) for these lights and at least one point"
+        )));
+    }
+    let w = (points.len() as u32).min(256);
+    let h = (points.len() as u32).div_ceil(w);
+    let mut pos = vec![[0.0f32; 4]; (w * h) as usize];
+    let mut nor = vec![[0.0f32; 4]; (w * h) as usize];
+    for (i, (p, n)) in points.iter().enumerate() {
+        pos[i] = p.extend(1.0).to_array();
+        nor[i] = n.extend(0.0).to_array();
+    }
+    let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
+    let points_texture = |label| {
+        super::targets::texture(
+            device,
+            label,
+            (w, h),
+            wgpu::TextureFormat::Rgba32Float,
+            usage,
+        )
+    };
+    let gpos = points_texture("shadowgraph.probe.position");
+    let gnorm = points_texture("shadowgraph.probe.normal");
+    write_texture(queue, &gpos, bytemuck::cast_slice(&pos));
+    write_texture(queue, &gnorm, bytemuck::cast_slice(&nor));
+    let mut views = Vec::new();
+    for m in maps {
+        let channels = crate::gpu::float_channels(m.format).unwrap_or(0);
+        let side = |l: u32| (m.size >> l).max(1) as usize;
+        let texels: usize = (0..m.mips).map(|l| side(l) * side(l)).sum();
+        let is_f32 = crate::graph::texel_bytes(m.format) == 4 * channels as u64;
+        if !is_f32 || channels == 0 || m.mips == 0 || m.data.len() != texels * channels {
+            return Err(Error::Invalid(format!(
+                "a {0}x{0} {1:?} probe map of {3} level(s) needs {2} f32 values",
+                m.size,
+                m.format,
+                texels * channels.max(1),
+                m.mips
+            )));
+        }
+        let t = created::texture(
+            device,
+            &wgpu::TextureDescriptor {
+                label: Some("shadowgraph.probe.map"),
+                size: wgpu::Extent3d {
+                    width: m.size,
+                    height: m.size,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: m.mips,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: m.format,
+                usage,
+                view_formats: &[],
+            },
+        );
+        let mut at = 0;
+        for level in 0..m.mips {
+            let n = side(level) * side(level) * channels;
+            crate::gpu::write_texture_level(
+                queue,
+                &t,
+                level,
+                bytemuck::cast_slice(&m.data[at..at + n]),
+            );
+            at += n;
+        }
+        views.push(created::view(&t, &Default::default()));
+    }
+    let frame = FrameGpu {
+        size: [w, h],
+        light_count: lights.len() as u32,
+        ..FrameGpu::zeroed()
+    };
+    let at = ShadePoints {
+        maps: &views,
+        frame: &frame,
+        gpos: &gpos,
+        gnorm: &gnorm,
+    };
+    let visibility = renderer.shade_points(device, queue, lights, &at)?;
+    let readback = created::buffer(
+        device,
+        &wgpu::BufferDescriptor {
+            label: Some("shadowgraph.visibility.readback"),
+            size: visibility.size(),
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        },
+    );
+    let mut enc = device.create_command_encoder(&Default::default());
+    enc.copy_buffer_to_buffer(&visibility, 0, &readback, 0, visibility.size());
+    submit_and_wait(device, queue, enc, "probe readback")?;
+    let mut vis: Vec<f32> = bytemuck::cast_slice(&read_buffer(device, &readback)?).to_vec();
+    vis.truncate(points.len() * lights.len());
+    Ok(vis)
+}
+
+/// What [`Renderer::shade_points`] evaluates at.
+pub(super) struct ShadePoints<'a> {
+    /// Light by light, the maps in binding order.
+    pub maps: &'a [wgpu::TextureView],
+    pub frame: &'a FrameGpu,
+    pub gpos: &'a wgpu::Texture,
+    pub gnorm: &'a wgpu::Texture,
+}
+
+impl Renderer {
+    /// Runs the shading kernel for `lights` once over positions and normals in `at` (the
+    /// probe: no camera, the frame's own buffers), returning its visibility buffer.
+    pub(super) fn shade_points(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        lights: &[Light],
+        at: &ShadePoints,
+    ) -> Result<wgpu::Buffer> {
+        use wgpu::BufferUsages as B;
+        let kernel = self.shade_kernel(device, lights)?;
+        let init = |label, bytes: &[u8], usage| {
+            created::buffer_init(
+                device,
+                &wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents: bytes,
+                    usage,
+                },
+            )
+        };
+        let gpu_lights: Vec<technique::LightGpu> =
+            lights.iter().map(technique::LightGpu::new).collect();
+        let (w, h) = (at.frame.size[0], at.frame.size[1]);
+        let color = super::targets::color_target(device, (w, h));
+        let vis_bytes = (u64::from(w) * u64::from(h) * lights.len().max(1) as u64 * 4).max(4);
+        let visibility = created::buffer(
+            device,
+            &wgpu::BufferDescriptor {
+                label: Some("shadowgraph.visibility"),
+                size: vis_bytes,
+                usage: B::STORAGE | B::COPY_SRC,
+                mapped_at_creation: false,
+            },
+        );
+        let views = [
+            created::view(at.gpos, &Default::default()),
+            created::view(at.gnorm, &Default::default()),
+            created::view(&color, &Default::default()),
+        ];
+        let inputs = ShadeInputs {
+            gpos: &views[0],
+            gnorm: &views[1],
+            materials: &init(
+                "shadowgraph.materials",
+                bytemuck::cast_slice(&[[1.0f32; 4]]),
+                B::STORAGE,
+            ),
+            lights: &init(
+                "shadowgraph.lights",
+                bytemuck::cast_slice(&gpu_lights),
+                B::STORAGE,
+            ),
+            frame: &init(
+                "shadowgraph.frame",
+                bytemuck::bytes_of(at.frame),
+                B::UNIFORM,
+            ),
+            color: &views[2],
+            visibility: &visibility,
+        };
+        let groups = self.shade_bind_groups(device, &kernel, &inputs, at.maps)?;
+        let mut enc = device.create_command_encoder(&Default::default());
+        record_shade(&mut enc, &kernel, &groups, (w, h), None);
+        submit_and_wait(device, queue, enc, "probe")?;
+        Ok(visibility)
+    }
+}

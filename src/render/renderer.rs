@@ -1,0 +1,656 @@
+//! The renderer: per light a depth-only raster pass, the planned kernels, the camera G-buffer
+//! and the generated shading kernel, recorded into one encoder per frame. Pipelines are made
+//! once (the shading kernel's looked up by [`technique::shade_key`]); textures, buffers and
+//! bind groups once per scene shape ([`super::targets`]); the executor keeps its plan's; the
+//! timer's readbacks are read a frame later. A frame after the first creates nothing.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use crate::created;
+use crate::error::{Error, Result};
+use crate::exec::{ComputeKernel, Executor, GpuTimer, Outputs};
+use crate::gpu::{scoped, submit_and_wait};
+use crate::kernels;
+use crate::scene::{Light, Scene};
+use crate::technique;
+
+use super::targets::{TargetKey, Targets, uniform_group};
+use super::{Frame, RenderOptions, ScenePlan, check_render, plan_lights};
+
+/// Renders scenes; holds pipelines, pooled textures and a frame's resources across frames.
+pub struct Renderer {
+    /// The graph executor (kernel pipelines, texture pool).
+    pub executor: Executor,
+    /// Raster pipelines by slope-scaled bias (pipeline state), with their layout.
+    shadow: HashMap<u32, (wgpu::RenderPipeline, wgpu::BindGroupLayout)>,
+    gbuffer: Option<(wgpu::RenderPipeline, wgpu::BindGroupLayout)>,
+    cmp_sampler: wgpu::Sampler,
+    /// The last scene shape's resources.
+    targets: Option<Targets>,
+    /// The shading pass's bind groups for the last kernel and maps.
+    binding: Option<ShadeBinding>,
+    timer: Option<GpuTimer>,
+}
+
+/// The shading pass's bind groups, valid for one kernel, one set of map textures and the
+/// targets they were made with.
+struct ShadeBinding {
+    kernel: Arc<ComputeKernel>,
+    maps: Vec<wgpu::Texture>,
+    groups: [wgpu::BindGroup; 2],
+}
+
+/// The shading pass's group-0 inputs and outputs (the sampler is the renderer's).
+pub(super) struct ShadeInputs<'a> {
+    pub gpos: &'a wgpu::TextureView,
+    pub gnorm: &'a wgpu::TextureView,
+    pub materials: &'a wgpu::Buffer,
+    pub lights: &'a wgpu::Buffer,
+    pub frame: &'a wgpu::Buffer,
+    pub color: &'a wgpu::TextureView,
+    pub visibility: &'a wgpu::Buffer,
+}
+
+const VERTEX_ATTRS: [wgpu::VertexAttribute; 3] =
+    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Uint32];
+
+fn vertex_layout() -> wgpu::VertexBufferLayout<'static> {
+    wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<crate::scene::Vertex>() as u64,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &VERTEX_ATTRS,
+    }
+}
+
+/// A depth attachment cleared to the far plane and kept.
+fn clear_depth(view: &wgpu::TextureView) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+    wgpu::RenderPassDepthStencilAttachment {
+        view,
+        depth_ops: Some(wgpu::Operations {
+            load: wgpu::LoadOp::Clear(1.0),
+            store: wgpu::StoreOp::Store,
+        }),
+        stencil_ops: None,
+    }
+}
+
+/// A view of all of `t` (its depth aspect for a depth texture).
+pub(super) fn depth_only_view(t: &wgpu::Texture) -> wgpu::TextureView {
+    created::view(
+        t,
+        &wgpu::TextureViewDescriptor {
+            aspect: if t.format().is_depth_stencil_format() {
+                wgpu::TextureAspect::DepthOnly
+            } else {
+                wgpu::TextureAspect::All
+            },
+            ..Default::default()
+        },
+    )
+}
+
+/// Records a depth-only raster pass: `count` vertices of `vertices` into `depth`.
+#[expect(clippy::too_many_arguments, reason = "one raster pass's inputs")]
+fn raster_pass(
+    enc: &mut wgpu::CommandEncoder,
+    label: &str,
+    pipeline: &wgpu::RenderPipeline,
+    bind_group: &wgpu::BindGroup,
+    depth: &wgpu::TextureView,
+    vertices: &wgpu::Buffer,
+    count: u32,
+    timer: Option<&mut GpuTimer>,
+) {
+    if let Some(t) = timer {
+        t.begin(enc, label);
+    }
+    let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[],
+        depth_stencil_attachment: Some(clear_depth(depth)),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, bind_group, &[]);
+    pass.set_vertex_buffer(0, vertices.slice(..));
+    pass.draw(0..count, 0..1);
+}
+
+impl Renderer {
+    /// A renderer for `device`.
+    pub fn new(device: &wgpu::Device) -> Self {
+        Self {
+            executor: Executor::new(),
+            shadow: HashMap::new(),
+            gbuffer: None,
+            targets: None,
+            binding: None,
+            timer: None,
+            cmp_sampler: created::sampler(
+                device,
+                &wgpu::SamplerDescriptor {
+                    label: Some("shadowgraph.cmp_sampler"),
+                    mag_filter: wgpu::FilterMode::Linear,
+                    min_filter: wgpu::FilterMode::Linear,
+                    compare: Some(wgpu::CompareFunction::LessEqual),
+                    ..Default::default()
+                },
+            ),
+        }
+    }
+
+    fn raster_pipeline(
+        device: &wgpu::Device,
+        name: &str,
+        fragment: Option<&[Option<wgpu::ColorTargetState>]>,
+        bias: wgpu::DepthBiasState,
+    ) -> Result<(wgpu::RenderPipeline, wgpu::BindGroupLayout)> {
+        let wgsl = kernels::resolve(name, None)?;
+        let (_, refl) = kernels::reflect(name, &wgsl)?;
+        let label = format!("shadowgraph.{name}");
+        scoped(
+            device,
+            || {
+                let module = created::shader_module(
+                    device,
+                    wgpu::ShaderModuleDescriptor {
+                        label: Some(&label),
+                        source: wgpu::ShaderSource::Wgsl(wgsl.as_str().into()),
+                    },
+                );
+                let bgl = created::bind_group_layout(
+                    device,
+                    &wgpu::BindGroupLayoutDescriptor {
+                        label: Some(&label),
+                        entries: &refl.layout_entries(0),
+                    },
+                );
+                let layout = created::pipeline_layout(
+                    device,
+                    &wgpu::PipelineLayoutDescriptor {
+                        label: Some(&label),
+                        bind_group_layouts: &[Some(&bgl)],
+                        immediate_size: 0,
+                    },
+                );
+                let pipeline = created::render_pipeline(
+                    device,
+                    &wgpu::RenderPipelineDescriptor {
+                        label: Some(&label),
+                        layout: Some(&layout),
+                        vertex: wgpu::VertexState {
+                            module: &module,
+                            entry_point: Some("vs_main"),
+                            compilation_options: Default::default(),
+                            buffers: &[Some(vertex_layout())],
+                        },
+                        // Two-sided: planes and open meshes cast and receive from both sides.
+                        primitive: wgpu::PrimitiveState::default(),
+                        depth_stencil: Some(wgpu::DepthStencilState {
+                            format: wgpu::TextureFormat::Depth32Float,
+                            depth_write_enabled: Some(true),
+                            depth_compare: Some(wgpu::CompareFunction::Less),
+                            stencil: Default::default(),
+                            bias,
+                        }),
+                        multisample: Default::default(),
+                        fragment: fragment.map(|targets| wgpu::FragmentState {
+                            module: &module,
+                            entry_point: Some("fs_main"),
+                            compilation_options: Default::default(),
+                            targets,
+                        }),
+                        multiview_mask: None,
+                        cache: None,
+                    },
+                );
+                (pipeline, bgl)
+            },
+            |message| Error::Pipeline {
+                kernel: name.to_string(),
+                message,
+            },
+        )
+    }
+
+    /// The raster pipeline for slope-scaled bias `slope` (pipeline state: one per distinct
+    /// value, made once) and its bind group layout.
+    fn shadow_pipeline(
+        &mut self,
+        device: &wgpu::Device,
+        slope: f32,
+    ) -> Result<&(wgpu::RenderPipeline, wgpu::BindGroupLayout)> {
+        match self.shadow.entry(slope.to_bits()) {
+            std::collections::hash_map::Entry::Occupied(e) => Ok(e.into_mut()),
+            std::collections::hash_map::Entry::Vacant(e) => {
+                let bias = wgpu::DepthBiasState {
+                    constant: 0,
+                    slope_scale: slope,
+                    clamp: 0.0,
+                };
+                Ok(e.insert(Self::raster_pipeline(device, "shadow_depth", None, bias)?))
+            }
+        }
+    }
+
+    /// The G-buffer pipeline and its layout, made once.
+    fn gbuffer_pipeline(
+        &mut self,
+        device: &wgpu::Device,
+    ) -> Result<&(wgpu::RenderPipeline, wgpu::BindGroupLayout)> {
+        if self.gbuffer.is_none() {
+            let t = Some(wgpu::ColorTargetState {
+                format: wgpu::TextureFormat::Rgba32Float,
+                blend: None,
+                write_mask: wgpu::ColorWrites::ALL,
+            });
+            self.gbuffer = Some(Self::raster_pipeline(
+                device,
+                "gbuffer",
+                Some(&[t.clone(), t]),
+                Default::default(),
+            )?);
+        }
+        self.gbuffer
+            .as_ref()
+            .ok_or_else(|| Error::Invalid("G-buffer pipeline missing".into()))
+    }
+
+    /// The kept resources for `scene` (made anew when its shape changed), taken out of the
+    /// renderer for the frame (put back by [`Renderer::render`]).
+    fn take_targets(
+        &mut self,
+        device: &wgpu::Device,
+        scene: &Scene,
+        vertices: usize,
+    ) -> Result<Targets> {
+        let key = TargetKey::new(scene, vertices);
+        if let Some(t) = self.targets.take().filter(|t| t.key == key) {
+            return Ok(t);
+        }
+        // The shading bind groups refer to the old targets; both go before new ones are made.
+        self.binding = None;
+        let mut raster_layouts = Vec::new();
+        for l in &scene.lights {
+            raster_layouts.push(self.shadow_pipeline(device, l.shadow.slope_bias)?.1.clone());
+        }
+        let gbuffer_layout = self.gbuffer_pipeline(device)?.1.clone();
+        Ok(Targets::new(device, key, &gbuffer_layout, &raster_layouts))
+    }
+
+    /// The shading kernel for `lights`, looked up by [`technique::shade_key`]; the block is
+    /// generated only to compile a kernel the cache does not hold.
+    pub(super) fn shade_kernel(
+        &mut self,
+        device: &wgpu::Device,
+        lights: &[Light],
+    ) -> Result<Arc<ComputeKernel>> {
+        self.executor
+            .kernels
+            .get_keyed(device, &technique::shade_key(lights), "shade", || {
+                technique::shading_block(lights)
+            })
+    }
+
+    /// Makes `wgsl` (the shading kernel rewritten with the same bindings) the kernel
+    /// [`Renderer::render`] uses for `lights` from now on, e.g. with every texture fetch
+    /// counted (`tests/cost.rs`).
+    pub fn insert_shade_kernel(
+        &mut self,
+        device: &wgpu::Device,
+        lights: &[Light],
+        wgsl: &str,
+    ) -> Result<()> {
+        self.executor
+            .kernels
+            .insert_keyed(device, &technique::shade_key(lights), "shade", wgsl)
+    }
+
+    /// Renders `scene` on `device`/`queue` and reads the frame back.
+    pub fn render(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+        opts: RenderOptions,
+    ) -> Result<Frame> {
+        check_render(device, scene, &opts)?;
+        let mut sp = plan_lights(&scene.lights)?;
+        if opts.dump {
+            // Everything is read back after the frame: no resource may share a texture.
+            sp.plan = sp.plan.unaliased();
+        }
+        let vertices = scene.vertices();
+        let mut targets = self.take_targets(device, scene, vertices.len())?;
+        targets.upload(queue, scene, &vertices);
+        let run = self.frames(device, queue, &sp, &targets, scene, opts.repeat.max(1));
+        let read = run.and_then(|(timings, wall_ms, outputs)| {
+            let (rgba, visibility) = targets.read_back(device, queue)?;
+            let sanitized = outputs.read_stats(device)?;
+            for (step, n) in &sanitized {
+                log::warn!("{step}: replaced {n} non-finite depth texel(s) with 1.0 (no occluder)");
+            }
+            let frame = Frame {
+                width: scene.width,
+                height: scene.height,
+                rgba,
+                visibility,
+                position: Vec::new(),
+                normal: Vec::new(),
+                timings,
+                wall_ms,
+                sanitized,
+                shade_maps: Vec::new(),
+                shade_mips: Vec::new(),
+                linear_maps: Vec::new(),
+                resources: Vec::new(),
+            };
+            super::read_extras(device, queue, scene, &sp, &outputs, &targets, opts, frame)
+        });
+        self.targets = Some(targets);
+        read
+    }
+
+    /// Renders `repeat` frames: per frame its pass times (timestamps read a frame later, the
+    /// rest after the last), its wall time from submission to completion, and the last
+    /// frame's plan outputs.
+    #[expect(clippy::type_complexity, reason = "timings, wall times and outputs")]
+    fn frames(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        sp: &ScenePlan,
+        targets: &Targets,
+        scene: &Scene,
+        repeat: u32,
+    ) -> Result<(Vec<Vec<(String, f64)>>, Vec<f64>, Outputs)> {
+        let kernel = self.shade_kernel(device, &scene.lights)?;
+        let spans = scene.lights.len() as u32 + sp.plan.steps.len() as u32 + 2;
+        let mut timer = match self.timer.take() {
+            Some(t) if t.span_capacity() >= spans => Some(t),
+            _ => GpuTimer::new(device, queue, spans),
+        };
+        let (mut timings, mut wall_ms, mut last) = (Vec::new(), Vec::new(), None);
+        for _ in 0..repeat {
+            if let Some(t) = timer.as_mut() {
+                t.reset();
+            }
+            let mut enc = device.create_command_encoder(&Default::default());
+            let outputs = self.record_frame(
+                device,
+                &mut enc,
+                sp,
+                targets,
+                scene,
+                &kernel,
+                timer.as_mut(),
+            )?;
+            if let Some(t) = timer.as_mut() {
+                t.resolve(&mut enc);
+            }
+            outputs.copy_stats(&mut enc);
+            let submitted = std::time::Instant::now();
+            submit_and_wait(device, queue, enc, "render")?;
+            wall_ms.push(submitted.elapsed().as_secs_f64() * 1e3);
+            if let Some(t) = timer.as_mut() {
+                timings.extend(t.collect(device)?);
+            }
+            last = Some(outputs);
+        }
+        if let Some(t) = timer.as_mut() {
+            timings.extend(t.finish(device)?);
+        }
+        self.timer = timer;
+        let outputs = last.ok_or_else(|| Error::Invalid("no frame rendered".into()))?;
+        Ok((timings, wall_ms, outputs))
+    }
+
+    /// Records one frame: the raster passes, the plan, the G-buffer and the shading pass.
+    #[expect(clippy::too_many_arguments, reason = "one frame's inputs")]
+    fn record_frame(
+        &mut self,
+        device: &wgpu::Device,
+        enc: &mut wgpu::CommandEncoder,
+        sp: &ScenePlan,
+        targets: &Targets,
+        scene: &Scene,
+        kernel: &Arc<ComputeKernel>,
+        mut timer: Option<&mut GpuTimer>,
+    ) -> Result<Outputs> {
+        for (l, t) in scene.lights.iter().zip(&targets.lights) {
+            let (pipeline, _) = self.shadow_pipeline(device, l.shadow.slope_bias)?;
+            raster_pass(
+                enc,
+                &t.label,
+                pipeline,
+                &t.bind_group,
+                &t.view,
+                &targets.vertices,
+                targets.vertex_count,
+                timer.as_deref_mut(),
+            );
+        }
+        let outputs = self.executor.record(
+            device,
+            enc,
+            &sp.plan,
+            &targets.imports,
+            timer.as_deref_mut(),
+        )?;
+        self.gbuffer_pass(device, enc, targets, timer.as_deref_mut())?;
+        let maps: Vec<wgpu::Texture> = sp
+            .shade_inputs
+            .iter()
+            .flat_map(|s| &s.maps)
+            .map(|m| outputs.textures[m].clone())
+            .collect();
+        let groups = self.shade_groups(device, kernel, targets, maps)?;
+        record_shade(enc, kernel, groups, targets.key.size, timer);
+        Ok(outputs)
+    }
+
+    fn gbuffer_pass(
+        &mut self,
+        device: &wgpu::Device,
+        enc: &mut wgpu::CommandEncoder,
+        targets: &Targets,
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
+        let (pipeline, _) = self.gbuffer_pipeline(device)?;
+        let clear = |view| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })
+        };
+        if let Some(t) = timer {
+            t.begin(enc, "gbuffer");
+        }
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("gbuffer"),
+            color_attachments: &[clear(&targets.gpos_view), clear(&targets.gnorm_view)],
+            depth_stencil_attachment: Some(clear_depth(&targets.depth_view)),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &targets.gbuffer_bind_group, &[]);
+        pass.set_vertex_buffer(0, targets.vertices.slice(..));
+        pass.draw(0..targets.vertex_count, 0..1);
+        Ok(())
+    }
+
+    /// The shading pass's bind groups for `kernel` over `maps` (light by light, in binding
+    /// order), made when either changed since the last frame.
+    fn shade_groups(
+        &mut self,
+        device: &wgpu::Device,
+        kernel: &Arc<ComputeKernel>,
+        targets: &Targets,
+        maps: Vec<wgpu::Texture>,
+    ) -> Result<&[wgpu::BindGroup; 2]> {
+        let current = self
+            .binding
+            .as_ref()
+            .is_some_and(|b| Arc::ptr_eq(&b.kernel, kernel) && b.maps == maps);
+        if !current {
+            let views: Vec<wgpu::TextureView> = maps.iter().map(depth_only_view).collect();
+            let inputs = ShadeInputs {
+                gpos: &targets.gpos_view,
+                gnorm: &targets.gnorm_view,
+                materials: &targets.materials,
+                lights: &targets.light_data,
+                frame: &targets.frame,
+                color: &targets.color_view,
+                visibility: &targets.visibility,
+            };
+            let groups = self.shade_bind_groups(device, kernel, &inputs, &views)?;
+            self.binding = Some(ShadeBinding {
+                kernel: kernel.clone(),
+                maps,
+                groups,
+            });
+        }
+        self.binding
+            .as_ref()
+            .map(|b| &b.groups)
+            .ok_or_else(|| Error::Invalid("the shading pass is not bound".into()))
+    }
+
+    /// The shading pass's bind groups: group 0 from `inputs`, group 1 the maps.
+    pub(super) fn shade_bind_groups(
+        &self,
+        device: &wgpu::Device,
+        kernel: &ComputeKernel,
+        inputs: &ShadeInputs,
+        maps: &[wgpu::TextureView],
+    ) -> Result<[wgpu::BindGroup; 2]> {
+        let err = |message: String| Error::Pipeline {
+            kernel: "shade".into(),
+            message,
+        };
+        let view = |binding, v| wgpu::BindGroupEntry {
+            binding,
+            resource: wgpu::BindingResource::TextureView(v),
+        };
+        fn buffer(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+            wgpu::BindGroupEntry {
+                binding,
+                resource: b.as_entire_binding(),
+            }
+        }
+        let entries = [
+            view(0, inputs.gpos),
+            view(1, inputs.gnorm),
+            buffer(2, inputs.materials),
+            buffer(3, inputs.lights),
+            buffer(4, inputs.frame),
+            view(5, inputs.color),
+            buffer(6, inputs.visibility),
+            wgpu::BindGroupEntry {
+                binding: 7,
+                resource: wgpu::BindingResource::Sampler(&self.cmp_sampler),
+            },
+        ];
+        let map_entries: Vec<wgpu::BindGroupEntry> = maps
+            .iter()
+            .enumerate()
+            .map(|(i, v)| view(i as u32, v))
+            .collect();
+        let group = |label, layout, entries: &[wgpu::BindGroupEntry]| {
+            scoped(
+                device,
+                || {
+                    created::bind_group(
+                        device,
+                        &wgpu::BindGroupDescriptor {
+                            label: Some(label),
+                            layout,
+                            entries,
+                        },
+                    )
+                },
+                err,
+            )
+        };
+        let (Some(l0), Some(l1)) = (kernel.layouts.first(), kernel.layouts.get(1)) else {
+            return Err(err("the shading kernel declares no group 0 and 1".into()));
+        };
+        Ok([
+            group("shadowgraph.shade", l0, &entries)?,
+            group("shadowgraph.shade.maps", l1, &map_entries)?,
+        ])
+    }
+
+    /// Records a depth-only raster pass of the scene's vertices `vbuf` (`count` vertices) into
+    /// `depth` (Depth32Float) with an explicit world → clip matrix: the pipeline and bias the
+    /// renderer's own shadow maps use (`truth` rasterizes its emitter samples with it). Each
+    /// call makes its own uniform, so that many passes can share one encoder.
+    #[expect(clippy::too_many_arguments, reason = "one raster pass's inputs")]
+    pub fn shadow_raster(
+        &mut self,
+        device: &wgpu::Device,
+        enc: &mut wgpu::CommandEncoder,
+        raster: &ShadowRaster,
+        vbuf: &wgpu::Buffer,
+        count: u32,
+        depth: &wgpu::Texture,
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
+        let (pipeline, layout) = self.shadow_pipeline(device, raster.slope_bias)?;
+        let ubuf = created::buffer_init(
+            device,
+            &wgpu::util::BufferInitDescriptor {
+                label: Some("shadowgraph.light_view"),
+                contents: bytemuck::cast_slice(&raster.view_proj),
+                usage: wgpu::BufferUsages::UNIFORM,
+            },
+        );
+        let bg = uniform_group(device, "shadowgraph.shadow_depth", layout, &ubuf);
+        let view = created::view(depth, &Default::default());
+        raster_pass(enc, raster.label, pipeline, &bg, &view, vbuf, count, timer);
+        Ok(())
+    }
+}
+
+/// Records the shading pass over a `w × h` image.
+pub(super) fn record_shade(
+    enc: &mut wgpu::CommandEncoder,
+    kernel: &ComputeKernel,
+    groups: &[wgpu::BindGroup; 2],
+    (w, h): (u32, u32),
+    timer: Option<&mut GpuTimer>,
+) {
+    let workgroups = kernel.groups_for(w, h);
+    if let Some(t) = timer {
+        t.begin(enc, "shade");
+    }
+    let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some("shade"),
+        timestamp_writes: None,
+    });
+    pass.set_pipeline(&kernel.pipeline);
+    pass.set_bind_group(0, &groups[0], &[]);
+    pass.set_bind_group(1, &groups[1], &[]);
+    pass.dispatch_workgroups(workgroups[0], workgroups[1], 1);
+}
+
+/// One depth-only raster pass for [`Renderer::shadow_raster`].
+#[derive(Clone, Copy, Debug)]
+pub struct ShadowRaster<'a> {
+    /// Pass label (and timer label).
+    pub label: &'a str,
+    /// World → clip, column-major (wgpu depth convention: 0 at near, 1 at far).
+    pub view_proj: [f32; 16],
+    /// Slope-scaled depth bias (`DepthBiasState::slope_scale`).
+    pub slope_bias: f32,
+}
