@@ -46,6 +46,10 @@ pub struct Config {
     pub box_width: Option<f64>,
 }
 
+/// PCSS tap counts (blocker search, filter) swept beside the scene's own: cheaper, and the
+/// wider counts engines ship (Bevy's PCSS, Filament's).
+pub const PCSS_TAPS: [(u32, u32); 4] = [(8, 16), (16, 32), (32, 64), (64, 64)];
+
 /// Configurations of the sweep for `scene` (every light gets each), filtered by
 /// `opts.techniques`. Unknown technique names are an error listing the known ones.
 pub fn sweep(scene: &Scene, opts: &EvaluateOptions) -> Result<Vec<Config>> {
@@ -130,8 +134,34 @@ pub fn sweep(scene: &Scene, opts: &EvaluateOptions) -> Result<Vec<Config>> {
                 filter_samples: 32,
                 max_search: 0.1,
             });
+        // PCSS as engines ship it, at several tap counts (blocker search + filter): the
+        // scene's (default 16 + 32) on every size, the others at the base size.
+        let pcss_label = |t: &Technique| match t {
+            Technique::Pcss {
+                blocker_samples,
+                filter_samples,
+                ..
+            } => format!("pcss {blocker_samples}+{filter_samples}"),
+            _ => "pcss".into(),
+        };
         for &size in &size_sweep("pcss") {
-            push("pcss".into(), pcss, size, None);
+            push(pcss_label(&pcss), pcss, size, None);
+        }
+        if !quick && wanted.iter().any(|w| w == "pcss") {
+            let max_search = match pcss {
+                Technique::Pcss { max_search, .. } => max_search,
+                _ => 0.1,
+            };
+            for (blocker_samples, filter_samples) in PCSS_TAPS {
+                let t = Technique::Pcss {
+                    blocker_samples,
+                    filter_samples,
+                    max_search,
+                };
+                if t != pcss {
+                    push(pcss_label(&t), t, base, None);
+                }
+            }
         }
         // The soft techniques (every step a summed-area-table lookup), validated as a scene
         // would be; their first variant on every size, the others at the base size.
@@ -320,4 +350,52 @@ fn prefiltered_configs(
         );
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene() -> Scene {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/sphere_on_plane.toml");
+        Scene::load(path).expect("sphere_on_plane")
+    }
+
+    fn pcss_rows(opts: &EvaluateOptions) -> Vec<(String, u32)> {
+        sweep(&scene(), opts)
+            .expect("sweep")
+            .into_iter()
+            .filter(|c| matches!(c.technique, Technique::Pcss { .. }))
+            .map(|c| (c.label, c.shadow_map))
+            .collect()
+    }
+
+    /// PCSS is on the front at the tap counts users pick: the scene's own (16 + 32) on every
+    /// size, each other count of `PCSS_TAPS` once at the base size, labelled by its taps.
+    #[test]
+    fn pcss_is_swept_at_several_tap_counts() {
+        let opts = EvaluateOptions {
+            techniques: Some(vec!["pcss".into()]),
+            sizes: Some(vec![512, 1024]),
+            ..Default::default()
+        };
+        let want: Vec<(String, u32)> = [
+            ("pcss 16+32 512", 512),
+            ("pcss 16+32 1024", 1024),
+            ("pcss 8+16 1024", 1024),
+            ("pcss 32+64 1024", 1024),
+            ("pcss 64+64 1024", 1024),
+        ]
+        .into_iter()
+        .map(|(l, s)| (l.to_string(), s))
+        .collect();
+        assert_eq!(pcss_rows(&opts), want);
+        let quick = EvaluateOptions {
+            quick: true,
+            sizes: None,
+            ..opts
+        };
+        assert_eq!(pcss_rows(&quick), [("pcss 16+32 512".to_string(), 512)]);
+    }
 }
