@@ -128,6 +128,7 @@ pub(crate) fn compute_pipeline(
 }
 
 /// `Device::create_render_pipeline`, counted.
+#[cfg(feature = "cli")]
 pub(crate) fn render_pipeline(
     device: &wgpu::Device,
     desc: &wgpu::RenderPipelineDescriptor,
@@ -137,6 +138,7 @@ pub(crate) fn render_pipeline(
 }
 
 /// `Device::create_sampler`, counted.
+#[cfg(feature = "cli")]
 pub(crate) fn sampler(device: &wgpu::Device, desc: &wgpu::SamplerDescriptor) -> wgpu::Sampler {
     count(|c| c.samplers += 1);
     device.create_sampler(desc)

@@ -1,20 +1,23 @@
 //! What kernels and plans need of a device (bindings per stage, workgroup sizes and memory,
 //! dispatch sizes), read from the WGSL by reflection and compared with `wgpu::Limits` before
-//! anything is created; [`scene`] adds what a frame needs (buffers, the shading pass, memory
-//! against a budget) and names the scene key that would fix it.
+//! anything is created, and the device features the lights' techniques need; `scene` (feature
+//! `cli`) adds what a frame needs (buffers, the shading pass, memory against a budget) and
+//! names the scene key that would fix it.
 
+mod budget;
+#[cfg(feature = "cli")]
 pub mod scene;
 
 use std::collections::HashMap;
 
-pub use scene::{
-    DEFAULT_MEMORY_BUDGET, MEMORY_BUDGET_ENV, Memory, check_scene, memory_budget, parse_bytes,
-    render_memory,
-};
+pub use budget::{DEFAULT_MEMORY_BUDGET, MEMORY_BUDGET_ENV, memory_budget, parse_bytes};
+#[cfg(feature = "cli")]
+pub use scene::{Memory, check_scene, render_memory};
 
 use crate::error::{Error, Result};
 use crate::graph::{Dispatch, Node, Plan};
 use crate::kernels;
+use crate::scene::{Light, Storage, Technique};
 
 /// One thing a kernel needs of the device, and the device's limit on it.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -249,4 +252,27 @@ pub fn dispatch_groups(plan: &Plan, node: &Node, wg: [u32; 3]) -> [u32; 3] {
         ];
     }
     node.dispatch.groups(size, wg).unwrap_or([1, 1, 1])
+}
+
+/// Checks that the device offers the features the lights' techniques need (unorm16 moment
+/// storage needs `TEXTURE_FORMAT_16BIT_NORM`).
+pub fn check_features(device: &wgpu::Device, lights: &[Light]) -> Result<()> {
+    for (i, l) in lights.iter().enumerate() {
+        let storage = match l.shadow.technique {
+            Technique::Msm { prefilter, .. } => Some(prefilter.storage),
+            Technique::MsmSoft { soft, .. } => Some(soft.storage),
+            _ => None,
+        };
+        if storage == Some(Storage::Unorm16)
+            && !device
+                .features()
+                .contains(wgpu::Features::TEXTURE_FORMAT_16BIT_NORM)
+        {
+            return Err(Error::MissingFeature {
+                what: format!("light[{i}].shadow.format = \"unorm16\""),
+                feature: "TEXTURE_FORMAT_16BIT_NORM",
+            });
+        }
+    }
+    Ok(())
 }

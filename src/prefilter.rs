@@ -119,7 +119,7 @@ impl Prefilter {
         let planned = plan_for(&config, &planning_params(), config.size)?;
         limits::check(device, &planned.plan, config.size)?;
         // Features the technique's storage needs (e.g. unorm16 MSM moments).
-        crate::render::check_features(
+        crate::limits::check_features(
             device,
             &[planning_params().scene_light(&config, config.size)],
         )?;

@@ -14,6 +14,7 @@ use crate::error::{Error, Result};
 use crate::exec::Outputs;
 use crate::gpu::read_texture;
 use crate::graph::{Graph, Plan, plan};
+pub use crate::limits::check_features;
 use crate::scene::{Light, Scene};
 use crate::technique;
 
@@ -168,31 +169,6 @@ pub const MAX_REPEAT: u32 = 1000;
 /// Most frames one [`Renderer::render`] call may run: [`MAX_REPEAT`] timed frames and as many
 /// warm-up frames (`evaluate` and `bench` add theirs to the timed ones).
 pub const MAX_FRAMES: u32 = 2 * MAX_REPEAT;
-
-/// Checks that the device offers the features the lights' techniques need.
-pub fn check_features(device: &wgpu::Device, lights: &[Light]) -> Result<()> {
-    use crate::scene::{Storage, Technique};
-    for (i, l) in lights.iter().enumerate() {
-        let storage = match l.shadow.technique {
-            Technique::Msm { prefilter, .. } => Some(prefilter.storage),
-            Technique::MsmSoft { soft, .. } => Some(soft.storage),
-            _ => None,
-        };
-        if let Some(storage) = storage {
-            if storage == Storage::Unorm16
-                && !device
-                    .features()
-                    .contains(wgpu::Features::TEXTURE_FORMAT_16BIT_NORM)
-            {
-                return Err(Error::MissingFeature {
-                    what: format!("light[{i}].shadow.format = \"unorm16\""),
-                    feature: "TEXTURE_FORMAT_16BIT_NORM",
-                });
-            }
-        }
-    }
-    Ok(())
-}
 
 /// What `render` asks for besides the image.
 #[derive(Clone, Copy, Debug, Default)]

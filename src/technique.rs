@@ -385,7 +385,7 @@ fn quantized_msm_range() -> ([f32; 4], [f32; 4]) {
         let (mut lo, mut hi) = ([f64::MAX; 4], [f64::MIN; 4]);
         for k in 0..=4096 {
             let z = f64::from(k) / 4096.0;
-            let q = crate::cpu::msm::quantize([z, z * z, z.powi(3), z.powi(4)]);
+            let q = crate::msm_quantize::quantize([z, z * z, z.powi(3), z.powi(4)]);
             for c in 0..4 {
                 lo[c] = lo[c].min(q[c]);
                 hi[c] = hi[c].max(q[c]);
