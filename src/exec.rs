@@ -326,11 +326,10 @@ impl Executor {
     /// Compiles every kernel `plan` uses (also done lazily by [`Executor::record`]).
     pub fn prepare(&mut self, device: &wgpu::Device, plan: &Plan) -> Result<()> {
         for step in &plan.steps {
-            let formats: Vec<(String, wgpu::TextureFormat)> = step
-                .node
-                .outputs
-                .iter()
-                .filter_map(|(slot, r)| plan.resource(r).map(|p| (slot.clone(), p.resource.format)))
+            let base = self.kernels.get(device, &step.node.kernel)?;
+            let formats: Vec<(String, wgpu::TextureFormat)> = bound_outputs(&base, &step.node)
+                .into_iter()
+                .filter_map(|(slot, r)| plan.resource(&r).map(|p| (slot, p.resource.format)))
                 .collect();
             self.kernels
                 .get_specialized(device, &step.node.kernel, &formats)?;
@@ -437,10 +436,11 @@ impl Executor {
                 self.record_mip_chain(device, encoder, node, &textures)?;
                 continue;
             }
-            let formats: Vec<(String, wgpu::TextureFormat)> = node
-                .outputs
+            let base = self.kernels.get(device, &node.kernel)?;
+            let outputs = bound_outputs(&base, node);
+            let formats: Vec<(String, wgpu::TextureFormat)> = outputs
                 .iter()
-                .map(|(slot, r)| (slot.clone(), textures[r].format()))
+                .filter_map(|(slot, r)| textures.get(r).map(|t| (slot.clone(), t.format())))
                 .collect();
             let kernel = self
                 .kernels
@@ -451,7 +451,7 @@ impl Executor {
                 let bound = node
                     .inputs
                     .iter()
-                    .chain(&node.outputs)
+                    .chain(&outputs)
                     .find(|(slot, _)| *slot == b.name);
                 if let Some((_, res)) = bound {
                     let view = textures[res].create_view(&wgpu::TextureViewDescriptor {
@@ -586,6 +586,36 @@ impl Executor {
         }
         Ok(())
     }
+}
+
+/// `node`'s outputs as `kernel` binds them: a kernel may declare more write-only storage
+/// outputs than a node writes (`kernels/csm.wgsl` writes up to four maps from one read of the
+/// depth); each one the node leaves unbound repeats the node's last output, which the kernel
+/// does not store to through it (as a mip chain's unused levels do), and which the cost model
+/// does not count.
+fn bound_outputs(kernel: &ComputeKernel, node: &crate::graph::Node) -> Vec<(String, String)> {
+    let mut outputs = node.outputs.clone();
+    let Some((_, last)) = node.outputs.last().cloned() else {
+        return outputs;
+    };
+    for b in kernel.reflection.bindings.iter().filter(|b| b.group == 0) {
+        let write_only = matches!(
+            b.ty,
+            wgpu::BindingType::StorageTexture {
+                access: wgpu::StorageTextureAccess::WriteOnly,
+                ..
+            }
+        );
+        let bound = node
+            .inputs
+            .iter()
+            .chain(&node.outputs)
+            .any(|(s, _)| *s == b.name);
+        if write_only && !bound {
+            outputs.push((b.name.clone(), last.clone()));
+        }
+    }
+    outputs
 }
 
 /// A mip-chain node's textures and the pieces of its dispatches.

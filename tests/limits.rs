@@ -199,7 +199,10 @@ fn lowered_limits_and_budgets_name_the_key() {
         64,
         48,
         // A summed-area table: its tile passes need workgroup memory (the blur needs none).
-        &[light(2048, "technique = \"vsm\"\nfilter = \"sat\"\nfilter_width = 5.0")],
+        &[light(
+            2048,
+            "technique = \"vsm\"\nfilter = \"sat\"\nfilter_width = 5.0",
+        )],
     );
     let sp = plan_lights(&s.lights).unwrap();
     let full = wgpu::Limits::default();

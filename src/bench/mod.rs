@@ -80,15 +80,15 @@ pub const CASES: &[BenchCase] = &[
     },
     BenchCase {
         name: "vsm",
-        build: |n| stage_graph(n, vsm(), "light0.linear", "light0.vsm"),
+        build: |n| stage_graph(n, vsm(), "light0.depth", "light0.vsm"),
     },
     BenchCase {
         name: "evsm4",
-        build: |n| stage_graph(n, evsm4(), "light0.linear", "light0.evsm"),
+        build: |n| stage_graph(n, evsm4(), "light0.depth", "light0.evsm"),
     },
     BenchCase {
         name: "esm",
-        build: |n| stage_graph(n, esm(), "light0.linear", "light0.esm"),
+        build: |n| stage_graph(n, esm(), "light0.depth", "light0.esm"),
     },
     BenchCase {
         name: "blur rg32f r4",
@@ -104,15 +104,15 @@ pub const CASES: &[BenchCase] = &[
     },
     BenchCase {
         name: "msm",
-        build: |n| stage_graph(n, msm(Storage::F32), "light0.linear", "light0.msm"),
+        build: |n| stage_graph(n, msm(Storage::F32), "light0.depth", "light0.msm"),
     },
     BenchCase {
         name: "msm f16 quantized",
-        build: |n| stage_graph(n, msm(Storage::F16), "light0.linear", "light0.msm"),
+        build: |n| stage_graph(n, msm(Storage::F16), "light0.depth", "light0.msm"),
     },
     BenchCase {
         name: "csm (2 terms)",
-        build: |n| stage_graph(n, csm(), "light0.linear", "light0.csm0"),
+        build: |n| stage_graph(n, csm(), "light0.depth", "light0.csm0"),
     },
     BenchCase {
         name: "mips rgba32f",
