@@ -1,27 +1,78 @@
-// Linear depth → two terms of the Fourier basis of convolution shadow maps (Annen et al.
-// 2007): (sin c_k z, cos c_k z, sin c_{k+1} z, cos c_{k+1} z), c_k = π (2k − 1), k = first_term.
-// A scene with M terms runs ⌈M/2⌉ of these; a pair past M is written as zeros. The values lie
-// in [−1, 1], so f16 storage keeps them to 2⁻¹¹. The argument is reduced exactly to [−π, π]
-// first (sin and cos have period 2 in (2k − 1)·z), where GPU sin/cos are specified.
+// Rasterized depth → up to four maps of the convolution basis, from one read of the depth.
+//
+// The light's maps, in order (map index m):
+//   - CSM basis (Annen et al. 2007), ⌈M/2⌉ maps: map m holds (sin c_k z, cos c_k z,
+//     sin c_{k+1} z, cos c_{k+1} z), k = 2m + 1, c_k = π (2k − 1); a pair past M is zeros.
+//   - CSSM only, the CSM-Z basis (Annen et al. 2008): the complementary basis images B̄_i(z)·z
+//     in the order [z, z·sin c₁z, z·cos c₁z, …, z·cos c_M z] (2M + 1 channels), four channels a
+//     map from channel 4·(m − ⌈M/2⌉) on, channels past the last zeros. Filtered next to the CSM
+//     basis they give E[f̄(d, z)·z] over any rectangle, f̄ = 1 − f, so the average blocker depth
+//     E[f̄·z] / E[f̄] (shared/blocker.wgsl) is a lookup.
+// This dispatch writes maps first_map … first_map + maps − 1 to dst0 … dst<maps − 1> (the
+// executor binds the unused outputs to the last bound one; they are not stored to). Every value
+// lies in [−1, 1] (|z·sin| ≤ z ≤ 1), so f16 storage keeps them to 2⁻¹¹. The argument is reduced
+// exactly to [−π, π] first (shared/csm_basis). The depth is linearized here (shared/linear_depth).
+// Storage: rgba32float by default; the executor re-declares each `dst<j>` for its bound format
+// (rg32float or r32float for a last map of fewer channels; rgba16float for f16).
+
 // #import shared/csm_basis
-// Storage: rgba32float by default; the executor re-declares `dst` for the bound format.
+// #import shared/linear_depth
 
 // Keep in sync with `CsmParams` in src/technique.rs.
 struct Params {
-    first_term: u32,
+    depth: DepthParams,
+    first_map: u32,
+    maps: u32,
     terms: u32,
-    _pad0: u32,
-    _pad1: u32,
+    _pad: u32,
 }
 
-// Traffic (the cost model, src/graph/cost): one texel in, one out.
+// Traffic (the cost model, src/graph/cost): one texel in, one out per bound map (an unbound
+// output is not in the node and costs nothing).
 // #traffic src: all
-// #traffic dst: all
+// #traffic dst0: all
+// #traffic dst1: all
+// #traffic dst2: all
+// #traffic dst3: all
+// #traffic stats: none
 @group(0) @binding(0) var src: texture_2d<f32>;
-@group(0) @binding(1) var dst: texture_storage_2d<rgba32float, write>;
-@group(0) @binding(2) var<uniform> params: Params;
+@group(0) @binding(1) var dst0: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(2) var dst1: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(3) var dst2: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(4) var dst3: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(5) var<uniform> params: Params;
+@group(0) @binding(6) var<storage, read_write> stats: array<atomic<u32>>;
 
 const WG_SIZE: u32 = 16u;
+
+// Channel i of the CSM-Z sequence at depth z (0 past channel 2M).
+fn csm_z_channel(i: u32, z: f32) -> f32 {
+    if i == 0u {
+        return z;
+    }
+    if i > 2u * params.terms {
+        return 0.0;
+    }
+    let sc = csm_sin_cos((i + 1u) / 2u, z);
+    return z * select(sc.y, sc.x, (i & 1u) == 1u);
+}
+
+// Map m's texel at depth z.
+fn basis_map(m: u32, z: f32) -> vec4<f32> {
+    let basis_maps = (params.terms + 1u) / 2u;
+    if m < basis_maps {
+        let k = 2u * m + 1u;
+        let v = vec4<f32>(csm_sin_cos(k, z), csm_sin_cos(k + 1u, z));
+        return select(v, vec4<f32>(v.xy, 0.0, 0.0), k + 1u > params.terms);
+    }
+    let first = 4u * (m - basis_maps);
+    return vec4<f32>(
+        csm_z_channel(first, z),
+        csm_z_channel(first + 1u, z),
+        csm_z_channel(first + 2u, z),
+        csm_z_channel(first + 3u, z),
+    );
+}
 
 @compute @workgroup_size(WG_SIZE, WG_SIZE)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -29,11 +80,20 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if any(id.xy >= size) {
         return;
     }
-    let z = textureLoad(src, id.xy, 0).r;
-    let k = params.first_term;
-    var v = vec4<f32>(csm_sin_cos(k, z), csm_sin_cos(k + 1u, z));
-    if k + 1u > params.terms {
-        v = vec4<f32>(v.xy, 0.0, 0.0);
+    let depth = load_linear_depth(src, id.xy, params.depth);
+    if !depth.finite {
+        atomicAdd(&stats[0], 1u);
     }
-    textureStore(dst, id.xy, v);
+    let z = depth.z;
+    let m = params.first_map;
+    textureStore(dst0, id.xy, basis_map(m, z));
+    if params.maps > 1u {
+        textureStore(dst1, id.xy, basis_map(m + 1u, z));
+    }
+    if params.maps > 2u {
+        textureStore(dst2, id.xy, basis_map(m + 2u, z));
+    }
+    if params.maps > 3u {
+        textureStore(dst3, id.xy, basis_map(m + 3u, z));
+    }
 }

@@ -1,16 +1,19 @@
-// Linear depth → exponential variance moments (Lauritzen): z' = 2z − 1 ∈ [−1, 1],
+// Rasterized depth → exponential variance moments (Lauritzen): z' = 2z − 1 ∈ [−1, 1],
 //   pos = exp(c⁺ z'),  neg = −exp(−c⁻ z'),  stored (pos, pos², neg, neg²).
 // EVSM2 binds an rg32float (or rgba16float) output and keeps (pos, pos²); EVSM4 keeps all four.
 // The scene clamps c to the storage's limit (42 for f32, 5.54 for f16) so pos² stays finite.
 
 // #import shared/exp_params
+// #import shared/linear_depth
 
 // Traffic (the cost model, src/graph/cost): one texel in, one out.
 // #traffic src: all
 // #traffic dst: all
+// #traffic stats: none
 @group(0) @binding(0) var src: texture_2d<f32>;
 @group(0) @binding(1) var dst: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(2) var<uniform> params: Params;
+@group(0) @binding(3) var<storage, read_write> stats: array<atomic<u32>>;
 
 const WG_SIZE: u32 = 16u;
 
@@ -20,7 +23,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if any(id.xy >= size) {
         return;
     }
-    let w = 2.0 * textureLoad(src, id.xy, 0).r - 1.0;
+    let depth = load_linear_depth(src, id.xy, params.depth);
+    if !depth.finite {
+        atomicAdd(&stats[0], 1u);
+    }
+    let w = 2.0 * depth.z - 1.0;
     let pos = exp(params.exp_pos * w);
     let neg = -exp(-params.exp_neg * w);
     textureStore(dst, id.xy, vec4<f32>(pos, pos * pos, neg, neg * neg));

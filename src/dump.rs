@@ -14,7 +14,7 @@ use serde::Serialize;
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
 use crate::io::{deinterleave, write_exr, write_png};
-use crate::render::{DumpedResource, FloatMap, RenderOptions, Renderer, plan_lights};
+use crate::render::{DumpedResource, FloatMap, RenderOptions, Renderer, plan_lights_for};
 use crate::scene::Scene;
 
 /// Statistics of one channel: range and mean over the finite values, and the non-finite count.
@@ -420,7 +420,12 @@ fn warn_non_finite(report: &mut String, entries: &[ManifestEntry]) {
 /// [`Error::Invalid`], listing the resource names.
 pub fn dump(gpu: &Gpu, scene: &Path, out: &Path, only: Option<&str>) -> Result<String> {
     let loaded = Scene::load(scene)?;
-    let sp = plan_lights(&loaded.lights)?;
+    let opts = RenderOptions {
+        aux: false,
+        repeat: 1,
+        dump: true,
+    };
+    let sp = plan_lights_for(&loaded.lights, &opts)?;
     if let Some(name) = only {
         let names: Vec<&str> = sp
             .plan
@@ -436,16 +441,7 @@ pub fn dump(gpu: &Gpu, scene: &Path, out: &Path, only: Option<&str>) -> Result<S
             )));
         }
     }
-    let frame = Renderer::new(&gpu.device).render(
-        &gpu.device,
-        &gpu.queue,
-        &loaded,
-        RenderOptions {
-            aux: false,
-            repeat: 1,
-            dump: true,
-        },
-    )?;
+    let frame = Renderer::new(&gpu.device).render(&gpu.device, &gpu.queue, &loaded, opts)?;
     std::fs::create_dir_all(out).map_err(|error| Error::Io {
         path: out.to_path_buf(),
         error,

@@ -401,11 +401,10 @@ impl Executor {
     /// Compiles every kernel `plan` uses (also done lazily by [`Executor::record`]).
     pub fn prepare(&mut self, device: &wgpu::Device, plan: &Plan) -> Result<()> {
         for step in &plan.steps {
-            let formats: Vec<(String, wgpu::TextureFormat)> = step
-                .node
-                .outputs
-                .iter()
-                .filter_map(|(slot, r)| plan.resource(r).map(|p| (slot.clone(), p.resource.format)))
+            let base = self.kernels.get(device, &step.node.kernel)?;
+            let formats: Vec<(String, wgpu::TextureFormat)> = bound_outputs(&base, &step.node)
+                .into_iter()
+                .filter_map(|(slot, r)| plan.resource(&r).map(|p| (slot, p.resource.format)))
                 .collect();
             self.kernels
                 .get_specialized(device, &step.node.kernel, &formats)?;
@@ -594,10 +593,11 @@ impl Executor {
             return self.bind_mip_chain(device, node, &outputs.textures);
         }
         let textures = &outputs.textures;
-        let formats: Vec<(String, wgpu::TextureFormat)> = node
-            .outputs
+        let base = self.kernels.get(device, &node.kernel)?;
+        let node_outputs = bound_outputs(&base, node);
+        let formats: Vec<(String, wgpu::TextureFormat)> = node_outputs
             .iter()
-            .map(|(slot, r)| (slot.clone(), textures[r].format()))
+            .filter_map(|(slot, r)| textures.get(r).map(|t| (slot.clone(), t.format())))
             .collect();
         let kernel = self
             .kernels
@@ -607,7 +607,7 @@ impl Executor {
             let bound = node
                 .inputs
                 .iter()
-                .chain(&node.outputs)
+                .chain(&node_outputs)
                 .find(|(slot, _)| *slot == b.name);
             if let Some((_, res)) = bound {
                 views.push((b.binding, aspect_view(&textures[res])));
@@ -810,6 +810,36 @@ fn aspect_view(t: &wgpu::Texture) -> wgpu::TextureView {
             ..Default::default()
         },
     )
+}
+
+/// `node`'s outputs as `kernel` binds them: a kernel may declare more write-only storage
+/// outputs than a node writes (`kernels/csm.wgsl` writes up to four maps from one read of the
+/// depth); each one the node leaves unbound repeats the node's last output, which the kernel
+/// does not store to through it (as a mip chain's unused levels do), and which the cost model
+/// does not count.
+fn bound_outputs(kernel: &ComputeKernel, node: &crate::graph::Node) -> Vec<(String, String)> {
+    let mut outputs = node.outputs.clone();
+    let Some((_, last)) = node.outputs.last().cloned() else {
+        return outputs;
+    };
+    for b in kernel.reflection.bindings.iter().filter(|b| b.group == 0) {
+        let write_only = matches!(
+            b.ty,
+            wgpu::BindingType::StorageTexture {
+                access: wgpu::StorageTextureAccess::WriteOnly,
+                ..
+            }
+        );
+        let bound = node
+            .inputs
+            .iter()
+            .chain(&node.outputs)
+            .any(|(s, _)| *s == b.name);
+        if write_only && !bound {
+            outputs.push((b.name.clone(), last.clone()));
+        }
+    }
+    outputs
 }
 
 /// A mip-chain node's textures and the pieces of its dispatches.

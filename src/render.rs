@@ -116,15 +116,29 @@ pub struct ScenePlan {
 
 /// Plans `lights` (no GPU needed): the kernels their techniques need and nothing else.
 pub fn plan_lights(lights: &[Light]) -> Result<ScenePlan> {
+    plan_lights_for(lights, &RenderOptions::default())
+}
+
+/// [`plan_lights`] for a render with `opts`: with `opts.aux` or `opts.dump`, each light's
+/// linear depth map ([`technique::linear_name`]) is an output too ([`Frame::linear_maps`],
+/// the dump; the encodings linearize the depth themselves, so it is planned only when asked
+/// for).
+pub fn plan_lights_for(lights: &[Light], opts: &RenderOptions) -> Result<ScenePlan> {
     let mut graph = Graph::default();
     let mut shade_inputs = Vec::new();
     for (i, l) in lights.iter().enumerate() {
         technique::sat_coding(l).map_err(|e| Error::Invalid(format!("light[{i}]: {e}")))?;
         shade_inputs.push(technique::add_light_nodes(&mut graph, i, l));
     }
+    let linear: Vec<String> = (0..lights.len()).map(technique::linear_name).collect();
+    let diagnostics = linear
+        .iter()
+        .filter(|_| opts.aux || opts.dump)
+        .map(String::as_str);
     let outputs: Vec<&str> = shade_inputs
         .iter()
         .flat_map(|s| s.maps.iter().map(String::as_str))
+        .chain(diagnostics)
         .collect();
     let plan = plan(&graph, &outputs)?;
     Ok(ScenePlan {
@@ -150,7 +164,7 @@ pub fn check_render(device: &wgpu::Device, scene: &Scene, opts: &RenderOptions) 
             opts.repeat
         )));
     }
-    let sp = plan_lights(&scene.lights)?;
+    let sp = plan_lights_for(&scene.lights, opts)?;
     crate::limits::check_scene(
         scene,
         &sp,

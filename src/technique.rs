@@ -399,9 +399,11 @@ fn quantized_msm_range() -> ([f32; 4], [f32; 4]) {
     })
 }
 
-/// Parameters of `kernels/linearize.wgsl` (mirrors its `Params`).
+/// How a depth buffer is linearized: `kernels/linearize.wgsl`'s params and the first member
+/// (`depth`) of every encoding's params (mirrors `DepthParams` in
+/// `kernels/shared/linear_depth.wgsl`).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct LinearizeParams {
     /// 1 for a perspective (spot) depth buffer.
     pub perspective: u32,
@@ -414,6 +416,15 @@ pub struct LinearizeParams {
 }
 
 impl LinearizeParams {
+    /// An orthographic depth buffer: depth in [0, 1] is linear already (only clamped, and
+    /// non-finite values replaced).
+    pub const ORTHOGRAPHIC: Self = Self {
+        perspective: 0,
+        near: 0.0,
+        far: 1.0,
+        _pad: 0,
+    };
+
     /// Parameters for `light`'s depth buffer.
     pub fn new(light: &Light) -> Self {
         Self {
@@ -423,6 +434,14 @@ impl LinearizeParams {
             _pad: 0,
         }
     }
+}
+
+/// Parameters of `kernels/vsm.wgsl` (mirrors its `Params`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct VsmParams {
+    /// The depth buffer's linearization.
+    pub depth: LinearizeParams,
 }
 
 /// Name of light `i`'s rasterized depth map (imported into the graph).
@@ -436,8 +455,10 @@ pub fn linear_name(i: usize) -> String {
 }
 
 /// Adds the nodes light `i`'s technique needs to `graph` and returns what the shading pass
-/// reads. The raw depth map and the linear map are always declared; the planner drops what the
-/// shading pass does not read (e.g. `linearize` for the hardware comparison sampler).
+/// reads. The raw depth map and the linear map are always declared; the planner drops what
+/// nothing reads: the encodings linearize the depth themselves, so `linearize` runs only for
+/// the techniques that shade from the linear depth (hard, PCF but the hardware comparison
+/// sampler, PCSS) or when a caller asks for [`linear_name`] (diagnostics).
 pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput {
     let depth = graph.import(
         depth_name(i),
@@ -446,6 +467,7 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
         light.shadow_map,
         Some(i),
     );
+    let lin = LinearizeParams::new(light);
     let linear = graph.resource(
         linear_name(i),
         wgpu::TextureFormat::R32Float,
@@ -460,7 +482,7 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
         kernel: "linearize".into(),
         inputs: vec![("src".into(), depth.clone())],
         outputs: vec![("dst".into(), linear.clone())],
-        params: bytemuck::bytes_of(&LinearizeParams::new(light)).to_vec(),
+        params: bytemuck::bytes_of(&lin).to_vec(),
         dispatch: Dispatch::Texels(linear.clone()),
         light: Some(i),
     });
@@ -484,7 +506,8 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
             ..
         } => {
             let format = moments_format(storage, 2);
-            let moments = encode(graph, i, "vsm", "vsm", &linear, format, Vec::new());
+            let params = bytemuck::bytes_of(&VsmParams { depth: lin }).to_vec();
+            let moments = encode(graph, i, "vsm", "vsm", &depth, format, params);
             one(filtered(graph, i, light, &moments, BlurMode::Linear), float)
         }
         Technique::Evsm {
@@ -495,16 +518,21 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
             ..
         } => {
             let format = moments_format(prefilter.storage, if four { 4 } else { 2 });
-            let params = bytemuck::bytes_of(&ExpParams::new(exp_pos, exp_neg)).to_vec();
-            let moments = encode(graph, i, "evsm", "evsm", &linear, format, params);
+            let params = ExpParams {
+                depth: lin,
+                ..ExpParams::new(exp_pos, exp_neg)
+            };
+            let params = bytemuck::bytes_of(&params).to_vec();
+            let moments = encode(graph, i, "evsm", "evsm", &depth, format, params);
             one(filtered(graph, i, light, &moments, BlurMode::Linear), float)
         }
         Technique::Esm { filter, exponent } => {
             let mut params = ExpParams::new(exponent, 0.0);
+            params.depth = lin;
             params.linear = u32::from(matches!(filter, Filter::Sat { .. }));
             let params = bytemuck::bytes_of(&params).to_vec();
             let format = wgpu::TextureFormat::R32Float;
-            let log_moment = encode(graph, i, "esm", "esm", &linear, format, params);
+            let log_moment = encode(graph, i, "esm", "esm", &depth, format, params);
             one(
                 filtered(graph, i, light, &log_moment, BlurMode::LogSumExp),
                 float,
@@ -520,11 +548,12 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
         } => {
             let format = moments_format(storage, 4);
             let params = bytemuck::bytes_of(&MsmParams {
+                depth: lin,
                 quantized: u32::from(msm_quantized(&light.shadow.technique)),
                 _pad: [0; 3],
             })
             .to_vec();
-            let moments = encode(graph, i, "msm", "msm", &linear, format, params);
+            let moments = encode(graph, i, "msm", "msm", &depth, format, params);
             one(filtered(graph, i, light, &moments, BlurMode::Linear), float)
         }
         Technique::Csm {
@@ -532,76 +561,92 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
             terms,
             ..
         } => ShadeInput {
-            maps: csm_nodes(graph, i, light, &linear, storage, terms),
+            maps: csm_nodes(graph, i, light, &depth, storage, terms),
             wgsl_type: float,
         },
         Technique::Cssm {
             soft: Soft { storage, .. },
             terms,
             ..
-        } => {
-            let mut maps = csm_nodes(graph, i, light, &linear, storage, terms);
-            maps.extend(csm_z_nodes(graph, i, light, &linear, storage, terms));
-            ShadeInput {
-                maps,
-                wgsl_type: float,
-            }
-        }
+        } => ShadeInput {
+            maps: csm_nodes(graph, i, light, &depth, storage, terms),
+            wgsl_type: float,
+        },
     }
 }
 
-/// The filtered CSM basis maps of light `i` (`light{i}.csm<chunk>`, two terms each).
+/// The filtered maps of light `i`'s convolution basis: the CSM basis maps
+/// (`light{i}.csm<chunk>`, two terms each), then for CSSM the CSM-Z maps
+/// (`light{i}.csm_z<chunk>`, four channels of the sequence `[z, z·sin c₁z, z·cos c₁z, …]`
+/// each), the complementary basis its blocker search filters. `kernels/csm.wgsl` writes up
+/// to [`CSM_OUTPUTS`] of them from one read of the depth (nodes `light{i}.csm.<g>`).
 fn csm_nodes(
     graph: &mut Graph,
     i: usize,
     light: &Light,
-    linear: &str,
+    depth: &str,
     storage: Storage,
     terms: u32,
 ) -> Vec<String> {
-    (0..csm_maps(terms))
+    let z_maps = match light.shadow.technique {
+        Technique::Cssm { .. } => csm_z_maps(terms),
+        _ => 0,
+    };
+    let z_channels = csm_z_channels(terms);
+    let maps: Vec<(String, wgpu::TextureFormat)> = (0..csm_maps(terms))
         .map(|chunk| {
             let pairs = (terms - 2 * chunk).min(2);
-            let format = moments_format(storage, 2 * pairs);
-            let params = bytemuck::bytes_of(&CsmParams {
-                first_term: 2 * chunk + 1,
-                terms,
-                _pad: [0; 2],
-            })
-            .to_vec();
-            let name = format!("csm{chunk}");
-            let basis = encode(graph, i, "csm", &name, linear, format, params);
-            filtered(graph, i, light, &basis, BlurMode::Linear)
+            (format!("csm{chunk}"), moments_format(storage, 2 * pairs))
         })
-        .collect()
-}
-
-/// The filtered CSM-Z maps of light `i` (`light{i}.csm_z<chunk>`, four channels of the
-/// sequence `[z, z·sin c₁z, z·cos c₁z, …]` each): the complementary basis the CSSM blocker
-/// search filters. Planned only for soft CSM.
-fn csm_z_nodes(
-    graph: &mut Graph,
-    i: usize,
-    light: &Light,
-    linear: &str,
-    storage: Storage,
-    terms: u32,
-) -> Vec<String> {
-    let channels = csm_z_channels(terms);
-    (0..csm_z_maps(terms))
-        .map(|chunk| {
-            let format = moments_format(storage, (channels - 4 * chunk).min(4));
-            let params = bytemuck::bytes_of(&CsmParams {
-                first_term: chunk,
-                terms,
-                _pad: [0; 2],
+        .chain((0..z_maps).map(|chunk| {
+            let channels = (z_channels - 4 * chunk).min(4);
+            (format!("csm_z{chunk}"), moments_format(storage, channels))
+        }))
+        .collect();
+    let mut out = Vec::new();
+    for (g, group) in maps.chunks(CSM_OUTPUTS as usize).enumerate() {
+        let outputs: Vec<(String, String)> = group
+            .iter()
+            .enumerate()
+            .map(|(j, (name, format))| {
+                let r = graph.resource(
+                    format!("light{i}.{name}"),
+                    *format,
+                    SizeRule::Reduced {
+                        of: depth.to_string(),
+                        shift: 0,
+                    },
+                    Some(i),
+                );
+                (format!("dst{j}"), r)
             })
-            .to_vec();
-            let name = format!("csm_z{chunk}");
-            let basis = encode(graph, i, "csm_z", &name, linear, format, params);
-            filtered(graph, i, light, &basis, BlurMode::Linear)
-        })
-        .collect()
+            .collect();
+        let params = CsmParams {
+            depth: LinearizeParams::new(light),
+            first_map: g as u32 * CSM_OUTPUTS,
+            maps: group.len() as u32,
+            terms,
+            _pad: 0,
+        };
+        let written: Vec<String> = outputs.iter().map(|(_, r)| r.clone()).collect();
+        graph.node(Node {
+            name: format!("light{i}.csm.{g}"),
+            kernel: "csm".into(),
+            inputs: vec![("src".into(), depth.to_string())],
+            dispatch: Dispatch::Texels(outputs[0].1.clone()),
+            outputs,
+            params: bytemuck::bytes_of(&params).to_vec(),
+            light: Some(i),
+        });
+        // Filtered before the next group is written (the planner orders by declaration), so
+        // at most one group's unfiltered maps are alive at a time.
+        out.extend(
+            written
+                .iter()
+                .map(|m| filtered(graph, i, light, m, BlurMode::Linear)),
+        );
+    }
+    out
 }
 
 /// The filter of light `light`'s representation applied to `input`: the summed-area table of
@@ -690,29 +735,42 @@ pub fn csm_z_maps(terms: u32) -> u32 {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct MsmParams {
+    /// The depth buffer's linearization.
+    pub depth: LinearizeParams,
     /// 1: store the optimized quantization of the moments; 0: the raw powers.
     pub quantized: u32,
     /// Padding.
     pub _pad: [u32; 3],
 }
 
-/// Parameters of `kernels/csm.wgsl` and `kernels/csm_z.wgsl` (mirrors their `Params`).
+/// Parameters of `kernels/csm.wgsl` (mirrors its `Params`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct CsmParams {
-    /// `csm`: term k of the map's first pair (channels sin, cos of c_k z, then of c_{k+1} z);
-    /// `csm_z`: the map's chunk j (channels 4j … 4j + 3 of the CSM-Z sequence).
-    pub first_term: u32,
+    /// The depth buffer's linearization.
+    pub depth: LinearizeParams,
+    /// Index of the map `dst0` receives in the light's sequence of maps: the ⌈M/2⌉ CSM basis
+    /// maps ([`csm_maps`]), then (CSSM) the CSM-Z maps ([`csm_z_maps`]).
+    pub first_map: u32,
+    /// Maps this dispatch writes (`dst0` … `dst<maps − 1>`; 1 to [`CSM_OUTPUTS`]).
+    pub maps: u32,
     /// Total terms M (a pair past M is written as zeros).
     pub terms: u32,
     /// Padding.
-    pub _pad: [u32; 2],
+    pub _pad: u32,
 }
+
+/// Storage-texture outputs of `kernels/csm.wgsl` (`dst0` … `dst3`): what WebGPU's default
+/// `max_storage_textures_per_shader_stage` allows every device, so one read of the depth
+/// writes up to four basis maps.
+pub const CSM_OUTPUTS: u32 = 4;
 
 /// Parameters of `kernels/evsm.wgsl` and `kernels/esm.wgsl` (mirror their `Params`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct ExpParams {
+    /// The depth buffer's linearization.
+    pub depth: LinearizeParams,
     /// c⁺ (EVSM) or c (ESM).
     pub exp_pos: f32,
     /// c⁻ (EVSM4).
@@ -725,9 +783,10 @@ pub struct ExpParams {
 }
 
 impl ExpParams {
-    /// Exponents `pos`, `neg`.
+    /// Exponents `pos`, `neg` on an orthographic depth buffer.
     pub fn new(exp_pos: f32, exp_neg: f32) -> Self {
         Self {
+            depth: LinearizeParams::ORTHOGRAPHIC,
             exp_pos,
             exp_neg,
             linear: 0,
@@ -748,14 +807,15 @@ pub fn moments_format(storage: Storage, channels: u32) -> wgpu::TextureFormat {
     }
 }
 
-/// Adds the encoding node `kernel` (linear depth → representation) of light `i`, writing
-/// `light{i}.{name}`; the output's format picks the kernel's storage variant.
+/// Adds the encoding node `kernel` (raw depth → representation, the kernel linearizing the
+/// depth itself) of light `i`, writing `light{i}.{name}`; the output's format picks the
+/// kernel's storage variant. `params` start with the depth's [`LinearizeParams`].
 fn encode(
     graph: &mut Graph,
     i: usize,
     kernel: &str,
     name: &str,
-    linear: &str,
+    depth: &str,
     format: wgpu::TextureFormat,
     params: Vec<u8>,
 ) -> String {
@@ -763,7 +823,7 @@ fn encode(
         format!("light{i}.{name}"),
         format,
         SizeRule::Reduced {
-            of: linear.to_string(),
+            of: depth.to_string(),
             shift: 0,
         },
         Some(i),
@@ -771,7 +831,7 @@ fn encode(
     graph.node(Node {
         name: format!("light{i}.{name}"),
         kernel: kernel.into(),
-        inputs: vec![("src".into(), linear.to_string())],
+        inputs: vec![("src".into(), depth.to_string())],
         outputs: vec![("dst".into(), out.clone())],
         params,
         dispatch: Dispatch::Texels(out.clone()),

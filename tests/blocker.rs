@@ -16,7 +16,7 @@ use shadowgraph::sat::SatVariant;
 use shadowgraph::scene::Storage;
 use shadowgraph::technique::{LightGpu, sat_coding};
 
-/// Runs the `csm_z` kernel for every chunk of `terms` terms at `storage` over `input`
+/// Runs the `csm` kernel's CSM-Z maps (one map a dispatch) for every chunk of `terms` terms at `storage` over `input`
 /// (`w`×`h`), outputs poisoned with NaN first; returns each chunk's texels (its format's
 /// channels).
 fn csm_z_on_gpu(
@@ -27,7 +27,9 @@ fn csm_z_on_gpu(
     storage: Storage,
 ) -> Vec<(usize, Vec<f32>)> {
     use shadowgraph::graph::{Dispatch, Graph, Node, SizeRule, plan};
-    use shadowgraph::technique::{CsmParams, csm_z_channels, csm_z_maps, moments_format};
+    use shadowgraph::technique::{
+        CsmParams, LinearizeParams, csm_maps, csm_z_channels, csm_z_maps, moments_format,
+    };
     let mut graph = Graph::default();
     graph.import("in", wgpu::TextureFormat::R32Float, w, h, Some(0));
     let mut outputs = Vec::new();
@@ -45,13 +47,16 @@ fn csm_z_on_gpu(
         );
         graph.node(Node {
             name: out.clone(),
-            kernel: "csm_z".into(),
+            kernel: "csm".into(),
             inputs: vec![("src".into(), "in".into())],
-            outputs: vec![("dst".into(), out.clone())],
+            outputs: vec![("dst0".into(), out.clone())],
+            // Orthographic depth in [0, 1] is read as linear depth unchanged.
             params: bytemuck::bytes_of(&CsmParams {
-                first_term: chunk,
+                depth: LinearizeParams::ORTHOGRAPHIC,
+                first_map: csm_maps(terms) + chunk,
+                maps: 1,
                 terms,
-                _pad: [0; 2],
+                _pad: 0,
             })
             .to_vec(),
             dispatch: Dispatch::Texels(out.clone()),

@@ -64,10 +64,9 @@ fn vsm_with_blur_moves_what_the_hand_count_says() {
     assert_traffic(
         "techniques/vsm.toml",
         &[
-            // depth32float in, r32float out.
-            ("linearize", 1, 4.0, 4.0),
-            // 16×16 workgroups load their tile and the 4×16 texels of its cross-shaped
-            // halo (the four neighbours of the derivatives): 320/256 × 4 B; rg32float out.
+            // The encoding reads the depth32float buffer itself (linearize fused): 16×16
+            // workgroups load their tile and the 4×16 texels of its cross-shaped halo (the
+            // four neighbours of the derivatives): 320/256 × 4 B; rg32float out.
             ("vsm", 1, 5.0, 8.0),
             // A row workgroup loads 64 × 8 texels of a row and 3 more on either side:
             // 518/512 × 8 B.
@@ -75,8 +74,8 @@ fn vsm_with_blur_moves_what_the_hand_count_says() {
             // A column workgroup loads 64 columns of 8 + 2 × 3 texels: 896/512 × 8 B.
             ("blur_v", 1, 14.0, 8.0),
         ],
-        // 8 + 13 + 16.09375 + 22
-        59.09375,
+        // 13 + 16.09375 + 22
+        51.09375,
         // one read of the depth (4 B) + one write of the blurred moments (8 B)
         12.0,
     );
@@ -89,13 +88,13 @@ fn vsm_with_mips_moves_every_level() {
     assert_traffic(
         "techniques/vsm_mips.toml",
         &[
-            ("linearize", 1, 4.0, 4.0),
+            // The depth32float buffer with the derivatives' halo (as in `vsm.toml`).
             ("vsm", 1, 5.0, 8.0),
             // Dispatch 1 reads the moments and writes levels 0–6; dispatch 2 reads level 6
             // and writes levels 7–9.
             ("vsm.mips", 2, 8.0 + level(6), (0..10).map(level).sum()),
         ],
-        21.0 + 8.0 + level(6) + (0..10).map(level).sum::<f64>(),
+        13.0 + 8.0 + level(6) + (0..10).map(level).sum::<f64>(),
         4.0 + (0..10).map(level).sum::<f64>(),
     );
 }
@@ -120,29 +119,31 @@ fn sat_rows(src: f64, table: f64) -> [Row; 3] {
 /// `msm_sat.toml`: a 512² map, 16-bit quantized moments (rgba16float), a fixed-point table.
 #[test]
 fn msm_with_sat_moves_what_the_hand_count_says() {
-    let mut rows = vec![("linearize", 1, 4.0, 4.0), ("msm", 1, 4.0, 8.0)];
+    // The encoding reads the depth32float buffer itself (linearize fused), writes rgba16float.
+    let mut rows = vec![("msm", 1, 4.0, 8.0)];
     rows.extend(sat_rows(8.0, 16.0));
-    // 8 + 12 + (8.5 + 1 + 24.5) of the table
-    assert_traffic("techniques/msm_sat.toml", &rows, 54.0, 4.0 + 16.0);
+    // 12 + (8.5 + 1 + 24.5) of the table
+    assert_traffic("techniques/msm_sat.toml", &rows, 46.0, 4.0 + 16.0);
 }
 
 /// `cssm.toml`: M = 8 terms at 512²: four CSM maps (rgba32float), five CSM-Z maps (four
-/// rgba32float, the 17th channel alone in r32float), each with its table.
+/// rgba32float, the 17th channel alone in r32float), each with its table; `csm` writes four
+/// maps a dispatch from one read of the depth (linearize fused).
 #[test]
 fn cssm_moves_what_the_hand_count_says() {
-    let mut rows: Vec<Row> = vec![("linearize", 1, 4.0, 4.0)];
-    for chunk in 0..4 {
-        rows.push((["csm0", "csm1", "csm2", "csm3"][chunk], 1, 4.0, 16.0));
-        rows.extend(sat_rows(16.0, 16.0));
+    let mut rows: Vec<Row> = Vec::new();
+    for (node, maps) in [("csm.0", 4), ("csm.1", 4), ("csm.2", 1)] {
+        // One read of the depth32float buffer; per map, an rgba32float write, or the last
+        // map's r32float one.
+        let bytes = if node == "csm.2" { 4.0 } else { 16.0 };
+        rows.push((node, 1, 4.0, maps as f64 * bytes));
+        for _ in 0..maps {
+            rows.extend(sat_rows(bytes, bytes));
+        }
     }
-    for chunk in 0..5 {
-        let bytes = if chunk < 4 { 16.0 } else { 4.0 };
-        let name = ["csm_z0", "csm_z1", "csm_z2", "csm_z3", "csm_z4"][chunk];
-        rows.push((name, 1, 4.0, bytes));
-        rows.extend(sat_rows(bytes, bytes));
-    }
-    // linearize 8; per rgba map 20 + 50; the r32float map 8 + 12.5.
-    let total = 8.0 + 8.0 * 70.0 + 20.5;
+    // Three depth reads (12) and the maps' writes (64 + 64 + 4); per rgba table 50, the
+    // r32uint one 12.5.
+    let total = 12.0 + 132.0 + 8.0 * 50.0 + 12.5;
     // One read of the depth, one write of eight rgba tables and one r32uint table.
     assert_traffic("techniques/cssm.toml", &rows, total, 4.0 + 8.0 * 16.0 + 4.0);
 }
@@ -174,7 +175,7 @@ fn plan_prints_traffic_and_fetches() {
     for needle in [
         "traffic per texel of the 512² map:",
         "reads    5.00 B, writes    8.00 B",
-        "total: 4 dispatches, 59.09 B/texel (one read + one write of the result: 12.00 B/texel)",
+        "total: 3 dispatches, 51.09 B/texel (one read + one write of the result: 12.00 B/texel)",
         "shade: vsm 4 fetches/pixel",
     ] {
         assert!(text.contains(needle), "`{needle}` missing:\n{text}");

@@ -242,21 +242,27 @@ fn rust_mirrors_match_naga_layouts() {
         Some(size_of::<shadowgraph::render::FrameGpu>() as u32),
         "FrameGpu vs struct Frame"
     );
-    for kernel in ["csm", "csm_z"] {
+    use shadowgraph::technique::{CsmParams, ExpParams, MsmParams, VsmParams};
+    for (kernel, rust) in [
+        ("csm", size_of::<CsmParams>()),
+        ("vsm", size_of::<VsmParams>()),
+        ("evsm", size_of::<ExpParams>()),
+        ("esm", size_of::<ExpParams>()),
+        ("msm", size_of::<MsmParams>()),
+    ] {
         let wgsl = kernels::resolve(kernel, None).unwrap();
         let (m, _) = kernels::reflect(kernel, &wgsl).unwrap();
         assert_eq!(
             struct_size(&m, "Params"),
-            Some(size_of::<shadowgraph::technique::CsmParams>() as u32),
-            "CsmParams vs {kernel}'s Params"
+            Some(rust as u32),
+            "Rust params vs {kernel}'s Params"
+        );
+        assert_eq!(
+            struct_size(&m, "DepthParams"),
+            Some(size_of::<LinearizeParams>() as u32),
+            "LinearizeParams vs {kernel}'s DepthParams"
         );
     }
-    let lin = kernels::resolve("linearize", None).unwrap();
-    let (m, _) = kernels::reflect("linearize", &lin).unwrap();
-    assert_eq!(
-        struct_size(&m, "Params"),
-        Some(size_of::<LinearizeParams>() as u32)
-    );
 }
 
 #[test]
@@ -285,9 +291,8 @@ fn storage_format_variants_validate() {
         ("blur", "rg32float", all),
         ("blur_log", "rg32float", &["r32float"][..]),
         ("msm", "rgba32float", &["rgba16float", "rgba16unorm"][..]),
-        ("csm", "rgba32float", &["rg32float", "rgba16float"][..]),
         (
-            "csm_z",
+            "csm",
             "rgba32float",
             &["r32float", "rg32float", "rgba16float"][..],
         ),

@@ -100,9 +100,12 @@ fn vsm_graph(
     format: wgpu::TextureFormat,
     filter: Option<Filter>,
 ) -> (Graph, String) {
+    let params = shadowgraph::technique::VsmParams {
+        depth: shadowgraph::technique::LinearizeParams::ORTHOGRAPHIC,
+    };
     encode_graph(
         "vsm",
-        vec![],
+        bytemuck::bytes_of(&params).to_vec(),
         w,
         h,
         format,
@@ -111,7 +114,9 @@ fn vsm_graph(
     )
 }
 
-/// `in` → encoding `kernel` (params) → optional blur in `mode`.
+/// `in` → encoding `kernel` (params) → optional blur in `mode`. With orthographic depth
+/// params (`LinearizeParams::ORTHOGRAPHIC`) the encodings read `in`'s values in [0, 1] as
+/// linear depth unchanged.
 fn encode_graph(
     kernel: &str,
     params: Vec<u8>,
@@ -137,7 +142,11 @@ fn encode_graph(
         name: "light0.vsm".into(),
         kernel: kernel.into(),
         inputs: vec![("src".into(), "in".into())],
-        outputs: vec![("dst".into(), "light0.vsm".into())],
+        // `csm` names its outputs dst0 … dst3.
+        outputs: vec![(
+            if kernel == "csm" { "dst0" } else { "dst" }.into(),
+            "light0.vsm".into(),
+        )],
         params,
         dispatch: shadowgraph::graph::Dispatch::Texels("light0.vsm".into()),
         light: Some(0),
@@ -274,7 +283,8 @@ fn vsm_light_plans_encode_and_two_blur_passes_only() {
         .iter()
         .map(|s| s.node.kernel.as_str())
         .collect();
-    assert_eq!(kernels, ["linearize", "vsm", "blur", "blur"]);
+    // The encoding linearizes the depth itself: no `linearize` dispatch.
+    assert_eq!(kernels, ["vsm", "blur", "blur"]);
     assert_eq!(sp.shade_inputs[0].maps, ["light0.vsm.blur_v"]);
     // The encode's output is dead once blur_h has read it: blur_v (same shape) reuses it.
     let slot = |r: &str| sp.plan.resource(r).unwrap().slot;
@@ -386,7 +396,7 @@ fn channels_of(t: &Texels, n: usize) -> Vec<f32> {
 #[test]
 fn msm_encoding_matches_reference_for_each_storage() {
     use shadowgraph::filter::BlurMode;
-    use shadowgraph::technique::MsmParams;
+    use shadowgraph::technique::{LinearizeParams, MsmParams};
     let g = common::gpu();
     let mut rng = common::rng(43);
     let (w, h) = (1000u32, 37u32);
@@ -432,6 +442,7 @@ fn msm_encoding_matches_reference_for_each_storage() {
         ),
     ] {
         let params = bytemuck::bytes_of(&MsmParams {
+            depth: LinearizeParams::ORTHOGRAPHIC,
             quantized: u32::from(quantized),
             _pad: [0; 3],
         })
@@ -488,10 +499,14 @@ fn csm_basis_matches_reference() {
         (5, wgpu::TextureFormat::Rgba16Float),
         (7, wgpu::TextureFormat::Rg32Float),
     ] {
+        // One map a dispatch here (`tests/fused.rs` writes several): map m holds terms
+        // 2m + 1 and 2m + 2.
         let params = bytemuck::bytes_of(&CsmParams {
-            first_term,
+            depth: shadowgraph::technique::LinearizeParams::ORTHOGRAPHIC,
+            first_map: (first_term - 1) / 2,
+            maps: 1,
             terms,
-            _pad: [0; 2],
+            _pad: 0,
         })
         .to_vec();
         let (graph, out) = encode_graph("csm", params, w, h, format, None, BlurMode::Linear);
@@ -610,7 +625,7 @@ fn mip_chain_matches_reference_and_ends_at_the_mean() {
 #[test]
 fn mip_chain_of_16_bit_maps_matches_reference() {
     use shadowgraph::filter::BlurMode;
-    use shadowgraph::technique::MsmParams;
+    use shadowgraph::technique::{LinearizeParams, MsmParams};
     let g = common::gpu();
     let mut rng = common::rng(46);
     let (w, h) = (200u32, 75u32);
@@ -621,6 +636,7 @@ fn mip_chain_of_16_bit_maps_matches_reference() {
         wgpu::TextureFormat::Rgba32Float,
     ] {
         let params = bytemuck::bytes_of(&MsmParams {
+            depth: LinearizeParams::ORTHOGRAPHIC,
             quantized: 1,
             _pad: [0; 3],
         })
@@ -726,17 +742,15 @@ fn plans_hold_exactly_what_each_light_needs() {
             .collect()
     };
     // PCF reads the linear map: no encoding, no filter; a second PCF light adds only its own.
+    // The encodings read the depth themselves: no `linearize` for them.
     assert_eq!(kernels(0), ["linearize"]);
     assert_eq!(kernels(4), ["linearize"]);
-    assert_eq!(kernels(1), ["linearize", "vsm", "blur", "blur"]);
-    assert_eq!(kernels(2), ["linearize", "msm", "mips"]);
-    // CSM with 3 terms: two basis maps, each encoded and blurred.
+    assert_eq!(kernels(1), ["vsm", "blur", "blur"]);
+    assert_eq!(kernels(2), ["msm", "mips"]);
+    // CSM with 3 terms: two basis maps, written by one dispatch and each blurred.
     let mut csm_kernels = kernels(3);
     csm_kernels.sort();
-    assert_eq!(
-        csm_kernels,
-        ["blur", "blur", "blur", "blur", "csm", "csm", "linearize"]
-    );
+    assert_eq!(csm_kernels, ["blur", "blur", "blur", "blur", "csm"]);
     assert_eq!(sp.shade_inputs[3].maps.len(), 2);
-    assert_eq!(sp.plan.steps.len(), 1 + 4 + 3 + 7 + 1);
+    assert_eq!(sp.plan.steps.len(), 1 + 3 + 2 + 5 + 1);
 }

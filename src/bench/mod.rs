@@ -82,15 +82,15 @@ pub const CASES: &[BenchCase] = &[
     },
     BenchCase {
         name: "vsm",
-        build: |n| stage_graph(n, vsm(), "light0.linear", "light0.vsm"),
+        build: |n| stage_graph(n, vsm(), "light0.depth", "light0.vsm"),
     },
     BenchCase {
         name: "evsm4",
-        build: |n| stage_graph(n, evsm4(), "light0.linear", "light0.evsm"),
+        build: |n| stage_graph(n, evsm4(), "light0.depth", "light0.evsm"),
     },
     BenchCase {
         name: "esm",
-        build: |n| stage_graph(n, esm(), "light0.linear", "light0.esm"),
+        build: |n| stage_graph(n, esm(), "light0.depth", "light0.esm"),
     },
     BenchCase {
         name: "blur rg32f r4",
@@ -106,15 +106,32 @@ pub const CASES: &[BenchCase] = &[
     },
     BenchCase {
         name: "msm",
-        build: |n| stage_graph(n, msm(Storage::F32), "light0.linear", "light0.msm"),
+        build: |n| stage_graph(n, msm(Storage::F32), "light0.depth", "light0.msm"),
     },
     BenchCase {
         name: "msm f16 quantized",
-        build: |n| stage_graph(n, msm(Storage::F16), "light0.linear", "light0.msm"),
+        build: |n| stage_graph(n, msm(Storage::F16), "light0.depth", "light0.msm"),
     },
     BenchCase {
         name: "csm (2 terms)",
-        build: |n| stage_graph(n, csm(), "light0.linear", "light0.csm0"),
+        build: |n| stage_graph(n, csm(), "light0.depth", "light0.csm0"),
+    },
+    // Depth → encoded maps, whatever the dispatches (linearize fused into the encodings, CSM
+    // maps four a dispatch since issue 15): timed against the chains of earlier builds.
+    BenchCase {
+        name: "chain vsm (depth → moments)",
+        build: |n| chain_graph(n, vsm(), &["light0.vsm"]),
+    },
+    BenchCase {
+        name: "chain msm f16 (depth → moments)",
+        build: |n| chain_graph(n, msm(Storage::F16), &["light0.msm"]),
+    },
+    BenchCase {
+        name: "chain csm 8 terms (depth → 4 maps)",
+        build: |n| {
+            let maps = ["light0.csm0", "light0.csm1", "light0.csm2", "light0.csm3"];
+            chain_graph(n, csm_terms(8), &maps)
+        },
     },
     BenchCase {
         name: "mips rgba32f",
@@ -225,6 +242,41 @@ fn esm() -> Technique {
     Technique::Esm {
         filter: blur4(),
         exponent: 80.0,
+    }
+}
+
+/// CSM with `terms` terms.
+fn csm_terms(terms: u32) -> Technique {
+    match csm() {
+        Technique::Csm {
+            prefilter,
+            attenuation,
+            offset,
+            scale,
+            ..
+        } => Technique::Csm {
+            prefilter,
+            terms,
+            attenuation,
+            offset,
+            scale,
+        },
+        other => other,
+    }
+}
+
+/// A light's shipped graph from its rasterized depth to `outputs` (the encoded maps). The
+/// depth is imported as r32float (4 B a texel, as depth32float; the harness writes imports,
+/// which a depth format forbids).
+fn chain_graph(n: u32, technique: Technique, outputs: &[&str]) -> BenchGraph {
+    let mut graph = Graph::default();
+    technique::add_light_nodes(&mut graph, 0, &bench_light(n, technique));
+    for r in graph.resources.iter_mut().filter(|r| r.imported) {
+        r.format = wgpu::TextureFormat::R32Float;
+    }
+    BenchGraph {
+        graph,
+        outputs: outputs.iter().map(|s| s.to_string()).collect(),
     }
 }
 

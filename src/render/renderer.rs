@@ -16,7 +16,7 @@ use crate::scene::{Light, Scene};
 use crate::technique;
 
 use super::targets::{TargetKey, Targets, uniform_group};
-use super::{Frame, RenderOptions, ScenePlan, check_render, plan_lights};
+use super::{Frame, RenderOptions, ScenePlan, check_render, plan_lights_for};
 
 /// Renders scenes; holds pipelines, pooled textures and a frame's resources across frames.
 pub struct Renderer {
@@ -318,7 +318,7 @@ impl Renderer {
         opts: RenderOptions,
     ) -> Result<Frame> {
         check_render(device, scene, &opts)?;
-        let mut sp = plan_lights(&scene.lights)?;
+        let mut sp = plan_lights_for(&scene.lights, &opts)?;
         if opts.dump {
             // Everything is read back after the frame: no resource may share a texture.
             sp.plan = sp.plan.unaliased();

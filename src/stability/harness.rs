@@ -48,7 +48,8 @@ pub(crate) struct Ran {
     pub plan: Plan,
     /// Every planned resource's texture.
     pub outputs: Outputs,
-    /// Texels the kernels replaced (non-finite depth at `linearize`), summed over steps.
+    /// Non-finite depth texels replaced (by `linearize` or an encoding reading the depth): the
+    /// most any one step counted.
     pub replaced: u32,
 }
 
@@ -100,7 +101,14 @@ pub(crate) fn run_graph(
     }
     out.copy_stats(&mut enc);
     submit_and_wait(&gpu.device, &gpu.queue, enc, "stability")?;
-    let replaced = out.read_stats(&gpu.device)?.iter().map(|(_, n)| n).sum();
+    // Every step that reads the depth (linearize, a fused encoding, each basis dispatch)
+    // counts the same texels: the most any one counted is the number replaced.
+    let replaced = out
+        .read_stats(&gpu.device)?
+        .iter()
+        .map(|&(_, n)| n)
+        .max()
+        .unwrap_or(0);
     Ok(Ran {
         plan,
         outputs: out,
@@ -292,7 +300,11 @@ pub(crate) fn run_light(
         bytemuck::cast_slice(raw),
     );
     let imports = HashMap::from([(technique::depth_name(0), depth)]);
-    let outputs: Vec<&str> = input.maps.iter().map(String::as_str).collect();
+    // The linear map too: the stages are judged against it (the encodings linearize the depth
+    // themselves through the same WGSL function).
+    let linear = technique::linear_name(0);
+    let mut outputs: Vec<&str> = input.maps.iter().map(String::as_str).collect();
+    outputs.push(&linear);
     let ran = run_graph(gpu, exec, &graph, &outputs, imports, true, Poison::All)?;
     Ok((ran, input.maps))
 }

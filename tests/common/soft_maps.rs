@@ -13,7 +13,9 @@ const ULP: f64 = 1.0 / 16_777_216.0; // 2⁻²⁴
 
 /// The device's largest error of CSM's `csm_sin_cos` against f64, measured by running the
 /// `csm` kernel (M = 16: every factor the shading can use) over 65 536 depths spread over
-/// [−0.25, 1.25] (receiver depths shifted by bias and offset stay inside). Asserts Vulkan's
+/// [−0.25, 1.25] (receiver depths shifted by bias and offset stay inside). The kernel clamps
+/// the depth it linearizes to [0, 1], so the sweep runs it with its depth read returning the
+/// raw value (the same WGSL otherwise, compiled under the kernel's name). Asserts Vulkan's
 /// bound of 2⁻¹¹ on [−π, π]; returns twice the measured error (the sweep samples the
 /// functions, the factor covers depths between samples) plus 2⁻²⁴.
 pub fn trig_error(g: &Gpu) -> f64 {
@@ -26,32 +28,39 @@ pub fn trig_error(g: &Gpu) -> f64 {
     let mut graph = Graph::default();
     graph.import("in", wgpu::TextureFormat::R32Float, w, h, Some(0));
     let mut outputs = Vec::new();
-    for chunk in 0..terms / 2 {
-        let out = format!("basis{chunk}");
-        graph.resource(
-            &out,
-            wgpu::TextureFormat::Rgba32Float,
-            SizeRule::Reduced {
-                of: "in".into(),
-                shift: 0,
-            },
-            Some(0),
-        );
+    let per = shadowgraph::technique::CSM_OUTPUTS;
+    for group in 0..(terms / 2).div_ceil(per) {
+        let mut slots = Vec::new();
+        for j in 0..per.min(terms / 2 - group * per) {
+            let out = format!("basis{}", group * per + j);
+            graph.resource(
+                &out,
+                wgpu::TextureFormat::Rgba32Float,
+                SizeRule::Reduced {
+                    of: "in".into(),
+                    shift: 0,
+                },
+                Some(0),
+            );
+            slots.push((format!("dst{j}"), out.clone()));
+            outputs.push(out);
+        }
         graph.node(Node {
-            name: out.clone(),
+            name: format!("basis.{group}"),
             kernel: "csm".into(),
             inputs: vec![("src".into(), "in".into())],
-            outputs: vec![("dst".into(), out.clone())],
+            dispatch: Dispatch::Texels(slots[0].1.clone()),
             params: bytemuck::bytes_of(&shadowgraph::technique::CsmParams {
-                first_term: 2 * chunk + 1,
+                depth: shadowgraph::technique::LinearizeParams::ORTHOGRAPHIC,
+                first_map: group * per,
+                maps: slots.len() as u32,
                 terms,
-                _pad: [0; 2],
+                _pad: 0,
             })
             .to_vec(),
-            dispatch: Dispatch::Texels(out.clone()),
+            outputs: slots,
             light: Some(0),
         });
-        outputs.push(out);
     }
     let names: Vec<&str> = outputs.iter().map(String::as_str).collect();
     let p = plan(&graph, &names).expect("plan");
@@ -71,6 +80,12 @@ pub fn trig_error(g: &Gpu) -> f64 {
     });
     shadowgraph::gpu::write_texture(&g.queue, &input, bytemuck::cast_slice(&z));
     let mut exec = shadowgraph::exec::Executor::new();
+    let csm = shadowgraph::kernels::resolve("csm", None).expect("csm");
+    let unclamped = csm.replace("let z = depth.z;", "let z = textureLoad(src, id.xy, 0).r;");
+    assert_ne!(csm, unclamped, "csm's depth read changed");
+    exec.kernels
+        .insert_generated(&g.device, "csm", None, &unclamped)
+        .expect("csm probe");
     let imports = HashMap::from([("in".to_string(), input)]);
     let mut enc = g.device.create_command_encoder(&Default::default());
     let out = exec

@@ -1,0 +1,216 @@
+//! The fused encodings: each reads the rasterized depth and linearizes it itself
+//! (`kernels/shared/linear_depth.wgsl`), and `csm` writes up to four basis maps from one read.
+//! Run through the technique's own graph builder on a perspective (spot) depth buffer with
+//! NaN and ±Inf texels, every map is compared against the f64 pipeline
+//! `cpu::linearize` → the technique's `cpu` encoding, and every step must count each
+//! non-finite texel exactly once.
+
+mod common;
+
+use std::collections::HashMap;
+
+use rand::Rng;
+use shadowgraph::cpu::{self, Texels};
+use shadowgraph::exec::Executor;
+use shadowgraph::gpu::{read_float_texture, submit_and_wait, write_texture};
+use shadowgraph::graph::{Graph, plan, texel_bytes};
+use shadowgraph::scene::{Light, Scene};
+use shadowgraph::technique;
+
+const MAP: u32 = 67;
+/// f32's unit roundoff.
+const U: f64 = 1.0 / (1u64 << 24) as f64;
+/// The perspective linearization is five roundings (`src/stability/stages.rs`, case 7).
+const LINEAR_RTOL: f64 = 5.0 * U;
+
+/// A spot light (perspective depth) from `scenes/techniques/cssm.toml` with `shadow` as its
+/// technique keys, on a `MAP`² map.
+fn spot(shadow: &str) -> Light {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/techniques/cssm.toml");
+    let text = std::fs::read_to_string(&path)
+        .expect("cssm.toml")
+        .replace("technique = \"cssm\"\nterms = 8", shadow)
+        .replace("shadow_map = 512", &format!("shadow_map = {MAP}"));
+    let scene = Scene::parse(&path, &text).unwrap_or_else(|e| panic!("{shadow}: {e}"));
+    scene.lights[0].clone()
+}
+
+/// A raw depth buffer: values spread over [0, 1] (perspective depth crowds near 1), with
+/// `bad` NaN and ±Inf texels.
+fn raw_depth(bad: usize) -> Vec<f32> {
+    let mut rng = common::rng(0xF05E);
+    let mut raw: Vec<f32> = (0..MAP * MAP)
+        .map(|_| 1.0 - rng.random_range(0.0f32..1.0).powi(3))
+        .collect();
+    for k in 0..bad {
+        let at = rng.random_range(0..raw.len());
+        raw[at] = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY][k % 3];
+    }
+    raw
+}
+
+/// Runs `light`'s graph on `raw` for `outputs` (each in its own texture, poisoned with NaN
+/// first so unwritten texels show); returns them and each step's non-finite count.
+fn run(light: &Light, raw: &[f32], outputs: &[String]) -> (Vec<Texels>, Vec<(String, u32)>) {
+    let g = common::gpu();
+    let mut graph = Graph::default();
+    technique::add_light_nodes(&mut graph, 0, light);
+    let names: Vec<&str> = outputs.iter().map(String::as_str).collect();
+    let plan = plan(&graph, &names).expect("plan").unaliased();
+    let depth = g.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("test.depth"),
+        size: wgpu::Extent3d {
+            width: MAP,
+            height: MAP,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::R32Float,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    write_texture(&g.queue, &depth, bytemuck::cast_slice(raw));
+    let imports = HashMap::from([(technique::depth_name(0), depth)]);
+    let mut exec = Executor::new();
+    let mut enc = g.device.create_command_encoder(&Default::default());
+    let out = exec
+        .record(&g.device, &mut enc, &plan, &imports, None)
+        .expect("record");
+    for name in outputs {
+        let t = &out.textures[name];
+        let bytes = texel_bytes(t.format()) as usize * (MAP * MAP) as usize;
+        // 0xFF bytes: NaN in every float format.
+        write_texture(&g.queue, t, &vec![0xFF; bytes]);
+    }
+    out.copy_stats(&mut enc);
+    submit_and_wait(&g.device, &g.queue, enc, "fused").expect("submit");
+    let maps = outputs
+        .iter()
+        .map(|name| {
+            let (c, v) =
+                read_float_texture(&g.device, &g.queue, &out.textures[name], 0).expect("read back");
+            Texels::from_f32(MAP as usize, MAP as usize, c, &v)
+        })
+        .collect();
+    (maps, out.read_stats(&g.device).expect("stats"))
+}
+
+/// The f64 linear depth of `raw` for `light`, and the texels it replaces.
+fn linear(light: &Light, raw: &[f32]) -> (Texels, u32) {
+    let (z, replaced) = cpu::linearize::linearize(raw, true, light.near.into(), light.far.into());
+    let t = Texels {
+        width: MAP as usize,
+        height: MAP as usize,
+        channels: 1,
+        data: z,
+    };
+    (t, replaced)
+}
+
+/// Channels `first .. first + n` of every texel.
+fn channels(t: &Texels, first: usize, n: usize) -> Vec<f64> {
+    t.data
+        .chunks(t.channels)
+        .flat_map(|c| c[first..first + n].to_vec())
+        .collect()
+}
+
+/// Every step of the run counted the `want` non-finite texels once.
+fn assert_counted(what: &str, stats: &[(String, u32)], steps: usize, want: u32) {
+    assert!(want > 0, "{what}: the input has no non-finite texel");
+    assert_eq!(stats.len(), steps, "{what}: steps that counted: {stats:?}");
+    for (step, n) in stats {
+        assert_eq!(*n, want, "{what}: {step} counted {n}");
+    }
+}
+
+#[test]
+fn fused_encodings_match_linearize_then_encode() {
+    let raw = raw_depth(12);
+    // (technique keys, encoded map, f64 encoding of the linear map, atol, rtol). The linear
+    // depth carries LINEAR_RTOL; a moment z^k carries k times that plus its own roundings.
+    type Encoding = fn(&Texels) -> Texels;
+    let cases: [(&str, &str, Encoding, f64, f64); 4] = [
+        // VSM's derivative term ¼(dx² + dy²) of differences of two linear depths: ≤ ½·2·(2·5u)
+        // absolute for |dx| ≤ 1.
+        (
+            "technique = \"vsm\"\nformat = \"f32\"",
+            "light0.vsm",
+            cpu::vsm::vsm,
+            10.0 * U,
+            2.0 * LINEAR_RTOL + 3.0 * U,
+        ),
+        (
+            "technique = \"msm\"\nformat = \"f32\"",
+            "light0.msm",
+            |t| cpu::msm::msm(t, false),
+            0.0,
+            4.0 * LINEAR_RTOL + 4.0 * U,
+        ),
+        // exp(c (2z − 1)) with c = 5: the argument's error c·2·5u·z, then SPIR-V's exp
+        // (3 + 2|x|) ULP; the square doubles both.
+        (
+            "technique = \"evsm4\"\nformat = \"f32\"\nexponent_pos = 5.0\nexponent_neg = 5.0",
+            "light0.evsm",
+            |t| cpu::evsm::evsm(t, 5.0, 5.0),
+            0.0,
+            2.0 * (10.0 * LINEAR_RTOL + 13.0 * U),
+        ),
+        (
+            "technique = \"esm\"\nexponent = 80.0",
+            "light0.esm",
+            |t| cpu::esm::esm(t, 80.0),
+            0.0,
+            LINEAR_RTOL + U,
+        ),
+    ];
+    for (shadow, map, encode, atol, rtol) in cases {
+        let light = spot(shadow);
+        let (maps, stats) = run(&light, &raw, &[map.to_string()]);
+        let (lin, replaced) = linear(&light, &raw);
+        let want = encode(&lin);
+        let got = &maps[0];
+        let n = want.channels;
+        let got: Vec<f32> = channels(got, 0, n).iter().map(|&v| v as f32).collect();
+        common::assert_close(map, &got, &want.data, atol, rtol);
+        assert_counted(map, &stats, 1, replaced);
+    }
+}
+
+#[test]
+fn csm_writes_basis_and_csm_z_maps_from_one_read() {
+    let raw = raw_depth(9);
+    let terms = 7;
+    let light = spot(&format!("technique = \"cssm\"\nterms = {terms}"));
+    let basis = technique::csm_maps(terms) as usize;
+    let z_maps = technique::csm_z_maps(terms) as usize;
+    let names: Vec<String> = (0..basis)
+        .map(|k| format!("light0.csm{k}"))
+        .chain((0..z_maps).map(|k| format!("light0.csm_z{k}")))
+        .collect();
+    let (maps, stats) = run(&light, &raw, &names);
+    let (lin, replaced) = linear(&light, &raw);
+    let (sin_cos, z_seq) = (cpu::csm::csm(&lin, terms), cpu::csm_z::csm_z(&lin, terms));
+    // Vulkan's sin/cos: 2⁻¹¹ absolute on [−π, π]; the linear depth's error moves the argument
+    // by c_M·5u (c_M = 13π), and the CSM-Z product adds a rounding.
+    let atol = 2f64.powi(-11) + 13.0 * std::f64::consts::PI * LINEAR_RTOL + U;
+    for (k, (name, got)) in names.iter().zip(&maps).enumerate() {
+        let (reference, first) = match k.checked_sub(basis) {
+            None => (&sin_cos, 4 * k),
+            Some(z) => (&z_seq, 4 * z),
+        };
+        let n = got.channels.min(reference.channels - first);
+        let got32: Vec<f32> = channels(got, 0, n).iter().map(|&v| v as f32).collect();
+        common::assert_close(name, &got32, &channels(reference, first, n), atol, 0.0);
+        // Channels past the sequence are zeros.
+        assert!(
+            channels(got, n, got.channels - n).iter().all(|&v| v == 0.0),
+            "{name}: padding channels are not zero"
+        );
+    }
+    // 4 basis + 4 CSM-Z maps: two dispatches of four outputs, one of the last map.
+    assert_eq!((basis, z_maps), (4, 4));
+    assert_counted("csm", &stats, 2, replaced);
+}
