@@ -1,4 +1,4 @@
-//! The moment-bias sweep behind MSM's default biases (README, "MSM moment bias"): every MSM
+//! The moment-bias sweep behind MSM's default biases (docs/STABILITY.md, "MSM moment bias"): every MSM
 //! technique and storage through the real kernels at each bias, against MSM in exact
 //! arithmetic on exact moments (`shadowgraph::stability::msm_bias_sweep`). Prints a Markdown
 //! table. About 6 s on a software GPU (lavapipe, 2 cores).

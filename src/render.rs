@@ -177,7 +177,7 @@ pub fn check_render(device: &wgpu::Device, scene: &Scene, opts: &RenderOptions) 
 
 /// Most frames a command's `--repeat` may ask for. Timings keep one row per frame, and on lavapipe (Mesa
 /// 22.3.6) every dispatch of the shading kernel keeps about 235 KB that the driver does not
-/// return (traced in the README), so 1000 frames bound that to about 240 MB.
+/// return (traced in docs/SCENES.md), so 1000 frames bound that to about 240 MB.
 pub const MAX_REPEAT: u32 = 1000;
 
 /// Most frames one [`Renderer::render`] call may run: [`MAX_REPEAT`] timed frames and as many

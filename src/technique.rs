@@ -704,7 +704,7 @@ pub fn mip_levels(width: u32, height: u32) -> u32 {
 /// whatever the storage. A table rounds each moment on its own to the coding's step (10⁻⁵ of
 /// the range for the default soft search cap on a 1024² map); in the raw basis that noise
 /// lands in the Hankel matrix's near-null directions, in the quantized basis it does not
-/// (README, "MSM moment bias": a 10× smaller error behind a flat occluder at the same bias).
+/// (docs/STABILITY.md, "MSM moment bias": a 10× smaller error behind a flat occluder at the same bias).
 /// Other f32 maps keep the raw powers.
 pub fn msm_quantized(technique: &Technique) -> bool {
     match technique {

@@ -17,7 +17,7 @@ pub const DEFAULT_SHARPEN_FALLOFF: f32 = 10.0;
 pub const DEFAULT_MAX_SEARCH: f32 = 0.1;
 
 /// Default MSM moment bias α per storage, from the measured sweep of bias against error
-/// (README, "MSM moment bias"; `cargo run --release --example msm_bias_sweep`): the smallest
+/// (docs/STABILITY.md, "MSM moment bias"; `cargo run --release --example msm_bias_sweep`): the smallest
 /// bias of the sweep whose largest error behind a flat occluder is at most half the stability
 /// suite's bound (case 8: 0.01 for f32, 0.03 for unorm16, 0.25 for f16 moments, whose 11-bit
 /// significand leaves them 2⁻¹² of their range). Against the area-light truth they cost f32

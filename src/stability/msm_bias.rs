@@ -1,4 +1,4 @@
-//! The moment-bias sweep behind MSM's defaults (README, "MSM moment bias";
+//! The moment-bias sweep behind MSM's defaults (docs/STABILITY.md, "MSM moment bias";
 //! `cargo run --release --example msm_bias_sweep`). A larger bias α keeps the Hankel matrix
 //! further from singular, so the f32 arithmetic and the storage's rounding matter less, but it
 //! lights the region just behind every occluder (the exact shadow behind a flat occluder takes

@@ -13,7 +13,7 @@
 //! fixed-point tables (the step of a table coded for 205-texel squares, 10⁻⁵ of the range,
 //! rounds each quantized moment once more), 0.25 for f16 (2⁻¹² of the range: no bias up to
 //! 10⁻² brings it under 0.03 without lighting the first 0.09 of depth behind every occluder). The defaults are the
-//! smallest biases of the measured sweep (`stability::msm_bias`, README "MSM moment bias")
+//! smallest biases of the measured sweep (`stability::msm_bias`, docs/STABILITY.md "MSM moment bias")
 //! whose error there is at most half these bounds. Reported beside: how far behind the
 //! occluder the exact shadow takes to reach 90% at that bias (what the bias costs at contact).
 
