@@ -1,5 +1,5 @@
 //! Scenes: the model (lights, techniques, filters, storages and their defaults), and with the
-//! `cli` feature the validated [`Scene`], loaded from TOML (see `format`) with errors that name
+//! `cli` feature the validated `Scene`, loaded from TOML (see `format`) with errors that name
 //! the file, the key and the line.
 
 #[cfg(feature = "cli")]
