@@ -700,12 +700,9 @@ impl Executor {
         let mut bound = Vec::new();
         for (k, &(first, count)) in dispatches.iter().enumerate() {
             let bg = mip.bind_group(device, &kernel, &params, k as u64 * align, first, count)?;
-            let tile = crate::filter::MIP_TILE / 2;
-            let next = [
-                (mip.dst.width() >> (first + 1)).max(1),
-                (mip.dst.height() >> (first + 1)).max(1),
-            ];
-            bound.push((bg, [next[0].div_ceil(tile), next[1].div_ceil(tile), 1]));
+            let groups =
+                crate::filter::mip_dispatch_groups(mip.dst.width(), mip.dst.height(), first);
+            bound.push((bg, groups));
         }
         Ok(PreparedStep {
             kernel,

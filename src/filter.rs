@@ -193,6 +193,15 @@ pub fn mip_dispatches(width: u32, height: u32) -> Vec<(u32, u32)> {
     out
 }
 
+/// Workgroups of the mip-chain dispatch that reads level `first` of a `width × height` chain:
+/// one per `MIP_TILE / 2` texels of level `first + 1` each way (a workgroup owns a 32 × 32 tile
+/// of it; a 1×1 level stays 1×1). The executor, the cost model and the limit check all use it.
+pub fn mip_dispatch_groups(width: u32, height: u32, first: u32) -> [u32; 3] {
+    let tile = MIP_TILE / 2;
+    let side = |n: u32| (n >> (first + 1)).max(1).div_ceil(tile);
+    [side(width), side(height), 1]
+}
+
 /// Adds the mip-chain node over `input`: `<input>.mips`, `input` at level 0 and area-weighted
 /// reductions below it, down to 1×1, in the dispatches of [`mip_dispatches`].
 fn add_mips(

@@ -244,12 +244,7 @@ pub fn dispatch_groups(plan: &Plan, node: &Node, wg: [u32; 3]) -> [u32; 3] {
             .first()
             .and_then(|(_, r)| size(r))
             .unwrap_or((1, 1));
-        let tile = crate::filter::MIP_TILE / 2;
-        return [
-            (w / 2).max(1).div_ceil(tile),
-            (h / 2).max(1).div_ceil(tile),
-            1,
-        ];
+        return crate::filter::mip_dispatch_groups(w, h, 0);
     }
     node.dispatch.groups(size, wg).unwrap_or([1, 1, 1])
 }

@@ -84,8 +84,9 @@ pub enum Dispatch {
         /// Lines per workgroup (the kernel's workgroup size).
         per_group: u32,
     },
-    /// A mip-chain node: the executor records one dispatch per two levels of the output
-    /// (its `dst` resource), each reading the level before (the `src` input for the first).
+    /// A mip-chain node: the executor records the dispatches of
+    /// [`crate::filter::mip_dispatches`] over the output (its `dst` resource), up to six levels
+    /// each, each reading the last level written (the `src` input for the first).
     MipChain,
 }
 

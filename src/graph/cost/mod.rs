@@ -224,7 +224,6 @@ fn dispatches(
     };
     let (src, dst) = (slot(&node.inputs, "src")?, slot(&node.outputs, "dst")?);
     let base = bound(&dst, 0)?;
-    let tile = crate::filter::MIP_TILE / 2;
     mip_dispatches(base.width, base.height)
         .into_iter()
         .map(|(first, count)| {
@@ -239,9 +238,8 @@ fn dispatches(
                 let level = (j <= count).then(|| bound(&dst, first + j)).transpose()?;
                 map.insert(format!("dst{j}"), level);
             }
-            let next = bound(&dst, (first + 1).min(first + count))?;
             Ok(Dispatched {
-                groups: [next.width.div_ceil(tile), next.height.div_ceil(tile), 1],
+                groups: crate::filter::mip_dispatch_groups(base.width, base.height, first),
                 bound: map,
             })
         })
