@@ -32,20 +32,30 @@ impl Gpu {
     /// Honours wgpu's environment overrides: `WGPU_BACKEND`, `WGPU_ADAPTER_NAME` (a substring of
     /// the adapter name), `WGPU_POWER_PREF`.
     pub fn new() -> Result<Self> {
-        pollster::block_on(Self::new_async())
+        pollster::block_on(Self::new_async(|_| {}))
     }
 
-    async fn new_async() -> Result<Self> {
+    /// As [`Gpu::new`], with the adapter's limits changed by `adjust` before the device is
+    /// requested: a host mirrors a smaller device it targets, and tests pin a limit to
+    /// WebGPU's default so that they refuse the same scenes on every adapter. Limits above the
+    /// adapter's fail with [`Error::RequestDevice`].
+    pub fn with_limits(adjust: impl FnOnce(&mut wgpu::Limits)) -> Result<Self> {
+        pollster::block_on(Self::new_async(adjust))
+    }
+
+    async fn new_async(adjust: impl FnOnce(&mut wgpu::Limits)) -> Result<Self> {
         let instance =
             wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let adapter = pick_adapter(&instance).await?;
         let info = adapter.get_info();
         let features = adapter.features() & WANTED_FEATURES;
+        let mut limits = adapter.limits();
+        adjust(&mut limits);
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("shadowgraph"),
                 required_features: features,
-                required_limits: adapter.limits(),
+                required_limits: limits,
                 ..Default::default()
             })
             .await
