@@ -1,6 +1,7 @@
 // One pass of a separable blur (Gaussian, or box with fractional edge weights) over every
 // channel of any float representation: the weighted sum of each texel's 2r + 1 neighbours
-// along the pass's axis, PER outputs an invocation (shared/blur_pass), each summed as the
+// along the pass's axis, PER outputs an invocation (shared/blur_pass; a row's interleaved
+// WG_SIZE apart so that neighbouring invocations touch neighbouring texels), each summed as the
 // centre and then the symmetric pairs, w₀·v₀ + Σ wᵢ·(v₋ᵢ + vᵢ), straight from the texture.
 // (Reading each texel once into PER running sums instead was 2.2 times faster on llvmpipe at
 // r = 4, but its different f32 rounding of the sums moved MSM moments onto points where the
@@ -14,15 +15,16 @@
 
 @compute @workgroup_size(WG_SIZE)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    let b = blur_line(wg.xy, li);
+    let b = blur_line(wg.xy, li, true);
     if !blur_active(b) {
         return;
     }
     for (var k = 0; k < i32(PER); k++) {
-        var s = weight(0, b.r) * tap(b, k);
+        let o = out_offset(b, k);
+        var s = weight(0, b.r) * tap(b, o);
         for (var i = 1; i <= b.r; i++) {
-            s += weight(i, b.r) * (tap(b, k - i) + tap(b, k + i));
+            s += weight(i, b.r) * (tap(b, o - i) + tap(b, o + i));
         }
-        put(b, k, s);
+        put(b, o, s);
     }
 }

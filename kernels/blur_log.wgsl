@@ -35,7 +35,7 @@ fn put_x(b: BlurLine, k: i32, v: f32) {
 
 @compute @workgroup_size(WG_SIZE)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    let b = blur_line(wg.xy, li);
+    let b = blur_line(wg.xy, li, false);
     if !blur_active(b) {
         return;
     }

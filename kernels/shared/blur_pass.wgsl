@@ -26,34 +26,51 @@ const PER: u32 = 8u;
 const WG_SIZE: u32 = 64u;
 const MAX_RADIUS: u32 = 32u;
 
-// The texels an invocation writes: `first` … `first + PER − 1` along line `line` of a map
-// `along` texels long and `across` lines wide; `r` taps each side.
+// The texels an invocation writes: `first + k · stride` for k = 0 … PER − 1 along line `line`
+// of a map `along` texels long and `across` lines wide; `r` taps each side. Offsets passed to
+// `tap` and `put` are relative to `first`.
 struct BlurLine {
     first: i32,
+    stride: i32,
     line: u32,
     along: i32,
     across: u32,
     r: i32,
 }
 
-// Rows: workgroup (x, y) covers texels [x·WG_SIZE·PER, …) of row y. Columns: workgroup (x, y)
-// covers columns x·WG_SIZE + li, rows [y·PER, (y + 1)·PER).
-fn blur_line(wg: vec2<u32>, li: u32) -> BlurLine {
+// Rows: workgroup (x, y) covers texels [x·WG_SIZE·PER, (x + 1)·WG_SIZE·PER) of row y; with
+// `interleave` invocation li writes texels li, li + WG_SIZE, …, so at each step neighbouring
+// invocations load and store neighbouring texels (coalesced on a GPU), else the PER
+// consecutive texels from li·PER (for kernels that slide one window along them). Columns:
+// workgroup (x, y) covers columns x·WG_SIZE + li, rows [y·PER, (y + 1)·PER): neighbouring
+// invocations are neighbouring columns either way.
+fn blur_line(wg: vec2<u32>, li: u32, interleave: bool) -> BlurLine {
     let size = textureDimensions(src);
     var b: BlurLine;
     b.r = i32(min(params.radius, MAX_RADIUS));
+    b.stride = 1;
     if params.axis == 1u {
         b.first = i32(wg.y * PER);
         b.line = wg.x * WG_SIZE + li;
         b.along = i32(size.y);
         b.across = size.x;
     } else {
-        b.first = i32((wg.x * WG_SIZE + li) * PER);
+        if interleave {
+            b.first = i32(wg.x * WG_SIZE * PER + li);
+            b.stride = i32(WG_SIZE);
+        } else {
+            b.first = i32((wg.x * WG_SIZE + li) * PER);
+        }
         b.line = wg.y;
         b.along = i32(size.x);
         b.across = size.y;
     }
     return b;
+}
+
+// The offset (from `first`) of output k.
+fn out_offset(b: BlurLine, k: i32) -> i32 {
+    return k * b.stride;
 }
 
 // Whether the invocation has any texel to write.
