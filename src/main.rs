@@ -76,6 +76,10 @@ enum Command {
         /// are compared on `scenes/techniques/cssm.toml`.
         #[arg(long, value_delimiter = ',', default_value = "0.25,0.5,1,2")]
         light_sizes: Vec<f32>,
+        /// With `--lookup`: shade at this image size, WIDTHxHEIGHT (default: the scenes' own,
+        /// 400x300 and 200x150, small for a CPU driver; a GPU wants 1920x1080).
+        #[arg(long, value_parser = parse_size)]
+        image: Option<(u32, u32)>,
     },
     /// Sweep techniques and their accuracy knobs, time each on the GPU and measure its error
     /// against ground truth: report.html/.md/.csv/.json, pareto{,_penumbra,_flip}.svg, grid.png
@@ -215,11 +219,12 @@ fn run(args: Args) -> Result<()> {
             repeat,
             lookup,
             light_sizes,
+            image,
         } => {
             let gpu = Gpu::new()?;
             match lookup {
                 Some(widths) => {
-                    let rows = shadowgraph::bench::lookup_cost(&gpu, &widths, repeat)?;
+                    let rows = shadowgraph::bench::lookup_cost(&gpu, &widths, repeat, image)?;
                     let cpu = gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu;
                     print!(
                         "{}",
@@ -230,7 +235,7 @@ fn run(args: Args) -> Result<()> {
                             &rows
                         )
                     );
-                    let soft = shadowgraph::bench::soft_cost(&gpu, &light_sizes, repeat)?;
+                    let soft = shadowgraph::bench::soft_cost(&gpu, &light_sizes, repeat, image)?;
                     print!(
                         "\n{}",
                         shadowgraph::bench::format_soft_table(

@@ -91,7 +91,7 @@ fn bad_scene_path_is_an_error_naming_the_file() {
 #[test]
 fn lookup_benchmark_reports_every_width() {
     let g = common::gpu();
-    let rows = shadowgraph::bench::lookup_cost(&g, &[3, 9], 1).expect("lookup bench");
+    let rows = shadowgraph::bench::lookup_cost(&g, &[3, 9], 1, None).expect("lookup bench");
     assert_eq!(rows.iter().map(|r| r.width).collect::<Vec<_>>(), vec![3, 9]);
     for r in &rows {
         for v in [r.pcf_ms, r.sat_fixed_ms, r.sat_float_ms] {
@@ -103,8 +103,14 @@ fn lookup_benchmark_reports_every_width() {
         table.contains("   3²") && table.contains("   9²"),
         "{table}"
     );
+    assert!(rows.iter().all(|r| r.image == (400, 300)), "{rows:?}");
+    // `--image` shades at the size asked for, and the table says so.
+    let small = shadowgraph::bench::lookup_cost(&g, &[3], 1, Some((64, 48))).expect("at 64x48");
+    assert_eq!(small[0].image, (64, 48));
+    let table = shadowgraph::bench::format_lookup_table("test", true, 1, &small);
+    assert!(table.contains("(64×48, 512² map)"), "{table}");
     for bad in [4, 0, 67] {
-        let e = shadowgraph::bench::lookup_cost(&g, &[bad], 1).expect_err("bad width");
+        let e = shadowgraph::bench::lookup_cost(&g, &[bad], 1, None).expect_err("bad width");
         assert!(e.to_string().contains(&format!("width {bad}")), "{e}");
     }
 }

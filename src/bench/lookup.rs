@@ -30,6 +30,8 @@ pub struct LookupRow {
     pub sat_float_ms: f64,
     /// Building the fixed-point table (its passes), ms.
     pub sat_build_ms: f64,
+    /// The image it was shaded at, width × height.
+    pub image: (u32, u32),
 }
 
 /// The shading pass's cost as the filter widens: for each width in `widths`, the median over
@@ -37,7 +39,15 @@ pub struct LookupRow {
 /// with a PCF box of that width and with VSM read through summed-area tables of that box.
 /// PCF's taps grow with the square of the width; the table's lookups stay at four per channel
 /// (sixteen with sub-texel edges) whatever the width.
-pub fn lookup_cost(gpu: &Gpu, widths: &[u32], repeat: u32) -> Result<Vec<LookupRow>> {
+///
+/// `image` shades at that size instead of the scene's 400×300 (a GPU's shading pass at that
+/// size is close to its launch floor).
+pub fn lookup_cost(
+    gpu: &Gpu,
+    widths: &[u32],
+    repeat: u32,
+    image: Option<(u32, u32)>,
+) -> Result<Vec<LookupRow>> {
     if widths.is_empty() || repeat == 0 {
         return Err(Error::Invalid(
             "lookup benchmark needs widths and repeat ≥ 1".into(),
@@ -55,7 +65,10 @@ pub fn lookup_cost(gpu: &Gpu, widths: &[u32], repeat: u32) -> Result<Vec<LookupR
                 .to_string(),
         ));
     }
-    let base = crate::scene::Scene::parse(std::path::Path::new("vsm.toml"), LOOKUP_SCENE)?;
+    let mut base = crate::scene::Scene::parse(std::path::Path::new("vsm.toml"), LOOKUP_SCENE)?;
+    if let Some((w, h)) = image {
+        (base.width, base.height) = (w, h);
+    }
     let mut renderer = crate::render::Renderer::new(&gpu.device);
     let mut shade = |technique: Technique| -> Result<(f64, f64)> {
         let mut scene = base.clone();
@@ -110,6 +123,7 @@ pub fn lookup_cost(gpu: &Gpu, widths: &[u32], repeat: u32) -> Result<Vec<LookupR
             sat_fixed_ms,
             sat_float_ms,
             sat_build_ms,
+            image: (base.width, base.height),
         });
     }
     Ok(rows)
@@ -119,10 +133,11 @@ pub fn lookup_cost(gpu: &Gpu, widths: &[u32], repeat: u32) -> Result<Vec<LookupR
 /// (on a CPU adapter only those ratios mean anything).
 pub fn format_lookup_table(device: &str, cpu: bool, repeat: u32, rows: &[LookupRow]) -> String {
     let mut s = String::new();
+    let (w, h) = rows.first().map_or((0, 0), |r| r.image);
     let _ = writeln!(s, "shading-pass lookup cost on {device}");
     let _ = writeln!(
         s,
-        "scenes/techniques/vsm.toml (400×300, 512² map); GPU timestamps of the shade pass, median \
+        "scenes/techniques/vsm.toml ({w}×{h}, 512² map); GPU timestamps of the shade pass, median \
          of {repeat} frame(s) after {WARMUP} warm-up frame(s); (×) = over the first width's time."
     );
     if cpu {

@@ -48,6 +48,8 @@ pub struct SoftRow {
     pub fetches: f64,
     /// Per light size (in the order asked for), the shading pass's median GPU time, ms.
     pub shade_ms: Vec<f64>,
+    /// The image it was shaded at, width × height.
+    pub image: (u32, u32),
 }
 
 /// The technique scene with `shadow` as its light's `[light.shadow]` table.
@@ -79,7 +81,14 @@ fn shading_fetches(scene: &Scene) -> Result<f64> {
 /// `sizes`: the median over `repeat` frames (after [`WARMUP`] untimed ones) of the `shade`
 /// pass, frames interleaved across configurations (one frame of each in turn), so that a
 /// change of load on a shared machine reaches every configuration alike.
-pub fn soft_cost(gpu: &Gpu, sizes: &[f32], repeat: u32) -> Result<Vec<SoftRow>> {
+///
+/// `image` shades at that size instead of the scene's 200×150.
+pub fn soft_cost(
+    gpu: &Gpu,
+    sizes: &[f32],
+    repeat: u32,
+    image: Option<(u32, u32)>,
+) -> Result<Vec<SoftRow>> {
     if sizes.is_empty() || repeat == 0 {
         return Err(Error::Invalid(
             "soft benchmark needs light sizes and repeat ≥ 1".into(),
@@ -99,7 +108,10 @@ pub fn soft_cost(gpu: &Gpu, sizes: &[f32], repeat: u32) -> Result<Vec<SoftRow>> 
     }
     let mut scenes = Vec::new();
     for (_, shadow) in SOFT_TECHNIQUES {
-        let base = scene_with(shadow)?;
+        let mut base = scene_with(shadow)?;
+        if let Some((w, h)) = image {
+            (base.width, base.height) = (w, h);
+        }
         for &size in sizes {
             let mut scene = base.clone();
             scene.lights[0].size = size;
@@ -136,6 +148,7 @@ pub fn soft_cost(gpu: &Gpu, sizes: &[f32], repeat: u32) -> Result<Vec<SoftRow>> 
                 .iter_mut()
                 .map(|t| median(t))
                 .collect(),
+            image: (scenes[at].width, scenes[at].height),
         });
     }
     Ok(rows)
@@ -152,10 +165,11 @@ pub fn format_soft_table(
     rows: &[SoftRow],
 ) -> String {
     let mut s = String::new();
+    let (w, h) = rows.first().map_or((0, 0), |r| r.image);
     let _ = writeln!(s, "soft-shadow shading cost on {device}");
     let _ = writeln!(
         s,
-        "scenes/techniques/cssm.toml (200×150, 512² spot map), the light's size swept (wider \
+        "scenes/techniques/cssm.toml ({w}×{h}, 512² spot map), the light's size swept (wider \
          penumbrae); GPU timestamps of the shade pass, median of {repeat} frame(s) after \
          {WARMUP} warm-up frame(s), frames interleaved; (×) = over PCSS 16+32 at the same size."
     );
