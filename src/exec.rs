@@ -125,6 +125,7 @@ impl KernelCache {
                 } = b.ty
                 {
                     if declared != *format {
+                        same_kind(name, binding, declared, *format)?;
                         changes.push((
                             binding.as_str(),
                             wgsl_storage_format(declared)?,
@@ -246,6 +247,31 @@ fn no_layout(kernel: &str) -> Error {
         kernel: kernel.to_string(),
         message: "the kernel declares no bind group".into(),
     }
+}
+
+/// Refuses to re-declare storage texture `binding` of kernel `name` as a format of another
+/// texel kind (float and integer texels are not interchangeable in the kernel's arithmetic).
+fn same_kind(
+    name: &str,
+    binding: &str,
+    declared: wgpu::TextureFormat,
+    bound: wgpu::TextureFormat,
+) -> Result<()> {
+    let float = |f: wgpu::TextureFormat| {
+        matches!(
+            f.sample_type(None, None),
+            Some(wgpu::TextureSampleType::Float { .. })
+        )
+    };
+    if float(declared) == float(bound) {
+        return Ok(());
+    }
+    Err(Error::Pipeline {
+        kernel: name.to_string(),
+        message: format!(
+            "storage texture `{binding}` is {declared:?}; a {bound:?} texture cannot be bound to it"
+        ),
+    })
 }
 
 /// The WGSL name of a storage texel format.
@@ -401,13 +427,13 @@ impl Executor {
     /// Compiles every kernel `plan` uses (also done lazily by [`Executor::record`]).
     pub fn prepare(&mut self, device: &wgpu::Device, plan: &Plan) -> Result<()> {
         for step in &plan.steps {
-            let base = self.kernels.get(device, &step.node.kernel)?;
+            let base = self.kernels.get(device, step.node.kernel.name())?;
             let formats: Vec<(String, wgpu::TextureFormat)> = bound_outputs(&base, &step.node)
                 .into_iter()
                 .filter_map(|(slot, r)| plan.resource(&r).map(|p| (slot, p.resource.format)))
                 .collect();
             self.kernels
-                .get_specialized(device, &step.node.kernel, &formats)?;
+                .get_specialized(device, step.node.kernel.name(), &formats)?;
         }
         Ok(())
     }
@@ -593,7 +619,7 @@ impl Executor {
             return self.bind_mip_chain(device, node, &outputs.textures);
         }
         let textures = &outputs.textures;
-        let base = self.kernels.get(device, &node.kernel)?;
+        let base = self.kernels.get(device, node.kernel.name())?;
         let node_outputs = bound_outputs(&base, node);
         let formats: Vec<(String, wgpu::TextureFormat)> = node_outputs
             .iter()
@@ -601,7 +627,7 @@ impl Executor {
             .collect();
         let kernel = self
             .kernels
-            .get_specialized(device, &node.kernel, &formats)?;
+            .get_specialized(device, node.kernel.name(), &formats)?;
         let mut views: Vec<(u32, wgpu::TextureView)> = Vec::new();
         for b in kernel.reflection.bindings.iter().filter(|b| b.group == 0) {
             let bound = node
@@ -613,7 +639,7 @@ impl Executor {
                 views.push((b.binding, aspect_view(&textures[res])));
             } else if b.name != "params" && b.name != "stats" {
                 return Err(Error::Pipeline {
-                    kernel: node.kernel.clone(),
+                    kernel: node.kernel.to_string(),
                     message: format!("node `{}` binds nothing to `{}`", node.name, b.name),
                 });
             }
@@ -658,7 +684,7 @@ impl Executor {
                 )
             },
             |message| Error::Pipeline {
-                kernel: node.kernel.clone(),
+                kernel: node.kernel.to_string(),
                 message: format!("binding node `{}`: {message}", node.name),
             },
         )?;
@@ -693,7 +719,7 @@ impl Executor {
             .collect();
         let kernel = self
             .kernels
-            .get_specialized(device, &node.kernel, &formats)?;
+            .get_specialized(device, node.kernel.name(), &formats)?;
         let dispatches = mip_dispatches(mip.dst.width(), mip.dst.height());
         let align = u64::from(device.limits().min_uniform_buffer_offset_alignment).max(32);
         let params = mip.params_buffer(device, &dispatches, align)?;
@@ -866,7 +892,7 @@ impl<'a> MipNode<'a> {
 
     fn error(node: &crate::graph::Node, message: String) -> Error {
         Error::Pipeline {
-            kernel: node.kernel.clone(),
+            kernel: node.kernel.to_string(),
             message: format!("node `{}`: {message}", node.name),
         }
     }

@@ -1,6 +1,7 @@
 //! Filters that work on any prefiltered representation: the separable blur and the mip chain.
 
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
+use crate::kernels::KernelId;
 use crate::scene::{BlurKernel, Filter};
 
 /// Taps each side the blur kernel's weight table holds.
@@ -109,10 +110,9 @@ pub fn add_filter(
         graph.node(Node {
             name: format!("{input}.{pass}"),
             kernel: match mode {
-                BlurMode::Linear => "blur",
-                BlurMode::LogSumExp => "blur_log",
-            }
-            .into(),
+                BlurMode::Linear => KernelId::Blur,
+                BlurMode::LogSumExp => KernelId::BlurLog,
+            },
             inputs: vec![("src".into(), src)],
             outputs: vec![("dst".into(), out.clone())],
             params: bytemuck::bytes_of(&BlurParams::new(axis, radius, sigma, kernel, mode))
@@ -227,10 +227,9 @@ fn add_mips(
     graph.node(Node {
         name: format!("{input}.mips"),
         kernel: match mode {
-            BlurMode::Linear => "mips",
-            BlurMode::LogSumExp => "mips_log",
-        }
-        .into(),
+            BlurMode::Linear => KernelId::Mips,
+            BlurMode::LogSumExp => KernelId::MipsLog,
+        },
         inputs: vec![("src".into(), input.to_string())],
         outputs: vec![("dst".into(), out.clone())],
         params: bytemuck::bytes_of(&params).to_vec(),

@@ -123,8 +123,9 @@ impl Dispatch {
 pub struct Node {
     /// Unique label, e.g. `light0.linearize`; pipelines and passes are labelled with it.
     pub name: String,
-    /// Kernel name: `kernels/<kernel>.wgsl`.
-    pub kernel: String,
+    /// The kernel, `kernels/<name>.wgsl`: an id generated from the folder, so a typo does not
+    /// compile.
+    pub kernel: crate::kernels::KernelId,
     /// `(binding name in the WGSL, resource name)` read by the kernel.
     pub inputs: Vec<(String, String)>,
     /// `(binding name in the WGSL, resource name)` written by the kernel.

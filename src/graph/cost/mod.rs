@@ -126,14 +126,14 @@ pub fn check_declarations(
 
 /// What `node` of `plan` moves, from its kernel's declarations and the plan's sizes.
 pub fn node_traffic(plan: &Plan, node: &Node) -> Result<Traffic> {
-    let wgsl = kernels::resolve(&node.kernel, None)?;
-    let (module, reflection) = kernels::reflect(&node.kernel, &wgsl)?;
-    let decls = check_declarations(&node.kernel, kernels::source(&node.kernel)?, &reflection)?;
+    let wgsl = kernels::resolve(node.kernel.name(), None)?;
+    let (module, reflection) = kernels::reflect(node.kernel.name(), &wgsl)?;
+    let decls = check_declarations(node.kernel.name(), node.kernel.source(), &reflection)?;
     let wg = reflection.workgroup_size.unwrap_or([1, 1, 1]);
     let consts = declare::constants(&module);
     let params = declare::global_type(&module, "params");
     let err = |message: String| Error::Kernel {
-        kernel: node.kernel.clone(),
+        kernel: node.kernel.to_string(),
         message: format!("node `{}`: {message}", node.name),
     };
     let mut name = |n: &str| -> std::result::Result<f64, String> {
