@@ -1,6 +1,6 @@
 //! Filters that work on any prefiltered representation: the separable blur and the mip chain.
 
-use crate::graph::{Dispatch, Graph, Node, SizeRule};
+use crate::graph::{Dispatch, Graph, LevelView, Node, SizeRule, SubDispatch};
 use crate::kernels::KernelId;
 use crate::scene::{BlurKernel, Filter};
 
@@ -135,8 +135,8 @@ pub fn add_filter(
     src
 }
 
-/// Parameters of `kernels/mips.wgsl` (mirrors its `Params`); the executor fills in each
-/// dispatch's levels ([`mip_dispatches`]), the graph only the mode.
+/// Parameters of `kernels/mips.wgsl` (mirrors its `Params`): one per dispatch of a mip chain
+/// ([`mip_dispatches`]).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct MipParams {
@@ -195,7 +195,7 @@ pub fn mip_dispatches(width: u32, height: u32) -> Vec<(u32, u32)> {
 
 /// Workgroups of the mip-chain dispatch that reads level `first` of a `width × height` chain:
 /// one per `MIP_TILE / 2` texels of level `first + 1` each way (a workgroup owns a 32 × 32 tile
-/// of it; a 1×1 level stays 1×1). The executor, the cost model and the limit check all use it.
+/// of it; a 1×1 level stays 1×1).
 pub fn mip_dispatch_groups(width: u32, height: u32, first: u32) -> [u32; 3] {
     let tile = MIP_TILE / 2;
     let side = |n: u32| (n >> (first + 1)).max(1).div_ceil(tile);
@@ -220,10 +220,11 @@ fn add_mips(
         },
         Some(light),
     );
-    let params = MipParams {
-        mode: u32::from(mode == BlurMode::LogSumExp),
-        ..Default::default()
-    };
+    // An input whose size does not resolve fails the planner (the chain follows its size).
+    let (params, dispatches) = graph
+        .size(input)
+        .map(|(w, h)| mip_chain(w, h, mode))
+        .unwrap_or_default();
     graph.node(Node {
         name: format!("{input}.mips"),
         kernel: match mode {
@@ -232,11 +233,54 @@ fn add_mips(
         },
         inputs: vec![("src".into(), input.to_string())],
         outputs: vec![("dst".into(), out.clone())],
-        params: bytemuck::bytes_of(&params).to_vec(),
-        dispatch: Dispatch::MipChain,
+        params,
+        dispatch: Dispatch::Several(dispatches),
         light: Some(light),
     });
     out
+}
+
+/// The parameters and dispatches of the mip chain of a `width × height` map
+/// ([`mip_dispatches`]): each dispatch reads one level (the `src` slot for the first, which also
+/// stores it as level 0 through `dst0`) and writes the `count` levels after it through `dst1` …;
+/// the kernel's other `dst` bindings repeat the last level written and are not stored to.
+pub fn mip_chain(width: u32, height: u32, mode: BlurMode) -> (Vec<u8>, Vec<SubDispatch>) {
+    let size = std::mem::size_of::<MipParams>();
+    let odd = |n: u32| n > 1 && n % 2 == 1;
+    let level = |binding: String, slot: &str, level: u32| LevelView {
+        binding,
+        slot: slot.into(),
+        level,
+    };
+    let mut bytes = Vec::new();
+    let mut dispatches = Vec::new();
+    for (first, count) in mip_dispatches(width, height) {
+        let p = MipParams {
+            base: [width, height],
+            first,
+            count,
+            mode: u32::from(mode == BlurMode::LogSumExp),
+            copy: u32::from(first == 0),
+            general: u32::from(odd((width >> first).max(1)) || odd((height >> first).max(1))),
+            _pad: 0,
+        };
+        let at = bytes.len();
+        bytes.extend_from_slice(bytemuck::bytes_of(&p));
+        let mut levels = vec![match first {
+            0 => level("src".into(), "src", 0),
+            l => level("src".into(), "dst", l),
+        }];
+        if first == 0 {
+            levels.push(level("dst0".into(), "dst", 0));
+        }
+        levels.extend((1..=count).map(|j| level(format!("dst{j}"), "dst", first + j)));
+        dispatches.push(SubDispatch {
+            params: at..at + size,
+            levels,
+            groups: mip_dispatch_groups(width, height, first),
+        });
+    }
+    (bytes, dispatches)
 }
 
 #[cfg(test)]

@@ -95,7 +95,7 @@ fn malformed_plans_are_typed_errors() {
     let mip = plan
         .steps
         .iter()
-        .position(|st| st.node.dispatch == Dispatch::MipChain)
+        .position(|st| matches!(st.node.dispatch, Dispatch::Several(_)))
         .unwrap();
     let blocks = plan
         .steps

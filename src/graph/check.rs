@@ -4,13 +4,13 @@
 
 use std::collections::HashSet;
 
-use super::{Dispatch, GraphError, Plan};
+use super::{Dispatch, GraphError, Node, Plan, SubDispatch};
 
 impl Plan {
     /// Checks every index and name the executor follows: resource slots in range and matching
     /// their slot's format and size, slots of a size and format it can allocate, unique
     /// resource names, every node's inputs, outputs and dispatch naming planned resources,
-    /// mip-chain nodes with their bindings and parameters, and outputs that exist.
+    /// the several dispatches of a node with their parameters and levels, and outputs that exist.
     pub fn check(&self) -> Result<(), GraphError> {
         let bad = |message: String| Err(GraphError::BadPlan(message));
         for (i, s) in self.slots.iter().enumerate() {
@@ -70,8 +70,8 @@ impl Plan {
                     Some(of)
                 }
                 Dispatch::Groups(_) => None,
-                Dispatch::MipChain => {
-                    self.check_mip_chain(n)?;
+                Dispatch::Several(subs) => {
+                    self.check_several(n, subs)?;
                     None
                 }
             };
@@ -88,21 +88,37 @@ impl Plan {
         Ok(())
     }
 
-    fn check_mip_chain(&self, n: &super::Node) -> Result<(), GraphError> {
-        let has = |list: &[(String, String)], slot: &str| list.iter().any(|(s, _)| s == slot);
-        if !has(&n.inputs, "src") || !has(&n.outputs, "dst") {
-            return Err(GraphError::BadPlan(format!(
-                "mip-chain node `{}` needs a `src` input and a `dst` output",
+    /// Each of a node's several dispatches reads parameter bytes the node has and binds levels
+    /// that exist of resources of the node's slots.
+    fn check_several(&self, n: &Node, subs: &[SubDispatch]) -> Result<(), GraphError> {
+        let bad = |k: usize, message: String| {
+            Err(GraphError::BadPlan(format!(
+                "dispatch {k} of node `{}` {message}",
                 n.name
-            )));
-        }
-        let need = std::mem::size_of::<crate::filter::MipParams>();
-        if n.params.len() < need {
-            return Err(GraphError::BadPlan(format!(
-                "mip-chain node `{}` has {} parameter bytes, {need} needed",
-                n.name,
-                n.params.len()
-            )));
+            )))
+        };
+        for (k, d) in subs.iter().enumerate() {
+            if d.params.start > d.params.end || n.params.get(d.params.clone()).is_none() {
+                return bad(
+                    k,
+                    format!("reads parameter bytes {:?} of {}", d.params, n.params.len()),
+                );
+            }
+            for v in &d.levels {
+                let Some(r) = n.slot_resource(&v.slot) else {
+                    return bad(
+                        k,
+                        format!("binds slot `{}`, which it does not have", v.slot),
+                    );
+                };
+                let mips = self.resource(r).map_or(0, |p| p.resource.mips);
+                if v.level >= mips {
+                    return bad(
+                        k,
+                        format!("binds level {} of `{r}` ({mips} levels)", v.level),
+                    );
+                }
+            }
         }
         Ok(())
     }
