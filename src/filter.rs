@@ -332,4 +332,57 @@ mod tests {
             assert_eq!(next + 1, levels, "{w}x{h}: {d:?}");
         }
     }
+
+    /// The chain as data: each dispatch's parameters are its slice of the node's bytes, it
+    /// reads the last level written and names the levels it writes (4096²: levels 0–6, then
+    /// 6–12; 1000×37: level 1 is 500×18, even, level 2 is 250×9, odd, a fractional step).
+    #[test]
+    fn mip_chain_dispatches_are_data() {
+        let (bytes, d) = mip_chain(4096, 4096, BlurMode::LogSumExp);
+        assert_eq!(d.len(), 2);
+        assert_eq!(bytes.len(), 2 * std::mem::size_of::<MipParams>());
+        let params =
+            |k: usize| -> MipParams { bytemuck::pod_read_unaligned(&bytes[d[k].params.clone()]) };
+        let want = MipParams {
+            base: [4096, 4096],
+            first: 6,
+            count: 6,
+            mode: 1,
+            copy: 0,
+            general: 0,
+            _pad: 0,
+        };
+        assert_eq!(params(1), want);
+        assert_eq!(
+            params(0),
+            MipParams {
+                first: 0,
+                copy: 1,
+                ..want
+            }
+        );
+        let names = |k: usize| -> Vec<(String, String, u32)> {
+            d[k].levels
+                .iter()
+                .map(|v| (v.binding.clone(), v.slot.clone(), v.level))
+                .collect()
+        };
+        let dst = |j: u32, l: u32| (format!("dst{j}"), "dst".to_string(), l);
+        let mut first = vec![("src".to_string(), "src".to_string(), 0), dst(0, 0)];
+        first.extend((1..=6).map(|j| dst(j, j)));
+        assert_eq!(names(0), first);
+        let mut second = vec![("src".to_string(), "dst".to_string(), 6)];
+        second.extend((1..=6).map(|j| dst(j, 6 + j)));
+        assert_eq!(names(1), second);
+        // A workgroup per 32² tile of the level after the one read.
+        assert_eq!(d[0].groups, [64, 64, 1]);
+        assert_eq!(d[1].groups, [1, 1, 1]);
+        let (bytes, d) = mip_chain(1000, 37, BlurMode::Linear);
+        let general: Vec<u32> = d
+            .iter()
+            .map(|d| bytemuck::pod_read_unaligned::<MipParams>(&bytes[d.params.clone()]).general)
+            .collect();
+        assert_eq!(general, [1, 0, 1, 1, 0, 1, 1, 1, 1]);
+        assert_eq!(d[0].groups, [16, 1, 1]);
+    }
 }

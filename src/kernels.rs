@@ -243,7 +243,7 @@ fn binding_type(
     g: &naga::GlobalVariable,
     filterable: bool,
 ) -> std::result::Result<wgpu::BindingType, String> {
-    use naga::{AddressSpace, ImageClass, ScalarKind, TypeInner};
+    use naga::{AddressSpace, TypeInner};
     Ok(match (&module.types[g.ty].inner, g.space) {
         (_, AddressSpace::Uniform) => wgpu::BindingType::Buffer {
             ty: wgpu::BufferBindingType::Uniform,
@@ -269,47 +269,54 @@ fn binding_type(
                 class,
             },
             _,
-        ) => {
-            let view_dimension = match (dim, arrayed) {
-                (naga::ImageDimension::D2, false) => wgpu::TextureViewDimension::D2,
-                (naga::ImageDimension::D2, true) => wgpu::TextureViewDimension::D2Array,
-                other => return Err(format!("unsupported image dimension {other:?}")),
-            };
-            match class {
-                ImageClass::Sampled { kind, multi } => wgpu::BindingType::Texture {
-                    sample_type: match kind {
-                        // Kernels read with textureLoad unless the module has a filtering
-                        // sampler; unfilterable float also admits depth32float views.
-                        ScalarKind::Float => wgpu::TextureSampleType::Float { filterable },
-                        ScalarKind::Uint => wgpu::TextureSampleType::Uint,
-                        ScalarKind::Sint => wgpu::TextureSampleType::Sint,
-                        other => return Err(format!("unsupported sample kind {other:?}")),
-                    },
-                    view_dimension,
-                    multisampled: *multi,
-                },
-                ImageClass::Depth { multi } => wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Depth,
-                    view_dimension,
-                    multisampled: *multi,
-                },
-                ImageClass::Storage { format, access } => wgpu::BindingType::StorageTexture {
-                    access: if access
-                        .contains(naga::StorageAccess::LOAD | naga::StorageAccess::STORE)
-                    {
-                        wgpu::StorageTextureAccess::ReadWrite
-                    } else if access.contains(naga::StorageAccess::STORE) {
-                        wgpu::StorageTextureAccess::WriteOnly
-                    } else {
-                        wgpu::StorageTextureAccess::ReadOnly
-                    },
-                    format: storage_format(*format)?,
-                    view_dimension,
-                },
-                other => return Err(format!("unsupported image class {other:?}")),
-            }
-        }
+        ) => image_type(*dim, *arrayed, class, filterable)?,
         (other, space) => return Err(format!("unsupported binding {other:?} in {space:?}")),
+    })
+}
+
+/// The binding type of a WGSL image of `class`.
+fn image_type(
+    dim: naga::ImageDimension,
+    arrayed: bool,
+    class: &naga::ImageClass,
+    filterable: bool,
+) -> std::result::Result<wgpu::BindingType, String> {
+    use naga::{ImageClass, ScalarKind};
+    let view_dimension = match (dim, arrayed) {
+        (naga::ImageDimension::D2, false) => wgpu::TextureViewDimension::D2,
+        (naga::ImageDimension::D2, true) => wgpu::TextureViewDimension::D2Array,
+        other => return Err(format!("unsupported image dimension {other:?}")),
+    };
+    Ok(match class {
+        ImageClass::Sampled { kind, multi } => wgpu::BindingType::Texture {
+            sample_type: match kind {
+                // Kernels read with textureLoad unless the module has a filtering
+                // sampler; unfilterable float also admits depth32float views.
+                ScalarKind::Float => wgpu::TextureSampleType::Float { filterable },
+                ScalarKind::Uint => wgpu::TextureSampleType::Uint,
+                ScalarKind::Sint => wgpu::TextureSampleType::Sint,
+                other => return Err(format!("unsupported sample kind {other:?}")),
+            },
+            view_dimension,
+            multisampled: *multi,
+        },
+        ImageClass::Depth { multi } => wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Depth,
+            view_dimension,
+            multisampled: *multi,
+        },
+        ImageClass::Storage { format, access } => wgpu::BindingType::StorageTexture {
+            access: if access.contains(naga::StorageAccess::LOAD | naga::StorageAccess::STORE) {
+                wgpu::StorageTextureAccess::ReadWrite
+            } else if access.contains(naga::StorageAccess::STORE) {
+                wgpu::StorageTextureAccess::WriteOnly
+            } else {
+                wgpu::StorageTextureAccess::ReadOnly
+            },
+            format: storage_format(*format)?,
+            view_dimension,
+        },
+        other => return Err(format!("unsupported image class {other:?}")),
     })
 }
 

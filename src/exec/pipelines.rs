@@ -166,8 +166,8 @@ impl KernelCache {
 
     /// The pipeline cached under `key`, compiled from the kernel `name` and the `// #generated`
     /// block `generated()` makes on a miss: a variant looked up by a key its caller derives
-    /// from what the block depends on (the renderer's shading kernel,
-    /// [`crate::technique::shade_key`]) instead of generating and hashing the block's text.
+    /// from what the block depends on (the renderer's shading kernel, keyed by
+    /// `technique::shade_key`) instead of generating and hashing the block's text.
     pub fn get_keyed(
         &mut self,
         device: &wgpu::Device,

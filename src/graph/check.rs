@@ -50,42 +50,47 @@ impl Plan {
         }
         let known = |r: &str| names.contains(r);
         for (i, step) in self.steps.iter().enumerate() {
-            let n = &step.node;
-            if let Some((_, r)) = n.inputs.iter().chain(&n.outputs).find(|(_, r)| !known(r)) {
-                return bad(format!(
-                    "step {i} (`{}`) uses `{r}`, which is not in the plan",
-                    n.name
-                ));
-            }
-            let of = match &n.dispatch {
-                Dispatch::Texels(r) => Some(r),
-                Dispatch::Blocks { of, .. } => Some(of),
-                Dispatch::Lines { of, per_group } => {
-                    if *per_group == 0 {
-                        return bad(format!(
-                            "step {i} (`{}`) dispatches lines with 0 per workgroup",
-                            n.name
-                        ));
-                    }
-                    Some(of)
-                }
-                Dispatch::Groups(_) => None,
-                Dispatch::Several(subs) => {
-                    self.check_several(n, subs)?;
-                    None
-                }
-            };
-            if let Some(r) = of.filter(|r| !known(r)) {
-                return bad(format!(
-                    "step {i} (`{}`) dispatches over `{r}`, which is not in the plan",
-                    n.name
-                ));
-            }
+            self.check_step(i, &step.node, &known)?;
         }
         if let Some(o) = self.outputs.iter().find(|o| !known(o)) {
             return bad(format!("output `{o}` is not in the plan"));
         }
         Ok(())
+    }
+
+    /// Step `i`'s node `n` names only resources that are `known` and dispatches over one.
+    fn check_step(
+        &self,
+        i: usize,
+        n: &Node,
+        known: &dyn Fn(&str) -> bool,
+    ) -> Result<(), GraphError> {
+        let bad = |message: String| {
+            Err(GraphError::BadPlan(format!(
+                "step {i} (`{}`) {message}",
+                n.name
+            )))
+        };
+        if let Some((_, r)) = n.inputs.iter().chain(&n.outputs).find(|(_, r)| !known(r)) {
+            return bad(format!("uses `{r}`, which is not in the plan"));
+        }
+        let of = match &n.dispatch {
+            Dispatch::Texels(r) => Some(r),
+            Dispatch::Blocks { of, .. } => Some(of),
+            Dispatch::Lines { per_group: 0, .. } => {
+                return bad("dispatches lines with 0 per workgroup".into());
+            }
+            Dispatch::Lines { of, .. } => Some(of),
+            Dispatch::Groups(_) => None,
+            Dispatch::Several(subs) => {
+                self.check_several(n, subs)?;
+                None
+            }
+        };
+        match of.filter(|r| !known(r)) {
+            Some(r) => bad(format!("dispatches over `{r}`, which is not in the plan")),
+            None => Ok(()),
+        }
     }
 
     /// Each of a node's several dispatches reads parameter bytes the node has and binds levels
