@@ -1,6 +1,5 @@
 // A mip chain, up to six levels per dispatch; every texel the mean of the texels
-// it covers (shared/mip_chain). The executor records the dispatches of a `Dispatch::MipChain`
-// node.
+// it covers (shared/mip_chain). `filter::mip_chain` gives the dispatches of a mip-chain node.
 // #import shared/mip_chain
 // Traffic (the cost model, src/graph/cost): each dispatch reads the level it reduces once and
 // writes each level it stores once (dst0 in the first dispatch only).

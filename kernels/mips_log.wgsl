@@ -1,6 +1,6 @@
 // A mip chain, up to six levels per dispatch; every texel the log of the mean of exp of the
-// texels it covers (logarithmic representations: ESM's c·z; shared/mip_chain). The executor records the dispatches of a `Dispatch::MipChain`
-// node.
+// texels it covers (logarithmic representations: ESM's c·z; shared/mip_chain).
+// `filter::mip_chain` gives the dispatches of a mip-chain node.
 // #import shared/mip_chain
 // Traffic (the cost model, src/graph/cost): each dispatch reads the level it reduces once and
 // writes each level it stores once (dst0 in the first dispatch only).

@@ -53,6 +53,9 @@ pub enum Error {
     /// The kernel graph is malformed.
     #[error("graph: {0}")]
     Graph(#[from] crate::graph::GraphError),
+    /// The executor cannot run a plan over the textures it was given.
+    #[error("executor: {0}")]
+    Exec(#[from] ExecError),
     /// A scene file could not be read or is invalid.
     #[error("{path}{location}: {message}")]
     Scene {
@@ -123,4 +126,69 @@ pub enum Error {
         /// Encoder message.
         message: String,
     },
+}
+
+/// Why the executor (`exec`) cannot record a plan, beyond the plan's own shape
+/// ([`crate::graph::GraphError::BadPlan`]) and the device's pipeline errors ([`Error::Pipeline`]).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ExecError {
+    /// An imported resource has no texture among the caller's imports.
+    #[error("imported resource `{0}` was not provided")]
+    MissingImport(String),
+    /// A texture is not the size the plan planned for its resource.
+    #[error("`{resource}` is {width}x{height}, the plan expects {plan_width}x{plan_height}")]
+    Size {
+        /// The resource.
+        resource: String,
+        /// The texture's width.
+        width: u32,
+        /// The texture's height.
+        height: u32,
+        /// The planned width.
+        plan_width: u32,
+        /// The planned height.
+        plan_height: u32,
+    },
+    /// A kernel binding that the node leaves unbound.
+    #[error("node `{node}` binds nothing to `{binding}`")]
+    Unbound {
+        /// The node.
+        node: String,
+        /// The binding (or the node slot a dispatch names).
+        binding: String,
+    },
+    /// A node binds a resource the run has no texture for.
+    #[error("node `{node}` binds `{resource}`, which has no texture in this run")]
+    NoTexture {
+        /// The node.
+        node: String,
+        /// The resource.
+        resource: String,
+    },
+    /// A dispatch binds a mip level its texture does not have.
+    #[error("node `{node}` binds mip level {level} of a texture of {levels}")]
+    NoLevel {
+        /// The node.
+        node: String,
+        /// The level asked for.
+        level: u32,
+        /// The texture's levels.
+        levels: u32,
+    },
+    /// A dispatch's parameter bytes are not the node's.
+    #[error("node `{node}`: a dispatch's parameter bytes are out of range")]
+    Params {
+        /// The node.
+        node: String,
+    },
+    /// A node's dispatch counts over a resource that is not in the plan.
+    #[error("node `{node}` dispatches over a resource that is not in the plan")]
+    DispatchOver {
+        /// The node.
+        node: String,
+    },
+    /// [`crate::exec::Outputs::view`] of a resource the plan does not have.
+    #[error("the plan has no resource `{0}`")]
+    NoResource(String),
 }

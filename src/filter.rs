@@ -1,6 +1,7 @@
 //! Filters that work on any prefiltered representation: the separable blur and the mip chain.
 
-use crate::graph::{Dispatch, Graph, Node, SizeRule};
+use crate::graph::{Dispatch, Graph, LevelView, Node, SizeRule, SubDispatch};
+use crate::kernels::KernelId;
 use crate::scene::{BlurKernel, Filter};
 
 /// Taps each side the blur kernel's weight table holds.
@@ -109,10 +110,9 @@ pub fn add_filter(
         graph.node(Node {
             name: format!("{input}.{pass}"),
             kernel: match mode {
-                BlurMode::Linear => "blur",
-                BlurMode::LogSumExp => "blur_log",
-            }
-            .into(),
+                BlurMode::Linear => KernelId::Blur,
+                BlurMode::LogSumExp => KernelId::BlurLog,
+            },
             inputs: vec![("src".into(), src)],
             outputs: vec![("dst".into(), out.clone())],
             params: bytemuck::bytes_of(&BlurParams::new(axis, radius, sigma, kernel, mode))
@@ -135,8 +135,8 @@ pub fn add_filter(
     src
 }
 
-/// Parameters of `kernels/mips.wgsl` (mirrors its `Params`); the executor fills in each
-/// dispatch's levels ([`mip_dispatches`]), the graph only the mode.
+/// Parameters of `kernels/mips.wgsl` (mirrors its `Params`): one per dispatch of a mip chain
+/// ([`mip_dispatches`]).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct MipParams {
@@ -195,7 +195,7 @@ pub fn mip_dispatches(width: u32, height: u32) -> Vec<(u32, u32)> {
 
 /// Workgroups of the mip-chain dispatch that reads level `first` of a `width × height` chain:
 /// one per `MIP_TILE / 2` texels of level `first + 1` each way (a workgroup owns a 32 × 32 tile
-/// of it; a 1×1 level stays 1×1). The executor, the cost model and the limit check all use it.
+/// of it; a 1×1 level stays 1×1).
 pub fn mip_dispatch_groups(width: u32, height: u32, first: u32) -> [u32; 3] {
     let tile = MIP_TILE / 2;
     let side = |n: u32| (n >> (first + 1)).max(1).div_ceil(tile);
@@ -220,24 +220,67 @@ fn add_mips(
         },
         Some(light),
     );
-    let params = MipParams {
-        mode: u32::from(mode == BlurMode::LogSumExp),
-        ..Default::default()
-    };
+    // An input whose size does not resolve fails the planner (the chain follows its size).
+    let (params, dispatches) = graph
+        .size(input)
+        .map(|(w, h)| mip_chain(w, h, mode))
+        .unwrap_or_default();
     graph.node(Node {
         name: format!("{input}.mips"),
         kernel: match mode {
-            BlurMode::Linear => "mips",
-            BlurMode::LogSumExp => "mips_log",
-        }
-        .into(),
+            BlurMode::Linear => KernelId::Mips,
+            BlurMode::LogSumExp => KernelId::MipsLog,
+        },
         inputs: vec![("src".into(), input.to_string())],
         outputs: vec![("dst".into(), out.clone())],
-        params: bytemuck::bytes_of(&params).to_vec(),
-        dispatch: Dispatch::MipChain,
+        params,
+        dispatch: Dispatch::Several(dispatches),
         light: Some(light),
     });
     out
+}
+
+/// The parameters and dispatches of the mip chain of a `width × height` map
+/// ([`mip_dispatches`]): each dispatch reads one level (the `src` slot for the first, which also
+/// stores it as level 0 through `dst0`) and writes the `count` levels after it through `dst1` …;
+/// the kernel's other `dst` bindings repeat the last level written and are not stored to.
+pub fn mip_chain(width: u32, height: u32, mode: BlurMode) -> (Vec<u8>, Vec<SubDispatch>) {
+    let size = std::mem::size_of::<MipParams>();
+    let odd = |n: u32| n > 1 && n % 2 == 1;
+    let level = |binding: String, slot: &str, level: u32| LevelView {
+        binding,
+        slot: slot.into(),
+        level,
+    };
+    let mut bytes = Vec::new();
+    let mut dispatches = Vec::new();
+    for (first, count) in mip_dispatches(width, height) {
+        let p = MipParams {
+            base: [width, height],
+            first,
+            count,
+            mode: u32::from(mode == BlurMode::LogSumExp),
+            copy: u32::from(first == 0),
+            general: u32::from(odd((width >> first).max(1)) || odd((height >> first).max(1))),
+            _pad: 0,
+        };
+        let at = bytes.len();
+        bytes.extend_from_slice(bytemuck::bytes_of(&p));
+        let mut levels = vec![match first {
+            0 => level("src".into(), "src", 0),
+            l => level("src".into(), "dst", l),
+        }];
+        if first == 0 {
+            levels.push(level("dst0".into(), "dst", 0));
+        }
+        levels.extend((1..=count).map(|j| level(format!("dst{j}"), "dst", first + j)));
+        dispatches.push(SubDispatch {
+            params: at..at + size,
+            levels,
+            groups: mip_dispatch_groups(width, height, first),
+        });
+    }
+    (bytes, dispatches)
 }
 
 #[cfg(test)]
@@ -288,5 +331,58 @@ mod tests {
             }
             assert_eq!(next + 1, levels, "{w}x{h}: {d:?}");
         }
+    }
+
+    /// The chain as data: each dispatch's parameters are its slice of the node's bytes, it
+    /// reads the last level written and names the levels it writes (4096²: levels 0–6, then
+    /// 6–12; 1000×37: level 1 is 500×18, even, level 2 is 250×9, odd, a fractional step).
+    #[test]
+    fn mip_chain_dispatches_are_data() {
+        let (bytes, d) = mip_chain(4096, 4096, BlurMode::LogSumExp);
+        assert_eq!(d.len(), 2);
+        assert_eq!(bytes.len(), 2 * std::mem::size_of::<MipParams>());
+        let params =
+            |k: usize| -> MipParams { bytemuck::pod_read_unaligned(&bytes[d[k].params.clone()]) };
+        let want = MipParams {
+            base: [4096, 4096],
+            first: 6,
+            count: 6,
+            mode: 1,
+            copy: 0,
+            general: 0,
+            _pad: 0,
+        };
+        assert_eq!(params(1), want);
+        assert_eq!(
+            params(0),
+            MipParams {
+                first: 0,
+                copy: 1,
+                ..want
+            }
+        );
+        let names = |k: usize| -> Vec<(String, String, u32)> {
+            d[k].levels
+                .iter()
+                .map(|v| (v.binding.clone(), v.slot.clone(), v.level))
+                .collect()
+        };
+        let dst = |j: u32, l: u32| (format!("dst{j}"), "dst".to_string(), l);
+        let mut first = vec![("src".to_string(), "src".to_string(), 0), dst(0, 0)];
+        first.extend((1..=6).map(|j| dst(j, j)));
+        assert_eq!(names(0), first);
+        let mut second = vec![("src".to_string(), "dst".to_string(), 6)];
+        second.extend((1..=6).map(|j| dst(j, 6 + j)));
+        assert_eq!(names(1), second);
+        // A workgroup per 32² tile of the level after the one read.
+        assert_eq!(d[0].groups, [64, 64, 1]);
+        assert_eq!(d[1].groups, [1, 1, 1]);
+        let (bytes, d) = mip_chain(1000, 37, BlurMode::Linear);
+        let general: Vec<u32> = d
+            .iter()
+            .map(|d| bytemuck::pod_read_unaligned::<MipParams>(&bytes[d.params.clone()]).general)
+            .collect();
+        assert_eq!(general, [1, 0, 1, 1, 0, 1, 1, 1, 1]);
+        assert_eq!(d[0].groups, [16, 1, 1]);
     }
 }

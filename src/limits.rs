@@ -233,18 +233,15 @@ pub fn plan_over(plan: &Plan, l: &wgpu::Limits) -> Result<Option<StepOver>> {
     Ok(None)
 }
 
-/// Workgroup counts of a node's dispatch (as the executor computes them; for a mip chain its
-/// largest dispatch, the first: tiles of level 1, or of level 0 for a 1×1 map).
+/// Workgroup counts of a node's dispatch (as the executor computes them; for several
+/// dispatches the largest along each axis, e.g. a mip chain's first).
 pub fn dispatch_groups(plan: &Plan, node: &Node, wg: [u32; 3]) -> [u32; 3] {
     let size = |r: &str| plan.resource(r).map(|p| (p.width, p.height));
     let wg = wg.map(|w| w.max(1));
-    if node.dispatch == Dispatch::MipChain {
-        let (w, h) = node
-            .outputs
-            .first()
-            .and_then(|(_, r)| size(r))
-            .unwrap_or((1, 1));
-        return crate::filter::mip_dispatch_groups(w, h, 0);
+    if let Dispatch::Several(subs) = &node.dispatch {
+        return subs
+            .iter()
+            .fold([1, 1, 1], |m, d| [0, 1, 2].map(|a| m[a].max(d.groups[a])));
     }
     node.dispatch.groups(size, wg).unwrap_or([1, 1, 1])
 }

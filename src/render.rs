@@ -425,7 +425,7 @@ fn dump_resources(
             Ok(DumpedResource {
                 levels,
                 light: r.resource.light,
-                producer: r.producer.map(|s| plan.steps[s].node.kernel.clone()),
+                producer: r.producer.map(|s| plan.steps[s].node.kernel.to_string()),
                 format: r.resource.format,
             })
         })

@@ -5,6 +5,7 @@ use std::fmt::Write;
 
 use crate::filter::{BlurMode, add_filter};
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
+use crate::kernels::KernelId;
 use crate::sat::{SatCoding, SatVariant, add_sat, lookup_area};
 use crate::scene::{Filter, Light, LightKind, PcfKernel, Prefilter, Soft, Storage, Technique};
 
@@ -479,7 +480,7 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
     );
     graph.node(Node {
         name: format!("light{i}.linearize"),
-        kernel: "linearize".into(),
+        kernel: KernelId::Linearize,
         inputs: vec![("src".into(), depth.clone())],
         outputs: vec![("dst".into(), linear.clone())],
         params: bytemuck::bytes_of(&lin).to_vec(),
@@ -507,7 +508,7 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
         } => {
             let format = moments_format(storage, 2);
             let params = bytemuck::bytes_of(&VsmParams { depth: lin }).to_vec();
-            let moments = encode(graph, i, "vsm", "vsm", &depth, format, params);
+            let moments = encode(graph, i, KernelId::Vsm, "vsm", &depth, format, params);
             one(filtered(graph, i, light, &moments, BlurMode::Linear), float)
         }
         Technique::Evsm {
@@ -523,7 +524,7 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
                 ..ExpParams::new(exp_pos, exp_neg)
             };
             let params = bytemuck::bytes_of(&params).to_vec();
-            let moments = encode(graph, i, "evsm", "evsm", &depth, format, params);
+            let moments = encode(graph, i, KernelId::Evsm, "evsm", &depth, format, params);
             one(filtered(graph, i, light, &moments, BlurMode::Linear), float)
         }
         Technique::Esm { filter, exponent } => {
@@ -532,7 +533,7 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
             params.linear = u32::from(matches!(filter, Filter::Sat { .. }));
             let params = bytemuck::bytes_of(&params).to_vec();
             let format = wgpu::TextureFormat::R32Float;
-            let log_moment = encode(graph, i, "esm", "esm", &depth, format, params);
+            let log_moment = encode(graph, i, KernelId::Esm, "esm", &depth, format, params);
             one(
                 filtered(graph, i, light, &log_moment, BlurMode::LogSumExp),
                 float,
@@ -553,7 +554,7 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
                 _pad: [0; 3],
             })
             .to_vec();
-            let moments = encode(graph, i, "msm", "msm", &depth, format, params);
+            let moments = encode(graph, i, KernelId::Msm, "msm", &depth, format, params);
             one(filtered(graph, i, light, &moments, BlurMode::Linear), float)
         }
         Technique::Csm {
@@ -631,7 +632,7 @@ fn csm_nodes(
         let written: Vec<String> = outputs.iter().map(|(_, r)| r.clone()).collect();
         graph.node(Node {
             name: format!("light{i}.csm.{g}"),
-            kernel: "csm".into(),
+            kernel: KernelId::Csm,
             inputs: vec![("src".into(), depth.to_string())],
             dispatch: Dispatch::Texels(outputs[0].1.clone()),
             outputs,
@@ -813,7 +814,7 @@ pub fn moments_format(storage: Storage, channels: u32) -> wgpu::TextureFormat {
 fn encode(
     graph: &mut Graph,
     i: usize,
-    kernel: &str,
+    kernel: KernelId,
     name: &str,
     depth: &str,
     format: wgpu::TextureFormat,
@@ -830,7 +831,7 @@ fn encode(
     );
     graph.node(Node {
         name: format!("light{i}.{name}"),
-        kernel: kernel.into(),
+        kernel,
         inputs: vec![("src".into(), depth.to_string())],
         outputs: vec![("dst".into(), out.clone())],
         params,

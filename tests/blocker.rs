@@ -47,7 +47,7 @@ fn csm_z_on_gpu(
         );
         graph.node(Node {
             name: out.clone(),
-            kernel: "csm".into(),
+            kernel: shadowgraph::kernels::KernelId::Csm,
             inputs: vec![("src".into(), "in".into())],
             outputs: vec![("dst0".into(), out.clone())],
             // Orthographic depth in [0, 1] is read as linear depth unchanged.

@@ -38,7 +38,7 @@ fn run_linearize(
     );
     graph.node(Node {
         name: "linearize".into(),
-        kernel: "linearize".into(),
+        kernel: shadowgraph::kernels::KernelId::Linearize,
         inputs: vec![("src".into(), input)],
         outputs: vec![("dst".into(), out.clone())],
         params: bytemuck::bytes_of(&p).to_vec(),

@@ -11,6 +11,7 @@ use std::path::Path;
 use rand::Rng;
 use shadowgraph::exec::Executor;
 use shadowgraph::graph::{Dispatch, GraphError, Plan};
+use shadowgraph::kernels::KernelId;
 use shadowgraph::render::plan_lights;
 use shadowgraph::scene::Scene;
 use shadowgraph::{Error, technique};
@@ -94,7 +95,7 @@ fn malformed_plans_are_typed_errors() {
     let mip = plan
         .steps
         .iter()
-        .position(|st| st.node.dispatch == Dispatch::MipChain)
+        .position(|st| matches!(st.node.dispatch, Dispatch::Several(_)))
         .unwrap();
     let blocks = plan
         .steps
@@ -174,8 +175,8 @@ fn malformed_plans_are_typed_errors() {
             }),
         ),
         (
-            "unknown kernel",
-            Box::new(|p| p.steps[0].node.kernel = "no_such_kernel".into()),
+            "kernel with other bindings",
+            Box::new(|p| p.steps[0].node.kernel = KernelId::SatCarries),
         ),
     ];
     for (what, edit) in edits {
@@ -187,7 +188,7 @@ fn malformed_plans_are_typed_errors() {
             Ok(Err(e)) => {
                 let shown = e.to_string();
                 assert!(!shown.contains('\n'), "{what}: {shown}");
-                if what != "unknown kernel" {
+                if what != "kernel with other bindings" {
                     assert!(
                         matches!(e, Error::Graph(GraphError::BadPlan(_))),
                         "{what}: {e:?}"

@@ -140,7 +140,7 @@ fn encode_graph(
     );
     g.node(shadowgraph::graph::Node {
         name: "light0.vsm".into(),
-        kernel: kernel.into(),
+        kernel: shadowgraph::kernels::KernelId::from_name(kernel).expect("a kernel"),
         inputs: vec![("src".into(), "in".into())],
         // `csm` names its outputs dst0 … dst3.
         outputs: vec![(

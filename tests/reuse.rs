@@ -229,7 +229,10 @@ fn creation_goes_through_the_counter() {
         "render/renderer.rs",
         "render/targets.rs",
         "render/probe.rs",
-        "exec.rs",
+        "exec/mod.rs",
+        "exec/pipelines.rs",
+        "exec/pool.rs",
+        "exec/record.rs",
         "timer.rs",
         "prefilter.rs",
     ] {

@@ -23,23 +23,23 @@
 // only `vis_pcf_hardware` takes a comparison sampler (linear filtering, compare less-equal).
 //
 // Visibility functions (map binding types as declared):
+//   fn vis_msm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
+//   fn vis_msm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32
+//   fn vis_esm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
+//   fn vis_esm_of_sat(m: vec4<f32>, l: Light, s: LightSample) -> f32
+//   fn vis_esm_of_log(log_moment: f32, l: Light, s: LightSample) -> f32
+//   fn vis_evsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
+//   fn vis_evsm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32
 //   fn vis_hard(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
+//   fn vis_msm_soft_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32
+//   fn vis_msm_soft_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
 //   fn vis_pcf(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
 //   fn vis_pcf_hardware(map: texture_depth_2d, cmp: sampler_comparison, l: Light, s: LightSample) -> f32
 //   fn vis_pcss(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
 //   fn vis_vsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
 //   fn vis_vsm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32
-//   fn vis_evsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
-//   fn vis_evsm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32
-//   fn vis_esm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
-//   fn vis_esm_of_sat(m: vec4<f32>, l: Light, s: LightSample) -> f32
-//   fn vis_esm_of_log(log_moment: f32, l: Light, s: LightSample) -> f32
-//   fn vis_msm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
-//   fn vis_msm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32
 //   fn vis_vssm_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32
 //   fn vis_vssm_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
-//   fn vis_msm_soft_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32
-//   fn vis_msm_soft_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
 //
 // Names defined here (a host must not reuse them):
 //   BLOCKER_MIN_SHARE CSM_PI GOLDEN_ANGLE Light LightSample MSM_B0 MSM_B0_COV MSM_B0_SCHUR
@@ -357,338 +357,6 @@ fn bilinear_log_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> f32 {
         + a.y * ((1.0 - a.x) * exp(v01 - m) + a.x * exp(v11 - m));
     return m + log(sum);
 }
-// Hard shadow test (Williams 1978): lit when d ≤ z_map + bias at the nearest texel.
-
-// #fetches vis_hard: 1
-fn vis_hard(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    let z = load_depth(map, texel_of(s.uv, l.map_size));
-    return select(0.0, 1.0, s.depth <= z + l.bias);
-}
-// Percentage-closer filtering (Reeves et al. 1987): the weighted mean of comparison results
-// over a (2r + 1)² window around the receiver's texel — never a filter of depths.
-
-// #fetches vis_pcf: (2 * l.radius + 1) * (2 * l.radius + 1)
-fn vis_pcf(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    let c = texel_of(s.uv, l.map_size);
-    let r = i32(l.radius);
-    var lit = 0.0;
-    var total = 0.0;
-    for (var dy = -r; dy <= r; dy++) {
-        for (var dx = -r; dx <= r; dx++) {
-            var w = 1.0;
-            if l.kernel == 1u {
-                w = f32(r + 1 - abs(dx)) * f32(r + 1 - abs(dy));
-            }
-            let z = load_depth(map, c + vec2<i32>(dx, dy));
-            lit += w * select(0.0, 1.0, s.depth <= z + l.bias);
-            total += w;
-        }
-    }
-    return lit / total;
-}
-
-// The hardware 2×2 comparison: bilinear weights of four comparisons against the raw depth map.
-// #fetches vis_pcf_hardware: 1
-fn vis_pcf_hardware(map: texture_depth_2d, cmp: sampler_comparison, l: Light, s: LightSample) -> f32 {
-    let reference = light_linear_to_ndc(l, clamp(s.depth - l.bias, 0.0, 1.0));
-    return textureSampleCompareLevel(map, cmp, s.uv, reference);
-}
-// Percentage-closer soft shadows (Fernando 2005), the brute-force peer of the prefiltered soft
-// shadows: 1) blocker search over the region the light cone cuts from the map, 2) penumbra
-// width w = size · (Z_r − Z_b) / Z_b, 3) PCF over that width. Taps lie on a Vogel disc.
-
-// Radius (UV) of the blocker search: the cone from the receiver to the light's width, at the
-// near plane where it is widest, capped by max_search.
-fn pcss_search_radius(l: Light, s: LightSample) -> f32 {
-    let world = 0.5 * l.size * (s.view_z - l.near) / s.view_z;
-    return min(world / light_map_width(l, l.near), l.max_search);
-}
-
-// #fetches vis_pcss: l.blocker_samples + l.filter_samples
-fn vis_pcss(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    let search = pcss_search_radius(l, s);
-    var sum = 0.0;
-    var count = 0u;
-    for (var i = 0u; i < l.blocker_samples; i++) {
-        let z = load_depth(map, texel_of(s.uv + search * vogel_disc(i, l.blocker_samples), l.map_size));
-        if z + l.bias < s.depth {
-            sum += z;
-            count += 1u;
-        }
-    }
-    if count == 0u {
-        return 1.0;
-    }
-    let z_blocker = light_linear_to_z(l, sum / f32(count));
-    let penumbra_world = l.size * (s.view_z - z_blocker) / z_blocker;
-    let radius = max(0.5 * penumbra_world / light_map_width(l, s.view_z), 0.5 / l.map_size.x);
-    var lit = 0.0;
-    for (var i = 0u; i < l.filter_samples; i++) {
-        let z = load_depth(map, texel_of(s.uv + radius * vogel_disc(i, l.filter_samples), l.map_size));
-        lit += select(0.0, 1.0, s.depth <= z + l.bias);
-    }
-    return lit / f32(l.filter_samples);
-}
-// Variance shadow maps: one-tailed Chebyshev (Cantelli) bound from the filtered moments,
-//   σ² = max(E[z²] − μ², min_variance),  p_max = σ² / (σ² + (d − μ)²) for d > μ, else 1,
-// then the light-bleeding reduction linstep(bleed, 1, p_max).
-
-// #fetches vis_vsm: sample_map
-fn vis_vsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    return vis_vsm_of(sample_map(map, l, s), l, s);
-}
-
-// The bound from filtered moments `m` however they were filtered (the `sat` filter calls this
-// with its rectangle mean).
-fn vis_vsm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
-    let d = s.depth - l.bias;
-    if d <= m.x {
-        return 1.0;
-    }
-    let variance = max(m.y - m.x * m.x, l.min_variance);
-    let t = d - m.x;
-    return linstep(l.bleed, 1.0, variance / (variance + t * t));
-}
-// Exponential variance shadow maps: Chebyshev bound on the warped moments; EVSM4 takes the
-// smaller of the positive and negative bounds (which removes EVSM2's contact leaks).
-// The variance floor is given in depth units² and carried through the warp's derivative at the
-// occluders' mean, where the variance lives: d exp(c (2z − 1)) / dz = 2c·exp(…), so
-// floor_warped = min_variance · (2c·E[warped])². (Taken at the receiver instead, the floor grows
-// with the receiver's own warped depth and, for c = 40, lets ~40% of the light into the umbra.)
-
-fn chebyshev_upper(mean: f32, mean_sq: f32, receiver: f32, floor: f32) -> f32 {
-    if receiver <= mean {
-        return 1.0;
-    }
-    let variance = max(mean_sq - mean * mean, floor);
-    let t = receiver - mean;
-    return variance / (variance + t * t);
-}
-
-// #fetches vis_evsm: sample_map
-fn vis_evsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    return vis_evsm_of(sample_map(map, l, s), l, s);
-}
-
-// The bounds from filtered moments `m` however they were filtered.
-fn vis_evsm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
-    let w = 2.0 * (s.depth - l.bias) - 1.0;
-    let pos = exp(l.exp_pos * w);
-    let slope_pos = 2.0 * l.exp_pos * m.x;
-    var p = chebyshev_upper(m.x, m.y, pos, l.min_variance * slope_pos * slope_pos);
-    if l.moments == 4u {
-        let neg = -exp(-l.exp_neg * w);
-        let slope_neg = 2.0 * l.exp_neg * m.z;
-        p = min(p, chebyshev_upper(m.z, m.w, neg, l.min_variance * slope_neg * slope_neg));
-    }
-    return linstep(l.bleed, 1.0, p);
-}
-// Exponential shadow maps: visibility = clamp(E[exp(c z)] · exp(−c d), 0, 1), with the filtered
-// moment kept as its logarithm L, so the product is exp(L − c d) and never overflows.
-
-// #fetches vis_esm: sample_map_log
-fn vis_esm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    return vis_esm_of_log(sample_map_log(map, l, s), l, s);
-}
-
-// The `sat` filter's table sums the moment scaled by exp(−c), m = E[exp(c (z − 1))]: its log
-// moment is ln m + c. A mean that quantization left at or below 0 reads as fully shadowed.
-fn vis_esm_of_sat(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
-    return vis_esm_of_log(log(max(m.x, 1e-37)) + l.exp_pos, l, s);
-}
-
-fn vis_esm_of_log(log_moment: f32, l: Light, s: LightSample) -> f32 {
-    return clamp(exp(log_moment - l.exp_pos * (s.depth - l.bias)), 0.0, 1.0);
-}
-// Moment shadow maps (Peters & Klein 2015), four moments b = (z, z², z³, z⁴) of the filtered
-// depth distribution. The moments are biased toward those of a fixed three-point distribution
-// (b' = (1 − α) b + α b₀) so the Hankel matrix stays positive definite, then:
-// Hamburger: solve B c = (1, d, d²) by Cholesky, the roots z₂ ≤ z₃ of c₃x² + c₂x + c₁ are the
-// other support points of the distribution through d that matches b', and the fraction of it
-// in front of d is the shadow intensity (three cases by where d lies). Hausdorff: the same when
-// z₂, z₃ lie in [0, 1], else the four-point solution supported on [0, 1].
-//
-// f32: the Cholesky pivots are the covariances of (z, z²) under b' (Var z, and Var z² less
-// its regression on z). Formed from b' they cancel ~1-sized terms down to ~α-sized ones, and
-// the mix's own roundings land in them too. Here the covariances of the stored moments are
-// formed once (raw f32 moments projected onto valid ones first), the bias is added as a
-// mixture's covariance, a sum of non-negative terms, and each pivot is floored at α times
-// b₀'s, which no distribution's biased moments go below. Measured behind flat occluders at
-// α = 10⁻⁴ (README, "MSM moment bias"): the largest error against exact arithmetic 0.016
-// where the mix-then-Cholesky form gave 0.053 (raw f32 moments).
-// Degenerate moments (bias 0 on a flat map) fall back to the two-moment Chebyshev bound or the
-// step at the mean instead of dividing by zero.
-// The optimized 16-bit moment quantization of Peters & Klein (2015), section 4.3, and its
-// inverse (import-only module). The moment vector multiplies the matrices from the left (as a
-// row vector); the constructors list their columns.
-
-fn msm_quantize(b: vec4<f32>) -> vec4<f32> {
-    let m = mat4x4<f32>(
-        vec4<f32>(-2.07224649, 32.23703778, -68.571074599, 39.3703274134),
-        vec4<f32>(13.7948857237, -59.4683975703, 82.0359750338, -35.364903257),
-        vec4<f32>(0.105877704, -1.9077466311, 9.3496555107, -6.6543490743),
-        vec4<f32>(9.7924062118, -33.7652110555, 47.9456096605, -23.9728048165),
-    );
-    return b * m + vec4<f32>(0.035955884801, 0.0, 0.0, 0.0);
-}
-
-fn msm_dequantize(q: vec4<f32>) -> vec4<f32> {
-    let m = mat4x4<f32>(
-        vec4<f32>(0.2227744146, 0.0771972861, 0.7926986636, 0.0319417555),
-        vec4<f32>(0.1549679261, 0.1394629426, 0.7963415838, -0.1722823173),
-        vec4<f32>(0.1451988946, 0.2120202157, 0.7258694464, -0.2758014811),
-        vec4<f32>(0.163127443, 0.2591432266, 0.6539092497, -0.3376131734),
-    );
-    return (q - vec4<f32>(0.035955884801, 0.0, 0.0, 0.0)) * m;
-}
-
-// Moments of {0, ½, 1} with weights (3/16, 10/16, 3/16): Peters' b₀ = (0, 0.375, 0, 0.375)
-// on [−1, 1], mapped to depth in [0, 1].
-const MSM_B0: vec4<f32> = vec4<f32>(0.5, 0.34375, 0.265625, 0.2265625);
-// Its covariances (Var z, Cov(z, z²), Var z²) and the Schur complement
-// Var z² − Cov(z, z²)²/Var z, exact in f32.
-const MSM_B0_COV: vec3<f32> = vec3<f32>(0.09375, 0.09375, 0.1083984375);
-const MSM_B0_SCHUR: f32 = 0.0146484375;
-
-// Biased moments as the reconstruction reads them: the raw moments (for Hausdorff's closed
-// form) and the mean, second moment and covariances of (z, z²).
-struct MsmMoments {
-    // (1 − α)·m + α·b₀.
-    b: vec4<f32>,
-    // Var z, Cov(z, z²), Var z² of the biased distribution.
-    cov: vec3<f32>,
-    // b'.yzw − b'.xyz and 1 − b'.x (Hausdorff), mixed from the data's and b₀'s differences
-    // rather than differenced after the mix (near z = 1 they are α-sized).
-    diff: vec3<f32>,
-    below_one: f32,
-    // The bias α.
-    alpha: f32,
-}
-
-// Data moments `m` (dequantized) biased by `alpha` toward MSM_B0, see the header. `project`:
-// raw moments, whose roundings are independent per channel, are first projected onto valid
-// ones (Var z, Var z² ≥ 0, |Cov(z, z²)| ≤ √(Var z·Var z²)); quantized ones are not: their
-// errors come through the dequantization's matrix, whose design keeps them out of the
-// near-null directions, and a clamp per entry would undo that.
-fn msm_moments(m: vec4<f32>, alpha: f32, project: bool) -> MsmMoments {
-    var c = vec3<f32>(m.y - m.x * m.x, m.z - m.x * m.y, m.w - m.y * m.y);
-    if project {
-        c.x = max(c.x, 0.0);
-        c.z = max(c.z, 0.0);
-        let limit = sqrt(c.x * c.z);
-        c.y = clamp(c.y, -limit, limit);
-    }
-    // A mixture's covariance: the parts' covariances plus that of their means,
-    // (1 − α)·C(m) + α·C(b₀) + α(1 − α)·e eᵀ, e the difference of the means of (z, z²).
-    let w = 1.0 - alpha;
-    let e = m.xy - MSM_B0.xy;
-    var out: MsmMoments;
-    out.b = w * m + alpha * MSM_B0;
-    out.cov = w * c + alpha * MSM_B0_COV + (alpha * w) * vec3<f32>(e.x * e.x, e.x * e.y, e.y * e.y);
-    out.alpha = alpha;
-    out.diff = w * (m.yzw - m.xyz) + alpha * (MSM_B0.yzw - MSM_B0.xyz);
-    out.below_one = w * (1.0 - m.x) + alpha * (1.0 - MSM_B0.x);
-    return out;
-}
-
-// The Hamburger reconstruction through d: (z₂, z₃, case) where z₂ ≤ z₃ are the other support
-// points of the three-point distribution that matches the biased moments and has a point at
-// d (solve B c = (1, d, d²) by B = L·diag(1, Var z, s)·Lᵀ, L = [[1], [μ, 1], [E z², ℓ, 1]],
-// ℓ = Cov(z, z²)/Var z, s = Var z² − ℓ·Cov(z, z²); roots of c₃x² + c₂x + c₁). The pivots
-// Var z and s are at least α times b₀'s (B ⪰ α·B₀ for the moments of any distribution), and
-// are floored there. case 0: regular; 1: the variance is (numerically) 0, a single point at
-// the mean; 2: rank-deficient, two support points (z₂, z₃ then meaningless).
-fn msm_roots(mm: MsmMoments, d: f32) -> vec3<f32> {
-    let var1 = max(mm.cov.x, mm.alpha * MSM_B0_COV.x);
-    if !(var1 > 1e-12) {
-        return vec3<f32>(0.0, 0.0, 1.0);
-    }
-    let l32 = mm.cov.y / var1;
-    let d3 = max(mm.cov.z - l32 * mm.cov.y, mm.alpha * MSM_B0_SCHUR);
-    if !(d3 > 0.0) {
-        return vec3<f32>(0.0, 0.0, 2.0);
-    }
-    // Forward substitution, scaling by the diagonal, back substitution.
-    let b = mm.b;
-    let y2 = d - b.x;
-    let y3 = d * d - b.y - l32 * y2;
-    let c3 = y3 / d3;
-    let c2 = y2 / var1 - l32 * c3;
-    let c1 = 1.0 - b.x * c2 - b.y * c3;
-    // The root of larger magnitude without cancellation, the other from Vieta's product
-    // c₁/c₃: −p/2 ± √(p²/4 − q) loses the smaller root when the other is far away (c₃ → 0,
-    // as behind a flat occluder), and with it the weights, which cancel against it.
-    let t = -0.5 * (c2 + select(-1.0, 1.0, c2 >= 0.0) * sqrt(max(c2 * c2 - 4.0 * c3 * c1, 0.0)));
-    let r1 = t / c3;
-    let r2 = c1 / t;
-    return vec3<f32>(min(r1, r2), max(r1, r2), 0.0);
-}
-
-// E[(z − x)(z − y)] under the biased moments: (μ − x)(μ − y) + Var z, free of the
-// cancellation in E z² − (x + y)·μ + x·y.
-fn msm_expect(mm: MsmMoments, x: f32, y: f32) -> f32 {
-    return (mm.b.x - x) * (mm.b.x - y) + mm.cov.x;
-}
-
-// Shadow intensity (share of the depth distribution in front of d) from biased moments.
-fn msm_intensity(mm: MsmMoments, d: f32, hausdorff: bool) -> f32 {
-    let b = mm.b;
-    let roots = msm_roots(mm, d);
-    if roots.z == 1.0 {
-        return select(0.0, 1.0, d > b.x);
-    }
-    if roots.z == 2.0 {
-        // Rank-deficient: two support points; Chebyshev's bound is the best statement left.
-        if d <= b.x {
-            return 0.0;
-        }
-        let t = d - b.x;
-        return t * t / (mm.cov.x + t * t);
-    }
-    let z2 = roots.x;
-    let z3 = roots.y;
-    if hausdorff && (z2 < 0.0 || z3 > 1.0) {
-        // Peters & Klein's four-point solution on [0, 1], in the differences D = mm.diff:
-        // free = ((b₃ − b₂)d + b₃ − b₄)/((b₂ − b₁)d + b₂ − b₃), and b₃ − b₁ − (free + 1)(b₂ − b₁)
-        // = D₁ − free·D₀.
-        let g = mm.diff;
-        let free = (g.y * d - g.z) / (g.x * d - g.y);
-        let w1 = select(0.0, 1.0, d > free);
-        return (g.x + (g.y - free * g.x) * (free - w1 - d) / (d * (d - free))) / (free - w1)
-            + mm.below_one;
-    }
-    if d <= z2 {
-        return 0.0;
-    }
-    if d <= z3 {
-        return msm_expect(mm, d, z3) / ((z3 - z2) * (d - z2));
-    }
-    return 1.0 - msm_expect(mm, z2, z3) / ((d - z2) * (d - z3));
-}
-
-// #fetches vis_msm: sample_map
-fn vis_msm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    return vis_msm_of(sample_map(map, l, s), l, s);
-}
-
-// Filtered (possibly quantized) moments `m` dequantized and biased toward MSM_B0.
-fn msm_biased(m: vec4<f32>, l: Light) -> MsmMoments {
-    let quantized = (l.msm_flags & 2u) != 0u;
-    var b = m;
-    if quantized {
-        b = msm_dequantize(b);
-    }
-    return msm_moments(b, l.moment_bias, !quantized);
-}
-
-// Visibility from filtered (possibly quantized) moments `m` however they were filtered.
-fn vis_msm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
-    let mm = msm_biased(m, l);
-    let intensity = msm_intensity(mm, s.depth - l.bias, (l.msm_flags & 1u) != 0u);
-    let v = 1.0 - clamp(intensity, 0.0, 1.0);
-    // NaN compares false both ways: a non-finite intensity reads as fully lit.
-    return linstep(l.bleed, 1.0, select(1.0, v, v == v));
-}
 // Convolution shadow maps (Annen et al. 2007): the step H(z − d) as its Fourier series
 //   f(d, z) ≈ ½ + Σ_k w_k [cos(c_k d) sin(c_k z) − sin(c_k d) cos(c_k z)],
 //   c_k = π (2k − 1),  w_k = (2 / c_k) · exp(−α (k / M)²)   (α: ringing attenuation),
@@ -913,6 +581,195 @@ fn sat_sample_float(map: texture_2d<f32>, l: Light, uv: vec2<f32>, width: f32) -
 // both · map_size, at least 1 texel and at most l.max_width (2·max_search·map_size, the square
 // the fixed-point table is coded for). A NaN width (outside the map, where the result is
 // discarded) reads as 1 texel.
+// Moment shadow maps (Peters & Klein 2015), four moments b = (z, z², z³, z⁴) of the filtered
+// depth distribution. The moments are biased toward those of a fixed three-point distribution
+// (b' = (1 − α) b + α b₀) so the Hankel matrix stays positive definite, then:
+// Hamburger: solve B c = (1, d, d²) by Cholesky, the roots z₂ ≤ z₃ of c₃x² + c₂x + c₁ are the
+// other support points of the distribution through d that matches b', and the fraction of it
+// in front of d is the shadow intensity (three cases by where d lies). Hausdorff: the same when
+// z₂, z₃ lie in [0, 1], else the four-point solution supported on [0, 1].
+//
+// f32: the Cholesky pivots are the covariances of (z, z²) under b' (Var z, and Var z² less
+// its regression on z). Formed from b' they cancel ~1-sized terms down to ~α-sized ones, and
+// the mix's own roundings land in them too. Here the covariances of the stored moments are
+// formed once (raw f32 moments projected onto valid ones first), the bias is added as a
+// mixture's covariance, a sum of non-negative terms, and each pivot is floored at α times
+// b₀'s, which no distribution's biased moments go below. Measured behind flat occluders at
+// α = 10⁻⁴ (README, "MSM moment bias"): the largest error against exact arithmetic 0.016
+// where the mix-then-Cholesky form gave 0.053 (raw f32 moments).
+// Degenerate moments (bias 0 on a flat map) fall back to the two-moment Chebyshev bound or the
+// step at the mean instead of dividing by zero.
+// The optimized 16-bit moment quantization of Peters & Klein (2015), section 4.3, and its
+// inverse (import-only module). The moment vector multiplies the matrices from the left (as a
+// row vector); the constructors list their columns.
+
+fn msm_quantize(b: vec4<f32>) -> vec4<f32> {
+    let m = mat4x4<f32>(
+        vec4<f32>(-2.07224649, 32.23703778, -68.571074599, 39.3703274134),
+        vec4<f32>(13.7948857237, -59.4683975703, 82.0359750338, -35.364903257),
+        vec4<f32>(0.105877704, -1.9077466311, 9.3496555107, -6.6543490743),
+        vec4<f32>(9.7924062118, -33.7652110555, 47.9456096605, -23.9728048165),
+    );
+    return b * m + vec4<f32>(0.035955884801, 0.0, 0.0, 0.0);
+}
+
+fn msm_dequantize(q: vec4<f32>) -> vec4<f32> {
+    let m = mat4x4<f32>(
+        vec4<f32>(0.2227744146, 0.0771972861, 0.7926986636, 0.0319417555),
+        vec4<f32>(0.1549679261, 0.1394629426, 0.7963415838, -0.1722823173),
+        vec4<f32>(0.1451988946, 0.2120202157, 0.7258694464, -0.2758014811),
+        vec4<f32>(0.163127443, 0.2591432266, 0.6539092497, -0.3376131734),
+    );
+    return (q - vec4<f32>(0.035955884801, 0.0, 0.0, 0.0)) * m;
+}
+
+// Moments of {0, ½, 1} with weights (3/16, 10/16, 3/16): Peters' b₀ = (0, 0.375, 0, 0.375)
+// on [−1, 1], mapped to depth in [0, 1].
+const MSM_B0: vec4<f32> = vec4<f32>(0.5, 0.34375, 0.265625, 0.2265625);
+// Its covariances (Var z, Cov(z, z²), Var z²) and the Schur complement
+// Var z² − Cov(z, z²)²/Var z, exact in f32.
+const MSM_B0_COV: vec3<f32> = vec3<f32>(0.09375, 0.09375, 0.1083984375);
+const MSM_B0_SCHUR: f32 = 0.0146484375;
+
+// Biased moments as the reconstruction reads them: the raw moments (for Hausdorff's closed
+// form) and the mean, second moment and covariances of (z, z²).
+struct MsmMoments {
+    // (1 − α)·m + α·b₀.
+    b: vec4<f32>,
+    // Var z, Cov(z, z²), Var z² of the biased distribution.
+    cov: vec3<f32>,
+    // b'.yzw − b'.xyz and 1 − b'.x (Hausdorff), mixed from the data's and b₀'s differences
+    // rather than differenced after the mix (near z = 1 they are α-sized).
+    diff: vec3<f32>,
+    below_one: f32,
+    // The bias α.
+    alpha: f32,
+}
+
+// Data moments `m` (dequantized) biased by `alpha` toward MSM_B0, see the header. `project`:
+// raw moments, whose roundings are independent per channel, are first projected onto valid
+// ones (Var z, Var z² ≥ 0, |Cov(z, z²)| ≤ √(Var z·Var z²)); quantized ones are not: their
+// errors come through the dequantization's matrix, whose design keeps them out of the
+// near-null directions, and a clamp per entry would undo that.
+fn msm_moments(m: vec4<f32>, alpha: f32, project: bool) -> MsmMoments {
+    var c = vec3<f32>(m.y - m.x * m.x, m.z - m.x * m.y, m.w - m.y * m.y);
+    if project {
+        c.x = max(c.x, 0.0);
+        c.z = max(c.z, 0.0);
+        let limit = sqrt(c.x * c.z);
+        c.y = clamp(c.y, -limit, limit);
+    }
+    // A mixture's covariance: the parts' covariances plus that of their means,
+    // (1 − α)·C(m) + α·C(b₀) + α(1 − α)·e eᵀ, e the difference of the means of (z, z²).
+    let w = 1.0 - alpha;
+    let e = m.xy - MSM_B0.xy;
+    var out: MsmMoments;
+    out.b = w * m + alpha * MSM_B0;
+    out.cov = w * c + alpha * MSM_B0_COV + (alpha * w) * vec3<f32>(e.x * e.x, e.x * e.y, e.y * e.y);
+    out.alpha = alpha;
+    out.diff = w * (m.yzw - m.xyz) + alpha * (MSM_B0.yzw - MSM_B0.xyz);
+    out.below_one = w * (1.0 - m.x) + alpha * (1.0 - MSM_B0.x);
+    return out;
+}
+
+// The Hamburger reconstruction through d: (z₂, z₃, case) where z₂ ≤ z₃ are the other support
+// points of the three-point distribution that matches the biased moments and has a point at
+// d (solve B c = (1, d, d²) by B = L·diag(1, Var z, s)·Lᵀ, L = [[1], [μ, 1], [E z², ℓ, 1]],
+// ℓ = Cov(z, z²)/Var z, s = Var z² − ℓ·Cov(z, z²); roots of c₃x² + c₂x + c₁). The pivots
+// Var z and s are at least α times b₀'s (B ⪰ α·B₀ for the moments of any distribution), and
+// are floored there. case 0: regular; 1: the variance is (numerically) 0, a single point at
+// the mean; 2: rank-deficient, two support points (z₂, z₃ then meaningless).
+fn msm_roots(mm: MsmMoments, d: f32) -> vec3<f32> {
+    let var1 = max(mm.cov.x, mm.alpha * MSM_B0_COV.x);
+    if !(var1 > 1e-12) {
+        return vec3<f32>(0.0, 0.0, 1.0);
+    }
+    let l32 = mm.cov.y / var1;
+    let d3 = max(mm.cov.z - l32 * mm.cov.y, mm.alpha * MSM_B0_SCHUR);
+    if !(d3 > 0.0) {
+        return vec3<f32>(0.0, 0.0, 2.0);
+    }
+    // Forward substitution, scaling by the diagonal, back substitution.
+    let b = mm.b;
+    let y2 = d - b.x;
+    let y3 = d * d - b.y - l32 * y2;
+    let c3 = y3 / d3;
+    let c2 = y2 / var1 - l32 * c3;
+    let c1 = 1.0 - b.x * c2 - b.y * c3;
+    // The root of larger magnitude without cancellation, the other from Vieta's product
+    // c₁/c₃: −p/2 ± √(p²/4 − q) loses the smaller root when the other is far away (c₃ → 0,
+    // as behind a flat occluder), and with it the weights, which cancel against it.
+    let t = -0.5 * (c2 + select(-1.0, 1.0, c2 >= 0.0) * sqrt(max(c2 * c2 - 4.0 * c3 * c1, 0.0)));
+    let r1 = t / c3;
+    let r2 = c1 / t;
+    return vec3<f32>(min(r1, r2), max(r1, r2), 0.0);
+}
+
+// E[(z − x)(z − y)] under the biased moments: (μ − x)(μ − y) + Var z, free of the
+// cancellation in E z² − (x + y)·μ + x·y.
+fn msm_expect(mm: MsmMoments, x: f32, y: f32) -> f32 {
+    return (mm.b.x - x) * (mm.b.x - y) + mm.cov.x;
+}
+
+// Shadow intensity (share of the depth distribution in front of d) from biased moments.
+fn msm_intensity(mm: MsmMoments, d: f32, hausdorff: bool) -> f32 {
+    let b = mm.b;
+    let roots = msm_roots(mm, d);
+    if roots.z == 1.0 {
+        return select(0.0, 1.0, d > b.x);
+    }
+    if roots.z == 2.0 {
+        // Rank-deficient: two support points; Chebyshev's bound is the best statement left.
+        if d <= b.x {
+            return 0.0;
+        }
+        let t = d - b.x;
+        return t * t / (mm.cov.x + t * t);
+    }
+    let z2 = roots.x;
+    let z3 = roots.y;
+    if hausdorff && (z2 < 0.0 || z3 > 1.0) {
+        // Peters & Klein's four-point solution on [0, 1], in the differences D = mm.diff:
+        // free = ((b₃ − b₂)d + b₃ − b₄)/((b₂ − b₁)d + b₂ − b₃), and b₃ − b₁ − (free + 1)(b₂ − b₁)
+        // = D₁ − free·D₀.
+        let g = mm.diff;
+        let free = (g.y * d - g.z) / (g.x * d - g.y);
+        let w1 = select(0.0, 1.0, d > free);
+        return (g.x + (g.y - free * g.x) * (free - w1 - d) / (d * (d - free))) / (free - w1)
+            + mm.below_one;
+    }
+    if d <= z2 {
+        return 0.0;
+    }
+    if d <= z3 {
+        return msm_expect(mm, d, z3) / ((z3 - z2) * (d - z2));
+    }
+    return 1.0 - msm_expect(mm, z2, z3) / ((d - z2) * (d - z3));
+}
+
+// #fetches vis_msm: sample_map
+fn vis_msm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
+    return vis_msm_of(sample_map(map, l, s), l, s);
+}
+
+// Filtered (possibly quantized) moments `m` dequantized and biased toward MSM_B0.
+fn msm_biased(m: vec4<f32>, l: Light) -> MsmMoments {
+    let quantized = (l.msm_flags & 2u) != 0u;
+    var b = m;
+    if quantized {
+        b = msm_dequantize(b);
+    }
+    return msm_moments(b, l.moment_bias, !quantized);
+}
+
+// Visibility from filtered (possibly quantized) moments `m` however they were filtered.
+fn vis_msm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
+    let mm = msm_biased(m, l);
+    let intensity = msm_intensity(mm, s.depth - l.bias, (l.msm_flags & 1u) != 0u);
+    let v = 1.0 - clamp(intensity, 0.0, 1.0);
+    // NaN compares false both ways: a non-finite intensity reads as fully lit.
+    return linstep(l.bleed, 1.0, select(1.0, v, v == v));
+}
 
 // A search square whose estimated share of blockers is below this reads as lit, without a
 // lookup at the filter width (PCSS: no blocker tap). The estimates are smooth, so a
@@ -1066,48 +923,63 @@ fn cssm_resolve(sum: f32, b: vec2<f32>, l: Light, s: LightSample) -> f32 {
     let p = 1.0 + l.sharpen * exp(-l.sharpen_falloff * gap);
     return cssm_sharpen(v, p);
 }
-// Variance soft shadow maps (Yang et al. 2010) from a summed-area table of the VSM moments:
-// the moments over the blocker-search square give the blocker share and depth (blocker_vsm),
-// the PCSS penumbra width follows, and the VSM bound (vis_vsm_of: variance floor, bleed
-// reduction) is read from the moments over that width. One table lookup per pass of
-// `blocker.wgsl`'s two-pass loop: a receiver whose search square holds no blockers (share below
-// BLOCKER_MIN_SHARE) is lit after the first.
-// `vis_vssm_fixed` reads a fixed-point table (rgba32uint), `vis_vssm_float` an f32 one.
+// Exponential shadow maps: visibility = clamp(E[exp(c z)] · exp(−c d), 0, 1), with the filtered
+// moment kept as its logarithm L, so the product is exp(L − c d) and never overflows.
 
-fn vssm_blocker(m: vec4<f32>, l: Light, s: LightSample) -> vec2<f32> {
-    return blocker_vsm(m, s.depth - l.bias, l.min_variance);
+// #fetches vis_esm: sample_map_log
+fn vis_esm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
+    return vis_esm_of_log(sample_map_log(map, l, s), l, s);
 }
 
-// #fetches vis_vssm_fixed: 2 * sat_sample_fixed
-fn vis_vssm_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32 {
-    var look = soft_search(l, s);
-    var m = vec4<f32>(0.0);
-    for (var k = 0u; k < 2u; k++) {
-        m = sat_sample_fixed(map, l, s.uv, look.width);
-        if k == 0u {
-            look = soft_blockers(vssm_blocker(m, l, s), l, s);
-            if !look.blockers {
-                return 1.0;
-            }
-        }
-    }
-    return vis_vsm_of(m, l, s);
+// The `sat` filter's table sums the moment scaled by exp(−c), m = E[exp(c (z − 1))]: its log
+// moment is ln m + c. A mean that quantization left at or below 0 reads as fully shadowed.
+fn vis_esm_of_sat(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
+    return vis_esm_of_log(log(max(m.x, 1e-37)) + l.exp_pos, l, s);
 }
 
-// #fetches vis_vssm_float: 2 * sat_sample_float
-fn vis_vssm_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    var look = soft_search(l, s);
-    var m = vec4<f32>(0.0);
-    for (var k = 0u; k < 2u; k++) {
-        m = sat_sample_float(map, l, s.uv, look.width);
-        if k == 0u {
-            look = soft_blockers(vssm_blocker(m, l, s), l, s);
-            if !look.blockers {
-                return 1.0;
-            }
-        }
+fn vis_esm_of_log(log_moment: f32, l: Light, s: LightSample) -> f32 {
+    return clamp(exp(log_moment - l.exp_pos * (s.depth - l.bias)), 0.0, 1.0);
+}
+// Exponential variance shadow maps: Chebyshev bound on the warped moments; EVSM4 takes the
+// smaller of the positive and negative bounds (which removes EVSM2's contact leaks).
+// The variance floor is given in depth units² and carried through the warp's derivative at the
+// occluders' mean, where the variance lives: d exp(c (2z − 1)) / dz = 2c·exp(…), so
+// floor_warped = min_variance · (2c·E[warped])². (Taken at the receiver instead, the floor grows
+// with the receiver's own warped depth and, for c = 40, lets ~40% of the light into the umbra.)
+
+fn chebyshev_upper(mean: f32, mean_sq: f32, receiver: f32, floor: f32) -> f32 {
+    if receiver <= mean {
+        return 1.0;
     }
-    return vis_vsm_of(m, l, s);
+    let variance = max(mean_sq - mean * mean, floor);
+    let t = receiver - mean;
+    return variance / (variance + t * t);
+}
+
+// #fetches vis_evsm: sample_map
+fn vis_evsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
+    return vis_evsm_of(sample_map(map, l, s), l, s);
+}
+
+// The bounds from filtered moments `m` however they were filtered.
+fn vis_evsm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
+    let w = 2.0 * (s.depth - l.bias) - 1.0;
+    let pos = exp(l.exp_pos * w);
+    let slope_pos = 2.0 * l.exp_pos * m.x;
+    var p = chebyshev_upper(m.x, m.y, pos, l.min_variance * slope_pos * slope_pos);
+    if l.moments == 4u {
+        let neg = -exp(-l.exp_neg * w);
+        let slope_neg = 2.0 * l.exp_neg * m.z;
+        p = min(p, chebyshev_upper(m.z, m.w, neg, l.min_variance * slope_neg * slope_neg));
+    }
+    return linstep(l.bleed, 1.0, p);
+}
+// Hard shadow test (Williams 1978): lit when d ≤ z_map + bias at the nearest texel.
+
+// #fetches vis_hard: 1
+fn vis_hard(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
+    let z = load_depth(map, texel_of(s.uv, l.map_size));
+    return select(0.0, 1.0, s.depth <= z + l.bias);
 }
 // Moment soft shadow maps (after Peters et al. 2016) from a summed-area table of the MSM
 // moments (raw or quantized): the biased moments over the blocker-search square give the
@@ -1152,4 +1024,132 @@ fn vis_msm_soft_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
         }
     }
     return vis_msm_of(m, l, s);
+}
+// Percentage-closer filtering (Reeves et al. 1987): the weighted mean of comparison results
+// over a (2r + 1)² window around the receiver's texel — never a filter of depths.
+
+// #fetches vis_pcf: (2 * l.radius + 1) * (2 * l.radius + 1)
+fn vis_pcf(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
+    let c = texel_of(s.uv, l.map_size);
+    let r = i32(l.radius);
+    var lit = 0.0;
+    var total = 0.0;
+    for (var dy = -r; dy <= r; dy++) {
+        for (var dx = -r; dx <= r; dx++) {
+            var w = 1.0;
+            if l.kernel == 1u {
+                w = f32(r + 1 - abs(dx)) * f32(r + 1 - abs(dy));
+            }
+            let z = load_depth(map, c + vec2<i32>(dx, dy));
+            lit += w * select(0.0, 1.0, s.depth <= z + l.bias);
+            total += w;
+        }
+    }
+    return lit / total;
+}
+
+// The hardware 2×2 comparison: bilinear weights of four comparisons against the raw depth map.
+// #fetches vis_pcf_hardware: 1
+fn vis_pcf_hardware(map: texture_depth_2d, cmp: sampler_comparison, l: Light, s: LightSample) -> f32 {
+    let reference = light_linear_to_ndc(l, clamp(s.depth - l.bias, 0.0, 1.0));
+    return textureSampleCompareLevel(map, cmp, s.uv, reference);
+}
+// Percentage-closer soft shadows (Fernando 2005), the brute-force peer of the prefiltered soft
+// shadows: 1) blocker search over the region the light cone cuts from the map, 2) penumbra
+// width w = size · (Z_r − Z_b) / Z_b, 3) PCF over that width. Taps lie on a Vogel disc.
+
+// Radius (UV) of the blocker search: the cone from the receiver to the light's width, at the
+// near plane where it is widest, capped by max_search.
+fn pcss_search_radius(l: Light, s: LightSample) -> f32 {
+    let world = 0.5 * l.size * (s.view_z - l.near) / s.view_z;
+    return min(world / light_map_width(l, l.near), l.max_search);
+}
+
+// #fetches vis_pcss: l.blocker_samples + l.filter_samples
+fn vis_pcss(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
+    let search = pcss_search_radius(l, s);
+    var sum = 0.0;
+    var count = 0u;
+    for (var i = 0u; i < l.blocker_samples; i++) {
+        let z = load_depth(map, texel_of(s.uv + search * vogel_disc(i, l.blocker_samples), l.map_size));
+        if z + l.bias < s.depth {
+            sum += z;
+            count += 1u;
+        }
+    }
+    if count == 0u {
+        return 1.0;
+    }
+    let z_blocker = light_linear_to_z(l, sum / f32(count));
+    let penumbra_world = l.size * (s.view_z - z_blocker) / z_blocker;
+    let radius = max(0.5 * penumbra_world / light_map_width(l, s.view_z), 0.5 / l.map_size.x);
+    var lit = 0.0;
+    for (var i = 0u; i < l.filter_samples; i++) {
+        let z = load_depth(map, texel_of(s.uv + radius * vogel_disc(i, l.filter_samples), l.map_size));
+        lit += select(0.0, 1.0, s.depth <= z + l.bias);
+    }
+    return lit / f32(l.filter_samples);
+}
+// Variance shadow maps: one-tailed Chebyshev (Cantelli) bound from the filtered moments,
+//   σ² = max(E[z²] − μ², min_variance),  p_max = σ² / (σ² + (d − μ)²) for d > μ, else 1,
+// then the light-bleeding reduction linstep(bleed, 1, p_max).
+
+// #fetches vis_vsm: sample_map
+fn vis_vsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
+    return vis_vsm_of(sample_map(map, l, s), l, s);
+}
+
+// The bound from filtered moments `m` however they were filtered (the `sat` filter calls this
+// with its rectangle mean).
+fn vis_vsm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
+    let d = s.depth - l.bias;
+    if d <= m.x {
+        return 1.0;
+    }
+    let variance = max(m.y - m.x * m.x, l.min_variance);
+    let t = d - m.x;
+    return linstep(l.bleed, 1.0, variance / (variance + t * t));
+}
+// Variance soft shadow maps (Yang et al. 2010) from a summed-area table of the VSM moments:
+// the moments over the blocker-search square give the blocker share and depth (blocker_vsm),
+// the PCSS penumbra width follows, and the VSM bound (vis_vsm_of: variance floor, bleed
+// reduction) is read from the moments over that width. One table lookup per pass of
+// `blocker.wgsl`'s two-pass loop: a receiver whose search square holds no blockers (share below
+// BLOCKER_MIN_SHARE) is lit after the first.
+// `vis_vssm_fixed` reads a fixed-point table (rgba32uint), `vis_vssm_float` an f32 one.
+
+fn vssm_blocker(m: vec4<f32>, l: Light, s: LightSample) -> vec2<f32> {
+    return blocker_vsm(m, s.depth - l.bias, l.min_variance);
+}
+
+// #fetches vis_vssm_fixed: 2 * sat_sample_fixed
+fn vis_vssm_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32 {
+    var look = soft_search(l, s);
+    var m = vec4<f32>(0.0);
+    for (var k = 0u; k < 2u; k++) {
+        m = sat_sample_fixed(map, l, s.uv, look.width);
+        if k == 0u {
+            look = soft_blockers(vssm_blocker(m, l, s), l, s);
+            if !look.blockers {
+                return 1.0;
+            }
+        }
+    }
+    return vis_vsm_of(m, l, s);
+}
+
+// #fetches vis_vssm_float: 2 * sat_sample_float
+fn vis_vssm_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
+    var look = soft_search(l, s);
+    var m = vec4<f32>(0.0);
+    for (var k = 0u; k < 2u; k++) {
+        m = sat_sample_float(map, l, s.uv, look.width);
+        if k == 0u {
+            look = soft_blockers(vssm_blocker(m, l, s), l, s);
+            if !look.blockers {
+                return 1.0;
+            }
+        }
+    }
+    return vis_vsm_of(m, l, s);
 }

@@ -10,6 +10,7 @@ use crate::error::{Error, Result};
 use crate::exec::{ComputeKernel, GpuTimer, KernelCache, wgsl_storage_format};
 use crate::gpu::scoped;
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
+use crate::kernels::KernelId;
 
 /// Bytes one invocation of the buffer copy kernel copies (one `vec4<u32>`).
 const COPY_BYTES_PER_INVOCATION: u64 = 16;
@@ -46,9 +47,9 @@ pub(super) fn copy_texture_graph(n: u32, format: wgpu::TextureFormat) -> BenchGr
     let (kernel, out) = match format {
         wgpu::TextureFormat::R32Uint
         | wgpu::TextureFormat::Rg32Uint
-        | wgpu::TextureFormat::Rgba32Uint => ("copy_texture_u32", format),
-        wgpu::TextureFormat::Depth32Float => ("copy_texture", wgpu::TextureFormat::R32Float),
-        f => ("copy_texture", f),
+        | wgpu::TextureFormat::Rgba32Uint => (KernelId::CopyTextureU32, format),
+        wgpu::TextureFormat::Depth32Float => (KernelId::CopyTexture, wgpu::TextureFormat::R32Float),
+        f => (KernelId::CopyTexture, f),
     };
     let mut graph = Graph::default();
     let src = graph.import("copy.src", format, n, n, None);
@@ -59,7 +60,7 @@ pub(super) fn copy_texture_graph(n: u32, format: wgpu::TextureFormat) -> BenchGr
     let dst = graph.resource("copy.dst", out, size, None);
     graph.node(Node {
         name: format!("copy texture {}", format_name(format)),
-        kernel: kernel.into(),
+        kernel,
         inputs: vec![("src".into(), src)],
         outputs: vec![("dst".into(), dst.clone())],
         params: Vec::new(),

@@ -4,13 +4,13 @@
 
 use std::collections::HashSet;
 
-use super::{Dispatch, GraphError, Plan};
+use super::{Dispatch, GraphError, Node, Plan, SubDispatch};
 
 impl Plan {
     /// Checks every index and name the executor follows: resource slots in range and matching
     /// their slot's format and size, slots of a size and format it can allocate, unique
     /// resource names, every node's inputs, outputs and dispatch naming planned resources,
-    /// mip-chain nodes with their bindings and parameters, and outputs that exist.
+    /// the several dispatches of a node with their parameters and levels, and outputs that exist.
     pub fn check(&self) -> Result<(), GraphError> {
         let bad = |message: String| Err(GraphError::BadPlan(message));
         for (i, s) in self.slots.iter().enumerate() {
@@ -50,37 +50,7 @@ impl Plan {
         }
         let known = |r: &str| names.contains(r);
         for (i, step) in self.steps.iter().enumerate() {
-            let n = &step.node;
-            if let Some((_, r)) = n.inputs.iter().chain(&n.outputs).find(|(_, r)| !known(r)) {
-                return bad(format!(
-                    "step {i} (`{}`) uses `{r}`, which is not in the plan",
-                    n.name
-                ));
-            }
-            let of = match &n.dispatch {
-                Dispatch::Texels(r) => Some(r),
-                Dispatch::Blocks { of, .. } => Some(of),
-                Dispatch::Lines { of, per_group } => {
-                    if *per_group == 0 {
-                        return bad(format!(
-                            "step {i} (`{}`) dispatches lines with 0 per workgroup",
-                            n.name
-                        ));
-                    }
-                    Some(of)
-                }
-                Dispatch::Groups(_) => None,
-                Dispatch::MipChain => {
-                    self.check_mip_chain(n)?;
-                    None
-                }
-            };
-            if let Some(r) = of.filter(|r| !known(r)) {
-                return bad(format!(
-                    "step {i} (`{}`) dispatches over `{r}`, which is not in the plan",
-                    n.name
-                ));
-            }
+            self.check_step(i, &step.node, &known)?;
         }
         if let Some(o) = self.outputs.iter().find(|o| !known(o)) {
             return bad(format!("output `{o}` is not in the plan"));
@@ -88,21 +58,72 @@ impl Plan {
         Ok(())
     }
 
-    fn check_mip_chain(&self, n: &super::Node) -> Result<(), GraphError> {
-        let has = |list: &[(String, String)], slot: &str| list.iter().any(|(s, _)| s == slot);
-        if !has(&n.inputs, "src") || !has(&n.outputs, "dst") {
-            return Err(GraphError::BadPlan(format!(
-                "mip-chain node `{}` needs a `src` input and a `dst` output",
+    /// Step `i`'s node `n` names only resources that are `known` and dispatches over one.
+    fn check_step(
+        &self,
+        i: usize,
+        n: &Node,
+        known: &dyn Fn(&str) -> bool,
+    ) -> Result<(), GraphError> {
+        let bad = |message: String| {
+            Err(GraphError::BadPlan(format!(
+                "step {i} (`{}`) {message}",
                 n.name
-            )));
+            )))
+        };
+        if let Some((_, r)) = n.inputs.iter().chain(&n.outputs).find(|(_, r)| !known(r)) {
+            return bad(format!("uses `{r}`, which is not in the plan"));
         }
-        let need = std::mem::size_of::<crate::filter::MipParams>();
-        if n.params.len() < need {
-            return Err(GraphError::BadPlan(format!(
-                "mip-chain node `{}` has {} parameter bytes, {need} needed",
-                n.name,
-                n.params.len()
-            )));
+        let of = match &n.dispatch {
+            Dispatch::Texels(r) => Some(r),
+            Dispatch::Blocks { of, .. } => Some(of),
+            Dispatch::Lines { per_group: 0, .. } => {
+                return bad("dispatches lines with 0 per workgroup".into());
+            }
+            Dispatch::Lines { of, .. } => Some(of),
+            Dispatch::Groups(_) => None,
+            Dispatch::Several(subs) => {
+                self.check_several(n, subs)?;
+                None
+            }
+        };
+        match of.filter(|r| !known(r)) {
+            Some(r) => bad(format!("dispatches over `{r}`, which is not in the plan")),
+            None => Ok(()),
+        }
+    }
+
+    /// Each of a node's several dispatches reads parameter bytes the node has and binds levels
+    /// that exist of resources of the node's slots.
+    fn check_several(&self, n: &Node, subs: &[SubDispatch]) -> Result<(), GraphError> {
+        let bad = |k: usize, message: String| {
+            Err(GraphError::BadPlan(format!(
+                "dispatch {k} of node `{}` {message}",
+                n.name
+            )))
+        };
+        for (k, d) in subs.iter().enumerate() {
+            if d.params.start > d.params.end || n.params.get(d.params.clone()).is_none() {
+                return bad(
+                    k,
+                    format!("reads parameter bytes {:?} of {}", d.params, n.params.len()),
+                );
+            }
+            for v in &d.levels {
+                let Some(r) = n.slot_resource(&v.slot) else {
+                    return bad(
+                        k,
+                        format!("binds slot `{}`, which it does not have", v.slot),
+                    );
+                };
+                let mips = self.resource(r).map_or(0, |p| p.resource.mips);
+                if v.level >= mips {
+                    return bad(
+                        k,
+                        format!("binds level {} of `{r}` ({mips} levels)", v.level),
+                    );
+                }
+            }
         }
         Ok(())
     }

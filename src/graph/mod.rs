@@ -84,16 +84,52 @@ pub enum Dispatch {
         /// Lines per workgroup (the kernel's workgroup size).
         per_group: u32,
     },
-    /// A mip-chain node: the executor records the dispatches of
-    /// [`crate::filter::mip_dispatches`] over the output (its `dst` resource), up to six levels
-    /// each, each reading the last level written (the `src` input for the first).
-    MipChain,
+    /// Several dispatches in the node's one compute pass, each with its own parameters, its
+    /// bindings of single mip levels and its workgroups: e.g. a mip chain, a few levels per
+    /// dispatch, each reading the last level written ([`crate::filter`] builds them). Planner,
+    /// cost model and executor read them as data.
+    Several(Vec<SubDispatch>),
+}
+
+/// One of the dispatches of a [`Dispatch::Several`] node.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SubDispatch {
+    /// Its parameters: these bytes of the node's `params`.
+    pub params: std::ops::Range<usize>,
+    /// Bindings of one mip level each. A write-only storage binding of the kernel that none
+    /// names repeats the last one (the kernel does not store through it; the cost model does
+    /// not count it); any other binding is bound by the node's slot of its name.
+    pub levels: Vec<LevelView>,
+    /// Workgroups.
+    pub groups: [u32; 3],
+}
+
+/// A kernel binding bound to one mip level of the resource of one of the node's slots.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct LevelView {
+    /// The binding's name in the WGSL.
+    pub binding: String,
+    /// The node's input or output slot whose resource is bound.
+    pub slot: String,
+    /// The mip level.
+    pub level: u32,
+}
+
+impl Node {
+    /// The resource bound to the node's input or output slot `slot`.
+    pub fn slot_resource(&self, slot: &str) -> Option<&str> {
+        self.inputs
+            .iter()
+            .chain(&self.outputs)
+            .find(|(s, _)| s == slot)
+            .map(|(_, r)| r.as_str())
+    }
 }
 
 impl Dispatch {
     /// Workgroup counts of a dispatch of a kernel whose workgroup is `workgroup`, with
     /// `size(resource)` the planned `(width, height)` of a resource; `None` when a resource it
-    /// counts is unknown, or for [`Dispatch::MipChain`] (the executor records those).
+    /// counts is unknown, or for [`Dispatch::Several`] (each of which has its own).
     pub fn groups(
         &self,
         size: impl Fn(&str) -> Option<(u32, u32)>,
@@ -113,7 +149,7 @@ impl Dispatch {
                 let (w, h) = size(of)?;
                 [block_count(w.max(h), *per_group), 2, 1]
             }
-            Self::MipChain => return None,
+            Self::Several(_) => return None,
         })
     }
 }
@@ -123,8 +159,9 @@ impl Dispatch {
 pub struct Node {
     /// Unique label, e.g. `light0.linearize`; pipelines and passes are labelled with it.
     pub name: String,
-    /// Kernel name: `kernels/<kernel>.wgsl`.
-    pub kernel: String,
+    /// The kernel, `kernels/<name>.wgsl`: an id generated from the folder, so a typo does not
+    /// compile.
+    pub kernel: crate::kernels::KernelId,
     /// `(binding name in the WGSL, resource name)` read by the kernel.
     pub inputs: Vec<(String, String)>,
     /// `(binding name in the WGSL, resource name)` written by the kernel.

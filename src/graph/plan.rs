@@ -295,6 +295,24 @@ fn order(
     Ok(order)
 }
 
+impl Graph {
+    /// The size of resource `name` by its size rule, as the planner resolves it (the sizes a
+    /// node's dispatches depend on are known while the graph is built).
+    pub fn size(&self, name: &str) -> Result<(u32, u32), GraphError> {
+        let index: HashMap<&str, usize> = self
+            .resources
+            .iter()
+            .enumerate()
+            .map(|(i, r)| (r.name.as_str(), i))
+            .collect();
+        let r = index.get(name).ok_or_else(|| GraphError::BadSize {
+            resource: name.to_string(),
+            message: "not declared".into(),
+        })?;
+        resolve_size(self, &index, &self.resources[*r], 0)
+    }
+}
+
 fn resolve_size(
     graph: &Graph,
     index: &HashMap<&str, usize>,

@@ -7,7 +7,7 @@ const F: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 fn node(name: &str, ins: &[&str], outs: &[&str]) -> Node {
     Node {
         name: name.into(),
-        kernel: name.into(),
+        kernel: crate::kernels::KernelId::Copy,
         inputs: ins
             .iter()
             .map(|r| ("src".to_string(), r.to_string()))

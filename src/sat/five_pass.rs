@@ -12,6 +12,7 @@
 
 use super::{SatCoding, SatVariant, format_channels, sat_name};
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
+use crate::kernels::KernelId;
 
 /// Texels per scanned block, one workgroup each (`BLOCK` = `WG_SIZE · ITEMS` in
 /// `kernels/shared/sat_scan.wgsl`; a test checks them against each other).
@@ -22,10 +23,10 @@ pub const SAT_CARRY_LINES: u32 = 64;
 
 impl SatVariant {
     /// The kernel of the five-pass table's last pass (the only one whose output type differs).
-    fn five_pass_last_kernel(self) -> &'static str {
+    fn five_pass_last_kernel(self) -> KernelId {
         match self {
-            Self::Fixed => "sat_cols",
-            Self::Float => "sat_cols_f32",
+            Self::Fixed => KernelId::SatCols,
+            Self::Float => KernelId::SatColsF32,
         }
     }
 }
@@ -78,7 +79,7 @@ pub fn add_sat_five_pass(
     for pass in passes(&names, coding.variant) {
         graph.node(Node {
             name: format!("{name}{}", pass.suffix),
-            kernel: pass.kernel.into(),
+            kernel: pass.kernel,
             inputs: named(pass.inputs),
             outputs: named(pass.outputs),
             params: bytemuck::bytes_of(&coding.params(channels, pass.axis)).to_vec(),
@@ -108,7 +109,7 @@ struct SatNames<'a> {
 /// `blocks_of`.
 struct Pass<'a> {
     suffix: &'a str,
-    kernel: &'a str,
+    kernel: KernelId,
     inputs: Vec<(&'a str, &'a str)>,
     outputs: Vec<(&'a str, &'a str)>,
     axis: u32,
@@ -122,7 +123,7 @@ fn passes<'a>(n: &SatNames<'a>, variant: SatVariant) -> [Pass<'a>; 5] {
     [
         Pass {
             suffix: ".rows",
-            kernel: "sat_rows",
+            kernel: KernelId::SatRows,
             inputs: vec![("src", n.input)],
             outputs: vec![("dst", n.rows), ("sums", n.row_sums)],
             axis: 0,
@@ -131,7 +132,7 @@ fn passes<'a>(n: &SatNames<'a>, variant: SatVariant) -> [Pass<'a>; 5] {
         },
         Pass {
             suffix: ".row_carry",
-            kernel: "sat_carry",
+            kernel: KernelId::SatCarry,
             inputs: vec![("src", n.row_sums)],
             outputs: vec![("dst", n.row_carry)],
             axis: 0,
@@ -140,7 +141,7 @@ fn passes<'a>(n: &SatNames<'a>, variant: SatVariant) -> [Pass<'a>; 5] {
         },
         Pass {
             suffix: ".col_sums",
-            kernel: "sat_cols_reduce",
+            kernel: KernelId::SatColsReduce,
             inputs: vec![("src", n.rows), ("row_carry", n.row_carry)],
             outputs: vec![("dst", n.col_sums)],
             axis: 1,
@@ -149,7 +150,7 @@ fn passes<'a>(n: &SatNames<'a>, variant: SatVariant) -> [Pass<'a>; 5] {
         },
         Pass {
             suffix: ".col_carry",
-            kernel: "sat_carry",
+            kernel: KernelId::SatCarry,
             inputs: vec![("src", n.col_sums)],
             outputs: vec![("dst", n.col_carry)],
             axis: 1,

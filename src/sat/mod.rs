@@ -39,6 +39,7 @@ pub mod five_pass;
 
 use crate::error::{Error, Result};
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
+use crate::kernels::KernelId;
 
 /// Side of the square tile one workgroup of `sat_tile_sums` and `sat_tiles` owns (`TILE` in
 /// `kernels/shared/sat_tile.wgsl`; a test checks them against each other).
@@ -78,10 +79,10 @@ impl SatVariant {
 
     /// The kernels of the first and the last pass (one per variant, so the variant's
     /// arithmetic is a constant in them).
-    fn kernels(self) -> [&'static str; 2] {
+    fn kernels(self) -> [KernelId; 2] {
         match self {
-            Self::Fixed => ["sat_tile_sums", "sat_tiles"],
-            Self::Float => ["sat_tile_sums_f32", "sat_tiles_f32"],
+            Self::Fixed => [KernelId::SatTileSums, KernelId::SatTiles],
+            Self::Float => [KernelId::SatTileSumsF32, KernelId::SatTilesF32],
         }
     }
 }
@@ -287,7 +288,7 @@ pub fn add_sat(graph: &mut Graph, light: usize, input: &str, coding: &SatCoding)
         ),
         (
             ".carries",
-            "sat_carries",
+            KernelId::SatCarries,
             vec![("col_part", col_part.as_str()), ("row_part", &row_part)],
             vec![("col_carry", col_carry.as_str()), ("row_carry", &row_carry)],
             Dispatch::Lines {
@@ -310,7 +311,7 @@ pub fn add_sat(graph: &mut Graph, light: usize, input: &str, coding: &SatCoding)
     for (suffix, kernel, inputs, outputs, dispatch) in passes {
         graph.node(Node {
             name: format!("{name}{suffix}"),
-            kernel: kernel.into(),
+            kernel,
             inputs: named(inputs),
             outputs: named(outputs),
             params: params.clone(),

@@ -47,7 +47,7 @@ pub fn trig_error(g: &Gpu) -> f64 {
         }
         graph.node(Node {
             name: format!("basis.{group}"),
-            kernel: "csm".into(),
+            kernel: shadowgraph::kernels::KernelId::Csm,
             inputs: vec![("src".into(), "in".into())],
             dispatch: Dispatch::Texels(slots[0].1.clone()),
             params: bytemuck::bytes_of(&shadowgraph::technique::CsmParams {

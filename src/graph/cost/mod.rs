@@ -19,7 +19,6 @@ use std::collections::HashMap;
 use self::declare::Pattern;
 use super::{Dispatch, Node, Plan, texel_bytes};
 use crate::error::{Error, Result};
-use crate::filter::{MIP_LEVELS_PER_DISPATCH, mip_dispatches};
 use crate::kernels::{self, Reflection};
 
 /// What one node moves.
@@ -48,11 +47,12 @@ struct Bound {
     format: wgpu::TextureFormat,
 }
 
-/// One dispatch: its workgroup count and, per binding, the texture bound (`None`: bound but
-/// not written, e.g. the second level of a 1×1 chain).
-struct Dispatched {
+/// One dispatch: its workgroup count, its parameters and, per binding it names, the texture
+/// bound (a binding it does not name is not counted).
+struct Dispatched<'a> {
     groups: [u32; 3],
-    bound: HashMap<String, Option<Bound>>,
+    params: &'a [u8],
+    bound: HashMap<String, Bound>,
 }
 
 /// Whether a binding moves data the model counts (textures and storage buffers; uniforms and
@@ -126,24 +126,15 @@ pub fn check_declarations(
 
 /// What `node` of `plan` moves, from its kernel's declarations and the plan's sizes.
 pub fn node_traffic(plan: &Plan, node: &Node) -> Result<Traffic> {
-    let wgsl = kernels::resolve(&node.kernel, None)?;
-    let (module, reflection) = kernels::reflect(&node.kernel, &wgsl)?;
-    let decls = check_declarations(&node.kernel, kernels::source(&node.kernel)?, &reflection)?;
+    let wgsl = kernels::resolve(node.kernel.name(), None)?;
+    let (module, reflection) = kernels::reflect(node.kernel.name(), &wgsl)?;
+    let decls = check_declarations(node.kernel.name(), node.kernel.source(), &reflection)?;
     let wg = reflection.workgroup_size.unwrap_or([1, 1, 1]);
     let consts = declare::constants(&module);
     let params = declare::global_type(&module, "params");
     let err = |message: String| Error::Kernel {
-        kernel: node.kernel.clone(),
+        kernel: node.kernel.to_string(),
         message: format!("node `{}`: {message}", node.name),
-    };
-    let mut name = |n: &str| -> std::result::Result<f64, String> {
-        if let Some(v) = consts.get(n) {
-            return Ok(*v);
-        }
-        match (n.strip_prefix("params."), params) {
-            (Some(field), Some(ty)) => declare::struct_field(&module, ty, &node.params, field),
-            _ => Err(format!("`{n}` is neither a constant nor `params.<field>`")),
-        }
     };
     let dispatched = dispatches(plan, node, wg).map_err(err)?;
     let mut t = Traffic {
@@ -151,11 +142,19 @@ pub fn node_traffic(plan: &Plan, node: &Node) -> Result<Traffic> {
         ..Default::default()
     };
     for d in &dispatched {
+        let mut name = |n: &str| -> std::result::Result<f64, String> {
+            if let Some(v) = consts.get(n) {
+                return Ok(*v);
+            }
+            match (n.strip_prefix("params."), params) {
+                (Some(field), Some(ty)) => declare::struct_field(&module, ty, d.params, field),
+                _ => Err(format!("`{n}` is neither a constant nor `params.<field>`")),
+            }
+        };
         let groups = d.groups.iter().map(|&g| f64::from(g)).product::<f64>();
         for b in reflection.bindings.iter().filter(|b| b.group == 0) {
             // Buffers (a counter) are not resources of the plan.
-            let (Some(Some(bound)), Some(pattern)) = (d.bound.get(&b.name), decls.get(&b.name))
-            else {
+            let (Some(bound), Some(pattern)) = (d.bound.get(&b.name), decls.get(&b.name)) else {
                 continue;
             };
             let texels = match pattern {
@@ -163,7 +162,7 @@ pub fn node_traffic(plan: &Plan, node: &Node) -> Result<Traffic> {
                 Pattern::None => 0.0,
                 Pattern::PerGroup(e) => e.eval(&mut name).map_err(err)? * groups,
                 Pattern::PerTexelOf(e, of) => {
-                    let Some(Some(other)) = d.bound.get(of) else {
+                    let Some(other) = d.bound.get(of) else {
                         return Err(err(format!(
                             "`{}` counts per texel of unbound `{of}`",
                             b.name
@@ -187,11 +186,11 @@ pub fn node_traffic(plan: &Plan, node: &Node) -> Result<Traffic> {
 }
 
 /// The dispatches `node` records, with what each binds.
-fn dispatches(
+fn dispatches<'n>(
     plan: &Plan,
-    node: &Node,
+    node: &'n Node,
     wg: [u32; 3],
-) -> std::result::Result<Vec<Dispatched>, String> {
+) -> std::result::Result<Vec<Dispatched<'n>>, String> {
     let bound = |r: &str, level: u32| -> std::result::Result<Bound, String> {
         let p = plan
             .resource(r)
@@ -206,40 +205,34 @@ fn dispatches(
     if let Some(groups) = node.dispatch.groups(size, wg) {
         let mut map = HashMap::new();
         for (slot, r) in node.inputs.iter().chain(&node.outputs) {
-            map.insert(slot.clone(), Some(bound(r, 0)?));
+            map.insert(slot.clone(), bound(r, 0)?);
         }
-        return Ok(vec![Dispatched { groups, bound: map }]);
+        return Ok(vec![Dispatched {
+            groups,
+            params: &node.params,
+            bound: map,
+        }]);
     }
-    if node.dispatch != Dispatch::MipChain {
+    let Dispatch::Several(subs) = &node.dispatch else {
         return Err("dispatches over a resource that is not in the plan".into());
-    }
-    // As `Executor::record_mip_chain` binds them: `src` (the input, then level `first` of
-    // `dst`), `dst0` (level 0, written by the first dispatch only) and `dst1` … `dst<count>`;
-    // the bindings past `count` repeat the last level and are not written.
-    let slot = |list: &[(String, String)], name: &str| {
-        list.iter()
-            .find(|(s, _)| s == name)
-            .map(|(_, r)| r.clone())
-            .ok_or_else(|| format!("binds nothing to `{name}`"))
     };
-    let (src, dst) = (slot(&node.inputs, "src")?, slot(&node.outputs, "dst")?);
-    let base = bound(&dst, 0)?;
-    mip_dispatches(base.width, base.height)
-        .into_iter()
-        .map(|(first, count)| {
-            let read = if first == 0 {
-                bound(&src, 0)?
-            } else {
-                bound(&dst, first)?
-            };
-            let mut map = HashMap::from([("src".to_string(), Some(read))]);
-            map.insert("dst0".into(), (first == 0).then_some(base));
-            for j in 1..=MIP_LEVELS_PER_DISPATCH {
-                let level = (j <= count).then(|| bound(&dst, first + j)).transpose()?;
-                map.insert(format!("dst{j}"), level);
+    // As the executor binds them: the levels each names (the bindings it leaves to repeat
+    // the last level are not written, and not counted).
+    subs.iter()
+        .map(|d| {
+            let mut map = HashMap::new();
+            for v in &d.levels {
+                let r = node
+                    .slot_resource(&v.slot)
+                    .ok_or_else(|| format!("binds nothing to `{}`", v.slot))?;
+                map.insert(v.binding.clone(), bound(r, v.level)?);
             }
             Ok(Dispatched {
-                groups: crate::filter::mip_dispatch_groups(base.width, base.height, first),
+                groups: d.groups,
+                params: node
+                    .params
+                    .get(d.params.clone())
+                    .ok_or("reads parameter bytes it does not have")?,
                 bound: map,
             })
         })

@@ -1,0 +1,202 @@
+//! The executor: records a [`Plan`] into a caller's command encoder, one compute pass per node,
+//! each node a span of the caller's [`GpuTimer`] when one is given. It borrows the device and
+//! never submits, so it runs the same inside shadowgraph's renderer and inside a host's frame.
+//! What a plan needs (textures, the parameter and counter buffers, every dispatch's bind group)
+//! is made on its first run and reused while the plan and its imported textures stay the same:
+//! a frame records passes and creates nothing.
+//!
+//! It knows no kernel, technique or filter: a node binds its slots by name and dispatches as
+//! its [`crate::graph::Dispatch`] says, several dispatches with their own parameters and mip
+//! levels included. By concern: [`pipelines`] (kernels compiled once and cached), [`pool`]
+//! (textures by shape, the run's outputs), `record` (bind groups and the passes).
+
+pub mod pipelines;
+pub mod pool;
+mod record;
+
+use std::collections::HashMap;
+
+use self::record::{PreparedStep, RunParams, StepBuffers};
+pub use crate::error::ExecError;
+use crate::error::Result;
+use crate::graph::{Plan, Slot};
+pub use crate::timer::GpuTimer;
+pub use pipelines::{ComputeKernel, KernelCache, wgsl_storage_format};
+pub use pool::{Outputs, TexturePool};
+
+/// Runs plans: owns pipelines, pooled textures and what the last plan's run needs; borrows
+/// everything else.
+#[derive(Default)]
+pub struct Executor {
+    /// Compiled kernels.
+    pub kernels: KernelCache,
+    pool: TexturePool,
+    in_use: Vec<(Slot, wgpu::Texture)>,
+    prepared: Option<Prepared>,
+}
+
+/// What a plan's run needs besides its passes, made once and reused while the plan and the
+/// imported textures stay the same.
+struct Prepared {
+    plan: Plan,
+    /// The imported textures bound, by resource name.
+    imports: Vec<(String, wgpu::Texture)>,
+    outputs: Outputs,
+    /// Every dispatch's parameters.
+    params: RunParams,
+    /// Per step: its pipeline and dispatches.
+    steps: Vec<PreparedStep>,
+}
+
+impl Executor {
+    /// An executor with empty caches.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Compiles every kernel `plan` uses (also done lazily by [`Executor::record`]).
+    pub fn prepare(&mut self, device: &wgpu::Device, plan: &Plan) -> Result<()> {
+        for step in &plan.steps {
+            record::compile(&mut self.kernels, device, plan, &step.node)?;
+        }
+        Ok(())
+    }
+
+    /// Textures held by the pool (constant across runs of the same plan).
+    pub fn texture_count(&self) -> usize {
+        self.pool.texture_count() + self.in_use.len()
+    }
+
+    /// Records `plan` into `encoder`. `imports` gives a texture for every imported resource.
+    /// With a `timer`, each node is a span named after it, and the last one ends with the plan.
+    /// The first run of a plan makes its textures, buffers and bind groups; later runs of the
+    /// same plan over the same imported textures reuse them and return the same textures.
+    pub fn record(
+        &mut self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        plan: &Plan,
+        imports: &HashMap<String, wgpu::Texture>,
+        mut timer: Option<&mut GpuTimer>,
+    ) -> Result<Outputs> {
+        // A plan's fields are public: check what the binding below relies on first.
+        plan.check()?;
+        let same_plan = self.prepared.as_ref().is_some_and(|p| p.plan == *plan);
+        let prepared = match self.prepared.take() {
+            Some(p) if same_plan && p.imports_match(imports) => p,
+            // New imported textures (a host's depth map): the nodes reading them are bound anew.
+            Some(p) if same_plan => self.rebind_imports(device, p, imports)?,
+            _ => self.prepare_run(device, plan, imports)?,
+        };
+        record::encode(encoder, &prepared, timer.as_deref_mut());
+        let outputs = prepared.outputs.clone();
+        self.prepared = Some(prepared);
+        // The last node ends here, not at whatever the caller records next.
+        if let Some(t) = timer {
+            t.end(encoder);
+        }
+        Ok(outputs)
+    }
+
+    /// Takes `plan`'s textures from the pool and makes its buffers and bind groups.
+    fn prepare_run(
+        &mut self,
+        device: &wgpu::Device,
+        plan: &Plan,
+        imports: &HashMap<String, wgpu::Texture>,
+    ) -> Result<Prepared> {
+        // Textures of the previous run go back to the pool, then each slot takes one.
+        for (slot, t) in self.in_use.drain(..) {
+            self.pool.free.entry(slot).or_default().push(t);
+        }
+        let slot_textures: Vec<wgpu::Texture> = plan
+            .slots
+            .iter()
+            .map(|s| self.pool.take(device, s))
+            .collect();
+        self.in_use = plan
+            .slots
+            .iter()
+            .cloned()
+            .zip(slot_textures.iter().cloned())
+            .collect();
+        let textures = pool::plan_textures(plan, &slot_textures, imports)?;
+        let outputs = Outputs::new(device, plan, textures);
+        let params = record::params_buffer(device, plan)?;
+        let mut bound = Vec::new();
+        for (si, step) in plan.steps.iter().enumerate() {
+            let buffers = StepBuffers {
+                params: &params.buffer,
+                at: &params.at[si],
+                outputs: &outputs,
+                step: si,
+            };
+            bound.push(record::bind_step(
+                &mut self.kernels,
+                device,
+                &step.node,
+                &buffers,
+            )?);
+        }
+        let imports = plan
+            .resources
+            .iter()
+            .filter(|r| r.slot.is_none())
+            .filter_map(|r| {
+                let t = imports.get(&r.resource.name)?;
+                Some((r.resource.name.clone(), t.clone()))
+            })
+            .collect();
+        Ok(Prepared {
+            plan: plan.clone(),
+            imports,
+            outputs,
+            params,
+            steps: bound,
+        })
+    }
+
+    /// `prepared` over other imported textures: the same textures and buffers, the steps that
+    /// read an import bound anew.
+    fn rebind_imports(
+        &mut self,
+        device: &wgpu::Device,
+        mut prepared: Prepared,
+        imports: &HashMap<String, wgpu::Texture>,
+    ) -> Result<Prepared> {
+        let slots: Vec<wgpu::Texture> = self.in_use.iter().map(|(_, t)| t.clone()).collect();
+        prepared.outputs.textures = pool::plan_textures(&prepared.plan, &slots, imports)?;
+        for (name, t) in &mut prepared.imports {
+            if let Some(new) = imports.get(name) {
+                *t = new.clone();
+            }
+        }
+        for (si, step) in prepared.plan.steps.iter().enumerate() {
+            let reads_import = step
+                .node
+                .inputs
+                .iter()
+                .any(|(_, r)| prepared.imports.iter().any(|(name, _)| name == r));
+            if reads_import {
+                let buffers = StepBuffers {
+                    params: &prepared.params.buffer,
+                    at: &prepared.params.at[si],
+                    outputs: &prepared.outputs,
+                    step: si,
+                };
+                prepared.steps[si] =
+                    record::bind_step(&mut self.kernels, device, &step.node, &buffers)?;
+            }
+        }
+        Ok(prepared)
+    }
+}
+
+impl Prepared {
+    /// Whether `imports` holds the same texture for every import this run bound.
+    fn imports_match(&self, imports: &HashMap<String, wgpu::Texture>) -> bool {
+        self.imports
+            .iter()
+            .all(|(name, t)| imports.get(name) == Some(t))
+    }
+}
