@@ -17,7 +17,7 @@ pub use scene::{Memory, check_scene, render_memory};
 use crate::error::{Error, Result};
 use crate::graph::{Dispatch, Node, Plan};
 use crate::kernels;
-use crate::scene::{Light, Storage, Technique};
+use crate::model::{Light, Storage, Technique};
 
 /// One thing a kernel needs of the device, and the device's limit on it.
 #[derive(Clone, Debug, PartialEq, Eq)]

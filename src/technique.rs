@@ -4,136 +4,57 @@
 use std::fmt::Write;
 
 use crate::filter::{BlurMode, add_filter};
+pub use crate::gpu_data::{
+    CSM_OUTPUTS, CsmParams, ExpParams, LightGpu, LinearizeParams, MSM_HAUSDORFF, MSM_QUANTIZED,
+    MsmParams, VsmParams,
+};
+use crate::gpu_data::{
+    TECHNIQUE_CSM, TECHNIQUE_CSSM, TECHNIQUE_ESM, TECHNIQUE_EVSM, TECHNIQUE_HARD, TECHNIQUE_MSM,
+    TECHNIQUE_MSM_SOFT, TECHNIQUE_PCF, TECHNIQUE_PCSS, TECHNIQUE_VSM, TECHNIQUE_VSSM,
+};
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
+pub use crate::model::mip_levels;
+use crate::model::{Filter, Light, LightKind, PcfKernel, Prefilter, Soft, Storage, Technique};
 use crate::sat::{SatCoding, SatVariant, add_sat, lookup_area};
-use crate::scene::{Filter, Light, LightKind, PcfKernel, Prefilter, Soft, Storage, Technique};
-
-/// A light as the shading kernel reads it. Mirrors `struct Light` in
-/// `kernels/shared/light.wgsl` (a test checks the size against naga's layout).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct LightGpu {
-    /// World → light clip.
-    pub view_proj: [[f32; 4]; 4],
-    /// World → light view.
-    pub view: [[f32; 4]; 4],
-    /// Colour × intensity.
-    pub radiance: [f32; 3],
-    /// 0 directional, 1 spot.
-    pub kind: u32,
-    /// Light position.
-    pub position: [f32; 3],
-    /// Near plane.
-    pub near: f32,
-    /// Unit direction light → target.
-    pub direction: [f32; 3],
-    /// Far plane.
-    pub far: f32,
-    /// Shadow-map size in texels.
-    pub map_size: [f32; 2],
-    /// Map width in world units (directional) or per unit distance (spot).
-    pub width_at_unit: f32,
-    /// Area-light width.
-    pub size: f32,
-    /// Constant bias, linear depth units.
-    pub bias: f32,
-    /// Normal offset, texels.
-    pub normal_bias: f32,
-    /// Spot: cos(fov/2); directional: −1.
-    pub cos_outer: f32,
-    /// 0 hard, 1 pcf, 2 pcss, 3 vsm, 4 evsm, 5 esm, 6 msm, 7 csm, 8 cssm, 9 vssm,
-    /// 10 msm_soft.
-    pub technique: u32,
-    /// PCF radius.
-    pub radius: u32,
-    /// PCF kernel: 0 box, 1 tent, 2 hardware.
-    pub kernel: u32,
-    /// PCSS blocker taps.
-    pub blocker_samples: u32,
-    /// PCSS filter taps.
-    pub filter_samples: u32,
-    /// PCSS and soft techniques: search cap (UV).
-    pub max_search: f32,
-    /// VSM light-bleeding reduction.
-    pub bleed: f32,
-    /// VSM/EVSM minimum variance (depth units²).
-    pub min_variance: f32,
-    /// EVSM positive exponent; ESM exponent.
-    pub exp_pos: f32,
-    /// EVSM negative exponent.
-    pub exp_neg: f32,
-    /// EVSM: 2 or 4 stored moments.
-    pub moments: u32,
-    /// MSM moment bias α.
-    pub moment_bias: f32,
-    /// MSM: bit 0 Hausdorff (else Hamburger), bit 1 quantized storage.
-    pub msm_flags: u32,
-    /// CSM terms M.
-    pub csm_terms: u32,
-    /// CSM ringing attenuation α.
-    pub csm_attenuation: f32,
-    /// CSM receiver-depth offset.
-    pub csm_offset: f32,
-    /// CSM response scale.
-    pub csm_scale: f32,
-    /// Mip levels of the filtered map (0 when the filter is not `mips`).
-    pub mip_levels: u32,
-    /// `log2` of the mip filter width in texels.
-    pub filter_lod: f32,
-    /// SAT filter: box width in texels (0 when the filter is not `sat`).
-    pub filter_width: f32,
-    /// Mips filter: 0 reads a fixed width; ≥ 1 follows the pixel's footprint with up to this
-    /// many trilinear taps along its major axis.
-    pub max_anisotropy: u32,
-    /// SAT filter: the table's per-channel offset ([`SatCoding::offset`]).
-    pub sat_offset: [f32; 4],
-    /// SAT filter: the table's per-channel scale ([`SatCoding::scale`]).
-    pub sat_scale: [f32; 4],
-    /// CSSM: sharpening strength A of `v^p`, `p = 1 + A·exp(−B (d − z_avg))`.
-    pub sharpen: f32,
-    /// CSSM: sharpening falloff B, per linear depth unit.
-    pub sharpen_falloff: f32,
-    /// Soft techniques: cap on the search and filter widths in texels ([`soft_max_width`];
-    /// 0 otherwise).
-    pub max_width: f32,
-    /// Padding to the WGSL struct's 16-byte alignment.
-    pub _pad1: u32,
-}
-
-/// MSM flag: Hausdorff reconstruction.
-pub const MSM_HAUSDORFF: u32 = 1;
-/// MSM flag: moments stored through the optimized quantization.
-pub const MSM_QUANTIZED: u32 = 2;
 
 impl LightGpu {
     /// The GPU description of `light`.
     pub fn new(light: &Light) -> Self {
         let view = light.view();
-        let (technique, radius, kernel, blocker_samples, filter_samples, max_search) =
-            match light.shadow.technique {
-                Technique::Hard => (0, 0, 0, 0, 0, 0.0),
-                Technique::Pcf { radius, kernel } => {
-                    let k = match kernel {
-                        PcfKernel::Box => 0,
-                        PcfKernel::Tent => 1,
-                        PcfKernel::Hardware => 2,
-                    };
-                    (1, radius, k, 0, 0, 0.0)
-                }
-                Technique::Pcss {
-                    blocker_samples,
-                    filter_samples,
-                    max_search,
-                } => (2, 0, 0, blocker_samples, filter_samples, max_search),
-                Technique::Vsm { .. } => (3, 0, 0, 0, 0, 0.0),
-                Technique::Evsm { .. } => (4, 0, 0, 0, 0, 0.0),
-                Technique::Esm { .. } => (5, 0, 0, 0, 0, 0.0),
-                Technique::Msm { .. } => (6, 0, 0, 0, 0, 0.0),
-                Technique::Csm { .. } => (7, 0, 0, 0, 0, 0.0),
-                Technique::Cssm { soft, .. } => (8, 0, 0, 0, 0, soft.max_search),
-                Technique::Vssm { soft, .. } => (9, 0, 0, 0, 0, soft.max_search),
-                Technique::MsmSoft { soft, .. } => (10, 0, 0, 0, 0, soft.max_search),
-            };
+        let (technique, radius, kernel, blocker_samples, filter_samples, max_search) = match light
+            .shadow
+            .technique
+        {
+            Technique::Hard => (TECHNIQUE_HARD, 0, 0, 0, 0, 0.0),
+            Technique::Pcf { radius, kernel } => {
+                let k = match kernel {
+                    PcfKernel::Box => 0,
+                    PcfKernel::Tent => 1,
+                    PcfKernel::Hardware => 2,
+                };
+                (TECHNIQUE_PCF, radius, k, 0, 0, 0.0)
+            }
+            Technique::Pcss {
+                blocker_samples,
+                filter_samples,
+                max_search,
+            } => (
+                TECHNIQUE_PCSS,
+                0,
+                0,
+                blocker_samples,
+                filter_samples,
+                max_search,
+            ),
+            Technique::Vsm { .. } => (TECHNIQUE_VSM, 0, 0, 0, 0, 0.0),
+            Technique::Evsm { .. } => (TECHNIQUE_EVSM, 0, 0, 0, 0, 0.0),
+            Technique::Esm { .. } => (TECHNIQUE_ESM, 0, 0, 0, 0, 0.0),
+            Technique::Msm { .. } => (TECHNIQUE_MSM, 0, 0, 0, 0, 0.0),
+            Technique::Csm { .. } => (TECHNIQUE_CSM, 0, 0, 0, 0, 0.0),
+            Technique::Cssm { soft, .. } => (TECHNIQUE_CSSM, 0, 0, 0, 0, soft.max_search),
+            Technique::Vssm { soft, .. } => (TECHNIQUE_VSSM, 0, 0, 0, 0, soft.max_search),
+            Technique::MsmSoft { soft, .. } => (TECHNIQUE_MSM_SOFT, 0, 0, 0, 0, soft.max_search),
+        };
         let (bleed, min_variance, exp_pos, exp_neg, moments) = match light.shadow.technique {
             Technique::Vsm {
                 bleed,
@@ -399,51 +320,6 @@ fn quantized_msm_range() -> ([f32; 4], [f32; 4]) {
     })
 }
 
-/// How a depth buffer is linearized: `kernels/linearize.wgsl`'s params and the first member
-/// (`depth`) of every encoding's params (mirrors `DepthParams` in
-/// `kernels/shared/linear_depth.wgsl`).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct LinearizeParams {
-    /// 1 for a perspective (spot) depth buffer.
-    pub perspective: u32,
-    /// Near plane.
-    pub near: f32,
-    /// Far plane.
-    pub far: f32,
-    /// Padding.
-    pub _pad: u32,
-}
-
-impl LinearizeParams {
-    /// An orthographic depth buffer: depth in [0, 1] is linear already (only clamped, and
-    /// non-finite values replaced).
-    pub const ORTHOGRAPHIC: Self = Self {
-        perspective: 0,
-        near: 0.0,
-        far: 1.0,
-        _pad: 0,
-    };
-
-    /// Parameters for `light`'s depth buffer.
-    pub fn new(light: &Light) -> Self {
-        Self {
-            perspective: u32::from(matches!(light.kind, LightKind::Spot { .. })),
-            near: light.near,
-            far: light.far,
-            _pad: 0,
-        }
-    }
-}
-
-/// Parameters of `kernels/vsm.wgsl` (mirrors its `Params`).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct VsmParams {
-    /// The depth buffer's linearization.
-    pub depth: LinearizeParams,
-}
-
 /// Name of light `i`'s rasterized depth map (imported into the graph).
 pub fn depth_name(i: usize) -> String {
     format!("light{i}.depth")
@@ -694,11 +570,6 @@ pub fn map_type(light: &Light) -> &'static str {
     }
 }
 
-/// Number of mip levels of a full chain for a `width`×`height` map (down to 1×1).
-pub fn mip_levels(width: u32, height: u32) -> u32 {
-    32 - width.max(height).max(1).leading_zeros()
-}
-
 /// Whether an MSM technique keeps its moments through the optimized quantization: every
 /// 16-bit storage does, and so does every summed-area table (`msm_soft`, `filter = "sat"`),
 /// whatever the storage. A table rounds each moment on its own to the coding's step (10⁻⁵ of
@@ -729,70 +600,6 @@ pub fn csm_z_channels(terms: u32) -> u32 {
 /// Four-channel CSM-Z maps CSSM with `terms` terms needs.
 pub fn csm_z_maps(terms: u32) -> u32 {
     csm_z_channels(terms).div_ceil(4)
-}
-
-/// Parameters of `kernels/msm.wgsl` (mirrors its `Params`).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct MsmParams {
-    /// The depth buffer's linearization.
-    pub depth: LinearizeParams,
-    /// 1: store the optimized quantization of the moments; 0: the raw powers.
-    pub quantized: u32,
-    /// Padding.
-    pub _pad: [u32; 3],
-}
-
-/// Parameters of `kernels/csm.wgsl` (mirrors its `Params`).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct CsmParams {
-    /// The depth buffer's linearization.
-    pub depth: LinearizeParams,
-    /// Index of the map `dst0` receives in the light's sequence of maps: the ⌈M/2⌉ CSM basis
-    /// maps ([`csm_maps`]), then (CSSM) the CSM-Z maps ([`csm_z_maps`]).
-    pub first_map: u32,
-    /// Maps this dispatch writes (`dst0` … `dst<maps − 1>`; 1 to [`CSM_OUTPUTS`]).
-    pub maps: u32,
-    /// Total terms M (a pair past M is written as zeros).
-    pub terms: u32,
-    /// Padding.
-    pub _pad: u32,
-}
-
-/// Storage-texture outputs of `kernels/csm.wgsl` (`dst0` … `dst3`): what WebGPU's default
-/// `max_storage_textures_per_shader_stage` allows every device, so one read of the depth
-/// writes up to four basis maps.
-pub const CSM_OUTPUTS: u32 = 4;
-
-/// Parameters of `kernels/evsm.wgsl` and `kernels/esm.wgsl` (mirror their `Params`).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct ExpParams {
-    /// The depth buffer's linearization.
-    pub depth: LinearizeParams,
-    /// c⁺ (EVSM) or c (ESM).
-    pub exp_pos: f32,
-    /// c⁻ (EVSM4).
-    pub exp_neg: f32,
-    /// ESM: 1 stores `exp(c (z − 1))` (for a summed-area table, which sums linearly) instead
-    /// of the log moment `c z`.
-    pub linear: u32,
-    /// Padding.
-    pub _pad: u32,
-}
-
-impl ExpParams {
-    /// Exponents `pos`, `neg` on an orthographic depth buffer.
-    pub fn new(exp_pos: f32, exp_neg: f32) -> Self {
-        Self {
-            depth: LinearizeParams::ORTHOGRAPHIC,
-            exp_pos,
-            exp_neg,
-            linear: 0,
-            _pad: 0,
-        }
-    }
 }
 
 /// The texel format of a `channels`-channel representation (1–4) at `storage` precision.
@@ -1129,4 +936,22 @@ pub fn shading_block(lights: &[Light]) -> String {
         "fn light_visibility(i: u32, p: vec3<f32>, n: vec3<f32>, dpdx: vec3<f32>, dpdy: vec3<f32>) -> f32 {{\n    switch i {{\n{cases}        default: {{ return 1.0; }}\n    }}\n}}\n"
     );
     s
+}
+
+/// The largest exponent a summed-area table keeps accurate (`None` without the `sat` filter).
+///
+/// Window sums are linear, so a table's error is absolute: the fixed-point coding's step per
+/// mean is `½ / scale ≈ range · A / 2³²` for windows of `A` texels (src/sat.rs), the f32
+/// coding's no better. EVSM's squared moment spans `e^{−2c}..e^{2c}`; its step at the centre
+/// of the depth range (moment 1) stays below 2⁻¹⁰ while `e^{2c} · A / 2³² ≤ 2⁻¹⁰`, so
+/// `c ≤ ½ ln(2²² / A)`. ESM's `exp(c (z − 1)) ∈ [e^{−c}, 1]` has visibility
+/// `mean · e^{c (1 − d)}`, whose error at mid depth stays below 2⁻¹⁰ while
+/// `e^{c/2} · A / 2³² ≤ 2⁻¹⁰`, so `c ≤ 2 ln(2²² / A)`.
+pub fn sat_exponent_limit(filter: &Filter, esm: bool) -> Option<f32> {
+    let Filter::Sat { width, .. } = *filter else {
+        return None;
+    };
+    let area = lookup_area(width, width) as f64;
+    let c = 0.5 * (f64::from(1u32 << 22) / area).ln().max(0.02);
+    Some(if esm { 4.0 * c } else { c } as f32)
 }

@@ -6,13 +6,14 @@ use std::ops::Range;
 use toml::Spanned;
 
 use super::ctx::Ctx;
-use super::defaults::{
-    DEFAULT_MAX_SEARCH, DEFAULT_SHARPEN, DEFAULT_SHARPEN_FALLOFF, default_moment_bias,
-    default_soft_moment_bias, exponent_limit, sat_exponent_limit,
-};
 use super::format::ShadowFile;
 use super::{BlurKernel, Filter, PcfKernel, Prefilter, Shadow, Soft, Storage, Technique};
 use crate::error::Result;
+use crate::model::{
+    DEFAULT_MAX_SEARCH, DEFAULT_SHARPEN, DEFAULT_SHARPEN_FALLOFF, default_moment_bias,
+    default_soft_moment_bias, exponent_limit,
+};
+use crate::technique::sat_exponent_limit;
 
 /// The technique-specific keys each technique accepts (the common ones — technique, bias,
 /// slope_bias, normal_bias — are always allowed).
