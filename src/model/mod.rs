@@ -4,10 +4,14 @@
 //! (`technique`) all build or read these values.
 
 mod defaults;
+mod params;
 
 pub use defaults::{
     DEFAULT_MAX_SEARCH, DEFAULT_SHARPEN, DEFAULT_SHARPEN_FALLOFF, default_moment_bias,
     default_soft_moment_bias, exponent_limit,
+};
+pub use params::{
+    Needs, ParamDefault, ParamKind, ParamSource, ParamSpec, ParamValue, ParamValues, check, keys,
 };
 
 use glam::{Mat4, Vec3};

@@ -1,0 +1,72 @@
+//! `pcf`: percentage-closer filtering over a `2r + 1` window, or the hardware 2×2 comparison.
+
+use super::params::{choice, int};
+use super::{TechniqueDef, no_clamp};
+use crate::gpu_data::TECHNIQUE_PCF;
+use crate::model::{Needs, ParamSpec, ParamValue, ParamValues, PcfKernel, Technique};
+
+const KERNELS: &[(&str, PcfKernel)] = &[
+    ("box", PcfKernel::Box),
+    ("tent", PcfKernel::Tent),
+    ("hardware", PcfKernel::Hardware),
+];
+
+const PARAMS: &[ParamSpec] = &[
+    choice(
+        "kernel",
+        &["box", "tent", "hardware"],
+        "box",
+        "window weights, or the hardware 2×2 comparison",
+    ),
+    ParamSpec {
+        needs: &[Needs {
+            key: "kernel",
+            one_of: &["box", "tent"],
+            why: "does not apply to the hardware 2×2 kernel",
+        }],
+        ..int("radius", 0, 32, 1, "window radius in texels")
+    },
+];
+
+fn build(v: &ParamValues) -> Technique {
+    let kernel = KERNELS
+        .iter()
+        .find(|(n, _)| *n == v.choice("kernel"))
+        .map_or(PcfKernel::Box, |&(_, k)| k);
+    Technique::Pcf {
+        // The hardware kernel reads no radius; it keeps the default.
+        radius: match v.get("radius") {
+            Some(ParamValue::Int(r)) => r,
+            _ => 1,
+        },
+        kernel,
+    }
+}
+
+fn values(t: &Technique) -> ParamValues {
+    let mut out = ParamValues::default();
+    if let Technique::Pcf { radius, kernel } = *t {
+        let name = KERNELS
+            .iter()
+            .find(|(_, k)| *k == kernel)
+            .map_or("box", |(n, _)| n);
+        out.set("kernel", ParamValue::Choice(name));
+        if kernel != PcfKernel::Hardware {
+            out.set("radius", ParamValue::Int(radius));
+        }
+    }
+    out
+}
+
+/// `pcf`.
+pub(super) static DEF: TechniqueDef = TechniqueDef {
+    name: "pcf",
+    id: TECHNIQUE_PCF,
+    doc: "percentage-closer filtering",
+    params: &[PARAMS],
+    build,
+    values,
+    clamp: no_clamp,
+    area_light: false,
+    example: "scenes/bunny.toml",
+};
