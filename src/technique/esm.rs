@@ -2,9 +2,13 @@
 //! (f16 `c·z` would cost percent-level visibility error).
 
 use super::TechniqueDef;
+use super::no_variant;
 use super::params::{
     Clamp, ClampReason, FILTER, clamp, filter, filter_values, float, sat_exponent_limit,
 };
+use super::shade::{ShadeInput, prefiltered};
+use crate::filter::BlurMode;
+use crate::gpu_data::ExpParams;
 use crate::gpu_data::TECHNIQUE_ESM;
 use crate::model::{ParamSpec, ParamValue, ParamValues, Technique};
 
@@ -27,6 +31,24 @@ fn clamp_exponent(t: &mut Technique, out: &mut Vec<Clamp>) {
     }
 }
 
+/// The log moment `c z`, or for a summed-area table (which sums linearly) `exp(c (z − 1))`,
+/// filtered in log space.
+fn nodes(n: &mut super::LightNodes) -> ShadeInput {
+    let Technique::Esm { filter, exponent } = n.light.shadow.technique else {
+        return n.one(n.depth.clone());
+    };
+    let mut params = ExpParams::new(exponent, 0.0);
+    params.depth = n.lin;
+    params.linear = u32::from(matches!(filter, crate::model::Filter::Sat { .. }));
+    let format = wgpu::TextureFormat::R32Float;
+    n.encoded(
+        "esm",
+        format,
+        bytemuck::bytes_of(&params),
+        BlurMode::LogSumExp,
+    )
+}
+
 /// `esm`.
 pub(super) static DEF: TechniqueDef = TechniqueDef {
     name: "esm",
@@ -38,6 +60,19 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
         exponent: v.float("exponent"),
     },
     values,
+    gpu: |t, g| {
+        if let Technique::Esm { exponent, .. } = *t {
+            g.exp_pos = exponent;
+            g.moments = 1;
+        }
+    },
+    nodes,
+    visibility: |light, maps| {
+        prefiltered(light, maps, "shared/vis_esm", "vis_esm", "vis_esm_of_sat")
+    },
+    variant: no_variant,
+    // Stored linearly for a table: `exp(c (z − 1)) ∈ [e^{−c}, 1]`, coded as ±1.
+    value_range: |_| ([-1.0, 0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]),
     clamp: clamp_exponent,
     area_light: false,
     example: "scenes/techniques/esm.toml",

@@ -2,11 +2,16 @@
 //! then `exp(c⁺ z')` and its square, plus (EVSM4) `−exp(−c⁻ z')` and its square.
 
 use super::TechniqueDef;
+use super::no_variant;
+use super::nodes::moments_format;
 use super::params::{
     Clamp, ClampReason, FILTER, FLOAT_FORMAT, clamp, float, prefilter, prefilter_values,
     sat_exponent_limit,
 };
+use super::shade::{ShadeInput, prefiltered};
+use crate::filter::BlurMode;
 use crate::gpu_data::TECHNIQUE_EVSM;
+use crate::gpu_data::{ExpParams, LightGpu};
 use crate::model::{ParamSpec, ParamValue, ParamValues, Technique, exponent_limit};
 
 /// c⁻ of EVSM2, which stores no negative moments (EVSM4's default).
@@ -99,6 +104,64 @@ fn clamp_exponents(t: &mut Technique, out: &mut Vec<Clamp>) {
     }
 }
 
+fn gpu(t: &Technique, g: &mut LightGpu) {
+    if let Technique::Evsm {
+        four,
+        exp_pos,
+        exp_neg,
+        bleed,
+        min_variance,
+        ..
+    } = *t
+    {
+        g.bleed = bleed;
+        g.min_variance = min_variance;
+        g.exp_pos = exp_pos;
+        g.exp_neg = exp_neg;
+        g.moments = if four { 4 } else { 2 };
+    }
+}
+
+fn nodes(n: &mut super::LightNodes) -> ShadeInput {
+    let Technique::Evsm {
+        prefilter,
+        four,
+        exp_pos,
+        exp_neg,
+        ..
+    } = n.light.shadow.technique
+    else {
+        return n.one(n.depth.clone());
+    };
+    let format = moments_format(prefilter.storage, if four { 4 } else { 2 });
+    let params = ExpParams {
+        depth: n.lin,
+        ..ExpParams::new(exp_pos, exp_neg)
+    };
+    n.encoded(
+        "evsm",
+        format,
+        bytemuck::bytes_of(&params),
+        BlurMode::Linear,
+    )
+}
+
+/// Exponential moments span orders of magnitude, most of them close to 0: coded about 0
+/// (range ±max|v|) every value keeps f32's relative precision through the lookups' weighting,
+/// where a centred offset would leave the small ones an absolute error of 2⁻²⁴ of the largest.
+/// The moments `±exp(±c z')` and their squares over z' ∈ [−1, 1].
+fn value_range(t: &Technique) -> ([f32; 4], [f32; 4]) {
+    let Technique::Evsm {
+        exp_pos, exp_neg, ..
+    } = *t
+    else {
+        return ([0.0; 4], [1.0; 4]);
+    };
+    let (p, n) = (exp_pos, exp_neg);
+    let hi = [p.exp(), (2.0 * p).exp(), n.exp(), (2.0 * n).exp()];
+    (hi.map(|v| -v), hi)
+}
+
 /// `evsm2`.
 pub(super) static EVSM2: TechniqueDef = TechniqueDef {
     name: "evsm2",
@@ -107,6 +170,13 @@ pub(super) static EVSM2: TechniqueDef = TechniqueDef {
     params: &[FLOAT_FORMAT, FILTER, COMMON],
     build: |v| build(v, false),
     values,
+    gpu,
+    nodes,
+    visibility: |light, maps| {
+        prefiltered(light, maps, "shared/vis_evsm", "vis_evsm", "vis_evsm_of")
+    },
+    variant: no_variant,
+    value_range,
     clamp: clamp_exponents,
     area_light: false,
     example: "scenes/techniques/evsm2.toml",
@@ -120,6 +190,13 @@ pub(super) static EVSM4: TechniqueDef = TechniqueDef {
     params: &[FLOAT_FORMAT, FILTER, COMMON, NEG],
     build: |v| build(v, true),
     values,
+    gpu,
+    nodes,
+    visibility: |light, maps| {
+        prefiltered(light, maps, "shared/vis_evsm", "vis_evsm", "vis_evsm_of")
+    },
+    variant: no_variant,
+    value_range,
     clamp: clamp_exponents,
     area_light: false,
     example: "scenes/techniques/evsm4.toml",

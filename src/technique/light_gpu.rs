@@ -1,127 +1,19 @@
 //! A light's GPU description ([`LightGpu`], mirrored in `crate::gpu_data`) filled from its
 //! technique, and the summed-area-table coding a technique's representation needs.
 
-use crate::gpu_data::{
-    LightGpu, MSM_HAUSDORFF, MSM_QUANTIZED, TECHNIQUE_CSM, TECHNIQUE_CSSM, TECHNIQUE_ESM,
-    TECHNIQUE_EVSM, TECHNIQUE_HARD, TECHNIQUE_MSM, TECHNIQUE_MSM_SOFT, TECHNIQUE_PCF,
-    TECHNIQUE_PCSS, TECHNIQUE_VSM, TECHNIQUE_VSSM,
-};
-use crate::model::{Filter, Light, LightKind, PcfKernel, Soft, Technique, mip_levels};
+use crate::gpu_data::LightGpu;
+use crate::model::{Filter, Light, LightKind, Soft, Technique, mip_levels};
 use crate::sat::{SatCoding, SatVariant, lookup_area};
 
-use super::msm_quantized;
-
 impl LightGpu {
-    /// The GPU description of `light`.
+    /// The GPU description of `light`: its matrices and biases, its technique's id and fields
+    /// ([`super::TechniqueDef::gpu`]), the filter's mip fields, the table's coding and the soft
+    /// width cap.
     pub fn new(light: &Light) -> Self {
         let view = light.view();
-        let (technique, radius, kernel, blocker_samples, filter_samples, max_search) = match light
-            .shadow
-            .technique
-        {
-            Technique::Hard => (TECHNIQUE_HARD, 0, 0, 0, 0, 0.0),
-            Technique::Pcf { radius, kernel } => {
-                let k = match kernel {
-                    PcfKernel::Box => 0,
-                    PcfKernel::Tent => 1,
-                    PcfKernel::Hardware => 2,
-                };
-                (TECHNIQUE_PCF, radius, k, 0, 0, 0.0)
-            }
-            Technique::Pcss {
-                blocker_samples,
-                filter_samples,
-                max_search,
-            } => (
-                TECHNIQUE_PCSS,
-                0,
-                0,
-                blocker_samples,
-                filter_samples,
-                max_search,
-            ),
-            Technique::Vsm { .. } => (TECHNIQUE_VSM, 0, 0, 0, 0, 0.0),
-            Technique::Evsm { .. } => (TECHNIQUE_EVSM, 0, 0, 0, 0, 0.0),
-            Technique::Esm { .. } => (TECHNIQUE_ESM, 0, 0, 0, 0, 0.0),
-            Technique::Msm { .. } => (TECHNIQUE_MSM, 0, 0, 0, 0, 0.0),
-            Technique::Csm { .. } => (TECHNIQUE_CSM, 0, 0, 0, 0, 0.0),
-            Technique::Cssm { soft, .. } => (TECHNIQUE_CSSM, 0, 0, 0, 0, soft.max_search),
-            Technique::Vssm { soft, .. } => (TECHNIQUE_VSSM, 0, 0, 0, 0, soft.max_search),
-            Technique::MsmSoft { soft, .. } => (TECHNIQUE_MSM_SOFT, 0, 0, 0, 0, soft.max_search),
-        };
-        let (bleed, min_variance, exp_pos, exp_neg, moments) = match light.shadow.technique {
-            Technique::Vsm {
-                bleed,
-                min_variance,
-                ..
-            }
-            | Technique::Vssm {
-                bleed,
-                min_variance,
-                ..
-            } => (bleed, min_variance, 0.0, 0.0, 2),
-            Technique::Evsm {
-                four,
-                exp_pos,
-                exp_neg,
-                bleed,
-                min_variance,
-                ..
-            } => (
-                bleed,
-                min_variance,
-                exp_pos,
-                exp_neg,
-                if four { 4 } else { 2 },
-            ),
-            Technique::Esm { exponent, .. } => (0.0, 0.0, exponent, 0.0, 1),
-            Technique::Msm { bleed, .. } | Technique::MsmSoft { bleed, .. } => {
-                (bleed, 0.0, 0.0, 0.0, 4)
-            }
-            _ => (0.0, 0.0, 0.0, 0.0, 0),
-        };
-        let (moment_bias, msm_flags) = match light.shadow.technique {
-            Technique::Msm {
-                hausdorff,
-                moment_bias,
-                ..
-            }
-            | Technique::MsmSoft {
-                hausdorff,
-                moment_bias,
-                ..
-            } => (
-                moment_bias,
-                msm_flags(hausdorff, msm_quantized(&light.shadow.technique)),
-            ),
-            _ => (0.0, 0),
-        };
-        let (csm_terms, csm_attenuation, csm_offset, csm_scale) = match light.shadow.technique {
-            Technique::Csm {
-                terms,
-                attenuation,
-                offset,
-                scale,
-                ..
-            }
-            | Technique::Cssm {
-                terms,
-                attenuation,
-                offset,
-                scale,
-                ..
-            } => (terms, attenuation, offset, scale),
-            _ => (0, 0.0, 0.0, 1.0),
-        };
-        let (sharpen, sharpen_falloff) = match light.shadow.technique {
-            Technique::Cssm {
-                sharpen,
-                sharpen_falloff,
-                ..
-            } => (sharpen, sharpen_falloff),
-            _ => (0.0, 0.0),
-        };
-        let (mip_levels, filter_lod, max_anisotropy) = match light.shadow.technique.filter() {
+        let t = &light.shadow.technique;
+        let def = super::of(t);
+        let (mip_levels, filter_lod, max_anisotropy) = match t.filter() {
             Some(Filter::Mips {
                 width,
                 max_anisotropy,
@@ -136,7 +28,7 @@ impl LightGpu {
             LightKind::Directional { .. } => (0, -1.0),
             LightKind::Spot { fov_degrees } => (1, (0.5 * fov_degrees.to_radians()).cos()),
         };
-        Self {
+        let mut g = Self {
             view_proj: (light.projection() * view).to_cols_array_2d(),
             view: view.to_cols_array_2d(),
             radiance: light.radiance.to_array(),
@@ -151,35 +43,20 @@ impl LightGpu {
             bias: light.shadow.bias,
             normal_bias: light.shadow.normal_bias,
             cos_outer,
-            technique,
-            radius,
-            kernel,
-            blocker_samples,
-            filter_samples,
-            max_search,
-            bleed,
-            min_variance,
-            exp_pos,
-            exp_neg,
-            moments,
-            moment_bias,
-            msm_flags,
-            csm_terms,
-            csm_attenuation,
-            csm_offset,
-            csm_scale,
+            technique: def.id,
+            csm_scale: 1.0,
             mip_levels,
             filter_lod,
-            filter_width: 0.0,
             max_anisotropy,
-            sat_offset: [0.0; 4],
             sat_scale: [1.0; 4],
-            sharpen,
-            sharpen_falloff,
             max_width: soft_max_width(light).unwrap_or(0.0),
-            _pad1: 0,
+            ..bytemuck::Zeroable::zeroed()
+        };
+        if let Some(soft) = t.soft() {
+            g.max_search = soft.max_search;
         }
-        .with_sat(light)
+        (def.gpu)(t, &mut g);
+        g.with_sat(light)
     }
 
     /// The SAT fields for `light` (left as they are without a summed-area table or when its
@@ -195,11 +72,6 @@ impl LightGpu {
         }
         self
     }
-}
-
-/// The MSM flags of a reconstruction and representation.
-fn msm_flags(hausdorff: bool, quantized: bool) -> u32 {
-    u32::from(hausdorff) * MSM_HAUSDORFF + u32::from(quantized) * MSM_QUANTIZED
 }
 
 /// The largest square a soft technique reads (blocker search or filter), in texels:
@@ -271,30 +143,17 @@ pub fn sat_coding(light: &Light) -> crate::error::Result<Option<SatCoding>> {
 
 /// Per channel, the range of the values a technique's table sums (see [`sat_coding`]).
 fn value_range(technique: &Technique) -> ([f32; 4], [f32; 4]) {
-    match *technique {
-        // Exponential moments span orders of magnitude, most of them close to 0: coded about 0
-        // (range ±max|v|) every value keeps f32's relative precision through the lookups'
-        // weighting, where a centred offset would leave the small ones an absolute error of
-        // 2⁻²⁴ of the largest.
-        Technique::Evsm {
-            exp_pos, exp_neg, ..
-        } => {
-            let (p, n) = (exp_pos, exp_neg);
-            let hi = [p.exp(), (2.0 * p).exp(), n.exp(), (2.0 * n).exp()];
-            (hi.map(|v| -v), hi)
-        }
-        Technique::Esm { .. } => ([-1.0, 0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]),
-        Technique::Msm { .. } | Technique::MsmSoft { .. } if msm_quantized(technique) => {
-            quantized_msm_range()
-        }
-        Technique::Csm { .. } | Technique::Cssm { .. } => ([-1.0; 4], [1.0; 4]),
-        _ => ([0.0; 4], [1.0; 4]),
-    }
+    (super::of(technique).value_range)(technique)
+}
+
+/// The range of values in [0, 1]: depth moments.
+pub(super) fn unit_range(_: &Technique) -> ([f32; 4], [f32; 4]) {
+    ([0.0; 4], [1.0; 4])
 }
 
 /// The range of MSM's optimized quantization over the moment curve (see [`sat_coding`]),
 /// computed once (every frame builds each light's `LightGpu`, which asks for it).
-fn quantized_msm_range() -> ([f32; 4], [f32; 4]) {
+pub(super) fn quantized_msm_range() -> ([f32; 4], [f32; 4]) {
     static RANGE: std::sync::OnceLock<([f32; 4], [f32; 4])> = std::sync::OnceLock::new();
     *RANGE.get_or_init(|| {
         let (mut lo, mut hi) = ([f64::MAX; 4], [f64::MIN; 4]);

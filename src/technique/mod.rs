@@ -26,12 +26,13 @@ pub use crate::gpu_data::{
     MsmParams, VsmParams,
 };
 pub use crate::model::mip_levels;
-use crate::model::{ParamSource, ParamSpec, ParamValues, Technique};
+use crate::model::{Light, ParamSource, ParamSpec, ParamValues, Technique};
+pub use csm::{csm_maps, csm_z_channels, csm_z_maps};
+use light_gpu::unit_range;
 pub use light_gpu::{sat_coding, sat_variant, soft_lookup_area, soft_max_width, soft_width_cap};
-pub use nodes::{
-    add_light_nodes, csm_maps, csm_z_channels, csm_z_maps, depth_name, linear_name, map_channels,
-    map_type, moments_format, msm_quantized,
-};
+pub use msm::msm_quantized;
+pub use nodes::LightNodes;
+pub use nodes::{add_light_nodes, depth_name, linear_name, map_channels, map_type, moments_format};
 pub use params::{Clamp, ClampReason, sat_exponent_limit};
 pub use shade::{ShadeInput, VisibilityBody, shade_key, shading_block, visibility_body};
 
@@ -56,6 +57,20 @@ pub struct TechniqueDef {
     /// Values past what the technique keeps accurate, clamped after checking (EVSM's and
     /// ESM's exponents), each recorded.
     pub clamp: fn(&mut Technique, &mut Vec<Clamp>),
+    /// Its fields of the light's GPU description (`LightGpu::new` fills the id, the
+    /// matrices, the filter's, the table's and the soft search cap's fields).
+    pub gpu: fn(&Technique, &mut LightGpu),
+    /// The nodes it adds to the light's graph after the depth and linear depth, and what the
+    /// shading reads.
+    pub nodes: fn(&mut LightNodes) -> ShadeInput,
+    /// Its visibility in the shading block: modules and statements with the light's maps
+    /// bound as given.
+    pub visibility: fn(&Light, &[String]) -> VisibilityBody,
+    /// What its visibility code depends on besides its name, table, footprint and maps (the
+    /// shading kernel's cache key: PCF's hardware kernel, CSM's terms).
+    pub variant: fn(&Technique) -> String,
+    /// Per channel, the range of the values its summed-area table sums (`sat_coding`).
+    pub value_range: fn(&Technique) -> ([f32; 4], [f32; 4]),
     /// Whether it needs an area light (`size` > 0): PCSS and the soft techniques.
     pub area_light: bool,
     /// A scene that shows it.
@@ -119,6 +134,14 @@ pub fn accepts(def: &TechniqueDef, key: &str, name: &str) -> bool {
     def.params.iter().flat_map(|t| t.iter()).any(|s| {
         s.key == key && matches!(s.kind, crate::model::ParamKind::Choice(o) if o.contains(&name))
     })
+}
+
+/// No GPU fields besides the common ones.
+fn no_gpu(_: &Technique, _: &mut LightGpu) {}
+
+/// Nothing besides the name.
+fn no_variant(_: &Technique) -> String {
+    String::new()
 }
 
 /// No clamps.

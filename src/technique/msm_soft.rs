@@ -2,7 +2,10 @@
 //! four moments over the search square, then MSM at the penumbra width.
 
 use super::msm::{moment_bias, msm_values};
+use super::msm::{moments, msm_gpu, value_range};
+use super::no_variant;
 use super::params::{MSM, MSM_FORMAT, SOFT, soft, soft_values, storage};
+use super::shade::soft_call;
 use super::{TechniqueDef, no_clamp};
 use crate::gpu_data::TECHNIQUE_MSM_SOFT;
 use crate::model::{ParamSpec, ParamValue, ParamValues, Technique, default_soft_moment_bias};
@@ -39,6 +42,11 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
         bleed: v.float("bleed_reduction"),
     },
     values,
+    gpu: msm_gpu,
+    nodes: moments,
+    visibility: |light, maps| soft_call(light, maps, "shared/vis_msm_soft", "vis_msm_soft"),
+    variant: no_variant,
+    value_range,
     clamp: no_clamp,
     area_light: true,
     example: "scenes/techniques/msm_soft.toml",

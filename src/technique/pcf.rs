@@ -1,8 +1,12 @@
 //! `pcf`: percentage-closer filtering over a `2r + 1` window, or the hardware 2×2 comparison.
 
 use super::params::{choice, int};
+use super::shade::{ShadeInput, VisibilityBody, call, first};
+use super::unit_range;
 use super::{TechniqueDef, no_clamp};
+use crate::gpu_data::LightGpu;
 use crate::gpu_data::TECHNIQUE_PCF;
+use crate::model::Light;
 use crate::model::{Needs, ParamSpec, ParamValue, ParamValues, PcfKernel, Technique};
 
 const KERNELS: &[(&str, PcfKernel)] = &[
@@ -58,6 +62,35 @@ fn values(t: &Technique) -> ParamValues {
     out
 }
 
+fn hardware(t: &Technique) -> bool {
+    matches!(
+        t,
+        Technique::Pcf {
+            kernel: PcfKernel::Hardware,
+            ..
+        }
+    )
+}
+
+/// The radius and the kernel's index (`LightGpu::kernel`: 0 box, 1 tent, 2 hardware).
+fn gpu(t: &Technique, g: &mut LightGpu) {
+    if let Technique::Pcf { radius, kernel } = *t {
+        g.radius = radius;
+        g.kernel = KERNELS.iter().position(|(_, k)| *k == kernel).unwrap_or(0) as u32;
+    }
+}
+
+fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
+    if hardware(&light.shadow.technique) {
+        let body = format!(
+            "return vis_pcf_hardware({}, cmp_sampler, l, s);",
+            first(maps)
+        );
+        return VisibilityBody::simple(vec!["shared/vis_pcf"], body);
+    }
+    call("shared/vis_pcf", "vis_pcf", maps)
+}
+
 /// `pcf`.
 pub(super) static DEF: TechniqueDef = TechniqueDef {
     name: "pcf",
@@ -66,6 +99,24 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     params: &[PARAMS],
     build,
     values,
+    gpu,
+    nodes: |n| match n.light.shadow.technique {
+        // The hardware comparison sampler reads the depth itself.
+        Technique::Pcf {
+            kernel: PcfKernel::Hardware,
+            ..
+        } => ShadeInput {
+            maps: vec![n.depth.clone()],
+            wgsl_type: "texture_depth_2d",
+        },
+        _ => {
+            let linear = n.linear.clone();
+            n.one(linear)
+        }
+    },
+    visibility,
+    variant: |t| u8::from(hardware(t)).to_string(),
+    value_range: unit_range,
     clamp: no_clamp,
     area_light: false,
     example: "scenes/bunny.toml",

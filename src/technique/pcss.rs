@@ -1,7 +1,9 @@
 //! `pcss`: percentage-closer soft shadows (Fernando 2005).
 
 use super::params::{float, int};
+use super::shade::call;
 use super::{TechniqueDef, no_clamp};
+use super::{no_variant, unit_range};
 use crate::gpu_data::TECHNIQUE_PCSS;
 use crate::model::{DEFAULT_MAX_SEARCH, ParamSpec, ParamValue, ParamValues, Technique};
 
@@ -44,6 +46,25 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
         max_search: v.float("max_search"),
     },
     values,
+    gpu: |t, g| {
+        if let Technique::Pcss {
+            blocker_samples,
+            filter_samples,
+            max_search,
+        } = *t
+        {
+            g.blocker_samples = blocker_samples;
+            g.filter_samples = filter_samples;
+            g.max_search = max_search;
+        }
+    },
+    nodes: |n| {
+        let linear = n.linear.clone();
+        n.one(linear)
+    },
+    visibility: |_, maps| call("shared/vis_pcss", "vis_pcss", maps),
+    variant: no_variant,
+    value_range: unit_range,
     clamp: no_clamp,
     area_light: true,
     example: "scenes/colonnade.toml",

@@ -1,14 +1,15 @@
 //! The shading kernel's generated block: per light the maps it binds and the WGSL visibility
-//! call of its technique.
+//! call of its technique ([`super::TechniqueDef::visibility`]), with the helpers the
+//! techniques' visibility bodies share.
 
 use std::fmt::Write;
 
 use crate::graph::Graph;
-use crate::model::{Filter, Light, PcfKernel, Technique};
+use crate::model::{Filter, Light};
 use crate::sat::SatVariant;
 
 use super::light_gpu::sat_variant;
-use super::nodes::{add_light_nodes, csm_maps};
+use super::nodes::add_light_nodes;
 
 /// How the shading kernel reads a light's maps.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -33,171 +34,90 @@ pub struct VisibilityBody {
     pub fetches: Option<String>,
 }
 
+impl VisibilityBody {
+    /// A body of `module` whose fetches sum from its calls.
+    pub fn simple(modules: Vec<&'static str>, body: String) -> Self {
+        Self {
+            modules,
+            body,
+            fetches: None,
+        }
+    }
+}
+
 /// The modules, statements and fetch count of light `light`'s visibility with its maps bound
 /// as `maps`.
 pub fn visibility_body(light: &Light, maps: &[String]) -> VisibilityBody {
-    let simple = |modules: Vec<&'static str>, body: String| VisibilityBody {
-        modules,
-        body,
-        fetches: None,
-    };
-    if let Some(soft) = light.shadow.technique.soft() {
-        let (body, fetches) = soft_visibility_body(light, maps, soft.sums);
-        return VisibilityBody {
-            modules: vec![soft_module(&light.shadow.technique)],
-            body,
-            fetches,
-        };
-    }
-    if let Some(Filter::Sat { variant, .. }) = light.shadow.technique.filter() {
-        let (module, body) = sat_visibility_body(light, maps, variant);
-        return simple(vec![module, "shared/sat_lookup"], body);
-    }
-    let (module, body) = filtered_visibility_body(light, maps);
-    simple(vec![module], body)
+    (super::of(&light.shadow.technique).visibility)(light, maps)
 }
 
-/// [`visibility_body`] with the `sat` filter: each map's rectangle mean, then the technique's
-/// `*_of` function.
-fn sat_visibility_body(
-    light: &Light,
-    maps: &[String],
-    variant: SatVariant,
-) -> (&'static str, String) {
-    let sample = |map: &str| {
-        let f = match variant {
-            SatVariant::Fixed => "sat_sample_fixed",
-            SatVariant::Float => "sat_sample_float",
-        };
-        format!("{f}({map}, l, s.uv, l.filter_width)")
-    };
-    let map = maps.first().map_or("", String::as_str);
-    let call = |module, f: &str| (module, format!("return {f}({}, l, s);", sample(map)));
-    match light.shadow.technique {
-        Technique::Evsm { .. } => call("shared/vis_evsm", "vis_evsm_of"),
-        Technique::Esm { .. } => call("shared/vis_esm", "vis_esm_of_sat"),
-        Technique::Msm { .. } => call("shared/vis_msm", "vis_msm_of"),
-        Technique::Csm { .. } => {
-            let mut body = String::from("var sum = 0.0;");
-            for (chunk, m) in maps.iter().enumerate() {
-                let _ = write!(
-                    body,
-                    "\n            sum += csm_chunk_of({}, {chunk}u, l, s);",
-                    sample(m)
-                );
-            }
-            body.push_str("\n            return csm_resolve(sum, l);");
-            ("shared/vis_csm", body)
-        }
-        _ => call("shared/vis_vsm", "vis_vsm_of"),
-    }
+/// The first map's name (every technique but CSM's binds one).
+pub(super) fn first(maps: &[String]) -> &str {
+    maps.first().map_or("", String::as_str)
 }
 
-/// The module of a soft technique's visibility (it imports the table lookups and
-/// `shared/blocker`).
-fn soft_module(technique: &Technique) -> &'static str {
-    match technique {
-        Technique::Cssm { .. } => "shared/vis_cssm",
-        Technique::MsmSoft { .. } => "shared/vis_msm_soft",
-        _ => "shared/vis_vssm",
-    }
+/// `return f(map, l, s);` from `module`.
+pub(super) fn call(module: &'static str, f: &str, maps: &[String]) -> VisibilityBody {
+    VisibilityBody::simple(vec![module], format!("return {f}({}, l, s);", first(maps)))
 }
 
-/// [`visibility_body`] of a soft technique and, where it loops, its fetch count: the table
-/// means over the blocker-search square, the blocker estimate, and only where that finds
-/// blockers the means over the penumbra width (`shared/blocker`'s two passes). VSSM and soft
-/// MSM call their module's complete function; CSSM sums its CSM-Z maps (the maps after the
-/// first ⌈M/2⌉) over the search square, then runs the two passes over its basis maps here.
-fn soft_visibility_body(
-    light: &Light,
-    maps: &[String],
-    variant: SatVariant,
-) -> (String, Option<String>) {
-    let suffix = match variant {
+/// The table lookup's suffix of a table variant (`sat_sample_fixed`, `vis_vssm_float`, …).
+pub(super) fn table_suffix(variant: SatVariant) -> &'static str {
+    match variant {
         SatVariant::Fixed => "fixed",
         SatVariant::Float => "float",
-    };
-    let map = maps.first().map_or("", String::as_str);
-    let Technique::Cssm { terms, .. } = light.shadow.technique else {
-        let f = match light.shadow.technique {
-            Technique::MsmSoft { .. } => "vis_msm_soft",
-            _ => "vis_vssm",
-        };
-        return (format!("return {f}_{suffix}({map}, l, s);"), None);
-    };
-    let (basis, z) = maps.split_at((csm_maps(terms) as usize).min(maps.len()));
-    let sample = |m: &str, width: &str| format!("sat_sample_{suffix}({m}, l, s.uv, {width})");
-    let mut body = String::from(
-        "var look = soft_search(l, s);
-    var zsum = 0.0;",
-    );
-    for (chunk, m) in z.iter().enumerate() {
-        let _ = write!(
-            body,
-            "\n    zsum += csm_z_chunk_of({}, {chunk}u, l, s);",
-            sample(m, "look.width")
-        );
     }
-    body.push_str("\n    var sum = 0.0;\n    for (var k = 0u; k < 2u; k++) {\n        sum = 0.0;");
-    for (chunk, m) in basis.iter().enumerate() {
-        let _ = write!(
-            body,
-            "\n        sum += csm_chunk_of({}, {chunk}u, l, s);",
-            sample(m, "look.width")
-        );
-    }
-    body.push_str(
-        "\n        if k == 0u {\n            look = soft_blockers(cssm_blocker(sum, zsum, l, s), l, s);\n            \
-         if !look.blockers {\n                return 1.0;\n            }\n        }\n    }\n    \
-         return cssm_resolve(sum, look.blocker, l, s);",
-    );
-    let fetches = format!(
-        "{} * sat_sample_{suffix} + 2 * {} * sat_sample_{suffix}",
-        z.len(),
-        basis.len()
-    );
-    (body, Some(fetches))
 }
 
-/// [`visibility_body`] without the `sat` filter.
-fn filtered_visibility_body(light: &Light, maps: &[String]) -> (&'static str, String) {
-    let map = maps.first().map_or("", String::as_str);
-    let call = |module, f: &str| (module, format!("return {f}({map}, l, s);"));
-    match light.shadow.technique {
-        Technique::Hard => call("shared/vis_hard", "vis_hard"),
-        Technique::Pcf {
-            kernel: PcfKernel::Hardware,
-            ..
-        } => (
-            "shared/vis_pcf",
-            format!("return vis_pcf_hardware({map}, cmp_sampler, l, s);"),
-        ),
-        Technique::Pcf { .. } => call("shared/vis_pcf", "vis_pcf"),
-        Technique::Pcss { .. } => call("shared/vis_pcss", "vis_pcss"),
-        Technique::Vsm { .. } => call("shared/vis_vsm", "vis_vsm"),
-        Technique::Evsm { .. } => call("shared/vis_evsm", "vis_evsm"),
-        Technique::Esm { .. } => call("shared/vis_esm", "vis_esm"),
-        Technique::Msm { .. } => call("shared/vis_msm", "vis_msm"),
-        Technique::Csm { .. } => {
-            let mut body = String::from("var sum = 0.0;");
-            for (chunk, m) in maps.iter().enumerate() {
-                let _ = write!(body, "\n            sum += csm_chunk({m}, {chunk}u, l, s);");
-            }
-            body.push_str("\n            return csm_resolve(sum, l);");
-            ("shared/vis_csm", body)
+/// The rectangle mean of `map` at `width` as a WGSL expression.
+pub(super) fn sat_sample(variant: SatVariant, map: &str, width: &str) -> String {
+    format!(
+        "sat_sample_{}({map}, l, s.uv, {width})",
+        table_suffix(variant)
+    )
+}
+
+/// A prefiltered technique's visibility: through the `sat` filter, `of(mean, l, s)` of the
+/// map's rectangle mean (and the table lookups' module); else `plain(map, l, s)`.
+pub(super) fn prefiltered(
+    light: &Light,
+    maps: &[String],
+    module: &'static str,
+    plain: &str,
+    of: &str,
+) -> VisibilityBody {
+    match light.shadow.technique.filter() {
+        Some(Filter::Sat { variant, .. }) => {
+            let mean = sat_sample(variant, first(maps), "l.filter_width");
+            VisibilityBody::simple(
+                vec![module, "shared/sat_lookup"],
+                format!("return {of}({mean}, l, s);"),
+            )
         }
-        // Soft techniques are handled by `soft_visibility_body`.
-        Technique::Cssm { .. } | Technique::Vssm { .. } | Technique::MsmSoft { .. } => {
-            (soft_module(&light.shadow.technique), String::new())
-        }
+        _ => call(module, plain, maps),
     }
+}
+
+/// A soft technique's visibility whose module does it all: `f_<table>(map, l, s)`.
+pub(super) fn soft_call(
+    light: &Light,
+    maps: &[String],
+    module: &'static str,
+    f: &str,
+) -> VisibilityBody {
+    let suffix = light
+        .shadow
+        .technique
+        .soft()
+        .map_or("fixed", |s| table_suffix(s.sums));
+    call(module, &format!("{f}_{suffix}"), maps)
 }
 
 /// The key of the shading kernel for `lights`: what [`shading_block`] reads of each light (its
-/// technique, the table it reads through, hardware PCF, whether it follows the pixel's
-/// footprint, CSM's terms, its maps' count and type), so that a scene of the same techniques
-/// finds its kernel without generating the block (`tests/reuse.rs` checks that lights with
-/// equal keys get equal blocks).
+/// technique and what its visibility code depends on, [`super::TechniqueDef::variant`], the
+/// table it reads through, whether it follows the pixel's footprint, its maps' count and
+/// type), so that a scene of the same techniques finds its kernel without generating the
+/// block (`tests/reuse.rs` checks that lights with equal keys get equal blocks).
 pub fn shade_key(lights: &[Light]) -> String {
     let mut key = String::from("shade");
     for (i, light) in lights.iter().enumerate() {
@@ -207,26 +127,16 @@ pub fn shade_key(lights: &[Light]) -> String {
             Some(SatVariant::Float) => "f32",
             None => "-",
         };
-        let hardware = matches!(
-            t,
-            Technique::Pcf {
-                kernel: PcfKernel::Hardware,
-                ..
-            }
-        );
         let footprint =
             matches!(t.filter(), Some(Filter::Mips { max_anisotropy, .. }) if max_anisotropy > 0);
-        let terms = match *t {
-            Technique::Csm { terms, .. } | Technique::Cssm { terms, .. } => terms,
-            _ => 0,
-        };
+        let def = super::of(t);
         let input = add_light_nodes(&mut Graph::default(), i, light);
         let _ = write!(
             key,
-            "|{} {table} {} {} {terms} {}x{}",
-            t.name(),
-            u8::from(hardware),
+            "|{} {table} {} {} {}x{}",
+            def.name,
             u8::from(footprint),
+            (def.variant)(t),
             input.maps.len(),
             input.wgsl_type
         );

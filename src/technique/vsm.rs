@@ -1,8 +1,14 @@
 //! `vsm`: variance shadow maps (Donnelly & Lauritzen 2006), moments (z, z²), filtered.
 
+use super::nodes::{LightNodes, moments_format};
 use super::params::{FILTER, FLOAT_FORMAT, float, prefilter, prefilter_values};
+use super::shade::{ShadeInput, prefiltered};
 use super::{TechniqueDef, no_clamp};
+use super::{no_variant, unit_range};
+use crate::filter::BlurMode;
 use crate::gpu_data::TECHNIQUE_VSM;
+use crate::gpu_data::{LightGpu, VsmParams};
+use crate::model::Storage;
 use crate::model::{ParamSpec, ParamValue, ParamValues, Technique};
 
 /// The Chebyshev bound's keys (`vsm`, `vssm`).
@@ -43,6 +49,20 @@ fn values(t: &Technique) -> ParamValues {
     out
 }
 
+/// The Chebyshev bound's GPU fields (`vsm`, `vssm`): two moments.
+pub(super) fn variance_gpu(bleed: f32, min_variance: f32, g: &mut LightGpu) {
+    g.bleed = bleed;
+    g.min_variance = min_variance;
+    g.moments = 2;
+}
+
+/// The moments (z, z²) at `storage` precision, filtered (`vsm`, `vssm`).
+pub(super) fn moments(n: &mut LightNodes, storage: Storage) -> ShadeInput {
+    let params = VsmParams { depth: n.lin };
+    let format = moments_format(storage, 2);
+    n.encoded("vsm", format, bytemuck::bytes_of(&params), BlurMode::Linear)
+}
+
 /// `vsm`.
 pub(super) static DEF: TechniqueDef = TechniqueDef {
     name: "vsm",
@@ -55,6 +75,23 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
         min_variance: v.float("min_variance"),
     },
     values,
+    gpu: |t, g| {
+        if let Technique::Vsm {
+            bleed,
+            min_variance,
+            ..
+        } = *t
+        {
+            variance_gpu(bleed, min_variance, g);
+        }
+    },
+    nodes: |n| match n.light.shadow.technique {
+        Technique::Vsm { prefilter, .. } => moments(n, prefilter.storage),
+        _ => n.one(n.depth.clone()),
+    },
+    visibility: |light, maps| prefiltered(light, maps, "shared/vis_vsm", "vis_vsm", "vis_vsm_of"),
+    variant: no_variant,
+    value_range: unit_range,
     clamp: no_clamp,
     area_light: false,
     example: "scenes/techniques/vsm.toml",

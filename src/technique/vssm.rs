@@ -1,8 +1,11 @@
 //! `vssm`: variance soft shadow maps (Yang et al. 2010) through a summed-area table.
 
 use super::params::{FLOAT_FORMAT, SOFT, soft, soft_values};
+use super::shade::soft_call;
 use super::vsm::{VARIANCE, variance_values};
+use super::vsm::{moments, variance_gpu};
 use super::{TechniqueDef, no_clamp};
+use super::{no_variant, unit_range};
 use crate::gpu_data::TECHNIQUE_VSSM;
 use crate::model::{ParamValues, Technique};
 
@@ -32,6 +35,23 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
         min_variance: v.float("min_variance"),
     },
     values,
+    gpu: |t, g| {
+        if let Technique::Vssm {
+            bleed,
+            min_variance,
+            ..
+        } = *t
+        {
+            variance_gpu(bleed, min_variance, g);
+        }
+    },
+    nodes: |n| match n.light.shadow.technique {
+        Technique::Vssm { soft, .. } => moments(n, soft.storage),
+        _ => n.one(n.depth.clone()),
+    },
+    visibility: |light, maps| soft_call(light, maps, "shared/vis_vssm", "vis_vssm"),
+    variant: no_variant,
+    value_range: unit_range,
     clamp: no_clamp,
     area_light: true,
     example: "scenes/techniques/vssm.toml",
