@@ -289,6 +289,30 @@ impl Technique {
         }
     }
 
+    /// The storage precision of a prefiltered or soft technique's representation (ESM's is
+    /// always f32); `None` for techniques that shade from the depth.
+    pub fn storage(&self) -> Option<Storage> {
+        match *self {
+            Technique::Esm { .. } => Some(Storage::F32),
+            _ => self
+                .prefilter()
+                .map(|p| p.storage)
+                .or(self.soft().map(|s| s.storage)),
+        }
+    }
+
+    /// The storage and filter of a prefiltered technique (VSM, EVSM, MSM, CSM; ESM has a filter
+    /// only).
+    pub fn prefilter(&self) -> Option<Prefilter> {
+        match *self {
+            Technique::Vsm { prefilter, .. }
+            | Technique::Evsm { prefilter, .. }
+            | Technique::Msm { prefilter, .. }
+            | Technique::Csm { prefilter, .. } => Some(prefilter),
+            _ => None,
+        }
+    }
+
     /// The name used in scene files.
     pub fn name(&self) -> &'static str {
         match self {

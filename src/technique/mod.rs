@@ -9,6 +9,7 @@ mod csm;
 mod cssm;
 mod esm;
 mod evsm;
+mod given;
 mod hard;
 mod light_gpu;
 mod msm;
