@@ -6,11 +6,6 @@ use crate::error::{Error, Result};
 use crate::prefilter::PrefilterConfig;
 use crate::scene::{BlurKernel, Filter, PcfKernel, Scene, Storage, Technique};
 
-/// Technique names `--techniques` accepts, in sweep order.
-pub const TECHNIQUES: &[&str] = &[
-    "hard", "pcf", "pcss", "vsm", "evsm2", "evsm4", "esm", "msm", "csm", "cssm", "vssm", "msm_soft",
-];
-
 /// A filter of a box `width` texels wide.
 pub type FilterOfWidth = fn(f32) -> Filter;
 
@@ -53,14 +48,15 @@ pub const PCSS_TAPS: [(u32, u32); 4] = [(8, 16), (16, 32), (32, 64), (64, 64)];
 /// Configurations of the sweep for `scene` (every light gets each), filtered by
 /// `opts.techniques`. Unknown technique names are an error listing the known ones.
 pub fn sweep(scene: &Scene, opts: &EvaluateOptions) -> Result<Vec<Config>> {
+    let known = crate::technique::names();
     let wanted: Vec<String> = match &opts.techniques {
-        None => TECHNIQUES.iter().map(|s| s.to_string()).collect(),
+        None => known.iter().map(|s| s.to_string()).collect(),
         Some(list) => {
             for t in list {
-                if !TECHNIQUES.contains(&t.as_str()) {
+                if !known.contains(&t.as_str()) {
                     return Err(Error::Invalid(format!(
                         "unknown technique `{t}` in --techniques (known: {})",
-                        TECHNIQUES.join(", ")
+                        known.join(", ")
                     )));
                 }
             }

@@ -189,4 +189,5 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     clamp: no_clamp,
     area_light: false,
     example: "scenes/techniques/csm.toml",
+    colour: [0xff, 0x7f, 0x0e],
 };

@@ -142,4 +142,5 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     clamp: no_clamp,
     area_light: true,
     example: "scenes/techniques/cssm.toml",
+    colour: [0xe3, 0x77, 0xc2],
 };

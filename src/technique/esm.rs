@@ -76,4 +76,5 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     clamp: clamp_exponent,
     area_light: false,
     example: "scenes/techniques/esm.toml",
+    colour: [0x94, 0x67, 0xbd],
 };

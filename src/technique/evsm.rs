@@ -180,6 +180,7 @@ pub(super) static EVSM2: TechniqueDef = TechniqueDef {
     clamp: clamp_exponents,
     area_light: false,
     example: "scenes/techniques/evsm2.toml",
+    colour: [0xbc, 0xbd, 0x22],
 };
 
 /// `evsm4`.
@@ -200,4 +201,5 @@ pub(super) static EVSM4: TechniqueDef = TechniqueDef {
     clamp: clamp_exponents,
     area_light: false,
     example: "scenes/techniques/evsm4.toml",
+    colour: [0x8c, 0x56, 0x4b],
 };

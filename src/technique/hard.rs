@@ -25,4 +25,5 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     clamp: no_clamp,
     area_light: false,
     example: "scenes/grazing.toml",
+    colour: [0x44, 0x44, 0x44],
 };

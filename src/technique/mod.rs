@@ -76,6 +76,8 @@ pub struct TechniqueDef {
     pub area_light: bool,
     /// A scene that shows it.
     pub example: &'static str,
+    /// Its colour in the evaluation's plots (sRGB), so families read at a glance.
+    pub colour: [u8; 3],
 }
 
 /// Every technique, in the order scene errors list them.
@@ -93,6 +95,11 @@ pub static REGISTRY: &[&TechniqueDef] = &[
     &vssm::DEF,
     &msm_soft::DEF,
 ];
+
+/// Every technique's scene name, in registry order.
+pub fn names() -> Vec<&'static str> {
+    REGISTRY.iter().map(|d| d.name).collect()
+}
 
 /// The technique named `name` in scene files.
 pub fn by_name(name: &str) -> Option<&'static TechniqueDef> {

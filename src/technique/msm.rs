@@ -141,4 +141,5 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     clamp: no_clamp,
     area_light: false,
     example: "scenes/techniques/msm.toml",
+    colour: [0xd6, 0x27, 0x28],
 };

@@ -50,4 +50,5 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     clamp: no_clamp,
     area_light: true,
     example: "scenes/techniques/msm_soft.toml",
+    colour: [0x8b, 0x00, 0x00],
 };

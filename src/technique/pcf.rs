@@ -120,4 +120,5 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     clamp: no_clamp,
     area_light: false,
     example: "scenes/bunny.toml",
+    colour: [0x1f, 0x77, 0xb4],
 };

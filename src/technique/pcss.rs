@@ -68,4 +68,5 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     clamp: no_clamp,
     area_light: true,
     example: "scenes/colonnade.toml",
+    colour: [0x17, 0xbe, 0xcf],
 };

@@ -95,4 +95,5 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     clamp: no_clamp,
     area_light: false,
     example: "scenes/techniques/vsm.toml",
+    colour: [0x2c, 0xa0, 0x2c],
 };

@@ -55,4 +55,5 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     clamp: no_clamp,
     area_light: true,
     example: "scenes/techniques/vssm.toml",
+    colour: [0x00, 0x5f, 0x3f],
 };
