@@ -29,7 +29,7 @@ use crate::error::{Error, Result};
 use crate::exec::Executor;
 use crate::gpu::Gpu;
 use crate::graph::{Graph, Plan, cost};
-use crate::model::{ParamValue, ParamValues};
+use crate::model::ParamValue;
 use crate::sat::{self, SatCoding, SatVariant};
 use crate::scene::{Light, LightKind, Shadow, Storage, Technique};
 use crate::technique;
@@ -160,9 +160,7 @@ fn texels(n: u32) -> u64 {
 
 /// Technique `name` of the registry with `values` over its defaults (the scene file's).
 fn named(name: &str, values: &[(&'static str, ParamValue)]) -> Technique {
-    let def = technique::by_name(name).expect("bench cases name registered techniques");
-    technique::build_with(def, &ParamValues(values.to_vec()))
-        .unwrap_or_else(|| technique::default_of(def))
+    technique::named(name, values).expect("bench cases name registered techniques and keys")
 }
 
 /// The Gaussian blur of radius 4 (σ = 2) the chains are timed with.

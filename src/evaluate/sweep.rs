@@ -3,8 +3,10 @@
 
 use super::EvaluateOptions;
 use crate::error::{Error, Result};
+use crate::model::ParamValue;
 use crate::prefilter::PrefilterConfig;
-use crate::scene::{BlurKernel, Filter, PcfKernel, Scene, Storage, Technique};
+use crate::scene::{BlurKernel, Filter, Scene, Storage, Technique};
+use crate::technique;
 
 /// A filter of a box `width` texels wide.
 pub type FilterOfWidth = fn(f32) -> Filter;
@@ -103,15 +105,17 @@ pub fn sweep(scene: &Scene, opts: &EvaluateOptions) -> Result<Vec<Config>> {
             Vec::new()
         }
     };
+    let named = |name: &str, values: &[(&'static str, ParamValue)]| {
+        technique::named(name, values)
+            .ok_or_else(|| Error::Invalid(format!("sweep: cannot build technique `{name}`")))
+    };
     for &size in &size_sweep("hard") {
-        push("hard".into(), Technique::Hard, size, None);
+        push("hard".into(), named("hard", &[])?, size, None);
     }
     if wanted.iter().any(|w| w == "pcf") {
         for r in if quick { vec![2] } else { vec![1, 2, 4] } {
-            let t = Technique::Pcf {
-                radius: r,
-                kernel: PcfKernel::Box,
-            };
+            // The default kernel (box) at radius r.
+            let t = named("pcf", &[("radius", ParamValue::Int(r))])?;
             let width = Some(f64::from(2 * r + 1));
             let on: Vec<u32> = if r == 2 { sizes.clone() } else { vec![base] };
             for size in on {
@@ -120,39 +124,33 @@ pub fn sweep(scene: &Scene, opts: &EvaluateOptions) -> Result<Vec<Config>> {
         }
     }
     if scene.lights.iter().all(|l| l.size > 0.0) {
-        let pcss = scene
+        let pcss = match scene
             .lights
             .iter()
             .map(|l| l.shadow.technique)
-            .find(|t| matches!(t, Technique::Pcss { .. }))
-            .unwrap_or(Technique::Pcss {
-                blocker_samples: 16,
-                filter_samples: 32,
-                max_search: 0.1,
-            });
+            .find(|t| t.name() == "pcss")
+        {
+            Some(t) => t,
+            None => named("pcss", &[])?,
+        };
         // PCSS as engines ship it, at several tap counts (blocker search + filter): the
         // scene's (default 16 + 32) on every size, the others at the base size.
-        let pcss_label = |t: &Technique| match t {
-            Technique::Pcss {
-                blocker_samples,
-                filter_samples,
-                ..
-            } => format!("pcss {blocker_samples}+{filter_samples}"),
-            _ => "pcss".into(),
+        let pcss_label = |t: &Technique| {
+            let v = (technique::of(t).values)(t);
+            let (blockers, taps) = (v.int("blocker_samples"), v.int("filter_samples"));
+            format!("pcss {blockers}+{taps}")
         };
         for &size in &size_sweep("pcss") {
             push(pcss_label(&pcss), pcss, size, None);
         }
         if !quick && wanted.iter().any(|w| w == "pcss") {
-            let max_search = match pcss {
-                Technique::Pcss { max_search, .. } => max_search,
-                _ => 0.1,
-            };
             for (blocker_samples, filter_samples) in PCSS_TAPS {
-                let t = Technique::Pcss {
-                    blocker_samples,
-                    filter_samples,
-                    max_search,
+                let taps = [
+                    ("blocker_samples", ParamValue::Int(blocker_samples)),
+                    ("filter_samples", ParamValue::Int(filter_samples)),
+                ];
+                let Some(t) = technique::with_values(&pcss, &taps) else {
+                    continue;
                 };
                 if t != pcss {
                     push(pcss_label(&t), t, base, None);
@@ -222,20 +220,17 @@ fn with_moment_biases(configs: Vec<Config>, biases: &[f32]) -> Result<Vec<Config
     }
     let mut out = Vec::new();
     for c in configs {
-        if !matches!(
-            c.technique,
-            Technique::Msm { .. } | Technique::MsmSoft { .. }
-        ) {
+        if technique::of(&c.technique)
+            .params
+            .iter()
+            .all(|t| t.iter().all(|s| s.key != "moment_bias"))
+        {
             out.push(c);
             continue;
         }
         for &a in biases {
-            let mut technique = c.technique;
-            if let Technique::Msm { moment_bias, .. } | Technique::MsmSoft { moment_bias, .. } =
-                &mut technique
-            {
-                *moment_bias = a;
-            }
+            let bias = [("moment_bias", ParamValue::Float(a))];
+            let technique = technique::with_values(&c.technique, &bias).unwrap_or(c.technique);
             out.push(Config {
                 label: format!("{} bias{a:e}", c.label),
                 technique,

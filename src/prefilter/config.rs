@@ -47,9 +47,7 @@ fn named(name: &str) -> Technique {
 
 /// The registry entry named `name` with `values` over its defaults.
 fn named_with(name: &str, values: &[(&'static str, ParamValue)]) -> Technique {
-    let def = technique::by_name(name).expect("the constructors name registered techniques");
-    let values = ParamValues(values.to_vec());
-    technique::build_with(def, &values).unwrap_or_else(|| technique::default_of(def))
+    technique::named(name, values).unwrap_or_else(|| named(name))
 }
 
 impl PrefilterConfig {

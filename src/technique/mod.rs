@@ -137,6 +137,28 @@ pub fn build_with(def: &TechniqueDef, values: &ParamValues) -> Option<Technique>
     Some((def.build)(&values))
 }
 
+/// The technique named `name` with `values` over its defaults, taken as they are (a later
+/// check reports them); `None` for a name the registry does not know or values its tables
+/// cannot hold.
+pub fn named(name: &str, values: &[(&'static str, crate::model::ParamValue)]) -> Option<Technique> {
+    build_with(by_name(name)?, &ParamValues(values.to_vec()))
+}
+
+/// `t` with `values` set over its own (the keys it has), rebuilt by its entry; `None` when a
+/// key does not apply to it.
+pub fn with_values(
+    t: &Technique,
+    values: &[(&'static str, crate::model::ParamValue)],
+) -> Option<Technique> {
+    let def = of(t);
+    let mut v = (def.values)(t);
+    for &(key, value) in values {
+        v.get(key)?;
+        v.set(key, value);
+    }
+    build_with(def, &v)
+}
+
 /// Whether option `name` of key `key` is one `def` accepts.
 pub fn accepts(def: &TechniqueDef, key: &str, name: &str) -> bool {
     def.params.iter().flat_map(|t| t.iter()).any(|s| {
