@@ -288,6 +288,18 @@ pub struct FrameGpu {
     pub _pad6: f32,
 }
 
+/// Vertex as uploaded: keep in sync with `VsIn` in `kernels/shared/vertex.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct Vertex {
+    /// World position.
+    pub position: [f32; 3],
+    /// World normal.
+    pub normal: [f32; 3],
+    /// Index into the scene's material (object colour) table.
+    pub material: u32,
+}
+
 #[cfg(test)]
 mod tests {
     use super::TECHNIQUE_IDS;
