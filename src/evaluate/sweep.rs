@@ -245,14 +245,11 @@ fn with_moment_biases(configs: Vec<Config>, biases: &[f32]) -> Result<Vec<Config
 /// like a scene file (EVSM exponents clamped to the storage's limit, MSM's default bias for
 /// the storage: `PrefilterConfig::with_storage`).
 fn prefiltered(name: &str, storage: Storage, filter: Filter, terms: u32) -> Result<Technique> {
-    let config = match name {
-        "vsm" => PrefilterConfig::vsm(1),
-        "evsm2" => PrefilterConfig::evsm2(1),
-        "evsm4" => PrefilterConfig::evsm4(1),
-        "esm" => PrefilterConfig::esm(1),
-        "msm" => PrefilterConfig::msm(1),
-        _ => PrefilterConfig::csm(1, terms),
-    };
+    let terms = [("terms", ParamValue::Int(terms))];
+    let values: &[(&str, ParamValue)] = if name == "csm" { &terms } else { &[] };
+    let t = technique::named(name, values)
+        .ok_or_else(|| Error::Invalid(format!("sweep: cannot build technique `{name}`")))?;
+    let config = PrefilterConfig::new(t, 1);
     let config = if name == "esm" {
         config.with_filter(filter)
     } else {
