@@ -193,28 +193,4 @@ mod tests {
             assert_eq!((def.build)(&again), t, "{}", def.name);
         }
     }
-
-    /// Names are unique (scene files and `--techniques` look them up), and each entry's
-    /// example scene loads and lights something with its technique.
-    #[cfg(feature = "cli")]
-    #[test]
-    fn names_are_unique_and_examples_use_their_technique() {
-        let names = names();
-        for (k, name) in names.iter().enumerate() {
-            assert!(!names[k + 1..].contains(name), "{name} registered twice");
-        }
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-        for def in REGISTRY {
-            let scene = crate::scene::Scene::load(root.join(def.example)).expect(def.example);
-            assert!(
-                scene
-                    .lights
-                    .iter()
-                    .any(|l| l.shadow.technique.name() == def.name),
-                "{} lights no {} light",
-                def.example,
-                def.name
-            );
-        }
-    }
 }
