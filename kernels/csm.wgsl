@@ -18,7 +18,7 @@
 // #import shared/csm_basis
 // #import shared/linear_depth
 
-// Keep in sync with `CsmParams` in src/technique.rs.
+// Keep in sync with `CsmParams` in src/gpu_data.rs.
 struct Params {
     depth: DepthParams,
     first_map: u32,

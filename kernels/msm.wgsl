@@ -7,7 +7,7 @@
 // #import shared/msm_quantize
 // #import shared/linear_depth
 
-// Keep in sync with `MsmParams` in src/technique.rs.
+// Keep in sync with `MsmParams` in src/gpu_data.rs.
 struct Params {
     depth: DepthParams,
     quantized: u32,

@@ -11,7 +11,7 @@
 
 // #import shared/linear_depth
 
-// Keep in sync with `VsmParams` in src/technique.rs.
+// Keep in sync with `VsmParams` in src/gpu_data.rs.
 struct Params {
     depth: DepthParams,
 }

@@ -39,7 +39,7 @@ pub use flip::{Shader, flip_map, flip_stats, to_unorm8};
 pub use stats::{EDGE_BAND, ErrorStats, PENUMBRA_HIGH, PENUMBRA_LOW, Region, Regions};
 pub use svg::{Metric, front, pareto};
 use sweep::storage_name;
-pub use sweep::{Config, FILTERS, FilterOfWidth, TECHNIQUES, sweep};
+pub use sweep::{Config, FILTERS, FilterOfWidth, sweep};
 
 use std::path::{Path, PathBuf};
 
@@ -52,7 +52,7 @@ use crate::truth::{Emitter, TruthOptions, area_light_truth};
 /// What the sweep covers and how it is measured.
 #[derive(Clone, Debug)]
 pub struct EvaluateOptions {
-    /// Technique names to keep (`None`: all of [`TECHNIQUES`]).
+    /// Technique names to keep (`None`: every registered technique, `technique::names`).
     pub techniques: Option<Vec<String>>,
     /// A tiny sweep (one map size, one width, one storage per technique; K = 16 at 1024²,
     /// image at most 160 wide, one repeat): seconds on a software GPU.

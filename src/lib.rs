@@ -18,11 +18,13 @@ pub mod evaluate;
 pub mod exec;
 pub mod filter;
 pub mod gpu;
+pub mod gpu_data;
 pub mod graph;
 #[cfg(feature = "cli")]
 pub mod io;
 pub mod kernels;
 pub mod limits;
+pub mod model;
 pub mod msm_quantize;
 pub mod prefilter;
 #[cfg(feature = "cli")]

@@ -17,7 +17,7 @@ pub use scene::{Memory, check_scene, render_memory};
 use crate::error::{Error, Result};
 use crate::graph::{Dispatch, Node, Plan};
 use crate::kernels;
-use crate::scene::{Light, Storage, Technique};
+use crate::model::{Light, Storage};
 
 /// One thing a kernel needs of the device, and the device's limit on it.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -250,11 +250,8 @@ pub fn dispatch_groups(plan: &Plan, node: &Node, wg: [u32; 3]) -> [u32; 3] {
 /// storage needs `TEXTURE_FORMAT_16BIT_NORM`).
 pub fn check_features(device: &wgpu::Device, lights: &[Light]) -> Result<()> {
     for (i, l) in lights.iter().enumerate() {
-        let storage = match l.shadow.technique {
-            Technique::Msm { prefilter, .. } => Some(prefilter.storage),
-            Technique::MsmSoft { soft, .. } => Some(soft.storage),
-            _ => None,
-        };
+        // Only MSM's tables accept unorm16 (`technique::params::MSM_FORMAT`).
+        let storage = l.shadow.technique.storage();
         if storage == Some(Storage::Unorm16)
             && !device
                 .features()

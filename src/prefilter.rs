@@ -20,7 +20,6 @@
 //! ```
 
 mod config;
-mod error;
 mod limits;
 pub mod wgsl;
 
@@ -28,8 +27,8 @@ use std::collections::HashMap;
 
 use glam::Mat4;
 
+pub use crate::error::StageError;
 pub use config::{LightParams, PrefilterConfig};
-pub use error::StageError;
 
 use crate::error::{Error, Result};
 use crate::exec::Executor;

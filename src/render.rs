@@ -18,41 +18,8 @@ pub use crate::limits::check_features;
 use crate::scene::{Light, Scene};
 use crate::technique;
 
-/// Frame constants of `kernels/shade.wgsl` (mirrors its `Frame`).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct FrameGpu {
-    /// Image size.
-    pub size: [u32; 2],
-    /// Number of lights.
-    pub light_count: u32,
-    /// 1 when the ray fields hold the camera (pixel footprints), 0 for the probe.
-    pub has_camera: u32,
-    /// Ambient colour.
-    pub ambient: [f32; 3],
-    /// Padding.
-    pub _pad1: f32,
-    /// Background colour.
-    pub background: [f32; 3],
-    /// Padding.
-    pub _pad2: f32,
-    /// Eye position.
-    pub camera: [f32; 3],
-    /// Padding.
-    pub _pad3: f32,
-    /// Unnormalized view ray through pixel corner (0, 0).
-    pub ray00: [f32; 3],
-    /// Padding.
-    pub _pad4: f32,
-    /// Ray change per pixel in x: pixel (x, y)'s ray is `ray00 + (x + ½)·ray_dx + (y + ½)·ray_dy`.
-    pub ray_dx: [f32; 3],
-    /// Padding.
-    pub _pad5: f32,
-    /// Ray change per pixel in y.
-    pub ray_dy: [f32; 3],
-    /// Padding.
-    pub _pad6: f32,
-}
+pub use crate::gpu_data::FrameGpu;
+pub use crate::model::CameraRays;
 
 impl FrameGpu {
     /// Frame constants for `scene` rendered at `width × height`, with the camera's rays.
@@ -69,37 +36,6 @@ impl FrameGpu {
             ray_dx: rays.ray_dx.to_array(),
             ray_dy: rays.ray_dy.to_array(),
             ..Self::zeroed()
-        }
-    }
-}
-
-/// A pinhole camera's unnormalized view rays as `glam`'s `look_at_rh` and `perspective_rh`
-/// (the G-buffer's projection) make them: forward `f`, right `s = f × up`, up `u = s × f`,
-/// `t = tan(fov_y / 2)`; pixel (x, y) of a `w × h` image sees along
-/// `ray00 + (x + ½)·ray_dx + (y + ½)·ray_dy` with `ray00 = f − t·aspect·s + t·u`,
-/// `ray_dx = 2t·aspect/w · s`, `ray_dy = −2t/h · u`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CameraRays {
-    /// Ray through pixel corner (0, 0).
-    pub ray00: glam::Vec3,
-    /// Per pixel in x.
-    pub ray_dx: glam::Vec3,
-    /// Per pixel in y.
-    pub ray_dy: glam::Vec3,
-}
-
-impl CameraRays {
-    /// The rays of `camera` for a `width × height` image.
-    pub fn new(camera: &crate::scene::Camera, width: u32, height: u32) -> Self {
-        let f = (camera.target - camera.position).normalize();
-        let s = f.cross(camera.up).normalize();
-        let u = s.cross(f);
-        let t = (0.5 * camera.fov_y_degrees.to_radians()).tan();
-        let aspect = width as f32 / height as f32;
-        Self {
-            ray00: f - t * aspect * s + t * u,
-            ray_dx: (2.0 * t * aspect / width as f32) * s,
-            ray_dy: (-2.0 * t / height as f32) * u,
         }
     }
 }

@@ -43,19 +43,20 @@
 //
 // Names defined here (a host must not reuse them):
 //   BLOCKER_MIN_SHARE CSM_PI GOLDEN_ANGLE Light LightSample MSM_B0 MSM_B0_COV MSM_B0_SCHUR
-//   MipTaps MsmMoments SAT_MIN_EXTENT SatNodes SoftLookup bilinear_level bilinear_log_level
-//   blocker_csm_z blocker_filter_width blocker_msm blocker_result blocker_search_width
-//   blocker_vsm blocker_width chebyshev_upper csm_chunk csm_chunk_of csm_resolve csm_sin_cos
-//   csm_weight csm_z_chunk_of cssm_blocker cssm_resolve cssm_sharpen level_size light_faces
-//   light_footprint light_linear_to_ndc light_linear_to_z light_map_width light_sample
-//   light_to_light linstep load_depth mip_tap_uv mip_taps msm_biased msm_dequantize msm_expect
-//   msm_intensity msm_moments msm_quantize msm_roots msm_soft_blocker pcss_search_radius
-//   sample_bilinear sample_bilinear_log sample_map sample_map_log sat_mean_fixed sat_mean_float
-//   sat_node_f32 sat_node_u32 sat_nodes sat_rect sat_sample_fixed sat_sample_float soft_blockers
-//   soft_search texel_of trilinear trilinear_log vis_esm vis_esm_of_log vis_esm_of_sat vis_evsm
-//   vis_evsm_of vis_hard vis_msm vis_msm_of vis_msm_soft_fixed vis_msm_soft_float vis_pcf
-//   vis_pcf_hardware vis_pcss vis_vsm vis_vsm_of vis_vssm_fixed vis_vssm_float vogel_disc
-//   vssm_blocker
+//   MipTaps MsmMoments SAT_MIN_EXTENT SatNodes SoftLookup TECHNIQUE_CSM TECHNIQUE_CSSM
+//   TECHNIQUE_ESM TECHNIQUE_EVSM TECHNIQUE_HARD TECHNIQUE_MSM TECHNIQUE_MSM_SOFT TECHNIQUE_PCF
+//   TECHNIQUE_PCSS TECHNIQUE_VSM TECHNIQUE_VSSM bilinear_level bilinear_log_level blocker_csm_z
+//   blocker_filter_width blocker_msm blocker_result blocker_search_width blocker_vsm
+//   blocker_width chebyshev_upper csm_chunk csm_chunk_of csm_resolve csm_sin_cos csm_weight
+//   csm_z_chunk_of cssm_blocker cssm_resolve cssm_sharpen level_size light_faces light_footprint
+//   light_linear_to_ndc light_linear_to_z light_map_width light_sample light_to_light linstep
+//   load_depth mip_tap_uv mip_taps msm_biased msm_dequantize msm_expect msm_intensity
+//   msm_moments msm_quantize msm_roots msm_soft_blocker pcss_search_radius sample_bilinear
+//   sample_bilinear_log sample_map sample_map_log sat_mean_fixed sat_mean_float sat_node_f32
+//   sat_node_u32 sat_nodes sat_rect sat_sample_fixed sat_sample_float soft_blockers soft_search
+//   texel_of trilinear trilinear_log vis_esm vis_esm_of_log vis_esm_of_sat vis_evsm vis_evsm_of
+//   vis_hard vis_msm vis_msm_of vis_msm_soft_fixed vis_msm_soft_float vis_pcf vis_pcf_hardware
+//   vis_pcss vis_vsm vis_vsm_of vis_vssm_fixed vis_vssm_float vogel_disc vssm_blocker
 
 // Shared light description and light-space helpers (import-only module).
 //
@@ -63,7 +64,7 @@
 //   d = (Z − near) / (far − near),  Z = distance along the light's view axis,
 // for both the orthographic (directional) and the perspective (spot) light.
 
-// Keep in sync with `LightGpu` in src/technique.rs.
+// Keep in sync with `LightGpu` in src/gpu_data.rs.
 struct Light {
     view_proj: mat4x4<f32>,  // world → light clip
     view: mat4x4<f32>,       // world → light view
@@ -79,7 +80,7 @@ struct Light {
     bias: f32,               // constant bias, linear depth units
     normal_bias: f32,        // normal offset, texels, scaled by (1 − N·L)
     cos_outer: f32,          // spot cone: cos(fov/2); directional: −1
-    technique: u32,          // 0 hard, 1 pcf, 2 pcss, 3 vsm, 4 evsm, 5 esm, 6 msm, 7 csm, 8 cssm, 9 vssm, 10 msm_soft
+    technique: u32,          // TECHNIQUE_* below
     radius: u32,             // pcf: window radius in texels
     kernel: u32,             // pcf: 0 box, 1 tent, 2 hardware 2×2
     blocker_samples: u32,    // pcss
@@ -107,6 +108,20 @@ struct Light {
     max_width: f32,          // soft techniques: cap on the search and filter widths, texels
     _pad1: u32,
 }
+
+// `Light::technique` (keep in sync with the `TECHNIQUE_*` constants of src/gpu_data.rs; a test
+// compares them).
+const TECHNIQUE_HARD: u32 = 0u;
+const TECHNIQUE_PCF: u32 = 1u;
+const TECHNIQUE_PCSS: u32 = 2u;
+const TECHNIQUE_VSM: u32 = 3u;
+const TECHNIQUE_EVSM: u32 = 4u;
+const TECHNIQUE_ESM: u32 = 5u;
+const TECHNIQUE_MSM: u32 = 6u;
+const TECHNIQUE_CSM: u32 = 7u;
+const TECHNIQUE_CSSM: u32 = 8u;
+const TECHNIQUE_VSSM: u32 = 9u;
+const TECHNIQUE_MSM_SOFT: u32 = 10u;
 
 // Where a receiver lands in a light's shadow map.
 struct LightSample {

@@ -4,7 +4,7 @@
 //   d = (Z − near) / (far − near),  Z = distance along the light's view axis,
 // for both the orthographic (directional) and the perspective (spot) light.
 
-// Keep in sync with `LightGpu` in src/technique.rs.
+// Keep in sync with `LightGpu` in src/gpu_data.rs.
 struct Light {
     view_proj: mat4x4<f32>,  // world → light clip
     view: mat4x4<f32>,       // world → light view
@@ -20,7 +20,7 @@ struct Light {
     bias: f32,               // constant bias, linear depth units
     normal_bias: f32,        // normal offset, texels, scaled by (1 − N·L)
     cos_outer: f32,          // spot cone: cos(fov/2); directional: −1
-    technique: u32,          // 0 hard, 1 pcf, 2 pcss, 3 vsm, 4 evsm, 5 esm, 6 msm, 7 csm, 8 cssm, 9 vssm, 10 msm_soft
+    technique: u32,          // TECHNIQUE_* below
     radius: u32,             // pcf: window radius in texels
     kernel: u32,             // pcf: 0 box, 1 tent, 2 hardware 2×2
     blocker_samples: u32,    // pcss
@@ -48,6 +48,20 @@ struct Light {
     max_width: f32,          // soft techniques: cap on the search and filter widths, texels
     _pad1: u32,
 }
+
+// `Light::technique` (keep in sync with the `TECHNIQUE_*` constants of src/gpu_data.rs; a test
+// compares them).
+const TECHNIQUE_HARD: u32 = 0u;
+const TECHNIQUE_PCF: u32 = 1u;
+const TECHNIQUE_PCSS: u32 = 2u;
+const TECHNIQUE_VSM: u32 = 3u;
+const TECHNIQUE_EVSM: u32 = 4u;
+const TECHNIQUE_ESM: u32 = 5u;
+const TECHNIQUE_MSM: u32 = 6u;
+const TECHNIQUE_CSM: u32 = 7u;
+const TECHNIQUE_CSSM: u32 = 8u;
+const TECHNIQUE_VSSM: u32 = 9u;
+const TECHNIQUE_MSM_SOFT: u32 = 10u;
 
 // Where a receiver lands in a light's shadow map.
 struct LightSample {

@@ -29,9 +29,11 @@ use crate::error::{Error, Result};
 use crate::exec::Executor;
 use crate::gpu::Gpu;
 use crate::graph::{Graph, Plan, cost};
+use crate::model::ParamValue;
 use crate::sat::{self, SatCoding, SatVariant};
-use crate::scene::{BlurKernel, Filter, Light, LightKind, Prefilter, Shadow, Storage, Technique};
+use crate::scene::{Light, LightKind, Shadow, Storage, Technique};
 use crate::technique;
+use crate::technique::params::storage_name;
 
 /// Untimed runs before the timed ones (pipeline warm-up, lazy clears, caches).
 pub const WARMUP: u32 = 2;
@@ -156,13 +158,16 @@ fn texels(n: u32) -> u64 {
     u64::from(n) * u64::from(n)
 }
 
-fn blur4() -> Filter {
-    Filter::Blur {
-        radius: 4.0,
-        sigma: 2.0,
-        kernel: BlurKernel::Gaussian,
-    }
+/// Technique `name` of the registry with `values` over its defaults (the scene file's).
+fn named(name: &str, values: &[(&'static str, ParamValue)]) -> Technique {
+    technique::named(name, values).expect("bench cases name registered techniques and keys")
 }
+
+/// The Gaussian blur of radius 4 (σ = 2) the chains are timed with.
+const BLUR4: [(&str, ParamValue); 2] = [
+    ("filter_radius", ParamValue::Float(4.0)),
+    ("filter_sigma", ParamValue::Float(2.0)),
+];
 
 fn vsm() -> Technique {
     vsm_blur(4.0)
@@ -170,99 +175,50 @@ fn vsm() -> Technique {
 
 /// VSM with a Gaussian blur of `radius` taps each side (σ = radius / 2).
 fn vsm_blur(radius: f32) -> Technique {
-    Technique::Vsm {
-        prefilter: Prefilter {
-            storage: Storage::F32,
-            filter: Filter::Blur {
-                radius,
-                sigma: radius / 2.0,
-                kernel: BlurKernel::Gaussian,
-            },
-        },
-        bleed: 0.2,
-        min_variance: 1e-5,
-    }
+    named(
+        "vsm",
+        &[
+            ("filter_radius", ParamValue::Float(radius)),
+            ("filter_sigma", ParamValue::Float(radius / 2.0)),
+        ],
+    )
 }
 
 fn evsm4() -> Technique {
-    Technique::Evsm {
-        prefilter: Prefilter {
-            storage: Storage::F32,
-            filter: blur4(),
-        },
-        four: true,
-        exp_pos: 40.0,
-        exp_neg: 5.0,
-        bleed: 0.0,
-        min_variance: 1e-4,
-    }
+    named("evsm4", &BLUR4)
 }
 
 fn msm(storage: Storage) -> Technique {
-    Technique::Msm {
-        prefilter: Prefilter {
-            storage,
-            filter: blur4(),
-        },
-        hausdorff: false,
-        moment_bias: crate::scene::default_moment_bias(storage),
-        bleed: 0.0,
-    }
+    let format = ("format", ParamValue::Choice(storage_name(storage)));
+    named("msm", &[format, BLUR4[0], BLUR4[1]])
 }
 
 fn msm_mips() -> Technique {
-    Technique::Msm {
-        prefilter: Prefilter {
-            storage: Storage::F32,
-            filter: Filter::Mips {
-                width: 1.0,
-                max_anisotropy: 0,
-            },
-        },
-        hausdorff: false,
-        moment_bias: 1e-5,
-        bleed: 0.0,
-    }
+    named(
+        "msm",
+        &[
+            ("filter", ParamValue::Choice("mips")),
+            ("filter_width", ParamValue::Float(1.0)),
+            ("moment_bias", ParamValue::Float(1e-5)),
+        ],
+    )
 }
 
 fn csm() -> Technique {
-    Technique::Csm {
-        prefilter: Prefilter {
-            storage: Storage::F32,
-            filter: blur4(),
-        },
-        terms: 2,
-        attenuation: 1.0,
-        offset: 0.25,
-        scale: 2.0,
-    }
+    csm_terms(2)
 }
 
 fn esm() -> Technique {
-    Technique::Esm {
-        filter: blur4(),
-        exponent: 80.0,
-    }
+    named("esm", &BLUR4)
 }
 
-/// CSM with `terms` terms.
+/// CSM with `terms` terms (offset 0.25 whatever M: the bench times the series, not its fit).
 fn csm_terms(terms: u32) -> Technique {
-    match csm() {
-        Technique::Csm {
-            prefilter,
-            attenuation,
-            offset,
-            scale,
-            ..
-        } => Technique::Csm {
-            prefilter,
-            terms,
-            attenuation,
-            offset,
-            scale,
-        },
-        other => other,
-    }
+    let values = [
+        ("terms", ParamValue::Int(terms)),
+        ("offset", ParamValue::Float(0.25)),
+    ];
+    named("csm", &[values[0], values[1], BLUR4[0], BLUR4[1]])
 }
 
 /// A light's shipped graph from its rasterized depth to `outputs` (the encoded maps). The
@@ -334,7 +290,7 @@ fn sat_graph_with(
 /// The shipped node of [`technique::add_light_nodes`] for a spot light (the perspective path,
 /// the more expensive one), reading a Depth32Float import as the renderer's does.
 fn linearize_graph(n: u32) -> BenchGraph {
-    let light = bench_light(n, Technique::Hard);
+    let light = bench_light(n, named("hard", &[]));
     let mut graph = Graph::default();
     technique::add_light_nodes(&mut graph, 0, &light);
     BenchGraph {

@@ -1,7 +1,7 @@
 //! Reference of `kernels/blur.wgsl`: both passes of the separable blur, clamp-to-edge.
 
 use super::Texels;
-use crate::scene::BlurKernel;
+use crate::model::BlurKernel;
 
 /// One-sided weights in f64, normalized so `w0 + 2 Σ wi = 1` (independent of `filter.rs`).
 pub fn weights(radius: f64, sigma: f64, kernel: BlurKernel) -> Vec<f64> {

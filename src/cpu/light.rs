@@ -2,7 +2,7 @@
 
 use glam::{DMat4, DVec3, DVec4};
 
-use crate::technique::LightGpu;
+use crate::gpu_data::LightGpu;
 
 /// Reference of `LightSample`.
 #[derive(Clone, Copy, Debug)]

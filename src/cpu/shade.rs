@@ -5,8 +5,9 @@
 
 use glam::DVec3;
 
-use crate::render::{CameraRays, FrameGpu};
-use crate::technique::LightGpu;
+use crate::gpu_data::FrameGpu;
+use crate::gpu_data::LightGpu;
+use crate::model::CameraRays;
 
 /// What [`shade`] needs besides the G-buffer: the frame constants, each light and each
 /// material's albedo, as the shading kernel receives them.

@@ -6,7 +6,7 @@
 use super::blocker::{self, Blocker};
 use super::light::LightSample;
 use super::sat::Integral;
-use crate::technique::LightGpu;
+use crate::gpu_data::LightGpu;
 
 /// A CSSM light's representations, each per texel as its tables sum them.
 #[derive(Clone, Copy, Debug)]

@@ -2,7 +2,7 @@
 
 use super::Map;
 use super::light::LightSample;
-use crate::technique::LightGpu;
+use crate::gpu_data::LightGpu;
 
 /// Lit (1) when the receiver is no deeper than the nearest texel plus the bias.
 pub fn vis_hard(map: &Map, l: &LightGpu, s: &LightSample) -> f64 {

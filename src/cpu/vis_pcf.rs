@@ -2,7 +2,7 @@
 
 use super::Map;
 use super::light::{LightSample, linear_to_ndc};
-use crate::technique::LightGpu;
+use crate::gpu_data::LightGpu;
 
 /// Weighted mean of comparisons over the (2r + 1)² window (box or tent weights).
 pub fn vis_pcf(map: &Map, l: &LightGpu, s: &LightSample) -> f64 {

@@ -2,7 +2,7 @@
 
 use super::light::{LightSample, linear_to_z, map_width};
 use super::{Map, vogel_disc};
-use crate::technique::LightGpu;
+use crate::gpu_data::LightGpu;
 
 /// Blocker-search radius in UV (`pcss_search_radius`).
 pub fn search_radius(l: &LightGpu, s: &LightSample) -> f64 {

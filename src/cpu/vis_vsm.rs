@@ -2,7 +2,7 @@
 
 use super::Texels;
 use super::light::LightSample;
-use crate::technique::LightGpu;
+use crate::gpu_data::LightGpu;
 
 /// Chebyshev upper bound from the filtered moments (`levels`: the map, or its mip chain),
 /// with bleeding reduction.

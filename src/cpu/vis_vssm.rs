@@ -6,7 +6,7 @@
 use super::blocker::{self, Blocker};
 use super::light::LightSample;
 use super::sat::Integral;
-use crate::technique::LightGpu;
+use crate::gpu_data::LightGpu;
 
 /// The mean moments over the blocker-search square.
 pub fn search(moments: &Integral, l: &LightGpu, s: &LightSample) -> Vec<f64> {

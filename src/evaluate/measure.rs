@@ -123,15 +123,8 @@ pub fn measure(
         .iter()
         .map(|l| u64::from(l.shadow_map).pow(2) * 4)
         .sum();
-    let (storage, filter) = match c.technique {
-        Technique::Vsm { prefilter, .. }
-        | Technique::Evsm { prefilter, .. }
-        | Technique::Msm { prefilter, .. }
-        | Technique::Csm { prefilter, .. } => (
-            storage_name(prefilter.storage).to_string(),
-            filter_name(prefilter.filter),
-        ),
-        Technique::Esm { filter, .. } => ("f32".to_string(), filter_name(filter)),
+    let (storage, filter) = match (c.technique.storage(), c.technique.filter()) {
+        (Some(storage), Some(filter)) => (storage_name(storage).to_string(), filter_name(filter)),
         _ => (String::new(), String::new()),
     };
     let row = Row {

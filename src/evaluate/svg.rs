@@ -70,23 +70,12 @@ impl Metric {
     }
 }
 
-/// Colour per technique (by name), so families read at a glance.
+/// Colour per technique (by name; the registry's `colour`), so families read at a glance.
 pub fn colour(technique: &str) -> RGBColor {
-    match technique {
-        "hard" => RGBColor(0x44, 0x44, 0x44),
-        "pcf" => RGBColor(0x1f, 0x77, 0xb4),
-        "pcss" => RGBColor(0x17, 0xbe, 0xcf),
-        "vsm" => RGBColor(0x2c, 0xa0, 0x2c),
-        "evsm2" => RGBColor(0xbc, 0xbd, 0x22),
-        "evsm4" => RGBColor(0x8c, 0x56, 0x4b),
-        "esm" => RGBColor(0x94, 0x67, 0xbd),
-        "msm" => RGBColor(0xd6, 0x27, 0x28),
-        "csm" => RGBColor(0xff, 0x7f, 0x0e),
-        "cssm" => RGBColor(0xe3, 0x77, 0xc2),
-        "vssm" => RGBColor(0x00, 0x5f, 0x3f),
-        "msm_soft" => RGBColor(0x8b, 0x00, 0x00),
-        _ => RGBColor(0x7f, 0x7f, 0x7f),
-    }
+    crate::technique::by_name(technique).map_or(RGBColor(0x7f, 0x7f, 0x7f), |d| {
+        let [r, g, b] = d.colour;
+        RGBColor(r, g, b)
+    })
 }
 
 /// Indices of the rows on the Pareto front of (total time, `metric`), fastest first: a row

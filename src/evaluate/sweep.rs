@@ -3,13 +3,10 @@
 
 use super::EvaluateOptions;
 use crate::error::{Error, Result};
+use crate::model::ParamValue;
 use crate::prefilter::PrefilterConfig;
-use crate::scene::{BlurKernel, Filter, PcfKernel, Scene, Storage, Technique};
-
-/// Technique names `--techniques` accepts, in sweep order.
-pub const TECHNIQUES: &[&str] = &[
-    "hard", "pcf", "pcss", "vsm", "evsm2", "evsm4", "esm", "msm", "csm", "cssm", "vssm", "msm_soft",
-];
+use crate::scene::{BlurKernel, Filter, Scene, Storage, Technique};
+use crate::technique;
 
 /// A filter of a box `width` texels wide.
 pub type FilterOfWidth = fn(f32) -> Filter;
@@ -53,14 +50,15 @@ pub const PCSS_TAPS: [(u32, u32); 4] = [(8, 16), (16, 32), (32, 64), (64, 64)];
 /// Configurations of the sweep for `scene` (every light gets each), filtered by
 /// `opts.techniques`. Unknown technique names are an error listing the known ones.
 pub fn sweep(scene: &Scene, opts: &EvaluateOptions) -> Result<Vec<Config>> {
+    let known = crate::technique::names();
     let wanted: Vec<String> = match &opts.techniques {
-        None => TECHNIQUES.iter().map(|s| s.to_string()).collect(),
+        None => known.iter().map(|s| s.to_string()).collect(),
         Some(list) => {
             for t in list {
-                if !TECHNIQUES.contains(&t.as_str()) {
+                if !known.contains(&t.as_str()) {
                     return Err(Error::Invalid(format!(
                         "unknown technique `{t}` in --techniques (known: {})",
-                        TECHNIQUES.join(", ")
+                        known.join(", ")
                     )));
                 }
             }
@@ -107,15 +105,17 @@ pub fn sweep(scene: &Scene, opts: &EvaluateOptions) -> Result<Vec<Config>> {
             Vec::new()
         }
     };
+    let named = |name: &str, values: &[(&'static str, ParamValue)]| {
+        technique::named(name, values)
+            .ok_or_else(|| Error::Invalid(format!("sweep: cannot build technique `{name}`")))
+    };
     for &size in &size_sweep("hard") {
-        push("hard".into(), Technique::Hard, size, None);
+        push("hard".into(), named("hard", &[])?, size, None);
     }
     if wanted.iter().any(|w| w == "pcf") {
         for r in if quick { vec![2] } else { vec![1, 2, 4] } {
-            let t = Technique::Pcf {
-                radius: r,
-                kernel: PcfKernel::Box,
-            };
+            // The default kernel (box) at radius r.
+            let t = named("pcf", &[("radius", ParamValue::Int(r))])?;
             let width = Some(f64::from(2 * r + 1));
             let on: Vec<u32> = if r == 2 { sizes.clone() } else { vec![base] };
             for size in on {
@@ -124,39 +124,33 @@ pub fn sweep(scene: &Scene, opts: &EvaluateOptions) -> Result<Vec<Config>> {
         }
     }
     if scene.lights.iter().all(|l| l.size > 0.0) {
-        let pcss = scene
+        let pcss = match scene
             .lights
             .iter()
             .map(|l| l.shadow.technique)
-            .find(|t| matches!(t, Technique::Pcss { .. }))
-            .unwrap_or(Technique::Pcss {
-                blocker_samples: 16,
-                filter_samples: 32,
-                max_search: 0.1,
-            });
+            .find(|t| t.name() == "pcss")
+        {
+            Some(t) => t,
+            None => named("pcss", &[])?,
+        };
         // PCSS as engines ship it, at several tap counts (blocker search + filter): the
         // scene's (default 16 + 32) on every size, the others at the base size.
-        let pcss_label = |t: &Technique| match t {
-            Technique::Pcss {
-                blocker_samples,
-                filter_samples,
-                ..
-            } => format!("pcss {blocker_samples}+{filter_samples}"),
-            _ => "pcss".into(),
+        let pcss_label = |t: &Technique| {
+            let v = (technique::of(t).values)(t);
+            let (blockers, taps) = (v.int("blocker_samples"), v.int("filter_samples"));
+            format!("pcss {blockers}+{taps}")
         };
         for &size in &size_sweep("pcss") {
             push(pcss_label(&pcss), pcss, size, None);
         }
         if !quick && wanted.iter().any(|w| w == "pcss") {
-            let max_search = match pcss {
-                Technique::Pcss { max_search, .. } => max_search,
-                _ => 0.1,
-            };
             for (blocker_samples, filter_samples) in PCSS_TAPS {
-                let t = Technique::Pcss {
-                    blocker_samples,
-                    filter_samples,
-                    max_search,
+                let taps = [
+                    ("blocker_samples", ParamValue::Int(blocker_samples)),
+                    ("filter_samples", ParamValue::Int(filter_samples)),
+                ];
+                let Some(t) = technique::with_values(&pcss, &taps) else {
+                    continue;
                 };
                 if t != pcss {
                     push(pcss_label(&t), t, base, None);
@@ -226,20 +220,17 @@ fn with_moment_biases(configs: Vec<Config>, biases: &[f32]) -> Result<Vec<Config
     }
     let mut out = Vec::new();
     for c in configs {
-        if !matches!(
-            c.technique,
-            Technique::Msm { .. } | Technique::MsmSoft { .. }
-        ) {
+        if technique::of(&c.technique)
+            .params
+            .iter()
+            .all(|t| t.iter().all(|s| s.key != "moment_bias"))
+        {
             out.push(c);
             continue;
         }
         for &a in biases {
-            let mut technique = c.technique;
-            if let Technique::Msm { moment_bias, .. } | Technique::MsmSoft { moment_bias, .. } =
-                &mut technique
-            {
-                *moment_bias = a;
-            }
+            let bias = [("moment_bias", ParamValue::Float(a))];
+            let technique = technique::with_values(&c.technique, &bias).unwrap_or(c.technique);
             out.push(Config {
                 label: format!("{} bias{a:e}", c.label),
                 technique,
@@ -254,14 +245,11 @@ fn with_moment_biases(configs: Vec<Config>, biases: &[f32]) -> Result<Vec<Config
 /// like a scene file (EVSM exponents clamped to the storage's limit, MSM's default bias for
 /// the storage: `PrefilterConfig::with_storage`).
 fn prefiltered(name: &str, storage: Storage, filter: Filter, terms: u32) -> Result<Technique> {
-    let config = match name {
-        "vsm" => PrefilterConfig::vsm(1),
-        "evsm2" => PrefilterConfig::evsm2(1),
-        "evsm4" => PrefilterConfig::evsm4(1),
-        "esm" => PrefilterConfig::esm(1),
-        "msm" => PrefilterConfig::msm(1),
-        _ => PrefilterConfig::csm(1, terms),
-    };
+    let terms = [("terms", ParamValue::Int(terms))];
+    let values: &[(&str, ParamValue)] = if name == "csm" { &terms } else { &[] };
+    let t = technique::named(name, values)
+        .ok_or_else(|| Error::Invalid(format!("sweep: cannot build technique `{name}`")))?;
+    let config = PrefilterConfig::new(t, 1);
     let config = if name == "esm" {
         config.with_filter(filter)
     } else {

@@ -138,14 +138,10 @@ impl Checker<'_> {
     }
 
     fn features(&self, features: wgpu::Features) -> Result<()> {
-        use crate::scene::{Storage, Technique};
+        use crate::scene::Storage;
         for (i, l) in self.scene.lights.iter().enumerate() {
-            let storage = match l.shadow.technique {
-                Technique::Msm { prefilter, .. } => prefilter.storage,
-                Technique::MsmSoft { soft, .. } => soft.storage,
-                _ => continue,
-            };
-            if storage == Storage::Unorm16
+            // Only MSM's tables accept unorm16 (`technique::params::MSM_FORMAT`).
+            if l.shadow.technique.storage() == Some(Storage::Unorm16)
                 && !features.contains(wgpu::Features::TEXTURE_FORMAT_16BIT_NORM)
             {
                 let key = format!("light[{i}].shadow.format");

@@ -1,15 +1,16 @@
-//! What the stage computes (a technique with its parameters, validated with the scene file's
-//! rules) and what changes per frame (the light's matrices and depth range).
+//! What the stage computes (a technique with its parameters, checked by the technique
+//! registry's tables, as a scene file's are) and what changes per frame (the light's matrices
+//! and depth range).
 
 use glam::{Mat4, Vec3, Vec4};
 
 use super::StageError;
-use crate::filter::MAX_BLUR_RADIUS;
-use crate::scene::{
-    BlurKernel, DEFAULT_MAX_SEARCH, DEFAULT_SHARPEN, DEFAULT_SHARPEN_FALLOFF, Filter, Light,
-    LightKind, Prefilter, Shadow, Soft, Storage, Technique, exponent_limit,
+use crate::model::{
+    BlurKernel, Filter, Light, LightKind, ParamValue, ParamValues, Shadow, Storage, Technique,
 };
-use crate::technique::LightGpu;
+use crate::sat::SatVariant;
+use crate::technique::params::{COMMON, Given, GivenError, filter_values, storage_name};
+use crate::technique::{self, LightGpu, TechniqueDef};
 
 /// Largest map side a scene accepts before the device is asked (as `shadow_map` in scenes).
 const MAX_SIDE: u32 = 1 << 16;
@@ -17,7 +18,7 @@ const MAX_SIDE: u32 = 1 << 16;
 /// The stage's fixed settings: a technique with its parameters, the map size it is made for,
 /// and the shading constants the visibility functions read. Build one with a constructor
 /// ([`PrefilterConfig::vsm`], …) and adjust it with the `with_*` methods; defaults are the
-/// scene file's.
+/// scene file's (the registry's parameter tables).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PrefilterConfig {
     /// Technique with its parameters (storage format, filter and its parameters, exponents).
@@ -38,24 +39,16 @@ pub struct PrefilterConfig {
     moment_bias_set: bool,
 }
 
-/// The blur a scene gets without filter keys: radius 2, sigma 1, Gaussian.
-const DEFAULT_BLUR: Filter = Filter::Blur {
-    radius: 2.0,
-    sigma: 1.0,
-    kernel: BlurKernel::Gaussian,
-};
+/// The registry entry named `name` with every key at its default.
+fn named(name: &str) -> Technique {
+    let def = technique::by_name(name).expect("the constructors name registered techniques");
+    technique::default_of(def)
+}
 
-const DEFAULT_PREFILTER: Prefilter = Prefilter {
-    storage: Storage::F32,
-    filter: DEFAULT_BLUR,
-};
-
-/// A soft technique's table without `format`, `sat_sums` or `max_search` keys.
-const DEFAULT_SOFT: Soft = Soft {
-    storage: Storage::F32,
-    sums: crate::sat::SatVariant::Fixed,
-    max_search: DEFAULT_MAX_SEARCH,
-};
+/// The registry entry named `name` with `values` over its defaults.
+fn named_with(name: &str, values: &[(&'static str, ParamValue)]) -> Technique {
+    technique::named(name, values).unwrap_or_else(|| named(name))
+}
 
 impl PrefilterConfig {
     /// `technique` on `size`² maps with the scene file's default bias, normal bias and size.
@@ -74,81 +67,34 @@ impl PrefilterConfig {
     /// VSM with a scene's defaults: f32 moments, Gaussian blur of radius 2, bleed reduction
     /// 0.2, variance floor 1e-5.
     pub fn vsm(size: u32) -> Self {
-        Self::new(
-            Technique::Vsm {
-                prefilter: DEFAULT_PREFILTER,
-                bleed: 0.2,
-                min_variance: 1e-5,
-            },
-            size,
-        )
+        Self::new(named("vsm"), size)
     }
 
     /// EVSM with two moments and a scene's defaults (c⁺ = 40, floor 1e-4, no bleed reduction).
     pub fn evsm2(size: u32) -> Self {
-        Self::evsm(size, false)
+        Self::new(named("evsm2"), size)
     }
 
     /// EVSM with four moments and a scene's defaults (c⁺ = 40, c⁻ = 5).
     pub fn evsm4(size: u32) -> Self {
-        Self::evsm(size, true)
-    }
-
-    fn evsm(size: u32, four: bool) -> Self {
-        Self::new(
-            Technique::Evsm {
-                prefilter: DEFAULT_PREFILTER,
-                four,
-                exp_pos: 40.0,
-                exp_neg: 5.0,
-                bleed: 0.0,
-                min_variance: 1e-4,
-            },
-            size,
-        )
+        Self::new(named("evsm4"), size)
     }
 
     /// ESM with a scene's defaults: c = 80, Gaussian blur of radius 2 in log space.
     pub fn esm(size: u32) -> Self {
-        Self::new(
-            Technique::Esm {
-                filter: DEFAULT_BLUR,
-                exponent: 80.0,
-            },
-            size,
-        )
+        Self::new(named("esm"), size)
     }
 
     /// MSM, 32-bit raw moments, Hamburger reconstruction, the scene default blur.
     pub fn msm(size: u32) -> Self {
-        Self::new(
-            Technique::Msm {
-                prefilter: crate::scene::Prefilter {
-                    storage: Storage::F32,
-                    filter: DEFAULT_BLUR,
-                },
-                hausdorff: false,
-                moment_bias: crate::scene::default_moment_bias(Storage::F32),
-                bleed: 0.0,
-            },
-            size,
-        )
+        Self::new(named("msm"), size)
     }
 
     /// CSM with `terms` Fourier terms and the scene defaults (attenuation 1, offset ½/M,
     /// scale 2), the scene default blur.
     pub fn csm(size: u32, terms: u32) -> Self {
         Self::new(
-            Technique::Csm {
-                prefilter: crate::scene::Prefilter {
-                    storage: Storage::F32,
-                    filter: DEFAULT_BLUR,
-                },
-                terms,
-                attenuation: 1.0,
-                offset: 0.5 / terms.max(1) as f32,
-                scale: 2.0,
-            },
+            named_with("csm", &[("terms", ParamValue::Int(terms))]),
             size,
         )
     }
@@ -156,52 +102,26 @@ impl PrefilterConfig {
     /// Soft VSM (`vssm`) with a scene's defaults, for an area light `light_size` wide: f32
     /// moments in a fixed-point table, search cap 0.1, bleed reduction 0.2, floor 1e-5.
     pub fn vssm(size: u32, light_size: f32) -> Self {
-        let mut c = Self::new(
-            Technique::Vssm {
-                soft: DEFAULT_SOFT,
-                bleed: 0.2,
-                min_variance: 1e-5,
-            },
-            size,
-        );
-        c.light_size = light_size;
-        c
+        Self::new(named("vssm"), size).with_light_size(light_size)
     }
 
     /// Soft MSM (`msm_soft`) with a scene's defaults: f32 moments (summed quantized, as every
     /// MSM table) in a fixed-point table, Hamburger reconstruction, search cap 0.1, the soft
     /// moment bias of f32.
     pub fn msm_soft(size: u32, light_size: f32) -> Self {
-        let mut c = Self::new(
-            Technique::MsmSoft {
-                soft: DEFAULT_SOFT,
-                hausdorff: false,
-                moment_bias: crate::scene::default_soft_moment_bias(Storage::F32),
-                bleed: 0.0,
-            },
-            size,
-        );
-        c.light_size = light_size;
-        c
+        Self::new(named("msm_soft"), size).with_light_size(light_size)
     }
 
     /// Convolution soft shadow maps (`cssm`) with `terms` terms and a scene's defaults
     /// (attenuation 1, offset ½/M, scale 2, the default sharpening, search cap 0.1).
     pub fn cssm(size: u32, terms: u32, light_size: f32) -> Self {
-        let mut c = Self::new(
-            Technique::Cssm {
-                soft: DEFAULT_SOFT,
-                terms,
-                attenuation: 1.0,
-                offset: 0.5 / terms.max(1) as f32,
-                scale: 2.0,
-                sharpen: DEFAULT_SHARPEN,
-                sharpen_falloff: DEFAULT_SHARPEN_FALLOFF,
-            },
-            size,
-        );
-        c.light_size = light_size;
-        c
+        let t = named_with("cssm", &[("terms", ParamValue::Int(terms))]);
+        Self::new(t, size).with_light_size(light_size)
+    }
+
+    fn with_light_size(mut self, light_size: f32) -> Self {
+        self.light_size = light_size;
+        self
     }
 
     /// The technique, map size and shading constants of a scene's light.
@@ -217,76 +137,72 @@ impl PrefilterConfig {
         }
     }
 
+    /// The technique with `change` made to its values, rebuilt by the registry; `key` is
+    /// reported as not applying when the technique has no such key, or refuses the option.
+    fn with_values(mut self, key: &'static str, change: impl FnOnce(&mut ParamValues)) -> Self {
+        let def = technique::of(&self.technique);
+        let mut values = (def.values)(&self.technique);
+        let before = values.get(key);
+        change(&mut values);
+        let refused = match values.get(key) {
+            Some(ParamValue::Choice(name)) => !technique::accepts(def, key, name),
+            _ => false,
+        };
+        match technique::build_with(def, &values) {
+            Some(t) if before.is_some() && !refused => self.technique = t,
+            _ => self.not_applicable = Some(key),
+        }
+        self
+    }
+
     /// The same with moments stored at `storage` precision (VSM, EVSM, MSM, CSM and the soft
     /// techniques; ESM is always f32; `Unorm16` only for MSM and soft MSM). MSM's moment bias
     /// becomes the storage's default unless [`PrefilterConfig::with_moment_bias`] set it.
-    pub fn with_storage(mut self, storage: Storage) -> Self {
+    pub fn with_storage(self, storage: Storage) -> Self {
         let keep = self.moment_bias_set;
-        match &mut self.technique {
-            Technique::Msm {
-                prefilter,
-                moment_bias,
-                ..
-            } => {
-                prefilter.storage = storage;
-                if !keep {
-                    *moment_bias = crate::scene::default_moment_bias(storage);
-                }
+        self.with_values("format", |v| {
+            v.set("format", ParamValue::Choice(storage_name(storage)));
+            if !keep {
+                v.remove("moment_bias");
             }
-            Technique::MsmSoft {
-                soft, moment_bias, ..
-            } => {
-                soft.storage = storage;
-                if !keep {
-                    *moment_bias = crate::scene::default_soft_moment_bias(storage);
-                }
-            }
-            Technique::Vssm { soft, .. } | Technique::Cssm { soft, .. }
-                if storage != Storage::Unorm16 =>
-            {
-                soft.storage = storage;
-            }
-            Technique::Vsm { prefilter, .. }
-            | Technique::Evsm { prefilter, .. }
-            | Technique::Csm { prefilter, .. }
-                if storage != Storage::Unorm16 =>
-            {
-                prefilter.storage = storage;
-            }
-            _ => self.not_applicable = Some("format"),
-        }
-        self
+        })
     }
 
     /// The same with `filter` over the representation (VSM, EVSM, ESM, MSM, CSM; the soft
     /// techniques always read a summed-area table: see [`PrefilterConfig::with_soft`]).
-    pub fn with_filter(mut self, filter: Filter) -> Self {
-        match &mut self.technique {
-            Technique::Vsm { prefilter, .. }
-            | Technique::Evsm { prefilter, .. }
-            | Technique::Msm { prefilter, .. }
-            | Technique::Csm { prefilter, .. } => {
-                prefilter.filter = filter;
+    pub fn with_filter(self, filter: Filter) -> Self {
+        self.with_values("filter", |v| {
+            for k in [
+                "filter_radius",
+                "filter_sigma",
+                "filter_kernel",
+                "filter_width",
+                "sat_sums",
+                "max_anisotropy",
+            ] {
+                v.remove(k);
             }
-            Technique::Esm { filter: f, .. } => *f = filter,
-            _ => self.not_applicable = Some("filter"),
-        }
-        self
+            filter_values(&filter, v);
+        })
     }
 
     /// The same with a soft technique's table sums and search cap (`cssm`, `vssm`,
     /// `msm_soft`; the storage is set by [`PrefilterConfig::with_storage`]).
-    pub fn with_soft(mut self, sums: crate::sat::SatVariant, max_search: f32) -> Self {
-        match &mut self.technique {
-            Technique::Cssm { soft, .. }
-            | Technique::Vssm { soft, .. }
-            | Technique::MsmSoft { soft, .. } => {
-                soft.sums = sums;
-                soft.max_search = max_search;
-            }
-            _ => self.not_applicable = Some("sat_sums"),
+    pub fn with_soft(self, sums: SatVariant, max_search: f32) -> Self {
+        if !technique::of(&self.technique).area_light || self.technique.soft().is_none() {
+            return Self {
+                not_applicable: Some("sat_sums"),
+                ..self
+            };
         }
-        self
+        self.with_values("sat_sums", |v| {
+            let name = match sums {
+                SatVariant::Fixed => "fixed",
+                SatVariant::Float => "float",
+            };
+            v.set("sat_sums", ParamValue::Choice(name));
+            v.set("max_search", ParamValue::Float(max_search));
+        })
     }
 
     /// The same with a Gaussian blur of `radius` texels and a scene's default sigma
@@ -309,12 +225,11 @@ impl PrefilterConfig {
     /// checked by validation against the same range [0, 0.5]). Without it, α is the default
     /// of the storage (`scene::default_moment_bias`, `default_soft_moment_bias`).
     pub fn with_moment_bias(mut self, alpha: f32) -> Self {
-        match &mut self.technique {
-            Technique::Msm { moment_bias, .. } | Technique::MsmSoft { moment_bias, .. } => {
-                *moment_bias = alpha;
-                self.moment_bias_set = true;
-            }
-            _ => self.not_applicable = Some("moment_bias"),
+        self = self.with_values("moment_bias", |v| {
+            v.set("moment_bias", ParamValue::Float(alpha));
+        });
+        if self.not_applicable.is_none() {
+            self.moment_bias_set = true;
         }
         self
     }
@@ -325,14 +240,15 @@ impl PrefilterConfig {
         self
     }
 
-    /// Checks every value against the scene file's rules and returns the configuration the
-    /// stage runs, with EVSM exponents clamped to the storage's safe limit, and a warning per
-    /// value changed.
+    /// Checks every value against the technique's parameter table (the scene file's rules)
+    /// and returns the configuration the stage runs, with EVSM and ESM exponents clamped as
+    /// a scene's are, and a warning per value changed.
     pub fn validated(&self) -> Result<(Self, Vec<String>), StageError> {
+        let def = technique::of(&self.technique);
         if let Some(field) = self.not_applicable {
             return Err(config_err(
                 field,
-                format!("does not apply to technique \"{}\"", self.technique.name()),
+                format!("does not apply to technique \"{}\"", def.name),
             ));
         }
         let side = u64::from(self.size);
@@ -342,16 +258,50 @@ impl PrefilterConfig {
                 format!("{side} is outside [1, {MAX_SIDE}]"),
             ));
         }
-        range("bias", self.bias, -1.0, 1.0)?;
-        range("normal_bias", self.normal_bias, 0.0, 100.0)?;
-        range("size (light)", self.light_size, 0.0, 1e6)?;
+        let common = ParamValues(vec![
+            ("bias", ParamValue::Float(self.bias)),
+            ("normal_bias", ParamValue::Float(self.normal_bias)),
+        ]);
+        crate::model::check(&[COMMON], &Given(&common)).map_err(given_err)?;
+        if !self.light_size.is_finite() || !(0.0..=1e6).contains(&self.light_size) {
+            return Err(config_err(
+                "size (light)",
+                format!("{} is outside [0, 1000000]", self.light_size),
+            ));
+        }
         let mut out = *self;
         // The bias is settled now: a later `with_storage` keeps it, as it keeps a light's.
         out.moment_bias_set = true;
-        let mut warnings = Vec::new();
-        out.technique = technique(self.technique, self.light_size, &mut warnings)?;
+        let warnings;
+        (out.technique, warnings) = checked(def, self.technique, self.light_size)?;
         Ok((out, warnings))
     }
+}
+
+/// `t` checked against `def`'s tables (the values it holds, as a scene's would be) with its
+/// clamps applied, and the warnings of the clamps. The technique is kept as built (a
+/// setting that does not apply, such as a box blur's sigma, keeps its value).
+fn checked(
+    def: &TechniqueDef,
+    mut t: Technique,
+    light_size: f32,
+) -> Result<(Technique, Vec<String>), StageError> {
+    let values = (def.values)(&t);
+    crate::model::check(def.params, &Given(&values)).map_err(given_err)?;
+    if def.area_light && light_size <= 0.0 {
+        return Err(config_err(
+            "size (light)",
+            format!("technique \"{}\" needs an area light width > 0", def.name),
+        ));
+    }
+    let mut clamps = Vec::new();
+    (def.clamp)(&mut t, &mut clamps);
+    let warnings = clamps.iter().map(|c| c.message(c.key)).collect();
+    Ok((t, warnings))
+}
+
+fn given_err(e: GivenError) -> StageError {
+    config_err(e.key, e.message)
 }
 
 fn config_err(field: &str, message: String) -> StageError {
@@ -359,221 +309,6 @@ fn config_err(field: &str, message: String) -> StageError {
         field: field.to_string(),
         message,
     }
-}
-
-/// A finite value inside `[lo, hi]`, worded as the scene parser words it. The scene checks
-/// its f64 text before rounding to f32; here the bounds are rounded instead, so that the f32 a
-/// scene bound turns into (0.99 → 0.9900000095) passes as it does in a scene.
-fn range(field: &str, v: f32, lo: f64, hi: f64) -> Result<(), StageError> {
-    if !v.is_finite() || v < lo as f32 || v > hi as f32 {
-        return Err(config_err(field, format!("{v} is outside [{lo}, {hi}]")));
-    }
-    Ok(())
-}
-
-fn int_range(field: &str, v: u32, lo: u32, hi: u32) -> Result<(), StageError> {
-    if v < lo || v > hi {
-        return Err(config_err(field, format!("{v} is outside [{lo}, {hi}]")));
-    }
-    Ok(())
-}
-
-/// The scene rules of each technique (`src/scene/validate.rs`, `shadow`); techniques without
-/// parameters pass as they are.
-fn technique(
-    t: Technique,
-    light_size: f32,
-    warnings: &mut Vec<String>,
-) -> Result<Technique, StageError> {
-    Ok(match t {
-        Technique::Pcf { radius, .. } => {
-            int_range("radius", radius, 0, 32)?;
-            t
-        }
-        Technique::Pcss {
-            blocker_samples,
-            filter_samples,
-            max_search,
-        } => {
-            int_range("blocker_samples", blocker_samples, 1, 256)?;
-            int_range("filter_samples", filter_samples, 1, 1024)?;
-            range("max_search", max_search, 1e-4, 1.0)?;
-            area_light(&t, light_size)?;
-            t
-        }
-        Technique::Cssm {
-            soft,
-            terms,
-            attenuation,
-            offset,
-            scale,
-            sharpen,
-            sharpen_falloff,
-        } => {
-            range("max_search", soft.max_search, 1e-4, 1.0)?;
-            range("terms", terms as f32, 1.0, 16.0)?;
-            range("attenuation", attenuation, 0.0, 20.0)?;
-            range("offset", offset, 0.0, 0.5)?;
-            range("scale", scale, 1.0, 16.0)?;
-            range("sharpen", sharpen, 0.0, 100.0)?;
-            range("sharpen_falloff", sharpen_falloff, 0.0, 1e4)?;
-            area_light(&t, light_size)?;
-            t
-        }
-        Technique::Vssm {
-            soft,
-            bleed,
-            min_variance,
-        } => {
-            range("max_search", soft.max_search, 1e-4, 1.0)?;
-            range("bleed_reduction", bleed, 0.0, 0.99)?;
-            range("min_variance", min_variance, 0.0, 1.0)?;
-            area_light(&t, light_size)?;
-            t
-        }
-        Technique::MsmSoft {
-            soft,
-            moment_bias,
-            bleed,
-            ..
-        } => {
-            range("max_search", soft.max_search, 1e-4, 1.0)?;
-            range("moment_bias", moment_bias, 0.0, 0.5)?;
-            range("bleed_reduction", bleed, 0.0, 0.99)?;
-            area_light(&t, light_size)?;
-            t
-        }
-        Technique::Vsm {
-            prefilter,
-            bleed,
-            min_variance,
-        } => {
-            filter(&prefilter.filter)?;
-            range("bleed_reduction", bleed, 0.0, 0.99)?;
-            range("min_variance", min_variance, 0.0, 1.0)?;
-            t
-        }
-        Technique::Evsm {
-            prefilter,
-            four,
-            exp_pos,
-            exp_neg,
-            bleed,
-            min_variance,
-        } => {
-            filter(&prefilter.filter)?;
-            range("bleed_reduction", bleed, 0.0, 0.99)?;
-            range("min_variance", min_variance, 0.0, 1.0)?;
-            let limit = exponent_limit(prefilter.storage);
-            let mut clamp = |field: &str, c: f32| -> Result<f32, StageError> {
-                range(field, c, 0.01, 1e4)?;
-                if c > limit {
-                    warnings.push(format!(
-                        "`{field}` = {c} exceeds the safe limit {limit} for {:?} storage; \
-                         clamped to {limit}",
-                        prefilter.storage
-                    ));
-                }
-                Ok(sat_clamp(
-                    warnings,
-                    field,
-                    c.min(limit),
-                    &prefilter.filter,
-                    false,
-                ))
-            };
-            Technique::Evsm {
-                prefilter,
-                four,
-                exp_pos: clamp("exponent_pos", exp_pos)?,
-                exp_neg: clamp("exponent_neg", exp_neg)?,
-                bleed,
-                min_variance,
-            }
-        }
-        Technique::Esm {
-            filter: f,
-            exponent,
-        } => {
-            filter(&f)?;
-            range("exponent", exponent, 0.01, 1e4)?;
-            Technique::Esm {
-                filter: f,
-                exponent: sat_clamp(warnings, "exponent", exponent, &f, true),
-            }
-        }
-        Technique::Msm {
-            prefilter,
-            moment_bias,
-            bleed,
-            ..
-        } => {
-            filter(&prefilter.filter)?;
-            range("moment_bias", moment_bias, 0.0, 0.5)?;
-            range("bleed_reduction", bleed, 0.0, 0.99)?;
-            t
-        }
-        Technique::Csm {
-            prefilter,
-            terms,
-            attenuation,
-            offset,
-            scale,
-        } => {
-            filter(&prefilter.filter)?;
-            range("terms", terms as f32, 1.0, 16.0)?;
-            range("attenuation", attenuation, 0.0, 20.0)?;
-            range("offset", offset, 0.0, 0.5)?;
-            range("scale", scale, 1.0, 16.0)?;
-            t
-        }
-        _ => t,
-    })
-}
-
-/// `c` clamped to what a summed-area table keeps accurate (`scene::sat_exponent_limit`), with
-/// a warning when it is clamped.
-fn sat_clamp(warnings: &mut Vec<String>, field: &str, c: f32, f: &Filter, esm: bool) -> f32 {
-    match crate::scene::sat_exponent_limit(f, esm) {
-        Some(limit) if c > limit => {
-            warnings.push(format!(
-                "`{field}` = {c} exceeds {limit:.2}, the largest a summed-area table of this \
-                 `filter_width` keeps accurate; clamped"
-            ));
-            limit
-        }
-        _ => c,
-    }
-}
-
-/// PCSS and the soft techniques need an area light (as a scene's `size` > 0).
-fn area_light(t: &Technique, light_size: f32) -> Result<(), StageError> {
-    if light_size <= 0.0 {
-        return Err(config_err(
-            "size (light)",
-            format!("technique \"{}\" needs an area light width > 0", t.name()),
-        ));
-    }
-    Ok(())
-}
-
-fn filter(f: &Filter) -> Result<(), StageError> {
-    if let Filter::Blur { radius, sigma, .. } = *f {
-        range("filter_radius", radius, 0.0, f64::from(MAX_BLUR_RADIUS))?;
-        range("filter_sigma", sigma, 0.1, 100.0)?;
-    }
-    if let Filter::Mips {
-        width,
-        max_anisotropy,
-    } = *f
-    {
-        range("filter_width", width, 1.0, 65536.0)?;
-        range("max_anisotropy", max_anisotropy as f32, 0.0, 16.0)?;
-    }
-    if let Filter::Sat { width, .. } = *f {
-        range("filter_width", width, 1.0, 1024.0)?;
-    }
-    Ok(())
 }
 
 /// What changes per frame: the matrices the host rasterized the depth texture with, and how

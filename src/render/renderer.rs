@@ -11,11 +11,16 @@ use crate::created;
 use crate::error::{Error, Result};
 use crate::exec::{ComputeKernel, Executor, GpuTimer, Outputs};
 use crate::gpu::{scoped, submit_and_wait};
-use crate::kernels;
 use crate::scene::{Light, Scene};
 use crate::technique;
 
-use super::targets::{TargetKey, Targets, uniform_group};
+mod raster;
+
+pub use raster::ShadowRaster;
+pub(super) use raster::depth_only_view;
+use raster::{clear_depth, raster_pass};
+
+use super::targets::{TargetKey, Targets};
 use super::{Frame, RenderOptions, ScenePlan, check_render, plan_lights_for};
 
 /// Renders scenes; holds pipelines, pooled textures and a frame's resources across frames.
@@ -52,73 +57,6 @@ pub(super) struct ShadeInputs<'a> {
     pub visibility: &'a wgpu::Buffer,
 }
 
-const VERTEX_ATTRS: [wgpu::VertexAttribute; 3] =
-    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Uint32];
-
-fn vertex_layout() -> wgpu::VertexBufferLayout<'static> {
-    wgpu::VertexBufferLayout {
-        array_stride: std::mem::size_of::<crate::scene::Vertex>() as u64,
-        step_mode: wgpu::VertexStepMode::Vertex,
-        attributes: &VERTEX_ATTRS,
-    }
-}
-
-/// A depth attachment cleared to the far plane and kept.
-fn clear_depth(view: &wgpu::TextureView) -> wgpu::RenderPassDepthStencilAttachment<'_> {
-    wgpu::RenderPassDepthStencilAttachment {
-        view,
-        depth_ops: Some(wgpu::Operations {
-            load: wgpu::LoadOp::Clear(1.0),
-            store: wgpu::StoreOp::Store,
-        }),
-        stencil_ops: None,
-    }
-}
-
-/// A view of all of `t` (its depth aspect for a depth texture).
-pub(super) fn depth_only_view(t: &wgpu::Texture) -> wgpu::TextureView {
-    created::view(
-        t,
-        &wgpu::TextureViewDescriptor {
-            aspect: if t.format().is_depth_stencil_format() {
-                wgpu::TextureAspect::DepthOnly
-            } else {
-                wgpu::TextureAspect::All
-            },
-            ..Default::default()
-        },
-    )
-}
-
-/// Records a depth-only raster pass: `count` vertices of `vertices` into `depth`.
-#[expect(clippy::too_many_arguments, reason = "one raster pass's inputs")]
-fn raster_pass(
-    enc: &mut wgpu::CommandEncoder,
-    label: &str,
-    pipeline: &wgpu::RenderPipeline,
-    bind_group: &wgpu::BindGroup,
-    depth: &wgpu::TextureView,
-    vertices: &wgpu::Buffer,
-    count: u32,
-    timer: Option<&mut GpuTimer>,
-) {
-    if let Some(t) = timer {
-        t.begin(enc, label);
-    }
-    let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-        label: Some(label),
-        color_attachments: &[],
-        depth_stencil_attachment: Some(clear_depth(depth)),
-        timestamp_writes: None,
-        occlusion_query_set: None,
-        multiview_mask: None,
-    });
-    pass.set_pipeline(pipeline);
-    pass.set_bind_group(0, bind_group, &[]);
-    pass.set_vertex_buffer(0, vertices.slice(..));
-    pass.draw(0..count, 0..1);
-}
-
 impl Renderer {
     /// A renderer for `device`.
     pub fn new(device: &wgpu::Device) -> Self {
@@ -140,123 +78,6 @@ impl Renderer {
                 },
             ),
         }
-    }
-
-    fn raster_pipeline(
-        device: &wgpu::Device,
-        name: &str,
-        fragment: Option<&[Option<wgpu::ColorTargetState>]>,
-        bias: wgpu::DepthBiasState,
-    ) -> Result<(wgpu::RenderPipeline, wgpu::BindGroupLayout)> {
-        let wgsl = kernels::resolve(name, None)?;
-        let (_, refl) = kernels::reflect(name, &wgsl)?;
-        let label = format!("shadowgraph.{name}");
-        scoped(
-            device,
-            || {
-                let module = created::shader_module(
-                    device,
-                    wgpu::ShaderModuleDescriptor {
-                        label: Some(&label),
-                        source: wgpu::ShaderSource::Wgsl(wgsl.as_str().into()),
-                    },
-                );
-                let bgl = created::bind_group_layout(
-                    device,
-                    &wgpu::BindGroupLayoutDescriptor {
-                        label: Some(&label),
-                        entries: &refl.layout_entries(0),
-                    },
-                );
-                let layout = created::pipeline_layout(
-                    device,
-                    &wgpu::PipelineLayoutDescriptor {
-                        label: Some(&label),
-                        bind_group_layouts: &[Some(&bgl)],
-                        immediate_size: 0,
-                    },
-                );
-                let pipeline = created::render_pipeline(
-                    device,
-                    &wgpu::RenderPipelineDescriptor {
-                        label: Some(&label),
-                        layout: Some(&layout),
-                        vertex: wgpu::VertexState {
-                            module: &module,
-                            entry_point: Some("vs_main"),
-                            compilation_options: Default::default(),
-                            buffers: &[Some(vertex_layout())],
-                        },
-                        // Two-sided: planes and open meshes cast and receive from both sides.
-                        primitive: wgpu::PrimitiveState::default(),
-                        depth_stencil: Some(wgpu::DepthStencilState {
-                            format: wgpu::TextureFormat::Depth32Float,
-                            depth_write_enabled: Some(true),
-                            depth_compare: Some(wgpu::CompareFunction::Less),
-                            stencil: Default::default(),
-                            bias,
-                        }),
-                        multisample: Default::default(),
-                        fragment: fragment.map(|targets| wgpu::FragmentState {
-                            module: &module,
-                            entry_point: Some("fs_main"),
-                            compilation_options: Default::default(),
-                            targets,
-                        }),
-                        multiview_mask: None,
-                        cache: None,
-                    },
-                );
-                (pipeline, bgl)
-            },
-            |message| Error::Pipeline {
-                kernel: name.to_string(),
-                message,
-            },
-        )
-    }
-
-    /// The raster pipeline for slope-scaled bias `slope` (pipeline state: one per distinct
-    /// value, made once) and its bind group layout.
-    fn shadow_pipeline(
-        &mut self,
-        device: &wgpu::Device,
-        slope: f32,
-    ) -> Result<&(wgpu::RenderPipeline, wgpu::BindGroupLayout)> {
-        match self.shadow.entry(slope.to_bits()) {
-            std::collections::hash_map::Entry::Occupied(e) => Ok(e.into_mut()),
-            std::collections::hash_map::Entry::Vacant(e) => {
-                let bias = wgpu::DepthBiasState {
-                    constant: 0,
-                    slope_scale: slope,
-                    clamp: 0.0,
-                };
-                Ok(e.insert(Self::raster_pipeline(device, "shadow_depth", None, bias)?))
-            }
-        }
-    }
-
-    /// The G-buffer pipeline and its layout, made once.
-    fn gbuffer_pipeline(
-        &mut self,
-        device: &wgpu::Device,
-    ) -> Result<&(wgpu::RenderPipeline, wgpu::BindGroupLayout)> {
-        if self.gbuffer.is_none() {
-            let t = Some(wgpu::ColorTargetState {
-                format: wgpu::TextureFormat::Rgba32Float,
-                blend: None,
-                write_mask: wgpu::ColorWrites::ALL,
-            });
-            self.gbuffer = Some(Self::raster_pipeline(
-                device,
-                "gbuffer",
-                Some(&[t.clone(), t]),
-                Default::default(),
-            )?);
-        }
-        self.gbuffer
-            .as_ref()
-            .ok_or_else(|| Error::Invalid("G-buffer pipeline missing".into()))
     }
 
     /// The kept resources for `scene` (made anew when its shape changed), taken out of the
@@ -590,36 +411,6 @@ impl Renderer {
             group("shadowgraph.shade.maps", l1, &map_entries)?,
         ])
     }
-
-    /// Records a depth-only raster pass of the scene's vertices `vbuf` (`count` vertices) into
-    /// `depth` (Depth32Float) with an explicit world → clip matrix: the pipeline and bias the
-    /// renderer's own shadow maps use (`truth` rasterizes its emitter samples with it). Each
-    /// call makes its own uniform, so that many passes can share one encoder.
-    #[expect(clippy::too_many_arguments, reason = "one raster pass's inputs")]
-    pub fn shadow_raster(
-        &mut self,
-        device: &wgpu::Device,
-        enc: &mut wgpu::CommandEncoder,
-        raster: &ShadowRaster,
-        vbuf: &wgpu::Buffer,
-        count: u32,
-        depth: &wgpu::Texture,
-        timer: Option<&mut GpuTimer>,
-    ) -> Result<()> {
-        let (pipeline, layout) = self.shadow_pipeline(device, raster.slope_bias)?;
-        let ubuf = created::buffer_init(
-            device,
-            &wgpu::util::BufferInitDescriptor {
-                label: Some("shadowgraph.light_view"),
-                contents: bytemuck::cast_slice(&raster.view_proj),
-                usage: wgpu::BufferUsages::UNIFORM,
-            },
-        );
-        let bg = uniform_group(device, "shadowgraph.shadow_depth", layout, &ubuf);
-        let view = created::view(depth, &Default::default());
-        raster_pass(enc, raster.label, pipeline, &bg, &view, vbuf, count, timer);
-        Ok(())
-    }
 }
 
 /// Records the shading pass over a `w × h` image.
@@ -642,15 +433,4 @@ pub(super) fn record_shade(
     pass.set_bind_group(0, &groups[0], &[]);
     pass.set_bind_group(1, &groups[1], &[]);
     pass.dispatch_workgroups(workgroups[0], workgroups[1], 1);
-}
-
-/// One depth-only raster pass for [`Renderer::shadow_raster`].
-#[derive(Clone, Copy, Debug)]
-pub struct ShadowRaster<'a> {
-    /// Pass label (and timer label).
-    pub label: &'a str,
-    /// World → clip, column-major (wgpu depth convention: 0 at near, 1 at far).
-    pub view_proj: [f32; 16],
-    /// Slope-scaled depth bias (`DepthBiasState::slope_scale`).
-    pub slope_bias: f32,
 }

@@ -13,17 +13,7 @@ pub struct Mesh {
     pub indices: Vec<u32>,
 }
 
-/// Vertex as uploaded: keep in sync with `VsIn` in `kernels/shared/vertex.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct Vertex {
-    /// World position.
-    pub position: [f32; 3],
-    /// World normal.
-    pub normal: [f32; 3],
-    /// Index into the scene's material (object colour) table.
-    pub material: u32,
-}
+pub use crate::gpu_data::Vertex;
 
 impl Mesh {
     /// The mesh under `m`, computed in f64. Normals go through the cofactor matrix (the inverse

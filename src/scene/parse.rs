@@ -168,9 +168,7 @@ fn light(ctx: &Ctx, i: usize, l: &LightFile) -> Result<Light> {
             normal_bias: 1.0,
         },
     };
-    let soft =
-        matches!(shadow.technique, Technique::Pcss { .. }) || shadow.technique.soft().is_some();
-    if soft && size <= 0.0 {
+    if crate::technique::of(&shadow.technique).area_light && size <= 0.0 {
         let span = l.size.as_ref().map(|s| s.span()).or(Some(l.kind.span()));
         return Err(ctx.err(
             span,

@@ -18,15 +18,16 @@ use std::path::Path;
 
 use super::Row;
 use super::check::{Check, Rng, U};
-use super::harness::{DIRECTIONAL, Poison, light, mips, run_graph};
+use super::harness::{DIRECTIONAL, Poison, light, mips, registered, run_graph};
 use super::stages::{Stages, run_stages};
 use crate::cpu::{self, Texels};
 use crate::error::{Error, Result};
 use crate::exec::Executor;
 use crate::gpu::{Gpu, read_texture};
 use crate::graph::Graph;
+use crate::model::ParamValue;
 use crate::sat::{SatCoding, SatVariant, add_sat, float_sum_depth};
-use crate::scene::{BlurKernel, Filter, Prefilter, Scene, Storage, Technique, exponent_limit};
+use crate::scene::{BlurKernel, Filter, Scene, Storage, Technique, exponent_limit};
 
 const MAP: u32 = 64;
 
@@ -89,21 +90,17 @@ fn filters() -> [Filter; 2] {
 }
 
 fn evsm4(storage: Storage, filter: Filter, c: f32) -> Technique {
-    Technique::Evsm {
-        prefilter: Prefilter { storage, filter },
-        four: true,
-        exp_pos: c,
-        exp_neg: c,
-        bleed: 0.0,
-        min_variance: 1e-4,
-    }
+    let c = ParamValue::Float(c);
+    registered(
+        "evsm4",
+        Some(storage),
+        filter,
+        &[("exponent_pos", c), ("exponent_neg", c)],
+    )
 }
 
 fn esm(filter: Filter, c: f32) -> Technique {
-    Technique::Esm {
-        filter,
-        exponent: c,
-    }
+    registered("esm", None, filter, &[("exponent", ParamValue::Float(c))])
 }
 
 /// Rows of one configuration: encode, blur, mips (stages), then the SAT of the encoded map.

@@ -11,9 +11,10 @@ use crate::error::{Error, Result};
 use crate::exec::{Executor, Outputs};
 use crate::gpu::{Gpu, read_buffer, read_float_texture, submit_and_wait, write_texture_level};
 use crate::graph::{Graph, Plan, plan, texel_bytes};
+use crate::model::{ParamValue, ParamValues};
 use crate::render::{ProbeMap, Renderer, probe};
 use crate::scene::{Light, LightKind, Shadow, Technique};
-use crate::technique::{self, LightGpu};
+use crate::technique::{self, LightGpu, params};
 
 /// A sampled, copyable texture holding `bytes` (tightly packed level 0).
 pub(crate) fn upload(
@@ -251,6 +252,25 @@ pub(crate) fn mips(width: f32) -> crate::scene::Filter {
         width,
         max_anisotropy: 0,
     }
+}
+
+/// Technique `name` of the registry at `storage` (when it has a `format` key) with `filter`
+/// and `values` over its defaults, taken as they are: the suite probes exponents past the
+/// clamps a scene applies.
+pub(crate) fn registered(
+    name: &str,
+    storage: Option<crate::scene::Storage>,
+    filter: crate::scene::Filter,
+    values: &[(&'static str, ParamValue)],
+) -> Technique {
+    let mut v = ParamValues(values.to_vec());
+    if let Some(s) = storage {
+        v.set("format", ParamValue::Choice(params::storage_name(s)));
+    }
+    params::filter_values(&filter, &mut v);
+    technique::by_name(name)
+        .and_then(|def| technique::build_with(def, &v))
+        .expect("the suite names registered techniques and their keys")
 }
 
 /// The suite's directional light (orthographic: the raw depth buffer is the linear depth).

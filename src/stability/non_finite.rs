@@ -12,16 +12,14 @@
 use super::Row;
 use super::check::{Check, Rng};
 use super::exponents::{range, sat_check, sat_coding_for};
-use super::harness::{DIRECTIONAL, SPOT, light, mips};
+use super::harness::{DIRECTIONAL, SPOT, light, mips, registered};
 use super::stages::run_stages;
 use crate::cpu::Texels;
 use crate::error::{Error, Result};
 use crate::exec::Executor;
 use crate::gpu::Gpu;
-use crate::scene::{
-    BlurKernel, Filter, LightKind, Prefilter, Storage, Technique, default_moment_bias,
-    exponent_limit,
-};
+use crate::model::ParamValue;
+use crate::scene::{BlurKernel, Filter, LightKind, Storage, Technique, exponent_limit};
 use crate::technique::linear_name;
 
 const MAP: u32 = 61;
@@ -68,15 +66,13 @@ fn blur() -> Filter {
     }
 }
 
-/// The techniques and filters run on the buffer, with the light kind.
+/// The techniques and filters run on the buffer, with the light kind (the scene defaults
+/// but where given).
 fn configurations() -> Vec<(String, &'static str, LightKind, Technique)> {
-    let pre = |storage, filter| Prefilter { storage, filter };
-    let vsm = |filter| Technique::Vsm {
-        prefilter: pre(Storage::F32, filter),
-        bleed: 0.2,
-        min_variance: 1e-5,
-    };
+    let vsm = |filter| registered("vsm", Some(Storage::F32), filter, &[]);
     let c16 = exponent_limit(Storage::F16);
+    let c = ParamValue::Float(c16);
+    let evsm4 = [("exponent_pos", c), ("exponent_neg", c)];
     vec![
         ("vsm → blur".into(), "f32", DIRECTIONAL, vsm(blur())),
         ("vsm → mips".into(), "f32", DIRECTIONAL, vsm(mips(2.0))),
@@ -85,55 +81,36 @@ fn configurations() -> Vec<(String, &'static str, LightKind, Technique)> {
             format!("evsm4 c={c16} → blur"),
             "f16",
             DIRECTIONAL,
-            Technique::Evsm {
-                prefilter: pre(Storage::F16, blur()),
-                four: true,
-                exp_pos: c16,
-                exp_neg: c16,
-                bleed: 0.0,
-                min_variance: 1e-4,
-            },
+            registered("evsm4", Some(Storage::F16), blur(), &evsm4),
         ),
         (
             "esm c=80 → blur (log)".into(),
             "f32",
             DIRECTIONAL,
-            Technique::Esm {
-                filter: blur(),
-                exponent: 80.0,
-            },
+            registered("esm", None, blur(), &[]),
         ),
         (
             "esm c=80 → mips (log)".into(),
             "f32",
             DIRECTIONAL,
-            Technique::Esm {
-                filter: mips(2.0),
-                exponent: 80.0,
-            },
+            registered("esm", None, mips(2.0), &[]),
         ),
         (
             "msm → blur".into(),
             "f16",
             DIRECTIONAL,
-            Technique::Msm {
-                prefilter: pre(Storage::F16, blur()),
-                hausdorff: false,
-                moment_bias: default_moment_bias(Storage::F16),
-                bleed: 0.0,
-            },
+            registered("msm", Some(Storage::F16), blur(), &[]),
         ),
         (
             "csm M=3 → blur".into(),
             "f32",
             DIRECTIONAL,
-            Technique::Csm {
-                prefilter: pre(Storage::F32, blur()),
-                terms: 3,
-                attenuation: 1.0,
-                offset: 0.5 / 3.0,
-                scale: 2.0,
-            },
+            registered(
+                "csm",
+                Some(Storage::F32),
+                blur(),
+                &[("terms", ParamValue::Int(3))],
+            ),
         ),
     ]
 }

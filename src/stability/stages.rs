@@ -47,13 +47,7 @@ struct Model {
 
 fn model(t: &Technique) -> Option<Model> {
     let ulp = 2.0 * U;
-    let storage = match t {
-        Technique::Vsm { prefilter, .. }
-        | Technique::Evsm { prefilter, .. }
-        | Technique::Msm { prefilter, .. }
-        | Technique::Csm { prefilter, .. } => prefilter.storage,
-        _ => Storage::F32,
-    };
+    let storage = t.prefilter().map_or(Storage::F32, |p| p.storage);
     let store = match storage {
         Storage::F32 => (0.0, 0.0),
         Storage::F16 => (U, 2f64.powi(-10)),

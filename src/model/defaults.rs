@@ -1,7 +1,7 @@
 //! Defaults and safe limits of technique parameters: the plain rules that scene validation and
 //! the plug-in's config both apply.
 
-use super::{Filter, Storage};
+use super::Storage;
 
 /// CSSM's default sharpening strength A (`sharpen`): with [`DEFAULT_SHARPEN_FALLOFF`], the
 /// best of a small grid (A ∈ {0, 1, 2, 4, 8, 16}, B ∈ {2, 5, 10, 20, 50, 100}) measured as the
@@ -49,22 +49,4 @@ pub fn exponent_limit(storage: Storage) -> f32 {
         Storage::F32 => 42.0,
         Storage::F16 | Storage::Unorm16 => 5.54,
     }
-}
-
-/// The largest exponent a summed-area table keeps accurate (`None` without the `sat` filter).
-///
-/// Window sums are linear, so a table's error is absolute: the fixed-point coding's step per
-/// mean is `½ / scale ≈ range · A / 2³²` for windows of `A` texels (src/sat.rs), the f32
-/// coding's no better. EVSM's squared moment spans `e^{−2c}..e^{2c}`; its step at the centre
-/// of the depth range (moment 1) stays below 2⁻¹⁰ while `e^{2c} · A / 2³² ≤ 2⁻¹⁰`, so
-/// `c ≤ ½ ln(2²² / A)`. ESM's `exp(c (z − 1)) ∈ [e^{−c}, 1]` has visibility
-/// `mean · e^{c (1 − d)}`, whose error at mid depth stays below 2⁻¹⁰ while
-/// `e^{c/2} · A / 2³² ≤ 2⁻¹⁰`, so `c ≤ 2 ln(2²² / A)`.
-pub fn sat_exponent_limit(filter: &Filter, esm: bool) -> Option<f32> {
-    let Filter::Sat { width, .. } = *filter else {
-        return None;
-    };
-    let area = crate::sat::lookup_area(width, width) as f64;
-    let c = 0.5 * (f64::from(1u32 << 22) / area).ln().max(0.02);
-    Some(if esm { 4.0 * c } else { c } as f32)
 }

@@ -1,0 +1,331 @@
+//! GPU data: every `#[repr(C)]` mirror of a WGSL struct the Rust side fills (bytemuck), each
+//! naming the struct it mirrors (`tests/kernels_validate.rs` checks their sizes against naga's
+//! layouts), and the technique ids and flags the shading kernel reads. What fills a
+//! [`LightGpu`] from a light lives with the techniques (`crate::technique`); the parameters of
+//! the filter and table kernels live beside their graph builders (`crate::filter::MipParams`,
+//! `crate::sat`).
+
+use crate::model::{Light, LightKind};
+
+/// A light as the shading kernel reads it. Mirrors `struct Light` in
+/// `kernels/shared/light.wgsl` (a test checks the size against naga's layout).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct LightGpu {
+    /// World → light clip.
+    pub view_proj: [[f32; 4]; 4],
+    /// World → light view.
+    pub view: [[f32; 4]; 4],
+    /// Colour × intensity.
+    pub radiance: [f32; 3],
+    /// 0 directional, 1 spot.
+    pub kind: u32,
+    /// Light position.
+    pub position: [f32; 3],
+    /// Near plane.
+    pub near: f32,
+    /// Unit direction light → target.
+    pub direction: [f32; 3],
+    /// Far plane.
+    pub far: f32,
+    /// Shadow-map size in texels.
+    pub map_size: [f32; 2],
+    /// Map width in world units (directional) or per unit distance (spot).
+    pub width_at_unit: f32,
+    /// Area-light width.
+    pub size: f32,
+    /// Constant bias, linear depth units.
+    pub bias: f32,
+    /// Normal offset, texels.
+    pub normal_bias: f32,
+    /// Spot: cos(fov/2); directional: −1.
+    pub cos_outer: f32,
+    /// The technique's id (`TECHNIQUE_*`).
+    pub technique: u32,
+    /// PCF radius.
+    pub radius: u32,
+    /// PCF kernel: 0 box, 1 tent, 2 hardware.
+    pub kernel: u32,
+    /// PCSS blocker taps.
+    pub blocker_samples: u32,
+    /// PCSS filter taps.
+    pub filter_samples: u32,
+    /// PCSS and soft techniques: search cap (UV).
+    pub max_search: f32,
+    /// VSM light-bleeding reduction.
+    pub bleed: f32,
+    /// VSM/EVSM minimum variance (depth units²).
+    pub min_variance: f32,
+    /// EVSM positive exponent; ESM exponent.
+    pub exp_pos: f32,
+    /// EVSM negative exponent.
+    pub exp_neg: f32,
+    /// EVSM: 2 or 4 stored moments.
+    pub moments: u32,
+    /// MSM moment bias α.
+    pub moment_bias: f32,
+    /// MSM: bit 0 Hausdorff (else Hamburger), bit 1 quantized storage.
+    pub msm_flags: u32,
+    /// CSM terms M.
+    pub csm_terms: u32,
+    /// CSM ringing attenuation α.
+    pub csm_attenuation: f32,
+    /// CSM receiver-depth offset.
+    pub csm_offset: f32,
+    /// CSM response scale.
+    pub csm_scale: f32,
+    /// Mip levels of the filtered map (0 when the filter is not `mips`).
+    pub mip_levels: u32,
+    /// `log2` of the mip filter width in texels.
+    pub filter_lod: f32,
+    /// SAT filter: box width in texels (0 when the filter is not `sat`).
+    pub filter_width: f32,
+    /// Mips filter: 0 reads a fixed width; ≥ 1 follows the pixel's footprint with up to this
+    /// many trilinear taps along its major axis.
+    pub max_anisotropy: u32,
+    /// SAT filter: the table's per-channel offset (`sat::SatCoding::offset`).
+    pub sat_offset: [f32; 4],
+    /// SAT filter: the table's per-channel scale (`sat::SatCoding::scale`).
+    pub sat_scale: [f32; 4],
+    /// CSSM: sharpening strength A of `v^p`, `p = 1 + A·exp(−B (d − z_avg))`.
+    pub sharpen: f32,
+    /// CSSM: sharpening falloff B, per linear depth unit.
+    pub sharpen_falloff: f32,
+    /// Soft techniques: cap on the search and filter widths in texels (`technique::soft_max_width`;
+    /// 0 otherwise).
+    pub max_width: f32,
+    /// Padding to the WGSL struct's 16-byte alignment.
+    pub _pad1: u32,
+}
+
+/// Technique id of `hard` (`LightGpu::technique`; `TECHNIQUE_HARD` in
+/// `kernels/shared/light.wgsl`, as every id below).
+pub const TECHNIQUE_HARD: u32 = 0;
+/// Technique id of `pcf`.
+pub const TECHNIQUE_PCF: u32 = 1;
+/// Technique id of `pcss`.
+pub const TECHNIQUE_PCSS: u32 = 2;
+/// Technique id of `vsm`.
+pub const TECHNIQUE_VSM: u32 = 3;
+/// Technique id of `evsm2` and `evsm4` (`LightGpu::moments` tells them apart).
+pub const TECHNIQUE_EVSM: u32 = 4;
+/// Technique id of `esm`.
+pub const TECHNIQUE_ESM: u32 = 5;
+/// Technique id of `msm`.
+pub const TECHNIQUE_MSM: u32 = 6;
+/// Technique id of `csm`.
+pub const TECHNIQUE_CSM: u32 = 7;
+/// Technique id of `cssm`.
+pub const TECHNIQUE_CSSM: u32 = 8;
+/// Technique id of `vssm`.
+pub const TECHNIQUE_VSSM: u32 = 9;
+/// Technique id of `msm_soft`.
+pub const TECHNIQUE_MSM_SOFT: u32 = 10;
+
+/// Every technique id with its WGSL constant's name (checked against
+/// `kernels/shared/light.wgsl` by a test).
+pub const TECHNIQUE_IDS: &[(&str, u32)] = &[
+    ("TECHNIQUE_HARD", TECHNIQUE_HARD),
+    ("TECHNIQUE_PCF", TECHNIQUE_PCF),
+    ("TECHNIQUE_PCSS", TECHNIQUE_PCSS),
+    ("TECHNIQUE_VSM", TECHNIQUE_VSM),
+    ("TECHNIQUE_EVSM", TECHNIQUE_EVSM),
+    ("TECHNIQUE_ESM", TECHNIQUE_ESM),
+    ("TECHNIQUE_MSM", TECHNIQUE_MSM),
+    ("TECHNIQUE_CSM", TECHNIQUE_CSM),
+    ("TECHNIQUE_CSSM", TECHNIQUE_CSSM),
+    ("TECHNIQUE_VSSM", TECHNIQUE_VSSM),
+    ("TECHNIQUE_MSM_SOFT", TECHNIQUE_MSM_SOFT),
+];
+
+/// MSM flag: Hausdorff reconstruction.
+pub const MSM_HAUSDORFF: u32 = 1;
+/// MSM flag: moments stored through the optimized quantization.
+pub const MSM_QUANTIZED: u32 = 2;
+
+/// How a depth buffer is linearized: `kernels/linearize.wgsl`'s params and the first member
+/// (`depth`) of every encoding's params (mirrors `DepthParams` in
+/// `kernels/shared/linear_depth.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct LinearizeParams {
+    /// 1 for a perspective (spot) depth buffer.
+    pub perspective: u32,
+    /// Near plane.
+    pub near: f32,
+    /// Far plane.
+    pub far: f32,
+    /// Padding.
+    pub _pad: u32,
+}
+
+impl LinearizeParams {
+    /// An orthographic depth buffer: depth in [0, 1] is linear already (only clamped, and
+    /// non-finite values replaced).
+    pub const ORTHOGRAPHIC: Self = Self {
+        perspective: 0,
+        near: 0.0,
+        far: 1.0,
+        _pad: 0,
+    };
+
+    /// Parameters for `light`'s depth buffer.
+    pub fn new(light: &Light) -> Self {
+        Self {
+            perspective: u32::from(matches!(light.kind, LightKind::Spot { .. })),
+            near: light.near,
+            far: light.far,
+            _pad: 0,
+        }
+    }
+}
+
+/// Parameters of `kernels/vsm.wgsl` (mirrors its `Params`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct VsmParams {
+    /// The depth buffer's linearization.
+    pub depth: LinearizeParams,
+}
+
+/// Parameters of `kernels/msm.wgsl` (mirrors its `Params`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct MsmParams {
+    /// The depth buffer's linearization.
+    pub depth: LinearizeParams,
+    /// 1: store the optimized quantization of the moments; 0: the raw powers.
+    pub quantized: u32,
+    /// Padding.
+    pub _pad: [u32; 3],
+}
+
+/// Parameters of `kernels/csm.wgsl` (mirrors its `Params`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct CsmParams {
+    /// The depth buffer's linearization.
+    pub depth: LinearizeParams,
+    /// Index of the map `dst0` receives in the light's sequence of maps: the ⌈M/2⌉ CSM basis
+    /// maps (`technique::csm_maps`), then (CSSM) the CSM-Z maps (`technique::csm_z_maps`).
+    pub first_map: u32,
+    /// Maps this dispatch writes (`dst0` … `dst<maps − 1>`; 1 to [`CSM_OUTPUTS`]).
+    pub maps: u32,
+    /// Total terms M (a pair past M is written as zeros).
+    pub terms: u32,
+    /// Padding.
+    pub _pad: u32,
+}
+
+/// Storage-texture outputs of `kernels/csm.wgsl` (`dst0` … `dst3`): what WebGPU's default
+/// `max_storage_textures_per_shader_stage` allows every device, so one read of the depth
+/// writes up to four basis maps.
+pub const CSM_OUTPUTS: u32 = 4;
+
+/// Parameters of `kernels/evsm.wgsl` and `kernels/esm.wgsl` (mirror their `Params`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ExpParams {
+    /// The depth buffer's linearization.
+    pub depth: LinearizeParams,
+    /// c⁺ (EVSM) or c (ESM).
+    pub exp_pos: f32,
+    /// c⁻ (EVSM4).
+    pub exp_neg: f32,
+    /// ESM: 1 stores `exp(c (z − 1))` (for a summed-area table, which sums linearly) instead
+    /// of the log moment `c z`.
+    pub linear: u32,
+    /// Padding.
+    pub _pad: u32,
+}
+
+impl ExpParams {
+    /// Exponents `pos`, `neg` on an orthographic depth buffer.
+    pub fn new(exp_pos: f32, exp_neg: f32) -> Self {
+        Self {
+            depth: LinearizeParams::ORTHOGRAPHIC,
+            exp_pos,
+            exp_neg,
+            linear: 0,
+            _pad: 0,
+        }
+    }
+}
+
+/// Frame constants of `kernels/shade.wgsl` (mirrors its `Frame`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct FrameGpu {
+    /// Image size.
+    pub size: [u32; 2],
+    /// Number of lights.
+    pub light_count: u32,
+    /// 1 when the ray fields hold the camera (pixel footprints), 0 for the probe.
+    pub has_camera: u32,
+    /// Ambient colour.
+    pub ambient: [f32; 3],
+    /// Padding.
+    pub _pad1: f32,
+    /// Background colour.
+    pub background: [f32; 3],
+    /// Padding.
+    pub _pad2: f32,
+    /// Eye position.
+    pub camera: [f32; 3],
+    /// Padding.
+    pub _pad3: f32,
+    /// Unnormalized view ray through pixel corner (0, 0).
+    pub ray00: [f32; 3],
+    /// Padding.
+    pub _pad4: f32,
+    /// Ray change per pixel in x: pixel (x, y)'s ray is `ray00 + (x + ½)·ray_dx + (y + ½)·ray_dy`.
+    pub ray_dx: [f32; 3],
+    /// Padding.
+    pub _pad5: f32,
+    /// Ray change per pixel in y.
+    pub ray_dy: [f32; 3],
+    /// Padding.
+    pub _pad6: f32,
+}
+
+/// Vertex as uploaded: keep in sync with `VsIn` in `kernels/shared/vertex.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct Vertex {
+    /// World position.
+    pub position: [f32; 3],
+    /// World normal.
+    pub normal: [f32; 3],
+    /// Index into the scene's material (object colour) table.
+    pub material: u32,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::TECHNIQUE_IDS;
+
+    /// Every `TECHNIQUE_*` constant of `kernels/shared/light.wgsl` has the value of the Rust
+    /// constant of the same name, and the two lists hold the same names.
+    #[test]
+    fn technique_ids_match_the_wgsl_constants() {
+        let wgsl = include_str!("../kernels/shared/light.wgsl");
+        let parsed: Vec<(String, u32)> = wgsl
+            .lines()
+            .filter_map(|line| {
+                let rest = line.trim().strip_prefix("const TECHNIQUE_")?;
+                let (name, value) = rest.split_once(": u32 = ")?;
+                let value = value
+                    .trim_end_matches(';')
+                    .trim_end_matches('u')
+                    .parse()
+                    .ok()?;
+                Some((format!("TECHNIQUE_{name}"), value))
+            })
+            .collect();
+        let rust: Vec<(String, u32)> = TECHNIQUE_IDS
+            .iter()
+            .map(|(n, v)| (n.to_string(), *v))
+            .collect();
+        assert_eq!(parsed, rust);
+    }
+}

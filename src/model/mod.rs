@@ -1,0 +1,453 @@
+//! The model: plain data that every layer above reads — lights, cameras, techniques with their
+//! parameters, filters, storages and their limits. No GPU objects and no file formats: the
+//! scene parser (`scene`), the plug-in's config (`prefilter`) and the technique registry
+//! (`technique`) all build or read these values.
+
+mod defaults;
+mod params;
+
+pub use defaults::{
+    DEFAULT_MAX_SEARCH, DEFAULT_SHARPEN, DEFAULT_SHARPEN_FALLOFF, default_moment_bias,
+    default_soft_moment_bias, exponent_limit,
+};
+pub use params::{
+    Needs, ParamDefault, ParamKind, ParamSource, ParamSpec, ParamValue, ParamValues, check, keys,
+};
+
+use glam::{Mat4, Vec3};
+
+/// A perspective camera.
+#[derive(Clone, Debug)]
+pub struct Camera {
+    /// Eye position.
+    pub position: Vec3,
+    /// Look-at point.
+    pub target: Vec3,
+    /// Up vector.
+    pub up: Vec3,
+    /// Vertical field of view, degrees.
+    pub fov_y_degrees: f32,
+}
+
+impl Camera {
+    /// World → clip for an image of `aspect` = width / height.
+    pub fn view_proj(&self, aspect: f32) -> Mat4 {
+        let proj = Mat4::perspective_rh(self.fov_y_degrees.to_radians(), aspect, 0.05, 500.0);
+        proj * Mat4::look_at_rh(self.position, self.target, self.up)
+    }
+}
+
+/// The projection a light's shadow map uses.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightKind {
+    /// Orthographic, half-width `extent`.
+    Directional {
+        /// Half-width of the frustum in world units.
+        extent: f32,
+    },
+    /// Perspective with a square frustum of full angle `fov_degrees`.
+    Spot {
+        /// Full cone angle, degrees.
+        fov_degrees: f32,
+    },
+}
+
+/// Weights of an N×N PCF window.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PcfKernel {
+    /// Equal weights.
+    Box,
+    /// Bilinear tent weights `(r + 1 − |dx|)(r + 1 − |dy|)`.
+    Tent,
+    /// The hardware 2×2 comparison sampler (`textureSampleCompareLevel`).
+    Hardware,
+}
+
+/// Storage precision of a prefiltered representation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Storage {
+    /// 32-bit float channels.
+    F32,
+    /// 16-bit float channels.
+    F16,
+    /// 16-bit normalized channels (MSM's optimized quantization; needs the device feature
+    /// `TEXTURE_FORMAT_16BIT_NORM`).
+    Unorm16,
+}
+
+/// Weights of the separable blur.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BlurKernel {
+    /// `exp(−i² / 2σ²)` for `|i| ≤ ceil(radius)`.
+    Gaussian,
+    /// 1 for `|i| ≤ floor(radius)`, the fraction `radius − floor(radius)` one texel further.
+    Box,
+}
+
+/// How a prefiltered representation is filtered before shading.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Filter {
+    /// Not filtered (shading still interpolates bilinearly).
+    None,
+    /// Separable blur, one pass per axis, clamp-to-edge.
+    Blur {
+        /// Radius in texels.
+        radius: f32,
+        /// Gaussian sigma in texels.
+        sigma: f32,
+        /// Weights.
+        kernel: BlurKernel,
+    },
+    /// A full mip chain (area-weighted 2×2 reduction, odd sizes included), sampled
+    /// trilinearly at the level of `width`.
+    Mips {
+        /// Filter width in level-0 texels (level `log2(width)` is sampled).
+        width: f32,
+        /// 0: the width is fixed. ≥ 1: the pixel's footprint in the map widens it (its minor
+        /// axis) and up to this many trilinear taps follow its major axis.
+        max_anisotropy: u32,
+    },
+    /// A summed-area table (`src/sat.rs`), read as the mean over a `width`-texel square
+    /// around the receiver with four lookups per channel and sub-texel edges.
+    Sat {
+        /// Box width in texels.
+        width: f32,
+        /// How the table stores its sums.
+        variant: crate::sat::SatVariant,
+    },
+}
+
+/// How a soft technique (`cssm`, `vssm`, `msm_soft`) stores its representation and reads it:
+/// always through a summed-area table, at a width per receiver.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Soft {
+    /// Storage precision of the representation the table sums.
+    pub storage: Storage,
+    /// How the table stores its sums.
+    pub sums: crate::sat::SatVariant,
+    /// Cap on the blocker-search half-width and on the filter's half-width, in shadow-map UV
+    /// (as PCSS's `max_search`); the fixed-point table is coded for squares of that size.
+    pub max_search: f32,
+}
+
+/// How a prefiltered technique stores and filters its representation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Prefilter {
+    /// Storage precision.
+    pub storage: Storage,
+    /// Filter.
+    pub filter: Filter,
+}
+
+/// A light's shadow technique and its parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Technique {
+    /// One comparison at the nearest texel.
+    Hard,
+    /// Percentage-closer filtering.
+    Pcf {
+        /// Window radius in texels (window is `2r + 1` wide).
+        radius: u32,
+        /// Weights.
+        kernel: PcfKernel,
+    },
+    /// Percentage-closer soft shadows (Fernando 2005).
+    Pcss {
+        /// Blocker-search taps.
+        blocker_samples: u32,
+        /// Filter taps.
+        filter_samples: u32,
+        /// Cap on the blocker-search radius in shadow-map UV.
+        max_search: f32,
+    },
+    /// Variance shadow maps (Donnelly & Lauritzen 2006): moments (z, z²), filtered.
+    Vsm {
+        /// Storage and filter of the moments.
+        prefilter: Prefilter,
+        /// Light-bleeding reduction `linstep(bleed, 1, p_max)`.
+        bleed: f32,
+        /// Minimum variance.
+        min_variance: f32,
+    },
+    /// Exponential variance shadow maps (Lauritzen): depth warped to [−1, 1], then
+    /// `exp(c⁺ z')` and its square (EVSM2), plus `−exp(−c⁻ z')` and its square (EVSM4).
+    Evsm {
+        /// Storage and filter of the moments.
+        prefilter: Prefilter,
+        /// Four moments (EVSM4) rather than two (EVSM2).
+        four: bool,
+        /// Positive exponent c⁺ (already clamped to the storage's safe limit).
+        exp_pos: f32,
+        /// Negative exponent c⁻ (EVSM4; clamped likewise).
+        exp_neg: f32,
+        /// Light-bleeding reduction.
+        bleed: f32,
+        /// Variance floor in depth units², scaled through the warp's derivative.
+        min_variance: f32,
+    },
+    /// Exponential shadow maps (Annen et al. 2008): `c·z` stored and filtered in log space
+    /// (log-sum-exp), so no exponent overflows; visibility `clamp(exp(L − c·d), 0, 1)`.
+    Esm {
+        /// Filter (storage is always f32: f16 `c·z` would cost percent-level visibility error).
+        filter: Filter,
+        /// Exponent c.
+        exponent: f32,
+    },
+    /// Moment shadow maps (Peters & Klein 2015): (z, z², z³, z⁴), raw in f32 or through the
+    /// optimized 16-bit quantization; Hamburger or Hausdorff reconstruction.
+    Msm {
+        /// Storage (f32 raw; f16 or unorm16 quantized) and filter.
+        prefilter: Prefilter,
+        /// Hausdorff (support on [0, 1]) rather than Hamburger reconstruction.
+        hausdorff: bool,
+        /// Moment bias α toward the moments of a fixed three-point distribution.
+        moment_bias: f32,
+        /// Light-bleeding reduction.
+        bleed: f32,
+    },
+    /// Convolution shadow maps (Annen et al. 2007): Fourier basis sin(c_k z), cos(c_k z),
+    /// k = 1..M, in ⌈M/2⌉ four-channel maps.
+    Csm {
+        /// Storage and filter of the basis images.
+        prefilter: Prefilter,
+        /// Number of terms M (1–16).
+        terms: u32,
+        /// Ringing attenuation α: term k weighted by exp(−α (k/M)²).
+        attenuation: f32,
+        /// Offset subtracted from the receiver depth.
+        offset: f32,
+        /// Scale of the response about ½ before the clamp to [0, 1].
+        scale: f32,
+    },
+    /// Convolution soft shadow maps (Annen et al. 2008): the CSM basis and the CSM-Z basis
+    /// (z, z·sin c_k z, z·cos c_k z) through summed-area tables; the average blocker depth over
+    /// the light cone's search square, the PCSS penumbra width, the CSM lookup at that width,
+    /// then the selective sharpening `v^p`, `p = 1 + A·exp(−B (d − z_avg))`.
+    Cssm {
+        /// Storage, table sums and search cap.
+        soft: Soft,
+        /// Number of terms M (1–16).
+        terms: u32,
+        /// Ringing attenuation α: term k weighted by exp(−α (k/M)²).
+        attenuation: f32,
+        /// Offset subtracted from the receiver depth.
+        offset: f32,
+        /// Scale of the response about ½ before the clamp to [0, 1].
+        scale: f32,
+        /// Sharpening strength A (0: none).
+        sharpen: f32,
+        /// Sharpening falloff B per linear depth unit of `d − z_avg`.
+        sharpen_falloff: f32,
+    },
+    /// Variance soft shadow maps (Yang et al. 2010): from the VSM moments over the search
+    /// square, the Chebyshev share p of lit texels and `z_avg = (μ − p·d)/(1 − p)`; then VSM
+    /// at the penumbra width.
+    Vssm {
+        /// Storage, table sums and search cap.
+        soft: Soft,
+        /// Light-bleeding reduction of the final bound.
+        bleed: f32,
+        /// Minimum variance.
+        min_variance: f32,
+    },
+    /// Moment soft shadow maps (after Peters et al. 2016): the blocker depth from the four
+    /// moments over the search square (the mean of the support points in front of the receiver
+    /// of the three-point distribution through d that Hamburger MSM reconstructs), then MSM at
+    /// the penumbra width.
+    MsmSoft {
+        /// Storage (f32 raw; f16 or unorm16 quantized), table sums and search cap.
+        soft: Soft,
+        /// Hausdorff rather than Hamburger reconstruction for the final visibility.
+        hausdorff: bool,
+        /// Moment bias α.
+        moment_bias: f32,
+        /// Light-bleeding reduction.
+        bleed: f32,
+    },
+}
+
+impl Technique {
+    /// The filter of a prefiltered technique's representation.
+    pub fn filter(&self) -> Option<Filter> {
+        match *self {
+            Technique::Vsm { prefilter, .. }
+            | Technique::Evsm { prefilter, .. }
+            | Technique::Msm { prefilter, .. }
+            | Technique::Csm { prefilter, .. } => Some(prefilter.filter),
+            Technique::Esm { filter, .. } => Some(filter),
+            _ => None,
+        }
+    }
+
+    /// The storage and table of a soft technique (`cssm`, `vssm`, `msm_soft`).
+    pub fn soft(&self) -> Option<Soft> {
+        match *self {
+            Technique::Cssm { soft, .. }
+            | Technique::Vssm { soft, .. }
+            | Technique::MsmSoft { soft, .. } => Some(soft),
+            _ => None,
+        }
+    }
+
+    /// The storage precision of a prefiltered or soft technique's representation (ESM's is
+    /// always f32); `None` for techniques that shade from the depth.
+    pub fn storage(&self) -> Option<Storage> {
+        match *self {
+            Technique::Esm { .. } => Some(Storage::F32),
+            _ => self
+                .prefilter()
+                .map(|p| p.storage)
+                .or(self.soft().map(|s| s.storage)),
+        }
+    }
+
+    /// The storage and filter of a prefiltered technique (VSM, EVSM, MSM, CSM; ESM has a filter
+    /// only).
+    pub fn prefilter(&self) -> Option<Prefilter> {
+        match *self {
+            Technique::Vsm { prefilter, .. }
+            | Technique::Evsm { prefilter, .. }
+            | Technique::Msm { prefilter, .. }
+            | Technique::Csm { prefilter, .. } => Some(prefilter),
+            _ => None,
+        }
+    }
+
+    /// The name used in scene files.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Technique::Hard => "hard",
+            Technique::Pcf { .. } => "pcf",
+            Technique::Pcss { .. } => "pcss",
+            Technique::Vsm { .. } => "vsm",
+            Technique::Evsm { four: false, .. } => "evsm2",
+            Technique::Evsm { four: true, .. } => "evsm4",
+            Technique::Esm { .. } => "esm",
+            Technique::Msm { .. } => "msm",
+            Technique::Csm { .. } => "csm",
+            Technique::Cssm { .. } => "cssm",
+            Technique::Vssm { .. } => "vssm",
+            Technique::MsmSoft { .. } => "msm_soft",
+        }
+    }
+}
+
+/// How a light's shadow map is made and read.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shadow {
+    /// Technique.
+    pub technique: Technique,
+    /// Constant bias at the comparison, in linear depth units.
+    pub bias: f32,
+    /// Slope-scaled bias at rasterization (wgpu `DepthBiasState::slope_scale`).
+    pub slope_bias: f32,
+    /// Normal offset in shadow-map texels, scaled by `1 − N·L`.
+    pub normal_bias: f32,
+}
+
+/// A light.
+#[derive(Clone, Debug)]
+pub struct Light {
+    /// Projection.
+    pub kind: LightKind,
+    /// Position.
+    pub position: Vec3,
+    /// Aim point.
+    pub target: Vec3,
+    /// Near plane.
+    pub near: f32,
+    /// Far plane.
+    pub far: f32,
+    /// Area-light width, world units (0 = point/sharp).
+    pub size: f32,
+    /// Colour × intensity.
+    pub radiance: Vec3,
+    /// Shadow-map resolution.
+    pub shadow_map: u32,
+    /// Shadow settings.
+    pub shadow: Shadow,
+}
+
+impl Light {
+    /// Unit vector from the light toward its target.
+    pub fn direction(&self) -> Vec3 {
+        (self.target - self.position).normalize()
+    }
+
+    /// World → light view space.
+    pub fn view(&self) -> Mat4 {
+        let dir = self.direction();
+        let up = if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
+        Mat4::look_at_rh(self.position, self.target, up)
+    }
+
+    /// Light view → clip (depth in [0, 1]).
+    pub fn projection(&self) -> Mat4 {
+        match self.kind {
+            LightKind::Directional { extent } => {
+                Mat4::orthographic_rh(-extent, extent, -extent, extent, self.near, self.far)
+            }
+            LightKind::Spot { fov_degrees } => {
+                Mat4::perspective_rh(fov_degrees.to_radians(), 1.0, self.near, self.far)
+            }
+        }
+    }
+
+    /// World width covered by the shadow map at view distance 1 (spot) or at any distance
+    /// (directional): the map spans `width_at_unit * distance` (spot) world units.
+    pub fn width_at_unit(&self) -> f32 {
+        match self.kind {
+            LightKind::Directional { extent } => 2.0 * extent,
+            LightKind::Spot { fov_degrees } => 2.0 * (0.5 * fov_degrees.to_radians()).tan(),
+        }
+    }
+
+    /// One-line description for plans and reports.
+    pub fn label(&self) -> String {
+        let kind = match self.kind {
+            LightKind::Directional { .. } => "directional",
+            LightKind::Spot { .. } => "spot",
+        };
+        format!(
+            "{kind}, {} shadows, {}² map",
+            self.shadow.technique.name(),
+            self.shadow_map
+        )
+    }
+}
+
+/// Number of mip levels of a full chain for a `width`×`height` map (down to 1×1).
+pub fn mip_levels(width: u32, height: u32) -> u32 {
+    32 - width.max(height).max(1).leading_zeros()
+}
+
+/// A pinhole camera's unnormalized view rays as `glam`'s `look_at_rh` and `perspective_rh`
+/// (the G-buffer's projection) make them: forward `f`, right `s = f × up`, up `u = s × f`,
+/// `t = tan(fov_y / 2)`; pixel (x, y) of a `w × h` image sees along
+/// `ray00 + (x + ½)·ray_dx + (y + ½)·ray_dy` with `ray00 = f − t·aspect·s + t·u`,
+/// `ray_dx = 2t·aspect/w · s`, `ray_dy = −2t/h · u`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraRays {
+    /// Ray through pixel corner (0, 0).
+    pub ray00: glam::Vec3,
+    /// Per pixel in x.
+    pub ray_dx: glam::Vec3,
+    /// Per pixel in y.
+    pub ray_dy: glam::Vec3,
+}
+
+impl CameraRays {
+    /// The rays of `camera` for a `width × height` image.
+    pub fn new(camera: &Camera, width: u32, height: u32) -> Self {
+        let f = (camera.target - camera.position).normalize();
+        let s = f.cross(camera.up).normalize();
+        let u = s.cross(f);
+        let t = (0.5 * camera.fov_y_degrees.to_radians()).tan();
+        let aspect = width as f32 / height as f32;
+        Self {
+            ray00: f - t * aspect * s + t * u,
+            ray_dx: (2.0 * t * aspect / width as f32) * s,
+            ray_dy: (-2.0 * t / height as f32) * u,
+        }
+    }
+}

@@ -1,0 +1,199 @@
+//! `csm`: convolution shadow maps (Annen et al. 2007), Fourier basis sin(c_k z), cos(c_k z),
+//! k = 1..M, in ⌈M/2⌉ four-channel maps.
+
+use super::params::{CSM, FILTER, FLOAT_FORMAT, prefilter, prefilter_values};
+use super::{TechniqueDef, no_clamp};
+use crate::gpu_data::TECHNIQUE_CSM;
+use crate::kernels::KernelId;
+use crate::model::{ParamValue, ParamValues, Technique};
+use std::fmt::Write;
+
+use super::nodes::{LightNodes, map_type, moments_format};
+use super::shade::{ShadeInput, VisibilityBody, sat_sample};
+use crate::filter::BlurMode;
+use crate::gpu_data::{CSM_OUTPUTS, CsmParams, LightGpu};
+use crate::model::{Filter, Light, Storage};
+
+/// The [`CSM`] values.
+pub(super) fn series_values(
+    terms: u32,
+    attenuation: f32,
+    offset: f32,
+    scale: f32,
+    out: &mut ParamValues,
+) {
+    out.set("terms", ParamValue::Int(terms));
+    out.set("attenuation", ParamValue::Float(attenuation));
+    out.set("offset", ParamValue::Float(offset));
+    out.set("scale", ParamValue::Float(scale));
+}
+
+fn values(t: &Technique) -> ParamValues {
+    let mut out = ParamValues::default();
+    if let Technique::Csm {
+        prefilter,
+        terms,
+        attenuation,
+        offset,
+        scale,
+    } = t
+    {
+        prefilter_values(prefilter, &mut out);
+        series_values(*terms, *attenuation, *offset, *scale, &mut out);
+    }
+    out
+}
+
+/// Four-channel basis maps CSM with `terms` terms needs (two channels per term).
+pub fn csm_maps(terms: u32) -> u32 {
+    terms.div_ceil(2)
+}
+
+/// Channels of the CSM-Z representation with `terms` terms: z, then z·sin and z·cos per term.
+pub fn csm_z_channels(terms: u32) -> u32 {
+    2 * terms + 1
+}
+
+/// Four-channel CSM-Z maps CSSM with `terms` terms needs.
+pub fn csm_z_maps(terms: u32) -> u32 {
+    csm_z_channels(terms).div_ceil(4)
+}
+
+/// The series' GPU fields (`csm`, `cssm`).
+pub(super) fn csm_gpu(t: &Technique, g: &mut LightGpu) {
+    if let Technique::Csm {
+        terms,
+        attenuation,
+        offset,
+        scale,
+        ..
+    }
+    | Technique::Cssm {
+        terms,
+        attenuation,
+        offset,
+        scale,
+        ..
+    } = *t
+    {
+        g.csm_terms = terms;
+        g.csm_attenuation = attenuation;
+        g.csm_offset = offset;
+        g.csm_scale = scale;
+    }
+}
+
+/// The terms M (the number of maps bound and of calls in the visibility body).
+pub(super) fn terms(t: &Technique) -> String {
+    match *t {
+        Technique::Csm { terms, .. } | Technique::Cssm { terms, .. } => terms.to_string(),
+        _ => String::new(),
+    }
+}
+
+/// The sum of each basis map's terms (`csm_chunk`, or through the `sat` filter `csm_chunk_of`
+/// its rectangle mean), resolved.
+fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
+    let table = match light.shadow.technique.filter() {
+        Some(Filter::Sat { variant, .. }) => Some(variant),
+        _ => None,
+    };
+    let mut body = String::from("var sum = 0.0;");
+    for (chunk, m) in maps.iter().enumerate() {
+        let call = match table {
+            Some(v) => format!(
+                "csm_chunk_of({}, {chunk}u, l, s)",
+                sat_sample(v, m, "l.filter_width")
+            ),
+            None => format!("csm_chunk({m}, {chunk}u, l, s)"),
+        };
+        let _ = write!(body, "\n            sum += {call};");
+    }
+    body.push_str("\n            return csm_resolve(sum, l);");
+    let mut modules = vec!["shared/vis_csm"];
+    if table.is_some() {
+        modules.push("shared/sat_lookup");
+    }
+    VisibilityBody::simple(modules, body)
+}
+
+/// The filtered maps of light `i`'s convolution basis: the CSM basis maps
+/// (`light{i}.csm<chunk>`, two terms each), then with `z` (CSSM) the CSM-Z maps
+/// (`light{i}.csm_z<chunk>`, four channels of the sequence `[z, z·sin c₁z, z·cos c₁z, …]`
+/// each), the complementary basis its blocker search filters. `kernels/csm.wgsl` writes up
+/// to [`CSM_OUTPUTS`] of them from one read of the depth (nodes `light{i}.csm.<g>`).
+pub(super) fn csm_nodes(n: &mut LightNodes, storage: Storage, terms: u32, z: bool) -> Vec<String> {
+    let z_maps = if z { csm_z_maps(terms) } else { 0 };
+    let z_channels = csm_z_channels(terms);
+    let maps: Vec<(String, wgpu::TextureFormat)> = (0..csm_maps(terms))
+        .map(|chunk| {
+            let pairs = (terms - 2 * chunk).min(2);
+            (format!("csm{chunk}"), moments_format(storage, 2 * pairs))
+        })
+        .chain((0..z_maps).map(|chunk| {
+            let channels = (z_channels - 4 * chunk).min(4);
+            (format!("csm_z{chunk}"), moments_format(storage, channels))
+        }))
+        .collect();
+    let mut out = Vec::new();
+    for (g, group) in maps.chunks(CSM_OUTPUTS as usize).enumerate() {
+        let outputs: Vec<(String, String)> = group
+            .iter()
+            .enumerate()
+            .map(|(j, (name, format))| (format!("dst{j}"), n.map(name, *format)))
+            .collect();
+        let params = CsmParams {
+            depth: n.lin,
+            first_map: g as u32 * CSM_OUTPUTS,
+            maps: group.len() as u32,
+            terms,
+            _pad: 0,
+        };
+        let written: Vec<String> = outputs.iter().map(|(_, r)| r.clone()).collect();
+        let name = format!("light{}.csm.{g}", n.i);
+        n.node(
+            name,
+            KernelId::Csm,
+            outputs,
+            bytemuck::bytes_of(&params).to_vec(),
+        );
+        // Filtered before the next group is written (the planner orders by declaration), so
+        // at most one group's unfiltered maps are alive at a time.
+        out.extend(written.iter().map(|m| n.filtered(m, BlurMode::Linear)));
+    }
+    out
+}
+
+/// `csm`.
+pub(super) static DEF: TechniqueDef = TechniqueDef {
+    name: "csm",
+    id: TECHNIQUE_CSM,
+    doc: "convolution shadow maps: a Fourier series of the step, filtered",
+    params: &[FLOAT_FORMAT, FILTER, CSM],
+    build: |v| Technique::Csm {
+        prefilter: prefilter(v),
+        terms: v.int("terms"),
+        attenuation: v.float("attenuation"),
+        offset: v.float("offset"),
+        scale: v.float("scale"),
+    },
+    values,
+    gpu: csm_gpu,
+    nodes: |n| match n.light.shadow.technique {
+        Technique::Csm {
+            prefilter, terms, ..
+        } => ShadeInput {
+            maps: csm_nodes(n, prefilter.storage, terms, false),
+            wgsl_type: map_type(n.light),
+        },
+        _ => n.one(n.depth.clone()),
+    },
+    visibility,
+    variant: terms,
+    // Sines and cosines.
+    value_range: |_| ([-1.0; 4], [1.0; 4]),
+    clamp: no_clamp,
+    area_light: false,
+    example: "scenes/techniques/csm.toml",
+    colour: [0xff, 0x7f, 0x0e],
+};

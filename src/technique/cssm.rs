@@ -1,0 +1,146 @@
+//! `cssm`: convolution soft shadow maps (Annen et al. 2008): the CSM and CSM-Z bases through
+//! summed-area tables, the blocker depth over the search square, CSM at the penumbra width,
+//! then the selective sharpening `v^p`, `p = 1 + A·exp(−B (d − z_avg))`.
+
+use super::csm::series_values;
+use super::params::{CSM, FLOAT_FORMAT, SOFT, float, soft, soft_values};
+use super::{TechniqueDef, no_clamp};
+use crate::gpu_data::TECHNIQUE_CSSM;
+use crate::model::{
+    DEFAULT_SHARPEN, DEFAULT_SHARPEN_FALLOFF, ParamSpec, ParamValue, ParamValues, Technique,
+};
+use std::fmt::Write;
+
+use super::csm::{csm_gpu, csm_maps, csm_nodes, terms};
+use super::nodes::map_type;
+use super::shade::{ShadeInput, VisibilityBody, sat_sample, table_suffix};
+use crate::model::Light;
+
+const SHARPEN: &[ParamSpec] = &[
+    float(
+        "sharpen",
+        0.0,
+        100.0,
+        DEFAULT_SHARPEN,
+        "sharpening strength A (0: none)",
+    ),
+    float(
+        "sharpen_falloff",
+        0.0,
+        1e4,
+        DEFAULT_SHARPEN_FALLOFF,
+        "sharpening falloff B per linear depth unit of d − z_avg",
+    ),
+];
+
+fn values(t: &Technique) -> ParamValues {
+    let mut out = ParamValues::default();
+    if let Technique::Cssm {
+        soft,
+        terms,
+        attenuation,
+        offset,
+        scale,
+        sharpen,
+        sharpen_falloff,
+    } = t
+    {
+        soft_values(soft, &mut out);
+        series_values(*terms, *attenuation, *offset, *scale, &mut out);
+        out.set("sharpen", ParamValue::Float(*sharpen));
+        out.set("sharpen_falloff", ParamValue::Float(*sharpen_falloff));
+    }
+    out
+}
+
+/// The table means over the blocker-search square, the blocker estimate, and only where that
+/// finds blockers the means over the penumbra width (`shared/blocker`'s two passes): the
+/// CSM-Z maps (the maps after the first ⌈M/2⌉) summed over the search square, then the two
+/// passes over the basis maps, with the fetch count of the loop.
+fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
+    let Technique::Cssm { terms, soft, .. } = light.shadow.technique else {
+        return VisibilityBody::simple(vec!["shared/vis_cssm"], String::new());
+    };
+    let suffix = table_suffix(soft.sums);
+    let (basis, z) = maps.split_at((csm_maps(terms) as usize).min(maps.len()));
+    let sample = |m: &str| sat_sample(soft.sums, m, "look.width");
+    let mut body = String::from(
+        "var look = soft_search(l, s);
+    var zsum = 0.0;",
+    );
+    for (chunk, m) in z.iter().enumerate() {
+        let _ = write!(
+            body,
+            "\n    zsum += csm_z_chunk_of({}, {chunk}u, l, s);",
+            sample(m)
+        );
+    }
+    body.push_str("\n    var sum = 0.0;\n    for (var k = 0u; k < 2u; k++) {\n        sum = 0.0;");
+    for (chunk, m) in basis.iter().enumerate() {
+        let _ = write!(
+            body,
+            "\n        sum += csm_chunk_of({}, {chunk}u, l, s);",
+            sample(m)
+        );
+    }
+    body.push_str(
+        "\n        if k == 0u {\n            look = soft_blockers(cssm_blocker(sum, zsum, l, s), l, s);\n            \
+         if !look.blockers {\n                return 1.0;\n            }\n        }\n    }\n    \
+         return cssm_resolve(sum, look.blocker, l, s);",
+    );
+    let fetches = format!(
+        "{} * sat_sample_{suffix} + 2 * {} * sat_sample_{suffix}",
+        z.len(),
+        basis.len()
+    );
+    VisibilityBody {
+        modules: vec!["shared/vis_cssm"],
+        body,
+        fetches: Some(fetches),
+    }
+}
+
+/// `cssm`.
+pub(super) static DEF: TechniqueDef = TechniqueDef {
+    name: "cssm",
+    id: TECHNIQUE_CSSM,
+    doc: "convolution soft shadow maps: CSM at the penumbra width, sharpened",
+    params: &[FLOAT_FORMAT, SOFT, CSM, SHARPEN],
+    build: |v| Technique::Cssm {
+        soft: soft(v),
+        terms: v.int("terms"),
+        attenuation: v.float("attenuation"),
+        offset: v.float("offset"),
+        scale: v.float("scale"),
+        sharpen: v.float("sharpen"),
+        sharpen_falloff: v.float("sharpen_falloff"),
+    },
+    values,
+    gpu: |t, g| {
+        csm_gpu(t, g);
+        if let Technique::Cssm {
+            sharpen,
+            sharpen_falloff,
+            ..
+        } = *t
+        {
+            g.sharpen = sharpen;
+            g.sharpen_falloff = sharpen_falloff;
+        }
+    },
+    nodes: |n| match n.light.shadow.technique {
+        Technique::Cssm { soft, terms, .. } => ShadeInput {
+            maps: csm_nodes(n, soft.storage, terms, true),
+            wgsl_type: map_type(n.light),
+        },
+        _ => n.one(n.depth.clone()),
+    },
+    visibility,
+    variant: terms,
+    // The CSM basis and the CSM-Z basis (z, z·sin, z·cos).
+    value_range: |_| ([-1.0; 4], [1.0; 4]),
+    clamp: no_clamp,
+    area_light: true,
+    example: "scenes/techniques/cssm.toml",
+    colour: [0xe3, 0x77, 0xc2],
+};

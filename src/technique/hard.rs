@@ -1,0 +1,29 @@
+//! `hard`: one comparison at the nearest texel.
+
+use super::shade::call;
+use super::{TechniqueDef, no_clamp};
+use super::{no_gpu, no_variant, unit_range};
+use crate::gpu_data::TECHNIQUE_HARD;
+use crate::model::{ParamValues, Technique};
+
+/// `hard`.
+pub(super) static DEF: TechniqueDef = TechniqueDef {
+    name: "hard",
+    id: TECHNIQUE_HARD,
+    doc: "one comparison at the nearest texel",
+    params: &[],
+    build: |_| Technique::Hard,
+    values: |_| ParamValues::default(),
+    gpu: no_gpu,
+    nodes: |n| {
+        let linear = n.linear.clone();
+        n.one(linear)
+    },
+    visibility: |_, maps| call("shared/vis_hard", "vis_hard", maps),
+    variant: no_variant,
+    value_range: unit_range,
+    clamp: no_clamp,
+    area_light: false,
+    example: "scenes/grazing.toml",
+    colour: [0x44, 0x44, 0x44],
+};

@@ -1,0 +1,196 @@
+//! The technique registry: one [`TechniqueDef`] per scene name, each in its own file owning its
+//! name, WGSL id, parameter table (key, range, default, doc), how its [`Technique`] is built
+//! from checked values and read back, the clamps it applies and its example scene. Front ends
+//! iterate [`REGISTRY`] or look a technique up ([`by_name`], [`of`]) instead of matching on
+//! it. The graph nodes, GPU fields and visibility calls of every technique are in
+//! `nodes.rs`, `light_gpu.rs` and `shade.rs`.
+
+mod csm;
+mod cssm;
+mod esm;
+mod evsm;
+mod given;
+mod hard;
+mod light_gpu;
+mod msm;
+mod msm_soft;
+mod nodes;
+pub mod params;
+mod pcf;
+mod pcss;
+mod shade;
+mod vsm;
+mod vssm;
+
+pub use crate::gpu_data::{
+    CSM_OUTPUTS, CsmParams, ExpParams, LightGpu, LinearizeParams, MSM_HAUSDORFF, MSM_QUANTIZED,
+    MsmParams, VsmParams,
+};
+pub use crate::model::mip_levels;
+use crate::model::{Light, ParamSource, ParamSpec, ParamValues, Technique};
+pub use csm::{csm_maps, csm_z_channels, csm_z_maps};
+use light_gpu::unit_range;
+pub use light_gpu::{sat_coding, sat_variant, soft_lookup_area, soft_max_width, soft_width_cap};
+pub use msm::msm_quantized;
+pub use nodes::LightNodes;
+pub use nodes::{add_light_nodes, depth_name, linear_name, map_channels, map_type, moments_format};
+pub use params::{Clamp, ClampReason, sat_exponent_limit};
+pub use shade::{ShadeInput, VisibilityBody, shade_key, shading_block, visibility_body};
+
+/// One technique as the front ends see it (a struct of plain functions, so the registry is a
+/// static table).
+#[derive(Debug)]
+pub struct TechniqueDef {
+    /// The scene name (`technique = "…"`).
+    pub name: &'static str,
+    /// The id the shading kernel reads (`LightGpu::technique`, `gpu_data::TECHNIQUE_*`).
+    pub id: u32,
+    /// One line for documentation.
+    pub doc: &'static str,
+    /// Its keys, table by table (shared tables from [`params`], then its own); the common
+    /// biases ([`params::COMMON`]) are every technique's and not repeated here.
+    pub params: &'static [&'static [ParamSpec]],
+    /// The technique of checked values.
+    pub build: fn(&ParamValues) -> Technique,
+    /// The values of a technique of this name (the keys that apply to it), so that a
+    /// technique built in code is checked by the same tables.
+    pub values: fn(&Technique) -> ParamValues,
+    /// Values past what the technique keeps accurate, clamped after checking (EVSM's and
+    /// ESM's exponents), each recorded.
+    pub clamp: fn(&mut Technique, &mut Vec<Clamp>),
+    /// Its fields of the light's GPU description (`LightGpu::new` fills the id, the
+    /// matrices, the filter's, the table's and the soft search cap's fields).
+    pub gpu: fn(&Technique, &mut LightGpu),
+    /// The nodes it adds to the light's graph after the depth and linear depth, and what the
+    /// shading reads.
+    pub nodes: fn(&mut LightNodes) -> ShadeInput,
+    /// Its visibility in the shading block: modules and statements with the light's maps
+    /// bound as given.
+    pub visibility: fn(&Light, &[String]) -> VisibilityBody,
+    /// What its visibility code depends on besides its name, table, footprint and maps (the
+    /// shading kernel's cache key: PCF's hardware kernel, CSM's terms).
+    pub variant: fn(&Technique) -> String,
+    /// Per channel, the range of the values its summed-area table sums (`sat_coding`).
+    pub value_range: fn(&Technique) -> ([f32; 4], [f32; 4]),
+    /// Whether it needs an area light (`size` > 0): PCSS and the soft techniques.
+    pub area_light: bool,
+    /// A scene that shows it.
+    pub example: &'static str,
+    /// Its colour in the evaluation's plots (sRGB), so families read at a glance.
+    pub colour: [u8; 3],
+}
+
+/// Every technique, in the order scene errors list them.
+pub static REGISTRY: &[&TechniqueDef] = &[
+    &hard::DEF,
+    &pcf::DEF,
+    &pcss::DEF,
+    &vsm::DEF,
+    &evsm::EVSM2,
+    &evsm::EVSM4,
+    &esm::DEF,
+    &msm::DEF,
+    &csm::DEF,
+    &cssm::DEF,
+    &vssm::DEF,
+    &msm_soft::DEF,
+];
+
+/// Every technique's scene name, in registry order.
+pub fn names() -> Vec<&'static str> {
+    REGISTRY.iter().map(|d| d.name).collect()
+}
+
+/// The technique named `name` in scene files.
+pub fn by_name(name: &str) -> Option<&'static TechniqueDef> {
+    REGISTRY.iter().copied().find(|d| d.name == name)
+}
+
+/// The registry entry of `t`.
+pub fn of(t: &Technique) -> &'static TechniqueDef {
+    by_name(t.name()).expect("every technique's name is registered")
+}
+
+/// Checks `source` against technique `def`'s tables and builds it, with the clamps applied.
+pub fn check<S: ParamSource>(
+    def: &TechniqueDef,
+    source: &S,
+) -> Result<(Technique, Vec<Clamp>), S::Error> {
+    let values = crate::model::check(def.params, source)?;
+    let mut t = (def.build)(&values);
+    let mut clamps = Vec::new();
+    (def.clamp)(&mut t, &mut clamps);
+    Ok((t, clamps))
+}
+
+/// `def` with every key at its default.
+pub fn default_of(def: &TechniqueDef) -> Technique {
+    let values = crate::model::check(def.params, &params::Given(&ParamValues::default()));
+    (def.build)(&values.unwrap_or_default())
+}
+
+/// `def` with `values` over its defaults, taken as they are: for a technique built in code,
+/// whose values a later check reports (`None` when a value is of another kind than its key's or
+/// a key is set where it does not apply).
+pub fn build_with(def: &TechniqueDef, values: &ParamValues) -> Option<Technique> {
+    let values = crate::model::check(def.params, &params::Loose(values)).ok()?;
+    Some((def.build)(&values))
+}
+
+/// The technique named `name` with `values` over its defaults, taken as they are (a later
+/// check reports them); `None` for a name the registry does not know or values its tables
+/// cannot hold.
+pub fn named(name: &str, values: &[(&'static str, crate::model::ParamValue)]) -> Option<Technique> {
+    build_with(by_name(name)?, &ParamValues(values.to_vec()))
+}
+
+/// `t` with `values` set over its own (the keys it has), rebuilt by its entry; `None` when a
+/// key does not apply to it.
+pub fn with_values(
+    t: &Technique,
+    values: &[(&'static str, crate::model::ParamValue)],
+) -> Option<Technique> {
+    let def = of(t);
+    let mut v = (def.values)(t);
+    for &(key, value) in values {
+        v.get(key)?;
+        v.set(key, value);
+    }
+    build_with(def, &v)
+}
+
+/// Whether option `name` of key `key` is one `def` accepts.
+pub fn accepts(def: &TechniqueDef, key: &str, name: &str) -> bool {
+    def.params.iter().flat_map(|t| t.iter()).any(|s| {
+        s.key == key && matches!(s.kind, crate::model::ParamKind::Choice(o) if o.contains(&name))
+    })
+}
+
+/// No GPU fields besides the common ones.
+fn no_gpu(_: &Technique, _: &mut LightGpu) {}
+
+/// Nothing besides the name.
+fn no_variant(_: &Technique) -> String {
+    String::new()
+}
+
+/// No clamps.
+fn no_clamp(_: &mut Technique, _: &mut Vec<Clamp>) {}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every registered technique round-trips: its defaults' values build it again, and its
+    /// name is its technique's.
+    #[test]
+    fn defaults_round_trip_through_values() {
+        for def in REGISTRY {
+            let t = default_of(def);
+            assert_eq!(t.name(), def.name);
+            let values = (def.values)(&t);
+            let again = crate::model::check(def.params, &params::Given(&values)).expect(def.name);
+            assert_eq!((def.build)(&again), t, "{}", def.name);
+        }
+    }
+}

@@ -1,0 +1,237 @@
+//! The graph nodes a light's technique adds: the imported depth, the linear depth, the
+//! encoding(s) and the filter or summed-area table over them.
+
+use crate::filter::{BlurMode, add_filter};
+use crate::gpu_data::LinearizeParams;
+use crate::graph::{Dispatch, Graph, Node, SizeRule};
+use crate::kernels::KernelId;
+use crate::model::{Light, Storage};
+use crate::sat::{SatVariant, add_sat};
+
+use super::light_gpu::{sat_coding, sat_variant};
+use super::shade::ShadeInput;
+
+/// Name of light `i`'s rasterized depth map (imported into the graph).
+pub fn depth_name(i: usize) -> String {
+    format!("light{i}.depth")
+}
+
+/// Name of light `i`'s linear depth map.
+pub fn linear_name(i: usize) -> String {
+    format!("light{i}.linear")
+}
+
+/// What a technique's [`super::TechniqueDef::nodes`] builds on: light `i`'s graph with its
+/// imported depth and linear depth declared.
+pub struct LightNodes<'a> {
+    /// The graph.
+    pub graph: &'a mut Graph,
+    /// The light's index.
+    pub i: usize,
+    /// The light.
+    pub light: &'a Light,
+    /// Its rasterized depth (`light{i}.depth`).
+    pub depth: String,
+    /// Its linear depth (`light{i}.linear`; planned only when read).
+    pub linear: String,
+    /// How its depth is linearized (the first member of every encoding's params).
+    pub lin: LinearizeParams,
+}
+
+impl LightNodes<'_> {
+    /// The shading reads `resource` alone, of the light's map type ([`map_type`]).
+    pub fn one(&self, resource: String) -> ShadeInput {
+        ShadeInput {
+            maps: vec![resource],
+            wgsl_type: map_type(self.light),
+        }
+    }
+
+    /// The encoding `kernel` (raw depth → representation, named after the kernel) with
+    /// `params`, then the light's filter over it in `mode`: what the shading reads.
+    pub fn encoded(
+        &mut self,
+        kernel: KernelId,
+        format: wgpu::TextureFormat,
+        params: &[u8],
+        mode: BlurMode,
+    ) -> ShadeInput {
+        let out = encode(
+            self.graph,
+            self.i,
+            kernel,
+            kernel.name(),
+            &self.depth,
+            format,
+            params.to_vec(),
+        );
+        let filtered = self.filtered(&out, mode);
+        self.one(filtered)
+    }
+
+    /// The filter of the light's representation applied to `input`: the summed-area table of
+    /// [`add_sat`] coded by [`sat_coding`] (the `sat` filter and the soft techniques; its errors
+    /// `render::plan_lights` reports before any graph is built), else the blur or mip chain of
+    /// [`add_filter`].
+    pub fn filtered(&mut self, input: &str, mode: BlurMode) -> String {
+        let light = self.light;
+        if sat_variant(light).is_some() {
+            return match sat_coding(light) {
+                Ok(Some(coding)) => add_sat(self.graph, self.i, input, &coding),
+                _ => input.to_string(),
+            };
+        }
+        match light.shadow.technique.filter() {
+            Some(filter) => add_filter(self.graph, self.i, input, &filter, mode),
+            None => input.to_string(),
+        }
+    }
+
+    /// Adds a node writing `outputs` (`dst0`, …) from the depth with `kernel` and `params`.
+    pub fn node(
+        &mut self,
+        name: String,
+        kernel: KernelId,
+        outputs: Vec<(String, String)>,
+        params: Vec<u8>,
+    ) {
+        self.graph.node(Node {
+            name,
+            kernel,
+            inputs: vec![("src".into(), self.depth.clone())],
+            dispatch: Dispatch::Texels(outputs[0].1.clone()),
+            outputs,
+            params,
+            light: Some(self.i),
+        });
+    }
+
+    /// Declares the light's map `name` (`light{i}.{name}`), the size of the depth.
+    pub fn map(&mut self, name: &str, format: wgpu::TextureFormat) -> String {
+        self.graph.resource(
+            format!("light{}.{name}", self.i),
+            format,
+            SizeRule::Reduced {
+                of: self.depth.clone(),
+                shift: 0,
+            },
+            Some(self.i),
+        )
+    }
+}
+
+/// Adds the nodes light `i`'s technique needs to `graph` and returns what the shading pass
+/// reads. The raw depth map and the linear map are always declared; the planner drops what
+/// nothing reads: the encodings linearize the depth themselves, so `linearize` runs only for
+/// the techniques that shade from the linear depth (hard, PCF but the hardware comparison
+/// sampler, PCSS) or when a caller asks for [`linear_name`] (diagnostics).
+pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput {
+    let depth = graph.import(
+        depth_name(i),
+        wgpu::TextureFormat::Depth32Float,
+        light.shadow_map,
+        light.shadow_map,
+        Some(i),
+    );
+    let lin = LinearizeParams::new(light);
+    let linear = graph.resource(
+        linear_name(i),
+        wgpu::TextureFormat::R32Float,
+        SizeRule::Reduced {
+            of: depth.clone(),
+            shift: 0,
+        },
+        Some(i),
+    );
+    graph.node(Node {
+        name: format!("light{i}.linearize"),
+        kernel: KernelId::Linearize,
+        inputs: vec![("src".into(), depth.clone())],
+        outputs: vec![("dst".into(), linear.clone())],
+        params: bytemuck::bytes_of(&lin).to_vec(),
+        dispatch: Dispatch::Texels(linear.clone()),
+        light: Some(i),
+    });
+    let mut nodes = LightNodes {
+        graph,
+        i,
+        light,
+        depth,
+        linear,
+        lin,
+    };
+    (super::of(&light.shadow.technique).nodes)(&mut nodes)
+}
+
+/// Channels of the representation behind each map the shading binds for `light` (for a
+/// summed-area table, those of the table's input: the table itself always has four).
+pub fn map_channels(light: &Light) -> Vec<usize> {
+    let mut graph = Graph::default();
+    let input = add_light_nodes(&mut graph, 0, light);
+    input
+        .maps
+        .iter()
+        .map(|m| {
+            let source = m
+                .strip_suffix(".sat")
+                .filter(|_| sat_coding(light).ok().flatten().is_some());
+            graph
+                .find(source.unwrap_or(m))
+                .map_or(4, |r| crate::sat::format_channels(r.format) as usize)
+        })
+        .collect()
+}
+
+/// The WGSL type of a prefiltered technique's maps: `texture_2d<u32>` for a fixed-point
+/// summed-area table, else `texture_2d<f32>`.
+pub fn map_type(light: &Light) -> &'static str {
+    match sat_variant(light) {
+        Some(SatVariant::Fixed) => "texture_2d<u32>",
+        _ => "texture_2d<f32>",
+    }
+}
+
+/// The texel format of a `channels`-channel representation (1–4) at `storage` precision.
+pub fn moments_format(storage: Storage, channels: u32) -> wgpu::TextureFormat {
+    match (storage, channels) {
+        (Storage::F32, 1) => wgpu::TextureFormat::R32Float,
+        (Storage::F32, 2) => wgpu::TextureFormat::Rg32Float,
+        (Storage::F32, _) => wgpu::TextureFormat::Rgba32Float,
+        // rg16float is no core storage format; rgba16float is.
+        (Storage::F16, _) => wgpu::TextureFormat::Rgba16Float,
+        (Storage::Unorm16, _) => wgpu::TextureFormat::Rgba16Unorm,
+    }
+}
+
+/// Adds the encoding node `kernel` (raw depth → representation, the kernel linearizing the
+/// depth itself) of light `i`, writing `light{i}.{name}`; the output's format picks the
+/// kernel's storage variant. `params` start with the depth's [`LinearizeParams`].
+fn encode(
+    graph: &mut Graph,
+    i: usize,
+    kernel: KernelId,
+    name: &str,
+    depth: &str,
+    format: wgpu::TextureFormat,
+    params: Vec<u8>,
+) -> String {
+    let out = graph.resource(
+        format!("light{i}.{name}"),
+        format,
+        SizeRule::Reduced {
+            of: depth.to_string(),
+            shift: 0,
+        },
+        Some(i),
+    );
+    graph.node(Node {
+        name: format!("light{i}.{name}"),
+        kernel,
+        inputs: vec![("src".into(), depth.to_string())],
+        outputs: vec![("dst".into(), out.clone())],
+        params,
+        dispatch: Dispatch::Texels(out.clone()),
+        light: Some(i),
+    });
+    out
+}

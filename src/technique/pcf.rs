@@ -1,0 +1,124 @@
+//! `pcf`: percentage-closer filtering over a `2r + 1` window, or the hardware 2×2 comparison.
+
+use super::params::{choice, int};
+use super::shade::{ShadeInput, VisibilityBody, call, first};
+use super::unit_range;
+use super::{TechniqueDef, no_clamp};
+use crate::gpu_data::LightGpu;
+use crate::gpu_data::TECHNIQUE_PCF;
+use crate::model::Light;
+use crate::model::{Needs, ParamSpec, ParamValue, ParamValues, PcfKernel, Technique};
+
+const KERNELS: &[(&str, PcfKernel)] = &[
+    ("box", PcfKernel::Box),
+    ("tent", PcfKernel::Tent),
+    ("hardware", PcfKernel::Hardware),
+];
+
+const PARAMS: &[ParamSpec] = &[
+    choice(
+        "kernel",
+        &["box", "tent", "hardware"],
+        "box",
+        "window weights, or the hardware 2×2 comparison",
+    ),
+    ParamSpec {
+        needs: &[Needs {
+            key: "kernel",
+            one_of: &["box", "tent"],
+            why: "does not apply to the hardware 2×2 kernel",
+        }],
+        ..int("radius", 0, 32, 1, "window radius in texels")
+    },
+];
+
+fn build(v: &ParamValues) -> Technique {
+    let kernel = KERNELS
+        .iter()
+        .find(|(n, _)| *n == v.choice("kernel"))
+        .map_or(PcfKernel::Box, |&(_, k)| k);
+    Technique::Pcf {
+        // The hardware kernel reads no radius; it keeps the default.
+        radius: match v.get("radius") {
+            Some(ParamValue::Int(r)) => r,
+            _ => 1,
+        },
+        kernel,
+    }
+}
+
+fn values(t: &Technique) -> ParamValues {
+    let mut out = ParamValues::default();
+    if let Technique::Pcf { radius, kernel } = *t {
+        let name = KERNELS
+            .iter()
+            .find(|(_, k)| *k == kernel)
+            .map_or("box", |(n, _)| n);
+        out.set("kernel", ParamValue::Choice(name));
+        if kernel != PcfKernel::Hardware {
+            out.set("radius", ParamValue::Int(radius));
+        }
+    }
+    out
+}
+
+fn hardware(t: &Technique) -> bool {
+    matches!(
+        t,
+        Technique::Pcf {
+            kernel: PcfKernel::Hardware,
+            ..
+        }
+    )
+}
+
+/// The radius and the kernel's index (`LightGpu::kernel`: 0 box, 1 tent, 2 hardware).
+fn gpu(t: &Technique, g: &mut LightGpu) {
+    if let Technique::Pcf { radius, kernel } = *t {
+        g.radius = radius;
+        g.kernel = KERNELS.iter().position(|(_, k)| *k == kernel).unwrap_or(0) as u32;
+    }
+}
+
+fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
+    if hardware(&light.shadow.technique) {
+        let body = format!(
+            "return vis_pcf_hardware({}, cmp_sampler, l, s);",
+            first(maps)
+        );
+        return VisibilityBody::simple(vec!["shared/vis_pcf"], body);
+    }
+    call("shared/vis_pcf", "vis_pcf", maps)
+}
+
+/// `pcf`.
+pub(super) static DEF: TechniqueDef = TechniqueDef {
+    name: "pcf",
+    id: TECHNIQUE_PCF,
+    doc: "percentage-closer filtering",
+    params: &[PARAMS],
+    build,
+    values,
+    gpu,
+    nodes: |n| match n.light.shadow.technique {
+        // The hardware comparison sampler reads the depth itself.
+        Technique::Pcf {
+            kernel: PcfKernel::Hardware,
+            ..
+        } => ShadeInput {
+            maps: vec![n.depth.clone()],
+            wgsl_type: "texture_depth_2d",
+        },
+        _ => {
+            let linear = n.linear.clone();
+            n.one(linear)
+        }
+    },
+    visibility,
+    variant: |t| u8::from(hardware(t)).to_string(),
+    value_range: unit_range,
+    clamp: no_clamp,
+    area_light: false,
+    example: "scenes/bunny.toml",
+    colour: [0x1f, 0x77, 0xb4],
+};

@@ -1,0 +1,72 @@
+//! `pcss`: percentage-closer soft shadows (Fernando 2005).
+
+use super::params::{float, int};
+use super::shade::call;
+use super::{TechniqueDef, no_clamp};
+use super::{no_variant, unit_range};
+use crate::gpu_data::TECHNIQUE_PCSS;
+use crate::model::{DEFAULT_MAX_SEARCH, ParamSpec, ParamValue, ParamValues, Technique};
+
+const PARAMS: &[ParamSpec] = &[
+    int("blocker_samples", 1, 256, 16, "blocker-search taps"),
+    int("filter_samples", 1, 1024, 32, "filter taps"),
+    float(
+        "max_search",
+        1e-4,
+        1.0,
+        DEFAULT_MAX_SEARCH,
+        "cap on the blocker-search radius, shadow-map UV",
+    ),
+];
+
+fn values(t: &Technique) -> ParamValues {
+    let mut out = ParamValues::default();
+    if let Technique::Pcss {
+        blocker_samples,
+        filter_samples,
+        max_search,
+    } = *t
+    {
+        out.set("blocker_samples", ParamValue::Int(blocker_samples));
+        out.set("filter_samples", ParamValue::Int(filter_samples));
+        out.set("max_search", ParamValue::Float(max_search));
+    }
+    out
+}
+
+/// `pcss`.
+pub(super) static DEF: TechniqueDef = TechniqueDef {
+    name: "pcss",
+    id: TECHNIQUE_PCSS,
+    doc: "percentage-closer soft shadows: blocker search, penumbra width, PCF",
+    params: &[PARAMS],
+    build: |v| Technique::Pcss {
+        blocker_samples: v.int("blocker_samples"),
+        filter_samples: v.int("filter_samples"),
+        max_search: v.float("max_search"),
+    },
+    values,
+    gpu: |t, g| {
+        if let Technique::Pcss {
+            blocker_samples,
+            filter_samples,
+            max_search,
+        } = *t
+        {
+            g.blocker_samples = blocker_samples;
+            g.filter_samples = filter_samples;
+            g.max_search = max_search;
+        }
+    },
+    nodes: |n| {
+        let linear = n.linear.clone();
+        n.one(linear)
+    },
+    visibility: |_, maps| call("shared/vis_pcss", "vis_pcss", maps),
+    variant: no_variant,
+    value_range: unit_range,
+    clamp: no_clamp,
+    area_light: true,
+    example: "scenes/colonnade.toml",
+    colour: [0x17, 0xbe, 0xcf],
+};
