@@ -13,9 +13,13 @@
 // kept), which a workgroup does from its own texels. For logarithmic representations (ESM's
 // c·z) every mean is of exp(v), as a log-sum-exp.
 //
-// A workgroup owns a 32 × 32 tile of level s + 1 (64 × 64 texels of level s when it halves);
-// each of its 8 × 8 invocations a 4 × 4 block of it, reduced in registers to one texel of
-// level s + 3; levels s + 4 … s + 6 go through workgroup memory (85 values).
+// A workgroup owns a 32 × 32 tile of level s + 1 (64 × 64 texels of level s when it halves).
+// Its 8 × 8 invocations reduce the tile's level s + 1 texels row by row, invocation li taking
+// texels li, li + 64, …, so that at each step neighbouring invocations read neighbouring
+// texels of level s (coalesced on a GPU; an invocation owning a 4 × 4 block read texels eight
+// apart, and ran at a third of a texture copy on an H100); levels s + 1, s + 2 and s + 4 … s + 6
+// meet in workgroup memory, each texel reduced from the same four values in the same order as
+// before, so the chain is bit-identical.
 // Storage: rgba32float by default; the executor re-declares `dst0` … `dst6` for the format.
 
 // Keep in sync with `MipParams` in src/filter.rs.
@@ -46,6 +50,9 @@ const TILE: u32 = 32u;   // WG · BLOCK
 // Levels s + 3 (8 × 8 per workgroup) at [0, 64), s + 4 at [64, 80), s + 5 at [80, 84), s + 6
 // at [84].
 var<workgroup> sh_level: array<vec4<f32>, 85>;
+// The workgroup's level s + 1 (32 × 32, row-major) and level s + 2 (16 × 16).
+var<workgroup> sh_level1: array<vec4<f32>, 1024>;
+var<workgroup> sh_level2: array<vec4<f32>, 256>;
 
 fn level_size(level: u32) -> vec2<u32> {
     return max(params.base >> vec2<u32>(level), vec2<u32>(1u));
@@ -177,19 +184,30 @@ fn level1(j: vec2<u32>, log_mode: bool) -> vec4<f32> {
     return v;
 }
 
-// Texel j of level s + 2 from its quad of level s + 1, each stored; stored too.
-fn level2(j: vec2<u32>, log_mode: bool) -> vec4<f32> {
-    let q = 2u * j;
+// Level s + 1's texel `idx` (row-major) of the workgroup's 32 × 32 tile of it and level
+// s + 2's texel `idx` of its 16 × 16, each from its quad of the level above, stored and kept in
+// workgroup memory; `LEVEL1_STEPS` and `LEVEL2_STEPS` of them per invocation, WG · WG apart.
+const LEVEL1_STEPS: u32 = 16u; // TILE² / (WG · WG)
+const LEVEL2_STEPS: u32 = 4u; // (TILE / 2)² / (WG · WG)
+
+fn level1_tile(wg: vec2<u32>, idx: u32, log_mode: bool) {
+    sh_level1[idx] = level1(wg * TILE + vec2<u32>(idx % TILE, idx / TILE), log_mode);
+}
+
+fn level2_tile(wg: vec2<u32>, idx: u32, log_mode: bool) {
+    let half = TILE / 2u;
+    let j = vec2<u32>(idx % half, idx / half);
+    let at = 2u * j.y * TILE + 2u * j.x;
     let v = quad(
-        level1(q, log_mode),
-        level1(q + vec2<u32>(1u, 0u), log_mode),
-        level1(q + vec2<u32>(0u, 1u), log_mode),
-        level1(q + vec2<u32>(1u, 1u), log_mode),
+        sh_level1[at],
+        sh_level1[at + 1u],
+        sh_level1[at + TILE],
+        sh_level1[at + TILE + 1u],
         params.first + 1u,
         log_mode,
     );
-    store(2u, j, v);
-    return v;
+    store(2u, wg * half + j, v);
+    sh_level2[idx] = v;
 }
 
 // Workgroup `wg`, invocation `lid` of the dispatch (workgroups of WG × WG).
@@ -213,26 +231,28 @@ fn mip_dispatch(wg: vec2<u32>, lid: vec2<u32>, log_mode: bool) {
         }
         return;
     }
-    // Levels s + 1 and s + 2: this invocation's four quads of level s + 1, each reduced to a
-    // texel of level s + 2, in a loop (one copy of the quad's code: unrolled, llvmpipe took
-    // seconds to compile it), kept as named values (no array: llvmpipe keeps dynamically
-    // indexed arrays in memory); level s + 3: one texel.
-    let origin2 = wg * (TILE / 2u) + lid * 2u;
-    var q0 = vec4<f32>(0.0);
-    var q1 = vec4<f32>(0.0);
-    var q2 = vec4<f32>(0.0);
-    var q3 = vec4<f32>(0.0);
-    for (var k = 0u; k < 4u; k++) {
-        let v = level2(origin2 + vec2<u32>(k % 2u, k / 2u), log_mode);
-        q0 = select(q0, v, k == 0u);
-        q1 = select(q1, v, k == 1u);
-        q2 = select(q2, v, k == 2u);
-        q3 = select(q3, v, k == 3u);
+    // Levels s + 1 and s + 2 through workgroup memory, in loops (one copy of each reduction's
+    // code: unrolled, llvmpipe took seconds to compile the quads); level s + 3: one texel.
+    let li = lid.y * WG + lid.x;
+    for (var k = 0u; k < LEVEL1_STEPS; k++) {
+        level1_tile(wg, li + k * WG * WG, log_mode);
     }
-    let v3 = quad(q0, q1, q2, q3, s + 2u, log_mode);
+    workgroupBarrier();
+    for (var k = 0u; k < LEVEL2_STEPS; k++) {
+        level2_tile(wg, li + k * WG * WG, log_mode);
+    }
+    workgroupBarrier();
+    let at = 2u * lid.y * (TILE / 2u) + 2u * lid.x;
+    let v3 = quad(
+        sh_level2[at],
+        sh_level2[at + 1u],
+        sh_level2[at + TILE / 2u],
+        sh_level2[at + TILE / 2u + 1u],
+        s + 2u,
+        log_mode,
+    );
     store(3u, wg * WG + lid, v3);
     // Levels s + 4 … s + 6 from workgroup memory: 4 × 4, 2 × 2, 1 texel per workgroup.
-    let li = lid.y * WG + lid.x;
     sh_level[li] = v3;
     var side = WG;
     var at_level = 0u;
