@@ -2,7 +2,7 @@
 
 use crate::graph::{Dispatch, Graph, LevelView, Node, SizeRule, SubDispatch};
 use crate::kernels::KernelId;
-use crate::scene::{BlurKernel, Filter};
+use crate::model::{BlurKernel, Filter};
 
 /// Taps each side the blur kernel's weight table holds.
 pub const MAX_BLUR_RADIUS: u32 = 32;
@@ -170,7 +170,7 @@ pub const MIP_TILE: u32 = 64;
 /// gets a dispatch of one level. A 1×1 map is one dispatch writing no level after level 0. A
 /// 4096² chain is `[(0, 6), (6, 6)]`.
 pub fn mip_dispatches(width: u32, height: u32) -> Vec<(u32, u32)> {
-    let levels = crate::technique::mip_levels(width, height);
+    let levels = crate::model::mip_levels(width, height);
     let size = |l: u32| [(width >> l).max(1), (height >> l).max(1)];
     let halves = |l: u32| size(l).iter().all(|&n| n == 1 || n % 2 == 0);
     if levels <= 1 {
@@ -316,7 +316,7 @@ mod tests {
             (4096, 4096),
             (3, 2100),
         ] {
-            let levels = crate::technique::mip_levels(w, h);
+            let levels = crate::model::mip_levels(w, h);
             let d = mip_dispatches(w, h);
             let mut next = 0;
             for &(first, count) in &d {

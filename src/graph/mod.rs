@@ -251,66 +251,7 @@ impl Graph {
     }
 }
 
-/// A wiring mistake in a graph, found by the planner.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[non_exhaustive]
-pub enum GraphError {
-    /// A node reads or writes a resource that was never declared.
-    #[error("node `{node}` uses undeclared resource `{resource}`")]
-    UnknownResource {
-        /// The node.
-        node: String,
-        /// The resource name.
-        resource: String,
-    },
-    /// An output was asked for that was never declared.
-    #[error("output `{0}` is not a declared resource")]
-    UnknownOutput(String),
-    /// A needed resource has no node producing it and is not imported.
-    #[error("resource `{resource}` (needed by {needed_by}) has no producer and is not imported")]
-    MissingProducer {
-        /// The resource.
-        resource: String,
-        /// Who needs it: a node name or `the outputs`.
-        needed_by: String,
-    },
-    /// Two nodes write the same resource.
-    #[error("resource `{resource}` is written by both `{first}` and `{second}`")]
-    DuplicateProducer {
-        /// The resource.
-        resource: String,
-        /// The first writer.
-        first: String,
-        /// The second writer.
-        second: String,
-    },
-    /// A node writes an imported resource.
-    #[error("node `{node}` writes imported resource `{resource}`")]
-    WritesImport {
-        /// The node.
-        node: String,
-        /// The resource.
-        resource: String,
-    },
-    /// Two nodes or two resources share a name.
-    #[error("name `{0}` is declared twice")]
-    DuplicateName(String),
-    /// The needed part of the graph has a cycle.
-    #[error("cycle through nodes {}", .0.join(" → "))]
-    Cycle(Vec<String>),
-    /// A plan (built or edited by hand) breaks what the executor relies on: a slot or a
-    /// resource out of range, mismatched, or missing (see [`Plan::check`]).
-    #[error("malformed plan: {0}")]
-    BadPlan(String),
-    /// A size rule refers to a missing resource or to itself.
-    #[error("size of `{resource}`: {message}")]
-    BadSize {
-        /// The resource.
-        resource: String,
-        /// What is wrong.
-        message: String,
-    },
-}
+pub use crate::error::GraphError;
 
 /// Blocks of `block` texels covering `len` texels, rounded up, at least 1; a `block` of 0
 /// spans the whole length (one block).

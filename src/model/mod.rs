@@ -5,6 +5,7 @@
 
 mod defaults;
 mod params;
+mod sat_variant;
 
 pub use defaults::{
     DEFAULT_MAX_SEARCH, DEFAULT_SHARPEN, DEFAULT_SHARPEN_FALLOFF, default_moment_bias,
@@ -15,6 +16,8 @@ pub use params::{
 };
 
 use glam::{Mat4, Vec3};
+
+pub use sat_variant::SatVariant;
 
 /// A perspective camera.
 #[derive(Clone, Debug)]
@@ -113,7 +116,7 @@ pub enum Filter {
         /// Box width in texels.
         width: f32,
         /// How the table stores its sums.
-        variant: crate::sat::SatVariant,
+        variant: SatVariant,
     },
 }
 
@@ -124,7 +127,7 @@ pub struct Soft {
     /// Storage precision of the representation the table sums.
     pub storage: Storage,
     /// How the table stores its sums.
-    pub sums: crate::sat::SatVariant,
+    pub sums: SatVariant,
     /// Cap on the blocker-search half-width and on the filter's half-width, in shadow-map UV
     /// (as PCSS's `max_search`); the fixed-point table is coded for squares of that size.
     pub max_search: f32,

@@ -51,39 +51,14 @@ pub const SAT_LINES_PER_GROUP: u32 = 64;
 /// The largest `max_area` the fixed-point coding accepts: one unit per texel must fit an i32.
 pub const MAX_FIXED_AREA: u64 = (1 << 31) - 1;
 
-/// How the table stores its sums.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum SatVariant {
-    /// u32 fixed point with wraparound (`r32uint` … `rgba32uint`): exact window sums.
-    Fixed,
-    /// f32 (`r32float` … `rgba32float`): window sums lose precision with the magnitude of the
-    /// corners.
-    Float,
-}
+pub use crate::model::SatVariant;
 
-impl SatVariant {
-    /// The table's texel format for a representation of `channels` channels (1, 2, or 4 for
-    /// 3 or 4): `r32uint`, `rg32uint`, `rgba32uint` for fixed point, the `*32float` formats for
-    /// f32 sums.
-    pub fn format(self, channels: u32) -> wgpu::TextureFormat {
-        use wgpu::TextureFormat as T;
-        match (self, channels) {
-            (Self::Fixed, 1) => T::R32Uint,
-            (Self::Fixed, 2) => T::Rg32Uint,
-            (Self::Fixed, _) => T::Rgba32Uint,
-            (Self::Float, 1) => T::R32Float,
-            (Self::Float, 2) => T::Rg32Float,
-            (Self::Float, _) => T::Rgba32Float,
-        }
-    }
-
-    /// The kernels of the first and the last pass (one per variant, so the variant's
-    /// arithmetic is a constant in them).
-    fn kernels(self) -> [KernelId; 2] {
-        match self {
-            Self::Fixed => [KernelId::SatTileSums, KernelId::SatTiles],
-            Self::Float => [KernelId::SatTileSumsF32, KernelId::SatTilesF32],
-        }
+/// The kernels of a table's first and last pass in `variant` (one per variant, so the
+/// variant's arithmetic is a constant in them).
+fn tile_kernels(variant: SatVariant) -> [KernelId; 2] {
+    match variant {
+        SatVariant::Fixed => [KernelId::SatTileSums, KernelId::SatTiles],
+        SatVariant::Float => [KernelId::SatTileSumsF32, KernelId::SatTilesF32],
     }
 }
 
@@ -281,7 +256,7 @@ pub fn add_sat(graph: &mut Graph, light: usize, input: &str, coding: &SatCoding)
     let passes = [
         (
             ".tile_sums",
-            coding.variant.kernels()[0],
+            tile_kernels(coding.variant)[0],
             vec![("src", input)],
             vec![("col_part", col_part.as_str()), ("row_part", &row_part)],
             tiles.clone(),
@@ -298,7 +273,7 @@ pub fn add_sat(graph: &mut Graph, light: usize, input: &str, coding: &SatCoding)
         ),
         (
             "",
-            coding.variant.kernels()[1],
+            tile_kernels(coding.variant)[1],
             vec![
                 ("src", input),
                 ("col_carry", &col_carry),
