@@ -18,6 +18,7 @@ mod nodes;
 pub mod params;
 mod pcf;
 mod pcss;
+mod reference;
 mod shade;
 mod vsm;
 mod vssm;
@@ -35,6 +36,7 @@ pub use msm::msm_quantized;
 pub use nodes::LightNodes;
 pub use nodes::{add_light_nodes, depth_name, linear_name, map_channels, map_type, moments_format};
 pub use params::{Clamp, ClampReason, sat_exponent_limit};
+pub use reference::parameters_markdown;
 pub use shade::{ShadeInput, VisibilityBody, shade_key, shading_block, visibility_body};
 
 /// One technique as the front ends see it (a struct of plain functions, so the registry is a
