@@ -6,7 +6,7 @@ use crate::error::{Error, Result};
 use crate::model::ParamValue;
 use crate::prefilter::PrefilterConfig;
 use crate::scene::{BlurKernel, Filter, Scene, Storage, Technique};
-use crate::technique;
+use crate::technique::{self, SweepPlan, SweptStorages, SweptTerms, TechniqueDef};
 
 /// A filter of a box `width` texels wide.
 pub type FilterOfWidth = fn(f32) -> Filter;
@@ -42,10 +42,6 @@ pub struct Config {
     /// then applies).
     pub box_width: Option<f64>,
 }
-
-/// PCSS tap counts (blocker search, filter) swept beside the scene's own: cheaper, and the
-/// wider counts engines ship (Bevy's PCSS, Filament's).
-pub const PCSS_TAPS: [(u32, u32); 4] = [(8, 16), (16, 32), (32, 64), (64, 64)];
 
 /// Configurations of the sweep for `scene` (every light gets each), filtered by
 /// `opts.techniques`. Unknown technique names are an error listing the known ones.
@@ -89,119 +85,26 @@ pub fn sweep(scene: &Scene, opts: &EvaluateOptions) -> Result<Vec<Config>> {
     } else {
         &[Storage::F32, Storage::F16]
     };
+    let area_lights = scene.lights.iter().all(|l| l.size > 0.0);
+    let knobs = Knobs {
+        quick,
+        base,
+        sizes: &sizes,
+        widths,
+        storages,
+        light_size: scene.lights[0].size,
+    };
     let mut out = Vec::new();
-    let mut push = |label: String, technique: Technique, size: u32, box_width: Option<f64>| {
-        out.push(Config {
-            label: format!("{label} {size}"),
-            technique,
-            shadow_map: size,
-            box_width,
-        });
-    };
-    let size_sweep = |t: &str| -> Vec<u32> {
-        if wanted.iter().any(|w| w == t) {
-            sizes.clone()
-        } else {
-            Vec::new()
+    for def in technique::REGISTRY {
+        if !wanted.iter().any(|w| w == def.name) || (def.area_light && !area_lights) {
+            continue;
         }
-    };
-    let named = |name: &str, values: &[(&'static str, ParamValue)]| {
-        technique::named(name, values)
-            .ok_or_else(|| Error::Invalid(format!("sweep: cannot build technique `{name}`")))
-    };
-    for &size in &size_sweep("hard") {
-        push("hard".into(), named("hard", &[])?, size, None);
-    }
-    if wanted.iter().any(|w| w == "pcf") {
-        for r in if quick { vec![2] } else { vec![1, 2, 4] } {
-            // The default kernel (box) at radius r.
-            let t = named("pcf", &[("radius", ParamValue::Int(r))])?;
-            let width = Some(f64::from(2 * r + 1));
-            let on: Vec<u32> = if r == 2 { sizes.clone() } else { vec![base] };
-            for size in on {
-                push(format!("pcf box{}", 2 * r + 1), t, size, width);
-            }
-        }
-    }
-    if scene.lights.iter().all(|l| l.size > 0.0) {
-        let pcss = match scene
+        let own = scene
             .lights
             .iter()
             .map(|l| l.shadow.technique)
-            .find(|t| t.name() == "pcss")
-        {
-            Some(t) => t,
-            None => named("pcss", &[])?,
-        };
-        // PCSS as engines ship it, at several tap counts (blocker search + filter): the
-        // scene's (default 16 + 32) on every size, the others at the base size.
-        let pcss_label = |t: &Technique| {
-            let v = (technique::of(t).values)(t);
-            let (blockers, taps) = (v.int("blocker_samples"), v.int("filter_samples"));
-            format!("pcss {blockers}+{taps}")
-        };
-        for &size in &size_sweep("pcss") {
-            push(pcss_label(&pcss), pcss, size, None);
-        }
-        if !quick && wanted.iter().any(|w| w == "pcss") {
-            for (blocker_samples, filter_samples) in PCSS_TAPS {
-                let taps = [
-                    ("blocker_samples", ParamValue::Int(blocker_samples)),
-                    ("filter_samples", ParamValue::Int(filter_samples)),
-                ];
-                let Some(t) = technique::with_values(&pcss, &taps) else {
-                    continue;
-                };
-                if t != pcss {
-                    push(pcss_label(&t), t, base, None);
-                }
-            }
-        }
-        // The soft techniques (every step a summed-area-table lookup), validated as a scene
-        // would be; their first variant on every size, the others at the base size.
-        let light_size = scene.lights[0].size;
-        for name in ["cssm", "vssm", "msm_soft"] {
-            if !wanted.iter().any(|w| w == name) {
-                continue;
-            }
-            let variants: Vec<(String, PrefilterConfig)> = match name {
-                "cssm" => (if quick { vec![8] } else { vec![8, 4, 16] })
-                    .into_iter()
-                    .map(|m| {
-                        (
-                            format!("cssm M{m}"),
-                            PrefilterConfig::cssm(1, m, light_size),
-                        )
-                    })
-                    .collect(),
-                "vssm" => vec![("vssm".into(), PrefilterConfig::vssm(1, light_size))],
-                _ => {
-                    let mut v = vec![(
-                        "msm_soft f32".to_string(),
-                        PrefilterConfig::msm_soft(1, light_size),
-                    )];
-                    if !quick {
-                        v.push((
-                            "msm_soft f16".into(),
-                            PrefilterConfig::msm_soft(1, light_size).with_storage(Storage::F16),
-                        ));
-                    }
-                    v
-                }
-            };
-            for (k, (label, config)) in variants.into_iter().enumerate() {
-                let (valid, _) = config.validated()?;
-                let on = if k == 0 { sizes.clone() } else { vec![base] };
-                for size in on {
-                    push(label.clone(), valid.technique, size, None);
-                }
-            }
-        }
-    }
-    for name in ["vsm", "evsm2", "evsm4", "esm", "msm", "csm"] {
-        if wanted.iter().any(|w| w == name) {
-            prefiltered_configs(name, quick, base, &sizes, widths, storages, &mut out)?;
-        }
+            .find(|t| t.name() == def.name);
+        swept(def, own, &knobs, &mut out)?;
     }
     match &opts.moment_biases {
         Some(biases) => with_moment_biases(out, biases),
@@ -241,21 +144,117 @@ fn with_moment_biases(configs: Vec<Config>, biases: &[f32]) -> Result<Vec<Config
     Ok(out)
 }
 
+/// The evaluation's side of a sweep: what every technique's plan is run over.
+struct Knobs<'a> {
+    quick: bool,
+    /// The map size the knobs are swept at.
+    base: u32,
+    sizes: &'a [u32],
+    /// Box widths of the filtered techniques (texels).
+    widths: &'a [f32],
+    /// Storages of the prefiltered techniques, f32 first.
+    storages: &'a [Storage],
+    /// The scene's first light's width (the soft techniques' validation).
+    light_size: f32,
+}
+
+impl Knobs<'_> {
+    /// `label` with `technique` at every map size (`every_size`) or at the base size.
+    fn push(&self, out: &mut Vec<Config>, label: &str, t: Technique, every: bool, w: Option<f64>) {
+        let base = [self.base];
+        for &size in if every { self.sizes } else { &base[..] } {
+            out.push(Config {
+                label: format!("{label} {size}"),
+                technique: t,
+                shadow_map: size,
+                box_width: w,
+            });
+        }
+    }
+}
+
+fn named(name: &str, values: &[(&'static str, ParamValue)]) -> Result<Technique> {
+    technique::named(name, values)
+        .ok_or_else(|| Error::Invalid(format!("sweep: cannot build technique `{name}`")))
+}
+
+/// The configurations of `def`'s sweep plan; `own` is the scene's configuration of it.
+fn swept(
+    def: &TechniqueDef,
+    own: Option<Technique>,
+    k: &Knobs,
+    out: &mut Vec<Config>,
+) -> Result<()> {
+    let name = def.name;
+    match def.sweep {
+        SweepPlan::Defaults => k.push(out, name, named(name, &[])?, true, None),
+        SweepPlan::Radii {
+            full,
+            quick,
+            every_size,
+        } => {
+            for &r in if k.quick { quick } else { full } {
+                // The default kernel (box) at radius r.
+                let t = named(name, &[("radius", ParamValue::Int(r))])?;
+                let label = format!("{name} box{}", 2 * r + 1);
+                k.push(out, &label, t, r == every_size, Some(f64::from(2 * r + 1)));
+            }
+        }
+        SweepPlan::Taps(taps) => {
+            let own = match own {
+                Some(t) => t,
+                None => named(name, &[])?,
+            };
+            let label = |t: &Technique| {
+                let v = (def.values)(t);
+                let (blockers, filter) = (v.int("blocker_samples"), v.int("filter_samples"));
+                format!("{name} {blockers}+{filter}")
+            };
+            k.push(out, &label(&own), own, true, None);
+            for &(blocker_samples, filter_samples) in taps.iter().filter(|_| !k.quick) {
+                let taps = [
+                    ("blocker_samples", ParamValue::Int(blocker_samples)),
+                    ("filter_samples", ParamValue::Int(filter_samples)),
+                ];
+                match technique::with_values(&own, &taps) {
+                    Some(t) if t != own => k.push(out, &label(&t), t, false, None),
+                    _ => {}
+                }
+            }
+        }
+        SweepPlan::Variants { full, quick } => {
+            let n = if k.quick { quick } else { full.len() };
+            for (i, v) in full.iter().take(n).enumerate() {
+                let mut config =
+                    PrefilterConfig::new(named(name, v.values)?, 1).with_light_size(k.light_size);
+                if let Some(storage) = v.storage {
+                    config = config.with_storage(storage);
+                }
+                let (valid, _) = config.validated()?;
+                k.push(out, v.label, valid.technique, i == 0, None);
+            }
+        }
+        SweepPlan::Prefiltered { storages, terms } => prefiltered(name, storages, terms, k, out)?,
+    }
+    Ok(())
+}
+
 /// The prefiltered technique `name` with `storage`, `filter` and (CSM) `terms`, validated
 /// like a scene file (EVSM exponents clamped to the storage's limit, MSM's default bias for
-/// the storage: `PrefilterConfig::with_storage`).
-fn prefiltered(name: &str, storage: Storage, filter: Filter, terms: u32) -> Result<Technique> {
-    let terms = [("terms", ParamValue::Int(terms))];
-    let values: &[(&str, ParamValue)] = if name == "csm" { &terms } else { &[] };
-    let t = technique::named(name, values)
-        .ok_or_else(|| Error::Invalid(format!("sweep: cannot build technique `{name}`")))?;
-    let config = PrefilterConfig::new(t, 1);
-    let config = if name == "esm" {
-        config.with_filter(filter)
-    } else {
-        config.with_storage(storage).with_filter(filter)
+/// the storage: `PrefilterConfig::with_storage`); a technique of one storage keeps it.
+fn prefiltered_one(
+    name: &str,
+    storage: Option<Storage>,
+    filter: Filter,
+    terms: Option<u32>,
+) -> Result<Technique> {
+    let values = terms.map(|m| ("terms", ParamValue::Int(m)));
+    let config = PrefilterConfig::new(named(name, values.as_slice())?, 1);
+    let config = match storage {
+        Some(s) => config.with_storage(s),
+        None => config,
     };
-    let (valid, _) = config.validated()?;
+    let (valid, _) = config.with_filter(filter).validated()?;
     Ok(valid.technique)
 }
 
@@ -267,75 +266,72 @@ pub(super) fn storage_name(s: Storage) -> &'static str {
     }
 }
 
-fn prefiltered_configs(
+/// A prefiltered encoding's configurations: every filter at every width (f32) or at the
+/// middle width (other storages) at the base size, CSM's other term counts with the first
+/// filter, and the default (f32, first filter, middle width) at every other map size.
+fn prefiltered(
     name: &str,
-    quick: bool,
-    base: u32,
-    sizes: &[u32],
-    widths: &[f32],
-    storages: &[Storage],
+    storages: SweptStorages,
+    terms: Option<SweptTerms>,
+    k: &Knobs,
     out: &mut Vec<Config>,
 ) -> Result<()> {
-    let mut push = |label: String, t: Technique, size: u32, width: f32| {
-        out.push(Config {
-            label: format!("{label} {size}"),
-            technique: t,
-            shadow_map: size,
-            box_width: Some(f64::from(width)),
-        });
+    let mid = k.widths[k.widths.len() / 2];
+    let (default_m, other_m): (Option<u32>, &[u32]) = match terms {
+        Some(t) if k.quick => (Some(t.quick), &[]),
+        Some(t) => (Some(t.full), t.others),
+        None => (None, &[]),
     };
-    let mid = widths[widths.len() / 2];
-    // CSM: the knobs are swept at M = 8 (4 when quick); the other M with the first filter.
-    let (default_m, other_m): (u32, &[u32]) = match (name, quick) {
-        ("csm", true) => (4, &[]),
-        ("csm", false) => (8, &[2, 4, 16]),
-        _ => (0, &[]),
+    let prefix = |m: Option<u32>| match m {
+        Some(m) => format!("{name} M{m}"),
+        None => name.to_string(),
     };
-    let prefix = |m: u32| {
-        if m > 0 {
-            format!("{name} M{m}")
-        } else {
-            name.to_string()
+    let swept: Vec<Option<Storage>> = match storages {
+        SweptStorages::F32Only => vec![None],
+        SweptStorages::Standard => k.storages.iter().map(|&s| Some(s)).collect(),
+        SweptStorages::WithUnorm16 => {
+            let mut v: Vec<Option<Storage>> = k.storages.iter().map(|&s| Some(s)).collect();
+            if !k.quick {
+                v.push(Some(Storage::Unorm16));
+            }
+            v
         }
     };
-    let mut storages = storages.to_vec();
-    if name == "esm" {
-        storages = vec![Storage::F32];
-    } else if name == "msm" && !quick {
-        storages.push(Storage::Unorm16);
-    }
-    for &storage in &storages {
+    let label = |m, storage: Option<Storage>, fname: &str, w: f32| {
+        let s = storage_name(storage.unwrap_or(Storage::F32));
+        format!("{} {s} {fname}{w}", prefix(m))
+    };
+    for &storage in &swept {
         for (fname, filter) in FILTERS {
             // Widths are swept for f32; other storages at the middle width.
-            let ws: &[f32] = if storage == Storage::F32 {
-                widths
-            } else {
-                &[mid]
-            };
+            let f32_storage = storage.is_none_or(|s| s == Storage::F32);
+            let ws: &[f32] = if f32_storage { k.widths } else { &[mid] };
             for &w in ws {
-                let t = prefiltered(name, storage, filter(w), default_m)?;
-                let label = format!("{} {} {fname}{w}", prefix(default_m), storage_name(storage));
-                push(label, t, base, w);
+                let t = prefiltered_one(name, storage, filter(w), default_m)?;
+                // The default configuration runs at every map size.
+                let every = f32_storage && *fname == FILTERS[0].0 && w == mid;
+                k.push(
+                    out,
+                    &label(default_m, storage, fname, w),
+                    t,
+                    every,
+                    Some(f64::from(w)),
+                );
             }
         }
     }
     let (fname, filter) = FILTERS[0];
     for &m in other_m {
-        for &storage in &storages {
-            let t = prefiltered(name, storage, filter(mid), m)?;
-            let label = format!("{} {} {fname}{mid}", prefix(m), storage_name(storage));
-            push(label, t, base, mid);
+        for &storage in &swept {
+            let t = prefiltered_one(name, storage, filter(mid), Some(m))?;
+            k.push(
+                out,
+                &label(Some(m), storage, fname, mid),
+                t,
+                false,
+                Some(f64::from(mid)),
+            );
         }
-    }
-    // Map sizes for the default configuration.
-    let t = prefiltered(name, Storage::F32, filter(mid), default_m)?;
-    for &size in sizes.iter().filter(|&&s| s != base) {
-        push(
-            format!("{} f32 {fname}{mid}", prefix(default_m)),
-            t,
-            size,
-            mid,
-        );
     }
     Ok(())
 }
@@ -360,7 +356,7 @@ mod tests {
     }
 
     /// PCSS is on the front at the tap counts users pick: the scene's own (16 + 32) on every
-    /// size, each other count of `PCSS_TAPS` once at the base size, labelled by its taps.
+    /// size, each other count of its `SweepPlan::Taps` once at the base size, labelled by its taps.
     #[test]
     fn pcss_is_swept_at_several_tap_counts() {
         let opts = EvaluateOptions {
@@ -385,5 +381,23 @@ mod tests {
             ..opts
         };
         assert_eq!(pcss_rows(&quick), [("pcss 16+32 512".to_string(), 512)]);
+    }
+
+    /// Every registered technique is swept (by its registry entry's plan) on a scene with an
+    /// area light, so a new technique reaches the evaluation by naming its plan.
+    #[test]
+    fn every_registered_technique_is_swept() {
+        let opts = EvaluateOptions {
+            sizes: Some(vec![512]),
+            ..Default::default()
+        };
+        let configs = sweep(&scene(), &opts).expect("sweep");
+        for def in technique::REGISTRY {
+            assert!(
+                configs.iter().any(|c| c.technique.name() == def.name),
+                "{} is not swept",
+                def.name
+            );
+        }
     }
 }

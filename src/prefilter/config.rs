@@ -119,7 +119,9 @@ impl PrefilterConfig {
         Self::new(t, size).with_light_size(light_size)
     }
 
-    fn with_light_size(mut self, light_size: f32) -> Self {
+    /// The same with the area light's width `light_size` (world units; PCSS and the soft
+    /// techniques need it > 0).
+    pub fn with_light_size(mut self, light_size: f32) -> Self {
         self.light_size = light_size;
         self
     }

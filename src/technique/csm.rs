@@ -2,6 +2,7 @@
 //! k = 1..M, in ⌈M/2⌉ four-channel maps.
 
 use super::params::{CSM, FILTER, FLOAT_FORMAT, prefilter, prefilter_values};
+use super::sweep_plan::{SweepPlan, SweptStorages, SweptTerms};
 use super::{TechniqueDef, no_clamp};
 use crate::gpu_data::TECHNIQUE_CSM;
 use crate::kernels::KernelId;
@@ -196,4 +197,13 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     area_light: false,
     example: "scenes/techniques/csm.toml",
     colour: [0xff, 0x7f, 0x0e],
+    // The knobs at M = 8 (4 when quick); the other M with the first filter.
+    sweep: SweepPlan::Prefiltered {
+        storages: SweptStorages::Standard,
+        terms: Some(SweptTerms {
+            full: 8,
+            quick: 4,
+            others: &[2, 4, 16],
+        }),
+    },
 };

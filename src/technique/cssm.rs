@@ -4,6 +4,7 @@
 
 use super::csm::series_values;
 use super::params::{CSM, FLOAT_FORMAT, SOFT, float, soft, soft_values};
+use super::sweep_plan::{SweepPlan, SweepVariant};
 use super::{TechniqueDef, no_clamp};
 use crate::gpu_data::TECHNIQUE_CSSM;
 use crate::model::{
@@ -143,4 +144,24 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     area_light: true,
     example: "scenes/techniques/cssm.toml",
     colour: [0xe3, 0x77, 0xc2],
+    sweep: SweepPlan::Variants {
+        full: &[
+            SweepVariant {
+                label: "cssm M8",
+                values: &[("terms", ParamValue::Int(8))],
+                storage: None,
+            },
+            SweepVariant {
+                label: "cssm M4",
+                values: &[("terms", ParamValue::Int(4))],
+                storage: None,
+            },
+            SweepVariant {
+                label: "cssm M16",
+                values: &[("terms", ParamValue::Int(16))],
+                storage: None,
+            },
+        ],
+        quick: 1,
+    },
 };

@@ -7,6 +7,7 @@ use super::params::{
     Clamp, ClampReason, FILTER, clamp, filter, filter_values, float, sat_exponent_limit,
 };
 use super::shade::{ShadeInput, prefiltered};
+use super::sweep_plan::{SweepPlan, SweptStorages};
 use crate::filter::BlurMode;
 use crate::gpu_data::ExpParams;
 use crate::gpu_data::TECHNIQUE_ESM;
@@ -78,4 +79,8 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     area_light: false,
     example: "scenes/techniques/esm.toml",
     colour: [0x94, 0x67, 0xbd],
+    sweep: SweepPlan::Prefiltered {
+        storages: SweptStorages::F32Only,
+        terms: None,
+    },
 };

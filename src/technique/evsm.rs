@@ -9,6 +9,7 @@ use super::params::{
     sat_exponent_limit,
 };
 use super::shade::{ShadeInput, prefiltered};
+use super::sweep_plan::{SweepPlan, SweptStorages};
 use crate::filter::BlurMode;
 use crate::gpu_data::TECHNIQUE_EVSM;
 use crate::gpu_data::{ExpParams, LightGpu};
@@ -182,6 +183,10 @@ pub(super) static EVSM2: TechniqueDef = TechniqueDef {
     area_light: false,
     example: "scenes/techniques/evsm2.toml",
     colour: [0xbc, 0xbd, 0x22],
+    sweep: SweepPlan::Prefiltered {
+        storages: SweptStorages::Standard,
+        terms: None,
+    },
 };
 
 /// `evsm4`.
@@ -203,4 +208,8 @@ pub(super) static EVSM4: TechniqueDef = TechniqueDef {
     area_light: false,
     example: "scenes/techniques/evsm4.toml",
     colour: [0x8c, 0x56, 0x4b],
+    sweep: SweepPlan::Prefiltered {
+        storages: SweptStorages::Standard,
+        terms: None,
+    },
 };

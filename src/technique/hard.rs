@@ -1,6 +1,7 @@
 //! `hard`: one comparison at the nearest texel.
 
 use super::shade::call;
+use super::sweep_plan::SweepPlan;
 use super::{TechniqueDef, no_clamp};
 use super::{no_gpu, no_variant, unit_range};
 use crate::gpu_data::TECHNIQUE_HARD;
@@ -26,4 +27,5 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     area_light: false,
     example: "scenes/grazing.toml",
     colour: [0x44, 0x44, 0x44],
+    sweep: SweepPlan::Defaults,
 };

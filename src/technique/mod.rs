@@ -20,6 +20,7 @@ mod pcf;
 mod pcss;
 mod reference;
 mod shade;
+mod sweep_plan;
 mod vsm;
 mod vssm;
 
@@ -38,6 +39,7 @@ pub use nodes::{add_light_nodes, depth_name, linear_name, map_channels, map_type
 pub use params::{Clamp, ClampReason, sat_exponent_limit};
 pub use reference::parameters_markdown;
 pub use shade::{ShadeInput, VisibilityBody, shade_key, shading_block, visibility_body};
+pub use sweep_plan::{SweepPlan, SweepVariant, SweptStorages, SweptTerms};
 
 /// One technique as the front ends see it (a struct of plain functions, so the registry is a
 /// static table).
@@ -80,6 +82,8 @@ pub struct TechniqueDef {
     pub example: &'static str,
     /// Its colour in the evaluation's plots (sRGB), so families read at a glance.
     pub colour: [u8; 3],
+    /// How the evaluation sweeps it.
+    pub sweep: SweepPlan,
 }
 
 /// Every technique, in the order scene errors list them.

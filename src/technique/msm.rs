@@ -5,6 +5,7 @@ use super::light_gpu::quantized_msm_range;
 use super::nodes::{LightNodes, moments_format};
 use super::params::{FILTER, MSM, MSM_FORMAT, prefilter, prefilter_values, storage};
 use super::shade::{ShadeInput, prefiltered};
+use super::sweep_plan::{SweepPlan, SweptStorages};
 use super::{TechniqueDef, no_clamp};
 use super::{no_variant, unit_range};
 use crate::filter::BlurMode;
@@ -148,4 +149,8 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     area_light: false,
     example: "scenes/techniques/msm.toml",
     colour: [0xd6, 0x27, 0x28],
+    sweep: SweepPlan::Prefiltered {
+        storages: SweptStorages::WithUnorm16,
+        terms: None,
+    },
 };

@@ -6,6 +6,7 @@ use super::msm::{moments, msm_gpu, value_range};
 use super::no_variant;
 use super::params::{MSM, MSM_FORMAT, SOFT, soft, soft_values, storage};
 use super::shade::soft_call;
+use super::sweep_plan::{SweepPlan, SweepVariant};
 use super::{TechniqueDef, no_clamp};
 use crate::gpu_data::TECHNIQUE_MSM_SOFT;
 use crate::model::{ParamSpec, ParamValue, ParamValues, Technique, default_soft_moment_bias};
@@ -51,4 +52,19 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     area_light: true,
     example: "scenes/techniques/msm_soft.toml",
     colour: [0x8b, 0x00, 0x00],
+    sweep: SweepPlan::Variants {
+        full: &[
+            SweepVariant {
+                label: "msm_soft f32",
+                values: &[],
+                storage: None,
+            },
+            SweepVariant {
+                label: "msm_soft f16",
+                values: &[],
+                storage: Some(crate::model::Storage::F16),
+            },
+        ],
+        quick: 1,
+    },
 };

@@ -2,6 +2,7 @@
 
 use super::params::{choice, int};
 use super::shade::{ShadeInput, VisibilityBody, call, first};
+use super::sweep_plan::SweepPlan;
 use super::unit_range;
 use super::{TechniqueDef, no_clamp};
 use crate::gpu_data::LightGpu;
@@ -121,4 +122,9 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     area_light: false,
     example: "scenes/bunny.toml",
     colour: [0x1f, 0x77, 0xb4],
+    sweep: SweepPlan::Radii {
+        full: &[1, 2, 4],
+        quick: &[2],
+        every_size: 2,
+    },
 };

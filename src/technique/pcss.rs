@@ -2,6 +2,7 @@
 
 use super::params::{float, int};
 use super::shade::call;
+use super::sweep_plan::SweepPlan;
 use super::{TechniqueDef, no_clamp};
 use super::{no_variant, unit_range};
 use crate::gpu_data::TECHNIQUE_PCSS;
@@ -69,4 +70,6 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     area_light: true,
     example: "scenes/colonnade.toml",
     colour: [0x17, 0xbe, 0xcf],
+    // PCSS as engines ship it, at several tap counts (blocker search + filter).
+    sweep: SweepPlan::Taps(&[(8, 16), (16, 32), (32, 64), (64, 64)]),
 };

@@ -3,6 +3,7 @@
 use super::nodes::{LightNodes, moments_format};
 use super::params::{FILTER, FLOAT_FORMAT, float, prefilter, prefilter_values};
 use super::shade::{ShadeInput, prefiltered};
+use super::sweep_plan::{SweepPlan, SweptStorages};
 use super::{TechniqueDef, no_clamp};
 use super::{no_variant, unit_range};
 use crate::filter::BlurMode;
@@ -102,4 +103,8 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     area_light: false,
     example: "scenes/techniques/vsm.toml",
     colour: [0x2c, 0xa0, 0x2c],
+    sweep: SweepPlan::Prefiltered {
+        storages: SweptStorages::Standard,
+        terms: None,
+    },
 };

@@ -2,6 +2,7 @@
 
 use super::params::{FLOAT_FORMAT, SOFT, soft, soft_values};
 use super::shade::soft_call;
+use super::sweep_plan::{SweepPlan, SweepVariant};
 use super::vsm::{VARIANCE, variance_values};
 use super::vsm::{moments, variance_gpu};
 use super::{TechniqueDef, no_clamp};
@@ -56,4 +57,12 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     area_light: true,
     example: "scenes/techniques/vssm.toml",
     colour: [0x00, 0x5f, 0x3f],
+    sweep: SweepPlan::Variants {
+        full: &[SweepVariant {
+            label: "vssm",
+            values: &[],
+            storage: None,
+        }],
+        quick: 1,
+    },
 };
