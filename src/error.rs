@@ -252,6 +252,17 @@ pub enum StageError {
         /// Its sample count.
         samples: u32,
     },
+    /// The device runs no compute shaders (its compute limits are zero, as
+    /// `wgpu::Limits::downlevel_webgl2_defaults()` makes them): the stage is compute kernels.
+    #[error(
+        "this device runs no compute shaders ({limit} = 0, as wgpu::Limits::downlevel_webgl2_defaults() \
+         gives): the stage runs its prefiltering as compute kernels; create the device with \
+         wgpu::Limits::default() or the adapter's own limits (adapter.limits())"
+    )]
+    NoCompute {
+        /// The first compute limit that is zero.
+        limit: &'static str,
+    },
     /// The device was created without a feature that was asked for.
     #[error("{needed_for} needs the device feature {feature}, which this device lacks")]
     MissingFeature {

@@ -2,13 +2,32 @@
 //! which cannot run it gets a named [`Error::Limit`] rather than a pipeline error. The kernels'
 //! needs come from [`crate::limits`], shared with the renderer.
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, StageError};
 use crate::graph::Plan;
 
 /// Checks the map size, every planned kernel and dispatch, and the plan's memory against the
 /// device's limits and the memory budget ([`crate::limits::memory_budget`]).
 pub(super) fn check(device: &wgpu::Device, plan: &Plan, size: u32) -> Result<()> {
     let l = device.limits();
+    // A device without compute shaders gets one message that says what to request, not the
+    // first kernel's workgroup width against a limit of 0.
+    let compute = [
+        (
+            "max_compute_workgroup_size_x",
+            l.max_compute_workgroup_size_x,
+        ),
+        (
+            "max_compute_invocations_per_workgroup",
+            l.max_compute_invocations_per_workgroup,
+        ),
+        (
+            "max_compute_workgroups_per_dimension",
+            l.max_compute_workgroups_per_dimension,
+        ),
+    ];
+    if let Some(&(limit, _)) = compute.iter().find(|(_, v)| *v == 0) {
+        return Err(StageError::NoCompute { limit }.into());
+    }
     let over = |what: String, requested: u64, limit: u64| {
         if requested > limit {
             Err(Error::Limit {
