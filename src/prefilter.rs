@@ -28,13 +28,16 @@ use std::collections::HashMap;
 use glam::Mat4;
 
 pub use crate::error::StageError;
+/// The light's GPU description the exported WGSL's `Light` mirrors (what
+/// [`LightParams::light_gpu`] returns), where a host looks for it.
+pub use crate::gpu_data::LightGpu;
 pub use config::{LightParams, PrefilterConfig};
 
 use crate::error::{Error, Result};
 use crate::exec::Executor;
 use crate::graph::{Graph, Plan, plan};
 use crate::scene::Light;
-use crate::technique::{self, LightGpu};
+use crate::technique;
 use crate::timer::{GpuTimer, TIMER_FEATURES};
 
 /// Depth formats the `linearize` kernel reads (as unfilterable float, depth aspect only).
