@@ -77,39 +77,15 @@ pub fn kernel_needs(
     refl: &kernels::Reflection,
     l: &wgpu::Limits,
 ) -> Result<Vec<Need>> {
-    use wgpu::BindingType as B;
-    use wgpu::BufferBindingType as Buf;
-    let count = |f: fn(&B) -> bool| refl.bindings.iter().filter(|b| f(&b.ty)).count() as u64;
+    let mut needs = workgroup_needs(refl, workgroup_bytes(module)?, l).to_vec();
+    needs.extend(binding_needs(refl, l));
+    Ok(needs)
+}
+
+/// The workgroup's shape, size and memory (`shared` bytes) against `l`.
+fn workgroup_needs(refl: &kernels::Reflection, shared: u64, l: &wgpu::Limits) -> [Need; 5] {
     let wg = refl.workgroup_size.unwrap_or([1, 1, 1]).map(u64::from);
-    let mut layouter = naga::proc::Layouter::default();
-    layouter
-        .update(module.to_ctx())
-        .map_err(|e| Error::Invalid(format!("workgroup memory layout: {e}")))?;
-    let shared: u64 = module
-        .global_variables
-        .iter()
-        .filter(|(_, g)| g.space == naga::AddressSpace::WorkGroup)
-        .map(|(_, g)| u64::from(layouter[g.ty].size))
-        .sum();
-    let storage = |t: &B| {
-        matches!(
-            t,
-            B::Buffer {
-                ty: Buf::Storage { .. },
-                ..
-            }
-        )
-    };
-    let uniform = |t: &B| {
-        matches!(
-            t,
-            B::Buffer {
-                ty: Buf::Uniform,
-                ..
-            }
-        )
-    };
-    Ok(vec![
+    [
         Need::new(
             "workgroup width",
             "max_compute_workgroup_size_x",
@@ -140,34 +116,41 @@ pub fn kernel_needs(
             shared,
             l.max_compute_workgroup_storage_size,
         ),
+    ]
+}
+
+/// The kernel's bindings, by the per-stage limit each counts against, and its bind groups.
+fn binding_needs(refl: &kernels::Reflection, l: &wgpu::Limits) -> [Need; 6] {
+    let b = BindingCounts::of(refl);
+    [
         Need::new(
             "storage textures",
             "max_storage_textures_per_shader_stage",
-            count(|t| matches!(t, B::StorageTexture { .. })),
+            b.storage_textures,
             l.max_storage_textures_per_shader_stage,
         ),
         Need::new(
             "storage buffers",
             "max_storage_buffers_per_shader_stage",
-            count(storage),
+            b.storage_buffers,
             l.max_storage_buffers_per_shader_stage,
         ),
         Need::new(
             "sampled textures",
             "max_sampled_textures_per_shader_stage",
-            count(|t| matches!(t, B::Texture { .. })),
+            b.sampled_textures,
             l.max_sampled_textures_per_shader_stage,
         ),
         Need::new(
             "samplers",
             "max_samplers_per_shader_stage",
-            count(|t| matches!(t, B::Sampler(_))),
+            b.samplers,
             l.max_samplers_per_shader_stage,
         ),
         Need::new(
             "uniform buffers",
             "max_uniform_buffers_per_shader_stage",
-            count(uniform),
+            b.uniform_buffers,
             l.max_uniform_buffers_per_shader_stage,
         ),
         Need::new(
@@ -176,7 +159,61 @@ pub fn kernel_needs(
             refl.group_count().into(),
             l.max_bind_groups,
         ),
-    ])
+    ]
+}
+
+/// Bytes of a kernel's workgroup-memory variables, laid out as naga lays them out.
+fn workgroup_bytes(module: &naga::Module) -> Result<u64> {
+    let mut layouter = naga::proc::Layouter::default();
+    layouter
+        .update(module.to_ctx())
+        .map_err(|e| Error::Invalid(format!("workgroup memory layout: {e}")))?;
+    Ok(module
+        .global_variables
+        .iter()
+        .filter(|(_, g)| g.space == naga::AddressSpace::WorkGroup)
+        .map(|(_, g)| u64::from(layouter[g.ty].size))
+        .sum())
+}
+
+/// A kernel's bindings by the per-stage limit each counts against.
+struct BindingCounts {
+    storage_textures: u64,
+    storage_buffers: u64,
+    sampled_textures: u64,
+    samplers: u64,
+    uniform_buffers: u64,
+}
+
+impl BindingCounts {
+    fn of(refl: &kernels::Reflection) -> Self {
+        use wgpu::BindingType as B;
+        use wgpu::BufferBindingType as Buf;
+        let count = |f: fn(&B) -> bool| refl.bindings.iter().filter(|b| f(&b.ty)).count() as u64;
+        Self {
+            storage_textures: count(|t| matches!(t, B::StorageTexture { .. })),
+            storage_buffers: count(|t| {
+                matches!(
+                    t,
+                    B::Buffer {
+                        ty: Buf::Storage { .. },
+                        ..
+                    }
+                )
+            }),
+            sampled_textures: count(|t| matches!(t, B::Texture { .. })),
+            samplers: count(|t| matches!(t, B::Sampler(_))),
+            uniform_buffers: count(|t| {
+                matches!(
+                    t,
+                    B::Buffer {
+                        ty: Buf::Uniform,
+                        ..
+                    }
+                )
+            }),
+        }
+    }
 }
 
 /// The first of kernel `name`'s needs (WGSL `wgsl`) past `l`, if any.

@@ -188,37 +188,57 @@ fn needed_nodes(
     index: &HashMap<&str, usize>,
     producers: &HashMap<&str, usize>,
 ) -> Result<BTreeSet<usize>, GraphError> {
-    #[derive(Clone, Copy, PartialEq)]
-    enum Mark {
-        Active,
-        Done,
+    let mut walk = Walk {
+        graph,
+        index,
+        producers,
+        marks: HashMap::new(),
+        stack: Vec::new(),
+    };
+    for out in outputs {
+        if !index.contains_key(out) {
+            return Err(GraphError::UnknownOutput(out.to_string()));
+        }
+        walk.need(out, "the outputs")?;
     }
-    let mut marks: HashMap<usize, Mark> = HashMap::new();
-    let mut stack: Vec<usize> = Vec::new();
+    Ok(walk.marks.keys().copied().collect())
+}
 
-    fn need(
-        graph: &Graph,
-        resource: &str,
-        needed_by: &str,
-        index: &HashMap<&str, usize>,
-        producers: &HashMap<&str, usize>,
-        marks: &mut HashMap<usize, Mark>,
-        stack: &mut Vec<usize>,
-    ) -> Result<(), GraphError> {
-        if graph.resources[index[resource]].imported {
+/// A node's state in the depth-first walk of [`needed_nodes`].
+#[derive(Clone, Copy, PartialEq)]
+enum Mark {
+    Active,
+    Done,
+}
+
+/// The depth-first walk from the outputs to the nodes they need (a node on the stack met
+/// again is a cycle).
+struct Walk<'a> {
+    graph: &'a Graph,
+    index: &'a HashMap<&'a str, usize>,
+    producers: &'a HashMap<&'a str, usize>,
+    marks: HashMap<usize, Mark>,
+    stack: Vec<usize>,
+}
+
+impl Walk<'_> {
+    /// Marks the producer of `resource` (needed by `needed_by`) and everything it needs.
+    fn need(&mut self, resource: &str, needed_by: &str) -> Result<(), GraphError> {
+        let graph = self.graph;
+        if graph.resources[self.index[resource]].imported {
             return Ok(());
         }
-        let Some(&node) = producers.get(resource) else {
+        let Some(&node) = self.producers.get(resource) else {
             return Err(GraphError::MissingProducer {
                 resource: resource.to_string(),
                 needed_by: needed_by.to_string(),
             });
         };
-        match marks.get(&node) {
+        match self.marks.get(&node) {
             Some(Mark::Done) => return Ok(()),
             Some(Mark::Active) => {
-                let start = stack.iter().position(|&n| n == node).unwrap_or(0);
-                let mut cycle: Vec<String> = stack[start..]
+                let start = self.stack.iter().position(|&n| n == node).unwrap_or(0);
+                let mut cycle: Vec<String> = self.stack[start..]
                     .iter()
                     .map(|&n| graph.nodes[n].name.clone())
                     .collect();
@@ -227,32 +247,16 @@ fn needed_nodes(
             }
             None => {}
         }
-        marks.insert(node, Mark::Active);
-        stack.push(node);
+        self.marks.insert(node, Mark::Active);
+        self.stack.push(node);
         let n = &graph.nodes[node];
         for (_, input) in &n.inputs {
-            need(graph, input, &n.name, index, producers, marks, stack)?;
+            self.need(input, &n.name)?;
         }
-        stack.pop();
-        marks.insert(node, Mark::Done);
+        self.stack.pop();
+        self.marks.insert(node, Mark::Done);
         Ok(())
     }
-
-    for out in outputs {
-        if !index.contains_key(out) {
-            return Err(GraphError::UnknownOutput(out.to_string()));
-        }
-        need(
-            graph,
-            out,
-            "the outputs",
-            index,
-            producers,
-            &mut marks,
-            &mut stack,
-        )?;
-    }
-    Ok(marks.keys().copied().collect())
 }
 
 /// Kahn's algorithm over the needed nodes, always taking the earliest-declared ready node.
