@@ -365,3 +365,45 @@ fn storage_format_variants_validate() {
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// Every compute kernel fits WebGPU's default limits (what `wgpu::Limits::default()` asks
+/// for), so a host's ordinary device runs the stage: workgroup shape and memory (16 KiB),
+/// bindings. The known exception, the mip chain: a dispatch binds seven storage textures (level
+/// 0 and six levels, past the default four) and keeps 21840 bytes of levels in workgroup memory
+/// (past the default 16 KiB; desktop adapters offer 32–64 KiB). A device with less is refused
+/// by name before anything is created (`tests/plugin_errors.rs`); docs/PLUGIN.md says so.
+#[test]
+fn compute_kernels_fit_webgpu_default_limits() {
+    let defaults = wgpu::Limits::default();
+    let mut over = Vec::new();
+    let mut checked = 0;
+    for &id in KernelId::ALL {
+        if id == KernelId::Shade {
+            continue; // the shading kernel, checked per scene with its generated block
+        }
+        let wgsl = kernels::resolve(id.name(), None).expect("resolves");
+        let (module, refl) = kernels::reflect(id.name(), &wgsl).expect("reflects");
+        if refl.workgroup_size.is_none() {
+            continue;
+        }
+        checked += 1;
+        let needs = shadowgraph::limits::kernel_needs(&module, &refl, &defaults).expect("needs");
+        for n in needs.iter().filter(|n| n.over()) {
+            let known = matches!(id.name(), "mips" | "mips_log")
+                && matches!(
+                    (n.limit_name, n.requested),
+                    ("max_storage_textures_per_shader_stage", 7)
+                        | ("max_compute_workgroup_storage_size", 21840)
+                );
+            if !known {
+                over.push(format!("{id}: {n:?}"));
+            }
+        }
+    }
+    assert!(checked >= 20, "only {checked} compute kernels reflected");
+    assert!(
+        over.is_empty(),
+        "past WebGPU's defaults:\n{}",
+        over.join("\n")
+    );
+}
