@@ -26,7 +26,7 @@ struct Vertex {
 /// The host's shading: Lambert and ambient, with shadowgraph's visibility per fragment.
 const SHADE: &str = "
 @group(0) @binding(0) var<uniform> camera: mat4x4<f32>;
-@group(0) @binding(1) var<uniform> light: Light;
+@group(0) @binding(1) var<uniform> light: sg_Light;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,

@@ -176,6 +176,16 @@ pub enum ExecError {
         /// The texture's levels.
         levels: u32,
     },
+    /// An import is read at an array layer its texture does not have.
+    #[error("import `{resource}` is read at layer {layer} of a texture of {layers} layer(s)")]
+    NoLayer {
+        /// The imported resource.
+        resource: String,
+        /// The layer asked for.
+        layer: u32,
+        /// The texture's layers.
+        layers: u32,
+    },
     /// A dispatch's parameter bytes are not the node's.
     #[error("node `{node}`: a dispatch's parameter bytes are out of range")]
     Params {
@@ -239,10 +249,11 @@ pub enum StageError {
         /// Height.
         height: u32,
     },
-    /// The depth texture is not one single-sampled 2-D layer.
+    /// The depth texture is not a single-sampled 2-D texture (of one or more layers).
     #[error(
-        "depth texture must be a single-sampled 2-D texture with one layer; it is {dimension:?} \
-         with {layers} layer(s) and {samples} sample(s)"
+        "depth texture must be a single-sampled 2-D texture (a layer of a 2-D array is passed as \
+         `DepthLayer::new(texture, layer)`); it is {dimension:?} with {layers} layer(s) and \
+         {samples} sample(s)"
     )]
     DepthLayout {
         /// Its dimension.
@@ -251,6 +262,22 @@ pub enum StageError {
         layers: u32,
         /// Its sample count.
         samples: u32,
+    },
+    /// The layer asked for is past the depth texture's layers.
+    #[error("depth layer {layer} asked for, but the depth texture has {layers} layer(s)")]
+    DepthLayer {
+        /// The layer asked for.
+        layer: u32,
+        /// The texture's layers.
+        layers: u32,
+    },
+    /// A light slot past what one stage serves.
+    #[error("light slot {slot}: one stage serves at most {max} lights (slots 0..{max})")]
+    LightSlot {
+        /// The slot asked for.
+        slot: usize,
+        /// The stage's maximum.
+        max: usize,
     },
     /// The device runs no compute shaders (its compute limits are zero, as
     /// `wgpu::Limits::downlevel_webgl2_defaults()` makes them): the stage is compute kernels.

@@ -34,7 +34,7 @@ pub use crate::gpu_data::LightGpu;
 pub use config::{LightParams, PrefilterConfig};
 
 use crate::error::{Error, Result};
-use crate::exec::Executor;
+use crate::exec::{Executor, KernelCache};
 use crate::graph::{Graph, Plan, plan};
 use crate::scene::Light;
 use crate::technique;
@@ -101,13 +101,50 @@ impl PlanKey {
     }
 }
 
-/// The stage: pipelines made once for a configuration, textures pooled across frames.
+/// The depth a light's maps are filtered from: a whole 2-D depth texture, or one layer of a
+/// 2-D array texture (a host's layered shadow maps: one layer per light or cascade), read in
+/// place through a view of that layer. `&wgpu::Texture` converts to layer 0.
+#[derive(Clone, Copy, Debug)]
+pub struct DepthLayer<'a> {
+    /// The depth texture (`D2`, one or more array layers).
+    pub texture: &'a wgpu::Texture,
+    /// The array layer to read.
+    pub layer: u32,
+}
+
+impl<'a> DepthLayer<'a> {
+    /// Layer `layer` of `texture`.
+    pub fn new(texture: &'a wgpu::Texture, layer: u32) -> Self {
+        Self { texture, layer }
+    }
+}
+
+impl<'a> From<&'a wgpu::Texture> for DepthLayer<'a> {
+    fn from(texture: &'a wgpu::Texture) -> Self {
+        Self { texture, layer: 0 }
+    }
+}
+
+/// Lights one stage serves at most ([`Prefilter::record_light`]'s `slot`).
+pub const MAX_LIGHTS: usize = 256;
+
+/// The stage: pipelines made once for a configuration and shared by every light it serves,
+/// textures pooled across frames per light.
 pub struct Prefilter {
     config: PrefilterConfig,
     warnings: Vec<String>,
+    /// The pipelines, shared by the lights' executors (each borrows them while it records).
+    kernels: KernelCache,
+    /// Per light slot: its plan, pooled textures and last maps.
+    lights: Vec<LightSlot>,
+    timer: Option<GpuTimer>,
+}
+
+/// What one light of a stage keeps between frames.
+struct LightSlot {
+    /// Its textures (its pipelines are the stage's, lent while it records).
     executor: Executor,
     planned: Planned,
-    timer: Option<GpuTimer>,
     /// The last record's maps (with their views), handed out again while the textures stay.
     maps: Vec<OutputMap>,
 }
@@ -127,96 +164,111 @@ impl Prefilter {
         )?;
         let mut executor = Executor::new();
         executor.prepare(device, &planned.plan)?;
+        let kernels = std::mem::take(&mut executor.kernels);
         Ok(Self {
             config,
             warnings,
-            executor,
-            planned,
+            kernels,
+            lights: vec![LightSlot {
+                executor,
+                planned,
+                maps: Vec::new(),
+            }],
             timer: None,
-            maps: Vec::new(),
         })
     }
 
     /// Records the technique's kernels over `depth` into `encoder` and returns the maps the
-    /// visibility function reads. Nothing is submitted.
-    ///
-    /// `depth` is a texture, not a view: the executor imports whole textures (it plans from
-    /// their size, picks the depth aspect and makes its own views), so a view of one layer or
-    /// aspect could not be honoured. It must be square, single-sampled, one layer, in one of
-    /// [`DEPTH_FORMATS`], with `TEXTURE_BINDING`. A size other than the last one's replans and
-    /// reallocates the pooled textures; pipelines are kept.
-    pub fn record(
+    /// visibility function reads: light slot 0 of [`Prefilter::record_light`]. Nothing is
+    /// submitted.
+    pub fn record<'a>(
         &mut self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        depth: &wgpu::Texture,
+        depth: impl Into<DepthLayer<'a>>,
         light: &LightParams,
     ) -> Result<PrefilterOutput> {
-        light.validate()?;
-        let size = check_depth(depth)?;
-        let key = PlanKey::new(light, size);
-        if key != self.planned.key {
-            let planned = plan_for(&self.config, light, size)?;
-            if size != self.planned.key.size {
-                limits::check(device, &planned.plan, size)?;
-                // Textures of the old size go back to the device; pipelines stay.
-                let kernels = std::mem::take(&mut self.executor.kernels);
-                self.executor = Executor::new();
-                self.executor.kernels = kernels;
-            }
-            self.planned = planned;
-        }
-        let imports = HashMap::from([(technique::depth_name(0), depth.clone())]);
-        if let Some(t) = self.timer.as_mut() {
-            t.reset();
-        }
-        let outputs = self.executor.record(
-            device,
-            encoder,
-            &self.planned.plan,
-            &imports,
-            self.timer.as_mut(),
-        )?;
-        if let Some(t) = self.timer.as_mut() {
-            t.resolve(encoder);
-        }
-        let maps = self.output_maps(&outputs.textures)?;
-        Ok(PrefilterOutput {
-            maps,
-            light: light.light_gpu(&self.config, size),
-        })
+        self.record_light(0, device, encoder, depth, light)
     }
 
-    /// The maps of a record whose plan produced `textures`: the last record's (views
-    /// included) while the textures are the same, else made anew.
-    fn output_maps(&mut self, textures: &HashMap<String, wgpu::Texture>) -> Result<Vec<OutputMap>> {
-        let texture = |m: &MapInput| {
-            textures
-                .get(&m.resource)
-                .cloned()
-                .ok_or_else(|| Error::Invalid(format!("the plan produced no `{}`", m.resource)))
-        };
-        let same = self.maps.len() == self.planned.maps.len()
-            && self.maps.iter().zip(&self.planned.maps).all(|(o, m)| {
-                o.resource == m.resource && textures.get(&m.resource) == Some(&o.texture)
-            });
-        if !same {
-            self.maps = self
-                .planned
-                .maps
-                .iter()
-                .map(|m| {
-                    let texture = texture(m)?;
-                    Ok(OutputMap {
-                        resource: m.resource.clone(),
-                        wgsl_type: m.wgsl_type,
-                        view: depth_aspect_view(&texture),
-                        texture,
-                    })
-                })
-                .collect::<Result<Vec<_>>>()?;
+    /// Records the kernels of light `slot` (below [`MAX_LIGHTS`]) over `depth` into
+    /// `encoder`: one stage serves many lights with one set of pipelines, and each slot keeps
+    /// its own textures, so its maps stay valid until the next record of the same slot (or a
+    /// new map size). Nothing is submitted.
+    ///
+    /// `depth` is a texture (`&wgpu::Texture`: layer 0) or [`DepthLayer`]: one layer of a 2-D
+    /// array, read through a view of it (no copy). It must be square, single-sampled, in one of
+    /// [`DEPTH_FORMATS`], with `TEXTURE_BINDING`. A size other than the slot's last one replans
+    /// and reallocates its pooled textures; pipelines are kept. With timing enabled, slot 0's
+    /// kernels are timed.
+    pub fn record_light<'a>(
+        &mut self,
+        slot: usize,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        depth: impl Into<DepthLayer<'a>>,
+        light: &LightParams,
+    ) -> Result<PrefilterOutput> {
+        let depth = depth.into();
+        light.validate()?;
+        if slot >= MAX_LIGHTS {
+            return Err(StageError::LightSlot {
+                slot,
+                max: MAX_LIGHTS,
+            }
+            .into());
         }
-        Ok(self.maps.clone())
+        let size = check_depth(depth)?;
+        while self.lights.len() <= slot {
+            let planned = plan_for(&self.config, &planning_params(), self.config.size)?;
+            self.lights.push(LightSlot {
+                executor: Executor::new(),
+                planned,
+                maps: Vec::new(),
+            });
+        }
+        let config = &self.config;
+        let one = &mut self.lights[slot];
+        let key = PlanKey::new(light, size);
+        if key != one.planned.key {
+            let planned = plan_for(config, light, size)?;
+            if size != one.planned.key.size {
+                limits::check(device, &planned.plan, size)?;
+                // Textures of the old size go back to the device; pipelines stay.
+                one.executor = Executor::new();
+            }
+            one.planned = planned;
+        }
+        let name = technique::depth_name(0);
+        let imports = HashMap::from([(name.clone(), depth.texture.clone())]);
+        let mut layers = HashMap::new();
+        if depth.texture.depth_or_array_layers() > 1 {
+            layers.insert(name, depth.layer);
+        }
+        let mut timer = self.timer.as_mut().filter(|_| slot == 0);
+        if let Some(t) = timer.as_mut() {
+            t.reset();
+        }
+        // The slot's executor records with the stage's pipelines, then gives them back.
+        one.executor.kernels = std::mem::take(&mut self.kernels);
+        let recorded = one.executor.record_layers(
+            device,
+            encoder,
+            &one.planned.plan,
+            &imports,
+            &layers,
+            timer.as_deref_mut(),
+        );
+        self.kernels = std::mem::take(&mut one.executor.kernels);
+        let outputs = recorded?;
+        if let Some(t) = timer {
+            t.resolve(encoder);
+        }
+        let maps = one.output_maps(&outputs.textures)?;
+        Ok(PrefilterOutput {
+            maps,
+            light: light.light_gpu(config, size),
+        })
     }
 
     /// The host's WGSL: the technique's visibility function, its maps bound at
@@ -225,6 +277,20 @@ impl Prefilter {
     /// `fn shadowgraph_visibility(l: Light, p: vec3<f32>, n: vec3<f32>) -> f32`.
     pub fn wgsl(&self, group: u32, first_binding: u32) -> Result<String> {
         wgsl::host_block(&self.config.technique, group, first_binding)
+    }
+
+    /// One light's bindings and functions for a shader module holding several lights, without
+    /// the functions they call: include [`Prefilter::wgsl_functions`] (or
+    /// [`wgsl::functions_for`] the techniques of several stages) once, then one block per
+    /// light, each at its own bindings: `shadowgraph_{name}_map{k}` and
+    /// `shadowgraph_visibility_{name}(l: sg_Light, p, n)` ([`wgsl::light_block`]).
+    pub fn wgsl_light(&self, name: &str, group: u32, first_binding: u32) -> Result<String> {
+        wgsl::light_block(&self.config.technique, name, group, first_binding)
+    }
+
+    /// The technique's functions (`sg_Light`, `sg_vis_…` and their helpers), no bindings.
+    pub fn wgsl_functions(&self) -> Result<String> {
+        wgsl::technique_functions(&self.config.technique)
     }
 
     /// The host's bind group layout entries for [`Prefilter::wgsl`]'s bindings (maps, then
@@ -247,7 +313,7 @@ impl Prefilter {
     /// ([`GpuTimer`]); an error when the device was created without `TIMESTAMP_QUERY` and
     /// `TIMESTAMP_QUERY_INSIDE_ENCODERS`.
     pub fn enable_timing(&mut self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<()> {
-        let spans = self.planned.plan.steps.len().max(1) as u32;
+        let spans = self.lights[0].planned.plan.steps.len().max(1) as u32;
         let timer = GpuTimer::new(device, queue, spans).ok_or(StageError::MissingFeature {
             feature: TIMER_FEATURES.difference(device.features()),
             needed_for: "per-kernel GPU timing",
@@ -290,12 +356,18 @@ impl Prefilter {
 
     /// The map side of the current plan (the last depth texture's, or the configuration's).
     pub fn size(&self) -> u32 {
-        self.planned.key.size
+        self.lights[0].planned.key.size
+    }
+
+    /// Light slots in use (1 + the highest slot recorded).
+    pub fn light_count(&self) -> usize {
+        self.lights.len()
     }
 
     /// Names of the planned kernels' nodes, in execution order.
     pub fn kernels(&self) -> Vec<String> {
-        self.planned
+        self.lights[0]
+            .planned
             .plan
             .steps
             .iter()
@@ -303,14 +375,49 @@ impl Prefilter {
             .collect()
     }
 
-    /// Textures the stage's pool holds (constant while the size stays the same).
+    /// Textures the stage's pools hold, all light slots together (constant while the sizes
+    /// stay the same).
     pub fn texture_count(&self) -> usize {
-        self.executor.texture_count()
+        self.lights.iter().map(|l| l.executor.texture_count()).sum()
     }
 
-    /// Pipelines created so far.
+    /// Pipelines created so far (shared by every light slot).
     pub fn pipeline_count(&self) -> usize {
-        self.executor.kernels.len()
+        self.kernels.len()
+    }
+}
+
+impl LightSlot {
+    /// The maps of a record whose plan produced `textures`: the last record's (views
+    /// included) while the textures are the same, else made anew.
+    fn output_maps(&mut self, textures: &HashMap<String, wgpu::Texture>) -> Result<Vec<OutputMap>> {
+        let texture = |m: &MapInput| {
+            textures
+                .get(&m.resource)
+                .cloned()
+                .ok_or_else(|| Error::Invalid(format!("the plan produced no `{}`", m.resource)))
+        };
+        let same = self.maps.len() == self.planned.maps.len()
+            && self.maps.iter().zip(&self.planned.maps).all(|(o, m)| {
+                o.resource == m.resource && textures.get(&m.resource) == Some(&o.texture)
+            });
+        if !same {
+            self.maps = self
+                .planned
+                .maps
+                .iter()
+                .map(|m| {
+                    let texture = texture(m)?;
+                    Ok(OutputMap {
+                        resource: m.resource.clone(),
+                        wgsl_type: m.wgsl_type,
+                        view: depth_aspect_view(&texture),
+                        texture,
+                    })
+                })
+                .collect::<Result<Vec<_>>>()?;
+        }
+        Ok(self.maps.clone())
     }
 }
 
@@ -369,7 +476,11 @@ struct MapInput {
 }
 
 /// The side of `depth`, or what makes it unusable.
-fn check_depth(depth: &wgpu::Texture) -> Result<u32, StageError> {
+fn check_depth(depth: DepthLayer<'_>) -> Result<u32, StageError> {
+    let DepthLayer {
+        texture: depth,
+        layer,
+    } = depth;
     if !DEPTH_FORMATS.contains(&depth.format()) {
         let accepted: Vec<String> = DEPTH_FORMATS.iter().map(|f| format!("{f:?}")).collect();
         return Err(StageError::DepthFormat {
@@ -387,12 +498,15 @@ fn check_depth(depth: &wgpu::Texture) -> Result<u32, StageError> {
         depth.depth_or_array_layers(),
         depth.sample_count(),
     );
-    if dimension != wgpu::TextureDimension::D2 || layers != 1 || samples != 1 {
+    if dimension != wgpu::TextureDimension::D2 || samples != 1 {
         return Err(StageError::DepthLayout {
             dimension,
             layers,
             samples,
         });
+    }
+    if layer >= layers {
+        return Err(StageError::DepthLayer { layer, layers });
     }
     if depth.width() != depth.height() {
         return Err(StageError::DepthNotSquare {

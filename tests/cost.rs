@@ -261,13 +261,13 @@ fn every_fetching_function_declares_its_fetches() {
         consistent > 30,
         "{consistent} declarations checked against their bodies"
     );
-    // Negative control: without its declaration, `load_depth` is named.
-    let stripped = library.replace("// #fetches load_depth: 1\n", "");
+    // Negative control: without its declaration, `sg_load_depth` is named.
+    let stripped = library.replace("// #fetches sg_load_depth: 1\n", "");
     assert_ne!(stripped, library);
     let light = &test_lights()[0];
     let mut f = Fetches::new("library", &stripped, light).expect("declarations");
-    let e = f.count_declared("load_depth").unwrap_err().to_string();
-    assert!(e.contains("load_depth"), "{e}");
+    let e = f.count_declared("sg_load_depth").unwrap_err().to_string();
+    assert!(e.contains("sg_load_depth"), "{e}");
 }
 
 /// Counting helpers: one per return type of a fetch in the shading kernel.

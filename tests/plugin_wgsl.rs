@@ -71,7 +71,7 @@ fn exported_library_is_current() {
 /// What a host writes around the committed file: its own bindings, a `Light` uniform and a
 /// fragment shader calling the visibility functions.
 const HOST_SHADER: &str = "
-@group(0) @binding(0) var<uniform> shadow_light: Light;
+@group(0) @binding(0) var<uniform> shadow_light: sg_Light;
 @group(1) @binding(0) var vsm_map: texture_2d<f32>;
 @group(1) @binding(1) var esm_map: texture_2d<f32>;
 @group(1) @binding(2) var raw_depth: texture_depth_2d;
@@ -79,11 +79,11 @@ const HOST_SHADER: &str = "
 
 @fragment
 fn fs_main(@location(0) p: vec3<f32>, @location(1) n: vec3<f32>) -> @location(0) vec4<f32> {
-    let s = light_sample(shadow_light, p, normalize(n));
+    let s = sg_light_sample(shadow_light, p, normalize(n));
     var v = vec3<f32>(1.0);
     if s.inside {
-        v = vec3<f32>(vis_vsm(vsm_map, shadow_light, s), vis_esm(esm_map, shadow_light, s),
-                      vis_pcf_hardware(raw_depth, shadow_cmp, shadow_light, s));
+        v = vec3<f32>(sg_vis_vsm(vsm_map, shadow_light, s), sg_vis_esm(esm_map, shadow_light, s),
+                      sg_vis_pcf_hardware(raw_depth, shadow_cmp, shadow_light, s));
     }
     return vec4<f32>(v, 1.0);
 }
@@ -96,7 +96,7 @@ fn host_shader_including_the_library_validates() {
     let host = format!("{library}{HOST_SHADER}");
     let module = kernels::validate("host", &host).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(
-        kernels::struct_size(&module, "Light"),
+        kernels::struct_size(&module, "sg_Light"),
         Some(size_of::<LightGpu>() as u32),
         "LightGpu vs the exported struct Light"
     );
@@ -113,7 +113,7 @@ fn host_shader_including_the_library_validates() {
         "vis_msm_soft_float",
     ] {
         assert!(
-            library.contains(&format!("//   fn {name}(")),
+            library.contains(&format!("//   fn sg_{name}(")),
             "{name} undocumented"
         );
     }
@@ -126,7 +126,7 @@ fn host_block_of_every_technique_validates_with_its_bindings() {
         let block = wgsl::host_block(&t, 2, 3).expect("host block");
         let host = format!(
             "{block}
-@group(0) @binding(0) var<uniform> l: Light;
+@group(0) @binding(0) var<uniform> l: sg_Light;
 @fragment
 fn fs_main(@location(0) p: vec3<f32>) -> @location(0) vec4<f32> {{
     return vec4<f32>(shadowgraph_visibility(l, p, vec3<f32>(0.0, 1.0, 0.0)));
@@ -460,4 +460,81 @@ fn settings_that_do_not_apply_are_named() {
     };
     let e = c.validated().unwrap_err();
     assert!(e.to_string().contains("filter_sigma"), "{e}");
+}
+
+/// Every module-scope name the exported WGSL defines carries the `sg_` prefix (the functions a
+/// host block generates carry `shadowgraph_`), so a host's own `struct Light`, `fn linstep` or
+/// `fn texel_of` composes with it; a light name that is not an identifier's tail is refused.
+#[test]
+fn exported_names_are_prefixed() {
+    let library = wgsl::library().expect("library");
+    let module = kernels::validate("library", &library).expect("validates");
+    let names: Vec<String> = module
+        .types
+        .iter()
+        .filter_map(|(_, t)| t.name.clone())
+        .chain(module.constants.iter().filter_map(|(_, c)| c.name.clone()))
+        .chain(module.functions.iter().filter_map(|(_, f)| f.name.clone()))
+        .collect();
+    assert!(names.len() > 50, "{} names", names.len());
+    let bare: Vec<&String> = names
+        .iter()
+        .filter(|n| !n.starts_with(wgsl::PREFIX))
+        .collect();
+    assert!(bare.is_empty(), "unprefixed: {bare:?}");
+    let host = format!(
+        "{library}
+struct Light {{ a: f32 }}
+struct LightSample {{ b: f32 }}
+fn linstep(x: f32) -> f32 {{ return x; }}
+fn texel_of(x: f32) -> f32 {{ return x; }}
+fn vis_vsm(x: f32) -> f32 {{ return x; }}
+@group(0) @binding(0) var<uniform> l: sg_Light;
+@group(1) @binding(0) var map: texture_2d<f32>;
+@fragment
+fn fs_main(@location(0) p: vec3<f32>) -> @location(0) vec4<f32> {{
+    let mine = linstep(texel_of(vis_vsm(Light(1.0).a + LightSample(2.0).b)));
+    let s = sg_light_sample(l, p, vec3<f32>(0.0, 1.0, 0.0));
+    return vec4<f32>(sg_vis_vsm(map, l, s), mine, 0.0, 1.0);
+}}"
+    );
+    kernels::validate("host", &host).unwrap_or_else(|e| panic!("{e}"));
+    // Several lights' blocks of several techniques after their functions, once.
+    let (vsm, pcf) = (every_technique()[4], every_technique()[1]);
+    let functions = wgsl::functions_for(&[vsm, pcf]).expect("functions");
+    let blocks = [
+        wgsl::light_block(&vsm, "sun", 1, 0).expect("sun"),
+        wgsl::light_block(&vsm, "lamp2", 1, 1).expect("lamp2"),
+        wgsl::light_block(&pcf, "torch", 1, 2).expect("torch"),
+    ];
+    let composed = format!(
+        "{functions}{}
+@group(0) @binding(0) var<uniform> l: sg_Light;
+@fragment
+fn fs_main(@location(0) p: vec3<f32>) -> @location(0) vec4<f32> {{
+    let n = vec3<f32>(0.0, 1.0, 0.0);
+    return vec4<f32>(shadowgraph_visibility_sun(l, p, n), shadowgraph_visibility_lamp2(l, p, n),
+                     shadowgraph_visibility_torch(l, p, n), 1.0);
+}}",
+        blocks.concat()
+    );
+    let (_, r) = kernels::reflect("composed", &composed).unwrap_or_else(|e| panic!("{e}"));
+    let maps: Vec<(u32, String)> = r
+        .bindings
+        .iter()
+        .filter(|b| b.group == 1)
+        .map(|b| (b.binding, b.name.clone()))
+        .collect();
+    assert_eq!(
+        maps,
+        vec![
+            (0, "shadowgraph_sun_map0".to_string()),
+            (1, "shadowgraph_lamp2_map0".to_string()),
+            (2, "shadowgraph_torch_map0".to_string()),
+        ]
+    );
+    for bad in ["sun light", "a-b", "x__y", "é"] {
+        let e = wgsl::light_block(&vsm, bad, 1, 0).unwrap_err();
+        assert!(e.to_string().contains(bad), "{bad}: {e}");
+    }
 }

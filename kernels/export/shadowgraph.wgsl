@@ -2,61 +2,68 @@
 // `shadowgraph::prefilter::wgsl::library()` from kernels/shared/; do not edit (the `plugin_wgsl`
 // test checks this file is current; `SHADOWGRAPH_BLESS=1` rewrites it).
 //
-// Usage, per light and shaded point p (world) with unit normal n:
+// Every name defined here carries the prefix `sg_` (`sg_Light`, `sg_vis_vsm`, …), so a host's
+// own names cannot collide. Usage, per light and shaded point p (world) with unit normal n:
 //   var v = 0.0;                                 // facing away: in its own shadow
-//   if light_faces(l, p, n) {
-//       let s = light_sample(l, p, n);           // where p lands in the light's map
+//   if sg_light_faces(l, p, n) {
+//       let s = sg_light_sample(l, p, n);        // where p lands in the light's map
 //       v = 1.0;                                 // outside the map: unshadowed
-//       if s.inside { v = vis_vsm(map, l, s); }
+//       if s.inside { v = sg_vis_vsm(map, l, s); }
 //   }
 // (Branching costs nothing here: every function reads with textureLoad or an explicit level,
 // which WGSL allows in non-uniform control flow.)
 // `map` is the texture `Prefilter::record` returned for the technique (its
-// `PrefilterOutput::maps`, in order), bound as the type in the signature below; `l` is a
-// `Light`, filled byte for byte from `PrefilterOutput::light` (Rust `LightGpu`, bytemuck):
+// `PrefilterOutput::maps`, in order), bound as the type in the signature below; `l` is an
+// `sg_Light`, filled byte for byte from `PrefilterOutput::light` (Rust `LightGpu`, bytemuck):
 // the host's view and view·projection matrices, near/far, map size, bias and the technique's
 // parameters. The projection is wgpu's (right-handed, depth 0 at near, 1 at far). Without
-// Rust, fill the fields as `struct Light` below comments them: view_proj = projection · view,
+// Rust, fill the fields as `struct sg_Light` below comments them: view_proj = projection · view,
 // position and direction from the inverse view (its origin and −Z), width_at_unit =
 // 2 / projection[0][0], map_size = the map's side, kind 1 for perspective depth.
 // Prefiltered maps are read with four loads, so no sampler or filterable format is needed;
-// only `vis_pcf_hardware` takes a comparison sampler (linear filtering, compare less-equal).
+// only `sg_vis_pcf_hardware` takes a comparison sampler (linear filtering, compare less-equal).
 //
 // Visibility functions (map binding types as declared):
-//   fn vis_msm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
-//   fn vis_msm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32
-//   fn vis_esm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
-//   fn vis_esm_of_sat(m: vec4<f32>, l: Light, s: LightSample) -> f32
-//   fn vis_esm_of_log(log_moment: f32, l: Light, s: LightSample) -> f32
-//   fn vis_evsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
-//   fn vis_evsm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32
-//   fn vis_hard(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
-//   fn vis_msm_soft_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32
-//   fn vis_msm_soft_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
-//   fn vis_pcf(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
-//   fn vis_pcf_hardware(map: texture_depth_2d, cmp: sampler_comparison, l: Light, s: LightSample) -> f32
-//   fn vis_pcss(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
-//   fn vis_vsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
-//   fn vis_vsm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32
-//   fn vis_vssm_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32
-//   fn vis_vssm_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
+//   fn sg_vis_msm(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32
+//   fn sg_vis_msm_of(m: vec4<f32>, l: sg_Light, s: sg_LightSample) -> f32
+//   fn sg_vis_esm(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32
+//   fn sg_vis_esm_of_sat(m: vec4<f32>, l: sg_Light, s: sg_LightSample) -> f32
+//   fn sg_vis_esm_of_log(log_moment: f32, l: sg_Light, s: sg_LightSample) -> f32
+//   fn sg_vis_evsm(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32
+//   fn sg_vis_evsm_of(m: vec4<f32>, l: sg_Light, s: sg_LightSample) -> f32
+//   fn sg_vis_hard(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32
+//   fn sg_vis_msm_soft_fixed(map: texture_2d<u32>, l: sg_Light, s: sg_LightSample) -> f32
+//   fn sg_vis_msm_soft_float(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32
+//   fn sg_vis_pcf(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32
+//   fn sg_vis_pcf_hardware(map: texture_depth_2d, cmp: sampler_comparison, l: sg_Light, s: sg_LightSample) -> f32
+//   fn sg_vis_pcss(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32
+//   fn sg_vis_vsm(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32
+//   fn sg_vis_vsm_of(m: vec4<f32>, l: sg_Light, s: sg_LightSample) -> f32
+//   fn sg_vis_vssm_fixed(map: texture_2d<u32>, l: sg_Light, s: sg_LightSample) -> f32
+//   fn sg_vis_vssm_float(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32
 //
-// Names defined here (a host must not reuse them):
-//   BLOCKER_MIN_SHARE CSM_PI GOLDEN_ANGLE Light LightSample MSM_B0 MSM_B0_COV MSM_B0_SCHUR
-//   MipTaps MsmMoments SAT_MIN_EXTENT SatNodes SoftLookup TECHNIQUE_CSM TECHNIQUE_CSSM
-//   TECHNIQUE_ESM TECHNIQUE_EVSM TECHNIQUE_HARD TECHNIQUE_MSM TECHNIQUE_MSM_SOFT TECHNIQUE_PCF
-//   TECHNIQUE_PCSS TECHNIQUE_VSM TECHNIQUE_VSSM bilinear_level bilinear_log_level blocker_csm_z
-//   blocker_filter_width blocker_msm blocker_result blocker_search_width blocker_vsm
-//   blocker_width chebyshev_upper csm_chunk csm_chunk_of csm_resolve csm_sin_cos csm_weight
-//   csm_z_chunk_of cssm_blocker cssm_resolve cssm_sharpen level_size light_faces light_footprint
-//   light_linear_to_ndc light_linear_to_z light_map_width light_sample light_to_light linstep
-//   load_depth mip_tap_uv mip_taps msm_biased msm_dequantize msm_expect msm_intensity
-//   msm_moments msm_quantize msm_roots msm_soft_blocker pcss_search_radius sample_bilinear
-//   sample_bilinear_log sample_map sample_map_log sat_mean_fixed sat_mean_float sat_node_f32
-//   sat_node_u32 sat_nodes sat_rect sat_sample_fixed sat_sample_float soft_blockers soft_search
-//   texel_of trilinear trilinear_log vis_esm vis_esm_of_log vis_esm_of_sat vis_evsm vis_evsm_of
-//   vis_hard vis_msm vis_msm_of vis_msm_soft_fixed vis_msm_soft_float vis_pcf vis_pcf_hardware
-//   vis_pcss vis_vsm vis_vsm_of vis_vssm_fixed vis_vssm_float vogel_disc vssm_blocker
+// Names defined here, each with the `sg_` prefix (a host's own names need only avoid
+// `sg_` and `shadowgraph_`):
+//   sg_BLOCKER_MIN_SHARE sg_CSM_PI sg_GOLDEN_ANGLE sg_Light sg_LightSample sg_MSM_B0
+//   sg_MSM_B0_COV sg_MSM_B0_SCHUR sg_MipTaps sg_MsmMoments sg_SAT_MIN_EXTENT sg_SatNodes
+//   sg_SoftLookup sg_TECHNIQUE_CSM sg_TECHNIQUE_CSSM sg_TECHNIQUE_ESM sg_TECHNIQUE_EVSM
+//   sg_TECHNIQUE_HARD sg_TECHNIQUE_MSM sg_TECHNIQUE_MSM_SOFT sg_TECHNIQUE_PCF sg_TECHNIQUE_PCSS
+//   sg_TECHNIQUE_VSM sg_TECHNIQUE_VSSM sg_bilinear_level sg_bilinear_log_level sg_blocker_csm_z
+//   sg_blocker_filter_width sg_blocker_msm sg_blocker_result sg_blocker_search_width
+//   sg_blocker_vsm sg_blocker_width sg_chebyshev_upper sg_csm_chunk sg_csm_chunk_of
+//   sg_csm_resolve sg_csm_sin_cos sg_csm_weight sg_csm_z_chunk_of sg_cssm_blocker
+//   sg_cssm_resolve sg_cssm_sharpen sg_level_size sg_light_faces sg_light_footprint
+//   sg_light_linear_to_ndc sg_light_linear_to_z sg_light_map_width sg_light_sample
+//   sg_light_to_light sg_linstep sg_load_depth sg_mip_tap_uv sg_mip_taps sg_msm_biased
+//   sg_msm_dequantize sg_msm_expect sg_msm_intensity sg_msm_moments sg_msm_quantize sg_msm_roots
+//   sg_msm_soft_blocker sg_pcss_search_radius sg_sample_bilinear sg_sample_bilinear_log
+//   sg_sample_map sg_sample_map_log sg_sat_mean_fixed sg_sat_mean_float sg_sat_node_f32
+//   sg_sat_node_u32 sg_sat_nodes sg_sat_rect sg_sat_sample_fixed sg_sat_sample_float
+//   sg_soft_blockers sg_soft_search sg_texel_of sg_trilinear sg_trilinear_log sg_vis_esm
+//   sg_vis_esm_of_log sg_vis_esm_of_sat sg_vis_evsm sg_vis_evsm_of sg_vis_hard sg_vis_msm
+//   sg_vis_msm_of sg_vis_msm_soft_fixed sg_vis_msm_soft_float sg_vis_pcf sg_vis_pcf_hardware
+//   sg_vis_pcss sg_vis_vsm sg_vis_vsm_of sg_vis_vssm_fixed sg_vis_vssm_float sg_vogel_disc
+//   sg_vssm_blocker
 
 // Shared light description and light-space helpers (import-only module).
 //
@@ -65,7 +72,7 @@
 // for both the orthographic (directional) and the perspective (spot) light.
 
 // Keep in sync with `LightGpu` in src/gpu_data.rs.
-struct Light {
+struct sg_Light {
     view_proj: mat4x4<f32>,  // world → light clip
     view: mat4x4<f32>,       // world → light view
     radiance: vec3<f32>,     // colour × intensity
@@ -111,20 +118,20 @@ struct Light {
 
 // `Light::technique` (keep in sync with the `TECHNIQUE_*` constants of src/gpu_data.rs; a test
 // compares them).
-const TECHNIQUE_HARD: u32 = 0u;
-const TECHNIQUE_PCF: u32 = 1u;
-const TECHNIQUE_PCSS: u32 = 2u;
-const TECHNIQUE_VSM: u32 = 3u;
-const TECHNIQUE_EVSM: u32 = 4u;
-const TECHNIQUE_ESM: u32 = 5u;
-const TECHNIQUE_MSM: u32 = 6u;
-const TECHNIQUE_CSM: u32 = 7u;
-const TECHNIQUE_CSSM: u32 = 8u;
-const TECHNIQUE_VSSM: u32 = 9u;
-const TECHNIQUE_MSM_SOFT: u32 = 10u;
+const sg_TECHNIQUE_HARD: u32 = 0u;
+const sg_TECHNIQUE_PCF: u32 = 1u;
+const sg_TECHNIQUE_PCSS: u32 = 2u;
+const sg_TECHNIQUE_VSM: u32 = 3u;
+const sg_TECHNIQUE_EVSM: u32 = 4u;
+const sg_TECHNIQUE_ESM: u32 = 5u;
+const sg_TECHNIQUE_MSM: u32 = 6u;
+const sg_TECHNIQUE_CSM: u32 = 7u;
+const sg_TECHNIQUE_CSSM: u32 = 8u;
+const sg_TECHNIQUE_VSSM: u32 = 9u;
+const sg_TECHNIQUE_MSM_SOFT: u32 = 10u;
 
 // Where a receiver lands in a light's shadow map.
-struct LightSample {
+struct sg_LightSample {
     uv: vec2<f32>,   // shadow-map UV, y down
     depth: f32,      // receiver's linear depth d
     view_z: f32,     // receiver's distance Z along the light axis
@@ -133,7 +140,7 @@ struct LightSample {
 }
 
 // World width of the whole map at view distance z.
-fn light_map_width(l: Light, z: f32) -> f32 {
+fn sg_light_map_width(l: sg_Light, z: f32) -> f32 {
     if l.kind == 0u {
         return l.width_at_unit;
     }
@@ -141,7 +148,7 @@ fn light_map_width(l: Light, z: f32) -> f32 {
 }
 
 // Unit vector from p toward the light.
-fn light_to_light(l: Light, p: vec3<f32>) -> vec3<f32> {
+fn sg_light_to_light(l: sg_Light, p: vec3<f32>) -> vec3<f32> {
     if l.kind == 0u {
         return -l.direction;
     }
@@ -151,19 +158,19 @@ fn light_to_light(l: Light, p: vec3<f32>) -> vec3<f32> {
 // Whether a receiver p with unit normal n faces light l (N·L > 0). One that faces away is in
 // its own shadow: its visibility is 0, known without reading a map (and its N·L, hence its
 // light, is 0 whatever a map says), so the shading skips its lookups.
-fn light_faces(l: Light, p: vec3<f32>, n: vec3<f32>) -> bool {
-    return dot(n, light_to_light(l, p)) > 0.0;
+fn sg_light_faces(l: sg_Light, p: vec3<f32>, n: vec3<f32>) -> bool {
+    return dot(n, sg_light_to_light(l, p)) > 0.0;
 }
 
 // Projects p, first moved along n by normal_bias texels scaled by (1 − N·L).
-fn light_sample(l: Light, p: vec3<f32>, n: vec3<f32>) -> LightSample {
+fn sg_light_sample(l: sg_Light, p: vec3<f32>, n: vec3<f32>) -> sg_LightSample {
     let z0 = -(l.view * vec4<f32>(p, 1.0)).z;
-    let texel = light_map_width(l, max(z0, l.near)) / l.map_size.x;
-    let ndl = clamp(dot(n, light_to_light(l, p)), 0.0, 1.0);
+    let texel = sg_light_map_width(l, max(z0, l.near)) / l.map_size.x;
+    let ndl = clamp(dot(n, sg_light_to_light(l, p)), 0.0, 1.0);
     let q = p + n * (l.normal_bias * texel * (1.0 - ndl));
     let clip = l.view_proj * vec4<f32>(q, 1.0);
     let ndc = clip.xy / clip.w;
-    var s: LightSample;
+    var s: sg_LightSample;
     s.uv = vec2<f32>(0.5 + 0.5 * ndc.x, 0.5 - 0.5 * ndc.y);
     s.view_z = -(l.view * vec4<f32>(q, 1.0)).z;
     s.depth = (s.view_z - l.near) / (l.far - l.near);
@@ -175,14 +182,14 @@ fn light_sample(l: Light, p: vec3<f32>, n: vec3<f32>) -> LightSample {
 
 // The footprint in light l's map, in texels, of the pixel whose receiver p (normal n) moves by
 // dpdx and dpdy from one pixel to the next: the differences of the projected points.
-fn light_footprint(l: Light, s: LightSample, p: vec3<f32>, n: vec3<f32>, dpdx: vec3<f32>, dpdy: vec3<f32>) -> vec4<f32> {
-    let a = (light_sample(l, p + dpdx, n).uv - s.uv) * l.map_size;
-    let b = (light_sample(l, p + dpdy, n).uv - s.uv) * l.map_size;
+fn sg_light_footprint(l: sg_Light, s: sg_LightSample, p: vec3<f32>, n: vec3<f32>, dpdx: vec3<f32>, dpdy: vec3<f32>) -> vec4<f32> {
+    let a = (sg_light_sample(l, p + dpdx, n).uv - s.uv) * l.map_size;
+    let b = (sg_light_sample(l, p + dpdy, n).uv - s.uv) * l.map_size;
     return vec4<f32>(a, b);
 }
 
 // Linear depth → the depth buffer's value (for the hardware comparison sampler).
-fn light_linear_to_ndc(l: Light, d: f32) -> f32 {
+fn sg_light_linear_to_ndc(l: sg_Light, d: f32) -> f32 {
     if l.kind == 0u {
         return d;
     }
@@ -191,29 +198,29 @@ fn light_linear_to_ndc(l: Light, d: f32) -> f32 {
 }
 
 // Linear depth → view distance.
-fn light_linear_to_z(l: Light, d: f32) -> f32 {
+fn sg_light_linear_to_z(l: sg_Light, d: f32) -> f32 {
     return l.near + d * (l.far - l.near);
 }
 // Texel and tap helpers shared by the visibility functions (import-only module).
 
-const GOLDEN_ANGLE: f32 = 2.399963229728653;
+const sg_GOLDEN_ANGLE: f32 = 2.399963229728653;
 
 // Tap i of n on a Vogel (golden-angle) spiral covering the unit disc evenly.
-fn vogel_disc(i: u32, n: u32) -> vec2<f32> {
+fn sg_vogel_disc(i: u32, n: u32) -> vec2<f32> {
     let r = sqrt((f32(i) + 0.5) / f32(n));
-    let theta = f32(i) * GOLDEN_ANGLE;
+    let theta = f32(i) * sg_GOLDEN_ANGLE;
     return r * vec2<f32>(cos(theta), sin(theta));
 }
 
 // The texel containing uv, clamped to the map.
-fn texel_of(uv: vec2<f32>, size: vec2<f32>) -> vec2<i32> {
+fn sg_texel_of(uv: vec2<f32>, size: vec2<f32>) -> vec2<i32> {
     let t = vec2<i32>(floor(uv * size));
     return clamp(t, vec2<i32>(0), vec2<i32>(size) - 1);
 }
 
 // Linear depth at texel t, clamped to the edge.
-// #fetches load_depth: 1
-fn load_depth(map: texture_2d<f32>, t: vec2<i32>) -> f32 {
+// #fetches sg_load_depth: 1
+fn sg_load_depth(map: texture_2d<f32>, t: vec2<i32>) -> f32 {
     let size = vec2<i32>(textureDimensions(map));
     return textureLoad(map, clamp(t, vec2<i32>(0), size - 1), 0).r;
 }
@@ -221,22 +228,22 @@ fn load_depth(map: texture_2d<f32>, t: vec2<i32>) -> f32 {
 // Bilinear interpolation of all four channels at uv (texel centres at (i + ½) / size),
 // clamp-to-edge, from four loads: exact and filter-feature independent (f32 maps need not be
 // filterable).
-// #fetches sample_bilinear: 4
-fn sample_bilinear(map: texture_2d<f32>, uv: vec2<f32>) -> vec4<f32> {
-    return bilinear_level(map, uv, 0);
+// #fetches sg_sample_bilinear: 4
+fn sg_sample_bilinear(map: texture_2d<f32>, uv: vec2<f32>) -> vec4<f32> {
+    return sg_bilinear_level(map, uv, 0);
 }
 
 // The size of mip `level`, max(1, size >> level), from level 0's: llvmpipe answers
 // textureDimensions(map, level) with one invocation's level when the invocations' levels differ
 // (per-pixel footprints), which sends the others' loads out of range.
-fn level_size(map: texture_2d<f32>, level: i32) -> vec2<f32> {
+fn sg_level_size(map: texture_2d<f32>, level: i32) -> vec2<f32> {
     return vec2<f32>(max(textureDimensions(map) >> vec2<u32>(u32(level)), vec2<u32>(1u)));
 }
 
 // `sample_bilinear` on mip `level` (texel centres at (i + ½) / level size).
-// #fetches bilinear_level: 4
-fn bilinear_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> vec4<f32> {
-    let size = level_size(map, level);
+// #fetches sg_bilinear_level: 4
+fn sg_bilinear_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> vec4<f32> {
+    let size = sg_level_size(map, level);
     let f = uv * size - 0.5;
     let i = vec2<i32>(floor(f));
     let a = f - floor(f);
@@ -249,17 +256,17 @@ fn bilinear_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> vec4<f32> 
 }
 
 // Trilinear sample of a mip chain at `lod` (clamped to the chain).
-// #fetches trilinear: 8
-fn trilinear(map: texture_2d<f32>, l: Light, uv: vec2<f32>, lod_in: f32) -> vec4<f32> {
+// #fetches sg_trilinear: 8
+fn sg_trilinear(map: texture_2d<f32>, l: sg_Light, uv: vec2<f32>, lod_in: f32) -> vec4<f32> {
     let lod = clamp(lod_in, 0.0, f32(l.mip_levels - 1u));
     let l0 = i32(floor(lod));
     let l1 = min(l0 + 1, i32(l.mip_levels) - 1);
-    return mix(bilinear_level(map, uv, l0), bilinear_level(map, uv, l1), lod - floor(lod));
+    return mix(sg_bilinear_level(map, uv, l0), sg_bilinear_level(map, uv, l1), lod - floor(lod));
 }
 
 // How a pixel's footprint is read from a mip chain: `count` trilinear taps at `lod`, spaced by
 // `step` (UV) along the footprint's major axis and centred on the receiver.
-struct MipTaps {
+struct sg_MipTaps {
     lod: f32,
     count: u32,
     step: vec2<f32>,
@@ -269,8 +276,8 @@ struct MipTaps {
 // footprint's axes a, b (texels) give major = max(|a|, |b|), minor = min; the width is
 // w = max(filter width, minor), the taps n = clamp(⌈major / w⌉, 1, max_anisotropy), each at
 // level log2(max(w, major / n)), spaced major / n apart along the major axis.
-fn mip_taps(l: Light, s: LightSample) -> MipTaps {
-    var t: MipTaps;
+fn sg_mip_taps(l: sg_Light, s: sg_LightSample) -> sg_MipTaps {
+    var t: sg_MipTaps;
     t.lod = l.filter_lod;
     t.count = 1u;
     t.step = vec2<f32>(0.0);
@@ -290,64 +297,64 @@ fn mip_taps(l: Light, s: LightSample) -> MipTaps {
 }
 
 // The UV of tap k of `t` around uv.
-fn mip_tap_uv(t: MipTaps, uv: vec2<f32>, k: u32) -> vec2<f32> {
+fn sg_mip_tap_uv(t: sg_MipTaps, uv: vec2<f32>, k: u32) -> vec2<f32> {
     return uv + t.step * (f32(k) + 0.5 - 0.5 * f32(t.count));
 }
 
 // A light's filtered representation at a receiver: bilinear, or with the `mips` filter
 // trilinear at log2(filter width), or along the pixel's footprint (`mip_taps`): each pixel reads
 // its own tap count, so the declaration is the most a pixel reads (`max_anisotropy` taps).
-// #fetches sample_map: select(4, 8 * max(l.max_anisotropy, 1), l.mip_levels > 1)
-fn sample_map(map: texture_2d<f32>, l: Light, s: LightSample) -> vec4<f32> {
+// #fetches sg_sample_map: select(4, 8 * max(l.max_anisotropy, 1), l.mip_levels > 1)
+fn sg_sample_map(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> vec4<f32> {
     if l.mip_levels <= 1u {
-        return sample_bilinear(map, s.uv);
+        return sg_sample_bilinear(map, s.uv);
     }
-    let t = mip_taps(l, s);
+    let t = sg_mip_taps(l, s);
     var sum = vec4<f32>(0.0);
     for (var k = 0u; k < t.count; k++) {
-        sum += trilinear(map, l, mip_tap_uv(t, s.uv, k), t.lod);
+        sum += sg_trilinear(map, l, sg_mip_tap_uv(t, s.uv, k), t.lod);
     }
     return sum / f32(t.count);
 }
 
 // Trilinear sample of a map of logarithms at `lod`, as a logarithm.
-// #fetches trilinear_log: 8
-fn trilinear_log(map: texture_2d<f32>, l: Light, uv: vec2<f32>, lod_in: f32) -> f32 {
+// #fetches sg_trilinear_log: 8
+fn sg_trilinear_log(map: texture_2d<f32>, l: sg_Light, uv: vec2<f32>, lod_in: f32) -> f32 {
     let lod = clamp(lod_in, 0.0, f32(l.mip_levels - 1u));
     let l0 = i32(floor(lod));
     let l1 = min(l0 + 1, i32(l.mip_levels) - 1);
-    let v0 = bilinear_log_level(map, uv, l0);
-    let v1 = bilinear_log_level(map, uv, l1);
+    let v0 = sg_bilinear_log_level(map, uv, l0);
+    let v1 = sg_bilinear_log_level(map, uv, l1);
     let t = lod - floor(lod);
     let m = max(v0, v1);
     return m + log((1.0 - t) * exp(v0 - m) + t * exp(v1 - m));
 }
 
 // linstep(lo, hi, x): the light-bleeding reduction of VSM-family techniques.
-fn linstep(lo: f32, hi: f32, x: f32) -> f32 {
+fn sg_linstep(lo: f32, hi: f32, x: f32) -> f32 {
     return clamp((x - lo) / (hi - lo), 0.0, 1.0);
 }
 
 // Bilinear interpolation of exp(v) for a map of logarithms v (channel 0), returned as a
 // logarithm: log Σ wᵢ exp(vᵢ), evaluated around the largest tap so nothing overflows.
-// #fetches sample_bilinear_log: 4
-fn sample_bilinear_log(map: texture_2d<f32>, uv: vec2<f32>) -> f32 {
-    return bilinear_log_level(map, uv, 0);
+// #fetches sg_sample_bilinear_log: 4
+fn sg_sample_bilinear_log(map: texture_2d<f32>, uv: vec2<f32>) -> f32 {
+    return sg_bilinear_log_level(map, uv, 0);
 }
 
 // `sample_map` for a map of logarithms: the same weights applied to exp(v), as a logarithm
 // (taps combined around the largest so far, so nothing overflows).
-// #fetches sample_map_log: select(4, 8 * max(l.max_anisotropy, 1), l.mip_levels > 1)
-fn sample_map_log(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
+// #fetches sg_sample_map_log: select(4, 8 * max(l.max_anisotropy, 1), l.mip_levels > 1)
+fn sg_sample_map_log(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
     if l.mip_levels <= 1u {
-        return sample_bilinear_log(map, s.uv);
+        return sg_sample_bilinear_log(map, s.uv);
     }
-    let t = mip_taps(l, s);
+    let t = sg_mip_taps(l, s);
     // A running log-sum-exp: m the largest tap so far, sum = Σ exp(tap − m).
-    var m = trilinear_log(map, l, mip_tap_uv(t, s.uv, 0u), t.lod);
+    var m = sg_trilinear_log(map, l, sg_mip_tap_uv(t, s.uv, 0u), t.lod);
     var sum = 1.0;
     for (var k = 1u; k < t.count; k++) {
-        let v = trilinear_log(map, l, mip_tap_uv(t, s.uv, k), t.lod);
+        let v = sg_trilinear_log(map, l, sg_mip_tap_uv(t, s.uv, k), t.lod);
         let m2 = max(m, v);
         sum = sum * exp(m - m2) + exp(v - m2);
         m = m2;
@@ -356,9 +363,9 @@ fn sample_map_log(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
 }
 
 // `sample_bilinear_log` on mip `level`.
-// #fetches bilinear_log_level: 4
-fn bilinear_log_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> f32 {
-    let size = level_size(map, level);
+// #fetches sg_bilinear_log_level: 4
+fn sg_bilinear_log_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> f32 {
+    let size = sg_level_size(map, level);
     let f = uv * size - 0.5;
     let i = vec2<i32>(floor(f));
     let a = f - floor(f);
@@ -382,24 +389,24 @@ fn bilinear_log_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> f32 {
 // `csm_resolve`.
 // The CSM Fourier basis (import-only module): (sin c_k x, cos c_k x), c_k = π (2k − 1).
 
-const CSM_PI: f32 = 3.141592653589793;
+const sg_CSM_PI: f32 = 3.141592653589793;
 
 // (sin, cos) of π (2k − 1) x, with (2k − 1) x reduced to [−1, 1] (period 2) before the
 // multiplication by π, so the trigonometric argument stays in [−π, π].
-fn csm_sin_cos(k: u32, x: f32) -> vec2<f32> {
+fn sg_csm_sin_cos(k: u32, x: f32) -> vec2<f32> {
     let y = f32(2u * k - 1u) * x;
-    let t = CSM_PI * (y - 2.0 * round(0.5 * y));
+    let t = sg_CSM_PI * (y - 2.0 * round(0.5 * y));
     return vec2<f32>(sin(t), cos(t));
 }
 
 // Terms 2·chunk + 1 and 2·chunk + 2 (those ≤ M) of the series at this receiver.
-// #fetches csm_chunk: sample_map
-fn csm_chunk(map: texture_2d<f32>, chunk: u32, l: Light, s: LightSample) -> f32 {
-    return csm_chunk_of(sample_map(map, l, s), chunk, l, s);
+// #fetches sg_csm_chunk: sg_sample_map
+fn sg_csm_chunk(map: texture_2d<f32>, chunk: u32, l: sg_Light, s: sg_LightSample) -> f32 {
+    return sg_csm_chunk_of(sg_sample_map(map, l, s), chunk, l, s);
 }
 
 // The same from the chunk's filtered basis values `v` however they were filtered.
-fn csm_chunk_of(v: vec4<f32>, chunk: u32, l: Light, s: LightSample) -> f32 {
+fn sg_csm_chunk_of(v: vec4<f32>, chunk: u32, l: sg_Light, s: sg_LightSample) -> f32 {
     let d = s.depth - l.bias - l.csm_offset;
     var sum = 0.0;
     for (var j = 0u; j < 2u; j++) {
@@ -407,21 +414,21 @@ fn csm_chunk_of(v: vec4<f32>, chunk: u32, l: Light, s: LightSample) -> f32 {
         if k > l.csm_terms {
             break;
         }
-        let w = csm_weight(k, l);
+        let w = sg_csm_weight(k, l);
         let basis = select(v.xy, v.zw, j == 1u);
-        let sc = csm_sin_cos(k, d);
+        let sc = sg_csm_sin_cos(k, d);
         sum += w * (sc.y * basis.x - sc.x * basis.y);
     }
     return sum;
 }
 
 // w_k = (2 / c_k) · exp(−α (k / M)²): the attenuated weight of term k.
-fn csm_weight(k: u32, l: Light) -> f32 {
+fn sg_csm_weight(k: u32, l: sg_Light) -> f32 {
     let kf = f32(k) / f32(l.csm_terms);
-    return 2.0 / (CSM_PI * f32(2u * k - 1u)) * exp(-l.csm_attenuation * kf * kf);
+    return 2.0 / (sg_CSM_PI * f32(2u * k - 1u)) * exp(-l.csm_attenuation * kf * kf);
 }
 
-fn csm_resolve(sum: f32, l: Light) -> f32 {
+fn sg_csm_resolve(sum: f32, l: sg_Light) -> f32 {
     return clamp(l.csm_scale * sum + 0.5, 0.0, 1.0);
 }
 // Convolution soft shadow maps (Annen et al. 2008; seed 000), every step a summed-area-table
@@ -459,12 +466,12 @@ fn csm_resolve(sum: f32, l: Light) -> f32 {
 // to it inside the map (the mean then tends to the point value, never 0/0). Channels the
 // representation does not have hold 0 in the table and decode to `offset`.
 
-const SAT_MIN_EXTENT: f32 = 0.00390625; // 2⁻⁸ texel
+const sg_SAT_MIN_EXTENT: f32 = 0.00390625; // 2⁻⁸ texel
 
 // The integer corner nodes of a clamped rectangle and their bilinear weights:
 // x = (i0, i0 + 1, i1, i1 + 1) with i0 = ⌊x0⌋, i1 = ⌊x1⌋ (clamped to the map),
 // wx = (1 − fract(x0), fract(x0), 1 − fract(x1), fract(x1)); the same for y.
-struct SatNodes {
+struct sg_SatNodes {
     x: vec4<i32>,
     y: vec4<i32>,
     wx: vec4<f32>,
@@ -472,18 +479,18 @@ struct SatNodes {
     area: f32,
 }
 
-fn sat_nodes(rect: vec4<f32>, size: vec2<u32>) -> SatNodes {
+fn sg_sat_nodes(rect: vec4<f32>, size: vec2<u32>) -> sg_SatNodes {
     let s = vec2<f32>(size);
     let lo0 = clamp(min(rect.xy, rect.zw), vec2<f32>(0.0), s);
     let hi0 = clamp(max(rect.xy, rect.zw), vec2<f32>(0.0), s);
-    let lo = min(lo0, s - SAT_MIN_EXTENT);
-    let hi = max(hi0, lo + SAT_MIN_EXTENT);
+    let lo = min(lo0, s - sg_SAT_MIN_EXTENT);
+    let hi = max(hi0, lo + sg_SAT_MIN_EXTENT);
     let i0 = floor(lo);
     let i1 = floor(hi);
     let a0 = lo - i0;
     let a1 = hi - i1;
     let top = vec2<i32>(size);
-    var n: SatNodes;
+    var n: sg_SatNodes;
     n.x = min(vec4<i32>(i32(i0.x), i32(i0.x) + 1, i32(i1.x), i32(i1.x) + 1), vec4<i32>(top.x));
     n.y = min(vec4<i32>(i32(i0.y), i32(i0.y) + 1, i32(i1.y), i32(i1.y) + 1), vec4<i32>(top.y));
     n.wx = vec4<f32>(1.0 - a0.x, a0.x, 1.0 - a1.x, a1.x);
@@ -493,16 +500,16 @@ fn sat_nodes(rect: vec4<f32>, size: vec2<u32>) -> SatNodes {
 }
 
 // F(X, Y) at integer nodes: 0 on the top and left edges, else SAT texel (X − 1, Y − 1).
-// #fetches sat_node_u32: 1
-fn sat_node_u32(sat: texture_2d<u32>, x: i32, y: i32) -> vec4<u32> {
+// #fetches sg_sat_node_u32: 1
+fn sg_sat_node_u32(sat: texture_2d<u32>, x: i32, y: i32) -> vec4<u32> {
     if x == 0 || y == 0 {
         return vec4<u32>(0u);
     }
     return textureLoad(sat, vec2<i32>(x - 1, y - 1), 0);
 }
 
-// #fetches sat_node_f32: 1
-fn sat_node_f32(sat: texture_2d<f32>, x: i32, y: i32) -> vec4<f32> {
+// #fetches sg_sat_node_f32: 1
+fn sg_sat_node_f32(sat: texture_2d<f32>, x: i32, y: i32) -> vec4<f32> {
     if x == 0 || y == 0 {
         return vec4<f32>(0.0);
     }
@@ -513,13 +520,13 @@ fn sat_node_f32(sat: texture_2d<f32>, x: i32, y: i32) -> vec4<f32> {
 // SAT (rgba32uint) encoded with `offset` and `scale` (SatCoding in src/sat.rs).
 // With F at the left edge a mix over r and at the right edge over p (weights summing to 1),
 // F(x1) − F(x0) = Σ_r,p wx0_r·wx1_p·(F(X1_p) − F(X0_r)): a weighted sum of integer windows.
-// #fetches sat_mean_fixed: 16
-fn sat_mean_fixed(sat: texture_2d<u32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
-    let n = sat_nodes(rect, textureDimensions(sat));
+// #fetches sg_sat_mean_fixed: 16
+fn sg_sat_mean_fixed(sat: texture_2d<u32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
+    let n = sg_sat_nodes(rect, textureDimensions(sat));
     var f: array<vec4<u32>, 16>;
     for (var j = 0; j < 4; j++) {
         for (var i = 0; i < 4; i++) {
-            f[j * 4 + i] = sat_node_u32(sat, n.x[i], n.y[j]);
+            f[j * 4 + i] = sg_sat_node_u32(sat, n.x[i], n.y[j]);
         }
     }
     var sum = vec4<f32>(0.0);
@@ -541,13 +548,13 @@ fn sat_mean_fixed(sat: texture_2d<u32>, rect: vec4<f32>, offset: vec4<f32>, scal
 // The same from an f32 SAT (rgba32float) built with `offset` and `scale` (scale is 1 for the
 // f32 variant). Each window is a difference of f32 sums: its error grows with the sums at the
 // corners (about 2⁻²⁴ of the sum over [0, X] × [0, Y] each), not with the window.
-// #fetches sat_mean_float: 16
-fn sat_mean_float(sat: texture_2d<f32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
-    let n = sat_nodes(rect, textureDimensions(sat));
+// #fetches sg_sat_mean_float: 16
+fn sg_sat_mean_float(sat: texture_2d<f32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
+    let n = sg_sat_nodes(rect, textureDimensions(sat));
     var f: array<vec4<f32>, 16>;
     for (var j = 0; j < 4; j++) {
         for (var i = 0; i < 4; i++) {
-            f[j * 4 + i] = sat_node_f32(sat, n.x[i], n.y[j]);
+            f[j * 4 + i] = sg_sat_node_f32(sat, n.x[i], n.y[j]);
         }
     }
     var sum = vec4<f32>(0.0);
@@ -565,22 +572,22 @@ fn sat_mean_float(sat: texture_2d<f32>, rect: vec4<f32>, offset: vec4<f32>, scal
 }
 
 // The square of `width` texels centred on uv, in texel units (x0, y0, x1, y1).
-fn sat_rect(l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
+fn sg_sat_rect(l: sg_Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
     let c = uv * l.map_size;
     let h = vec2<f32>(0.5 * width);
     return vec4<f32>(c - h, c + h);
 }
 
 // The mean over `sat_rect(l, uv, width)` from a fixed-point table (rgba32uint).
-// #fetches sat_sample_fixed: 16
-fn sat_sample_fixed(map: texture_2d<u32>, l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
-    return sat_mean_fixed(map, sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
+// #fetches sg_sat_sample_fixed: 16
+fn sg_sat_sample_fixed(map: texture_2d<u32>, l: sg_Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
+    return sg_sat_mean_fixed(map, sg_sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
 }
 
 // The mean over `sat_rect(l, uv, width)` from an f32 table (rgba32float).
-// #fetches sat_sample_float: 16
-fn sat_sample_float(map: texture_2d<f32>, l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
-    return sat_mean_float(map, sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
+// #fetches sg_sat_sample_float: 16
+fn sg_sat_sample_float(map: texture_2d<f32>, l: sg_Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
+    return sg_sat_mean_float(map, sg_sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
 }
 // The blocker search of the soft techniques (cssm, vssm, msm_soft) as filtered lookups
 // (import-only module): each technique reads the mean of its representation over the search
@@ -618,7 +625,7 @@ fn sat_sample_float(map: texture_2d<f32>, l: Light, uv: vec2<f32>, width: f32) -
 // inverse (import-only module). The moment vector multiplies the matrices from the left (as a
 // row vector); the constructors list their columns.
 
-fn msm_quantize(b: vec4<f32>) -> vec4<f32> {
+fn sg_msm_quantize(b: vec4<f32>) -> vec4<f32> {
     let m = mat4x4<f32>(
         vec4<f32>(-2.07224649, 32.23703778, -68.571074599, 39.3703274134),
         vec4<f32>(13.7948857237, -59.4683975703, 82.0359750338, -35.364903257),
@@ -628,7 +635,7 @@ fn msm_quantize(b: vec4<f32>) -> vec4<f32> {
     return b * m + vec4<f32>(0.035955884801, 0.0, 0.0, 0.0);
 }
 
-fn msm_dequantize(q: vec4<f32>) -> vec4<f32> {
+fn sg_msm_dequantize(q: vec4<f32>) -> vec4<f32> {
     let m = mat4x4<f32>(
         vec4<f32>(0.2227744146, 0.0771972861, 0.7926986636, 0.0319417555),
         vec4<f32>(0.1549679261, 0.1394629426, 0.7963415838, -0.1722823173),
@@ -640,15 +647,15 @@ fn msm_dequantize(q: vec4<f32>) -> vec4<f32> {
 
 // Moments of {0, ½, 1} with weights (3/16, 10/16, 3/16): Peters' b₀ = (0, 0.375, 0, 0.375)
 // on [−1, 1], mapped to depth in [0, 1].
-const MSM_B0: vec4<f32> = vec4<f32>(0.5, 0.34375, 0.265625, 0.2265625);
+const sg_MSM_B0: vec4<f32> = vec4<f32>(0.5, 0.34375, 0.265625, 0.2265625);
 // Its covariances (Var z, Cov(z, z²), Var z²) and the Schur complement
 // Var z² − Cov(z, z²)²/Var z, exact in f32.
-const MSM_B0_COV: vec3<f32> = vec3<f32>(0.09375, 0.09375, 0.1083984375);
-const MSM_B0_SCHUR: f32 = 0.0146484375;
+const sg_MSM_B0_COV: vec3<f32> = vec3<f32>(0.09375, 0.09375, 0.1083984375);
+const sg_MSM_B0_SCHUR: f32 = 0.0146484375;
 
 // Biased moments as the reconstruction reads them: the raw moments (for Hausdorff's closed
 // form) and the mean, second moment and covariances of (z, z²).
-struct MsmMoments {
+struct sg_MsmMoments {
     // (1 − α)·m + α·b₀.
     b: vec4<f32>,
     // Var z, Cov(z, z²), Var z² of the biased distribution.
@@ -666,7 +673,7 @@ struct MsmMoments {
 // ones (Var z, Var z² ≥ 0, |Cov(z, z²)| ≤ √(Var z·Var z²)); quantized ones are not: their
 // errors come through the dequantization's matrix, whose design keeps them out of the
 // near-null directions, and a clamp per entry would undo that.
-fn msm_moments(m: vec4<f32>, alpha: f32, project: bool) -> MsmMoments {
+fn sg_msm_moments(m: vec4<f32>, alpha: f32, project: bool) -> sg_MsmMoments {
     var c = vec3<f32>(m.y - m.x * m.x, m.z - m.x * m.y, m.w - m.y * m.y);
     if project {
         c.x = max(c.x, 0.0);
@@ -677,13 +684,13 @@ fn msm_moments(m: vec4<f32>, alpha: f32, project: bool) -> MsmMoments {
     // A mixture's covariance: the parts' covariances plus that of their means,
     // (1 − α)·C(m) + α·C(b₀) + α(1 − α)·e eᵀ, e the difference of the means of (z, z²).
     let w = 1.0 - alpha;
-    let e = m.xy - MSM_B0.xy;
-    var out: MsmMoments;
-    out.b = w * m + alpha * MSM_B0;
-    out.cov = w * c + alpha * MSM_B0_COV + (alpha * w) * vec3<f32>(e.x * e.x, e.x * e.y, e.y * e.y);
+    let e = m.xy - sg_MSM_B0.xy;
+    var out: sg_MsmMoments;
+    out.b = w * m + alpha * sg_MSM_B0;
+    out.cov = w * c + alpha * sg_MSM_B0_COV + (alpha * w) * vec3<f32>(e.x * e.x, e.x * e.y, e.y * e.y);
     out.alpha = alpha;
-    out.diff = w * (m.yzw - m.xyz) + alpha * (MSM_B0.yzw - MSM_B0.xyz);
-    out.below_one = w * (1.0 - m.x) + alpha * (1.0 - MSM_B0.x);
+    out.diff = w * (m.yzw - m.xyz) + alpha * (sg_MSM_B0.yzw - sg_MSM_B0.xyz);
+    out.below_one = w * (1.0 - m.x) + alpha * (1.0 - sg_MSM_B0.x);
     return out;
 }
 
@@ -694,13 +701,13 @@ fn msm_moments(m: vec4<f32>, alpha: f32, project: bool) -> MsmMoments {
 // Var z and s are at least α times b₀'s (B ⪰ α·B₀ for the moments of any distribution), and
 // are floored there. case 0: regular; 1: the variance is (numerically) 0, a single point at
 // the mean; 2: rank-deficient, two support points (z₂, z₃ then meaningless).
-fn msm_roots(mm: MsmMoments, d: f32) -> vec3<f32> {
-    let var1 = max(mm.cov.x, mm.alpha * MSM_B0_COV.x);
+fn sg_msm_roots(mm: sg_MsmMoments, d: f32) -> vec3<f32> {
+    let var1 = max(mm.cov.x, mm.alpha * sg_MSM_B0_COV.x);
     if !(var1 > 1e-12) {
         return vec3<f32>(0.0, 0.0, 1.0);
     }
     let l32 = mm.cov.y / var1;
-    let d3 = max(mm.cov.z - l32 * mm.cov.y, mm.alpha * MSM_B0_SCHUR);
+    let d3 = max(mm.cov.z - l32 * mm.cov.y, mm.alpha * sg_MSM_B0_SCHUR);
     if !(d3 > 0.0) {
         return vec3<f32>(0.0, 0.0, 2.0);
     }
@@ -722,14 +729,14 @@ fn msm_roots(mm: MsmMoments, d: f32) -> vec3<f32> {
 
 // E[(z − x)(z − y)] under the biased moments: (μ − x)(μ − y) + Var z, free of the
 // cancellation in E z² − (x + y)·μ + x·y.
-fn msm_expect(mm: MsmMoments, x: f32, y: f32) -> f32 {
+fn sg_msm_expect(mm: sg_MsmMoments, x: f32, y: f32) -> f32 {
     return (mm.b.x - x) * (mm.b.x - y) + mm.cov.x;
 }
 
 // Shadow intensity (share of the depth distribution in front of d) from biased moments.
-fn msm_intensity(mm: MsmMoments, d: f32, hausdorff: bool) -> f32 {
+fn sg_msm_intensity(mm: sg_MsmMoments, d: f32, hausdorff: bool) -> f32 {
     let b = mm.b;
-    let roots = msm_roots(mm, d);
+    let roots = sg_msm_roots(mm, d);
     if roots.z == 1.0 {
         return select(0.0, 1.0, d > b.x);
     }
@@ -757,53 +764,53 @@ fn msm_intensity(mm: MsmMoments, d: f32, hausdorff: bool) -> f32 {
         return 0.0;
     }
     if d <= z3 {
-        return msm_expect(mm, d, z3) / ((z3 - z2) * (d - z2));
+        return sg_msm_expect(mm, d, z3) / ((z3 - z2) * (d - z2));
     }
-    return 1.0 - msm_expect(mm, z2, z3) / ((d - z2) * (d - z3));
+    return 1.0 - sg_msm_expect(mm, z2, z3) / ((d - z2) * (d - z3));
 }
 
-// #fetches vis_msm: sample_map
-fn vis_msm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    return vis_msm_of(sample_map(map, l, s), l, s);
+// #fetches sg_vis_msm: sg_sample_map
+fn sg_vis_msm(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
+    return sg_vis_msm_of(sg_sample_map(map, l, s), l, s);
 }
 
 // Filtered (possibly quantized) moments `m` dequantized and biased toward MSM_B0.
-fn msm_biased(m: vec4<f32>, l: Light) -> MsmMoments {
+fn sg_msm_biased(m: vec4<f32>, l: sg_Light) -> sg_MsmMoments {
     let quantized = (l.msm_flags & 2u) != 0u;
     var b = m;
     if quantized {
-        b = msm_dequantize(b);
+        b = sg_msm_dequantize(b);
     }
-    return msm_moments(b, l.moment_bias, !quantized);
+    return sg_msm_moments(b, l.moment_bias, !quantized);
 }
 
 // Visibility from filtered (possibly quantized) moments `m` however they were filtered.
-fn vis_msm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
-    let mm = msm_biased(m, l);
-    let intensity = msm_intensity(mm, s.depth - l.bias, (l.msm_flags & 1u) != 0u);
+fn sg_vis_msm_of(m: vec4<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
+    let mm = sg_msm_biased(m, l);
+    let intensity = sg_msm_intensity(mm, s.depth - l.bias, (l.msm_flags & 1u) != 0u);
     let v = 1.0 - clamp(intensity, 0.0, 1.0);
     // NaN compares false both ways: a non-finite intensity reads as fully lit.
-    return linstep(l.bleed, 1.0, select(1.0, v, v == v));
+    return sg_linstep(l.bleed, 1.0, select(1.0, v, v == v));
 }
 
 // A search square whose estimated share of blockers is below this reads as lit, without a
 // lookup at the filter width (PCSS: no blocker tap). The estimates are smooth, so a
 // threshold keeps ringing (CSM-Z) and Chebyshev's tail (VSM) from turning into blockers.
-const BLOCKER_MIN_SHARE: f32 = 0.01;
+const sg_BLOCKER_MIN_SHARE: f32 = 0.01;
 
-fn blocker_width(texels: f32, l: Light) -> f32 {
+fn sg_blocker_width(texels: f32, l: sg_Light) -> f32 {
     return min(select(1.0, texels, texels > 1.0), l.max_width);
 }
 
-fn blocker_search_width(l: Light, s: LightSample) -> f32 {
+fn sg_blocker_search_width(l: sg_Light, s: sg_LightSample) -> f32 {
     let world = l.size * (s.view_z - l.near) / s.view_z;
-    return blocker_width(world / light_map_width(l, l.near) * l.map_size.x, l);
+    return sg_blocker_width(world / sg_light_map_width(l, l.near) * l.map_size.x, l);
 }
 
-fn blocker_filter_width(l: Light, s: LightSample, z_avg: f32) -> f32 {
-    let z_b = light_linear_to_z(l, z_avg);
+fn sg_blocker_filter_width(l: sg_Light, s: sg_LightSample, z_avg: f32) -> f32 {
+    let z_b = sg_light_linear_to_z(l, z_avg);
     let penumbra = l.size * (s.view_z - z_b) / z_b;
-    return blocker_width(penumbra / light_map_width(l, s.view_z) * l.map_size.x, l);
+    return sg_blocker_width(penumbra / sg_light_map_width(l, s.view_z) * l.map_size.x, l);
 }
 
 // A soft technique's two table lookups as two passes of one loop: pass 0 reads the table over
@@ -815,45 +822,45 @@ fn blocker_filter_width(l: Light, s: LightSample, z_avg: f32) -> f32 {
 // only a loop lets a group without blockers skip the second lookup there (measured: 64 loads
 // under a branch never taken cost what they cost taken, 11.0 against 10.9 ms; a loop-bearing
 // body under a branch or loop never entered, 3 against 12 ms); a GPU runs either as a branch.
-struct SoftLookup {
+struct sg_SoftLookup {
     width: f32,          // texels: the square the next pass reads
     blocker: vec2<f32>,  // (z_avg, share) from the search (pass 1)
     blockers: bool,      // whether the search found any (pass 1 is made)
 }
 
 // Pass 0: the search square.
-fn soft_search(l: Light, s: LightSample) -> SoftLookup {
-    var look: SoftLookup;
-    look.width = blocker_search_width(l, s);
+fn sg_soft_search(l: sg_Light, s: sg_LightSample) -> sg_SoftLookup {
+    var look: sg_SoftLookup;
+    look.width = sg_blocker_search_width(l, s);
     look.blocker = vec2<f32>(0.0);
     look.blockers = false;
     return look;
 }
 
 // Pass 1 after the search's estimate b = (z_avg, share): the penumbra width of z_avg.
-fn soft_blockers(b: vec2<f32>, l: Light, s: LightSample) -> SoftLookup {
-    var look: SoftLookup;
-    look.width = blocker_filter_width(l, s, b.x);
+fn sg_soft_blockers(b: vec2<f32>, l: sg_Light, s: sg_LightSample) -> sg_SoftLookup {
+    var look: sg_SoftLookup;
+    look.width = sg_blocker_filter_width(l, s, b.x);
     look.blocker = b;
-    look.blockers = b.y >= BLOCKER_MIN_SHARE;
+    look.blockers = b.y >= sg_BLOCKER_MIN_SHARE;
     return look;
 }
 
 // (z_avg, share) from a blocker depth estimate `z` and share: z clamped to [0, d] (blockers
 // are in front of the receiver d).
-fn blocker_result(z: f32, share: f32, d: f32) -> vec2<f32> {
+fn sg_blocker_result(z: f32, share: f32, d: f32) -> vec2<f32> {
     return vec2<f32>(clamp(z, 0.0, max(d, 0.0)), share);
 }
 
 // VSM moments m = (μ, E[z²]) over the search square, receiver depth d (Yang et al. 2010):
 // Chebyshev's one-tailed bound p on the share of texels at or behind d, and with those texels
 // taken at d, μ = p·d + (1 − p)·z_avg, so z_avg = (μ − p·d)/(1 − p). σ² is floored at `floor`.
-fn blocker_vsm(m: vec4<f32>, d: f32, floor: f32) -> vec2<f32> {
+fn sg_blocker_vsm(m: vec4<f32>, d: f32, floor: f32) -> vec2<f32> {
     let variance = max(m.y - m.x * m.x, floor);
     let t = d - m.x;
     let p = select(1.0, variance / (variance + t * t), t > 0.0);
     let share = 1.0 - p;
-    return blocker_result((m.x - p * d) / max(share, BLOCKER_MIN_SHARE), share, d);
+    return sg_blocker_result((m.x - p * d) / max(share, sg_BLOCKER_MIN_SHARE), share, d);
 }
 
 // Biased MSM moments over the search square, receiver depth d: the three-point distribution
@@ -866,28 +873,28 @@ fn blocker_vsm(m: vec4<f32>, d: f32, floor: f32) -> vec2<f32> {
 // reorder), a point far outside [0, 1] carries a vanishing weight whose product with its depth
 // need not vanish; clamped, it does, and z_avg stays continuous. Degenerate moments: a single
 // point at μ, or (rank-deficient) the two-moment estimate.
-fn blocker_msm(mm: MsmMoments, d: f32) -> vec2<f32> {
+fn sg_blocker_msm(mm: sg_MsmMoments, d: f32) -> vec2<f32> {
     let b = mm.b;
-    let roots = msm_roots(mm, d);
+    let roots = sg_msm_roots(mm, d);
     if roots.z == 1.0 {
         return vec2<f32>(b.x, select(0.0, 1.0, d > b.x));
     }
     if roots.z == 2.0 {
-        return blocker_vsm(b, d, 0.0);
+        return sg_blocker_vsm(b, d, 0.0);
     }
     let z2 = roots.x;
     let z3 = roots.y;
     if d <= z2 {
         return vec2<f32>(max(d, 0.0), 0.0);
     }
-    let w2 = msm_expect(mm, d, z3) / ((z3 - z2) * (d - z2));
+    let w2 = sg_msm_expect(mm, d, z3) / ((z3 - z2) * (d - z2));
     if d <= z3 {
-        return blocker_result(z2, w2, d);
+        return sg_blocker_result(z2, w2, d);
     }
-    let w1 = msm_expect(mm, z2, z3) / ((d - z2) * (d - z3));
+    let w1 = sg_msm_expect(mm, z2, z3) / ((d - z2) * (d - z3));
     let share = 1.0 - w1;
     let z = w2 * clamp(z2, 0.0, d) + (share - w2) * clamp(z3, 0.0, d);
-    return blocker_result(z / max(share, BLOCKER_MIN_SHARE), share, d);
+    return sg_blocker_result(z / max(share, sg_BLOCKER_MIN_SHARE), share, d);
 }
 
 // The CSM-Z basis (Annen et al. 2008): with f̄(d, z) = 1 − f(d, z) the complementary test
@@ -896,15 +903,15 @@ fn blocker_msm(mm: MsmMoments, d: f32) -> vec2<f32> {
 // linear in the images z, z·sin(c_k z), z·cos(c_k z), which `csm_z` writes in the order
 // [z, z·sin c₁z, z·cos c₁z, z·sin c₂z, …], four to a map. This is map `chunk`'s share of
 // E[f̄·z] from its filtered values v, at the shifted receiver depth CSM uses.
-fn csm_z_chunk_of(v: vec4<f32>, chunk: u32, l: Light, s: LightSample) -> f32 {
+fn sg_csm_z_chunk_of(v: vec4<f32>, chunk: u32, l: sg_Light, s: sg_LightSample) -> f32 {
     let d = s.depth - l.bias - l.csm_offset;
     var sum = 0.0;
     for (var c = 0u; c < 4u; c++) {
         let i = 4u * chunk + c;
         let k = (i + 1u) / 2u;
-        let sc = csm_sin_cos(max(k, 1u), d);
+        let sc = sg_csm_sin_cos(max(k, 1u), d);
         // Odd i: z·sin c_k z, weighted −w_k cos(c_k d); even i > 0: z·cos, weighted w_k sin.
-        var weight = select(csm_weight(max(k, 1u), l) * sc.x, -csm_weight(max(k, 1u), l) * sc.y,
+        var weight = select(sg_csm_weight(max(k, 1u), l) * sc.x, -sg_csm_weight(max(k, 1u), l) * sc.y,
             (i & 1u) == 1u);
         weight = select(weight, 0.5, i == 0u);
         sum += select(0.0, weight * v[c], i <= 2u * l.csm_terms);
@@ -916,43 +923,43 @@ fn csm_z_chunk_of(v: vec4<f32>, chunk: u32, l: Light, s: LightSample) -> f32 {
 // basis maps = E[f] − ½ (unscaled), `zsum` = Σ csm_z_chunk_of over the CSM-Z maps = E[f̄·z].
 // Share E[f̄] = ½ − below, z_avg = E[f̄·z] / E[f̄] (seed 000: the denominator is 1 − the
 // filtered CSM test).
-fn blocker_csm_z(below: f32, zsum: f32, d: f32) -> vec2<f32> {
+fn sg_blocker_csm_z(below: f32, zsum: f32, d: f32) -> vec2<f32> {
     let share = 0.5 - below;
-    return blocker_result(zsum / max(share, BLOCKER_MIN_SHARE), share, d);
+    return sg_blocker_result(zsum / max(share, sg_BLOCKER_MIN_SHARE), share, d);
 }
 
-fn cssm_blocker(below: f32, zsum: f32, l: Light, s: LightSample) -> vec2<f32> {
-    return blocker_csm_z(below, zsum, s.depth - l.bias);
+fn sg_cssm_blocker(below: f32, zsum: f32, l: sg_Light, s: sg_LightSample) -> vec2<f32> {
+    return sg_blocker_csm_z(below, zsum, s.depth - l.bias);
 }
 
 // v^p for v in [0, 1], p ≥ 1 (0 at v = 0, where log2 is −∞).
-fn cssm_sharpen(v: f32, p: f32) -> f32 {
+fn sg_cssm_sharpen(v: f32, p: f32) -> f32 {
     return select(0.0, exp2(p * log2(v)), v > 0.0);
 }
 
 // The visibility from the basis sum at the filter width and the blocker estimate `b` (which
 // found blockers: share ≥ BLOCKER_MIN_SHARE).
-fn cssm_resolve(sum: f32, b: vec2<f32>, l: Light, s: LightSample) -> f32 {
-    let v = csm_resolve(sum, l);
+fn sg_cssm_resolve(sum: f32, b: vec2<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
+    let v = sg_csm_resolve(sum, l);
     let gap = max(s.depth - l.bias - b.x, 0.0);
     let p = 1.0 + l.sharpen * exp(-l.sharpen_falloff * gap);
-    return cssm_sharpen(v, p);
+    return sg_cssm_sharpen(v, p);
 }
 // Exponential shadow maps: visibility = clamp(E[exp(c z)] · exp(−c d), 0, 1), with the filtered
 // moment kept as its logarithm L, so the product is exp(L − c d) and never overflows.
 
-// #fetches vis_esm: sample_map_log
-fn vis_esm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    return vis_esm_of_log(sample_map_log(map, l, s), l, s);
+// #fetches sg_vis_esm: sg_sample_map_log
+fn sg_vis_esm(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
+    return sg_vis_esm_of_log(sg_sample_map_log(map, l, s), l, s);
 }
 
 // The `sat` filter's table sums the moment scaled by exp(−c), m = E[exp(c (z − 1))]: its log
 // moment is ln m + c. A mean that quantization left at or below 0 reads as fully shadowed.
-fn vis_esm_of_sat(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
-    return vis_esm_of_log(log(max(m.x, 1e-37)) + l.exp_pos, l, s);
+fn sg_vis_esm_of_sat(m: vec4<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
+    return sg_vis_esm_of_log(log(max(m.x, 1e-37)) + l.exp_pos, l, s);
 }
 
-fn vis_esm_of_log(log_moment: f32, l: Light, s: LightSample) -> f32 {
+fn sg_vis_esm_of_log(log_moment: f32, l: sg_Light, s: sg_LightSample) -> f32 {
     return clamp(exp(log_moment - l.exp_pos * (s.depth - l.bias)), 0.0, 1.0);
 }
 // Exponential variance shadow maps: Chebyshev bound on the warped moments; EVSM4 takes the
@@ -962,7 +969,7 @@ fn vis_esm_of_log(log_moment: f32, l: Light, s: LightSample) -> f32 {
 // floor_warped = min_variance · (2c·E[warped])². (Taken at the receiver instead, the floor grows
 // with the receiver's own warped depth and, for c = 40, lets ~40% of the light into the umbra.)
 
-fn chebyshev_upper(mean: f32, mean_sq: f32, receiver: f32, floor: f32) -> f32 {
+fn sg_chebyshev_upper(mean: f32, mean_sq: f32, receiver: f32, floor: f32) -> f32 {
     if receiver <= mean {
         return 1.0;
     }
@@ -971,29 +978,29 @@ fn chebyshev_upper(mean: f32, mean_sq: f32, receiver: f32, floor: f32) -> f32 {
     return variance / (variance + t * t);
 }
 
-// #fetches vis_evsm: sample_map
-fn vis_evsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    return vis_evsm_of(sample_map(map, l, s), l, s);
+// #fetches sg_vis_evsm: sg_sample_map
+fn sg_vis_evsm(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
+    return sg_vis_evsm_of(sg_sample_map(map, l, s), l, s);
 }
 
 // The bounds from filtered moments `m` however they were filtered.
-fn vis_evsm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
+fn sg_vis_evsm_of(m: vec4<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
     let w = 2.0 * (s.depth - l.bias) - 1.0;
     let pos = exp(l.exp_pos * w);
     let slope_pos = 2.0 * l.exp_pos * m.x;
-    var p = chebyshev_upper(m.x, m.y, pos, l.min_variance * slope_pos * slope_pos);
+    var p = sg_chebyshev_upper(m.x, m.y, pos, l.min_variance * slope_pos * slope_pos);
     if l.moments == 4u {
         let neg = -exp(-l.exp_neg * w);
         let slope_neg = 2.0 * l.exp_neg * m.z;
-        p = min(p, chebyshev_upper(m.z, m.w, neg, l.min_variance * slope_neg * slope_neg));
+        p = min(p, sg_chebyshev_upper(m.z, m.w, neg, l.min_variance * slope_neg * slope_neg));
     }
-    return linstep(l.bleed, 1.0, p);
+    return sg_linstep(l.bleed, 1.0, p);
 }
 // Hard shadow test (Williams 1978): lit when d ≤ z_map + bias at the nearest texel.
 
-// #fetches vis_hard: 1
-fn vis_hard(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    let z = load_depth(map, texel_of(s.uv, l.map_size));
+// #fetches sg_vis_hard: 1
+fn sg_vis_hard(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
+    let z = sg_load_depth(map, sg_texel_of(s.uv, l.map_size));
     return select(0.0, 1.0, s.depth <= z + l.bias);
 }
 // Moment soft shadow maps (after Peters et al. 2016) from a summed-area table of the MSM
@@ -1005,47 +1012,47 @@ fn vis_hard(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
 // lit after the first.
 // `vis_msm_soft_fixed` reads a fixed-point table (rgba32uint), `vis_msm_soft_float` an f32 one.
 
-fn msm_soft_blocker(m: vec4<f32>, l: Light, s: LightSample) -> vec2<f32> {
-    return blocker_msm(msm_biased(m, l), s.depth - l.bias);
+fn sg_msm_soft_blocker(m: vec4<f32>, l: sg_Light, s: sg_LightSample) -> vec2<f32> {
+    return sg_blocker_msm(sg_msm_biased(m, l), s.depth - l.bias);
 }
 
-// #fetches vis_msm_soft_fixed: 2 * sat_sample_fixed
-fn vis_msm_soft_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32 {
-    var look = soft_search(l, s);
+// #fetches sg_vis_msm_soft_fixed: 2 * sg_sat_sample_fixed
+fn sg_vis_msm_soft_fixed(map: texture_2d<u32>, l: sg_Light, s: sg_LightSample) -> f32 {
+    var look = sg_soft_search(l, s);
     var m = vec4<f32>(0.0);
     for (var k = 0u; k < 2u; k++) {
-        m = sat_sample_fixed(map, l, s.uv, look.width);
+        m = sg_sat_sample_fixed(map, l, s.uv, look.width);
         if k == 0u {
-            look = soft_blockers(msm_soft_blocker(m, l, s), l, s);
+            look = sg_soft_blockers(sg_msm_soft_blocker(m, l, s), l, s);
             if !look.blockers {
                 return 1.0;
             }
         }
     }
-    return vis_msm_of(m, l, s);
+    return sg_vis_msm_of(m, l, s);
 }
 
-// #fetches vis_msm_soft_float: 2 * sat_sample_float
-fn vis_msm_soft_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    var look = soft_search(l, s);
+// #fetches sg_vis_msm_soft_float: 2 * sg_sat_sample_float
+fn sg_vis_msm_soft_float(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
+    var look = sg_soft_search(l, s);
     var m = vec4<f32>(0.0);
     for (var k = 0u; k < 2u; k++) {
-        m = sat_sample_float(map, l, s.uv, look.width);
+        m = sg_sat_sample_float(map, l, s.uv, look.width);
         if k == 0u {
-            look = soft_blockers(msm_soft_blocker(m, l, s), l, s);
+            look = sg_soft_blockers(sg_msm_soft_blocker(m, l, s), l, s);
             if !look.blockers {
                 return 1.0;
             }
         }
     }
-    return vis_msm_of(m, l, s);
+    return sg_vis_msm_of(m, l, s);
 }
 // Percentage-closer filtering (Reeves et al. 1987): the weighted mean of comparison results
 // over a (2r + 1)² window around the receiver's texel — never a filter of depths.
 
-// #fetches vis_pcf: (2 * l.radius + 1) * (2 * l.radius + 1)
-fn vis_pcf(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    let c = texel_of(s.uv, l.map_size);
+// #fetches sg_vis_pcf: (2 * l.radius + 1) * (2 * l.radius + 1)
+fn sg_vis_pcf(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
+    let c = sg_texel_of(s.uv, l.map_size);
     let r = i32(l.radius);
     var lit = 0.0;
     var total = 0.0;
@@ -1055,7 +1062,7 @@ fn vis_pcf(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
             if l.kernel == 1u {
                 w = f32(r + 1 - abs(dx)) * f32(r + 1 - abs(dy));
             }
-            let z = load_depth(map, c + vec2<i32>(dx, dy));
+            let z = sg_load_depth(map, c + vec2<i32>(dx, dy));
             lit += w * select(0.0, 1.0, s.depth <= z + l.bias);
             total += w;
         }
@@ -1064,9 +1071,9 @@ fn vis_pcf(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
 }
 
 // The hardware 2×2 comparison: bilinear weights of four comparisons against the raw depth map.
-// #fetches vis_pcf_hardware: 1
-fn vis_pcf_hardware(map: texture_depth_2d, cmp: sampler_comparison, l: Light, s: LightSample) -> f32 {
-    let reference = light_linear_to_ndc(l, clamp(s.depth - l.bias, 0.0, 1.0));
+// #fetches sg_vis_pcf_hardware: 1
+fn sg_vis_pcf_hardware(map: texture_depth_2d, cmp: sampler_comparison, l: sg_Light, s: sg_LightSample) -> f32 {
+    let reference = sg_light_linear_to_ndc(l, clamp(s.depth - l.bias, 0.0, 1.0));
     return textureSampleCompareLevel(map, cmp, s.uv, reference);
 }
 // Percentage-closer soft shadows (Fernando 2005), the brute-force peer of the prefiltered soft
@@ -1075,18 +1082,18 @@ fn vis_pcf_hardware(map: texture_depth_2d, cmp: sampler_comparison, l: Light, s:
 
 // Radius (UV) of the blocker search: the cone from the receiver to the light's width, at the
 // near plane where it is widest, capped by max_search.
-fn pcss_search_radius(l: Light, s: LightSample) -> f32 {
+fn sg_pcss_search_radius(l: sg_Light, s: sg_LightSample) -> f32 {
     let world = 0.5 * l.size * (s.view_z - l.near) / s.view_z;
-    return min(world / light_map_width(l, l.near), l.max_search);
+    return min(world / sg_light_map_width(l, l.near), l.max_search);
 }
 
-// #fetches vis_pcss: l.blocker_samples + l.filter_samples
-fn vis_pcss(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    let search = pcss_search_radius(l, s);
+// #fetches sg_vis_pcss: l.blocker_samples + l.filter_samples
+fn sg_vis_pcss(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
+    let search = sg_pcss_search_radius(l, s);
     var sum = 0.0;
     var count = 0u;
     for (var i = 0u; i < l.blocker_samples; i++) {
-        let z = load_depth(map, texel_of(s.uv + search * vogel_disc(i, l.blocker_samples), l.map_size));
+        let z = sg_load_depth(map, sg_texel_of(s.uv + search * sg_vogel_disc(i, l.blocker_samples), l.map_size));
         if z + l.bias < s.depth {
             sum += z;
             count += 1u;
@@ -1095,12 +1102,12 @@ fn vis_pcss(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     if count == 0u {
         return 1.0;
     }
-    let z_blocker = light_linear_to_z(l, sum / f32(count));
+    let z_blocker = sg_light_linear_to_z(l, sum / f32(count));
     let penumbra_world = l.size * (s.view_z - z_blocker) / z_blocker;
-    let radius = max(0.5 * penumbra_world / light_map_width(l, s.view_z), 0.5 / l.map_size.x);
+    let radius = max(0.5 * penumbra_world / sg_light_map_width(l, s.view_z), 0.5 / l.map_size.x);
     var lit = 0.0;
     for (var i = 0u; i < l.filter_samples; i++) {
-        let z = load_depth(map, texel_of(s.uv + radius * vogel_disc(i, l.filter_samples), l.map_size));
+        let z = sg_load_depth(map, sg_texel_of(s.uv + radius * sg_vogel_disc(i, l.filter_samples), l.map_size));
         lit += select(0.0, 1.0, s.depth <= z + l.bias);
     }
     return lit / f32(l.filter_samples);
@@ -1109,21 +1116,21 @@ fn vis_pcss(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
 //   σ² = max(E[z²] − μ², min_variance),  p_max = σ² / (σ² + (d − μ)²) for d > μ, else 1,
 // then the light-bleeding reduction linstep(bleed, 1, p_max).
 
-// #fetches vis_vsm: sample_map
-fn vis_vsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    return vis_vsm_of(sample_map(map, l, s), l, s);
+// #fetches sg_vis_vsm: sg_sample_map
+fn sg_vis_vsm(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
+    return sg_vis_vsm_of(sg_sample_map(map, l, s), l, s);
 }
 
 // The bound from filtered moments `m` however they were filtered (the `sat` filter calls this
 // with its rectangle mean).
-fn vis_vsm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
+fn sg_vis_vsm_of(m: vec4<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
     let d = s.depth - l.bias;
     if d <= m.x {
         return 1.0;
     }
     let variance = max(m.y - m.x * m.x, l.min_variance);
     let t = d - m.x;
-    return linstep(l.bleed, 1.0, variance / (variance + t * t));
+    return sg_linstep(l.bleed, 1.0, variance / (variance + t * t));
 }
 // Variance soft shadow maps (Yang et al. 2010) from a summed-area table of the VSM moments:
 // the moments over the blocker-search square give the blocker share and depth (blocker_vsm),
@@ -1133,38 +1140,38 @@ fn vis_vsm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
 // BLOCKER_MIN_SHARE) is lit after the first.
 // `vis_vssm_fixed` reads a fixed-point table (rgba32uint), `vis_vssm_float` an f32 one.
 
-fn vssm_blocker(m: vec4<f32>, l: Light, s: LightSample) -> vec2<f32> {
-    return blocker_vsm(m, s.depth - l.bias, l.min_variance);
+fn sg_vssm_blocker(m: vec4<f32>, l: sg_Light, s: sg_LightSample) -> vec2<f32> {
+    return sg_blocker_vsm(m, s.depth - l.bias, l.min_variance);
 }
 
-// #fetches vis_vssm_fixed: 2 * sat_sample_fixed
-fn vis_vssm_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32 {
-    var look = soft_search(l, s);
+// #fetches sg_vis_vssm_fixed: 2 * sg_sat_sample_fixed
+fn sg_vis_vssm_fixed(map: texture_2d<u32>, l: sg_Light, s: sg_LightSample) -> f32 {
+    var look = sg_soft_search(l, s);
     var m = vec4<f32>(0.0);
     for (var k = 0u; k < 2u; k++) {
-        m = sat_sample_fixed(map, l, s.uv, look.width);
+        m = sg_sat_sample_fixed(map, l, s.uv, look.width);
         if k == 0u {
-            look = soft_blockers(vssm_blocker(m, l, s), l, s);
+            look = sg_soft_blockers(sg_vssm_blocker(m, l, s), l, s);
             if !look.blockers {
                 return 1.0;
             }
         }
     }
-    return vis_vsm_of(m, l, s);
+    return sg_vis_vsm_of(m, l, s);
 }
 
-// #fetches vis_vssm_float: 2 * sat_sample_float
-fn vis_vssm_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    var look = soft_search(l, s);
+// #fetches sg_vis_vssm_float: 2 * sg_sat_sample_float
+fn sg_vis_vssm_float(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
+    var look = sg_soft_search(l, s);
     var m = vec4<f32>(0.0);
     for (var k = 0u; k < 2u; k++) {
-        m = sat_sample_float(map, l, s.uv, look.width);
+        m = sg_sat_sample_float(map, l, s.uv, look.width);
         if k == 0u {
-            look = soft_blockers(vssm_blocker(m, l, s), l, s);
+            look = sg_soft_blockers(sg_vssm_blocker(m, l, s), l, s);
             if !look.blockers {
                 return 1.0;
             }
         }
     }
-    return vis_vsm_of(m, l, s);
+    return sg_vis_vsm_of(m, l, s);
 }

@@ -41,6 +41,8 @@ struct Prepared {
     plan: Plan,
     /// The imported textures bound, by resource name.
     imports: Vec<(String, wgpu::Texture)>,
+    /// The layer of each import read as one layer of an array texture.
+    layers: HashMap<String, u32>,
     outputs: Outputs,
     /// Every dispatch's parameters.
     params: RunParams,
@@ -77,16 +79,31 @@ impl Executor {
         encoder: &mut wgpu::CommandEncoder,
         plan: &Plan,
         imports: &HashMap<String, wgpu::Texture>,
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<Outputs> {
+        self.record_layers(device, encoder, plan, imports, &HashMap::new(), timer)
+    }
+
+    /// [`Executor::record`] where some imports are one layer of an array texture: `layers`
+    /// gives that layer by resource name (read through a 2-D view of it; no copy).
+    pub fn record_layers(
+        &mut self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        plan: &Plan,
+        imports: &HashMap<String, wgpu::Texture>,
+        layers: &HashMap<String, u32>,
         mut timer: Option<&mut GpuTimer>,
     ) -> Result<Outputs> {
         // A plan's fields are public: check what the binding below relies on first.
         plan.check()?;
+        check_layers(imports, layers)?;
         let same_plan = self.prepared.as_ref().is_some_and(|p| p.plan == *plan);
         let prepared = match self.prepared.take() {
-            Some(p) if same_plan && p.imports_match(imports) => p,
+            Some(p) if same_plan && p.imports_match(imports, layers) => p,
             // New imported textures (a host's depth map): the nodes reading them are bound anew.
-            Some(p) if same_plan => self.rebind_imports(device, p, imports)?,
-            _ => self.prepare_run(device, plan, imports)?,
+            Some(p) if same_plan => self.rebind_imports(device, p, imports, layers)?,
+            _ => self.prepare_run(device, plan, imports, layers)?,
         };
         record::encode(encoder, &prepared, timer.as_deref_mut());
         let outputs = prepared.outputs.clone();
@@ -104,6 +121,7 @@ impl Executor {
         device: &wgpu::Device,
         plan: &Plan,
         imports: &HashMap<String, wgpu::Texture>,
+        layers: &HashMap<String, u32>,
     ) -> Result<Prepared> {
         // Textures of the previous run go back to the pool, then each slot takes one.
         for (slot, t) in self.in_use.drain(..) {
@@ -121,7 +139,7 @@ impl Executor {
             .zip(slot_textures.iter().cloned())
             .collect();
         let textures = pool::plan_textures(plan, &slot_textures, imports)?;
-        let outputs = Outputs::new(device, plan, textures);
+        let outputs = Outputs::new(device, plan, textures, layers.clone());
         let params = record::params_buffer(device, plan)?;
         let mut bound = Vec::new();
         for (si, step) in plan.steps.iter().enumerate() {
@@ -150,6 +168,7 @@ impl Executor {
         Ok(Prepared {
             plan: plan.clone(),
             imports,
+            layers: layers.clone(),
             outputs,
             params,
             steps: bound,
@@ -163,9 +182,12 @@ impl Executor {
         device: &wgpu::Device,
         mut prepared: Prepared,
         imports: &HashMap<String, wgpu::Texture>,
+        layers: &HashMap<String, u32>,
     ) -> Result<Prepared> {
         let slots: Vec<wgpu::Texture> = self.in_use.iter().map(|(_, t)| t.clone()).collect();
         prepared.outputs.textures = pool::plan_textures(&prepared.plan, &slots, imports)?;
+        prepared.outputs.layers = layers.clone();
+        prepared.layers = layers.clone();
         for (name, t) in &mut prepared.imports {
             if let Some(new) = imports.get(name) {
                 *t = new.clone();
@@ -193,10 +215,37 @@ impl Executor {
 }
 
 impl Prepared {
-    /// Whether `imports` holds the same texture for every import this run bound.
-    fn imports_match(&self, imports: &HashMap<String, wgpu::Texture>) -> bool {
-        self.imports
-            .iter()
-            .all(|(name, t)| imports.get(name) == Some(t))
+    /// Whether `imports` holds the same texture (and layer) for every import this run bound.
+    fn imports_match(
+        &self,
+        imports: &HashMap<String, wgpu::Texture>,
+        layers: &HashMap<String, u32>,
+    ) -> bool {
+        self.layers == *layers
+            && self
+                .imports
+                .iter()
+                .all(|(name, t)| imports.get(name) == Some(t))
     }
+}
+
+/// Every layer names an import that has it.
+fn check_layers(
+    imports: &HashMap<String, wgpu::Texture>,
+    layers: &HashMap<String, u32>,
+) -> Result<()> {
+    for (name, &layer) in layers {
+        let t = imports
+            .get(name)
+            .ok_or_else(|| ExecError::MissingImport(name.clone()))?;
+        if layer >= t.depth_or_array_layers() {
+            return Err(ExecError::NoLayer {
+                resource: name.clone(),
+                layer,
+                layers: t.depth_or_array_layers(),
+            }
+            .into());
+        }
+    }
+    Ok(())
 }

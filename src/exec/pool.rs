@@ -52,6 +52,9 @@ impl TexturePool {
 pub struct Outputs {
     /// Texture of every planned resource, imports included.
     pub textures: HashMap<String, wgpu::Texture>,
+    /// The array layer each imported resource is read from, where it is one layer of an array
+    /// texture (absent: the whole texture).
+    pub layers: HashMap<String, u32>,
     /// One counter per step that a kernel may increment (e.g. non-finite texels replaced).
     pub stats: wgpu::Buffer,
     pub(super) stats_readback: wgpu::Buffer,
@@ -68,6 +71,7 @@ impl Outputs {
         device: &wgpu::Device,
         plan: &Plan,
         textures: HashMap<String, wgpu::Texture>,
+        layers: HashMap<String, u32>,
     ) -> Self {
         let steps = plan.steps.len().max(1) as u64;
         let counters = |label, usage| {
@@ -94,6 +98,7 @@ impl Outputs {
             ),
             steps: plan.steps.iter().map(|s| s.node.name.clone()).collect(),
             textures,
+            layers,
         }
     }
 

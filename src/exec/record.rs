@@ -203,7 +203,8 @@ fn bind_group(
                     node: node.name.clone(),
                     resource: r.to_string(),
                 })?;
-            views.push((b.binding, texture_view(node, t, *level)?));
+            let layer = buffers.outputs.layers.get(*r).copied();
+            views.push((b.binding, texture_view(node, t, *level, layer)?));
         } else if b.name != "params" && b.name != "stats" {
             return Err(ExecError::Unbound {
                 node: node.name.clone(),
@@ -246,9 +247,14 @@ fn bind_group(
     )
 }
 
-/// A view of all of `t` (`level` `None`) or of its one mip level `level`; the depth aspect for
-/// a depth texture.
-fn texture_view(node: &Node, t: &wgpu::Texture, level: Option<u32>) -> Result<wgpu::TextureView> {
+/// A view of all of `t` (`level` `None`) or of its one mip level `level`, of its one array
+/// layer `layer` (as a 2-D view) where given; the depth aspect for a depth texture.
+fn texture_view(
+    node: &Node,
+    t: &wgpu::Texture,
+    level: Option<u32>,
+    layer: Option<u32>,
+) -> Result<wgpu::TextureView> {
     if let Some(l) = level.filter(|&l| l >= t.mip_level_count()) {
         return Err(ExecError::NoLevel {
             node: node.name.clone(),
@@ -267,6 +273,9 @@ fn texture_view(node: &Node, t: &wgpu::Texture, level: Option<u32>) -> Result<wg
             },
             base_mip_level: level.unwrap_or(0),
             mip_level_count: level.map(|_| 1),
+            dimension: layer.map(|_| wgpu::TextureViewDimension::D2),
+            base_array_layer: layer.unwrap_or(0),
+            array_layer_count: layer.map(|_| 1),
             ..Default::default()
         },
     ))

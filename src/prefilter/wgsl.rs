@@ -16,6 +16,11 @@ use super::{LightParams, PrefilterConfig};
 /// Where the generated library is committed (relative to the crate root).
 pub const LIBRARY_PATH: &str = "kernels/export/shadowgraph.wgsl";
 
+/// The prefix of every name the exported WGSL defines (`sg_Light`, `sg_vis_vsm`, …), so that a
+/// host's own `struct Light` or `fn linstep` cannot collide with it; the functions a host block
+/// generates are `shadowgraph_…`.
+pub const PREFIX: &str = "sg_";
+
 /// The identifier a map of the shading block is renamed to in a host's WGSL.
 const MAP_PREFIX: &str = "shadowgraph_map";
 /// The comparison sampler of hardware PCF (a global of `kernels/shade.wgsl`) and its host name.
@@ -34,13 +39,16 @@ pub fn library() -> Result<String> {
     let mut s = String::new();
     s.push_str(LIBRARY_HEADER);
     s.push_str("//\n// Visibility functions (map binding types as declared):\n");
-    for line in body.lines().filter(|l| l.starts_with("fn vis_")) {
+    for line in body.lines().filter(|l| l.starts_with("fn sg_vis_")) {
         let sig = line.trim_end_matches('{').trim_end();
         let _ = writeln!(s, "//   {sig}");
     }
-    s.push_str("//\n// Names defined here (a host must not reuse them):\n");
+    s.push_str(
+        "//\n// Names defined here, each with the `sg_` prefix (a host's own names need only avoid\n\
+         // `sg_` and `shadowgraph_`):\n",
+    );
     let mut line = String::from("//  ");
-    for name in defined_names(&body)? {
+    for name in defined_names("export/shadowgraph", &body)? {
         if line.len() + name.len() > 96 {
             let _ = writeln!(s, "{line}");
             line = String::from("//  ");
@@ -57,39 +65,78 @@ const LIBRARY_HEADER: &str = "\
 // `shadowgraph::prefilter::wgsl::library()` from kernels/shared/; do not edit (the `plugin_wgsl`
 // test checks this file is current; `SHADOWGRAPH_BLESS=1` rewrites it).
 //
-// Usage, per light and shaded point p (world) with unit normal n:
+// Every name defined here carries the prefix `sg_` (`sg_Light`, `sg_vis_vsm`, …), so a host's
+// own names cannot collide. Usage, per light and shaded point p (world) with unit normal n:
 //   var v = 0.0;                                 // facing away: in its own shadow
-//   if light_faces(l, p, n) {
-//       let s = light_sample(l, p, n);           // where p lands in the light's map
+//   if sg_light_faces(l, p, n) {
+//       let s = sg_light_sample(l, p, n);        // where p lands in the light's map
 //       v = 1.0;                                 // outside the map: unshadowed
-//       if s.inside { v = vis_vsm(map, l, s); }
+//       if s.inside { v = sg_vis_vsm(map, l, s); }
 //   }
 // (Branching costs nothing here: every function reads with textureLoad or an explicit level,
 // which WGSL allows in non-uniform control flow.)
 // `map` is the texture `Prefilter::record` returned for the technique (its
-// `PrefilterOutput::maps`, in order), bound as the type in the signature below; `l` is a
-// `Light`, filled byte for byte from `PrefilterOutput::light` (Rust `LightGpu`, bytemuck):
+// `PrefilterOutput::maps`, in order), bound as the type in the signature below; `l` is an
+// `sg_Light`, filled byte for byte from `PrefilterOutput::light` (Rust `LightGpu`, bytemuck):
 // the host's view and view·projection matrices, near/far, map size, bias and the technique's
 // parameters. The projection is wgpu's (right-handed, depth 0 at near, 1 at far). Without
-// Rust, fill the fields as `struct Light` below comments them: view_proj = projection · view,
+// Rust, fill the fields as `struct sg_Light` below comments them: view_proj = projection · view,
 // position and direction from the inverse view (its origin and −Z), width_at_unit =
 // 2 / projection[0][0], map_size = the map's side, kind 1 for perspective depth.
 // Prefiltered maps are read with four loads, so no sampler or filterable format is needed;
-// only `vis_pcf_hardware` takes a comparison sampler (linear filtering, compare less-equal).
+// only `sg_vis_pcf_hardware` takes a comparison sampler (linear filtering, compare less-equal).
 ";
 
-/// Resolves `// #import` lines for `modules`, in order, each once.
+/// Resolves `// #import` lines for `modules`, in order, each once, and gives every name the
+/// result defines the [`PREFIX`].
 fn resolve_modules(label: &str, modules: &[&str]) -> Result<String> {
+    let (resolved, names) = resolve_unprefixed(label, modules)?;
+    let prefixed = prefix_names(&resolved, &names);
+    // A member or local spelt like a module-scope name would break here, not in a host.
+    kernels::validate(label, &prefixed)?;
+    Ok(prefixed)
+}
+
+/// The modules resolved as the renderer has them, and the names they define (sorted).
+fn resolve_unprefixed(label: &str, modules: &[&str]) -> Result<(String, Vec<String>)> {
     let mut text = String::new();
     for m in ["shared/light", "shared/sampling"].iter().chain(modules) {
         let _ = writeln!(text, "// #import {m}");
     }
-    kernels::resolve_source(label, &text)
+    let resolved = kernels::resolve_source(label, &text)?;
+    let names = defined_names(label, &resolved)?;
+    Ok((resolved, names))
 }
 
-/// Module-scope names of `wgsl`, sorted: what a host must not redefine.
-fn defined_names(wgsl: &str) -> Result<Vec<String>> {
-    let module = kernels::validate("export/shadowgraph", wgsl)?;
+/// `wgsl` with every identifier in `names` prefixed by [`PREFIX`]; member names (after a `.`)
+/// and comments are left as they are, except `// #fetches` lines, whose expressions name
+/// functions.
+fn prefix_names(wgsl: &str, names: &[String]) -> String {
+    let mut out = String::with_capacity(wgsl.len() + wgsl.len() / 8);
+    for line in wgsl.split_inclusive('\n') {
+        let (code, comment) = match line.find("//") {
+            Some(at) if !line[at..].starts_with("// #fetches") => line.split_at(at),
+            _ => (line, ""),
+        };
+        let mut after_dot = false;
+        for t in split_tokens(code) {
+            let ident = t.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_');
+            if ident && !after_dot && names.binary_search_by(|n| n.as_str().cmp(t)).is_ok() {
+                out.push_str(PREFIX);
+            }
+            out.push_str(t);
+            if !t.trim().is_empty() {
+                after_dot = t.ends_with('.');
+            }
+        }
+        out.push_str(comment);
+    }
+    out
+}
+
+/// Module-scope names of `wgsl` (sorted): the names [`resolve_modules`] prefixes.
+fn defined_names(label: &str, wgsl: &str) -> Result<Vec<String>> {
+    let module = kernels::validate(label, wgsl)?;
     let mut names: Vec<String> = module
         .types
         .iter()
@@ -150,11 +197,35 @@ fn malformed(text: &str) -> Error {
 }
 
 /// The resolved modules `technique` calls (no bindings): its visibility function with
-/// `struct Light` and the sampling helpers.
+/// `struct sg_Light` and the sampling helpers, every name prefixed with [`PREFIX`].
 pub fn technique_functions(technique: &Technique) -> Result<String> {
-    let block = block_of(technique)?;
-    let modules: Vec<&str> = block.imports.iter().map(String::as_str).collect();
-    resolve_modules(&format!("export/{}", technique.name()), &modules)
+    functions_for(std::slice::from_ref(technique))
+}
+
+/// The functions of several techniques in one text, each module once: what a host shader
+/// holding several lights (of one technique or several) includes once, before each light's
+/// [`light_block`].
+pub fn functions_for(techniques: &[Technique]) -> Result<String> {
+    let modules = modules_of(techniques)?;
+    let modules: Vec<&str> = modules.iter().map(String::as_str).collect();
+    let label = match techniques {
+        [t] => format!("export/{}", t.name()),
+        _ => "export/functions".to_string(),
+    };
+    resolve_modules(&label, &modules)
+}
+
+/// The modules `techniques` import, each once, in first-use order.
+fn modules_of(techniques: &[Technique]) -> Result<Vec<String>> {
+    let mut modules: Vec<String> = Vec::new();
+    for t in techniques {
+        for m in block_of(t)?.imports {
+            if !modules.contains(&m) {
+                modules.push(m);
+            }
+        }
+    }
+    Ok(modules)
 }
 
 /// Whether `technique` binds a comparison sampler after its maps (hardware PCF).
@@ -162,69 +233,128 @@ pub fn needs_comparison_sampler(technique: &Technique) -> Result<bool> {
     Ok(split_tokens(&block_of(technique)?.body).contains(&CMP_SAMPLER))
 }
 
-/// A host's WGSL for `technique`: [`technique_functions`], one binding per map at
-/// `@group(group) @binding(first_binding + k)` named `shadowgraph_map{k}` (then
-/// `shadowgraph_cmp_sampler` where [`needs_comparison_sampler`]), and
-/// `fn shadowgraph_visibility(l: Light, p: vec3<f32>, n: vec3<f32>) -> f32`: 0 where the
-/// receiver faces away from the light, 1 outside the map, else the technique's visibility.
+/// A host's WGSL for `technique`: [`technique_functions`], then its [`light_block`] with the
+/// default names: one binding per map at `@group(group) @binding(first_binding + k)` named
+/// `shadowgraph_map{k}` (then `shadowgraph_cmp_sampler` where [`needs_comparison_sampler`]),
+/// and `fn shadowgraph_visibility(l: sg_Light, p: vec3<f32>, n: vec3<f32>) -> f32`: 0 where
+/// the receiver faces away from the light, 1 outside the map, else the technique's
+/// visibility.
 pub fn host_block(technique: &Technique, group: u32, first_binding: u32) -> Result<String> {
-    let block = block_of(technique)?;
     let mut s = String::new();
     let name = technique.name();
     let _ = writeln!(
         s,
         "// shadowgraph plug-in stage, technique \"{name}\" (generated by \
          shadowgraph::prefilter; do not edit).\n// Bind PrefilterOutput::maps[k] at \
-         @group({group}) @binding({first_binding} + k); fill `Light` from \
+         @group({group}) @binding({first_binding} + k); fill `sg_Light` from \
          PrefilterOutput::light."
     );
     s.push_str(&technique_functions(technique)?);
+    s.push_str(&light_block(technique, "", group, first_binding)?);
+    Ok(s)
+}
+
+/// One light's bindings and functions, without the functions they call (include
+/// [`functions_for`] the techniques once per shader module). With `light` empty the names are
+/// [`host_block`]'s; else `shadowgraph_{light}_map{k}`, `shadowgraph_{light}_cmp_sampler`,
+/// `shadowgraph_visibility_{light}(l, p, n)` and `shadowgraph_visibility_footprint_{light}`,
+/// so that blocks of several lights (each at its own bindings) live in one module. `light`
+/// is an identifier's tail: ASCII letters, digits and `_`.
+pub fn light_block(
+    technique: &Technique,
+    light: &str,
+    group: u32,
+    first_binding: u32,
+) -> Result<String> {
+    if !light.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') || light.contains("__") {
+        return Err(Error::Invalid(format!(
+            "light name `{light}` for the exported WGSL: use ASCII letters, digits and single `_`"
+        )));
+    }
+    let block = block_of(technique)?;
+    let modules: Vec<&str> = block.imports.iter().map(String::as_str).collect();
+    let (_, library_names) = resolve_unprefixed(&format!("export/{}", technique.name()), &modules)?;
+    let names = BlockNames::new(light);
+    let mut s = String::new();
     for (k, (_, ty)) in block.maps.iter().enumerate() {
         let binding = first_binding + k as u32;
         let _ = writeln!(
             s,
-            "@group({group}) @binding({binding}) var {MAP_PREFIX}{k}: {ty};"
+            "@group({group}) @binding({binding}) var {}{k}: {ty};",
+            names.map
         );
     }
     let mut call = String::new();
     for t in split_tokens(&block.body) {
         match block.maps.iter().position(|(n, _)| n == t) {
             Some(k) => {
-                let _ = write!(call, "{MAP_PREFIX}{k}");
+                let _ = write!(call, "{}{k}", names.map);
             }
-            None if t == CMP_SAMPLER => call.push_str(HOST_CMP_SAMPLER),
+            None if t == CMP_SAMPLER => call.push_str(&names.cmp_sampler),
             None => call.push_str(t),
         }
     }
-    if call.contains(HOST_CMP_SAMPLER) {
+    if call.contains(&names.cmp_sampler) {
         let binding = first_binding + block.maps.len() as u32;
         let _ = writeln!(
             s,
-            "@group({group}) @binding({binding}) var {HOST_CMP_SAMPLER}: sampler_comparison;"
+            "@group({group}) @binding({binding}) var {}: sampler_comparison;",
+            names.cmp_sampler
         );
     }
     if let Some(fetches) = &block.fetches {
-        let _ = writeln!(s, "// #fetches shadowgraph_light_visibility: {fetches}");
+        let _ = writeln!(s, "// #fetches {}: {fetches}", names.light_visibility);
     }
+    let (lv, v, vf) = (&names.light_visibility, &names.visibility, &names.footprint);
     // As the renderer's shading block: no lookup facing away (0) or outside the map (1).
     let _ = write!(
         s,
-        "fn shadowgraph_light_visibility(l: Light, s: LightSample) -> f32 {{\n    {call}\n}}\n\
-         fn shadowgraph_visibility(l: Light, p: vec3<f32>, n: vec3<f32>) -> f32 {{\n    \
+        "fn {lv}(l: Light, s: LightSample) -> f32 {{\n    {call}\n}}\n\
+         fn {v}(l: Light, p: vec3<f32>, n: vec3<f32>) -> f32 {{\n    \
          if !light_faces(l, p, n) {{\n        return 0.0;\n    }}\n    \
          let s = light_sample(l, p, n);\n    \
          if !s.inside {{\n        return 1.0;\n    }}\n    \
-         return shadowgraph_light_visibility(l, s);\n}}\n\
+         return {lv}(l, s);\n}}\n\
          // With the pixel's footprint (e.g. dpdx(p), dpdy(p) in a fragment shader): mip lookups\n\
          // with `max_anisotropy` ≥ 1 follow it; other lookups ignore it.\n\
-         fn shadowgraph_visibility_footprint(l: Light, p: vec3<f32>, n: vec3<f32>, dpdx: vec3<f32>, dpdy: vec3<f32>) -> f32 {{\n    \
+         fn {vf}(l: Light, p: vec3<f32>, n: vec3<f32>, dpdx: vec3<f32>, dpdy: vec3<f32>) -> f32 {{\n    \
          if !light_faces(l, p, n) {{\n        return 0.0;\n    }}\n    \
          var s = light_sample(l, p, n);\n    \
          if !s.inside {{\n        return 1.0;\n    }}\n    \
          s.footprint = light_footprint(l, s, p, n, dpdx, dpdy);\n    \
-         return shadowgraph_light_visibility(l, s);\n}}\n"
+         return {lv}(l, s);\n}}\n"
     );
-    Ok(s)
+    Ok(prefix_names(&s, &library_names))
+}
+
+/// The names one light's block declares.
+struct BlockNames {
+    map: String,
+    cmp_sampler: String,
+    light_visibility: String,
+    visibility: String,
+    footprint: String,
+}
+
+impl BlockNames {
+    fn new(light: &str) -> Self {
+        if light.is_empty() {
+            return Self {
+                map: MAP_PREFIX.to_string(),
+                cmp_sampler: HOST_CMP_SAMPLER.to_string(),
+                light_visibility: "shadowgraph_light_visibility".into(),
+                visibility: "shadowgraph_visibility".into(),
+                footprint: "shadowgraph_visibility_footprint".into(),
+            };
+        }
+        Self {
+            map: format!("shadowgraph_{light}_map"),
+            cmp_sampler: format!("shadowgraph_{light}_cmp_sampler"),
+            light_visibility: format!("shadowgraph_light_visibility_{light}"),
+            visibility: format!("shadowgraph_visibility_{light}"),
+            footprint: format!("shadowgraph_visibility_footprint_{light}"),
+        }
+    }
 }
 
 /// `text` cut into identifiers and the runs of other characters between them.

@@ -2,6 +2,7 @@
 #![allow(dead_code, unused_imports, reason = "each test binary uses a subset")]
 
 pub mod evaluate;
+pub mod host;
 pub mod soft;
 pub mod soft_maps;
 

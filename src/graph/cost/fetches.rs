@@ -133,7 +133,10 @@ impl<'a> Fetches<'a> {
     /// A name in a declaration: a light field, a constant, or a function's fetches.
     fn value(&mut self, n: &str) -> std::result::Result<f64, String> {
         if let Some(field) = n.strip_prefix("l.") {
-            let ty = declare::named_type(&self.module, "Light").ok_or("no `struct Light`")?;
+            // The renderer's `Light`, or the exported library's `sg_Light`.
+            let ty = declare::named_type(&self.module, "Light")
+                .or_else(|| declare::named_type(&self.module, "sg_Light"))
+                .ok_or("no `struct Light`")?;
             return declare::struct_field(&self.module, ty, self.light, field);
         }
         if let Some(v) = self.consts.get(n) {
