@@ -117,7 +117,13 @@ fn unusable_depth_textures_are_named() {
     let past = shadowgraph::prefilter::DepthLayer::new(&layered, 2);
     let e = record_err(&g, past, &light());
     assert!(
-        matches!(e, StageError::DepthLayer { layer: 2, layers: 2 }),
+        matches!(
+            e,
+            StageError::DepthLayer {
+                layer: 2,
+                layers: 2
+            }
+        ),
         "{e}"
     );
 

@@ -1,0 +1,464 @@
+//! A host with several lights, as real renderers keep them: one `Depth32Float` array texture
+//! with a layer per light, rendered by the host's own depth pass; ONE `Prefilter` serves every
+//! light (one set of pipelines, `record_light(k, …, DepthLayer::new(&array, k), …)` reads each
+//! layer in place, and each light's maps live until that light is recorded again); the host's
+//! shader holds the technique's functions once and one generated block per light
+//! (`shadowgraph_visibility_key`, `…_fill`, `…_sun`), next to its own names. Writes a PNG.
+//!
+//!     cargo run --release --example host_lights [-- out.png]     (default target/host_lights.png)
+
+mod common;
+
+use anyhow::{Context, Result};
+use common::{clear_depth, depth_state, device, read, scene, target, uniform_entry, vertex_layout};
+use glam::{Mat4, Vec3};
+use shadowgraph::prefilter::{DepthLayer, LightParams, Prefilter, PrefilterConfig};
+use wgpu::util::DeviceExt;
+
+const IMAGE: (u32, u32) = (640, 480);
+const SHADOW_MAP: u32 = 512;
+/// The lights' names in the shader, their colours and how they see the scene.
+const LIGHTS: [(&str, [f32; 3]); 3] = [
+    ("key", [0.95, 0.8, 0.6]),
+    ("fill", [0.35, 0.45, 0.75]),
+    ("sun", [0.5, 0.5, 0.45]),
+];
+
+fn light_params() -> Vec<LightParams> {
+    let spot = |eye: Vec3| {
+        LightParams::perspective(Mat4::look_at_rh(eye, Vec3::ZERO, Vec3::Y), 1.0, 2.0, 20.0)
+    };
+    let sun = Mat4::look_at_rh(Vec3::new(-6.0, 9.0, 2.0), Vec3::ZERO, Vec3::Y);
+    vec![
+        spot(Vec3::new(4.0, 6.0, 4.0)),
+        spot(Vec3::new(-5.0, 4.0, 3.0)),
+        LightParams::orthographic(sun, 5.0, 2.0, 20.0),
+    ]
+}
+
+/// The host's own shading and names (a `struct Light` of its own, unrelated to
+/// shadowgraph's `sg_Light`); `VISIBILITY` becomes one term per light.
+const SHADE: &str = "
+struct Light { color: vec4<f32> }
+@group(0) @binding(0) var<uniform> camera: mat4x4<f32>;
+@group(0) @binding(1) var<uniform> colors: array<Light, 3>;
+// The lights as the stage describes them (`PrefilterOutput::light`, one after another, in one
+// uniform buffer; lavapipe 22.3 crashed when a fifth uniform binding fed the visibility).
+@group(0) @binding(2) var<uniform> shadows: array<sg_Light, 3>;
+
+struct VsOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) color: vec3<f32>,
+}
+
+@vertex
+fn vs_main(@location(0) p: vec3<f32>, @location(1) n: vec3<f32>, @location(2) c: vec3<f32>) -> VsOut {
+    return VsOut(camera * vec4<f32>(p, 1.0), p, n, c);
+}
+
+fn lambert(l: sg_Light, p: vec3<f32>, n: vec3<f32>) -> f32 {
+    // Spot lights shine from their position, the sun along its direction.
+    let to_light = select(-l.direction, normalize(l.position - p), l.kind == 1u);
+    return max(dot(n, to_light), 0.0);
+}
+
+@fragment
+fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
+    let n = normalize(in.normal);
+    let p = in.world;
+    var light = vec3<f32>(0.08);
+    let key = shadows[0];
+    let fill = shadows[1];
+    let sun = shadows[2];
+    light += colors[0].color.rgb * lambert(key, p, n) * shadowgraph_visibility_key(key, p, n);
+    light += colors[1].color.rgb * lambert(fill, p, n) * shadowgraph_visibility_fill(fill, p, n);
+    light += colors[2].color.rgb * lambert(sun, p, n) * shadowgraph_visibility_sun(sun, p, n);
+    return vec4<f32>(in.color * light, 1.0);
+}
+";
+
+/// The host's depth pass, once per layer.
+const DEPTH: &str = "
+@group(0) @binding(0) var<uniform> view_proj: mat4x4<f32>;
+@vertex
+fn vs_main(@location(0) p: vec3<f32>) -> @builtin(position) vec4<f32> {
+    return view_proj * vec4<f32>(p, 1.0);
+}
+";
+
+fn main() -> Result<()> {
+    let out = std::env::args()
+        .nth(1)
+        .unwrap_or_else(|| "target/host_lights.png".into());
+    let start = std::time::Instant::now();
+    let (device, queue) = pollster::block_on(device())?;
+    let verts = scene();
+    let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("host.vertices"),
+        contents: bytemuck::cast_slice(&verts),
+        usage: wgpu::BufferUsages::VERTEX,
+    });
+    let params = light_params();
+    let shadows = shadow_array(&device, LIGHTS.len() as u32);
+
+    // One stage for every light: pipelines once.
+    let mut stage = Prefilter::new(&device, &PrefilterConfig::msm(SHADOW_MAP))?;
+    // Each light's maps at their own bindings of group 1: the technique's functions once, then
+    // one block per light.
+    let per_light = stage.layout_entries(0, wgpu::ShaderStages::FRAGMENT)?.len() as u32;
+    let mut wgsl = stage.wgsl_functions()?;
+    let mut maps_entries = Vec::new();
+    for (k, (name, _)) in LIGHTS.iter().enumerate() {
+        let first = k as u32 * per_light;
+        wgsl.push_str(&stage.wgsl_light(name, 1, first)?);
+        maps_entries.extend(stage.layout_entries(first, wgpu::ShaderStages::FRAGMENT)?);
+    }
+    let maps_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("host.maps"),
+        entries: &maps_entries,
+    });
+    let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("host.frame"),
+        entries: &(0..3)
+            .map(|b| {
+                let stage = match b {
+                    0 => wgpu::ShaderStages::VERTEX,
+                    _ => wgpu::ShaderStages::FRAGMENT,
+                };
+                uniform_entry(b, stage)
+            })
+            .collect::<Vec<_>>(),
+    });
+    let shade = shade_pipeline(
+        &device,
+        &format!("{wgsl}{SHADE}"),
+        &frame_layout,
+        &maps_layout,
+    );
+    let depth_pipeline = depth_pipeline(&device);
+
+    let mut enc = device.create_command_encoder(&Default::default());
+    let mut outputs = Vec::new();
+    for (k, light) in params.iter().enumerate() {
+        if std::env::var_os("STEP").is_some() {
+            eprintln!("depth {k}");
+        }
+        depth_pass(
+            &device,
+            &mut enc,
+            &depth_pipeline,
+            &vertices,
+            verts.len() as u32,
+            &shadows,
+            k as u32,
+            light,
+        );
+        if std::env::var_os("STEP1").is_some() {
+            queue.submit([std::mem::replace(
+                &mut enc,
+                device.create_command_encoder(&Default::default()),
+            )
+            .finish()]);
+            device.poll(wgpu::PollType::wait_indefinitely()).unwrap();
+            eprintln!("depth {k} done");
+        }
+        outputs.push(stage.record_light(
+            k,
+            &device,
+            &mut enc,
+            DepthLayer::new(&shadows, k as u32),
+            light,
+        )?);
+    }
+    if std::env::var_os("STEP1").is_some() {
+        queue.submit([std::mem::replace(
+            &mut enc,
+            device.create_command_encoder(&Default::default()),
+        )
+        .finish()]);
+        device.poll(wgpu::PollType::wait_indefinitely()).unwrap();
+        eprintln!("stage done");
+    }
+    let views: Vec<&wgpu::TextureView> = outputs
+        .iter()
+        .flat_map(|o| o.maps.iter().map(|m| &m.view))
+        .collect();
+    let maps = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("host.maps"),
+        layout: &maps_layout,
+        entries: &views
+            .iter()
+            .enumerate()
+            .map(|(b, v)| wgpu::BindGroupEntry {
+                binding: b as u32,
+                resource: wgpu::BindingResource::TextureView(v),
+            })
+            .collect::<Vec<_>>(),
+    });
+    let aspect = IMAGE.0 as f32 / IMAGE.1 as f32;
+    let camera = Mat4::perspective_rh(0.75, aspect, 0.1, 100.0)
+        * Mat4::look_at_rh(Vec3::new(3.0, 4.0, 6.5), Vec3::new(0.2, 0.5, 0.5), Vec3::Y);
+    let mut uniforms: Vec<Vec<u8>> = vec![
+        bytemuck::cast_slice(&camera.to_cols_array()).to_vec(),
+        LIGHTS
+            .iter()
+            .flat_map(|(_, c)| bytemuck::cast_slice(&[c[0], c[1], c[2], 0.0]).to_vec())
+            .collect(),
+    ];
+    uniforms.push(
+        outputs
+            .iter()
+            .flat_map(|o| bytemuck::bytes_of(&o.light).to_vec())
+            .collect(),
+    );
+    let buffers: Vec<wgpu::Buffer> = uniforms
+        .iter()
+        .map(|u| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("host.uniform"),
+                contents: u,
+                usage: wgpu::BufferUsages::UNIFORM,
+            })
+        })
+        .collect();
+    let frame = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("host.frame"),
+        layout: &frame_layout,
+        entries: &buffers
+            .iter()
+            .enumerate()
+            .map(|(b, buf)| wgpu::BindGroupEntry {
+                binding: b as u32,
+                resource: buf.as_entire_binding(),
+            })
+            .collect::<Vec<_>>(),
+    });
+    let color = target(&device, IMAGE, wgpu::TextureFormat::Rgba8UnormSrgb);
+    let depth = target(&device, IMAGE, wgpu::TextureFormat::Depth32Float);
+    shade_pass(
+        &mut enc,
+        &shade,
+        &frame,
+        &maps,
+        &vertices,
+        verts.len() as u32,
+        &color,
+        &depth,
+    );
+    let readback = copy_color(&device, &mut enc, &color);
+    queue.submit([enc.finish()]);
+    let rgba = read(&device, &readback)?;
+    image::save_buffer(&out, &rgba, IMAGE.0, IMAGE.1, image::ColorType::Rgba8)
+        .with_context(|| format!("writing {out}"))?;
+    println!(
+        "wrote {out} ({}x{}: {} lights from one {}² msm stage, layers of one depth array; \
+         {} pipelines, {} textures) in {:.2} s",
+        IMAGE.0,
+        IMAGE.1,
+        stage.light_count(),
+        SHADOW_MAP,
+        stage.pipeline_count(),
+        stage.texture_count(),
+        start.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+/// The host's shadow maps: one layer per light.
+fn shadow_array(device: &wgpu::Device, layers: u32) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("host.shadows"),
+        size: wgpu::Extent3d {
+            width: SHADOW_MAP,
+            height: SHADOW_MAP,
+            depth_or_array_layers: layers,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Depth32Float,
+        // Read by the stage: TEXTURE_BINDING.
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    })
+}
+
+fn depth_pipeline(device: &wgpu::Device) -> wgpu::RenderPipeline {
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("host.depth"),
+        source: wgpu::ShaderSource::Wgsl(DEPTH.into()),
+    });
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("host.depth"),
+        layout: None,
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[Some(vertex_layout())],
+        },
+        primitive: Default::default(),
+        depth_stencil: Some(depth_state(1.5)),
+        multisample: Default::default(),
+        fragment: None,
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+fn shade_pipeline(
+    device: &wgpu::Device,
+    wgsl: &str,
+    frame_layout: &wgpu::BindGroupLayout,
+    maps_layout: &wgpu::BindGroupLayout,
+) -> wgpu::RenderPipeline {
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("host.shade"),
+        source: wgpu::ShaderSource::Wgsl(wgsl.into()),
+    });
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("host.shade"),
+        bind_group_layouts: &[Some(frame_layout), Some(maps_layout)],
+        immediate_size: 0,
+    });
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("host.shade"),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[Some(vertex_layout())],
+        },
+        primitive: Default::default(),
+        depth_stencil: Some(depth_state(0.0)),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::TextureFormat::Rgba8UnormSrgb.into())],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// The scene's depth from `light` into layer `layer` of `shadows`.
+#[allow(clippy::too_many_arguments, reason = "a flat example")]
+fn depth_pass(
+    device: &wgpu::Device,
+    enc: &mut wgpu::CommandEncoder,
+    pipeline: &wgpu::RenderPipeline,
+    vertices: &wgpu::Buffer,
+    count: u32,
+    shadows: &wgpu::Texture,
+    layer: u32,
+    light: &LightParams,
+) {
+    let vp = (light.projection * light.view).to_cols_array();
+    let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("host.light_view_proj"),
+        contents: bytemuck::cast_slice(&vp),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("host.depth"),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: buffer.as_entire_binding(),
+        }],
+    });
+    let view = shadows.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2),
+        base_array_layer: layer,
+        array_layer_count: Some(1),
+        ..Default::default()
+    });
+    let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("host.depth"),
+        color_attachments: &[],
+        depth_stencil_attachment: Some(clear_depth(&view)),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, &bg, &[]);
+    pass.set_vertex_buffer(0, vertices.slice(..));
+    pass.draw(0..count, 0..1);
+}
+
+#[allow(clippy::too_many_arguments, reason = "a flat example")]
+fn shade_pass(
+    enc: &mut wgpu::CommandEncoder,
+    pipeline: &wgpu::RenderPipeline,
+    frame: &wgpu::BindGroup,
+    maps: &wgpu::BindGroup,
+    vertices: &wgpu::Buffer,
+    count: u32,
+    color: &wgpu::Texture,
+    depth: &wgpu::Texture,
+) {
+    let (cv, dv) = (
+        color.create_view(&Default::default()),
+        depth.create_view(&Default::default()),
+    );
+    let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("host.shade"),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: &cv,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color {
+                    r: 0.3,
+                    g: 0.38,
+                    b: 0.5,
+                    a: 1.0,
+                }),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: Some(clear_depth(&dv)),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, frame, &[]);
+    pass.set_bind_group(1, maps, &[]);
+    pass.set_vertex_buffer(0, vertices.slice(..));
+    pass.draw(0..count, 0..1);
+}
+
+fn copy_color(
+    device: &wgpu::Device,
+    enc: &mut wgpu::CommandEncoder,
+    color: &wgpu::Texture,
+) -> wgpu::Buffer {
+    let (w, h) = (color.width(), color.height());
+    // 640 · 4 bytes per row: a multiple of COPY_BYTES_PER_ROW_ALIGNMENT (256).
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("host.readback"),
+        size: u64::from(w * h * 4),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    enc.copy_texture_to_buffer(
+        color.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(w * 4),
+                rows_per_image: Some(h),
+            },
+        },
+        color.size(),
+    );
+    buffer
+}
