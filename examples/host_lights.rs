@@ -1,9 +1,11 @@
 //! A host with several lights, as real renderers keep them: one `Depth32Float` array texture
-//! with a layer per light, rendered by the host's own depth pass; ONE `Prefilter` serves every
-//! light (one set of pipelines, `record_light(k, …, DepthLayer::new(&array, k), …)` reads each
-//! layer in place, and each light's maps live until that light is recorded again); the host's
-//! shader holds the technique's functions once and one generated block per light
-//! (`shadowgraph_visibility_key`, `…_fill`, `…_sun`), next to its own names. Writes a PNG.
+//! with a layer per shadow map, rendered by the host's own depth pass: two spot lights and a
+//! directional sun in three cascades (`prefilter::cascades`: practical split, texel-snapped).
+//! ONE `Prefilter` serves every map (one set of pipelines, `record_light(k, …,
+//! DepthLayer::new(&array, k), …)` reads each layer in place, and each map lives until its slot
+//! is recorded again); the host's shader holds the technique's functions once and one generated
+//! block per map (`shadowgraph_visibility_key`, `…_fill`, `…_sun0` …), next to its own names,
+//! and picks the sun's cascade by view distance. Writes a PNG.
 //!
 //!     cargo run --release --example host_lights [-- out.png]     (default target/host_lights.png)
 
@@ -12,39 +14,63 @@ mod common;
 use anyhow::{Context, Result};
 use common::{clear_depth, depth_state, device, read, scene, target, uniform_entry, vertex_layout};
 use glam::{Mat4, Vec3};
+use shadowgraph::prefilter::cascades::{CascadeCamera, CascadeLayout, fit_cascades};
 use shadowgraph::prefilter::{DepthLayer, LightParams, Prefilter, PrefilterConfig};
 use wgpu::util::DeviceExt;
 
 const IMAGE: (u32, u32) = (640, 480);
 const SHADOW_MAP: u32 = 512;
-/// The lights' names in the shader, their colours and how they see the scene.
-const LIGHTS: [(&str, [f32; 3]); 3] = [
-    ("key", [0.95, 0.8, 0.6]),
-    ("fill", [0.35, 0.45, 0.75]),
-    ("sun", [0.5, 0.5, 0.45]),
-];
+/// The shadow maps' names in the shader (one layer and light slot each) and the lights'
+/// colours (key, fill, sun).
+const MAPS: [&str; 5] = ["key", "fill", "sun0", "sun1", "sun2"];
+const COLORS: [[f32; 3]; 3] = [[0.95, 0.8, 0.6], [0.35, 0.45, 0.75], [0.5, 0.5, 0.45]];
 
-fn light_params() -> Vec<LightParams> {
+fn camera() -> CascadeCamera {
+    CascadeCamera {
+        view: Mat4::look_at_rh(Vec3::new(3.0, 4.0, 6.5), Vec3::new(0.2, 0.5, 0.5), Vec3::Y),
+        fov_y: 0.75,
+        aspect: IMAGE.0 as f32 / IMAGE.1 as f32,
+        near: 0.5,
+        far: 16.0,
+    }
+}
+
+/// Each map's light: the two spots, then the sun's cascades (and their far distances).
+fn light_params() -> Result<(Vec<LightParams>, [f32; 4])> {
     let spot = |eye: Vec3| {
         LightParams::perspective(Mat4::look_at_rh(eye, Vec3::ZERO, Vec3::Y), 1.0, 2.0, 20.0)
     };
-    let sun = Mat4::look_at_rh(Vec3::new(-6.0, 9.0, 2.0), Vec3::ZERO, Vec3::Y);
-    vec![
+    let layout = CascadeLayout {
+        count: 3,
+        lambda: 0.7,
+        map_size: SHADOW_MAP,
+        caster_margin: 10.0,
+    };
+    let cascades = fit_cascades(&camera(), Vec3::new(6.0, -9.0, -2.0), &layout)?;
+    let mut fars = [0.0; 4];
+    for (f, c) in fars.iter_mut().zip(&cascades) {
+        *f = c.far;
+    }
+    let mut lights = vec![
         spot(Vec3::new(4.0, 6.0, 4.0)),
         spot(Vec3::new(-5.0, 4.0, 3.0)),
-        LightParams::orthographic(sun, 5.0, 2.0, 20.0),
-    ]
+    ];
+    lights.extend(cascades.iter().map(|c| c.light));
+    Ok((lights, fars))
 }
 
 /// The host's own shading and names (a `struct Light` of its own, unrelated to
 /// shadowgraph's `sg_Light`); `VISIBILITY` becomes one term per light.
 const SHADE: &str = "
 struct Light { color: vec4<f32> }
+// The lights' colours, the camera's view and the sun's cascade ends (view distances).
+struct Frame { colors: array<Light, 3>, view: mat4x4<f32>, cascade_far: vec4<f32> }
 @group(0) @binding(0) var<uniform> camera: mat4x4<f32>;
-@group(0) @binding(1) var<uniform> colors: array<Light, 3>;
-// The lights as the stage describes them (`PrefilterOutput::light`, one after another, in one
-// uniform buffer; lavapipe 22.3 crashed when a fifth uniform binding fed the visibility).
-@group(0) @binding(2) var<uniform> shadows: array<sg_Light, 3>;
+@group(0) @binding(1) var<uniform> frame: Frame;
+// The maps' lights as the stage describes them (`PrefilterOutput::light`, one after another,
+// in one uniform buffer; lavapipe 22.3 crashed when more than three uniform bindings fed the
+// fragment shader with the visibility functions).
+@group(0) @binding(2) var<uniform> shadows: array<sg_Light, 5>;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -64,6 +90,22 @@ fn lambert(l: sg_Light, p: vec3<f32>, n: vec3<f32>) -> f32 {
     return max(dot(n, to_light), 0.0);
 }
 
+// The sun's visibility from the first cascade whose range holds the pixel (lit beyond the last).
+fn sun_visibility(p: vec3<f32>, n: vec3<f32>) -> f32 {
+    let d = -(frame.view * vec4<f32>(p, 1.0)).z;
+    let cascade_far = frame.cascade_far;
+    if d <= cascade_far.x {
+        return shadowgraph_visibility_sun0(shadows[2], p, n);
+    }
+    if d <= cascade_far.y {
+        return shadowgraph_visibility_sun1(shadows[3], p, n);
+    }
+    if d <= cascade_far.z {
+        return shadowgraph_visibility_sun2(shadows[4], p, n);
+    }
+    return 1.0;
+}
+
 @fragment
 fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     let n = normalize(in.normal);
@@ -71,10 +113,9 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     var light = vec3<f32>(0.08);
     let key = shadows[0];
     let fill = shadows[1];
-    let sun = shadows[2];
-    light += colors[0].color.rgb * lambert(key, p, n) * shadowgraph_visibility_key(key, p, n);
-    light += colors[1].color.rgb * lambert(fill, p, n) * shadowgraph_visibility_fill(fill, p, n);
-    light += colors[2].color.rgb * lambert(sun, p, n) * shadowgraph_visibility_sun(sun, p, n);
+    light += frame.colors[0].color.rgb * lambert(key, p, n) * shadowgraph_visibility_key(key, p, n);
+    light += frame.colors[1].color.rgb * lambert(fill, p, n) * shadowgraph_visibility_fill(fill, p, n);
+    light += frame.colors[2].color.rgb * lambert(shadows[2], p, n) * sun_visibility(p, n);
     return vec4<f32>(in.color * light, 1.0);
 }
 ";
@@ -100,8 +141,8 @@ fn main() -> Result<()> {
         contents: bytemuck::cast_slice(&verts),
         usage: wgpu::BufferUsages::VERTEX,
     });
-    let params = light_params();
-    let shadows = shadow_array(&device, LIGHTS.len() as u32);
+    let (params, cascade_far) = light_params()?;
+    let shadows = shadow_array(&device, MAPS.len() as u32);
 
     // One stage for every light: pipelines once.
     let mut stage = Prefilter::new(&device, &PrefilterConfig::msm(SHADOW_MAP))?;
@@ -110,7 +151,7 @@ fn main() -> Result<()> {
     let per_light = stage.layout_entries(0, wgpu::ShaderStages::FRAGMENT)?.len() as u32;
     let mut wgsl = stage.wgsl_functions()?;
     let mut maps_entries = Vec::new();
-    for (k, (name, _)) in LIGHTS.iter().enumerate() {
+    for (k, name) in MAPS.iter().enumerate() {
         let first = k as u32 * per_light;
         wgsl.push_str(&stage.wgsl_light(name, 1, first)?);
         maps_entries.extend(stage.layout_entries(first, wgpu::ShaderStages::FRAGMENT)?);
@@ -197,14 +238,15 @@ fn main() -> Result<()> {
             })
             .collect::<Vec<_>>(),
     });
-    let aspect = IMAGE.0 as f32 / IMAGE.1 as f32;
-    let camera = Mat4::perspective_rh(0.75, aspect, 0.1, 100.0)
-        * Mat4::look_at_rh(Vec3::new(3.0, 4.0, 6.5), Vec3::new(0.2, 0.5, 0.5), Vec3::Y);
+    let cam = camera();
+    let view_proj = Mat4::perspective_rh(cam.fov_y, cam.aspect, 0.1, 100.0) * cam.view;
     let mut uniforms: Vec<Vec<u8>> = vec![
-        bytemuck::cast_slice(&camera.to_cols_array()).to_vec(),
-        LIGHTS
+        bytemuck::cast_slice(&view_proj.to_cols_array()).to_vec(),
+        COLORS
             .iter()
-            .flat_map(|(_, c)| bytemuck::cast_slice(&[c[0], c[1], c[2], 0.0]).to_vec())
+            .flat_map(|c| bytemuck::cast_slice(&[c[0], c[1], c[2], 0.0]).to_vec())
+            .chain(bytemuck::cast_slice(&cam.view.to_cols_array()).to_vec())
+            .chain(bytemuck::cast_slice(&cascade_far).to_vec())
             .collect(),
     ];
     uniforms.push(
@@ -253,8 +295,8 @@ fn main() -> Result<()> {
     image::save_buffer(&out, &rgba, IMAGE.0, IMAGE.1, image::ColorType::Rgba8)
         .with_context(|| format!("writing {out}"))?;
     println!(
-        "wrote {out} ({}x{}: {} lights from one {}² msm stage, layers of one depth array; \
-         {} pipelines, {} textures) in {:.2} s",
+        "wrote {out} ({}x{}: two spot lights and a sun in three cascades, {} maps from one {}² msm \
+         stage, layers of one depth array; {} pipelines, {} textures) in {:.2} s",
         IMAGE.0,
         IMAGE.1,
         stage.light_count(),

@@ -19,6 +19,7 @@
 //! # Ok(()) }
 //! ```
 
+pub mod cascades;
 mod config;
 mod limits;
 pub mod wgsl;
