@@ -445,6 +445,7 @@ impl LightParams {
                 // Slope-scaled bias is rasterization state: the host's depth pass owns it.
                 slope_bias: 0.0,
                 normal_bias: config.normal_bias,
+                receiver_plane: 0.0,
             },
         }
     }
