@@ -48,10 +48,11 @@
 //   TECHNIQUE_PCSS TECHNIQUE_VSM TECHNIQUE_VSSM bilinear_level bilinear_log_level blocker_csm_z
 //   blocker_filter_width blocker_msm blocker_result blocker_search_width blocker_vsm
 //   blocker_width chebyshev_upper csm_chunk csm_chunk_of csm_resolve csm_sin_cos csm_weight
-//   csm_z_chunk_of cssm_blocker cssm_resolve cssm_sharpen level_size light_faces light_footprint
-//   light_linear_to_ndc light_linear_to_z light_map_width light_sample light_to_light linstep
-//   load_depth mip_tap_uv mip_taps msm_biased msm_dequantize msm_expect msm_intensity
-//   msm_moments msm_quantize msm_roots msm_soft_blocker pcss_search_radius sample_bilinear
+//   csm_z_chunk_of cssm_blocker cssm_resolve cssm_sharpen level_size light_depth_slope
+//   light_faces light_footprint light_linear_to_ndc light_linear_to_z light_map_width
+//   light_receiver_offset light_sample light_tap_offset light_to_light linstep load_depth
+//   mip_tap_uv mip_taps msm_biased msm_dequantize msm_expect msm_intensity msm_moments
+//   msm_quantize msm_roots msm_soft_blocker pcss_search_radius sample_bilinear
 //   sample_bilinear_log sample_map sample_map_log sat_mean_fixed sat_mean_float sat_node_f32
 //   sat_node_u32 sat_nodes sat_rect sat_sample_fixed sat_sample_float soft_blockers soft_search
 //   texel_of trilinear trilinear_log vis_esm vis_esm_of_log vis_esm_of_sat vis_evsm vis_evsm_of
@@ -106,7 +107,7 @@ struct Light {
     sharpen: f32,            // cssm: sharpening strength A of v^p, p = 1 + A·exp(−B (d − z_avg))
     sharpen_falloff: f32,    // cssm: sharpening falloff B, per linear depth unit
     max_width: f32,          // soft techniques: cap on the search and filter widths, texels
-    _pad1: u32,
+    receiver_plane: f32,     // receiver-plane bias: cap on a tap's depth correction (0: off)
 }
 
 // `Light::technique` (keep in sync with the `TECHNIQUE_*` constants of src/gpu_data.rs; a test
@@ -130,6 +131,7 @@ struct LightSample {
     view_z: f32,     // receiver's distance Z along the light axis
     inside: bool,    // inside the map and the depth range
     footprint: vec4<f32>, // the pixel's footprint in the map, texels: axes (x, y) and (z, w); 0 unknown
+    depth_slope: vec2<f32>, // receiver plane: d(depth)/d(texel) along u and v (0 when off)
 }
 
 // World width of the whole map at view distance z.
@@ -170,7 +172,43 @@ fn light_sample(l: Light, p: vec3<f32>, n: vec3<f32>) -> LightSample {
     s.inside = clip.w > 0.0 && all(s.uv >= vec2<f32>(0.0)) && all(s.uv <= vec2<f32>(1.0))
         && s.depth >= 0.0 && s.depth <= 1.0;
     s.footprint = vec4<f32>(0.0);
+    s.depth_slope = vec2<f32>(0.0);
+    if l.receiver_plane > 0.0 {
+        s.depth_slope = light_depth_slope(l, q, n, s.view_z);
+    }
     return s;
+}
+
+// Receiver-plane depth bias (Isidoro, GDC 2006): the depth of the plane through the receiver q
+// with normal n, per texel of offset in the map. A compute shading pass has no dpdx, so the
+// plane comes from the G-buffer normal: exact for planar receivers. View space v = V q; a point
+// of the plane seen through map coordinates (a, b) at distance Z is Z·(a, b, −1) (spot) or
+// (x, y, −Z) (directional), so Z = n·v / (n_x a + n_y b − n_z) and dZ/da = −Z² n_x / n·v
+// (directional: dZ/dx = n_x / n_z); a and x grow with u, b and y with −v.
+fn light_depth_slope(l: Light, q: vec3<f32>, n: vec3<f32>, z: f32) -> vec2<f32> {
+    let v = (l.view * vec4<f32>(q, 1.0)).xyz;
+    let nv = (l.view * vec4<f32>(n, 0.0)).xyz;
+    var per_world: vec2<f32>;
+    if l.kind == 0u {
+        per_world = vec2<f32>(nv.x, -nv.y) / nv.z;
+    } else {
+        per_world = vec2<f32>(-nv.x, nv.y) * (z * z / dot(nv, v));
+    }
+    let texel = l.width_at_unit / l.map_size.x;
+    let slope = per_world * texel / (l.far - l.near);
+    // Edge-on (n·v or n_z → 0) the slope is unbounded or NaN: the cap bounds each tap instead.
+    return select(vec2<f32>(0.0), slope, all(abs(slope) < vec2<f32>(1e30)));
+}
+
+// The receiver plane's depth change to a tap `offset` texels from the receiver, capped at
+// ±receiver_plane (0 when the bias is off).
+fn light_receiver_offset(l: Light, s: LightSample, offset: vec2<f32>) -> f32 {
+    return clamp(dot(s.depth_slope, offset), -l.receiver_plane, l.receiver_plane);
+}
+
+// The offset in texels from the receiver to texel t's centre.
+fn light_tap_offset(l: Light, s: LightSample, t: vec2<i32>) -> vec2<f32> {
+    return vec2<f32>(t) + 0.5 - s.uv * l.map_size;
 }
 
 // The footprint in light l's map, in texels, of the pixel whose receiver p (normal n) moves by
@@ -989,12 +1027,15 @@ fn vis_evsm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32 {
     }
     return linstep(l.bleed, 1.0, p);
 }
-// Hard shadow test (Williams 1978): lit when d ≤ z_map + bias at the nearest texel.
+// Hard shadow test (Williams 1978): lit when d ≤ z_map + bias at the nearest texel, d moved
+// along the receiver plane to the texel's centre when the receiver-plane bias is on.
 
 // #fetches vis_hard: 1
 fn vis_hard(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    let z = load_depth(map, texel_of(s.uv, l.map_size));
-    return select(0.0, 1.0, s.depth <= z + l.bias);
+    let t = texel_of(s.uv, l.map_size);
+    let z = load_depth(map, t);
+    let d = s.depth + light_receiver_offset(l, s, light_tap_offset(l, s, t));
+    return select(0.0, 1.0, d <= z + l.bias);
 }
 // Moment soft shadow maps (after Peters et al. 2016) from a summed-area table of the MSM
 // moments (raw or quantized): the biased moments over the blocker-search square give the
@@ -1041,7 +1082,8 @@ fn vis_msm_soft_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     return vis_msm_of(m, l, s);
 }
 // Percentage-closer filtering (Reeves et al. 1987): the weighted mean of comparison results
-// over a (2r + 1)² window around the receiver's texel — never a filter of depths.
+// over a (2r + 1)² window around the receiver's texel — never a filter of depths. With the
+// receiver-plane bias each tap compares the receiver plane's depth at that texel's centre.
 
 // #fetches vis_pcf: (2 * l.radius + 1) * (2 * l.radius + 1)
 fn vis_pcf(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
@@ -1055,8 +1097,10 @@ fn vis_pcf(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
             if l.kernel == 1u {
                 w = f32(r + 1 - abs(dx)) * f32(r + 1 - abs(dy));
             }
-            let z = load_depth(map, c + vec2<i32>(dx, dy));
-            lit += w * select(0.0, 1.0, s.depth <= z + l.bias);
+            let t = c + vec2<i32>(dx, dy);
+            let z = load_depth(map, t);
+            let d = s.depth + light_receiver_offset(l, s, light_tap_offset(l, s, t));
+            lit += w * select(0.0, 1.0, d <= z + l.bias);
             total += w;
         }
     }
