@@ -51,9 +51,12 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let n = select(normalize(gn.xyz), vec3<f32>(0.0, 1.0, 0.0), gp.w == 0.0 || dot(gn.xyz, gn.xyz) == 0.0);
     let l = sample_light[0];
     let s = light_sample(l, gp.xyz, n);
-    let raw = textureLoad(depth, texel_of(s.uv, l.map_size), 0);
+    let t = texel_of(s.uv, l.map_size);
+    let raw = textureLoad(depth, t, 0);
     let z = linear_depth(l, raw);
-    let lit = select(1u, select(0u, 1u, s.depth <= z + l.bias), s.inside);
+    // The scene's bias, the receiver-plane bias included (0 when off).
+    let d = s.depth + light_receiver_offset(l, s, light_tap_offset(l, s, t));
+    let lit = select(1u, select(0u, 1u, d <= z + l.bias), s.inside);
     if inside_image {
         let i = xy.y * size.x + xy.x;
         lit_count[i] = lit_count[i] + lit;

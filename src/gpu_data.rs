@@ -94,8 +94,9 @@ pub struct LightGpu {
     /// Soft techniques: cap on the search and filter widths in texels (`technique::soft_max_width`;
     /// 0 otherwise).
     pub max_width: f32,
-    /// Padding to the WGSL struct's 16-byte alignment.
-    pub _pad1: u32,
+    /// Receiver-plane depth bias: the cap on each tap's depth correction, linear depth units
+    /// (0: off; `Shadow::receiver_plane`).
+    pub receiver_plane: f32,
 }
 
 /// Technique id of `hard` (`LightGpu::technique`; `TECHNIQUE_HARD` in

@@ -355,6 +355,7 @@ fn blocker_estimates_match_reference() {
         view_z: 1.0,
         inside: true,
         footprint: [0.0; 4],
+        depth_slope: [0.0; 2],
     };
 
     // VSM: (μ, E[z²]) ± their errors.

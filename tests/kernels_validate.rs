@@ -25,6 +25,7 @@ fn light(technique: Technique) -> Light {
             bias: 0.002,
             slope_bias: 1.0,
             normal_bias: 1.0,
+            receiver_plane: 0.0,
         },
     }
 }

@@ -435,6 +435,32 @@ fn settings_that_do_not_apply_are_named() {
     let e = PrefilterConfig::vsm(0).validated().unwrap_err();
     assert!(e.to_string().contains("size"), "{e}");
     let e = PrefilterConfig::vsm(64)
+        .with_receiver_plane(0.01)
+        .validated()
+        .unwrap_err();
+    assert!(
+        matches!(&e, StageError::Config { field, .. } if field == "receiver_plane"),
+        "{e}"
+    );
+    let hardware = Technique::Pcf {
+        radius: 1,
+        kernel: PcfKernel::Hardware,
+    };
+    let e = PrefilterConfig::new(hardware, 64)
+        .with_receiver_plane(0.01)
+        .validated()
+        .unwrap_err();
+    assert!(e.to_string().contains("bias_mode"), "{e}");
+    let e = PrefilterConfig::new(Technique::Hard, 64)
+        .with_receiver_plane(2.0)
+        .validated()
+        .unwrap_err();
+    assert!(e.to_string().contains("receiver_plane_cap"), "{e}");
+    PrefilterConfig::new(Technique::Hard, 64)
+        .with_receiver_plane(0.01)
+        .validated()
+        .expect("hard takes the receiver-plane bias");
+    let e = PrefilterConfig::vsm(64)
         .with_soft(shadowgraph::sat::SatVariant::Float, 0.1)
         .validated()
         .unwrap_err();

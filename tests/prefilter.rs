@@ -690,6 +690,7 @@ fn plans_hold_exactly_what_each_light_needs() {
             bias: 0.002,
             slope_bias: 1.0,
             normal_bias: 1.0,
+            receiver_plane: 0.0,
         },
     };
     let blur = Filter::Blur {

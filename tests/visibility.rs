@@ -36,15 +36,30 @@ fn light(kind: LightKind, technique: Technique) -> Light {
             bias: 0.002,
             slope_bias: 0.0,
             normal_bias: 1.0,
+            receiver_plane: 0.0,
         },
     }
 }
 
 /// A world point whose light-space UV and linear depth are given, with a normal facing the light.
 fn point(l: &Light, rng: &mut impl Rng) -> (Vec3, Vec3) {
-    let g = LightGpu::new(l);
     let uv = [rng.random_range(0.08..0.92), rng.random_range(0.08..0.92)];
     let d: f64 = rng.random_range(0.05..0.98);
+    point_at(l, uv, d, rng)
+}
+
+/// A point near the surface `map` holds: at its texel's depth ± 0.01, where the comparisons
+/// are close and a receiver-plane correction decides them.
+fn point_on(l: &Light, map: &[f32], rng: &mut impl Rng) -> (Vec3, Vec3) {
+    let uv = [rng.random_range(0.08..0.92), rng.random_range(0.08..0.92)];
+    let t = |c: f64| ((c * MAP as f64).floor() as usize).min(MAP - 1);
+    let z = f64::from(map[t(uv[1]) * MAP + t(uv[0])]);
+    let d = (z + rng.random_range(-0.01..0.01)).clamp(0.01, 0.99);
+    point_at(l, uv, d, rng)
+}
+
+fn point_at(l: &Light, uv: [f64; 2], d: f64, rng: &mut impl Rng) -> (Vec3, Vec3) {
+    let g = LightGpu::new(l);
     let ndc_z = cpu::light::linear_to_ndc(&g, d);
     let inv = (l.projection() * l.view()).as_dmat4().inverse();
     let p = inv.project_point3(DVec3::new(2.0 * uv[0] - 1.0, 1.0 - 2.0 * uv[1], ndc_z));
@@ -75,11 +90,21 @@ fn robust_reference(l: &LightGpu, map: &Map, p: Vec3, n: Vec3) -> Option<f64> {
 }
 
 fn check(kind: LightKind, technique: Technique, seed: u64) {
+    check_light(light(kind, technique), seed, false);
+}
+
+/// `on_map`: receivers near the map's surface ([`point_on`]) rather than anywhere.
+fn check_light(l: Light, seed: u64, on_map: bool) {
+    let (kind, technique) = (l.kind, l.shadow.technique);
     let g = common::gpu();
     let mut rng = common::rng(seed);
-    let l = light(kind, technique);
     let map = common::blocky_map(&mut rng, MAP);
-    let points: Vec<(Vec3, Vec3)> = (0..6000).map(|_| point(&l, &mut rng)).collect();
+    let points: Vec<(Vec3, Vec3)> = (0..6000)
+        .map(|_| match on_map {
+            true => point_on(&l, &map, &mut rng),
+            false => point(&l, &mut rng),
+        })
+        .collect();
     let mut renderer = Renderer::new(&g.device);
     let vis = probe(
         &mut renderer,
@@ -164,6 +189,93 @@ fn pcf_box_and_tent_match_reference() {
         },
         23,
     );
+}
+
+/// The receiver-plane bias (random normals tilt the receiver's plane every way) with a cap of
+/// 0.02 that binds at some taps: the same f32-vs-f64 tolerance, and the bias must change the
+/// reference's answer at a good share of the points (else the test could not see it).
+#[test]
+fn receiver_plane_bias_matches_reference() {
+    let tent = Technique::Pcf {
+        radius: 2,
+        kernel: PcfKernel::Tent,
+    };
+    for (i, (kind, technique)) in [
+        (DIR, Technique::Hard),
+        (SPOT, Technique::Hard),
+        (DIR, tent),
+        (SPOT, tent),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let mut l = light(kind, technique);
+        (l.shadow.bias, l.shadow.receiver_plane) = (0.0005, 0.02);
+        check_light(l.clone(), 40 + i as u64, true);
+        let (on, mut off) = (LightGpu::new(&l), LightGpu::new(&l));
+        off.receiver_plane = 0.0;
+        let mut rng = common::rng(40 + i as u64);
+        let map = common::blocky_map(&mut rng, MAP);
+        let cmap = Map {
+            size: MAP,
+            texels: &map,
+        };
+        let changed = (0..2000)
+            .map(|_| point_on(&l, &map, &mut rng))
+            .filter(|&(p, n)| {
+                let v = |g: &LightGpu| {
+                    reference(g, &cmap, &cpu::light::sample(g, p.as_dvec3(), n.as_dvec3()))
+                };
+                (v(&on) - v(&off)).abs() > 1e-3
+            })
+            .count();
+        assert!(
+            changed > 20,
+            "{kind:?} {technique:?}: the bias changed only {changed} of 2000 points"
+        );
+    }
+}
+
+/// The f64 receiver-plane slope against the plane itself: a point moved within the receiver's
+/// plane (by up to 3 texels) lands at depth `d + slope · Δtexels` — exactly for the directional
+/// light (1e-6 relative: the light's matrices are f32, orthonormal to ~1e-7), to first order for the spot light, whose depth over a plane is
+/// not affine in the map's coordinates (1e-3 of the move's depth change plus 1e-9).
+#[test]
+fn receiver_plane_slope_is_the_planes_depth() {
+    let mut rng = common::rng(50);
+    for kind in [DIR, SPOT] {
+        let mut l = light(kind, Technique::Hard);
+        (l.shadow.normal_bias, l.shadow.receiver_plane) = (0.0, 0.02);
+        let g = LightGpu::new(&l);
+        let texel = f64::from(g.width_at_unit) / MAP as f64;
+        for _ in 0..500 {
+            let (p, n) = point(&l, &mut rng);
+            let (p, n) = (p.as_dvec3(), n.as_dvec3());
+            let s = cpu::light::sample(&g, p, n);
+            let along = n.any_orthonormal_pair();
+            let (a, b) = (rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+            let scale = match kind {
+                LightKind::Spot { .. } => 1e-3 * s.view_z,
+                _ => 1.0,
+            };
+            let q = p + (along.0 * a + along.1 * b) * (3.0 * texel * scale);
+            let t = cpu::light::sample(&g, q, n);
+            let moved = [
+                (t.uv[0] - s.uv[0]) * MAP as f64,
+                (t.uv[1] - s.uv[1]) * MAP as f64,
+            ];
+            let predicted = s.depth_slope[0] * moved[0] + s.depth_slope[1] * moved[1];
+            let actual = t.depth - s.depth;
+            let allowed = match kind {
+                LightKind::Spot { .. } => 1e-3 * actual.abs() + 1e-9,
+                _ => 1e-6 * actual.abs() + 1e-9,
+            };
+            assert!(
+                (predicted - actual).abs() <= allowed,
+                "{kind:?}: predicted {predicted}, actual {actual}"
+            );
+        }
+    }
 }
 
 #[test]

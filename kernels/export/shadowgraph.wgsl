@@ -52,18 +52,18 @@
 //   sg_blocker_filter_width sg_blocker_msm sg_blocker_result sg_blocker_search_width
 //   sg_blocker_vsm sg_blocker_width sg_chebyshev_upper sg_csm_chunk sg_csm_chunk_of
 //   sg_csm_resolve sg_csm_sin_cos sg_csm_weight sg_csm_z_chunk_of sg_cssm_blocker
-//   sg_cssm_resolve sg_cssm_sharpen sg_level_size sg_light_faces sg_light_footprint
-//   sg_light_linear_to_ndc sg_light_linear_to_z sg_light_map_width sg_light_sample
-//   sg_light_to_light sg_linstep sg_load_depth sg_mip_tap_uv sg_mip_taps sg_msm_biased
-//   sg_msm_dequantize sg_msm_expect sg_msm_intensity sg_msm_moments sg_msm_quantize sg_msm_roots
-//   sg_msm_soft_blocker sg_pcss_search_radius sg_sample_bilinear sg_sample_bilinear_log
-//   sg_sample_map sg_sample_map_log sg_sat_mean_fixed sg_sat_mean_float sg_sat_node_f32
-//   sg_sat_node_u32 sg_sat_nodes sg_sat_rect sg_sat_sample_fixed sg_sat_sample_float
-//   sg_soft_blockers sg_soft_search sg_texel_of sg_trilinear sg_trilinear_log sg_vis_esm
-//   sg_vis_esm_of_log sg_vis_esm_of_sat sg_vis_evsm sg_vis_evsm_of sg_vis_hard sg_vis_msm
-//   sg_vis_msm_of sg_vis_msm_soft_fixed sg_vis_msm_soft_float sg_vis_pcf sg_vis_pcf_hardware
-//   sg_vis_pcss sg_vis_vsm sg_vis_vsm_of sg_vis_vssm_fixed sg_vis_vssm_float sg_vogel_disc
-//   sg_vssm_blocker
+//   sg_cssm_resolve sg_cssm_sharpen sg_level_size sg_light_depth_slope sg_light_faces
+//   sg_light_footprint sg_light_linear_to_ndc sg_light_linear_to_z sg_light_map_width
+//   sg_light_receiver_offset sg_light_sample sg_light_tap_offset sg_light_to_light sg_linstep
+//   sg_load_depth sg_mip_tap_uv sg_mip_taps sg_msm_biased sg_msm_dequantize sg_msm_expect
+//   sg_msm_intensity sg_msm_moments sg_msm_quantize sg_msm_roots sg_msm_soft_blocker
+//   sg_pcss_search_radius sg_sample_bilinear sg_sample_bilinear_log sg_sample_map
+//   sg_sample_map_log sg_sat_mean_fixed sg_sat_mean_float sg_sat_node_f32 sg_sat_node_u32
+//   sg_sat_nodes sg_sat_rect sg_sat_sample_fixed sg_sat_sample_float sg_soft_blockers
+//   sg_soft_search sg_texel_of sg_trilinear sg_trilinear_log sg_vis_esm sg_vis_esm_of_log
+//   sg_vis_esm_of_sat sg_vis_evsm sg_vis_evsm_of sg_vis_hard sg_vis_msm sg_vis_msm_of
+//   sg_vis_msm_soft_fixed sg_vis_msm_soft_float sg_vis_pcf sg_vis_pcf_hardware sg_vis_pcss
+//   sg_vis_vsm sg_vis_vsm_of sg_vis_vssm_fixed sg_vis_vssm_float sg_vogel_disc sg_vssm_blocker
 
 // Shared light description and light-space helpers (import-only module).
 //
@@ -113,7 +113,7 @@ struct sg_Light {
     sharpen: f32,            // cssm: sharpening strength A of v^p, p = 1 + A·exp(−B (d − z_avg))
     sharpen_falloff: f32,    // cssm: sharpening falloff B, per linear depth unit
     max_width: f32,          // soft techniques: cap on the search and filter widths, texels
-    _pad1: u32,
+    receiver_plane: f32,     // receiver-plane bias: cap on a tap's depth correction (0: off)
 }
 
 // `Light::technique` (keep in sync with the `TECHNIQUE_*` constants of src/gpu_data.rs; a test
@@ -137,6 +137,7 @@ struct sg_LightSample {
     view_z: f32,     // receiver's distance Z along the light axis
     inside: bool,    // inside the map and the depth range
     footprint: vec4<f32>, // the pixel's footprint in the map, texels: axes (x, y) and (z, w); 0 unknown
+    depth_slope: vec2<f32>, // receiver plane: d(depth)/d(texel) along u and v (0 when off)
 }
 
 // World width of the whole map at view distance z.
@@ -177,7 +178,43 @@ fn sg_light_sample(l: sg_Light, p: vec3<f32>, n: vec3<f32>) -> sg_LightSample {
     s.inside = clip.w > 0.0 && all(s.uv >= vec2<f32>(0.0)) && all(s.uv <= vec2<f32>(1.0))
         && s.depth >= 0.0 && s.depth <= 1.0;
     s.footprint = vec4<f32>(0.0);
+    s.depth_slope = vec2<f32>(0.0);
+    if l.receiver_plane > 0.0 {
+        s.depth_slope = sg_light_depth_slope(l, q, n, s.view_z);
+    }
     return s;
+}
+
+// Receiver-plane depth bias (Isidoro, GDC 2006): the depth of the plane through the receiver q
+// with normal n, per texel of offset in the map. A compute shading pass has no dpdx, so the
+// plane comes from the G-buffer normal: exact for planar receivers. View space v = V q; a point
+// of the plane seen through map coordinates (a, b) at distance Z is Z·(a, b, −1) (spot) or
+// (x, y, −Z) (directional), so Z = n·v / (n_x a + n_y b − n_z) and dZ/da = −Z² n_x / n·v
+// (directional: dZ/dx = n_x / n_z); a and x grow with u, b and y with −v.
+fn sg_light_depth_slope(l: sg_Light, q: vec3<f32>, n: vec3<f32>, z: f32) -> vec2<f32> {
+    let v = (l.view * vec4<f32>(q, 1.0)).xyz;
+    let nv = (l.view * vec4<f32>(n, 0.0)).xyz;
+    var per_world: vec2<f32>;
+    if l.kind == 0u {
+        per_world = vec2<f32>(nv.x, -nv.y) / nv.z;
+    } else {
+        per_world = vec2<f32>(-nv.x, nv.y) * (z * z / dot(nv, v));
+    }
+    let texel = l.width_at_unit / l.map_size.x;
+    let slope = per_world * texel / (l.far - l.near);
+    // Edge-on (n·v or n_z → 0) the slope is unbounded or NaN: the cap bounds each tap instead.
+    return select(vec2<f32>(0.0), slope, all(abs(slope) < vec2<f32>(1e30)));
+}
+
+// The receiver plane's depth change to a tap `offset` texels from the receiver, capped at
+// ±receiver_plane (0 when the bias is off).
+fn sg_light_receiver_offset(l: sg_Light, s: sg_LightSample, offset: vec2<f32>) -> f32 {
+    return clamp(dot(s.depth_slope, offset), -l.receiver_plane, l.receiver_plane);
+}
+
+// The offset in texels from the receiver to texel t's centre.
+fn sg_light_tap_offset(l: sg_Light, s: sg_LightSample, t: vec2<i32>) -> vec2<f32> {
+    return vec2<f32>(t) + 0.5 - s.uv * l.map_size;
 }
 
 // The footprint in light l's map, in texels, of the pixel whose receiver p (normal n) moves by
@@ -996,12 +1033,15 @@ fn sg_vis_evsm_of(m: vec4<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
     }
     return sg_linstep(l.bleed, 1.0, p);
 }
-// Hard shadow test (Williams 1978): lit when d ≤ z_map + bias at the nearest texel.
+// Hard shadow test (Williams 1978): lit when d ≤ z_map + bias at the nearest texel, d moved
+// along the receiver plane to the texel's centre when the receiver-plane bias is on.
 
 // #fetches sg_vis_hard: 1
 fn sg_vis_hard(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
-    let z = sg_load_depth(map, sg_texel_of(s.uv, l.map_size));
-    return select(0.0, 1.0, s.depth <= z + l.bias);
+    let t = sg_texel_of(s.uv, l.map_size);
+    let z = sg_load_depth(map, t);
+    let d = s.depth + sg_light_receiver_offset(l, s, sg_light_tap_offset(l, s, t));
+    return select(0.0, 1.0, d <= z + l.bias);
 }
 // Moment soft shadow maps (after Peters et al. 2016) from a summed-area table of the MSM
 // moments (raw or quantized): the biased moments over the blocker-search square give the
@@ -1048,7 +1088,8 @@ fn sg_vis_msm_soft_float(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -
     return sg_vis_msm_of(m, l, s);
 }
 // Percentage-closer filtering (Reeves et al. 1987): the weighted mean of comparison results
-// over a (2r + 1)² window around the receiver's texel — never a filter of depths.
+// over a (2r + 1)² window around the receiver's texel — never a filter of depths. With the
+// receiver-plane bias each tap compares the receiver plane's depth at that texel's centre.
 
 // #fetches sg_vis_pcf: (2 * l.radius + 1) * (2 * l.radius + 1)
 fn sg_vis_pcf(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
@@ -1062,8 +1103,10 @@ fn sg_vis_pcf(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
             if l.kernel == 1u {
                 w = f32(r + 1 - abs(dx)) * f32(r + 1 - abs(dy));
             }
-            let z = sg_load_depth(map, c + vec2<i32>(dx, dy));
-            lit += w * select(0.0, 1.0, s.depth <= z + l.bias);
+            let t = c + vec2<i32>(dx, dy);
+            let z = sg_load_depth(map, t);
+            let d = s.depth + sg_light_receiver_offset(l, s, sg_light_tap_offset(l, s, t));
+            lit += w * select(0.0, 1.0, d <= z + l.bias);
             total += w;
         }
     }

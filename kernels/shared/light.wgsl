@@ -46,7 +46,7 @@ struct Light {
     sharpen: f32,            // cssm: sharpening strength A of v^p, p = 1 + A·exp(−B (d − z_avg))
     sharpen_falloff: f32,    // cssm: sharpening falloff B, per linear depth unit
     max_width: f32,          // soft techniques: cap on the search and filter widths, texels
-    _pad1: u32,
+    receiver_plane: f32,     // receiver-plane bias: cap on a tap's depth correction (0: off)
 }
 
 // `Light::technique` (keep in sync with the `TECHNIQUE_*` constants of src/gpu_data.rs; a test
@@ -70,6 +70,7 @@ struct LightSample {
     view_z: f32,     // receiver's distance Z along the light axis
     inside: bool,    // inside the map and the depth range
     footprint: vec4<f32>, // the pixel's footprint in the map, texels: axes (x, y) and (z, w); 0 unknown
+    depth_slope: vec2<f32>, // receiver plane: d(depth)/d(texel) along u and v (0 when off)
 }
 
 // World width of the whole map at view distance z.
@@ -110,7 +111,43 @@ fn light_sample(l: Light, p: vec3<f32>, n: vec3<f32>) -> LightSample {
     s.inside = clip.w > 0.0 && all(s.uv >= vec2<f32>(0.0)) && all(s.uv <= vec2<f32>(1.0))
         && s.depth >= 0.0 && s.depth <= 1.0;
     s.footprint = vec4<f32>(0.0);
+    s.depth_slope = vec2<f32>(0.0);
+    if l.receiver_plane > 0.0 {
+        s.depth_slope = light_depth_slope(l, q, n, s.view_z);
+    }
     return s;
+}
+
+// Receiver-plane depth bias (Isidoro, GDC 2006): the depth of the plane through the receiver q
+// with normal n, per texel of offset in the map. A compute shading pass has no dpdx, so the
+// plane comes from the G-buffer normal: exact for planar receivers. View space v = V q; a point
+// of the plane seen through map coordinates (a, b) at distance Z is Z·(a, b, −1) (spot) or
+// (x, y, −Z) (directional), so Z = n·v / (n_x a + n_y b − n_z) and dZ/da = −Z² n_x / n·v
+// (directional: dZ/dx = n_x / n_z); a and x grow with u, b and y with −v.
+fn light_depth_slope(l: Light, q: vec3<f32>, n: vec3<f32>, z: f32) -> vec2<f32> {
+    let v = (l.view * vec4<f32>(q, 1.0)).xyz;
+    let nv = (l.view * vec4<f32>(n, 0.0)).xyz;
+    var per_world: vec2<f32>;
+    if l.kind == 0u {
+        per_world = vec2<f32>(nv.x, -nv.y) / nv.z;
+    } else {
+        per_world = vec2<f32>(-nv.x, nv.y) * (z * z / dot(nv, v));
+    }
+    let texel = l.width_at_unit / l.map_size.x;
+    let slope = per_world * texel / (l.far - l.near);
+    // Edge-on (n·v or n_z → 0) the slope is unbounded or NaN: the cap bounds each tap instead.
+    return select(vec2<f32>(0.0), slope, all(abs(slope) < vec2<f32>(1e30)));
+}
+
+// The receiver plane's depth change to a tap `offset` texels from the receiver, capped at
+// ±receiver_plane (0 when the bias is off).
+fn light_receiver_offset(l: Light, s: LightSample, offset: vec2<f32>) -> f32 {
+    return clamp(dot(s.depth_slope, offset), -l.receiver_plane, l.receiver_plane);
+}
+
+// The offset in texels from the receiver to texel t's centre.
+fn light_tap_offset(l: Light, s: LightSample, t: vec2<i32>) -> vec2<f32> {
+    return vec2<f32>(t) + 0.5 - s.uv * l.map_size;
 }
 
 // The footprint in light l's map, in texels, of the pixel whose receiver p (normal n) moves by

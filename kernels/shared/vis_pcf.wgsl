@@ -1,5 +1,6 @@
 // Percentage-closer filtering (Reeves et al. 1987): the weighted mean of comparison results
-// over a (2r + 1)² window around the receiver's texel — never a filter of depths.
+// over a (2r + 1)² window around the receiver's texel — never a filter of depths. With the
+// receiver-plane bias each tap compares the receiver plane's depth at that texel's centre.
 // #import shared/light
 // #import shared/sampling
 
@@ -15,8 +16,10 @@ fn vis_pcf(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
             if l.kernel == 1u {
                 w = f32(r + 1 - abs(dx)) * f32(r + 1 - abs(dy));
             }
-            let z = load_depth(map, c + vec2<i32>(dx, dy));
-            lit += w * select(0.0, 1.0, s.depth <= z + l.bias);
+            let t = c + vec2<i32>(dx, dy);
+            let z = load_depth(map, t);
+            let d = s.depth + light_receiver_offset(l, s, light_tap_offset(l, s, t));
+            lit += w * select(0.0, 1.0, d <= z + l.bias);
             total += w;
         }
     }

@@ -315,6 +315,7 @@ fn bench_light(n: u32, technique: Technique) -> Light {
             bias: 0.0,
             slope_bias: 0.0,
             normal_bias: 0.0,
+            receiver_plane: 0.0,
         },
     }
 }

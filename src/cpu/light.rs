@@ -17,6 +17,8 @@ pub struct LightSample {
     pub inside: bool,
     /// The pixel's footprint in the map, texels: axes `[0..2]` and `[2..4]` (0: unknown).
     pub footprint: [f64; 4],
+    /// Receiver plane: d(depth)/d(texel) along u and v (0 when the bias is off).
+    pub depth_slope: [f64; 2],
 }
 
 fn mat(m: &[[f32; 4]; 4]) -> DMat4 {
@@ -65,13 +67,55 @@ pub fn sample(l: &LightGpu, p: DVec3, n: DVec3) -> LightSample {
     let inside = clip.w > 0.0
         && uv.iter().all(|&c| (0.0..=1.0).contains(&c))
         && (0.0..=1.0).contains(&depth);
+    let depth_slope = if l.receiver_plane > 0.0 {
+        depth_slope(l, q, n, view_z)
+    } else {
+        [0.0; 2]
+    };
     LightSample {
         uv,
         depth,
         view_z,
         inside,
         footprint: [0.0; 4],
+        depth_slope,
     }
+}
+
+/// `light_depth_slope`: the depth of the plane through `q` with normal `n` per texel of offset
+/// in the map along u and v; 0 where it is not finite (edge-on).
+pub fn depth_slope(l: &LightGpu, q: DVec3, n: DVec3, z: f64) -> [f64; 2] {
+    let view = mat(&l.view);
+    let v = (view * q.extend(1.0)).truncate();
+    let nv = (view * n.extend(0.0)).truncate();
+    let per_world = if l.kind == 0 {
+        [nv.x / nv.z, -nv.y / nv.z]
+    } else {
+        let k = z * z / nv.dot(v);
+        [-nv.x * k, nv.y * k]
+    };
+    let texel = f64::from(l.width_at_unit) / f64::from(l.map_size[0]);
+    let slope = per_world.map(|w| w * texel / f64::from(l.far - l.near));
+    if slope.iter().all(|s| s.abs() < 1e30) {
+        slope
+    } else {
+        [0.0; 2]
+    }
+}
+
+/// `light_receiver_offset`: the receiver plane's depth change to a tap `offset` texels away,
+/// capped at ±`receiver_plane`.
+pub fn receiver_offset(l: &LightGpu, s: &LightSample, offset: [f64; 2]) -> f64 {
+    let cap = f64::from(l.receiver_plane);
+    (s.depth_slope[0] * offset[0] + s.depth_slope[1] * offset[1]).clamp(-cap, cap)
+}
+
+/// `light_tap_offset`: texels from the receiver to the centre of texel `(x, y)`.
+pub fn tap_offset(l: &LightGpu, s: &LightSample, x: i64, y: i64) -> [f64; 2] {
+    [
+        x as f64 + 0.5 - s.uv[0] * f64::from(l.map_size[0]),
+        y as f64 + 0.5 - s.uv[1] * f64::from(l.map_size[1]),
+    ]
 }
 
 /// `light_footprint`: the differences, in texels, of the points `p + dpdx` and `p + dpdy`

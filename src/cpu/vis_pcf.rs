@@ -1,10 +1,11 @@
 //! Reference of `kernels/shared/vis_pcf.wgsl`.
 
 use super::Map;
-use super::light::{LightSample, linear_to_ndc};
+use super::light::{LightSample, linear_to_ndc, receiver_offset, tap_offset};
 use crate::gpu_data::LightGpu;
 
-/// Weighted mean of comparisons over the (2r + 1)² window (box or tent weights).
+/// Weighted mean of comparisons over the (2r + 1)² window (box or tent weights), each against
+/// the receiver plane's depth at its texel's centre when the receiver-plane bias is on.
 pub fn vis_pcf(map: &Map, l: &LightGpu, s: &LightSample) -> f64 {
     let (cx, cy) = map.texel_of(s.uv);
     let r = i64::from(l.radius);
@@ -16,7 +17,9 @@ pub fn vis_pcf(map: &Map, l: &LightGpu, s: &LightSample) -> f64 {
             } else {
                 1.0
             };
-            if s.depth <= map.load(cx + dx, cy + dy) + f64::from(l.bias) {
+            let (x, y) = (cx + dx, cy + dy);
+            let d = s.depth + receiver_offset(l, s, tap_offset(l, s, x, y));
+            if d <= map.load(x, y) + f64::from(l.bias) {
                 lit += w;
             }
             total += w;

@@ -346,6 +346,9 @@ pub struct Shadow {
     pub slope_bias: f32,
     /// Normal offset in shadow-map texels, scaled by `1 − N·L`.
     pub normal_bias: f32,
+    /// Receiver-plane depth bias: the cap on each tap's depth correction along the receiver's
+    /// plane, linear depth units; 0 off (`bias_mode = "constant"`).
+    pub receiver_plane: f32,
 }
 
 /// A light.

@@ -30,6 +30,9 @@ pub struct PrefilterConfig {
     pub bias: f32,
     /// Normal offset in shadow-map texels, scaled by `1 − N·L`.
     pub normal_bias: f32,
+    /// Receiver-plane depth bias: the cap on each tap's correction (0: off; `hard` and `pcf`
+    /// box/tent only, checked by validation).
+    pub receiver_plane: f32,
     /// Area-light width in world units (PCSS penumbrae; 0 for a point light).
     pub light_size: f32,
     /// A `with_*` call that did not apply to the technique (reported by validation).
@@ -58,6 +61,7 @@ impl PrefilterConfig {
             size,
             bias: 0.002,
             normal_bias: 1.0,
+            receiver_plane: 0.0,
             light_size: 0.0,
             not_applicable: None,
             moment_bias_set: false,
@@ -133,6 +137,7 @@ impl PrefilterConfig {
             size: light.shadow_map,
             bias: light.shadow.bias,
             normal_bias: light.shadow.normal_bias,
+            receiver_plane: light.shadow.receiver_plane,
             light_size: light.size,
             not_applicable: None,
             moment_bias_set: true,
@@ -236,6 +241,13 @@ impl PrefilterConfig {
         self
     }
 
+    /// The same with the receiver-plane depth bias on, each tap's correction capped at `cap`
+    /// linear depth units (0: off).
+    pub fn with_receiver_plane(mut self, cap: f32) -> Self {
+        self.receiver_plane = cap;
+        self
+    }
+
     /// The same with constant bias `bias` (linear depth units).
     pub fn with_bias(mut self, bias: f32) -> Self {
         self.bias = bias;
@@ -265,6 +277,19 @@ impl PrefilterConfig {
             ("normal_bias", ParamValue::Float(self.normal_bias)),
         ]);
         crate::model::check(&[COMMON], &Given(&common)).map_err(given_err)?;
+        if self.receiver_plane != 0.0 {
+            if !crate::model::keys(def.params).contains(&"bias_mode") {
+                return Err(config_err(
+                    "receiver_plane",
+                    format!("does not apply to technique \"{}\"", def.name),
+                ));
+            }
+            // The scene's rules: the technique's table says where the keys apply and the range.
+            let mut values = (def.values)(&self.technique);
+            values.set("bias_mode", ParamValue::Choice("receiver_plane"));
+            values.set("receiver_plane_cap", ParamValue::Float(self.receiver_plane));
+            crate::model::check(def.params, &Given(&values)).map_err(given_err)?;
+        }
         if !self.light_size.is_finite() || !(0.0..=1e6).contains(&self.light_size) {
             return Err(config_err(
                 "size (light)",
@@ -445,6 +470,7 @@ impl LightParams {
                 // Slope-scaled bias is rasterization state: the host's depth pass owns it.
                 slope_bias: 0.0,
                 normal_bias: config.normal_bias,
+                receiver_plane: config.receiver_plane,
             },
         }
     }

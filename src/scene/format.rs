@@ -102,6 +102,10 @@ pub struct ShadowFile {
     pub slope_bias: Option<Spanned<f64>>,
     /// Normal offset in shadow-map texels.
     pub normal_bias: Option<Spanned<f64>>,
+    /// `constant` or `receiver_plane` (hard, pcf box/tent).
+    pub bias_mode: Option<Spanned<String>>,
+    /// Cap on a tap's receiver-plane depth correction (linear depth units).
+    pub receiver_plane_cap: Option<Spanned<f64>>,
     /// PCF radius in texels.
     pub radius: Option<Spanned<i64>>,
     /// PCF weights: `box`, `tent` or `hardware`.

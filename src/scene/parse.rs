@@ -166,6 +166,7 @@ fn light(ctx: &Ctx, i: usize, l: &LightFile) -> Result<Light> {
             bias: 0.002,
             slope_bias: 1.0,
             normal_bias: 1.0,
+            receiver_plane: 0.0,
         },
     };
     if crate::technique::of(&shadow.technique).area_light && size <= 0.0 {

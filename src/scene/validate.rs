@@ -56,6 +56,8 @@ const KEYS: &[&str] = &[
     "scale",
     "sharpen",
     "sharpen_falloff",
+    "bias_mode",
+    "receiver_plane_cap",
 ];
 
 /// The value of `key` as written, if it is.
@@ -93,6 +95,8 @@ fn raw<'a>(s: &'a ShadowFile, key: &str) -> Option<Raw<'a>> {
         "scale" => n(&s.scale),
         "sharpen" => n(&s.sharpen),
         "sharpen_falloff" => n(&s.sharpen_falloff),
+        "bias_mode" => t(&s.bias_mode),
+        "receiver_plane_cap" => n(&s.receiver_plane_cap),
         _ => None,
     }
 }
@@ -196,6 +200,10 @@ pub(super) fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
         }
         ctx.warn(written.map(|r| r.span()), c.message(&table.key(c.key)));
     }
+    // The technique's own values again, for the keys its `Technique` does not hold (the
+    // receiver-plane bias, which is the light's `Shadow`).
+    let receiver_plane =
+        technique::params::receiver_plane(&crate::model::check(def.params, &table)?);
     let common = crate::model::check(&[COMMON], &table)?;
     let float = |k| match common.get(k) {
         Some(ParamValue::Float(v)) => v,
@@ -206,5 +214,6 @@ pub(super) fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
         bias: float("bias"),
         slope_bias: float("slope_bias"),
         normal_bias: float("normal_bias"),
+        receiver_plane,
     })
 }

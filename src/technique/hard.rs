@@ -12,7 +12,7 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     name: "hard",
     id: TECHNIQUE_HARD,
     doc: "one comparison at the nearest texel",
-    params: &[],
+    params: &[super::params::RECEIVER_PLANE],
     build: |_| Technique::Hard,
     values: |_| ParamValues::default(),
     gpu: no_gpu,

@@ -42,6 +42,7 @@ impl LightGpu {
             size: light.size,
             bias: light.shadow.bias,
             normal_bias: light.shadow.normal_bias,
+            receiver_plane: light.shadow.receiver_plane,
             cos_outer,
             technique: def.id,
             csm_scale: 1.0,

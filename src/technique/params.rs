@@ -86,6 +86,45 @@ pub const COMMON: &[ParamSpec] = &[
     ),
 ];
 
+const RECEIVER_PLANE_ON: &[Needs] = &[Needs {
+    key: "bias_mode",
+    one_of: &["receiver_plane"],
+    why: "needs `bias_mode = \"receiver_plane\"`",
+}];
+
+/// The default cap on a tap's receiver-plane depth correction, linear depth units (MJP's
+/// Shadows sample caps its fractional-sampling bias at 0.01).
+pub const DEFAULT_RECEIVER_PLANE_CAP: f32 = 0.01;
+
+/// The receiver-plane bias keys of the techniques that compare depths tap by tap (`hard`,
+/// `pcf`'s box and tent windows): `bias_mode` and its cap.
+pub const RECEIVER_PLANE: &[ParamSpec] = &[
+    choice(
+        "bias_mode",
+        &["constant", "receiver_plane"],
+        "constant",
+        "`receiver_plane` also moves each tap's receiver depth along the receiver's plane (from the G-buffer normal)",
+    ),
+    ParamSpec {
+        needs: RECEIVER_PLANE_ON,
+        ..float(
+            "receiver_plane_cap",
+            1e-6,
+            1.0,
+            DEFAULT_RECEIVER_PLANE_CAP,
+            "cap on each tap's receiver-plane depth correction, linear depth units",
+        )
+    },
+];
+
+/// `Shadow::receiver_plane` of checked values: the cap when `bias_mode = "receiver_plane"`, else 0.
+pub fn receiver_plane(v: &ParamValues) -> f32 {
+    match (v.get("bias_mode"), v.get("receiver_plane_cap")) {
+        (Some(ParamValue::Choice("receiver_plane")), Some(ParamValue::Float(cap))) => cap,
+        _ => 0.0,
+    }
+}
+
 /// `format` of the float representations (VSM, EVSM, CSM and their soft forms).
 pub const FLOAT_FORMAT: &[ParamSpec] = &[choice(
     "format",

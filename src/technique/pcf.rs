@@ -33,6 +33,20 @@ const PARAMS: &[ParamSpec] = &[
     },
 ];
 
+/// The receiver-plane bias keys ([`super::params::RECEIVER_PLANE`]) for the box and tent
+/// windows; the hardware kernel compares four texels against one reference.
+const RECEIVER_PLANE: &[ParamSpec] = &[
+    ParamSpec {
+        needs: &[Needs {
+            key: "kernel",
+            one_of: &["box", "tent"],
+            why: "does not apply to the hardware 2×2 kernel (one reference depth for four texels)",
+        }],
+        ..super::params::RECEIVER_PLANE[0]
+    },
+    super::params::RECEIVER_PLANE[1],
+];
+
 fn build(v: &ParamValues) -> Technique {
     let kernel = KERNELS
         .iter()
@@ -97,7 +111,7 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     name: "pcf",
     id: TECHNIQUE_PCF,
     doc: "percentage-closer filtering",
-    params: &[PARAMS],
+    params: &[PARAMS, RECEIVER_PLANE],
     build,
     values,
     gpu,

@@ -153,6 +153,7 @@ pub fn light(kind: LightKind, technique: Technique) -> Light {
             bias: 0.002,
             slope_bias: 0.0,
             normal_bias: 1.0,
+            receiver_plane: 0.0,
         },
     }
 }

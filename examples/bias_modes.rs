@@ -1,0 +1,89 @@
+//! Depth biases against the bias-free ray cast: renders a scene once per bias setting of its
+//! first light (constant only, slope-scaled only, normal offset only, the scene's own, and
+//! receiver-plane) and counts, over the pixels the f64 ray cast finds relevant, *acne* (the ray
+//! cast sees the light's centre, the render's visibility < ½) and *leak* (the ray cast does not,
+//! the render ≥ ½). `cargo run --release --example bias_modes -- scenes/grazing.toml [MAP]`
+//! (`MAP`: the first light's map side instead of the scene's).
+
+use shadowgraph::gpu::Gpu;
+use shadowgraph::render::{RenderOptions, Renderer};
+use shadowgraph::scene::Scene;
+use shadowgraph::truth::{emitter, raycast::ray_cast_truth};
+
+/// (label, bias, slope_bias, normal_bias, receiver_plane cap).
+const MODES: &[(&str, f32, f32, f32, f32)] = &[
+    ("constant 0.0005", 0.0005, 0.0, 0.0, 0.0),
+    ("constant 0.002", 0.002, 0.0, 0.0, 0.0),
+    ("constant 0.01", 0.01, 0.0, 0.0, 0.0),
+    ("slope 0.5", 0.0, 0.5, 0.0, 0.0),
+    ("slope 1", 0.0, 1.0, 0.0, 0.0),
+    ("slope 4", 0.0, 4.0, 0.0, 0.0),
+    ("normal 0.5", 0.0, 0.0, 0.5, 0.0),
+    ("normal 1", 0.0, 0.0, 1.0, 0.0),
+    ("normal 2", 0.0, 0.0, 2.0, 0.0),
+    ("receiver plane, cap 0.01", 0.0, 0.0, 0.0, 0.01),
+    (
+        "receiver plane + constant 0.0002, cap 0.01",
+        0.0002,
+        0.0,
+        0.0,
+        0.01,
+    ),
+];
+
+fn main() -> anyhow::Result<()> {
+    let path = std::env::args()
+        .nth(1)
+        .unwrap_or("scenes/grazing.toml".into());
+    let mut base = Scene::load(&path)?;
+    if let Some(side) = std::env::args().nth(2) {
+        base.lights[0].shadow_map = side.parse()?;
+    }
+    let truth = ray_cast_truth(&base, &emitter::centre_offset());
+    let gpu = Gpu::new()?;
+    let mut renderer = Renderer::new(&gpu.device);
+    let lights = base.lights.len();
+    let mut own = base.lights[0].shadow;
+    own.receiver_plane = 0.0;
+    let scene_own = (
+        "the scene's own",
+        own.bias,
+        own.slope_bias,
+        own.normal_bias,
+        0.0,
+    );
+    println!(
+        "{path}, light 0 ({}), map {}²: pixels over the relevant ones of the ray cast",
+        base.lights[0].shadow.technique.name(),
+        base.lights[0].shadow_map
+    );
+    println!("| bias | acne | leak |\n| --- | --- | --- |");
+    for &(label, bias, slope, normal, cap) in MODES.iter().chain([&scene_own]) {
+        let mut scene = base.clone();
+        let s = &mut scene.lights[0].shadow;
+        (s.bias, s.slope_bias, s.normal_bias, s.receiver_plane) = (bias, slope, normal, cap);
+        let frame = renderer.render(&gpu.device, &gpu.queue, &scene, RenderOptions::default())?;
+        let (mut acne, mut leak, mut lit, mut dark) = (0u32, 0u32, 0u32, 0u32);
+        for px in 0..(truth.width * truth.height) as usize {
+            let i = px * lights;
+            if !truth.mask[i] {
+                continue;
+            }
+            let v = frame.visibility[i];
+            if truth.visibility[i] > 0.5 {
+                lit += 1;
+                acne += u32::from(v < 0.5);
+            } else {
+                dark += 1;
+                leak += u32::from(v >= 0.5);
+            }
+        }
+        let pct = |a: u32, b: u32| 100.0 * f64::from(a) / f64::from(b.max(1));
+        println!(
+            "| {label} | {:.2}% of {lit} lit | {:.2}% of {dark} shadowed |",
+            pct(acne, lit),
+            pct(leak, dark)
+        );
+    }
+    Ok(())
+}
