@@ -69,6 +69,15 @@ fn soft_blockers(b: vec2<f32>, l: Light, s: LightSample) -> SoftLookup {
     return look;
 }
 
+// The trips of the filter lookup's loop: 1 where the search found blockers, else 0. The
+// lookup sits in a loop of this many trips rather than under a branch: llvmpipe runs a
+// loop-free branch body for its whole SIMD group whatever its lanes decide, and leaves a loop
+// whose lanes have all left it without running its body again (see SoftLookup); a GPU runs
+// either as a branch.
+fn soft_filter_trips(look: SoftLookup) -> u32 {
+    return select(0u, 1u, look.blockers);
+}
+
 // (z_avg, share) from a blocker depth estimate `z` and share: z clamped to [0, d] (blockers
 // are in front of the receiver d).
 fn blocker_result(z: f32, share: f32, d: f32) -> vec2<f32> {

@@ -15,34 +15,30 @@ fn msm_soft_blocker(m: vec4<f32>, l: Light, s: LightSample) -> vec2<f32> {
     return blocker_msm(msm_biased(m, l), s.depth - l.bias);
 }
 
-// #fetches vis_msm_soft_fixed: 2 * sat_sample_fixed
+// #fetches vis_msm_soft_fixed: sat_search_fixed + sat_sample_fixed
 fn vis_msm_soft_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32 {
-    var look = soft_search(l, s);
+    let search = sat_search_fixed(map, l, s.uv, blocker_search_width(l, s));
+    let look = soft_blockers(msm_soft_blocker(search, l, s), l, s);
     var m = vec4<f32>(0.0);
-    for (var k = 0u; k < 2u; k++) {
+    for (var k = 0u; k < soft_filter_trips(look); k++) {
         m = sat_sample_fixed(map, l, s.uv, look.width);
-        if k == 0u {
-            look = soft_blockers(msm_soft_blocker(m, l, s), l, s);
-            if !look.blockers {
-                return 1.0;
-            }
-        }
+    }
+    if !look.blockers {
+        return 1.0;
     }
     return vis_msm_of(m, l, s);
 }
 
-// #fetches vis_msm_soft_float: 2 * sat_sample_float
+// #fetches vis_msm_soft_float: sat_search_float + sat_sample_float
 fn vis_msm_soft_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    var look = soft_search(l, s);
+    let search = sat_search_float(map, l, s.uv, blocker_search_width(l, s));
+    let look = soft_blockers(msm_soft_blocker(search, l, s), l, s);
     var m = vec4<f32>(0.0);
-    for (var k = 0u; k < 2u; k++) {
+    for (var k = 0u; k < soft_filter_trips(look); k++) {
         m = sat_sample_float(map, l, s.uv, look.width);
-        if k == 0u {
-            look = soft_blockers(msm_soft_blocker(m, l, s), l, s);
-            if !look.blockers {
-                return 1.0;
-            }
-        }
+    }
+    if !look.blockers {
+        return 1.0;
     }
     return vis_msm_of(m, l, s);
 }
