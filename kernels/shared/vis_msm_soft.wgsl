@@ -2,9 +2,11 @@
 // moments (raw or quantized): the biased moments over the blocker-search square give the
 // blocker share and depth from the Hamburger reconstruction (blocker_msm), the PCSS penumbra
 // width follows, and MSM's visibility (vis_msm_of: Hamburger or Hausdorff, bleed reduction) is
-// read from the moments over that width. One table lookup per pass of `blocker.wgsl`'s two-pass
-// loop: a receiver whose search square holds no blockers (share below BLOCKER_MIN_SHARE) is
-// lit after the first.
+// read from the moments over that width. The search reads the
+// square snapped outward to texel edges (`sat_search_*`: 4 loads; the square grows by less
+// than a texel per side, an estimate either way), the filter the exact square (16 loads), in
+// a loop of `soft_filter_trips` trips: a receiver whose search square holds no blockers
+// (share below BLOCKER_MIN_SHARE) is lit after the search.
 // `vis_msm_soft_fixed` reads a fixed-point table (rgba32uint), `vis_msm_soft_float` an f32 one.
 // #import shared/light
 // #import shared/sat_lookup

@@ -1,9 +1,11 @@
 // Variance soft shadow maps (Yang et al. 2010) from a summed-area table of the VSM moments:
 // the moments over the blocker-search square give the blocker share and depth (blocker_vsm),
 // the PCSS penumbra width follows, and the VSM bound (vis_vsm_of: variance floor, bleed
-// reduction) is read from the moments over that width. One table lookup per pass of
-// `blocker.wgsl`'s two-pass loop: a receiver whose search square holds no blockers (share below
-// BLOCKER_MIN_SHARE) is lit after the first.
+// reduction) is read from the moments over that width. The search reads the
+// square snapped outward to texel edges (`sat_search_*`: 4 loads; the square grows by less
+// than a texel per side, an estimate either way), the filter the exact square (16 loads), in
+// a loop of `soft_filter_trips` trips: a receiver whose search square holds no blockers
+// (share below BLOCKER_MIN_SHARE) is lit after the search.
 // `vis_vssm_fixed` reads a fixed-point table (rgba32uint), `vis_vssm_float` an f32 one.
 // #import shared/light
 // #import shared/sat_lookup
