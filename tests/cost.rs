@@ -158,7 +158,7 @@ fn shading_fetches_match_the_hand_counts() {
     for (name, fetches) in [
         ("techniques/vsm.toml", 4.0),
         ("techniques/msm_sat.toml", 16.0),
-        ("techniques/cssm.toml", 208.0),
+        ("techniques/cssm.toml", 100.0),
         ("sphere_on_plane.toml", 48.0),
         ("techniques/vsm_mips_aniso.toml", 64.0),
     ] {

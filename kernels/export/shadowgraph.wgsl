@@ -58,12 +58,14 @@
 //   sg_load_depth sg_mip_tap_uv sg_mip_taps sg_msm_biased sg_msm_dequantize sg_msm_expect
 //   sg_msm_intensity sg_msm_moments sg_msm_quantize sg_msm_roots sg_msm_soft_blocker
 //   sg_pcss_search_radius sg_sample_bilinear sg_sample_bilinear_log sg_sample_map
-//   sg_sample_map_log sg_sat_mean_fixed sg_sat_mean_float sg_sat_node_f32 sg_sat_node_u32
-//   sg_sat_nodes sg_sat_rect sg_sat_sample_fixed sg_sat_sample_float sg_soft_blockers
-//   sg_soft_search sg_texel_of sg_trilinear sg_trilinear_log sg_vis_esm sg_vis_esm_of_log
-//   sg_vis_esm_of_sat sg_vis_evsm sg_vis_evsm_of sg_vis_hard sg_vis_msm sg_vis_msm_of
-//   sg_vis_msm_soft_fixed sg_vis_msm_soft_float sg_vis_pcf sg_vis_pcf_hardware sg_vis_pcss
-//   sg_vis_vsm sg_vis_vsm_of sg_vis_vssm_fixed sg_vis_vssm_float sg_vogel_disc sg_vssm_blocker
+//   sg_sample_map_log sg_sat_box sg_sat_box_fixed sg_sat_box_float sg_sat_mean_fixed
+//   sg_sat_mean_float sg_sat_node_f32 sg_sat_node_u32 sg_sat_nodes sg_sat_rect
+//   sg_sat_sample_fixed sg_sat_sample_float sg_sat_search_fixed sg_sat_search_float
+//   sg_sat_span_weights sg_soft_blockers sg_soft_filter_trips sg_texel_of sg_trilinear
+//   sg_trilinear_log sg_vis_esm sg_vis_esm_of_log sg_vis_esm_of_sat sg_vis_evsm sg_vis_evsm_of
+//   sg_vis_hard sg_vis_msm sg_vis_msm_of sg_vis_msm_soft_fixed sg_vis_msm_soft_float sg_vis_pcf
+//   sg_vis_pcf_hardware sg_vis_pcss sg_vis_vsm sg_vis_vsm_of sg_vis_vssm_fixed sg_vis_vssm_float
+//   sg_vogel_disc sg_vssm_blocker
 
 // Shared light description and light-space helpers (import-only module).
 //
@@ -477,10 +479,11 @@ fn sg_csm_resolve(sum: f32, l: sg_Light) -> f32 {
 // where the smooth Fourier step leaks light and the penumbra is narrow, the darkening is
 // strongest; it fades as the receiver leaves its blockers. A square without blockers
 // (share < BLOCKER_MIN_SHARE) is lit.
-// The shading block (technique::soft_visibility_body) sums `csm_z_chunk_of` over the light's
-// CSM-Z tables at the search width, then runs `blocker.wgsl`'s two passes over its basis
-// tables: `csm_chunk_of` summed at the search width gives `cssm_blocker`, and where that finds
-// blockers, summed again at `blocker_filter_width(l, s, b.x)`, `cssm_resolve`.
+// The shading block (technique::cssm's `visibility`) sums `csm_z_chunk_of` over the light's
+// CSM-Z tables and `csm_chunk_of` over its basis tables at the search width snapped outward
+// to texel edges (`sat_search_*`, 4 loads a table), which gives `cssm_blocker`; where that
+// finds blockers, a loop of `soft_filter_trips` trips sums the basis tables again at
+// `blocker_filter_width(l, s, b.x)` (16 loads a table) for `cssm_resolve`.
 // The `sat` filter's lookups for the shading side (import-only module): a light's filtered
 // representation at a receiver as the mean over a square of `width` shadow-map texels centred
 // on it, from the light's summed-area table, four lookups per channel (sixteen with the
@@ -536,48 +539,60 @@ fn sg_sat_nodes(rect: vec4<f32>, size: vec2<u32>) -> sg_SatNodes {
     return n;
 }
 
-// F(X, Y) at integer nodes: 0 on the top and left edges, else SAT texel (X − 1, Y − 1).
+// F(X, Y) at integer nodes: 0 on the top and left edges, else SAT texel (X − 1, Y − 1). The
+// load is made unconditionally (at a clamped texel) and the edge selected after: a branch per
+// load costs a CPU driver a divergent branch per node and a GPU nothing either way.
 // #fetches sg_sat_node_u32: 1
 fn sg_sat_node_u32(sat: texture_2d<u32>, x: i32, y: i32) -> vec4<u32> {
-    if x == 0 || y == 0 {
-        return vec4<u32>(0u);
-    }
-    return textureLoad(sat, vec2<i32>(x - 1, y - 1), 0);
+    let v = textureLoad(sat, max(vec2<i32>(x - 1, y - 1), vec2<i32>(0)), 0);
+    return select(v, vec4<u32>(0u), x == 0 || y == 0);
 }
 
 // #fetches sg_sat_node_f32: 1
 fn sg_sat_node_f32(sat: texture_2d<f32>, x: i32, y: i32) -> vec4<f32> {
-    if x == 0 || y == 0 {
-        return vec4<f32>(0.0);
-    }
-    return textureLoad(sat, vec2<i32>(x - 1, y - 1), 0);
+    let v = textureLoad(sat, max(vec2<i32>(x - 1, y - 1), vec2<i32>(0)), 0);
+    return select(v, vec4<f32>(0.0), x == 0 || y == 0);
+}
+
+// The exact integral as nine integer windows: the nodes X = (i0, i0 + 1, i1, i1 + 1) cut the
+// x axis into three spans [X_k, X_k+1), the left texel column (weight 1 − fract(x0)), the
+// whole columns between (weight 1) and the right column (weight fract(x1)); the same for y.
+// F(x1) − F(x0) = (1 − a0)·C(i0) + Σ_(i0 < i < i1) C(i) + a1·C(i1) is Σ_k w_k·(F(X_k+1) − F(X_k))
+// with w = (1 − a0, 1, a1), also for i0 = i1 (the middle span is then [i0 + 1, i0): −C(i0),
+// and the weights sum to a1 − a0). Every window lies inside [X0, X3) × [Y0, Y3), so in fixed
+// point each is exact under the same scale rule as before; nine conversions and products
+// instead of sixteen overlapping windows.
+fn sg_sat_span_weights(w: vec4<f32>) -> vec3<f32> {
+    return vec3<f32>(w.x, 1.0, w.w);
 }
 
 // Mean of the representation over `rect` = (x0, y0, x1, y1), texel units, from a fixed-point
 // SAT (rgba32uint) encoded with `offset` and `scale` (SatCoding in src/sat.rs).
-// With F at the left edge a mix over r and at the right edge over p (weights summing to 1),
-// F(x1) − F(x0) = Σ_r,p wx0_r·wx1_p·(F(X1_p) − F(X0_r)): a weighted sum of integer windows.
 // #fetches sg_sat_mean_fixed: 16
 fn sg_sat_mean_fixed(sat: texture_2d<u32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
     let n = sg_sat_nodes(rect, textureDimensions(sat));
-    var f: array<vec4<u32>, 16>;
+    let wx = sg_sat_span_weights(n.wx);
+    let wy = sg_sat_span_weights(n.wy);
+    // Row differences first: d[j][k] = F(X_k+1, Y_j) − F(X_k, Y_j), wrapping.
+    var d: array<vec4<u32>, 12>;
     for (var j = 0; j < 4; j++) {
-        for (var i = 0; i < 4; i++) {
-            f[j * 4 + i] = sg_sat_node_u32(sat, n.x[i], n.y[j]);
-        }
+        let f0 = sg_sat_node_u32(sat, n.x[0], n.y[j]);
+        let f1 = sg_sat_node_u32(sat, n.x[1], n.y[j]);
+        let f2 = sg_sat_node_u32(sat, n.x[2], n.y[j]);
+        let f3 = sg_sat_node_u32(sat, n.x[3], n.y[j]);
+        d[j * 3] = f1 - f0;
+        d[j * 3 + 1] = f2 - f1;
+        d[j * 3 + 2] = f3 - f2;
     }
     var sum = vec4<f32>(0.0);
-    for (var s = 0; s < 2; s++) {
-        for (var q = 2; q < 4; q++) {
-            for (var r = 0; r < 2; r++) {
-                for (var p = 2; p < 4; p++) {
-                    // Wrapping differences: exact whatever the SAT values are.
-                    let window = f[q * 4 + p] - f[q * 4 + r] - f[s * 4 + p] + f[s * 4 + r];
-                    let w = n.wx[r] * n.wx[p] * n.wy[s] * n.wy[q];
-                    sum += w * vec4<f32>(bitcast<vec4<i32>>(window));
-                }
-            }
+    for (var m = 0; m < 3; m++) {
+        var row = vec4<f32>(0.0);
+        for (var k = 0; k < 3; k++) {
+            // Wrapping differences: exact whatever the SAT values are.
+            let window = d[(m + 1) * 3 + k] - d[m * 3 + k];
+            row += wx[k] * vec4<f32>(bitcast<vec4<i32>>(window));
         }
+        sum += wy[m] * row;
     }
     return sum / (scale * n.area) + offset;
 }
@@ -588,24 +603,59 @@ fn sg_sat_mean_fixed(sat: texture_2d<u32>, rect: vec4<f32>, offset: vec4<f32>, s
 // #fetches sg_sat_mean_float: 16
 fn sg_sat_mean_float(sat: texture_2d<f32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
     let n = sg_sat_nodes(rect, textureDimensions(sat));
-    var f: array<vec4<f32>, 16>;
+    let wx = sg_sat_span_weights(n.wx);
+    let wy = sg_sat_span_weights(n.wy);
+    var d: array<vec4<f32>, 12>;
     for (var j = 0; j < 4; j++) {
-        for (var i = 0; i < 4; i++) {
-            f[j * 4 + i] = sg_sat_node_f32(sat, n.x[i], n.y[j]);
-        }
+        let f0 = sg_sat_node_f32(sat, n.x[0], n.y[j]);
+        let f1 = sg_sat_node_f32(sat, n.x[1], n.y[j]);
+        let f2 = sg_sat_node_f32(sat, n.x[2], n.y[j]);
+        let f3 = sg_sat_node_f32(sat, n.x[3], n.y[j]);
+        d[j * 3] = f1 - f0;
+        d[j * 3 + 1] = f2 - f1;
+        d[j * 3 + 2] = f3 - f2;
     }
     var sum = vec4<f32>(0.0);
-    for (var s = 0; s < 2; s++) {
-        for (var q = 2; q < 4; q++) {
-            for (var r = 0; r < 2; r++) {
-                for (var p = 2; p < 4; p++) {
-                    let window = (f[q * 4 + p] - f[q * 4 + r]) - (f[s * 4 + p] - f[s * 4 + r]);
-                    sum += n.wx[r] * n.wx[p] * n.wy[s] * n.wy[q] * window;
-                }
-            }
+    for (var m = 0; m < 3; m++) {
+        var row = vec4<f32>(0.0);
+        for (var k = 0; k < 3; k++) {
+            row += wx[k] * (d[(m + 1) * 3 + k] - d[m * 3 + k]);
         }
+        sum += wy[m] * row;
     }
     return sum / (scale * n.area) + offset;
+}
+
+// Mean over the rectangle snapped outward to texel edges, [⌊x0⌋, ⌈x1⌉) × [⌊y0⌋, ⌈y1⌉) after
+// the clamp of `sat_nodes`: one integer window, four loads. For estimates (the blocker search)
+// where a square up to one texel wider per side reads as well as the exact one.
+// #fetches sg_sat_box_fixed: 4
+fn sg_sat_box_fixed(sat: texture_2d<u32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
+    let b = sg_sat_box(rect, textureDimensions(sat));
+    let window = sg_sat_node_u32(sat, b.z, b.w) - sg_sat_node_u32(sat, b.x, b.w)
+        - sg_sat_node_u32(sat, b.z, b.y) + sg_sat_node_u32(sat, b.x, b.y);
+    let area = f32((b.z - b.x) * (b.w - b.y));
+    return vec4<f32>(bitcast<vec4<i32>>(window)) / (scale * area) + offset;
+}
+
+// #fetches sg_sat_box_float: 4
+fn sg_sat_box_float(sat: texture_2d<f32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
+    let b = sg_sat_box(rect, textureDimensions(sat));
+    let window = (sg_sat_node_f32(sat, b.z, b.w) - sg_sat_node_f32(sat, b.x, b.w))
+        - (sg_sat_node_f32(sat, b.z, b.y) - sg_sat_node_f32(sat, b.x, b.y));
+    let area = f32((b.z - b.x) * (b.w - b.y));
+    return window / (scale * area) + offset;
+}
+
+// The integer nodes (X0, Y0, X1, Y1) of `sat_nodes`' rectangle snapped outward: X0 = ⌊x0⌋,
+// X1 = ⌈x1⌉ (> X0: the rectangle is at least SAT_MIN_EXTENT wide), within [0, size].
+fn sg_sat_box(rect: vec4<f32>, size: vec2<u32>) -> vec4<i32> {
+    let s = vec2<f32>(size);
+    let lo0 = clamp(min(rect.xy, rect.zw), vec2<f32>(0.0), s);
+    let hi0 = clamp(max(rect.xy, rect.zw), vec2<f32>(0.0), s);
+    let lo = min(lo0, s - sg_SAT_MIN_EXTENT);
+    let hi = max(hi0, lo + sg_SAT_MIN_EXTENT);
+    return vec4<i32>(vec2<i32>(floor(lo)), min(vec2<i32>(ceil(hi)), vec2<i32>(size)));
 }
 
 // The square of `width` texels centred on uv, in texel units (x0, y0, x1, y1).
@@ -625,6 +675,18 @@ fn sg_sat_sample_fixed(map: texture_2d<u32>, l: sg_Light, uv: vec2<f32>, width: 
 // #fetches sg_sat_sample_float: 16
 fn sg_sat_sample_float(map: texture_2d<f32>, l: sg_Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
     return sg_sat_mean_float(map, sg_sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
+}
+
+// The mean over `sat_rect(l, uv, width)` snapped outward to texel edges (`sat_box_*`): the
+// blocker search's estimate in four loads.
+// #fetches sg_sat_search_fixed: 4
+fn sg_sat_search_fixed(map: texture_2d<u32>, l: sg_Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
+    return sg_sat_box_fixed(map, sg_sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
+}
+
+// #fetches sg_sat_search_float: 4
+fn sg_sat_search_float(map: texture_2d<f32>, l: sg_Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
+    return sg_sat_box_float(map, sg_sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
 }
 // The blocker search of the soft techniques (cssm, vssm, msm_soft) as filtered lookups
 // (import-only module): each technique reads the mean of its representation over the search
@@ -850,37 +912,33 @@ fn sg_blocker_filter_width(l: sg_Light, s: sg_LightSample, z_avg: f32) -> f32 {
     return sg_blocker_width(penumbra / sg_light_map_width(l, s.view_z) * l.map_size.x, l);
 }
 
-// A soft technique's two table lookups as two passes of one loop: pass 0 reads the table over
-// the search square and estimates the blockers (soft_blockers); pass 1, made only where the
-// search found some (share ≥ BLOCKER_MIN_SHARE), reads it over the penumbra width; elsewhere
-// the receiver is lit after one lookup. A loop, not a second lookup in a branch: llvmpipe
-// (lavapipe) runs a loop-free branch body (a table lookup's loads) for its whole SIMD group
-// whatever its lanes decide, and leaves a loop after the trip in which no lane continues, so
-// only a loop lets a group without blockers skip the second lookup there (measured: 64 loads
-// under a branch never taken cost what they cost taken, 11.0 against 10.9 ms; a loop-bearing
-// body under a branch or loop never entered, 3 against 12 ms); a GPU runs either as a branch.
+// A soft technique's two table lookups: the search (`sat_search_*`, the square snapped
+// outward to texel edges, 4 loads a table) estimates the blockers (soft_blockers); the filter
+// lookup at the penumbra width (16 loads a table), made only where the search found some
+// (share ≥ BLOCKER_MIN_SHARE), sits in a loop of `soft_filter_trips` (0 or 1) trips; elsewhere
+// the receiver is lit after the search. A loop, not a branch: llvmpipe (lavapipe) runs a
+// loop-free branch body (a table lookup's loads) for its whole SIMD group whatever its lanes
+// decide, but skips a loop no lane enters (measured: 64 loads under a branch never taken cost
+// what they cost taken, 11.0 against 10.9 ms; a loop-bearing body under a branch or loop never
+// entered, 3 against 12 ms); a GPU runs either as a branch.
 struct sg_SoftLookup {
-    width: f32,          // texels: the square the next pass reads
-    blocker: vec2<f32>,  // (z_avg, share) from the search (pass 1)
-    blockers: bool,      // whether the search found any (pass 1 is made)
+    width: f32,          // texels: the square the filter lookup reads
+    blocker: vec2<f32>,  // (z_avg, share) from the search
+    blockers: bool,      // whether the search found any (the filter lookup is made)
 }
 
-// Pass 0: the search square.
-fn sg_soft_search(l: sg_Light, s: sg_LightSample) -> sg_SoftLookup {
-    var look: sg_SoftLookup;
-    look.width = sg_blocker_search_width(l, s);
-    look.blocker = vec2<f32>(0.0);
-    look.blockers = false;
-    return look;
-}
-
-// Pass 1 after the search's estimate b = (z_avg, share): the penumbra width of z_avg.
+// After the search's estimate b = (z_avg, share): the penumbra width of z_avg.
 fn sg_soft_blockers(b: vec2<f32>, l: sg_Light, s: sg_LightSample) -> sg_SoftLookup {
     var look: sg_SoftLookup;
     look.width = sg_blocker_filter_width(l, s, b.x);
     look.blocker = b;
     look.blockers = b.y >= sg_BLOCKER_MIN_SHARE;
     return look;
+}
+
+// The trips of the filter lookup's loop: 1 where the search found blockers, else 0.
+fn sg_soft_filter_trips(look: sg_SoftLookup) -> u32 {
+    return select(0u, 1u, look.blockers);
 }
 
 // (z_avg, share) from a blocker depth estimate `z` and share: z clamped to [0, d] (blockers
@@ -1047,43 +1105,41 @@ fn sg_vis_hard(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
 // moments (raw or quantized): the biased moments over the blocker-search square give the
 // blocker share and depth from the Hamburger reconstruction (blocker_msm), the PCSS penumbra
 // width follows, and MSM's visibility (vis_msm_of: Hamburger or Hausdorff, bleed reduction) is
-// read from the moments over that width. One table lookup per pass of `blocker.wgsl`'s two-pass
-// loop: a receiver whose search square holds no blockers (share below BLOCKER_MIN_SHARE) is
-// lit after the first.
+// read from the moments over that width. The search reads the
+// square snapped outward to texel edges (`sat_search_*`: 4 loads; the square grows by less
+// than a texel per side, an estimate either way), the filter the exact square (16 loads), in
+// a loop of `soft_filter_trips` trips: a receiver whose search square holds no blockers
+// (share below BLOCKER_MIN_SHARE) is lit after the search.
 // `vis_msm_soft_fixed` reads a fixed-point table (rgba32uint), `vis_msm_soft_float` an f32 one.
 
 fn sg_msm_soft_blocker(m: vec4<f32>, l: sg_Light, s: sg_LightSample) -> vec2<f32> {
     return sg_blocker_msm(sg_msm_biased(m, l), s.depth - l.bias);
 }
 
-// #fetches sg_vis_msm_soft_fixed: 2 * sg_sat_sample_fixed
+// #fetches sg_vis_msm_soft_fixed: sg_sat_search_fixed + sg_sat_sample_fixed
 fn sg_vis_msm_soft_fixed(map: texture_2d<u32>, l: sg_Light, s: sg_LightSample) -> f32 {
-    var look = sg_soft_search(l, s);
+    let search = sg_sat_search_fixed(map, l, s.uv, sg_blocker_search_width(l, s));
+    let look = sg_soft_blockers(sg_msm_soft_blocker(search, l, s), l, s);
     var m = vec4<f32>(0.0);
-    for (var k = 0u; k < 2u; k++) {
+    for (var k = 0u; k < sg_soft_filter_trips(look); k++) {
         m = sg_sat_sample_fixed(map, l, s.uv, look.width);
-        if k == 0u {
-            look = sg_soft_blockers(sg_msm_soft_blocker(m, l, s), l, s);
-            if !look.blockers {
-                return 1.0;
-            }
-        }
+    }
+    if !look.blockers {
+        return 1.0;
     }
     return sg_vis_msm_of(m, l, s);
 }
 
-// #fetches sg_vis_msm_soft_float: 2 * sg_sat_sample_float
+// #fetches sg_vis_msm_soft_float: sg_sat_search_float + sg_sat_sample_float
 fn sg_vis_msm_soft_float(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
-    var look = sg_soft_search(l, s);
+    let search = sg_sat_search_float(map, l, s.uv, sg_blocker_search_width(l, s));
+    let look = sg_soft_blockers(sg_msm_soft_blocker(search, l, s), l, s);
     var m = vec4<f32>(0.0);
-    for (var k = 0u; k < 2u; k++) {
+    for (var k = 0u; k < sg_soft_filter_trips(look); k++) {
         m = sg_sat_sample_float(map, l, s.uv, look.width);
-        if k == 0u {
-            look = sg_soft_blockers(sg_msm_soft_blocker(m, l, s), l, s);
-            if !look.blockers {
-                return 1.0;
-            }
-        }
+    }
+    if !look.blockers {
+        return 1.0;
     }
     return sg_vis_msm_of(m, l, s);
 }
@@ -1178,43 +1234,41 @@ fn sg_vis_vsm_of(m: vec4<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
 // Variance soft shadow maps (Yang et al. 2010) from a summed-area table of the VSM moments:
 // the moments over the blocker-search square give the blocker share and depth (blocker_vsm),
 // the PCSS penumbra width follows, and the VSM bound (vis_vsm_of: variance floor, bleed
-// reduction) is read from the moments over that width. One table lookup per pass of
-// `blocker.wgsl`'s two-pass loop: a receiver whose search square holds no blockers (share below
-// BLOCKER_MIN_SHARE) is lit after the first.
+// reduction) is read from the moments over that width. The search reads the
+// square snapped outward to texel edges (`sat_search_*`: 4 loads; the square grows by less
+// than a texel per side, an estimate either way), the filter the exact square (16 loads), in
+// a loop of `soft_filter_trips` trips: a receiver whose search square holds no blockers
+// (share below BLOCKER_MIN_SHARE) is lit after the search.
 // `vis_vssm_fixed` reads a fixed-point table (rgba32uint), `vis_vssm_float` an f32 one.
 
 fn sg_vssm_blocker(m: vec4<f32>, l: sg_Light, s: sg_LightSample) -> vec2<f32> {
     return sg_blocker_vsm(m, s.depth - l.bias, l.min_variance);
 }
 
-// #fetches sg_vis_vssm_fixed: 2 * sg_sat_sample_fixed
+// #fetches sg_vis_vssm_fixed: sg_sat_search_fixed + sg_sat_sample_fixed
 fn sg_vis_vssm_fixed(map: texture_2d<u32>, l: sg_Light, s: sg_LightSample) -> f32 {
-    var look = sg_soft_search(l, s);
+    let search = sg_sat_search_fixed(map, l, s.uv, sg_blocker_search_width(l, s));
+    let look = sg_soft_blockers(sg_vssm_blocker(search, l, s), l, s);
     var m = vec4<f32>(0.0);
-    for (var k = 0u; k < 2u; k++) {
+    for (var k = 0u; k < sg_soft_filter_trips(look); k++) {
         m = sg_sat_sample_fixed(map, l, s.uv, look.width);
-        if k == 0u {
-            look = sg_soft_blockers(sg_vssm_blocker(m, l, s), l, s);
-            if !look.blockers {
-                return 1.0;
-            }
-        }
+    }
+    if !look.blockers {
+        return 1.0;
     }
     return sg_vis_vsm_of(m, l, s);
 }
 
-// #fetches sg_vis_vssm_float: 2 * sg_sat_sample_float
+// #fetches sg_vis_vssm_float: sg_sat_search_float + sg_sat_sample_float
 fn sg_vis_vssm_float(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
-    var look = sg_soft_search(l, s);
+    let search = sg_sat_search_float(map, l, s.uv, sg_blocker_search_width(l, s));
+    let look = sg_soft_blockers(sg_vssm_blocker(search, l, s), l, s);
     var m = vec4<f32>(0.0);
-    for (var k = 0u; k < 2u; k++) {
+    for (var k = 0u; k < sg_soft_filter_trips(look); k++) {
         m = sg_sat_sample_float(map, l, s.uv, look.width);
-        if k == 0u {
-            look = sg_soft_blockers(sg_vssm_blocker(m, l, s), l, s);
-            if !look.blockers {
-                return 1.0;
-            }
-        }
+    }
+    if !look.blockers {
+        return 1.0;
     }
     return sg_vis_vsm_of(m, l, s);
 }

@@ -36,37 +36,33 @@ fn blocker_filter_width(l: Light, s: LightSample, z_avg: f32) -> f32 {
     return blocker_width(penumbra / light_map_width(l, s.view_z) * l.map_size.x, l);
 }
 
-// A soft technique's two table lookups as two passes of one loop: pass 0 reads the table over
-// the search square and estimates the blockers (soft_blockers); pass 1, made only where the
-// search found some (share ≥ BLOCKER_MIN_SHARE), reads it over the penumbra width; elsewhere
-// the receiver is lit after one lookup. A loop, not a second lookup in a branch: llvmpipe
-// (lavapipe) runs a loop-free branch body (a table lookup's loads) for its whole SIMD group
-// whatever its lanes decide, and leaves a loop after the trip in which no lane continues, so
-// only a loop lets a group without blockers skip the second lookup there (measured: 64 loads
-// under a branch never taken cost what they cost taken, 11.0 against 10.9 ms; a loop-bearing
-// body under a branch or loop never entered, 3 against 12 ms); a GPU runs either as a branch.
+// A soft technique's two table lookups: the search (`sat_search_*`, the square snapped
+// outward to texel edges, 4 loads a table) estimates the blockers (soft_blockers); the filter
+// lookup at the penumbra width (16 loads a table), made only where the search found some
+// (share ≥ BLOCKER_MIN_SHARE), sits in a loop of `soft_filter_trips` (0 or 1) trips; elsewhere
+// the receiver is lit after the search. A loop, not a branch: llvmpipe (lavapipe) runs a
+// loop-free branch body (a table lookup's loads) for its whole SIMD group whatever its lanes
+// decide, but skips a loop no lane enters (measured: 64 loads under a branch never taken cost
+// what they cost taken, 11.0 against 10.9 ms; a loop-bearing body under a branch or loop never
+// entered, 3 against 12 ms); a GPU runs either as a branch.
 struct SoftLookup {
-    width: f32,          // texels: the square the next pass reads
-    blocker: vec2<f32>,  // (z_avg, share) from the search (pass 1)
-    blockers: bool,      // whether the search found any (pass 1 is made)
+    width: f32,          // texels: the square the filter lookup reads
+    blocker: vec2<f32>,  // (z_avg, share) from the search
+    blockers: bool,      // whether the search found any (the filter lookup is made)
 }
 
-// Pass 0: the search square.
-fn soft_search(l: Light, s: LightSample) -> SoftLookup {
-    var look: SoftLookup;
-    look.width = blocker_search_width(l, s);
-    look.blocker = vec2<f32>(0.0);
-    look.blockers = false;
-    return look;
-}
-
-// Pass 1 after the search's estimate b = (z_avg, share): the penumbra width of z_avg.
+// After the search's estimate b = (z_avg, share): the penumbra width of z_avg.
 fn soft_blockers(b: vec2<f32>, l: Light, s: LightSample) -> SoftLookup {
     var look: SoftLookup;
     look.width = blocker_filter_width(l, s, b.x);
     look.blocker = b;
     look.blockers = b.y >= BLOCKER_MIN_SHARE;
     return look;
+}
+
+// The trips of the filter lookup's loop: 1 where the search found blockers, else 0.
+fn soft_filter_trips(look: SoftLookup) -> u32 {
+    return select(0u, 1u, look.blockers);
 }
 
 // (z_avg, share) from a blocker depth estimate `z` and share: z clamped to [0, d] (blockers

@@ -48,48 +48,60 @@ fn sat_nodes(rect: vec4<f32>, size: vec2<u32>) -> SatNodes {
     return n;
 }
 
-// F(X, Y) at integer nodes: 0 on the top and left edges, else SAT texel (X − 1, Y − 1).
+// F(X, Y) at integer nodes: 0 on the top and left edges, else SAT texel (X − 1, Y − 1). The
+// load is made unconditionally (at a clamped texel) and the edge selected after: a branch per
+// load costs a CPU driver a divergent branch per node and a GPU nothing either way.
 // #fetches sat_node_u32: 1
 fn sat_node_u32(sat: texture_2d<u32>, x: i32, y: i32) -> vec4<u32> {
-    if x == 0 || y == 0 {
-        return vec4<u32>(0u);
-    }
-    return textureLoad(sat, vec2<i32>(x - 1, y - 1), 0);
+    let v = textureLoad(sat, max(vec2<i32>(x - 1, y - 1), vec2<i32>(0)), 0);
+    return select(v, vec4<u32>(0u), x == 0 || y == 0);
 }
 
 // #fetches sat_node_f32: 1
 fn sat_node_f32(sat: texture_2d<f32>, x: i32, y: i32) -> vec4<f32> {
-    if x == 0 || y == 0 {
-        return vec4<f32>(0.0);
-    }
-    return textureLoad(sat, vec2<i32>(x - 1, y - 1), 0);
+    let v = textureLoad(sat, max(vec2<i32>(x - 1, y - 1), vec2<i32>(0)), 0);
+    return select(v, vec4<f32>(0.0), x == 0 || y == 0);
+}
+
+// The exact integral as nine integer windows: the nodes X = (i0, i0 + 1, i1, i1 + 1) cut the
+// x axis into three spans [X_k, X_k+1), the left texel column (weight 1 − fract(x0)), the
+// whole columns between (weight 1) and the right column (weight fract(x1)); the same for y.
+// F(x1) − F(x0) = (1 − a0)·C(i0) + Σ_(i0 < i < i1) C(i) + a1·C(i1) is Σ_k w_k·(F(X_k+1) − F(X_k))
+// with w = (1 − a0, 1, a1), also for i0 = i1 (the middle span is then [i0 + 1, i0): −C(i0),
+// and the weights sum to a1 − a0). Every window lies inside [X0, X3) × [Y0, Y3), so in fixed
+// point each is exact under the same scale rule as before; nine conversions and products
+// instead of sixteen overlapping windows.
+fn sat_span_weights(w: vec4<f32>) -> vec3<f32> {
+    return vec3<f32>(w.x, 1.0, w.w);
 }
 
 // Mean of the representation over `rect` = (x0, y0, x1, y1), texel units, from a fixed-point
 // SAT (rgba32uint) encoded with `offset` and `scale` (SatCoding in src/sat.rs).
-// With F at the left edge a mix over r and at the right edge over p (weights summing to 1),
-// F(x1) − F(x0) = Σ_r,p wx0_r·wx1_p·(F(X1_p) − F(X0_r)): a weighted sum of integer windows.
 // #fetches sat_mean_fixed: 16
 fn sat_mean_fixed(sat: texture_2d<u32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
     let n = sat_nodes(rect, textureDimensions(sat));
-    var f: array<vec4<u32>, 16>;
+    let wx = sat_span_weights(n.wx);
+    let wy = sat_span_weights(n.wy);
+    // Row differences first: d[j][k] = F(X_k+1, Y_j) − F(X_k, Y_j), wrapping.
+    var d: array<vec4<u32>, 12>;
     for (var j = 0; j < 4; j++) {
-        for (var i = 0; i < 4; i++) {
-            f[j * 4 + i] = sat_node_u32(sat, n.x[i], n.y[j]);
-        }
+        let f0 = sat_node_u32(sat, n.x[0], n.y[j]);
+        let f1 = sat_node_u32(sat, n.x[1], n.y[j]);
+        let f2 = sat_node_u32(sat, n.x[2], n.y[j]);
+        let f3 = sat_node_u32(sat, n.x[3], n.y[j]);
+        d[j * 3] = f1 - f0;
+        d[j * 3 + 1] = f2 - f1;
+        d[j * 3 + 2] = f3 - f2;
     }
     var sum = vec4<f32>(0.0);
-    for (var s = 0; s < 2; s++) {
-        for (var q = 2; q < 4; q++) {
-            for (var r = 0; r < 2; r++) {
-                for (var p = 2; p < 4; p++) {
-                    // Wrapping differences: exact whatever the SAT values are.
-                    let window = f[q * 4 + p] - f[q * 4 + r] - f[s * 4 + p] + f[s * 4 + r];
-                    let w = n.wx[r] * n.wx[p] * n.wy[s] * n.wy[q];
-                    sum += w * vec4<f32>(bitcast<vec4<i32>>(window));
-                }
-            }
+    for (var m = 0; m < 3; m++) {
+        var row = vec4<f32>(0.0);
+        for (var k = 0; k < 3; k++) {
+            // Wrapping differences: exact whatever the SAT values are.
+            let window = d[(m + 1) * 3 + k] - d[m * 3 + k];
+            row += wx[k] * vec4<f32>(bitcast<vec4<i32>>(window));
         }
+        sum += wy[m] * row;
     }
     return sum / (scale * n.area) + offset;
 }
@@ -100,22 +112,57 @@ fn sat_mean_fixed(sat: texture_2d<u32>, rect: vec4<f32>, offset: vec4<f32>, scal
 // #fetches sat_mean_float: 16
 fn sat_mean_float(sat: texture_2d<f32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
     let n = sat_nodes(rect, textureDimensions(sat));
-    var f: array<vec4<f32>, 16>;
+    let wx = sat_span_weights(n.wx);
+    let wy = sat_span_weights(n.wy);
+    var d: array<vec4<f32>, 12>;
     for (var j = 0; j < 4; j++) {
-        for (var i = 0; i < 4; i++) {
-            f[j * 4 + i] = sat_node_f32(sat, n.x[i], n.y[j]);
-        }
+        let f0 = sat_node_f32(sat, n.x[0], n.y[j]);
+        let f1 = sat_node_f32(sat, n.x[1], n.y[j]);
+        let f2 = sat_node_f32(sat, n.x[2], n.y[j]);
+        let f3 = sat_node_f32(sat, n.x[3], n.y[j]);
+        d[j * 3] = f1 - f0;
+        d[j * 3 + 1] = f2 - f1;
+        d[j * 3 + 2] = f3 - f2;
     }
     var sum = vec4<f32>(0.0);
-    for (var s = 0; s < 2; s++) {
-        for (var q = 2; q < 4; q++) {
-            for (var r = 0; r < 2; r++) {
-                for (var p = 2; p < 4; p++) {
-                    let window = (f[q * 4 + p] - f[q * 4 + r]) - (f[s * 4 + p] - f[s * 4 + r]);
-                    sum += n.wx[r] * n.wx[p] * n.wy[s] * n.wy[q] * window;
-                }
-            }
+    for (var m = 0; m < 3; m++) {
+        var row = vec4<f32>(0.0);
+        for (var k = 0; k < 3; k++) {
+            row += wx[k] * (d[(m + 1) * 3 + k] - d[m * 3 + k]);
         }
+        sum += wy[m] * row;
     }
     return sum / (scale * n.area) + offset;
+}
+
+// Mean over the rectangle snapped outward to texel edges, [⌊x0⌋, ⌈x1⌉) × [⌊y0⌋, ⌈y1⌉) after
+// the clamp of `sat_nodes`: one integer window, four loads. For estimates (the blocker search)
+// where a square up to one texel wider per side reads as well as the exact one.
+// #fetches sat_box_fixed: 4
+fn sat_box_fixed(sat: texture_2d<u32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
+    let b = sat_box(rect, textureDimensions(sat));
+    let window = sat_node_u32(sat, b.z, b.w) - sat_node_u32(sat, b.x, b.w)
+        - sat_node_u32(sat, b.z, b.y) + sat_node_u32(sat, b.x, b.y);
+    let area = f32((b.z - b.x) * (b.w - b.y));
+    return vec4<f32>(bitcast<vec4<i32>>(window)) / (scale * area) + offset;
+}
+
+// #fetches sat_box_float: 4
+fn sat_box_float(sat: texture_2d<f32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
+    let b = sat_box(rect, textureDimensions(sat));
+    let window = (sat_node_f32(sat, b.z, b.w) - sat_node_f32(sat, b.x, b.w))
+        - (sat_node_f32(sat, b.z, b.y) - sat_node_f32(sat, b.x, b.y));
+    let area = f32((b.z - b.x) * (b.w - b.y));
+    return window / (scale * area) + offset;
+}
+
+// The integer nodes (X0, Y0, X1, Y1) of `sat_nodes`' rectangle snapped outward: X0 = ⌊x0⌋,
+// X1 = ⌈x1⌉ (> X0: the rectangle is at least SAT_MIN_EXTENT wide), within [0, size].
+fn sat_box(rect: vec4<f32>, size: vec2<u32>) -> vec4<i32> {
+    let s = vec2<f32>(size);
+    let lo0 = clamp(min(rect.xy, rect.zw), vec2<f32>(0.0), s);
+    let hi0 = clamp(max(rect.xy, rect.zw), vec2<f32>(0.0), s);
+    let lo = min(lo0, s - SAT_MIN_EXTENT);
+    let hi = max(hi0, lo + SAT_MIN_EXTENT);
+    return vec4<i32>(vec2<i32>(floor(lo)), min(vec2<i32>(ceil(hi)), vec2<i32>(size)));
 }

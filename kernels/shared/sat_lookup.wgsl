@@ -24,3 +24,15 @@ fn sat_sample_fixed(map: texture_2d<u32>, l: Light, uv: vec2<f32>, width: f32) -
 fn sat_sample_float(map: texture_2d<f32>, l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
     return sat_mean_float(map, sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
 }
+
+// The mean over `sat_rect(l, uv, width)` snapped outward to texel edges (`sat_box_*`): the
+// blocker search's estimate in four loads.
+// #fetches sat_search_fixed: 4
+fn sat_search_fixed(map: texture_2d<u32>, l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
+    return sat_box_fixed(map, sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
+}
+
+// #fetches sat_search_float: 4
+fn sat_search_float(map: texture_2d<f32>, l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
+    return sat_box_float(map, sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
+}

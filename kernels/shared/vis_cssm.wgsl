@@ -7,10 +7,11 @@
 // where the smooth Fourier step leaks light and the penumbra is narrow, the darkening is
 // strongest; it fades as the receiver leaves its blockers. A square without blockers
 // (share < BLOCKER_MIN_SHARE) is lit.
-// The shading block (technique::soft_visibility_body) sums `csm_z_chunk_of` over the light's
-// CSM-Z tables at the search width, then runs `blocker.wgsl`'s two passes over its basis
-// tables: `csm_chunk_of` summed at the search width gives `cssm_blocker`, and where that finds
-// blockers, summed again at `blocker_filter_width(l, s, b.x)`, `cssm_resolve`.
+// The shading block (technique::cssm's `visibility`) sums `csm_z_chunk_of` over the light's
+// CSM-Z tables and `csm_chunk_of` over its basis tables at the search width snapped outward
+// to texel edges (`sat_search_*`, 4 loads a table), which gives `cssm_blocker`; where that
+// finds blockers, a loop of `soft_filter_trips` trips sums the basis tables again at
+// `blocker_filter_width(l, s, b.x)` (16 loads a table) for `cssm_resolve`.
 // #import shared/light
 // #import shared/sat_lookup
 // #import shared/blocker

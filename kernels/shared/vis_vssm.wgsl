@@ -1,9 +1,11 @@
 // Variance soft shadow maps (Yang et al. 2010) from a summed-area table of the VSM moments:
 // the moments over the blocker-search square give the blocker share and depth (blocker_vsm),
 // the PCSS penumbra width follows, and the VSM bound (vis_vsm_of: variance floor, bleed
-// reduction) is read from the moments over that width. One table lookup per pass of
-// `blocker.wgsl`'s two-pass loop: a receiver whose search square holds no blockers (share below
-// BLOCKER_MIN_SHARE) is lit after the first.
+// reduction) is read from the moments over that width. The search reads the
+// square snapped outward to texel edges (`sat_search_*`: 4 loads; the square grows by less
+// than a texel per side, an estimate either way), the filter the exact square (16 loads), in
+// a loop of `soft_filter_trips` trips: a receiver whose search square holds no blockers
+// (share below BLOCKER_MIN_SHARE) is lit after the search.
 // `vis_vssm_fixed` reads a fixed-point table (rgba32uint), `vis_vssm_float` an f32 one.
 // #import shared/light
 // #import shared/sat_lookup
@@ -14,34 +16,30 @@ fn vssm_blocker(m: vec4<f32>, l: Light, s: LightSample) -> vec2<f32> {
     return blocker_vsm(m, s.depth - l.bias, l.min_variance);
 }
 
-// #fetches vis_vssm_fixed: 2 * sat_sample_fixed
+// #fetches vis_vssm_fixed: sat_search_fixed + sat_sample_fixed
 fn vis_vssm_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32 {
-    var look = soft_search(l, s);
+    let search = sat_search_fixed(map, l, s.uv, blocker_search_width(l, s));
+    let look = soft_blockers(vssm_blocker(search, l, s), l, s);
     var m = vec4<f32>(0.0);
-    for (var k = 0u; k < 2u; k++) {
+    for (var k = 0u; k < soft_filter_trips(look); k++) {
         m = sat_sample_fixed(map, l, s.uv, look.width);
-        if k == 0u {
-            look = soft_blockers(vssm_blocker(m, l, s), l, s);
-            if !look.blockers {
-                return 1.0;
-            }
-        }
+    }
+    if !look.blockers {
+        return 1.0;
     }
     return vis_vsm_of(m, l, s);
 }
 
-// #fetches vis_vssm_float: 2 * sat_sample_float
+// #fetches vis_vssm_float: sat_search_float + sat_sample_float
 fn vis_vssm_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
-    var look = soft_search(l, s);
+    let search = sat_search_float(map, l, s.uv, blocker_search_width(l, s));
+    let look = soft_blockers(vssm_blocker(search, l, s), l, s);
     var m = vec4<f32>(0.0);
-    for (var k = 0u; k < 2u; k++) {
+    for (var k = 0u; k < soft_filter_trips(look); k++) {
         m = sat_sample_float(map, l, s.uv, look.width);
-        if k == 0u {
-            look = soft_blockers(vssm_blocker(m, l, s), l, s);
-            if !look.blockers {
-                return 1.0;
-            }
-        }
+    }
+    if !look.blockers {
+        return 1.0;
     }
     return vis_vsm_of(m, l, s);
 }

@@ -249,6 +249,16 @@ impl Integral {
         let h = 0.5 * width as f32;
         self.rect_mean([cx - h, cy - h, cx + h, cy + h])
     }
+
+    /// The mean over the square of [`Self::square_mean`] snapped outward to texel edges after
+    /// [`clamp_rect`]: `[⌊x0⌋, ⌈x1⌉) × [⌊y0⌋, ⌈y1⌉)` (`sat_search_*`, the blocker search).
+    pub fn snapped_square_mean(&self, map_size: [f32; 2], uv: [f64; 2], width: f64) -> Vec<f64> {
+        let (cx, cy) = (uv[0] as f32 * map_size[0], uv[1] as f32 * map_size[1]);
+        let h = 0.5 * width as f32;
+        let r = clamp_rect([cx - h, cy - h, cx + h, cy + h], self.width, self.height);
+        let snapped = [r[0].floor(), r[1].floor(), r[2].ceil(), r[3].ceil()];
+        self.rect_mean(snapped)
+    }
 }
 
 #[cfg(test)]

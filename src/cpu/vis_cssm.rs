@@ -17,12 +17,13 @@ pub struct Maps<'a> {
     pub z: &'a Integral,
 }
 
-/// The two series over the search square: `(below, zsum)` = (E[f] − ½, E[f̄·z]).
+/// The two series over the search square snapped outward to texel edges: `(below, zsum)` =
+/// (E[f] − ½, E[f̄·z]).
 pub fn search(maps: Maps, l: &LightGpu, s: &LightSample) -> (f64, f64) {
     let w = blocker::search_width(l, s);
     let d = super::vis_csm::shifted_depth(l, s);
-    let basis = maps.basis.square_mean(l.map_size, s.uv, w);
-    let z = maps.z.square_mean(l.map_size, s.uv, w);
+    let basis = maps.basis.snapped_square_mean(l.map_size, s.uv, w);
+    let z = maps.z.snapped_square_mean(l.map_size, s.uv, w);
     (
         super::vis_csm::series(&basis, l, d),
         blocker::csm_z_series(&z, l, d),

@@ -7,9 +7,10 @@ use super::light::LightSample;
 use super::sat::Integral;
 use crate::gpu_data::LightGpu;
 
-/// The mean (possibly quantized) moments over the blocker-search square.
+/// The mean (possibly quantized) moments over the blocker-search square snapped outward to
+/// texel edges.
 pub fn search(moments: &Integral, l: &LightGpu, s: &LightSample) -> Vec<f64> {
-    moments.square_mean(l.map_size, s.uv, blocker::search_width(l, s))
+    moments.snapped_square_mean(l.map_size, s.uv, blocker::search_width(l, s))
 }
 
 /// `msm_soft_blocker`.

@@ -54,29 +54,40 @@ fn values(t: &Technique) -> ParamValues {
     out
 }
 
-/// The table means over the blocker-search square, the blocker estimate, and only where that
-/// finds blockers the means over the penumbra width (`shared/blocker`'s two passes): the
-/// CSM-Z maps (the maps after the first ⌈M/2⌉) summed over the search square, then the two
-/// passes over the basis maps, with the fetch count of the loop.
+/// The table means over the blocker-search square snapped to texel edges (the CSM-Z maps,
+/// the maps after the first ⌈M/2⌉, and the basis maps), the blocker estimate, and only where
+/// that finds blockers the basis maps' means over the penumbra width, with the fetch count of
+/// the loop.
 fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
     let Technique::Cssm { terms, soft, .. } = light.shadow.technique else {
         return VisibilityBody::simple(vec!["shared/vis_cssm"], String::new());
     };
     let suffix = table_suffix(soft.sums);
     let (basis, z) = maps.split_at((csm_maps(terms) as usize).min(maps.len()));
+    let search = |m: &str| format!("sat_search_{suffix}({m}, l, s.uv, width)");
     let sample = |m: &str| sat_sample(soft.sums, m, "look.width");
-    let mut body = String::from(
-        "var look = soft_search(l, s);
-    var zsum = 0.0;",
-    );
+    // The search reads every table over the square snapped to texel edges (4 loads each); the
+    // filter reads the basis tables again, in a loop of 0 or 1 trips (`soft_filter_trips`).
+    let mut body = String::from("let width = blocker_search_width(l, s);\n    var zsum = 0.0;");
     for (chunk, m) in z.iter().enumerate() {
         let _ = write!(
             body,
             "\n    zsum += csm_z_chunk_of({}, {chunk}u, l, s);",
-            sample(m)
+            search(m)
         );
     }
-    body.push_str("\n    var sum = 0.0;\n    for (var k = 0u; k < 2u; k++) {\n        sum = 0.0;");
+    body.push_str("\n    var below = 0.0;");
+    for (chunk, m) in basis.iter().enumerate() {
+        let _ = write!(
+            body,
+            "\n    below += csm_chunk_of({}, {chunk}u, l, s);",
+            search(m)
+        );
+    }
+    body.push_str(
+        "\n    let look = soft_blockers(cssm_blocker(below, zsum, l, s), l, s);\n    \
+         var sum = 0.0;\n    for (var k = 0u; k < soft_filter_trips(look); k++) {",
+    );
     for (chunk, m) in basis.iter().enumerate() {
         let _ = write!(
             body,
@@ -85,13 +96,12 @@ fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
         );
     }
     body.push_str(
-        "\n        if k == 0u {\n            look = soft_blockers(cssm_blocker(sum, zsum, l, s), l, s);\n            \
-         if !look.blockers {\n                return 1.0;\n            }\n        }\n    }\n    \
+        "\n    }\n    if !look.blockers {\n        return 1.0;\n    }\n    \
          return cssm_resolve(sum, look.blocker, l, s);",
     );
     let fetches = format!(
-        "{} * sat_sample_{suffix} + 2 * {} * sat_sample_{suffix}",
-        z.len(),
+        "{} * sat_search_{suffix} + {} * sat_sample_{suffix}",
+        z.len() + basis.len(),
         basis.len()
     );
     VisibilityBody {
