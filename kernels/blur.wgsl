@@ -9,17 +9,23 @@
 // order keeps the sums the earlier kernel computed.)
 // #import shared/blur_pass
 // Traffic (the cost model, src/graph/cost): a row workgroup loads its WG_SIZE · PER texels and
-// a halo of r each side; a column workgroup WG_SIZE columns of PER + 2r texels each.
-// #traffic src: select(WG_SIZE * PER + 2 * min(params.radius, MAX_RADIUS), WG_SIZE * (PER + 2 * min(params.radius, MAX_RADIUS)), params.axis == 1) per group
+// a halo of r each side; a column workgroup WG_SIZE columns of COL_PER + 2r texels each.
+// #traffic src: select(WG_SIZE * PER + 2 * min(params.radius, MAX_RADIUS), WG_SIZE * (COL_PER + 2 * min(params.radius, MAX_RADIUS)), params.axis == 1) per group
 // #traffic dst: all
+
+// Rows down a column one invocation writes: the column halo of 2r rows is read by a workgroup
+// once per COL_PER outputs (at r = 3, 38/32 of the map instead of 14/8 with PER rows), while
+// 64 · 32 texels a workgroup keep 512² maps at 8192 invocations. Keep in sync with
+// `BLUR_COL_PER` in src/filter.rs.
+const COL_PER: u32 = 32u;
 
 @compute @workgroup_size(WG_SIZE)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    let b = blur_line(wg.xy, li, true);
+    let b = blur_line(wg.xy, li, true, COL_PER);
     if !blur_active(b) {
         return;
     }
-    for (var k = 0; k < i32(PER); k++) {
+    for (var k = 0; k < b.count; k++) {
         let o = out_offset(b, k);
         var s = weight(0, b.r) * tap(b, o);
         for (var i = 1; i <= b.r; i++) {

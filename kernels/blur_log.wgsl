@@ -16,6 +16,10 @@
 
 const SPAN: f32 = 80.0;
 
+// Rows down a column one invocation writes: PER, the named running sums s0 … s7 below. Keep in
+// sync with `BLUR_PER_INVOCATION` in src/filter.rs.
+const COL_PER: u32 = PER;
+
 // The log-sum-exp of output k's window around its own maximum.
 fn log_sum_at(b: BlurLine, k: i32) -> f32 {
     var m = -3.0e38;
@@ -35,7 +39,7 @@ fn put_x(b: BlurLine, k: i32, v: f32) {
 
 @compute @workgroup_size(WG_SIZE)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    let b = blur_line(wg.xy, li, false);
+    let b = blur_line(wg.xy, li, false, COL_PER);
     if !blur_active(b) {
         return;
     }

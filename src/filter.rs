@@ -11,6 +11,11 @@ pub const MAX_BLUR_RADIUS: u32 = 32;
 /// `kernels/shared/blur_pass.wgsl`).
 pub const BLUR_PER_INVOCATION: u32 = 8;
 
+/// Rows down a column one `blur` invocation writes (`COL_PER` in `kernels/blur.wgsl`; `blur_log`
+/// writes [`BLUR_PER_INVOCATION`]): the vertical pass reads its halo of 2r rows once per this
+/// many outputs.
+pub const BLUR_COL_PER: u32 = 32;
+
 /// Invocations of a `blur` or `blur_log` workgroup (`WG_SIZE` in
 /// `kernels/shared/blur_pass.wgsl`): along a row, or across neighbouring columns.
 pub const BLUR_GROUP: u32 = 64;
@@ -96,6 +101,10 @@ pub fn add_filter(
             kernel,
         } => (radius, sigma, kernel),
     };
+    let (kernel_id, col_per) = match mode {
+        BlurMode::Linear => (KernelId::Blur, BLUR_COL_PER),
+        BlurMode::LogSumExp => (KernelId::BlurLog, BLUR_PER_INVOCATION),
+    };
     let mut src = input.to_string();
     for (axis, pass) in [(0, "blur_h"), (1, "blur_v")] {
         let out = graph.resource(
@@ -109,16 +118,13 @@ pub fn add_filter(
         );
         graph.node(Node {
             name: format!("{input}.{pass}"),
-            kernel: match mode {
-                BlurMode::Linear => KernelId::Blur,
-                BlurMode::LogSumExp => KernelId::BlurLog,
-            },
+            kernel: kernel_id,
             inputs: vec![("src".into(), src)],
             outputs: vec![("dst".into(), out.clone())],
             params: bytemuck::bytes_of(&BlurParams::new(axis, radius, sigma, kernel, mode))
                 .to_vec(),
             // Rows: a workgroup per BLUR_GROUP · PER texels of a row; columns: a workgroup per
-            // BLUR_GROUP columns × PER rows.
+            // BLUR_GROUP columns × the kernel's rows per column invocation.
             dispatch: Dispatch::Blocks {
                 of: out.clone(),
                 x: if axis == 0 {
@@ -126,7 +132,7 @@ pub fn add_filter(
                 } else {
                     BLUR_GROUP
                 },
-                y: if axis == 0 { 1 } else { BLUR_PER_INVOCATION },
+                y: if axis == 0 { 1 } else { col_per },
             },
             light: Some(light),
         });

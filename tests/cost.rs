@@ -71,11 +71,12 @@ fn vsm_with_blur_moves_what_the_hand_count_says() {
             // A row workgroup loads 64 × 8 texels of a row and 3 more on either side:
             // 518/512 × 8 B.
             ("blur_h", 1, 8.09375, 8.0),
-            // A column workgroup loads 64 columns of 8 + 2 × 3 texels: 896/512 × 8 B.
-            ("blur_v", 1, 14.0, 8.0),
+            // A column workgroup loads 64 columns of 32 + 2 × 3 texels (BLUR_COL_PER rows an
+            // invocation): 2432/2048 × 8 B.
+            ("blur_v", 1, 9.5, 8.0),
         ],
-        // 13 + 16.09375 + 22
-        51.09375,
+        // 13 + 16.09375 + 17.5
+        46.59375,
         // one read of the depth (4 B) + one write of the blurred moments (8 B)
         12.0,
     );
@@ -175,7 +176,7 @@ fn plan_prints_traffic_and_fetches() {
     for needle in [
         "traffic per texel of the 512² map:",
         "reads    5.00 B, writes    8.00 B",
-        "total: 3 dispatches, 51.09 B/texel (one read + one write of the result: 12.00 B/texel)",
+        "total: 3 dispatches, 46.59 B/texel (one read + one write of the result: 12.00 B/texel)",
         "shade: vsm 4 fetches/pixel",
     ] {
         assert!(text.contains(needle), "`{needle}` missing:\n{text}");

@@ -408,3 +408,45 @@ fn compute_kernels_fit_webgpu_default_limits() {
         over.join("\n")
     );
 }
+
+/// A `const NAME: u32` of a kernel, from naga's IR (following a constant defined as another).
+fn wgsl_const(module: &naga::Module, name: &str) -> Option<u32> {
+    let (_, c) = module
+        .constants
+        .iter()
+        .find(|(_, c)| c.name.as_deref() == Some(name))?;
+    let mut init = c.init;
+    loop {
+        match module.global_expressions[init] {
+            naga::Expression::Literal(naga::Literal::U32(v)) => return Some(v),
+            naga::Expression::Constant(h) => init = module.constants[h].init,
+            _ => return None,
+        }
+    }
+}
+
+/// The blur passes' geometry that `filter::add_filter` dispatches by is the kernels' own: a
+/// column invocation of `blur` writes `BLUR_COL_PER` rows, one of `blur_log` `PER`.
+#[test]
+fn blur_dispatch_constants_match_the_wgsl() {
+    use shadowgraph::filter::{BLUR_COL_PER, BLUR_GROUP, BLUR_PER_INVOCATION};
+    for (kernel, col_per) in [("blur", BLUR_COL_PER), ("blur_log", BLUR_PER_INVOCATION)] {
+        let wgsl = kernels::resolve(kernel, None).expect("resolve");
+        let (module, r) = kernels::reflect(kernel, &wgsl).expect("reflect");
+        assert_eq!(
+            wgsl_const(&module, "PER"),
+            Some(BLUR_PER_INVOCATION),
+            "{kernel}: PER"
+        );
+        assert_eq!(
+            wgsl_const(&module, "COL_PER"),
+            Some(col_per),
+            "{kernel}: COL_PER"
+        );
+        assert_eq!(
+            r.workgroup_size,
+            Some([BLUR_GROUP, 1, 1]),
+            "{kernel}: workgroup"
+        );
+    }
+}

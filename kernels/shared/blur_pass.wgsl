@@ -3,7 +3,8 @@
 // of a line, reading its taps straight from the texture: no workgroup memory, so any radius up
 // to MAX_RADIUS fits (and llvmpipe, where a workgroup-memory access costs several texture
 // loads, runs it fast). Rows: a workgroup covers WG_SIZE · PER texels of one row; columns:
-// WG_SIZE neighbouring columns, PER rows each, so a workgroup's loads lie side by side. Edges
+// WG_SIZE neighbouring columns, `col_per` rows each (the importing kernel's choice), so a
+// workgroup's loads lie side by side and its halo of 2r rows is shared by `col_per` outputs. Edges
 // clamp (replicate the border texel), so the map edge keeps its shadow instead of fading
 // toward zero.
 // Storage: rg32float by default; the executor re-declares `dst` for the bound format.
@@ -36,21 +37,24 @@ struct BlurLine {
     along: i32,
     across: u32,
     r: i32,
+    // Outputs the invocation writes: PER along a row, `col_per` down a column.
+    count: i32,
 }
 
 // Rows: workgroup (x, y) covers texels [x·WG_SIZE·PER, (x + 1)·WG_SIZE·PER) of row y; with
 // `interleave` invocation li writes texels li, li + WG_SIZE, …, so at each step neighbouring
 // invocations load and store neighbouring texels (coalesced on a GPU), else the PER
 // consecutive texels from li·PER (for kernels that slide one window along them). Columns:
-// workgroup (x, y) covers columns x·WG_SIZE + li, rows [y·PER, (y + 1)·PER): neighbouring
-// invocations are neighbouring columns either way.
-fn blur_line(wg: vec2<u32>, li: u32, interleave: bool) -> BlurLine {
+// workgroup (x, y) covers columns x·WG_SIZE + li, rows [y·col_per, (y + 1)·col_per):
+// neighbouring invocations are neighbouring columns either way.
+fn blur_line(wg: vec2<u32>, li: u32, interleave: bool, col_per: u32) -> BlurLine {
     let size = textureDimensions(src);
     var b: BlurLine;
     b.r = i32(min(params.radius, MAX_RADIUS));
     b.stride = 1;
+    b.count = i32(select(PER, col_per, params.axis == 1u));
     if params.axis == 1u {
-        b.first = i32(wg.y * PER);
+        b.first = i32(wg.y * col_per);
         b.line = wg.x * WG_SIZE + li;
         b.along = i32(size.y);
         b.across = size.x;

@@ -559,10 +559,11 @@ mod tests {
             8.0 + 16.0 + 32.0 + 32.0 + 16.0 + 7.0 / 32.0
         );
         // Two passes of radius 4, 8 B out each: a row workgroup reads its 512 texels and 4 on
-        // either side (520/512 × 8 B), a column workgroup 64 columns of 8 + 8 texels (2 × 8 B).
+        // either side (520/512 × 8 B), a column workgroup 64 columns of 32 + 8 texels
+        // (BLUR_COL_PER rows an invocation: 40/32 × 8 B).
         assert_eq!(
             bytes("blur rg32f r4"),
-            520.0 / 512.0 * 8.0 + 8.0 + 16.0 + 8.0
+            520.0 / 512.0 * 8.0 + 8.0 + 40.0 / 32.0 * 8.0 + 8.0
         );
         // Depth (4 B) in, linear depth (4 B) out.
         assert_eq!(bytes("linearize"), 8.0);
