@@ -56,6 +56,9 @@ const KEYS: &[&str] = &[
     "scale",
     "sharpen",
     "sharpen_falloff",
+    "rays",
+    "steps",
+    "max_slope",
 ];
 
 /// The value of `key` as written, if it is.
@@ -93,6 +96,9 @@ fn raw<'a>(s: &'a ShadowFile, key: &str) -> Option<Raw<'a>> {
         "scale" => n(&s.scale),
         "sharpen" => n(&s.sharpen),
         "sharpen_falloff" => n(&s.sharpen_falloff),
+        "rays" => i(&s.rays),
+        "steps" => i(&s.steps),
+        "max_slope" => n(&s.max_slope),
         _ => None,
     }
 }
