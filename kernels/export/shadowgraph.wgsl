@@ -36,6 +36,7 @@
 //   fn vis_pcf(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
 //   fn vis_pcf_hardware(map: texture_depth_2d, cmp: sampler_comparison, l: Light, s: LightSample) -> f32
 //   fn vis_pcss(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
+//   fn vis_smrt(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
 //   fn vis_vsm(map: texture_2d<f32>, l: Light, s: LightSample) -> f32
 //   fn vis_vsm_of(m: vec4<f32>, l: Light, s: LightSample) -> f32
 //   fn vis_vssm_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32
@@ -45,18 +46,19 @@
 //   BLOCKER_MIN_SHARE CSM_PI GOLDEN_ANGLE Light LightSample MSM_B0 MSM_B0_COV MSM_B0_SCHUR
 //   MipTaps MsmMoments SAT_MIN_EXTENT SatNodes SoftLookup TECHNIQUE_CSM TECHNIQUE_CSSM
 //   TECHNIQUE_ESM TECHNIQUE_EVSM TECHNIQUE_HARD TECHNIQUE_MSM TECHNIQUE_MSM_SOFT TECHNIQUE_PCF
-//   TECHNIQUE_PCSS TECHNIQUE_VSM TECHNIQUE_VSSM bilinear_level bilinear_log_level blocker_csm_z
-//   blocker_filter_width blocker_msm blocker_result blocker_search_width blocker_vsm
-//   blocker_width chebyshev_upper csm_chunk csm_chunk_of csm_resolve csm_sin_cos csm_weight
-//   csm_z_chunk_of cssm_blocker cssm_resolve cssm_sharpen level_size light_faces light_footprint
-//   light_linear_to_ndc light_linear_to_z light_map_width light_sample light_to_light linstep
-//   load_depth mip_tap_uv mip_taps msm_biased msm_dequantize msm_expect msm_intensity
-//   msm_moments msm_quantize msm_roots msm_soft_blocker pcss_search_radius sample_bilinear
-//   sample_bilinear_log sample_map sample_map_log sat_mean_fixed sat_mean_float sat_node_f32
-//   sat_node_u32 sat_nodes sat_rect sat_sample_fixed sat_sample_float soft_blockers soft_search
-//   texel_of trilinear trilinear_log vis_esm vis_esm_of_log vis_esm_of_sat vis_evsm vis_evsm_of
-//   vis_hard vis_msm vis_msm_of vis_msm_soft_fixed vis_msm_soft_float vis_pcf vis_pcf_hardware
-//   vis_pcss vis_vsm vis_vsm_of vis_vssm_fixed vis_vssm_float vogel_disc vssm_blocker
+//   TECHNIQUE_PCSS TECHNIQUE_SMRT TECHNIQUE_VSM TECHNIQUE_VSSM bilinear_level bilinear_log_level
+//   blocker_csm_z blocker_filter_width blocker_msm blocker_result blocker_search_width
+//   blocker_vsm blocker_width chebyshev_upper csm_chunk csm_chunk_of csm_resolve csm_sin_cos
+//   csm_weight csm_z_chunk_of cssm_blocker cssm_resolve cssm_sharpen level_size light_faces
+//   light_footprint light_linear_to_ndc light_linear_to_z light_map_width light_sample
+//   light_to_light linstep load_depth mip_tap_uv mip_taps msm_biased msm_dequantize msm_expect
+//   msm_intensity msm_moments msm_quantize msm_roots msm_soft_blocker pcss_search_radius
+//   sample_bilinear sample_bilinear_log sample_map sample_map_log sat_mean_fixed sat_mean_float
+//   sat_node_f32 sat_node_u32 sat_nodes sat_rect sat_sample_fixed sat_sample_float
+//   smrt_emitter_point smrt_ray soft_blockers soft_search texel_of trilinear trilinear_log
+//   vis_esm vis_esm_of_log vis_esm_of_sat vis_evsm vis_evsm_of vis_hard vis_msm vis_msm_of
+//   vis_msm_soft_fixed vis_msm_soft_float vis_pcf vis_pcf_hardware vis_pcss vis_smrt vis_vsm
+//   vis_vsm_of vis_vssm_fixed vis_vssm_float vogel_disc vssm_blocker
 
 // Shared light description and light-space helpers (import-only module).
 //
@@ -107,6 +109,10 @@ struct Light {
     sharpen_falloff: f32,    // cssm: sharpening falloff B, per linear depth unit
     max_width: f32,          // soft techniques: cap on the search and filter widths, texels
     _pad1: u32,
+    smrt_rays: u32,          // smrt: rays per receiver
+    smrt_steps: u32,         // smrt: depth-map samples per ray
+    smrt_max_slope: f32,     // smrt: cap on the receding slope extrapolated behind an occluder
+    target_distance: f32,    // position–target distance (directional emitter rays, smrt)
 }
 
 // `Light::technique` (keep in sync with the `TECHNIQUE_*` constants of src/gpu_data.rs; a test
@@ -122,6 +128,7 @@ const TECHNIQUE_CSM: u32 = 7u;
 const TECHNIQUE_CSSM: u32 = 8u;
 const TECHNIQUE_VSSM: u32 = 9u;
 const TECHNIQUE_MSM_SOFT: u32 = 10u;
+const TECHNIQUE_SMRT: u32 = 20u;
 
 // Where a receiver lands in a light's shadow map.
 struct LightSample {
@@ -1104,6 +1111,102 @@ fn vis_pcss(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
         lit += select(0.0, 1.0, s.depth <= z + l.bias);
     }
     return lit / f32(l.filter_samples);
+}
+// Shadow-map ray tracing (SMRT), after Unreal Engine 5's virtual shadow maps and Blender
+// EEVEE-Next (descended from Xie, Tabellion & Pearce, EGSR 2007): from the receiver, one ray
+// toward each of `smrt_rays` fixed points on the emitter, each marched through the one linear
+// depth map with `smrt_steps` samples; visibility is the share of rays no sample occludes.
+//
+// The emitter is the truth's (src/truth/emitter.rs): a square of side `size` in the light's
+// plane. A spot's rays converge on the emitter point (the map UV moves with 1/Z); a
+// directional light's rays are parallel, from the emitter point to the target `target_distance`
+// away (the UV moves with Z). A ray runs from the receiver (t = 0) to the near plane (t = 1),
+// where the map's depths end. Steps are spaced in the light's depth, quadratically from the
+// light end, t_i = ((S − i − ½) / S)², i = 0 … S − 1: dense near the receiver, where contact
+// shadows are decided within a few texels, sparse near the light, where the ray is in front of
+// everything; the last is ¼ S⁻² of the ray away from the receiver, not on its own surface.
+//
+// The map is a height field with no thickness. A sample behind the stored surface (by more
+// than the bias) is a hit only if the last surface seen in front of the ray, continued at its
+// slope along the ray (its receding rate capped at `smrt_max_slope` times the ray's own depth
+// rate), still covers it: a ray passing behind an occluder's silhouette, seen last as the floor
+// far behind it, goes on (UE's and EEVEE's extrapolation behind occluders). The first sample
+// has no history: behind is a hit. Samples off the map are skipped.
+
+// Emitter point k of n in units of the light's size, in [−½, ½]²: the centre of stratum k on the
+// truth's grid (`stratified_offsets`): ⌊√n⌋ rows, the first (n mod rows) holding one point more,
+// each row's height in proportion to its count.
+fn smrt_emitter_point(k: u32, n: u32) -> vec2<f32> {
+    var rows = 1u;
+    while (rows + 1u) * (rows + 1u) <= n {
+        rows++;
+    }
+    var before = 0u;
+    var r = 0u;
+    var cols = n / rows + select(0u, 1u, 0u < n % rows);
+    while k >= before + cols {
+        before += cols;
+        r++;
+        cols = n / rows + select(0u, 1u, r < n % rows);
+    }
+    let x = (f32(k - before) + 0.5) / f32(cols);
+    let y = (f32(before) + 0.5 * f32(cols)) / f32(n);
+    return vec2<f32>(x - 0.5, y - 0.5);
+}
+
+// Whether the ray toward emitter point `o` is occluded.
+// #fetches smrt_ray: l.smrt_steps
+fn smrt_ray(map: texture_2d<f32>, l: Light, s: LightSample, o: vec2<f32>) -> bool {
+    let n = l.smrt_steps;
+    let span = s.view_z - l.near;
+    // The emitter point's view-space offset as a UV direction (UV y runs down).
+    let e = l.size * vec2<f32>(o.x, -o.y) / l.width_at_unit;
+    let cap = l.smrt_max_slope * s.depth;
+    var seen = false;
+    var t_seen = 0.0;
+    var z_seen = 0.0;
+    var slope = 0.0;
+    for (var i = 0u; i < n; i++) {
+        let f = (f32(n - i) - 0.5) / f32(n);
+        let t = f * f;
+        let z_view = s.view_z - t * span;
+        let k = select(l.target_distance, z_view * s.view_z, l.kind == 1u);
+        let uv = s.uv + e * (t * span / k);
+        if any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) {
+            continue;
+        }
+        let z = load_depth(map, texel_of(uv, l.map_size));
+        let ray = s.depth * (1.0 - t);
+        if ray > z + l.bias {
+            if !seen {
+                return true;
+            }
+            let z_ext = z_seen + min(slope, cap) * (t_seen - t);
+            if ray > z_ext + l.bias {
+                return true;
+            }
+        } else {
+            if seen {
+                slope = (z - z_seen) / (t_seen - t);
+            }
+            seen = true;
+            t_seen = t;
+            z_seen = z;
+        }
+    }
+    return false;
+}
+
+// #fetches vis_smrt: l.smrt_rays * smrt_ray
+fn vis_smrt(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
+    if s.view_z <= l.near {
+        return 1.0;
+    }
+    var lit = 0u;
+    for (var k = 0u; k < l.smrt_rays; k++) {
+        lit += select(1u, 0u, smrt_ray(map, l, s, smrt_emitter_point(k, l.smrt_rays)));
+    }
+    return f32(lit) / f32(l.smrt_rays);
 }
 // Variance shadow maps: one-tailed Chebyshev (Cantelli) bound from the filtered moments,
 //   σ² = max(E[z²] − μ², min_variance),  p_max = σ² / (σ² + (d − μ)²) for d > μ, else 1,
