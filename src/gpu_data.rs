@@ -97,6 +97,15 @@ pub struct LightGpu {
     /// Receiver-plane depth bias: the cap on each tap's depth correction, linear depth units
     /// (0: off; `Shadow::receiver_plane`).
     pub receiver_plane: f32,
+    /// SMRT: rays per receiver.
+    pub smrt_rays: u32,
+    /// SMRT: depth-map samples per ray.
+    pub smrt_steps: u32,
+    /// SMRT: cap on the receding slope of the surface extrapolated behind an occluder.
+    pub smrt_max_slope: f32,
+    /// Distance from the light's position to its target (the directional emitter's rays run
+    /// from each emitter point to the target, as in `truth::emitter`).
+    pub target_distance: f32,
 }
 
 /// Technique id of `hard` (`LightGpu::technique`; `TECHNIQUE_HARD` in
@@ -122,6 +131,8 @@ pub const TECHNIQUE_CSSM: u32 = 8;
 pub const TECHNIQUE_VSSM: u32 = 9;
 /// Technique id of `msm_soft`.
 pub const TECHNIQUE_MSM_SOFT: u32 = 10;
+/// Technique id of `smrt`.
+pub const TECHNIQUE_SMRT: u32 = 20;
 
 /// Every technique id with its WGSL constant's name (checked against
 /// `kernels/shared/light.wgsl` by a test).
@@ -137,6 +148,7 @@ pub const TECHNIQUE_IDS: &[(&str, u32)] = &[
     ("TECHNIQUE_CSSM", TECHNIQUE_CSSM),
     ("TECHNIQUE_VSSM", TECHNIQUE_VSSM),
     ("TECHNIQUE_MSM_SOFT", TECHNIQUE_MSM_SOFT),
+    ("TECHNIQUE_SMRT", TECHNIQUE_SMRT),
 ];
 
 /// MSM flag: Hausdorff reconstruction.

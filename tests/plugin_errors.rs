@@ -221,6 +221,13 @@ fn inconsistent_light_params_are_named() {
         ),
         (
             LightParams {
+                target_distance: f32::NAN,
+                ..light()
+            },
+            "target_distance",
+        ),
+        (
+            LightParams {
                 view: glam::Mat4::from_cols_array(&[f32::NAN; 16]),
                 ..light()
             },

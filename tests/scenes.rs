@@ -86,6 +86,7 @@ fn pixel_reference(
             } => cpu::vis_pcf::vis_pcf_hardware(&map, &lg, t),
             Technique::Pcf { .. } => cpu::vis_pcf::vis_pcf(&map, &lg, t),
             Technique::Pcss { .. } => cpu::vis_pcss::vis_pcss(&map, &lg, t),
+            Technique::Smrt { .. } => cpu::vis_smrt::vis_smrt(&map, &lg, t),
             Technique::Vsm { .. } => cpu::vis_vsm::vis_vsm(moments, &lg, t),
             Technique::Evsm { .. } => cpu::vis_evsm::vis_evsm(moments, &lg, t),
             Technique::Esm { .. } => cpu::vis_esm::vis_esm(moments, &lg, t),

@@ -37,6 +37,7 @@
 //   fn sg_vis_pcf(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32
 //   fn sg_vis_pcf_hardware(map: texture_depth_2d, cmp: sampler_comparison, l: sg_Light, s: sg_LightSample) -> f32
 //   fn sg_vis_pcss(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32
+//   fn sg_vis_smrt(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32
 //   fn sg_vis_vsm(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32
 //   fn sg_vis_vsm_of(m: vec4<f32>, l: sg_Light, s: sg_LightSample) -> f32
 //   fn sg_vis_vssm_fixed(map: texture_2d<u32>, l: sg_Light, s: sg_LightSample) -> f32
@@ -48,24 +49,24 @@
 //   sg_MSM_B0_COV sg_MSM_B0_SCHUR sg_MipTaps sg_MsmMoments sg_SAT_MIN_EXTENT sg_SatNodes
 //   sg_SoftLookup sg_TECHNIQUE_CSM sg_TECHNIQUE_CSSM sg_TECHNIQUE_ESM sg_TECHNIQUE_EVSM
 //   sg_TECHNIQUE_HARD sg_TECHNIQUE_MSM sg_TECHNIQUE_MSM_SOFT sg_TECHNIQUE_PCF sg_TECHNIQUE_PCSS
-//   sg_TECHNIQUE_VSM sg_TECHNIQUE_VSSM sg_bilinear_level sg_bilinear_log_level sg_blocker_csm_z
-//   sg_blocker_filter_width sg_blocker_msm sg_blocker_result sg_blocker_search_width
-//   sg_blocker_vsm sg_blocker_width sg_chebyshev_upper sg_csm_chunk sg_csm_chunk_of
-//   sg_csm_resolve sg_csm_sin_cos sg_csm_weight sg_csm_z_chunk_of sg_cssm_blocker
-//   sg_cssm_resolve sg_cssm_sharpen sg_level_size sg_light_depth_slope sg_light_faces
-//   sg_light_footprint sg_light_linear_to_ndc sg_light_linear_to_z sg_light_map_width
-//   sg_light_receiver_offset sg_light_sample sg_light_tap_offset sg_light_to_light sg_linstep
-//   sg_load_depth sg_mip_tap_uv sg_mip_taps sg_msm_biased sg_msm_dequantize sg_msm_expect
-//   sg_msm_intensity sg_msm_moments sg_msm_quantize sg_msm_roots sg_msm_soft_blocker
-//   sg_pcss_search_radius sg_sample_bilinear sg_sample_bilinear_log sg_sample_map
-//   sg_sample_map_log sg_sat_box sg_sat_box_fixed sg_sat_box_float sg_sat_mean_fixed
-//   sg_sat_mean_float sg_sat_node_f32 sg_sat_node_u32 sg_sat_nodes sg_sat_rect
+//   sg_TECHNIQUE_SMRT sg_TECHNIQUE_VSM sg_TECHNIQUE_VSSM sg_bilinear_level sg_bilinear_log_level
+//   sg_blocker_csm_z sg_blocker_filter_width sg_blocker_msm sg_blocker_result
+//   sg_blocker_search_width sg_blocker_vsm sg_blocker_width sg_chebyshev_upper sg_csm_chunk
+//   sg_csm_chunk_of sg_csm_resolve sg_csm_sin_cos sg_csm_weight sg_csm_z_chunk_of
+//   sg_cssm_blocker sg_cssm_resolve sg_cssm_sharpen sg_level_size sg_light_depth_slope
+//   sg_light_faces sg_light_footprint sg_light_linear_to_ndc sg_light_linear_to_z
+//   sg_light_map_width sg_light_receiver_offset sg_light_sample sg_light_tap_offset
+//   sg_light_to_light sg_linstep sg_load_depth sg_mip_tap_uv sg_mip_taps sg_msm_biased
+//   sg_msm_dequantize sg_msm_expect sg_msm_intensity sg_msm_moments sg_msm_quantize sg_msm_roots
+//   sg_msm_soft_blocker sg_pcss_search_radius sg_sample_bilinear sg_sample_bilinear_log
+//   sg_sample_map sg_sample_map_log sg_sat_box sg_sat_box_fixed sg_sat_box_float
+//   sg_sat_mean_fixed sg_sat_mean_float sg_sat_node_f32 sg_sat_node_u32 sg_sat_nodes sg_sat_rect
 //   sg_sat_sample_fixed sg_sat_sample_float sg_sat_search_fixed sg_sat_search_float
-//   sg_sat_span_weights sg_soft_blockers sg_soft_filter_trips sg_texel_of sg_trilinear
-//   sg_trilinear_log sg_vis_esm sg_vis_esm_of_log sg_vis_esm_of_sat sg_vis_evsm sg_vis_evsm_of
-//   sg_vis_hard sg_vis_msm sg_vis_msm_of sg_vis_msm_soft_fixed sg_vis_msm_soft_float sg_vis_pcf
-//   sg_vis_pcf_hardware sg_vis_pcss sg_vis_vsm sg_vis_vsm_of sg_vis_vssm_fixed sg_vis_vssm_float
-//   sg_vogel_disc sg_vssm_blocker
+//   sg_sat_span_weights sg_smrt_emitter_point sg_smrt_ray sg_soft_blockers sg_soft_filter_trips
+//   sg_texel_of sg_trilinear sg_trilinear_log sg_vis_esm sg_vis_esm_of_log sg_vis_esm_of_sat
+//   sg_vis_evsm sg_vis_evsm_of sg_vis_hard sg_vis_msm sg_vis_msm_of sg_vis_msm_soft_fixed
+//   sg_vis_msm_soft_float sg_vis_pcf sg_vis_pcf_hardware sg_vis_pcss sg_vis_smrt sg_vis_vsm
+//   sg_vis_vsm_of sg_vis_vssm_fixed sg_vis_vssm_float sg_vogel_disc sg_vssm_blocker
 
 // Shared light description and light-space helpers (import-only module).
 //
@@ -116,6 +117,10 @@ struct sg_Light {
     sharpen_falloff: f32,    // cssm: sharpening falloff B, per linear depth unit
     max_width: f32,          // soft techniques: cap on the search and filter widths, texels
     receiver_plane: f32,     // receiver-plane bias: cap on a tap's depth correction (0: off)
+    smrt_rays: u32,          // smrt: rays per receiver
+    smrt_steps: u32,         // smrt: depth-map samples per ray
+    smrt_max_slope: f32,     // smrt: cap on the receding slope extrapolated behind an occluder
+    target_distance: f32,    // position–target distance (directional emitter rays, smrt)
 }
 
 // `Light::technique` (keep in sync with the `TECHNIQUE_*` constants of src/gpu_data.rs; a test
@@ -131,6 +136,7 @@ const sg_TECHNIQUE_CSM: u32 = 7u;
 const sg_TECHNIQUE_CSSM: u32 = 8u;
 const sg_TECHNIQUE_VSSM: u32 = 9u;
 const sg_TECHNIQUE_MSM_SOFT: u32 = 10u;
+const sg_TECHNIQUE_SMRT: u32 = 20u;
 
 // Where a receiver lands in a light's shadow map.
 struct sg_LightSample {
@@ -1210,6 +1216,102 @@ fn sg_vis_pcss(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
         lit += select(0.0, 1.0, s.depth <= z + l.bias);
     }
     return lit / f32(l.filter_samples);
+}
+// Shadow-map ray tracing (SMRT), after Unreal Engine 5's virtual shadow maps and Blender
+// EEVEE-Next (descended from Xie, Tabellion & Pearce, EGSR 2007): from the receiver, one ray
+// toward each of `smrt_rays` fixed points on the emitter, each marched through the one linear
+// depth map with `smrt_steps` samples; visibility is the share of rays no sample occludes.
+//
+// The emitter is the truth's (src/truth/emitter.rs): a square of side `size` in the light's
+// plane. A spot's rays converge on the emitter point (the map UV moves with 1/Z); a
+// directional light's rays are parallel, from the emitter point to the target `target_distance`
+// away (the UV moves with Z). A ray runs from the receiver (t = 0) to the near plane (t = 1),
+// where the map's depths end. Steps are spaced in the light's depth, quadratically from the
+// light end, t_i = ((S − i − ½) / S)², i = 0 … S − 1: dense near the receiver, where contact
+// shadows are decided within a few texels, sparse near the light, where the ray is in front of
+// everything; the last is ¼ S⁻² of the ray away from the receiver, not on its own surface.
+//
+// The map is a height field with no thickness. A sample behind the stored surface (by more
+// than the bias) is a hit only if the last surface seen in front of the ray, continued at its
+// slope along the ray (its receding rate capped at `smrt_max_slope` times the ray's own depth
+// rate), still covers it: a ray passing behind an occluder's silhouette, seen last as the floor
+// far behind it, goes on (UE's and EEVEE's extrapolation behind occluders). The first sample
+// has no history: behind is a hit. Samples off the map are skipped.
+
+// Emitter point k of n in units of the light's size, in [−½, ½]²: the centre of stratum k on the
+// truth's grid (`stratified_offsets`): ⌊√n⌋ rows, the first (n mod rows) holding one point more,
+// each row's height in proportion to its count.
+fn sg_smrt_emitter_point(k: u32, n: u32) -> vec2<f32> {
+    var rows = 1u;
+    while (rows + 1u) * (rows + 1u) <= n {
+        rows++;
+    }
+    var before = 0u;
+    var r = 0u;
+    var cols = n / rows + select(0u, 1u, 0u < n % rows);
+    while k >= before + cols {
+        before += cols;
+        r++;
+        cols = n / rows + select(0u, 1u, r < n % rows);
+    }
+    let x = (f32(k - before) + 0.5) / f32(cols);
+    let y = (f32(before) + 0.5 * f32(cols)) / f32(n);
+    return vec2<f32>(x - 0.5, y - 0.5);
+}
+
+// Whether the ray toward emitter point `o` is occluded.
+// #fetches sg_smrt_ray: l.smrt_steps
+fn sg_smrt_ray(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample, o: vec2<f32>) -> bool {
+    let n = l.smrt_steps;
+    let span = s.view_z - l.near;
+    // The emitter point's view-space offset as a UV direction (UV y runs down).
+    let e = l.size * vec2<f32>(o.x, -o.y) / l.width_at_unit;
+    let cap = l.smrt_max_slope * s.depth;
+    var seen = false;
+    var t_seen = 0.0;
+    var z_seen = 0.0;
+    var slope = 0.0;
+    for (var i = 0u; i < n; i++) {
+        let f = (f32(n - i) - 0.5) / f32(n);
+        let t = f * f;
+        let z_view = s.view_z - t * span;
+        let k = select(l.target_distance, z_view * s.view_z, l.kind == 1u);
+        let uv = s.uv + e * (t * span / k);
+        if any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) {
+            continue;
+        }
+        let z = sg_load_depth(map, sg_texel_of(uv, l.map_size));
+        let ray = s.depth * (1.0 - t);
+        if ray > z + l.bias {
+            if !seen {
+                return true;
+            }
+            let z_ext = z_seen + min(slope, cap) * (t_seen - t);
+            if ray > z_ext + l.bias {
+                return true;
+            }
+        } else {
+            if seen {
+                slope = (z - z_seen) / (t_seen - t);
+            }
+            seen = true;
+            t_seen = t;
+            z_seen = z;
+        }
+    }
+    return false;
+}
+
+// #fetches sg_vis_smrt: l.smrt_rays * sg_smrt_ray
+fn sg_vis_smrt(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
+    if s.view_z <= l.near {
+        return 1.0;
+    }
+    var lit = 0u;
+    for (var k = 0u; k < l.smrt_rays; k++) {
+        lit += select(1u, 0u, sg_smrt_ray(map, l, s, sg_smrt_emitter_point(k, l.smrt_rays)));
+    }
+    return f32(lit) / f32(l.smrt_rays);
 }
 // Variance shadow maps: one-tailed Chebyshev (Cantelli) bound from the filtered moments,
 //   σ² = max(E[z²] − μ², min_variance),  p_max = σ² / (σ² + (d − μ)²) for d > μ, else 1,

@@ -47,6 +47,10 @@ struct Light {
     sharpen_falloff: f32,    // cssm: sharpening falloff B, per linear depth unit
     max_width: f32,          // soft techniques: cap on the search and filter widths, texels
     receiver_plane: f32,     // receiver-plane bias: cap on a tap's depth correction (0: off)
+    smrt_rays: u32,          // smrt: rays per receiver
+    smrt_steps: u32,         // smrt: depth-map samples per ray
+    smrt_max_slope: f32,     // smrt: cap on the receding slope extrapolated behind an occluder
+    target_distance: f32,    // position–target distance (directional emitter rays, smrt)
 }
 
 // `Light::technique` (keep in sync with the `TECHNIQUE_*` constants of src/gpu_data.rs; a test
@@ -62,6 +66,7 @@ const TECHNIQUE_CSM: u32 = 7u;
 const TECHNIQUE_CSSM: u32 = 8u;
 const TECHNIQUE_VSSM: u32 = 9u;
 const TECHNIQUE_MSM_SOFT: u32 = 10u;
+const TECHNIQUE_SMRT: u32 = 20u;
 
 // Where a receiver lands in a light's shadow map.
 struct LightSample {

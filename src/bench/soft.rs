@@ -34,6 +34,7 @@ pub const SOFT_TECHNIQUES: &[(&str, &str)] = &[
     ("vssm", "technique = \"vssm\""),
     ("msm_soft", "technique = \"msm_soft\""),
     ("cssm M=8", "technique = \"cssm\"\nterms = 8"),
+    ("smrt 7x8", "technique = \"smrt\"\nrays = 7\nsteps = 8"),
 ];
 
 /// Index of the yardstick in [`SOFT_TECHNIQUES`]: PCSS with 16 blocker and 32 filter taps.

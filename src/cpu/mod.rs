@@ -22,6 +22,7 @@ pub mod vis_msm;
 pub mod vis_msm_soft;
 pub mod vis_pcf;
 pub mod vis_pcss;
+pub mod vis_smrt;
 pub mod vis_vsm;
 pub mod vis_vssm;
 pub mod vsm;

@@ -253,6 +253,17 @@ pub enum Technique {
         /// Minimum variance.
         min_variance: f32,
     },
+    /// Shadow-map ray tracing (after UE5's and EEVEE's SMRT): rays from the receiver toward
+    /// stratified points on the emitter, each marched through the linear depth map.
+    Smrt {
+        /// Rays per receiver (points on the emitter).
+        rays: u32,
+        /// Depth-map samples per ray.
+        steps: u32,
+        /// Cap on how fast the last surface seen in front of a ray may recede behind an
+        /// occluder, relative to the ray's own depth rate (0: it does not recede).
+        max_slope: f32,
+    },
     /// Moment soft shadow maps (after Peters et al. 2016): the blocker depth from the four
     /// moments over the search square (the mean of the support points in front of the receiver
     /// of the three-point distribution through d that Hamburger MSM reconstructs), then MSM at
@@ -331,6 +342,7 @@ impl Technique {
             Technique::Cssm { .. } => "cssm",
             Technique::Vssm { .. } => "vssm",
             Technique::MsmSoft { .. } => "msm_soft",
+            Technique::Smrt { .. } => "smrt",
         }
     }
 }

@@ -354,6 +354,11 @@ pub struct LightParams {
     pub near: f32,
     /// Far plane.
     pub far: f32,
+    /// Distance from the light's position to its target along the view axis (world units):
+    /// where a directional light's area emitter sits, so its angular size is
+    /// `light_size / target_distance` (what `smrt`'s parallel rays follow, as the renderer's
+    /// truth does). The constructors set 1; [`LightParams::from_light`] the scene's.
+    pub target_distance: f32,
 }
 
 impl LightParams {
@@ -366,6 +371,7 @@ impl LightParams {
             perspective: false,
             near,
             far,
+            target_distance: 1.0,
         }
     }
 
@@ -377,6 +383,7 @@ impl LightParams {
             perspective: true,
             near,
             far,
+            target_distance: 1.0,
         }
     }
 
@@ -388,7 +395,15 @@ impl LightParams {
             perspective: matches!(light.kind, LightKind::Spot { .. }),
             near: light.near,
             far: light.far,
+            target_distance: (light.target - light.position).length(),
         }
+    }
+
+    /// These parameters with the emitter `distance` from the light's position
+    /// ([`LightParams::target_distance`]).
+    pub fn with_target_distance(mut self, distance: f32) -> Self {
+        self.target_distance = distance;
+        self
     }
 
     /// Checks the planes (as a scene does) and that the projection maps the near plane to
@@ -407,6 +422,12 @@ impl LightParams {
             if !v.is_finite() || !(1e-6..=1e7).contains(&v) {
                 return Err(err(field, format!("{v} is outside [1e-6, 1e7]")));
             }
+        }
+        if !(self.target_distance.is_finite() && self.target_distance > 0.0) {
+            return Err(err(
+                "target_distance",
+                format!("{} must be finite and positive", self.target_distance),
+            ));
         }
         if self.far <= self.near {
             return Err(err(
@@ -458,7 +479,7 @@ impl LightParams {
         Light {
             kind,
             position,
-            target: position + forward,
+            target: position + forward * self.target_distance,
             near: self.near,
             far: self.far,
             size: config.light_size,

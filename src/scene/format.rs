@@ -158,6 +158,12 @@ pub struct ShadowFile {
     pub sharpen: Option<Spanned<f64>>,
     /// CSSM sharpening falloff B.
     pub sharpen_falloff: Option<Spanned<f64>>,
+    /// SMRT: rays per receiver.
+    pub rays: Option<Spanned<i64>>,
+    /// SMRT: depth-map samples per ray.
+    pub steps: Option<Spanned<i64>>,
+    /// SMRT: cap on the receding slope extrapolated behind an occluder.
+    pub max_slope: Option<Spanned<f64>>,
 }
 
 /// `[[object]]`.

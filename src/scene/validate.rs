@@ -58,6 +58,9 @@ const KEYS: &[&str] = &[
     "sharpen_falloff",
     "bias_mode",
     "receiver_plane_cap",
+    "rays",
+    "steps",
+    "max_slope",
 ];
 
 /// The value of `key` as written, if it is.
@@ -97,6 +100,9 @@ fn raw<'a>(s: &'a ShadowFile, key: &str) -> Option<Raw<'a>> {
         "sharpen_falloff" => n(&s.sharpen_falloff),
         "bias_mode" => t(&s.bias_mode),
         "receiver_plane_cap" => n(&s.receiver_plane_cap),
+        "rays" => i(&s.rays),
+        "steps" => i(&s.steps),
+        "max_slope" => n(&s.max_slope),
         _ => None,
     }
 }

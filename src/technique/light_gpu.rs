@@ -40,6 +40,7 @@ impl LightGpu {
             map_size: [light.shadow_map as f32; 2],
             width_at_unit: light.width_at_unit(),
             size: light.size,
+            target_distance: (light.target - light.position).length(),
             bias: light.shadow.bias,
             normal_bias: light.shadow.normal_bias,
             receiver_plane: light.shadow.receiver_plane,

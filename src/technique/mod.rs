@@ -20,6 +20,7 @@ mod pcf;
 mod pcss;
 mod reference;
 mod shade;
+mod smrt;
 mod sweep_plan;
 mod vsm;
 mod vssm;
@@ -100,6 +101,7 @@ pub static REGISTRY: &[&TechniqueDef] = &[
     &cssm::DEF,
     &vssm::DEF,
     &msm_soft::DEF,
+    &smrt::DEF,
 ];
 
 /// Every technique's scene name, in registry order.
