@@ -200,11 +200,18 @@ fn receiver_plane_bias_matches_reference() {
         radius: 2,
         kernel: PcfKernel::Tent,
     };
+    let pcss = Technique::Pcss {
+        blocker_samples: 16,
+        filter_samples: 32,
+        max_search: 0.1,
+    };
     for (i, (kind, technique)) in [
         (DIR, Technique::Hard),
         (SPOT, Technique::Hard),
         (DIR, tent),
         (SPOT, tent),
+        (DIR, pcss),
+        (SPOT, pcss),
     ]
     .into_iter()
     .enumerate()

@@ -1183,7 +1183,9 @@ fn sg_vis_pcf_hardware(map: texture_depth_2d, cmp: sampler_comparison, l: sg_Lig
 }
 // Percentage-closer soft shadows (Fernando 2005), the brute-force peer of the prefiltered soft
 // shadows: 1) blocker search over the region the light cone cuts from the map, 2) penumbra
-// width w = size · (Z_r − Z_b) / Z_b, 3) PCF over that width. Taps lie on a Vogel disc.
+// width w = size · (Z_r − Z_b) / Z_b, 3) PCF over that width. Taps lie on a Vogel disc. With
+// the receiver-plane bias each tap (search and filter) compares the receiver plane's depth at
+// its texel's centre.
 
 // Radius (UV) of the blocker search: the cone from the receiver to the light's width, at the
 // near plane where it is widest, capped by max_search.
@@ -1198,8 +1200,9 @@ fn sg_vis_pcss(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
     var sum = 0.0;
     var count = 0u;
     for (var i = 0u; i < l.blocker_samples; i++) {
-        let z = sg_load_depth(map, sg_texel_of(s.uv + search * sg_vogel_disc(i, l.blocker_samples), l.map_size));
-        if z + l.bias < s.depth {
+        let t = sg_texel_of(s.uv + search * sg_vogel_disc(i, l.blocker_samples), l.map_size);
+        let z = sg_load_depth(map, t);
+        if z + l.bias < s.depth + sg_light_receiver_offset(l, s, sg_light_tap_offset(l, s, t)) {
             sum += z;
             count += 1u;
         }
@@ -1212,8 +1215,9 @@ fn sg_vis_pcss(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
     let radius = max(0.5 * penumbra_world / sg_light_map_width(l, s.view_z), 0.5 / l.map_size.x);
     var lit = 0.0;
     for (var i = 0u; i < l.filter_samples; i++) {
-        let z = sg_load_depth(map, sg_texel_of(s.uv + radius * sg_vogel_disc(i, l.filter_samples), l.map_size));
-        lit += select(0.0, 1.0, s.depth <= z + l.bias);
+        let t = sg_texel_of(s.uv + radius * sg_vogel_disc(i, l.filter_samples), l.map_size);
+        let d = s.depth + sg_light_receiver_offset(l, s, sg_light_tap_offset(l, s, t));
+        lit += select(0.0, 1.0, d <= sg_load_depth(map, t) + l.bias);
     }
     return lit / f32(l.filter_samples);
 }

@@ -1,6 +1,8 @@
 // Percentage-closer soft shadows (Fernando 2005), the brute-force peer of the prefiltered soft
 // shadows: 1) blocker search over the region the light cone cuts from the map, 2) penumbra
-// width w = size · (Z_r − Z_b) / Z_b, 3) PCF over that width. Taps lie on a Vogel disc.
+// width w = size · (Z_r − Z_b) / Z_b, 3) PCF over that width. Taps lie on a Vogel disc. With
+// the receiver-plane bias each tap (search and filter) compares the receiver plane's depth at
+// its texel's centre.
 // #import shared/light
 // #import shared/sampling
 
@@ -17,8 +19,9 @@ fn vis_pcss(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     var sum = 0.0;
     var count = 0u;
     for (var i = 0u; i < l.blocker_samples; i++) {
-        let z = load_depth(map, texel_of(s.uv + search * vogel_disc(i, l.blocker_samples), l.map_size));
-        if z + l.bias < s.depth {
+        let t = texel_of(s.uv + search * vogel_disc(i, l.blocker_samples), l.map_size);
+        let z = load_depth(map, t);
+        if z + l.bias < s.depth + light_receiver_offset(l, s, light_tap_offset(l, s, t)) {
             sum += z;
             count += 1u;
         }
@@ -31,8 +34,9 @@ fn vis_pcss(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     let radius = max(0.5 * penumbra_world / light_map_width(l, s.view_z), 0.5 / l.map_size.x);
     var lit = 0.0;
     for (var i = 0u; i < l.filter_samples; i++) {
-        let z = load_depth(map, texel_of(s.uv + radius * vogel_disc(i, l.filter_samples), l.map_size));
-        lit += select(0.0, 1.0, s.depth <= z + l.bias);
+        let t = texel_of(s.uv + radius * vogel_disc(i, l.filter_samples), l.map_size);
+        let d = s.depth + light_receiver_offset(l, s, light_tap_offset(l, s, t));
+        lit += select(0.0, 1.0, d <= load_depth(map, t) + l.bias);
     }
     return lit / f32(l.filter_samples);
 }

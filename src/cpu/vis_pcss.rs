@@ -1,6 +1,6 @@
 //! Reference of `kernels/shared/vis_pcss.wgsl`.
 
-use super::light::{LightSample, linear_to_z, map_width};
+use super::light::{LightSample, linear_to_z, map_width, receiver_offset, tap_offset};
 use super::{Map, vogel_disc};
 use crate::gpu_data::LightGpu;
 
@@ -10,7 +10,8 @@ pub fn search_radius(l: &LightGpu, s: &LightSample) -> f64 {
     (world / map_width(l, f64::from(l.near))).min(f64::from(l.max_search))
 }
 
-/// Blocker search, penumbra estimate, PCF over the penumbra.
+/// Blocker search, penumbra estimate, PCF over the penumbra; each tap against the receiver
+/// plane's depth at its texel's centre when the receiver-plane bias is on.
 pub fn vis_pcss(map: &Map, l: &LightGpu, s: &LightSample) -> f64 {
     let bias = f64::from(l.bias);
     let search = search_radius(l, s);
@@ -19,7 +20,7 @@ pub fn vis_pcss(map: &Map, l: &LightGpu, s: &LightSample) -> f64 {
         let o = vogel_disc(i, l.blocker_samples);
         let (x, y) = map.texel_of([s.uv[0] + search * o[0], s.uv[1] + search * o[1]]);
         let z = map.load(x, y);
-        if z + bias < s.depth {
+        if z + bias < s.depth + receiver_offset(l, s, tap_offset(l, s, x, y)) {
             sum += z;
             count += 1;
         }
@@ -34,7 +35,8 @@ pub fn vis_pcss(map: &Map, l: &LightGpu, s: &LightSample) -> f64 {
     for i in 0..l.filter_samples {
         let o = vogel_disc(i, l.filter_samples);
         let (x, y) = map.texel_of([s.uv[0] + radius * o[0], s.uv[1] + radius * o[1]]);
-        if s.depth <= map.load(x, y) + bias {
+        let d = s.depth + receiver_offset(l, s, tap_offset(l, s, x, y));
+        if d <= map.load(x, y) + bias {
             lit += 1.0;
         }
     }

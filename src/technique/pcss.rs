@@ -40,7 +40,7 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     name: "pcss",
     id: TECHNIQUE_PCSS,
     doc: "percentage-closer soft shadows: blocker search, penumbra width, PCF",
-    params: &[PARAMS],
+    params: &[PARAMS, super::params::RECEIVER_PLANE],
     build: |v| Technique::Pcss {
         blocker_samples: v.int("blocker_samples"),
         filter_samples: v.int("filter_samples"),
