@@ -15,9 +15,13 @@
 //! let light = LightParams::orthographic(view, 5.0, 2.0, 20.0);
 //! let out = stage.record(device, &mut encoder, depth, &light)?;
 //! // bind out.maps[k].view at binding k of group 1, upload bytemuck::bytes_of(&out.light)
-//! // as the `Light` the host passes to `shadowgraph_visibility(l, p, n)`, then submit.
+//! // as the `sg_Light` the host passes to `shadowgraph_visibility(l, p, n)`, then submit.
 //! # Ok(()) }
 //! ```
+//!
+//! Many lights: one stage, `record_light(k, …, DepthLayer::new(&array, k), …)` per light (or
+//! cascade, [`cascades`]), the functions once ([`Prefilter::wgsl_functions`]) and one
+//! [`Prefilter::wgsl_light`] block per light in the host's shader.
 
 pub mod cascades;
 mod config;
@@ -71,7 +75,7 @@ pub struct PrefilterOutput {
     /// The maps, in binding order: map `k` goes to `@binding(first_binding + k)` of
     /// [`Prefilter::wgsl`].
     pub maps: Vec<OutputMap>,
-    /// The WGSL `struct Light` to upload (bytemuck) for this frame's matrices.
+    /// The WGSL `struct sg_Light` to upload (bytemuck) for this frame's matrices.
     pub light: LightGpu,
 }
 
