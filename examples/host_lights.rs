@@ -12,7 +12,10 @@
 mod common;
 
 use anyhow::{Context, Result};
-use common::{clear_depth, depth_state, device, read, scene, target, uniform_entry, vertex_layout};
+use common::{
+    begin_shade_pass, copy_color, depth_pass, depth_pipeline, device, read, scene, shade_pipeline,
+    target, uniform_entry,
+};
 use glam::{Mat4, Vec3};
 use shadowgraph::prefilter::cascades::{CascadeCamera, CascadeLayout, fit_cascades};
 use shadowgraph::prefilter::{DepthLayer, LightParams, Prefilter, PrefilterConfig};
@@ -120,15 +123,6 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
 }
 ";
 
-/// The host's depth pass, once per layer.
-const DEPTH: &str = "
-@group(0) @binding(0) var<uniform> view_proj: mat4x4<f32>;
-@vertex
-fn vs_main(@location(0) p: vec3<f32>) -> @builtin(position) vec4<f32> {
-    return view_proj * vec4<f32>(p, 1.0);
-}
-";
-
 fn main() -> Result<()> {
     let out = std::env::args()
         .nth(1)
@@ -175,52 +169,24 @@ fn main() -> Result<()> {
     let shade = shade_pipeline(
         &device,
         &format!("{wgsl}{SHADE}"),
-        &frame_layout,
-        &maps_layout,
+        &[&frame_layout, &maps_layout],
     );
     let depth_pipeline = depth_pipeline(&device);
 
     let mut enc = device.create_command_encoder(&Default::default());
     let mut outputs = Vec::new();
     for (k, light) in params.iter().enumerate() {
-        if std::env::var_os("STEP").is_some() {
-            eprintln!("depth {k}");
-        }
-        depth_pass(
-            &device,
-            &mut enc,
-            &depth_pipeline,
-            &vertices,
-            verts.len() as u32,
-            &shadows,
-            k as u32,
-            light,
-        );
-        if std::env::var_os("STEP1").is_some() {
-            queue.submit([std::mem::replace(
-                &mut enc,
-                device.create_command_encoder(&Default::default()),
-            )
-            .finish()]);
-            device.poll(wgpu::PollType::wait_indefinitely()).unwrap();
-            eprintln!("depth {k} done");
-        }
-        outputs.push(stage.record_light(
-            k,
-            &device,
-            &mut enc,
-            DepthLayer::new(&shadows, k as u32),
-            light,
-        )?);
-    }
-    if std::env::var_os("STEP1").is_some() {
-        queue.submit([std::mem::replace(
-            &mut enc,
-            device.create_command_encoder(&Default::default()),
-        )
-        .finish()]);
-        device.poll(wgpu::PollType::wait_indefinitely()).unwrap();
-        eprintln!("stage done");
+        let layer = k as u32;
+        let view = shadows.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2),
+            base_array_layer: layer,
+            array_layer_count: Some(1),
+            ..Default::default()
+        });
+        let geometry = (&vertices, verts.len() as u32);
+        depth_pass(&device, &mut enc, &depth_pipeline, geometry, &view, light);
+        let depth = DepthLayer::new(&shadows, layer);
+        outputs.push(stage.record_light(k, &device, &mut enc, depth, light)?);
     }
     let views: Vec<&wgpu::TextureView> = outputs
         .iter()
@@ -279,16 +245,18 @@ fn main() -> Result<()> {
     });
     let color = target(&device, IMAGE, wgpu::TextureFormat::Rgba8UnormSrgb);
     let depth = target(&device, IMAGE, wgpu::TextureFormat::Depth32Float);
-    shade_pass(
-        &mut enc,
-        &shade,
-        &frame,
-        &maps,
-        &vertices,
-        verts.len() as u32,
-        &color,
-        &depth,
-    );
+    {
+        let (cv, dv) = (
+            color.create_view(&Default::default()),
+            depth.create_view(&Default::default()),
+        );
+        let mut pass = begin_shade_pass(&mut enc, &cv, &dv);
+        pass.set_pipeline(&shade);
+        pass.set_bind_group(0, &frame, &[]);
+        pass.set_bind_group(1, &maps, &[]);
+        pass.set_vertex_buffer(0, vertices.slice(..));
+        pass.draw(0..verts.len() as u32, 0..1);
+    }
     let readback = copy_color(&device, &mut enc, &color);
     queue.submit([enc.finish()]);
     let rgba = read(&device, &readback)?;
@@ -325,182 +293,4 @@ fn shadow_array(device: &wgpu::Device, layers: u32) -> wgpu::Texture {
         usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
         view_formats: &[],
     })
-}
-
-fn depth_pipeline(device: &wgpu::Device) -> wgpu::RenderPipeline {
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("host.depth"),
-        source: wgpu::ShaderSource::Wgsl(DEPTH.into()),
-    });
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("host.depth"),
-        layout: None,
-        vertex: wgpu::VertexState {
-            module: &module,
-            entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
-            buffers: &[Some(vertex_layout())],
-        },
-        primitive: Default::default(),
-        depth_stencil: Some(depth_state(1.5)),
-        multisample: Default::default(),
-        fragment: None,
-        multiview_mask: None,
-        cache: None,
-    })
-}
-
-fn shade_pipeline(
-    device: &wgpu::Device,
-    wgsl: &str,
-    frame_layout: &wgpu::BindGroupLayout,
-    maps_layout: &wgpu::BindGroupLayout,
-) -> wgpu::RenderPipeline {
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("host.shade"),
-        source: wgpu::ShaderSource::Wgsl(wgsl.into()),
-    });
-    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("host.shade"),
-        bind_group_layouts: &[Some(frame_layout), Some(maps_layout)],
-        immediate_size: 0,
-    });
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("host.shade"),
-        layout: Some(&layout),
-        vertex: wgpu::VertexState {
-            module: &module,
-            entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
-            buffers: &[Some(vertex_layout())],
-        },
-        primitive: Default::default(),
-        depth_stencil: Some(depth_state(0.0)),
-        multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
-            module: &module,
-            entry_point: Some("fs_main"),
-            compilation_options: Default::default(),
-            targets: &[Some(wgpu::TextureFormat::Rgba8UnormSrgb.into())],
-        }),
-        multiview_mask: None,
-        cache: None,
-    })
-}
-
-/// The scene's depth from `light` into layer `layer` of `shadows`.
-#[allow(clippy::too_many_arguments, reason = "a flat example")]
-fn depth_pass(
-    device: &wgpu::Device,
-    enc: &mut wgpu::CommandEncoder,
-    pipeline: &wgpu::RenderPipeline,
-    vertices: &wgpu::Buffer,
-    count: u32,
-    shadows: &wgpu::Texture,
-    layer: u32,
-    light: &LightParams,
-) {
-    let vp = (light.projection * light.view).to_cols_array();
-    let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("host.light_view_proj"),
-        contents: bytemuck::cast_slice(&vp),
-        usage: wgpu::BufferUsages::UNIFORM,
-    });
-    let bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("host.depth"),
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[wgpu::BindGroupEntry {
-            binding: 0,
-            resource: buffer.as_entire_binding(),
-        }],
-    });
-    let view = shadows.create_view(&wgpu::TextureViewDescriptor {
-        dimension: Some(wgpu::TextureViewDimension::D2),
-        base_array_layer: layer,
-        array_layer_count: Some(1),
-        ..Default::default()
-    });
-    let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-        label: Some("host.depth"),
-        color_attachments: &[],
-        depth_stencil_attachment: Some(clear_depth(&view)),
-        timestamp_writes: None,
-        occlusion_query_set: None,
-        multiview_mask: None,
-    });
-    pass.set_pipeline(pipeline);
-    pass.set_bind_group(0, &bg, &[]);
-    pass.set_vertex_buffer(0, vertices.slice(..));
-    pass.draw(0..count, 0..1);
-}
-
-#[allow(clippy::too_many_arguments, reason = "a flat example")]
-fn shade_pass(
-    enc: &mut wgpu::CommandEncoder,
-    pipeline: &wgpu::RenderPipeline,
-    frame: &wgpu::BindGroup,
-    maps: &wgpu::BindGroup,
-    vertices: &wgpu::Buffer,
-    count: u32,
-    color: &wgpu::Texture,
-    depth: &wgpu::Texture,
-) {
-    let (cv, dv) = (
-        color.create_view(&Default::default()),
-        depth.create_view(&Default::default()),
-    );
-    let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-        label: Some("host.shade"),
-        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-            view: &cv,
-            depth_slice: None,
-            resolve_target: None,
-            ops: wgpu::Operations {
-                load: wgpu::LoadOp::Clear(wgpu::Color {
-                    r: 0.3,
-                    g: 0.38,
-                    b: 0.5,
-                    a: 1.0,
-                }),
-                store: wgpu::StoreOp::Store,
-            },
-        })],
-        depth_stencil_attachment: Some(clear_depth(&dv)),
-        timestamp_writes: None,
-        occlusion_query_set: None,
-        multiview_mask: None,
-    });
-    pass.set_pipeline(pipeline);
-    pass.set_bind_group(0, frame, &[]);
-    pass.set_bind_group(1, maps, &[]);
-    pass.set_vertex_buffer(0, vertices.slice(..));
-    pass.draw(0..count, 0..1);
-}
-
-fn copy_color(
-    device: &wgpu::Device,
-    enc: &mut wgpu::CommandEncoder,
-    color: &wgpu::Texture,
-) -> wgpu::Buffer {
-    let (w, h) = (color.width(), color.height());
-    // 640 · 4 bytes per row: a multiple of COPY_BYTES_PER_ROW_ALIGNMENT (256).
-    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("host.readback"),
-        size: u64::from(w * h * 4),
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
-    enc.copy_texture_to_buffer(
-        color.as_image_copy(),
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(w * 4),
-                rows_per_image: Some(h),
-            },
-        },
-        color.size(),
-    );
-    buffer
 }

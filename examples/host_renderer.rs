@@ -8,7 +8,10 @@
 mod common;
 
 use anyhow::{Context, Result};
-use common::{clear_depth, depth_state, device, read, scene, target, uniform_entry, vertex_layout};
+use common::{
+    begin_shade_pass, copy_color, depth_pass, depth_pipeline, device, read, scene, shade_pipeline,
+    target, uniform_entry,
+};
 use glam::{Mat4, Vec3};
 use shadowgraph::prefilter::{LightParams, Prefilter, PrefilterConfig};
 use shadowgraph::timer::TIMER_FEATURES;
@@ -40,15 +43,6 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     let n = normalize(in.normal);
     let lit = max(dot(n, -light.direction), 0.0) * shadowgraph_visibility(light, in.world, n);
     return vec4<f32>(in.color * (0.15 + 0.85 * lit), 1.0);
-}
-";
-
-/// The host's depth pass from the light.
-const DEPTH: &str = "
-@group(0) @binding(0) var<uniform> view_proj: mat4x4<f32>;
-@vertex
-fn vs_main(@location(0) p: vec3<f32>) -> @builtin(position) vec4<f32> {
-    return view_proj * vec4<f32>(p, 1.0);
 }
 ";
 
@@ -165,26 +159,7 @@ impl Host {
             contents: bytemuck::cast_slice(&verts),
             usage: wgpu::BufferUsages::VERTEX,
         });
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("host.depth"),
-            source: wgpu::ShaderSource::Wgsl(DEPTH.into()),
-        });
-        let depth_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("host.depth"),
-            layout: None,
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[Some(vertex_layout())],
-            },
-            primitive: Default::default(),
-            depth_stencil: Some(depth_state(1.5)),
-            multisample: Default::default(),
-            fragment: None,
-            multiview_mask: None,
-            cache: None,
-        });
+        let depth_pipeline = depth_pipeline(device);
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("host.frame"),
             entries: &[
@@ -218,36 +193,8 @@ impl Host {
         stage_wgsl: &str,
         maps_layout: &wgpu::BindGroupLayout,
     ) -> wgpu::RenderPipeline {
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("host.shade"),
-            source: wgpu::ShaderSource::Wgsl(format!("{stage_wgsl}{SHADE}").into()),
-        });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("host.shade"),
-            bind_group_layouts: &[Some(&self.frame_layout), Some(maps_layout)],
-            immediate_size: 0,
-        });
-        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("host.shade"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[Some(vertex_layout())],
-            },
-            primitive: Default::default(),
-            depth_stencil: Some(depth_state(0.0)),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::TextureFormat::Rgba8UnormSrgb.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        })
+        let wgsl = format!("{stage_wgsl}{SHADE}");
+        shade_pipeline(device, &wgsl, &[&self.frame_layout, maps_layout])
     }
 
     fn depth_pass(
@@ -256,33 +203,9 @@ impl Host {
         enc: &mut wgpu::CommandEncoder,
         light: &LightParams,
     ) {
-        let vp = (light.projection * light.view).to_cols_array();
-        let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("host.light_view_proj"),
-            contents: bytemuck::cast_slice(&vp),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("host.depth"),
-            layout: &self.depth_pipeline.get_bind_group_layout(0),
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: buffer.as_entire_binding(),
-            }],
-        });
         let view = self.shadow.create_view(&Default::default());
-        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("host.depth"),
-            color_attachments: &[],
-            depth_stencil_attachment: Some(clear_depth(&view)),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&self.depth_pipeline);
-        pass.set_bind_group(0, &bg, &[]);
-        pass.set_vertex_buffer(0, self.vertices.slice(..));
-        pass.draw(0..self.count, 0..1);
+        let geometry = (&self.vertices, self.count);
+        depth_pass(device, enc, &self.depth_pipeline, geometry, &view, light);
     }
 
     /// Camera and light uniforms of one panel (`light` is the stage's `struct Light` bytes).
@@ -322,27 +245,7 @@ impl Host {
             self.color.create_view(&Default::default()),
             self.depth.create_view(&Default::default()),
         );
-        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("host.shade"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &cv,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color {
-                        r: 0.3,
-                        g: 0.38,
-                        b: 0.5,
-                        a: 1.0,
-                    }),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(clear_depth(&dv)),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = begin_shade_pass(enc, &cv, &dv);
         pass.set_vertex_buffer(0, self.vertices.slice(..));
         for (k, (pipeline, frame, maps)) in panels.iter().enumerate() {
             let (x, y) = ((k as u32 % 2) * PANEL.0, (k as u32 / 2) * PANEL.1);
@@ -355,26 +258,7 @@ impl Host {
     }
 
     fn copy_color(&self, device: &wgpu::Device, enc: &mut wgpu::CommandEncoder) -> wgpu::Buffer {
-        let (w, h) = (self.color.width(), self.color.height());
         // 2 · 384 · 4 bytes per row: a multiple of COPY_BYTES_PER_ROW_ALIGNMENT (256).
-        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("host.readback"),
-            size: u64::from(w * h * 4),
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
-        enc.copy_texture_to_buffer(
-            self.color.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(w * 4),
-                    rows_per_image: Some(h),
-                },
-            },
-            self.color.size(),
-        );
-        buffer
+        copy_color(device, enc, &self.color)
     }
 }

@@ -4,7 +4,9 @@
 
 use anyhow::{Context, Result};
 use glam::Vec3;
+use shadowgraph::prefilter::LightParams;
 use shadowgraph::timer::TIMER_FEATURES;
+use wgpu::util::DeviceExt;
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -171,4 +173,172 @@ pub fn cuboid(out: &mut Vec<Vertex>, center: Vec3, size: Vec3, color: [f32; 3]) 
             }
         }
     }
+}
+
+/// The hosts' depth pass from a light.
+const DEPTH: &str = "
+@group(0) @binding(0) var<uniform> view_proj: mat4x4<f32>;
+@vertex
+fn vs_main(@location(0) p: vec3<f32>) -> @builtin(position) vec4<f32> {
+    return view_proj * vec4<f32>(p, 1.0);
+}
+";
+
+/// The depth-only pipeline of the hosts' shadow pass (slope-scaled bias 1.5).
+pub fn depth_pipeline(device: &wgpu::Device) -> wgpu::RenderPipeline {
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("host.depth"),
+        source: wgpu::ShaderSource::Wgsl(DEPTH.into()),
+    });
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("host.depth"),
+        layout: None,
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[Some(vertex_layout())],
+        },
+        primitive: Default::default(),
+        depth_stencil: Some(depth_state(1.5)),
+        multisample: Default::default(),
+        fragment: None,
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// The scene's depth from `light` into `view` (a depth texture, or one layer of an array).
+pub fn depth_pass(
+    device: &wgpu::Device,
+    enc: &mut wgpu::CommandEncoder,
+    pipeline: &wgpu::RenderPipeline,
+    (vertices, count): (&wgpu::Buffer, u32),
+    view: &wgpu::TextureView,
+    light: &LightParams,
+) {
+    let vp = (light.projection * light.view).to_cols_array();
+    let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("host.light_view_proj"),
+        contents: bytemuck::cast_slice(&vp),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("host.depth"),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: buffer.as_entire_binding(),
+        }],
+    });
+    let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("host.depth"),
+        color_attachments: &[],
+        depth_stencil_attachment: Some(clear_depth(view)),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, &bg, &[]);
+    pass.set_vertex_buffer(0, vertices.slice(..));
+    pass.draw(0..count, 0..1);
+}
+
+/// A shading pipeline from `wgsl` (`vs_main`, `fs_main`) over the scene's vertices, writing
+/// `Rgba8UnormSrgb` with a depth test, bind groups laid out by `layouts`.
+pub fn shade_pipeline(
+    device: &wgpu::Device,
+    wgsl: &str,
+    layouts: &[&wgpu::BindGroupLayout],
+) -> wgpu::RenderPipeline {
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("host.shade"),
+        source: wgpu::ShaderSource::Wgsl(wgsl.into()),
+    });
+    let layouts: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().copied().map(Some).collect();
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("host.shade"),
+        bind_group_layouts: &layouts,
+        immediate_size: 0,
+    });
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("host.shade"),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[Some(vertex_layout())],
+        },
+        primitive: Default::default(),
+        depth_stencil: Some(depth_state(0.0)),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::TextureFormat::Rgba8UnormSrgb.into())],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// The shading pass into `color` and `depth`, both cleared (sky colour, far).
+pub fn begin_shade_pass<'e>(
+    enc: &'e mut wgpu::CommandEncoder,
+    color: &wgpu::TextureView,
+    depth: &wgpu::TextureView,
+) -> wgpu::RenderPass<'e> {
+    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("host.shade"),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: color,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color {
+                    r: 0.3,
+                    g: 0.38,
+                    b: 0.5,
+                    a: 1.0,
+                }),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: Some(clear_depth(depth)),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+    .forget_lifetime()
+}
+
+/// A readback buffer and the copy of `color` (RGBA8, rows a multiple of 256 bytes) into it.
+pub fn copy_color(
+    device: &wgpu::Device,
+    enc: &mut wgpu::CommandEncoder,
+    color: &wgpu::Texture,
+) -> wgpu::Buffer {
+    let (w, h) = (color.width(), color.height());
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("host.readback"),
+        size: u64::from(w * h * 4),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    enc.copy_texture_to_buffer(
+        color.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(w * 4),
+                rows_per_image: Some(h),
+            },
+        },
+        color.size(),
+    );
+    buffer
 }

@@ -59,7 +59,7 @@
 //   sg_light_to_light sg_linstep sg_load_depth sg_mip_tap_uv sg_mip_taps sg_msm_biased
 //   sg_msm_dequantize sg_msm_expect sg_msm_intensity sg_msm_moments sg_msm_quantize sg_msm_roots
 //   sg_msm_soft_blocker sg_pcss_search_radius sg_sample_bilinear sg_sample_bilinear_log
-//   sg_sample_map sg_sample_map_log sg_sat_box sg_sat_box_fixed sg_sat_box_float
+//   sg_sample_map sg_sample_map_log sg_sat_box sg_sat_box_fixed sg_sat_box_float sg_sat_clamp
 //   sg_sat_mean_fixed sg_sat_mean_float sg_sat_node_f32 sg_sat_node_u32 sg_sat_nodes sg_sat_rect
 //   sg_sat_sample_fixed sg_sat_sample_float sg_sat_search_fixed sg_sat_search_float
 //   sg_sat_span_weights sg_smrt_emitter_point sg_smrt_ray sg_soft_blockers sg_soft_filter_trips
@@ -525,12 +525,19 @@ struct sg_SatNodes {
     area: f32,
 }
 
-fn sg_sat_nodes(rect: vec4<f32>, size: vec2<u32>) -> sg_SatNodes {
+// `rect` ordered, clamped to the map and widened to SAT_MIN_EXTENT inside it: (lo, hi).
+fn sg_sat_clamp(rect: vec4<f32>, size: vec2<u32>) -> vec4<f32> {
     let s = vec2<f32>(size);
     let lo0 = clamp(min(rect.xy, rect.zw), vec2<f32>(0.0), s);
     let hi0 = clamp(max(rect.xy, rect.zw), vec2<f32>(0.0), s);
     let lo = min(lo0, s - sg_SAT_MIN_EXTENT);
-    let hi = max(hi0, lo + sg_SAT_MIN_EXTENT);
+    return vec4<f32>(lo, max(hi0, lo + sg_SAT_MIN_EXTENT));
+}
+
+fn sg_sat_nodes(rect: vec4<f32>, size: vec2<u32>) -> sg_SatNodes {
+    let c = sg_sat_clamp(rect, size);
+    let lo = c.xy;
+    let hi = c.zw;
     let i0 = floor(lo);
     let i1 = floor(hi);
     let a0 = lo - i0;
@@ -656,12 +663,8 @@ fn sg_sat_box_float(sat: texture_2d<f32>, rect: vec4<f32>, offset: vec4<f32>, sc
 // The integer nodes (X0, Y0, X1, Y1) of `sat_nodes`' rectangle snapped outward: X0 = ⌊x0⌋,
 // X1 = ⌈x1⌉ (> X0: the rectangle is at least SAT_MIN_EXTENT wide), within [0, size].
 fn sg_sat_box(rect: vec4<f32>, size: vec2<u32>) -> vec4<i32> {
-    let s = vec2<f32>(size);
-    let lo0 = clamp(min(rect.xy, rect.zw), vec2<f32>(0.0), s);
-    let hi0 = clamp(max(rect.xy, rect.zw), vec2<f32>(0.0), s);
-    let lo = min(lo0, s - sg_SAT_MIN_EXTENT);
-    let hi = max(hi0, lo + sg_SAT_MIN_EXTENT);
-    return vec4<i32>(vec2<i32>(floor(lo)), min(vec2<i32>(ceil(hi)), vec2<i32>(size)));
+    let c = sg_sat_clamp(rect, size);
+    return vec4<i32>(vec2<i32>(floor(c.xy)), min(vec2<i32>(ceil(c.zw)), vec2<i32>(size)));
 }
 
 // The square of `width` texels centred on uv, in texel units (x0, y0, x1, y1).

@@ -28,12 +28,19 @@ struct SatNodes {
     area: f32,
 }
 
-fn sat_nodes(rect: vec4<f32>, size: vec2<u32>) -> SatNodes {
+// `rect` ordered, clamped to the map and widened to SAT_MIN_EXTENT inside it: (lo, hi).
+fn sat_clamp(rect: vec4<f32>, size: vec2<u32>) -> vec4<f32> {
     let s = vec2<f32>(size);
     let lo0 = clamp(min(rect.xy, rect.zw), vec2<f32>(0.0), s);
     let hi0 = clamp(max(rect.xy, rect.zw), vec2<f32>(0.0), s);
     let lo = min(lo0, s - SAT_MIN_EXTENT);
-    let hi = max(hi0, lo + SAT_MIN_EXTENT);
+    return vec4<f32>(lo, max(hi0, lo + SAT_MIN_EXTENT));
+}
+
+fn sat_nodes(rect: vec4<f32>, size: vec2<u32>) -> SatNodes {
+    let c = sat_clamp(rect, size);
+    let lo = c.xy;
+    let hi = c.zw;
     let i0 = floor(lo);
     let i1 = floor(hi);
     let a0 = lo - i0;
@@ -159,10 +166,6 @@ fn sat_box_float(sat: texture_2d<f32>, rect: vec4<f32>, offset: vec4<f32>, scale
 // The integer nodes (X0, Y0, X1, Y1) of `sat_nodes`' rectangle snapped outward: X0 = ⌊x0⌋,
 // X1 = ⌈x1⌉ (> X0: the rectangle is at least SAT_MIN_EXTENT wide), within [0, size].
 fn sat_box(rect: vec4<f32>, size: vec2<u32>) -> vec4<i32> {
-    let s = vec2<f32>(size);
-    let lo0 = clamp(min(rect.xy, rect.zw), vec2<f32>(0.0), s);
-    let hi0 = clamp(max(rect.xy, rect.zw), vec2<f32>(0.0), s);
-    let lo = min(lo0, s - SAT_MIN_EXTENT);
-    let hi = max(hi0, lo + SAT_MIN_EXTENT);
-    return vec4<i32>(vec2<i32>(floor(lo)), min(vec2<i32>(ceil(hi)), vec2<i32>(size)));
+    let c = sat_clamp(rect, size);
+    return vec4<i32>(vec2<i32>(floor(c.xy)), min(vec2<i32>(ceil(c.zw)), vec2<i32>(size)));
 }
