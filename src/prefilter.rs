@@ -140,8 +140,9 @@ pub struct Prefilter {
     warnings: Vec<String>,
     /// The pipelines, shared by the lights' executors (each borrows them while it records).
     kernels: KernelCache,
-    /// Per light slot: its plan, pooled textures and last maps.
-    lights: Vec<LightSlot>,
+    /// Per light slot: its plan, pooled textures and last maps (`None`: never recorded; slot
+    /// 0 is made by [`Prefilter::new`]).
+    lights: Vec<Option<LightSlot>>,
     timer: Option<GpuTimer>,
 }
 
@@ -161,7 +162,7 @@ impl Prefilter {
     pub fn new(device: &wgpu::Device, config: &PrefilterConfig) -> Result<Self> {
         let (config, warnings) = config.validated()?;
         let planned = plan_for(&config, &planning_params(), config.size)?;
-        limits::check(device, &planned.plan, config.size)?;
+        limits::check(device, &planned.plan, config.size, 0)?;
         // Features the technique's storage needs (e.g. unorm16 MSM moments).
         crate::limits::check_features(
             device,
@@ -174,11 +175,11 @@ impl Prefilter {
             config,
             warnings,
             kernels,
-            lights: vec![LightSlot {
+            lights: vec![Some(LightSlot {
                 executor,
                 planned,
                 maps: Vec::new(),
-            }],
+            })],
             timer: None,
         })
     }
@@ -224,26 +225,12 @@ impl Prefilter {
             .into());
         }
         let size = check_depth(depth)?;
-        while self.lights.len() <= slot {
-            let planned = plan_for(&self.config, &planning_params(), self.config.size)?;
-            self.lights.push(LightSlot {
-                executor: Executor::new(),
-                planned,
-                maps: Vec::new(),
-            });
-        }
-        let config = &self.config;
-        let one = &mut self.lights[slot];
         let key = PlanKey::new(light, size);
-        if key != one.planned.key {
-            let planned = plan_for(config, light, size)?;
-            if size != one.planned.key.size {
-                limits::check(device, &planned.plan, size)?;
-                // Textures of the old size go back to the device; pipelines stay.
-                one.executor = Executor::new();
-            }
-            one.planned = planned;
-        }
+        self.replan(device, slot, key, light)?;
+        let config = &self.config;
+        let one = self.lights[slot]
+            .as_mut()
+            .ok_or_else(|| Error::Invalid(format!("light slot {slot} was not planned")))?;
         let name = technique::depth_name(0);
         let imports = HashMap::from([(name.clone(), depth.texture.clone())]);
         let mut layers = HashMap::new();
@@ -284,6 +271,60 @@ impl Prefilter {
         wgsl::host_block(&self.config.technique, group, first_binding)
     }
 
+    /// Plans light `slot` for `key` unless it is planned for it already. A new slot, or a new
+    /// map size, is checked against the device's limits and the memory budget with every
+    /// other slot's textures counted; a new size drops the slot's old textures.
+    fn replan(
+        &mut self,
+        device: &wgpu::Device,
+        slot: usize,
+        key: PlanKey,
+        light: &LightParams,
+    ) -> Result<()> {
+        if self.lights.len() <= slot {
+            self.lights.resize_with(slot + 1, || None);
+        }
+        let current = self.lights[slot].as_ref().map(|l| l.planned.key);
+        if current == Some(key) {
+            return Ok(());
+        }
+        let planned = plan_for(&self.config, light, key.size)?;
+        let resized = current.is_none_or(|k| k.size != key.size);
+        if resized {
+            let others: u64 = self
+                .lights
+                .iter()
+                .enumerate()
+                .filter(|&(k, _)| k != slot)
+                .filter_map(|(_, l)| l.as_ref())
+                .map(|l| l.planned.plan.slot_bytes())
+                .sum();
+            limits::check(device, &planned.plan, key.size, others)?;
+        }
+        match &mut self.lights[slot] {
+            Some(one) => {
+                if resized {
+                    // Textures of the old size go back to the device; pipelines stay.
+                    one.executor = Executor::new();
+                }
+                one.planned = planned;
+            }
+            empty => {
+                *empty = Some(LightSlot {
+                    executor: Executor::new(),
+                    planned,
+                    maps: Vec::new(),
+                })
+            }
+        }
+        Ok(())
+    }
+
+    /// Light slot 0 (made by [`Prefilter::new`]).
+    fn first(&self) -> Option<&LightSlot> {
+        self.lights.first().and_then(Option::as_ref)
+    }
+
     /// One light's bindings and functions for a shader module holding several lights, without
     /// the functions they call: include [`Prefilter::wgsl_functions`] (or
     /// [`wgsl::functions_for`] the techniques of several stages) once, then one block per
@@ -318,7 +359,9 @@ impl Prefilter {
     /// ([`GpuTimer`]); an error when the device was created without `TIMESTAMP_QUERY` and
     /// `TIMESTAMP_QUERY_INSIDE_ENCODERS`.
     pub fn enable_timing(&mut self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<()> {
-        let spans = self.lights[0].planned.plan.steps.len().max(1) as u32;
+        let spans = self
+            .first()
+            .map_or(1, |l| l.planned.plan.steps.len().max(1)) as u32;
         let timer = GpuTimer::new(device, queue, spans).ok_or(StageError::MissingFeature {
             feature: TIMER_FEATURES.difference(device.features()),
             needed_for: "per-kernel GPU timing",
@@ -361,21 +404,20 @@ impl Prefilter {
 
     /// The map side of the current plan (the last depth texture's, or the configuration's).
     pub fn size(&self) -> u32 {
-        self.lights[0].planned.key.size
+        self.first()
+            .map_or(self.config.size, |l| l.planned.key.size)
     }
 
-    /// Light slots in use (1 + the highest slot recorded).
+    /// Light slots in use (slot 0 and every slot recorded since).
     pub fn light_count(&self) -> usize {
-        self.lights.len()
+        self.lights.iter().flatten().count()
     }
 
     /// Names of the planned kernels' nodes, in execution order.
     pub fn kernels(&self) -> Vec<String> {
-        self.lights[0]
-            .planned
-            .plan
-            .steps
-            .iter()
+        self.first()
+            .into_iter()
+            .flat_map(|l| &l.planned.plan.steps)
             .map(|s| s.node.name.clone())
             .collect()
     }
@@ -383,7 +425,11 @@ impl Prefilter {
     /// Textures the stage's pools hold, all light slots together (constant while the sizes
     /// stay the same).
     pub fn texture_count(&self) -> usize {
-        self.lights.iter().map(|l| l.executor.texture_count()).sum()
+        self.lights
+            .iter()
+            .flatten()
+            .map(|l| l.executor.texture_count())
+            .sum()
     }
 
     /// Pipelines created so far (shared by every light slot).

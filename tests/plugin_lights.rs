@@ -433,3 +433,46 @@ fn several_lights_compose_in_one_module() {
         );
     }
 }
+
+/// The memory budget counts every light of a stage: a CSSM (M = 8) stage planned at 4096²
+/// (about 3.2 GiB of textures, under the default 4 GiB) refuses a second light at 4096² before
+/// allocating anything for it.
+#[test]
+fn the_memory_budget_counts_every_light() {
+    let g = common::gpu();
+    if std::env::var_os(shadowgraph::limits::MEMORY_BUDGET_ENV).is_some() {
+        panic!(
+            "unset {} to run this test",
+            shadowgraph::limits::MEMORY_BUDGET_ENV
+        );
+    }
+    let big = 4096;
+    let config = PrefilterConfig::cssm(big, 8, 0.5);
+    let mut stage = Prefilter::new(&g.device, &config).expect("one light fits the budget");
+    let depth = g.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("host.depth"),
+        size: wgpu::Extent3d {
+            width: big,
+            height: big,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Depth32Float,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    });
+    let (_, params) = lights();
+    let mut enc = g.device.create_command_encoder(&Default::default());
+    let e = stage
+        .record_light(1, &g.device, &mut enc, &depth, &params[0])
+        .unwrap_err();
+    assert!(
+        matches!(&e, shadowgraph::Error::Limit { what, .. } if what.contains("all its lights")),
+        "{e}"
+    );
+    assert!(e.to_string().contains("memory budget"), "{e}");
+    assert_eq!(stage.light_count(), 1, "the refused light holds nothing");
+    assert_eq!(stage.texture_count(), 0);
+}

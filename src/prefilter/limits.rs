@@ -5,9 +5,10 @@
 use crate::error::{Error, Result, StageError};
 use crate::graph::Plan;
 
-/// Checks the map size, every planned kernel and dispatch, and the plan's memory against the
-/// device's limits and the memory budget ([`crate::limits::memory_budget`]).
-pub(super) fn check(device: &wgpu::Device, plan: &Plan, size: u32) -> Result<()> {
+/// Checks the map size, every planned kernel and dispatch, and the plan's memory with the
+/// stage's `other_bytes` (its other lights' textures) against the device's limits and the
+/// memory budget ([`crate::limits::memory_budget`]).
+pub(super) fn check(device: &wgpu::Device, plan: &Plan, size: u32, other_bytes: u64) -> Result<()> {
     let l = device.limits();
     // A device without compute shaders gets one message that says what to request, not the
     // first kernel's workgroup width against a limit of 0.
@@ -54,10 +55,11 @@ pub(super) fn check(device: &wgpu::Device, plan: &Plan, size: u32) -> Result<()>
     }
     over(
         format!(
-            "the stage's textures at map size {size}, in bytes (the memory budget, {})",
+            "the stage's textures at map size {size}, all its lights, in bytes (the memory \
+             budget, {})",
             crate::limits::MEMORY_BUDGET_ENV
         ),
-        plan.slot_bytes(),
+        plan.slot_bytes().saturating_add(other_bytes),
         crate::limits::memory_budget()?,
     )
 }
