@@ -1,6 +1,7 @@
 //! Depth biases against the bias-free ray cast: renders a scene once per bias setting of its
 //! first light (constant only, slope-scaled only, normal offset only, the scene's own, and
-//! receiver-plane) and counts, over the pixels the f64 ray cast finds relevant, *acne* (the ray
+//! receiver-plane), then with the second-depth techniques (`midpoint`, `second_depth`: no bias
+//! but the constant one where a texel has no second surface), and counts, over the pixels the f64 ray cast finds relevant, *acne* (the ray
 //! cast sees the light's centre, the render's visibility < ½) and *leak* (the ray cast does not,
 //! the render ≥ ½). `cargo run --release --example bias_modes -- scenes/grazing.toml [MAP]`
 //! (`MAP`: the first light's map side instead of the scene's).
@@ -11,9 +12,18 @@ use shadowgraph::scene::Scene;
 use shadowgraph::truth::{emitter, raycast::ray_cast_truth};
 
 /// (label, bias, slope_bias, normal_bias, receiver_plane cap).
-const MODES: &[(&str, f32, f32, f32, f32)] = &[
+type Mode = (&'static str, f32, f32, f32, f32);
+
+/// The second-depth techniques, with the constant bias of their fallback texels.
+const SECOND_DEPTH: &[(&str, &str, f32)] = &[
+    ("midpoint (fallback bias 0.002)", "midpoint", 0.002),
+    ("second_depth (fallback bias 0.002)", "second_depth", 0.002),
+];
+
+const MODES: &[Mode] = &[
     ("constant 0.0005", 0.0005, 0.0, 0.0, 0.0),
     ("constant 0.002", 0.002, 0.0, 0.0, 0.0),
+    ("constant 0.005", 0.005, 0.0, 0.0, 0.0),
     ("constant 0.01", 0.01, 0.0, 0.0, 0.0),
     ("slope 0.5", 0.0, 0.5, 0.0, 0.0),
     ("slope 1", 0.0, 1.0, 0.0, 0.0),
@@ -58,10 +68,20 @@ fn main() -> anyhow::Result<()> {
         base.lights[0].shadow_map
     );
     println!("| bias | acne | leak |\n| --- | --- | --- |");
-    for &(label, bias, slope, normal, cap) in MODES.iter().chain([&scene_own]) {
+    let hard = base.lights[0].shadow.technique;
+    let rows = MODES
+        .iter()
+        .chain([&scene_own])
+        .map(|&(label, bias, slope, normal, cap)| (label, hard, (bias, slope, normal, cap)));
+    let second = SECOND_DEPTH.iter().filter_map(|&(label, name, bias)| {
+        let t = shadowgraph::technique::named(name, &[])?;
+        Some((label, t, (bias, 0.0, 0.0, 0.0)))
+    });
+    for (label, technique, (bias, slope, normal, cap)) in rows.chain(second) {
         let mut scene = base.clone();
         let s = &mut scene.lights[0].shadow;
         (s.bias, s.slope_bias, s.normal_bias, s.receiver_plane) = (bias, slope, normal, cap);
+        s.technique = technique;
         let frame = renderer.render(&gpu.device, &gpu.queue, &scene, RenderOptions::default())?;
         let (mut acne, mut leak, mut lit, mut dark) = (0u32, 0u32, 0u32, 0u32);
         for px in 0..(truth.width * truth.height) as usize {

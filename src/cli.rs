@@ -25,6 +25,7 @@ pub fn plan(scene: &Path, dot: bool) -> Result<String> {
     let per_light = (0..scene.lights.len())
         .map(|i| {
             let mut s = sp.plan.cost_text(i)?;
+            let _ = writeln!(s, "    raster: {}", raster_passes(&sp.plan, i));
             let name = scene.lights[i].shadow.technique.name();
             let _ = writeln!(s, "    shade: {name} {} fetches/pixel", fetches[i]);
             Ok(s)
@@ -34,6 +35,22 @@ pub fn plan(scene: &Path, dot: bool) -> Result<String> {
     s.push_str(&sp.plan.to_text(&labels, &per_light));
     s.push_str("then: shade (one visibility function per light)\n");
     Ok(s)
+}
+
+/// Light `i`'s raster passes: its depth, and the peel pass where the plan reads a second
+/// depth ([`technique::second_depth_name`]).
+fn raster_passes(plan: &crate::graph::Plan, i: usize) -> String {
+    let mut s = format!("light{i}.shadow_raster -> {}", technique::depth_name(i));
+    let second = technique::second_depth_name(i);
+    if plan.resource(&second).is_some() {
+        let _ = write!(
+            s,
+            ", light{i}.shadow_peel -> {second} (depth peeling: fragments at or in front of {} + {:e} discarded)",
+            technique::depth_name(i),
+            technique::PEEL_EPSILON
+        );
+    }
+    s
 }
 
 /// Per light, the texture fetches per pixel of its visibility function in the shading kernel

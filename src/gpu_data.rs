@@ -133,6 +133,10 @@ pub const TECHNIQUE_VSSM: u32 = 9;
 pub const TECHNIQUE_MSM_SOFT: u32 = 10;
 /// Technique id of `smrt`.
 pub const TECHNIQUE_SMRT: u32 = 20;
+/// Technique id of `midpoint`.
+pub const TECHNIQUE_MIDPOINT: u32 = 30;
+/// Technique id of `second_depth`.
+pub const TECHNIQUE_SECOND_DEPTH: u32 = 31;
 
 /// Every technique id with its WGSL constant's name (checked against
 /// `kernels/shared/light.wgsl` by a test).
@@ -149,6 +153,8 @@ pub const TECHNIQUE_IDS: &[(&str, u32)] = &[
     ("TECHNIQUE_VSSM", TECHNIQUE_VSSM),
     ("TECHNIQUE_MSM_SOFT", TECHNIQUE_MSM_SOFT),
     ("TECHNIQUE_SMRT", TECHNIQUE_SMRT),
+    ("TECHNIQUE_MIDPOINT", TECHNIQUE_MIDPOINT),
+    ("TECHNIQUE_SECOND_DEPTH", TECHNIQUE_SECOND_DEPTH),
 ];
 
 /// MSM flag: Hausdorff reconstruction.
@@ -200,6 +206,24 @@ pub struct VsmParams {
     /// The depth buffer's linearization.
     pub depth: LinearizeParams,
 }
+
+/// Parameters of `kernels/second_depth.wgsl` (mirrors its `Params`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct SecondDepthParams {
+    /// The depth buffer's linearization (both depths').
+    pub depth: LinearizeParams,
+    /// 0: the midpoint of the first and second depths; 1: the second depth.
+    pub mode: u32,
+    /// Added to the first depth where no second surface was rasterized, linear depth units.
+    pub fallback_bias: f32,
+    /// Padding.
+    pub _pad: [u32; 2],
+}
+
+/// The peel pass's margin in depth-buffer units (`PEEL_EPSILON` in `kernels/shadow_peel.wgsl`,
+/// 2⁻¹⁸): a fragment no deeper than the first depth plus this is discarded.
+pub const PEEL_EPSILON: f32 = 1.0 / 262_144.0;
 
 /// Parameters of `kernels/msm.wgsl` (mirrors its `Params`).
 #[repr(C)]

@@ -26,6 +26,7 @@
 pub mod bvh;
 pub mod emitter;
 pub mod pcf;
+pub mod peel;
 pub mod raycast;
 
 use glam::DVec3;

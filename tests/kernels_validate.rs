@@ -278,8 +278,9 @@ fn rust_mirrors_match_naga_layouts() {
         Some(size_of::<shadowgraph::render::FrameGpu>() as u32),
         "FrameGpu vs struct Frame"
     );
-    use shadowgraph::technique::{CsmParams, ExpParams, MsmParams, VsmParams};
+    use shadowgraph::technique::{CsmParams, ExpParams, MsmParams, SecondDepthParams, VsmParams};
     for (kernel, rust) in [
+        ("second_depth", size_of::<SecondDepthParams>()),
         ("csm", size_of::<CsmParams>()),
         ("vsm", size_of::<VsmParams>()),
         ("evsm", size_of::<ExpParams>()),
@@ -449,4 +450,22 @@ fn blur_dispatch_constants_match_the_wgsl() {
             "{kernel}: workgroup"
         );
     }
+}
+
+/// The peel pass discards by the margin the f64 reference of the second depth
+/// (`truth::peel`) peels by: `PEEL_EPSILON` in `shadow_peel.wgsl` is `gpu_data`'s.
+#[test]
+fn peel_epsilon_matches_the_wgsl() {
+    let wgsl = kernels::resolve("shadow_peel", None).expect("resolve");
+    let (module, _) = kernels::reflect("shadow_peel", &wgsl).expect("reflect");
+    let (_, c) = module
+        .constants
+        .iter()
+        .find(|(_, c)| c.name.as_deref() == Some("PEEL_EPSILON"))
+        .expect("PEEL_EPSILON in shadow_peel.wgsl");
+    let value = match module.global_expressions[c.init] {
+        naga::Expression::Literal(naga::Literal::F32(v)) => v,
+        ref e => panic!("PEEL_EPSILON is {e:?}, not an f32 literal"),
+    };
+    assert_eq!(value, shadowgraph::technique::PEEL_EPSILON);
 }

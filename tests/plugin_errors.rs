@@ -291,6 +291,28 @@ fn invalid_configs_are_named_by_new() {
     );
 }
 
+/// The second-depth techniques read a second, peeled depth map the stage has no input for:
+/// refused by name when the stage is made, not planned with a missing import.
+#[test]
+fn second_depth_techniques_are_refused_by_the_stage() {
+    let g = common::gpu();
+    for name in ["midpoint", "second_depth"] {
+        let t = shadowgraph::technique::named(name, &[]).expect(name);
+        let config = PrefilterConfig::new(t, 64);
+        match Prefilter::new(&g.device, &config) {
+            Err(Error::Stage(StageError::Config { field, message })) => {
+                assert_eq!(field, "technique", "{message}");
+                assert!(
+                    message.contains(name) && message.contains("second, peeled depth"),
+                    "{message}"
+                );
+            }
+            Err(e) => panic!("{name}: {e}"),
+            Ok(_) => panic!("{name} accepted by the plug-in stage"),
+        }
+    }
+}
+
 /// A device (and queue) of the same adapter with `limits` and no optional features.
 fn device_with(g: &Gpu, limits: wgpu::Limits) -> (wgpu::Device, wgpu::Queue) {
     pollster::block_on(g.adapter.request_device(&wgpu::DeviceDescriptor {

@@ -87,6 +87,9 @@ fn pixel_reference(
             Technique::Pcf { .. } => cpu::vis_pcf::vis_pcf(&map, &lg, t),
             Technique::Pcss { .. } => cpu::vis_pcss::vis_pcss(&map, &lg, t),
             Technique::Smrt { .. } => cpu::vis_smrt::vis_smrt(&map, &lg, t),
+            // The map holds the comparison depth (bias folded in): tests/second_depth.rs
+            // checks it against the ray cast and the kernel's reference.
+            Technique::Midpoint | Technique::SecondDepth => cpu::vis_hard::vis_hard(&map, &lg, t),
             Technique::Vsm { .. } => cpu::vis_vsm::vis_vsm(moments, &lg, t),
             Technique::Evsm { .. } => cpu::vis_evsm::vis_evsm(moments, &lg, t),
             Technique::Esm { .. } => cpu::vis_esm::vis_esm(moments, &lg, t),

@@ -48,18 +48,19 @@
 //   sg_BLOCKER_MIN_SHARE sg_CSM_PI sg_GOLDEN_ANGLE sg_Light sg_LightSample sg_MSM_B0
 //   sg_MSM_B0_COV sg_MSM_B0_SCHUR sg_MipTaps sg_MsmMoments sg_SAT_MIN_EXTENT sg_SatNodes
 //   sg_SoftLookup sg_TECHNIQUE_CSM sg_TECHNIQUE_CSSM sg_TECHNIQUE_ESM sg_TECHNIQUE_EVSM
-//   sg_TECHNIQUE_HARD sg_TECHNIQUE_MSM sg_TECHNIQUE_MSM_SOFT sg_TECHNIQUE_PCF sg_TECHNIQUE_PCSS
-//   sg_TECHNIQUE_SMRT sg_TECHNIQUE_VSM sg_TECHNIQUE_VSSM sg_bilinear_level sg_bilinear_log_level
-//   sg_blocker_csm_z sg_blocker_filter_width sg_blocker_msm sg_blocker_result
-//   sg_blocker_search_width sg_blocker_vsm sg_blocker_width sg_chebyshev_upper sg_csm_chunk
-//   sg_csm_chunk_of sg_csm_resolve sg_csm_sin_cos sg_csm_weight sg_csm_z_chunk_of
-//   sg_cssm_blocker sg_cssm_resolve sg_cssm_sharpen sg_level_size sg_light_depth_slope
-//   sg_light_faces sg_light_footprint sg_light_linear_to_ndc sg_light_linear_to_z
-//   sg_light_map_width sg_light_receiver_offset sg_light_sample sg_light_tap_offset
-//   sg_light_to_light sg_linstep sg_load_depth sg_mip_tap_uv sg_mip_taps sg_msm_biased
-//   sg_msm_dequantize sg_msm_expect sg_msm_intensity sg_msm_moments sg_msm_quantize sg_msm_roots
-//   sg_msm_soft_blocker sg_pcss_search_radius sg_sample_bilinear sg_sample_bilinear_log
-//   sg_sample_map sg_sample_map_log sg_sat_box sg_sat_box_fixed sg_sat_box_float sg_sat_clamp
+//   sg_TECHNIQUE_HARD sg_TECHNIQUE_MIDPOINT sg_TECHNIQUE_MSM sg_TECHNIQUE_MSM_SOFT
+//   sg_TECHNIQUE_PCF sg_TECHNIQUE_PCSS sg_TECHNIQUE_SECOND_DEPTH sg_TECHNIQUE_SMRT
+//   sg_TECHNIQUE_VSM sg_TECHNIQUE_VSSM sg_bilinear_level sg_bilinear_log_level sg_blocker_csm_z
+//   sg_blocker_filter_width sg_blocker_msm sg_blocker_result sg_blocker_search_width
+//   sg_blocker_vsm sg_blocker_width sg_chebyshev_upper sg_csm_chunk sg_csm_chunk_of
+//   sg_csm_resolve sg_csm_sin_cos sg_csm_weight sg_csm_z_chunk_of sg_cssm_blocker
+//   sg_cssm_resolve sg_cssm_sharpen sg_level_size sg_light_depth_slope sg_light_faces
+//   sg_light_footprint sg_light_linear_to_ndc sg_light_linear_to_z sg_light_map_width
+//   sg_light_receiver_offset sg_light_sample sg_light_tap_offset sg_light_to_light sg_linstep
+//   sg_load_depth sg_mip_tap_uv sg_mip_taps sg_msm_biased sg_msm_dequantize sg_msm_expect
+//   sg_msm_intensity sg_msm_moments sg_msm_quantize sg_msm_roots sg_msm_soft_blocker
+//   sg_pcss_search_radius sg_sample_bilinear sg_sample_bilinear_log sg_sample_map
+//   sg_sample_map_log sg_sat_box sg_sat_box_fixed sg_sat_box_float sg_sat_clamp
 //   sg_sat_mean_fixed sg_sat_mean_float sg_sat_node_f32 sg_sat_node_u32 sg_sat_nodes sg_sat_rect
 //   sg_sat_sample_fixed sg_sat_sample_float sg_sat_search_fixed sg_sat_search_float
 //   sg_sat_span_weights sg_smrt_emitter_point sg_smrt_ray sg_soft_blockers sg_soft_filter_trips
@@ -137,6 +138,8 @@ const sg_TECHNIQUE_CSSM: u32 = 8u;
 const sg_TECHNIQUE_VSSM: u32 = 9u;
 const sg_TECHNIQUE_MSM_SOFT: u32 = 10u;
 const sg_TECHNIQUE_SMRT: u32 = 20u;
+const sg_TECHNIQUE_MIDPOINT: u32 = 30u;
+const sg_TECHNIQUE_SECOND_DEPTH: u32 = 31u;
 
 // Where a receiver lands in a light's shadow map.
 struct sg_LightSample {

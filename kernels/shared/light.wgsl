@@ -67,6 +67,8 @@ const TECHNIQUE_CSSM: u32 = 8u;
 const TECHNIQUE_VSSM: u32 = 9u;
 const TECHNIQUE_MSM_SOFT: u32 = 10u;
 const TECHNIQUE_SMRT: u32 = 20u;
+const TECHNIQUE_MIDPOINT: u32 = 30u;
+const TECHNIQUE_SECOND_DEPTH: u32 = 31u;
 
 // Where a receiver lands in a light's shadow map.
 struct LightSample {

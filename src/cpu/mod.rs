@@ -12,6 +12,7 @@ pub mod linearize;
 pub mod mips;
 pub mod msm;
 pub mod sat;
+pub mod second_depth;
 pub mod shade;
 pub mod vis_csm;
 pub mod vis_cssm;

@@ -315,6 +315,15 @@ fn checked(
 ) -> Result<(Technique, Vec<String>), StageError> {
     let values = (def.values)(&t);
     crate::model::check(def.params, &Given(&values)).map_err(given_err)?;
+    if technique::peels(&t) {
+        return Err(config_err(
+            "technique",
+            format!(
+                "technique \"{}\" reads a second, peeled depth map, and the stage takes one depth texture: use it in the renderer, or a single-depth technique here",
+                def.name
+            ),
+        ));
+    }
     if def.area_light && light_size <= 0.0 {
         return Err(config_err(
             "size (light)",

@@ -29,6 +29,8 @@ pub struct Renderer {
     pub executor: Executor,
     /// Raster pipelines by slope-scaled bias (pipeline state), with their layout.
     shadow: HashMap<u32, (wgpu::RenderPipeline, wgpu::BindGroupLayout)>,
+    /// Peel pipelines (second depth) by slope-scaled bias, with their layout.
+    peel: HashMap<u32, (wgpu::RenderPipeline, wgpu::BindGroupLayout)>,
     gbuffer: Option<(wgpu::RenderPipeline, wgpu::BindGroupLayout)>,
     cmp_sampler: wgpu::Sampler,
     /// The last scene shape's resources.
@@ -63,6 +65,7 @@ impl Renderer {
         Self {
             executor: Executor::new(),
             shadow: HashMap::new(),
+            peel: HashMap::new(),
             gbuffer: None,
             targets: None,
             binding: None,
@@ -96,7 +99,12 @@ impl Renderer {
         self.binding = None;
         let mut raster_layouts = Vec::new();
         for l in &scene.lights {
-            raster_layouts.push(self.shadow_pipeline(device, l.shadow.slope_bias)?.1.clone());
+            let first = self.shadow_pipeline(device, l.shadow.slope_bias)?.1.clone();
+            let peel = match technique::peels(&l.shadow.technique) {
+                true => Some(self.peel_pipeline(device, l.shadow.slope_bias)?.1.clone()),
+                false => None,
+            };
+            raster_layouts.push((first, peel));
         }
         let gbuffer_layout = self.gbuffer_pipeline(device)?.1.clone();
         Ok(Targets::new(device, key, &gbuffer_layout, &raster_layouts))
@@ -189,7 +197,8 @@ impl Renderer {
         repeat: u32,
     ) -> Result<(Vec<Vec<(String, f64)>>, Vec<f64>, Outputs)> {
         let kernel = self.shade_kernel(device, &scene.lights)?;
-        let spans = scene.lights.len() as u32 + sp.plan.steps.len() as u32 + 2;
+        let peels = targets.lights.iter().filter(|t| t.peel.is_some()).count();
+        let spans = (scene.lights.len() + peels) as u32 + sp.plan.steps.len() as u32 + 2;
         let mut timer = match self.timer.take() {
             Some(t) if t.span_capacity() >= spans => Some(t),
             _ => GpuTimer::new(device, queue, spans),
@@ -229,7 +238,8 @@ impl Renderer {
         Ok((timings, wall_ms, outputs))
     }
 
-    /// Records one frame: the raster passes, the plan, the G-buffer and the shading pass.
+    /// Records one frame: the raster passes (each light's depth, then its peeled second depth
+    /// where its technique reads one), the plan, the G-buffer and the shading pass.
     #[expect(clippy::too_many_arguments, reason = "one frame's inputs")]
     fn record_frame(
         &mut self,
@@ -253,6 +263,19 @@ impl Renderer {
                 targets.vertex_count,
                 timer.as_deref_mut(),
             );
+            if let Some(peel) = &t.peel {
+                let (pipeline, _) = self.peel_pipeline(device, l.shadow.slope_bias)?;
+                raster_pass(
+                    enc,
+                    &peel.label,
+                    pipeline,
+                    &peel.bind_group,
+                    &peel.view,
+                    &targets.vertices,
+                    targets.vertex_count,
+                    timer.as_deref_mut(),
+                );
+            }
         }
         let outputs = self.executor.record(
             device,

@@ -26,6 +26,8 @@ pub(super) struct TargetKey {
     pub size: (u32, u32),
     /// Per light: shadow-map side and slope-scaled bias (its raster pipeline's key).
     pub lights: Vec<(u32, u32)>,
+    /// Per light: whether it rasterizes a second, peeled depth ([`technique::peels`]).
+    pub peels: Vec<bool>,
     /// Vertex buffer bytes.
     pub vertex_bytes: u64,
     /// Materials.
@@ -41,6 +43,11 @@ impl TargetKey {
                 .lights
                 .iter()
                 .map(|l| (l.shadow_map, l.shadow.slope_bias.to_bits()))
+                .collect(),
+            peels: scene
+                .lights
+                .iter()
+                .map(|l| technique::peels(&l.shadow.technique))
                 .collect(),
             vertex_bytes: (vertices * std::mem::size_of::<Vertex>()) as u64,
             materials: scene.objects.len(),
@@ -58,6 +65,19 @@ pub(super) struct LightTarget {
     /// World → light clip (the raster pass's uniform).
     pub view_proj: wgpu::Buffer,
     /// Binds `view_proj` for the light's raster pipeline.
+    pub bind_group: wgpu::BindGroup,
+    /// Its peel pass, where its technique reads a second depth.
+    pub peel: Option<PeelTarget>,
+}
+
+/// A light's second depth map and its peel pass's bind group.
+pub(super) struct PeelTarget {
+    /// The pass's label (and timer span), `light<i>.shadow_peel`.
+    pub label: String,
+    /// The view of its second depth map (Depth32Float, kept in [`Targets::imports`] as
+    /// [`technique::second_depth_name`]) as the pass's attachment.
+    pub view: wgpu::TextureView,
+    /// Binds the light's `view_proj` and its first depth map for the peel pipeline.
     pub bind_group: wgpu::BindGroup,
 }
 
@@ -168,14 +188,60 @@ pub(super) fn uniform_group(
     )
 }
 
+/// Light `i`'s second depth map (`side`², imported as [`technique::second_depth_name`]) and
+/// its peel pass's bind group over `view_proj` and the first depth map `first`.
+fn peel_target(
+    device: &wgpu::Device,
+    i: usize,
+    side: u32,
+    layout: &wgpu::BindGroupLayout,
+    view_proj: &wgpu::Buffer,
+    first: &wgpu::Texture,
+    imports: &mut HashMap<String, wgpu::Texture>,
+) -> PeelTarget {
+    let second = texture(
+        device,
+        "shadowgraph.second_depth",
+        (side, side),
+        wgpu::TextureFormat::Depth32Float,
+        TARGET,
+    );
+    let first_view = super::renderer::depth_only_view(first);
+    let bind_group = created::bind_group(
+        device,
+        &wgpu::BindGroupDescriptor {
+            label: Some("shadowgraph.shadow_peel"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: view_proj.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&first_view),
+                },
+            ],
+        },
+    );
+    let view = created::view(&second, &Default::default());
+    imports.insert(technique::second_depth_name(i), second);
+    PeelTarget {
+        label: format!("light{i}.shadow_peel"),
+        view,
+        bind_group,
+    }
+}
+
 impl Targets {
     /// Makes the resources of `key`; `gbuffer_layout` and `raster_layouts` (one per light)
-    /// are the layouts of the G-buffer and each light's raster pipeline.
+    /// are the layouts of the G-buffer and each light's raster pipeline (and its peel
+    /// pipeline's, where it peels).
     pub fn new(
         device: &wgpu::Device,
         key: TargetKey,
         gbuffer_layout: &wgpu::BindGroupLayout,
-        raster_layouts: &[wgpu::BindGroupLayout],
+        raster_layouts: &[(wgpu::BindGroupLayout, Option<wgpu::BindGroupLayout>)],
     ) -> Self {
         use wgpu::BufferUsages as B;
         use wgpu::TextureFormat as F;
@@ -200,7 +266,9 @@ impl Targets {
             uniform_group(device, "shadowgraph.gbuffer", gbuffer_layout, &camera);
         let mut lights = Vec::new();
         let mut imports = HashMap::new();
-        for (i, (&(side, _), layout)) in key.lights.iter().zip(raster_layouts).enumerate() {
+        for (i, (&(side, _), (layout, peel_layout))) in
+            key.lights.iter().zip(raster_layouts).enumerate()
+        {
             let depth = texture(
                 device,
                 "shadowgraph.shadow_map",
@@ -214,12 +282,16 @@ impl Targets {
                 64,
                 B::UNIFORM | B::COPY_DST,
             );
+            let peel = peel_layout
+                .as_ref()
+                .map(|l| peel_target(device, i, side, l, &view_proj, &depth, &mut imports));
             imports.insert(technique::depth_name(i), depth.clone());
             lights.push(LightTarget {
                 label: format!("light{i}.shadow_raster"),
                 view: created::view(&depth, &Default::default()),
                 bind_group: uniform_group(device, "shadowgraph.shadow_depth", layout, &view_proj),
                 view_proj,
+                peel,
             });
         }
         let color = color_target(device, size);

@@ -19,6 +19,7 @@ pub mod params;
 mod pcf;
 mod pcss;
 mod reference;
+mod second_depth;
 mod shade;
 mod smrt;
 mod sweep_plan;
@@ -27,7 +28,7 @@ mod vssm;
 
 pub use crate::gpu_data::{
     CSM_OUTPUTS, CsmParams, ExpParams, LightGpu, LinearizeParams, MSM_HAUSDORFF, MSM_QUANTIZED,
-    MsmParams, VsmParams,
+    MsmParams, PEEL_EPSILON, SecondDepthParams, VsmParams,
 };
 pub use crate::model::mip_levels;
 use crate::model::{Light, ParamSource, ParamSpec, ParamValues, Technique};
@@ -39,6 +40,7 @@ pub use nodes::LightNodes;
 pub use nodes::{add_light_nodes, depth_name, linear_name, map_channels, map_type, moments_format};
 pub use params::{Clamp, ClampReason, sat_exponent_limit};
 pub use reference::parameters_markdown;
+pub use second_depth::{peels, second_depth_name};
 pub use shade::{ShadeInput, VisibilityBody, shade_key, shading_block, visibility_body};
 pub use sweep_plan::{SweepPlan, SweepVariant, SweptStorages, SweptTerms};
 
@@ -102,6 +104,8 @@ pub static REGISTRY: &[&TechniqueDef] = &[
     &vssm::DEF,
     &msm_soft::DEF,
     &smrt::DEF,
+    &second_depth::MIDPOINT,
+    &second_depth::SECOND_DEPTH,
 ];
 
 /// Every technique's scene name, in registry order.

@@ -172,6 +172,32 @@ impl Renderer {
         }
     }
 
+    /// The peel pass's pipeline (`shadow_peel`: the second-nearest surface, after the first
+    /// depth map) for slope-scaled bias `slope`, the same raster state as
+    /// [`Renderer::shadow_pipeline`]'s, and its bind group layout.
+    pub(super) fn peel_pipeline(
+        &mut self,
+        device: &wgpu::Device,
+        slope: f32,
+    ) -> Result<&(wgpu::RenderPipeline, wgpu::BindGroupLayout)> {
+        match self.peel.entry(slope.to_bits()) {
+            std::collections::hash_map::Entry::Occupied(e) => Ok(e.into_mut()),
+            std::collections::hash_map::Entry::Vacant(e) => {
+                let bias = wgpu::DepthBiasState {
+                    constant: 0,
+                    slope_scale: slope,
+                    clamp: 0.0,
+                };
+                Ok(e.insert(Self::raster_pipeline(
+                    device,
+                    "shadow_peel",
+                    Some(&[]),
+                    bias,
+                )?))
+            }
+        }
+    }
+
     /// The G-buffer pipeline and its layout, made once.
     pub(super) fn gbuffer_pipeline(
         &mut self,
