@@ -109,19 +109,24 @@ pub fn measure(
     let sum = |f: &dyn Fn(&str) -> bool| -> Option<f64> {
         (!passes.is_empty()).then(|| passes.iter().filter(|(l, _)| f(l)).map(|p| p.1).sum())
     };
-    let raster_ms = sum(&|l| l.ends_with(".shadow_raster"));
+    // The depth passes: each light's map and, for the second-depth techniques, its peel pass.
+    let raster = |l: &str| l.ends_with(".shadow_raster") || l.ends_with(".shadow_peel");
+    let raster_ms = sum(&raster);
     let gbuffer_ms = sum(&|l| l == "gbuffer");
     let shade_ms = sum(&|l| l == "shade");
-    let kernels_ms = sum(&|l| !l.ends_with(".shadow_raster") && l != "gbuffer" && l != "shade");
+    let kernels_ms = sum(&|l| !raster(l) && l != "gbuffer" && l != "shade");
     let total_ms = match (raster_ms, kernels_ms, shade_ms) {
         (Some(a), Some(b), Some(c)) => Some(a + b + c),
         _ => None,
     };
     let plan = plan_lights(&scene.lights)?;
-    let depth: u64 = scene
-        .lights
+    // The rasterized maps the plan imports (one depth per light, two where it peels).
+    let depth: u64 = plan
+        .plan
+        .resources
         .iter()
-        .map(|l| u64::from(l.shadow_map).pow(2) * 4)
+        .filter(|r| r.resource.imported)
+        .map(|r| r.bytes)
         .sum();
     let (storage, filter) = match (c.technique.storage(), c.technique.filter()) {
         (Some(storage), Some(filter)) => (storage_name(storage).to_string(), filter_name(filter)),

@@ -200,7 +200,7 @@ pub fn markdown(report: &Report) -> String {
     }
     s.push_str(
         "Columns: GPU time per part (median over the repeats, from timestamps): raster = shadow \
-         map, kernels = the graph (linearize, encode, filter), shade = the shading pass, total = \
+         map (and the peel pass of a second-depth technique), kernels = the graph (linearize, encode, filter), shade = the shading pass, total = \
          their sum (the camera G-buffer is common to all and left out); memory = the plan's peak \
          live textures plus the depth maps. *soft*: error against the area-light truth (the \
          scene as it should look); *pcf*: error against brute-force box PCF of the \
