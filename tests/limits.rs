@@ -204,6 +204,22 @@ fn memory_estimate_is_the_sum_of_its_parts() {
     assert_eq!(m.total, frame + maps);
 }
 
+/// A second-depth light counts its peeled second depth map too: two depth maps and the
+/// comparison map, by hand.
+#[test]
+fn memory_estimate_counts_the_second_depth() {
+    for technique in ["midpoint", "second_depth"] {
+        let (_, s) = scene(
+            64,
+            48,
+            &[light(512, &format!("technique = \"{technique}\""))],
+        );
+        let sp = plan_lights(&s.lights).unwrap();
+        let m = shadowgraph::limits::render_memory(&s, &sp.plan, &RenderOptions::default());
+        assert_eq!(m.lights, vec![3 * 512 * 512 * 4], "{technique}");
+    }
+}
+
 /// Checks without a device: lowered limits and a small budget name the key and its line.
 #[test]
 fn lowered_limits_and_budgets_name_the_key() {

@@ -44,10 +44,14 @@ pub fn render_memory(scene: &Scene, plan: &Plan, opts: &RenderOptions) -> Memory
         // Position and normal: staging, raw bytes, f32 copy.
         frame += 2 * 3 * pixels * 16;
     }
+    // Each light's depth map, and its peeled second depth where its technique reads one.
     let depth: Vec<u64> = scene
         .lights
         .iter()
-        .map(|l| u64::from(l.shadow_map).pow(2) * 4)
+        .map(|l| {
+            let maps = 1 + u64::from(technique::peels(&l.shadow.technique));
+            u64::from(l.shadow_map).pow(2) * 4 * maps
+        })
         .collect();
     let n = depth.len();
     let light_of = |r: &crate::graph::PlannedResource| r.resource.light.filter(|&i| i < n);
