@@ -89,7 +89,12 @@ fn pixel_reference(
             Technique::Smrt { .. } => cpu::vis_smrt::vis_smrt(&map, &lg, t),
             // The map holds the comparison depth (bias folded in): tests/second_depth.rs
             // checks it against the ray cast and the kernel's reference.
-            Technique::Midpoint | Technique::SecondDepth => cpu::vis_hard::vis_hard(&map, &lg, t),
+            Technique::Midpoint { radius: 0, .. } | Technique::SecondDepth { radius: 0, .. } => {
+                cpu::vis_hard::vis_hard(&map, &lg, t)
+            }
+            Technique::Midpoint { .. } | Technique::SecondDepth { .. } => {
+                cpu::vis_pcf::vis_pcf(&map, &lg, t)
+            }
             Technique::Vsm { .. } => cpu::vis_vsm::vis_vsm(moments, &lg, t),
             Technique::Evsm { .. } => cpu::vis_evsm::vis_evsm(moments, &lg, t),
             Technique::Esm { .. } => cpu::vis_esm::vis_esm(moments, &lg, t),

@@ -267,10 +267,20 @@ pub enum Technique {
     /// Midpoint shadow maps (Woo 1992): the shading compares against the midpoint of the first
     /// and second rasterized depths (a second, peeled raster pass); the first depth plus the
     /// constant bias where no second surface exists.
-    Midpoint,
+    Midpoint {
+        /// PCF window radius in texels over the comparisons (0: the nearest texel alone).
+        radius: u32,
+        /// PCF weights (box or tent).
+        kernel: PcfKernel,
+    },
     /// Second-depth shadow maps (Wang & Molnar 1994): the shading compares against the second
     /// rasterized depth; the first depth plus the constant bias where none exists.
-    SecondDepth,
+    SecondDepth {
+        /// PCF window radius in texels over the comparisons (0: the nearest texel alone).
+        radius: u32,
+        /// PCF weights (box or tent).
+        kernel: PcfKernel,
+    },
     /// Moment soft shadow maps (after Peters et al. 2016): the blocker depth from the four
     /// moments over the search square (the mean of the support points in front of the receiver
     /// of the three-point distribution through d that Hamburger MSM reconstructs), then MSM at
@@ -350,8 +360,8 @@ impl Technique {
             Technique::Vssm { .. } => "vssm",
             Technique::MsmSoft { .. } => "msm_soft",
             Technique::Smrt { .. } => "smrt",
-            Technique::Midpoint => "midpoint",
-            Technique::SecondDepth => "second_depth",
+            Technique::Midpoint { .. } => "midpoint",
+            Technique::SecondDepth { .. } => "second_depth",
         }
     }
 }

@@ -6,13 +6,72 @@
 //! map's empty texels) a texel holds the first depth plus the constant `bias`, so a caster that
 //! is not watertight shades as `hard` with that bias there; elsewhere no bias is added.
 
-use super::shade::call;
+use super::params::{choice, int};
+use super::shade::{VisibilityBody, call};
 use super::sweep_plan::SweepPlan;
-use super::{LightNodes, ShadeInput, TechniqueDef, no_clamp, no_variant, unit_range};
-use crate::gpu_data::{SecondDepthParams, TECHNIQUE_MIDPOINT, TECHNIQUE_SECOND_DEPTH};
+use super::{LightNodes, ShadeInput, TechniqueDef, no_clamp, unit_range};
+use crate::gpu_data::{LightGpu, SecondDepthParams, TECHNIQUE_MIDPOINT, TECHNIQUE_SECOND_DEPTH};
 use crate::graph::{Dispatch, Node, SizeRule};
 use crate::kernels::KernelId;
-use crate::model::{ParamValues, Technique};
+use crate::model::{Light, ParamSpec, ParamValue, ParamValues, PcfKernel, Technique};
+
+/// PCF over the comparisons with the map (`vis_pcf`'s box and tent windows; the hardware 2×2
+/// comparison reads the first depth, not this map).
+const PARAMS: &[ParamSpec] = &[
+    choice(
+        "kernel",
+        &["box", "tent"],
+        "box",
+        "PCF window weights over the comparisons (radius > 0)",
+    ),
+    int(
+        "radius",
+        0,
+        32,
+        0,
+        "PCF window radius in texels; 0 compares the nearest texel alone, as `hard`",
+    ),
+];
+
+/// The PCF window of `t`: (radius, kernel).
+fn window(t: &Technique) -> (u32, PcfKernel) {
+    match *t {
+        Technique::Midpoint { radius, kernel } | Technique::SecondDepth { radius, kernel } => {
+            (radius, kernel)
+        }
+        _ => (0, PcfKernel::Box),
+    }
+}
+
+/// The window of checked values.
+fn build_window(v: &ParamValues) -> (u32, PcfKernel) {
+    let kernel = match v.choice("kernel") {
+        "tent" => PcfKernel::Tent,
+        _ => PcfKernel::Box,
+    };
+    (v.int("radius"), kernel)
+}
+
+fn values(t: &Technique) -> ParamValues {
+    let (radius, kernel) = window(t);
+    let mut out = ParamValues::default();
+    let name = if kernel == PcfKernel::Tent {
+        "tent"
+    } else {
+        "box"
+    };
+    out.set("kernel", ParamValue::Choice(name));
+    out.set("radius", ParamValue::Int(radius));
+    out
+}
+
+/// The nearest texel's comparison at radius 0, else PCF over the window.
+fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
+    match window(&light.shadow.technique).0 {
+        0 => call("shared/vis_hard", "vis_hard", maps),
+        _ => call("shared/vis_pcf", "vis_pcf", maps),
+    }
+}
 
 /// Name of light `i`'s second rasterized depth (the peel pass's output, imported into the
 /// graph like the first).
@@ -23,7 +82,10 @@ pub fn second_depth_name(i: usize) -> String {
 /// Whether technique `t` reads a second, peeled depth map: the renderer then rasterizes it
 /// after the first, and the plug-in stage (which takes one depth texture) refuses it.
 pub fn peels(t: &Technique) -> bool {
-    matches!(t, Technique::Midpoint | Technique::SecondDepth)
+    matches!(
+        t,
+        Technique::Midpoint { .. } | Technique::SecondDepth { .. }
+    )
 }
 
 /// The second depth's import and the `second_depth` node (`mode` 0 midpoint, 1 second depth)
@@ -66,9 +128,12 @@ fn nodes(n: &mut LightNodes, mode: u32) -> ShadeInput {
 }
 
 /// The constant bias went into the map where it applies (the fallback texels): the shading
-/// adds none.
-fn gpu(_: &Technique, g: &mut crate::gpu_data::LightGpu) {
+/// adds none. The PCF window as `pcf`'s (`LightGpu::kernel`: 0 box, 1 tent).
+fn gpu(t: &Technique, g: &mut LightGpu) {
     g.bias = 0.0;
+    let (radius, kernel) = window(t);
+    g.radius = radius;
+    g.kernel = u32::from(kernel == PcfKernel::Tent);
 }
 
 /// `midpoint`.
@@ -76,13 +141,16 @@ pub(super) static MIDPOINT: TechniqueDef = TechniqueDef {
     name: "midpoint",
     id: TECHNIQUE_MIDPOINT,
     doc: "midpoint shadow map (Woo): compares against (z1 + z2)/2 of a second, peeled raster pass; z1 + bias where there is no z2",
-    params: &[],
-    build: |_| Technique::Midpoint,
-    values: |_| ParamValues::default(),
+    params: &[PARAMS],
+    build: |v| {
+        let (radius, kernel) = build_window(v);
+        Technique::Midpoint { radius, kernel }
+    },
+    values,
     gpu,
     nodes: |n| nodes(n, 0),
-    visibility: |_, maps| call("shared/vis_hard", "vis_hard", maps),
-    variant: no_variant,
+    visibility,
+    variant: |t| u8::from(window(t).0 > 0).to_string(),
     value_range: unit_range,
     clamp: no_clamp,
     area_light: false,
@@ -96,13 +164,16 @@ pub(super) static SECOND_DEPTH: TechniqueDef = TechniqueDef {
     name: "second_depth",
     id: TECHNIQUE_SECOND_DEPTH,
     doc: "second-depth shadow map (Wang & Molnar): compares against z2 of a second, peeled raster pass; z1 + bias where there is no z2",
-    params: &[],
-    build: |_| Technique::SecondDepth,
-    values: |_| ParamValues::default(),
+    params: &[PARAMS],
+    build: |v| {
+        let (radius, kernel) = build_window(v);
+        Technique::SecondDepth { radius, kernel }
+    },
+    values,
     gpu,
     nodes: |n| nodes(n, 1),
-    visibility: |_, maps| call("shared/vis_hard", "vis_hard", maps),
-    variant: no_variant,
+    visibility,
+    variant: |t| u8::from(window(t).0 > 0).to_string(),
     value_range: unit_range,
     clamp: no_clamp,
     area_light: false,
