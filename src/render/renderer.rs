@@ -100,9 +100,10 @@ impl Renderer {
         let mut raster_layouts = Vec::new();
         for l in &scene.lights {
             let first = self.shadow_pipeline(device, l.shadow.slope_bias)?.1.clone();
-            let peel = match technique::peels(&l.shadow.technique) {
-                true => Some(self.peel_pipeline(device, l.shadow.slope_bias)?.1.clone()),
-                false => None,
+            let peel = if technique::peels(&l.shadow.technique) {
+                Some(self.peel_pipeline(device, l.shadow.slope_bias)?.1.clone())
+            } else {
+                None
             };
             raster_layouts.push((first, peel));
         }

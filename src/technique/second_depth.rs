@@ -2,9 +2,10 @@
 //! of the first and second surfaces, or of the second surface, seen from the light. A second
 //! raster pass peels the first surface off (`kernels/shadow_peel.wgsl`, imported as
 //! [`second_depth_name`]); the `second_depth` kernel turns both depths into the one map the
-//! shading compares against with `vis_hard` (or `vis_pcf` over a window, `radius` > 0). Where no second surface exists (a lone plane, the
-//! map's empty texels) a texel holds the first depth plus the constant `bias`, so a caster that
-//! is not watertight shades as `hard` with that bias there; elsewhere no bias is added.
+//! shading compares against with `vis_hard` (or `vis_pcf` over a window, `radius` > 0). Where
+//! no second surface exists (a lone plane, the map's empty texels) a texel holds the first depth
+//! plus the constant `bias`, so a caster that is not watertight shades as `hard` with that bias
+//! there; elsewhere no bias is added.
 
 use super::params::{choice, int};
 use super::shade::{VisibilityBody, call};
