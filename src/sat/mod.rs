@@ -36,6 +36,7 @@
 //! quantization error (plus 2⁻²⁴·|v − offset| from the subtraction), and so does every mean.
 
 pub mod five_pass;
+pub mod layers;
 
 use crate::error::{Error, Result};
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
@@ -79,8 +80,8 @@ pub struct SatParams {
     pub float_sums: u32,
     /// The five-pass baseline's `sat_carry`: 0 scans along rows, 1 along columns (0 elsewhere).
     pub axis: u32,
-    /// Padding.
-    pub _pad: u32,
+    /// Tables whose edges `sat_carries` finds stacked in its inputs ([`layers`]; 0 or 1: one).
+    pub layers: u32,
 }
 
 /// How values are coded into a table, per channel: everything a lookup needs to decode it
@@ -139,7 +140,7 @@ impl SatCoding {
             channels: channels.clamp(1, 4),
             float_sums: u32::from(self.variant == SatVariant::Float),
             axis,
-            _pad: 0,
+            layers: 1,
         }
     }
 }
