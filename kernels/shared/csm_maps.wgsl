@@ -3,34 +3,28 @@
 // Fourier basis of shared/csm_basis.
 // #import shared/csm_basis
 
-// Channel i of the CSM-Z sequence [z, z·sin c₁z, z·cos c₁z, …, z·cos c_M z] at depth z, M =
-// `terms` (0 past channel 2M).
-fn csm_z_channel(i: u32, terms: u32, z: f32) -> f32 {
-    if i == 0u {
-        return z;
-    }
-    if i > 2u * terms {
-        return 0.0;
-    }
-    let sc = csm_sin_cos((i + 1u) / 2u, z);
-    return z * select(sc.y, sc.x, (i & 1u) == 1u);
-}
-
-// Map m of the light's sequence at depth z: the ⌈M/2⌉ CSM basis maps (sin c_k z, cos c_k z,
-// sin c_{k+1} z, cos c_{k+1} z), k = 2m + 1, a pair past M zeros; then (CSSM) the CSM-Z maps,
-// four channels of the CSM-Z sequence each from channel 4·(m − ⌈M/2⌉) on.
+// Map m of the light's sequence at depth z, M = `terms`: the ⌈M/2⌉ CSM basis maps (sin c_k z,
+// cos c_k z, sin c_{k+1} z, cos c_{k+1} z), k = 2m + 1, a pair past M zeros; then (CSSM) the
+// CSM-Z maps, map j = m − ⌈M/2⌉ holding channels 4j … 4j + 3 of the CSM-Z sequence
+// [z, z·sin c₁z, z·cos c₁z, …, z·cos c_M z] (channel i ≥ 1: z·sin of term ⌈i/2⌉ for odd i,
+// z·cos for even i; past channel 2M zeros): z·cos of term 2j (z itself for j = 0), z·sin and
+// z·cos of term 2j + 1, z·sin of term 2j + 2.
+// Branch-free, three (sin, cos) pairs whichever the map: a software rasterizer runs both
+// sides of a branch on the map index, and a GPU's workgroups of one layer agree on it anyway.
 fn csm_basis_map(m: u32, terms: u32, z: f32) -> vec4<f32> {
     let basis_maps = (terms + 1u) / 2u;
-    if m < basis_maps {
-        let k = 2u * m + 1u;
-        let v = vec4<f32>(csm_sin_cos(k, z), csm_sin_cos(k + 1u, z));
-        return select(v, vec4<f32>(v.xy, 0.0, 0.0), k + 1u > terms);
-    }
-    let first = 4u * (m - basis_maps);
-    return vec4<f32>(
-        csm_z_channel(first, terms, z),
-        csm_z_channel(first + 1u, terms, z),
-        csm_z_channel(first + 2u, terms, z),
-        csm_z_channel(first + 3u, terms, z),
-    );
+    let csm = m < basis_maps;
+    let j = m - min(m, basis_maps);
+    // The map's first term: 2m + 1 (CSM) or 2j (CSM-Z; term 0 of map 0 is z, not evaluated).
+    let k = select(2u * j, 2u * m + 1u, csm);
+    let a = csm_sin_cos(max(k, 1u), z);
+    let b = csm_sin_cos(k + 1u, z);
+    let c = csm_sin_cos(k + 2u, z);
+    let basis = vec4<f32>(a, b);
+    let z_seq = z * vec4<f32>(select(a.y, 1.0, j == 0u), b, c.x);
+    // What each channel holds: CSM its term (≤ M kept), CSM-Z its channel (≤ 2M kept).
+    let term = vec4<u32>(k, k, k + 1u, k + 1u);
+    let channel = 4u * j + vec4<u32>(0u, 1u, 2u, 3u);
+    let keep = select(channel <= vec4<u32>(2u * terms), term <= vec4<u32>(terms), csm);
+    return select(vec4<f32>(0.0), select(z_seq, basis, csm), keep);
 }
