@@ -149,3 +149,113 @@ pub fn add_layered_sat(graph: &mut Graph, light: usize, sat: &LayeredSat<'_>) ->
     }
     tables
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::graph::plan;
+
+    /// Five layers of a ragged 200 × 130 source: the stacked edges' sizes, the passes, their
+    /// workgroups along z and each pass-3 dispatch's tables.
+    #[test]
+    fn layered_sat_plans_stacked_edges_and_four_tables_a_dispatch() {
+        let mut g = Graph::default();
+        g.import("d", wgpu::TextureFormat::R32Float, 200, 130, Some(0));
+        let tables: Vec<(String, u32)> = (0..5)
+            .map(|k| (format!("t{k}"), if k == 4 { 1 } else { 4 }))
+            .collect();
+        let coding = SatCoding::fixed(64, [-1.0; 4], [1.0; 4]).unwrap();
+        let params = |s: SatParams, first: u32, count: u32| {
+            let mut b = bytemuck::bytes_of(&s).to_vec();
+            b.extend([first, count].iter().flat_map(|v| v.to_le_bytes()));
+            b
+        };
+        let sat = LayeredSat {
+            source: "d",
+            prefix: "l",
+            tables: &tables,
+            kernels: [KernelId::CsmSatTileSums, KernelId::CsmSatTiles],
+            params: &params,
+            coding,
+        };
+        let out = add_layered_sat(&mut g, 0, &sat);
+        assert_eq!(out, ["t0.sat", "t1.sat", "t2.sat", "t3.sat", "t4.sat"]);
+        let names: Vec<&str> = out.iter().map(String::as_str).collect();
+        let p = plan(&g, &names).unwrap();
+        let kernels: Vec<&str> = p.steps.iter().map(|s| s.node.kernel.as_str()).collect();
+        assert_eq!(
+            kernels,
+            [
+                "csm_sat_tile_sums",
+                "sat_carries",
+                "csm_sat_tiles",
+                "csm_sat_tiles"
+            ]
+        );
+        let size = |n: &str| p.resource(n).map(|r| (r.width, r.height));
+        // 4 × 3 tiles of 64: five bands of 3 rows (col_*) and of 4 columns (row_*).
+        assert_eq!(size("l.sat.col_part"), Some((200, 15)));
+        assert_eq!(size("l.sat.row_carry"), Some((20, 130)));
+        let format = |n: &str| p.resource(n).map(|r| r.resource.format);
+        assert_eq!(format("t0.sat"), Some(wgpu::TextureFormat::Rgba32Uint));
+        assert_eq!(format("t4.sat"), Some(wgpu::TextureFormat::R32Uint));
+        let groups: Vec<Option<[u32; 3]>> = p
+            .steps
+            .iter()
+            .map(|s| s.node.dispatch.groups(size, [64, 1, 1]))
+            .collect();
+        assert_eq!(
+            groups,
+            [
+                Some([4, 3, 5]),
+                Some([4, 2, 5]),
+                Some([4, 3, 4]),
+                Some([4, 3, 1])
+            ]
+        );
+        // Every pass codes alike; `sat_carries` sees every layer; pass 3 its first table.
+        let sat_params = |k: usize| -> SatParams {
+            *bytemuck::from_bytes(&p.steps[k].node.params[..std::mem::size_of::<SatParams>()])
+        };
+        assert!((0..4).all(|k| sat_params(k).layers == 5));
+        let first = |k: usize| p.steps[k].node.params[std::mem::size_of::<SatParams>()];
+        assert_eq!((first(2), first(3)), (0, 4));
+        let outputs: Vec<&str> = p.steps[3]
+            .node
+            .outputs
+            .iter()
+            .map(|o| o.1.as_str())
+            .collect();
+        assert_eq!(outputs, ["t4.sat"]);
+    }
+
+    #[test]
+    fn zero_layers_is_a_plan_error_and_no_layers_no_nodes() {
+        let mut g = Graph::default();
+        g.import("d", wgpu::TextureFormat::R32Float, 8, 8, Some(0));
+        let params = |s: SatParams, _: u32, _: u32| bytemuck::bytes_of(&s).to_vec();
+        let sat = LayeredSat {
+            source: "d",
+            prefix: "l",
+            tables: &[],
+            kernels: [KernelId::CsmSatTileSums, KernelId::CsmSatTiles],
+            params: &params,
+            coding: SatCoding::float([0.0; 4], [1.0; 4]).unwrap(),
+        };
+        assert!(add_layered_sat(&mut g, 0, &sat).is_empty());
+        assert!(g.nodes.is_empty());
+        let tables = [("t".to_string(), 4)];
+        let sat = LayeredSat {
+            tables: &tables,
+            ..sat
+        };
+        let out = add_layered_sat(&mut g, 0, &sat);
+        let mut p = plan(&g, &[out[0].as_str()]).unwrap();
+        assert!(p.check().is_ok());
+        p.steps[0].node.dispatch = Dispatch::Layers {
+            base: Box::new(Dispatch::Groups([1, 1, 1])),
+            layers: 0,
+        };
+        assert!(p.check().is_err());
+    }
+}
