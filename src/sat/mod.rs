@@ -20,7 +20,9 @@
 //! 8/[`SAT_TILE`] of a table texel for the edges and carries. The table and its intermediates
 //! have the representation's channels (1, 2 or 4: [`SatVariant::format`]).
 //! [`five_pass`] keeps the first design (five scan passes over 4-channel tables) as the
-//! benchmark's baseline.
+//! benchmark's baseline. [`layers`] builds several tables whose tile kernels compute their
+//! representations from one shared source (CSM's and CSSM's basis from the depth), the same
+//! three passes once over all of them.
 //!
 //! Two codings ([`SatVariant`]): **fixed** point, `e = round(clamp((v − offset)·scale, ±limit))`
 //! in wrapping u32, whose window sums are exact whatever the map size, and **float**,
