@@ -15,7 +15,7 @@
 // Storage: rgba32float by default; the executor re-declares each `dst<j>` for its bound format
 // (rg32float or r32float for a last map of fewer channels; rgba16float for f16).
 
-// #import shared/csm_basis
+// #import shared/csm_maps
 // #import shared/linear_depth
 
 // Keep in sync with `CsmParams` in src/gpu_data.rs.
@@ -45,35 +45,6 @@ struct Params {
 
 const WG_SIZE: u32 = 16u;
 
-// Channel i of the CSM-Z sequence at depth z (0 past channel 2M).
-fn csm_z_channel(i: u32, z: f32) -> f32 {
-    if i == 0u {
-        return z;
-    }
-    if i > 2u * params.terms {
-        return 0.0;
-    }
-    let sc = csm_sin_cos((i + 1u) / 2u, z);
-    return z * select(sc.y, sc.x, (i & 1u) == 1u);
-}
-
-// Map m's texel at depth z.
-fn basis_map(m: u32, z: f32) -> vec4<f32> {
-    let basis_maps = (params.terms + 1u) / 2u;
-    if m < basis_maps {
-        let k = 2u * m + 1u;
-        let v = vec4<f32>(csm_sin_cos(k, z), csm_sin_cos(k + 1u, z));
-        return select(v, vec4<f32>(v.xy, 0.0, 0.0), k + 1u > params.terms);
-    }
-    let first = 4u * (m - basis_maps);
-    return vec4<f32>(
-        csm_z_channel(first, z),
-        csm_z_channel(first + 1u, z),
-        csm_z_channel(first + 2u, z),
-        csm_z_channel(first + 3u, z),
-    );
-}
-
 @compute @workgroup_size(WG_SIZE, WG_SIZE)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = textureDimensions(src);
@@ -86,14 +57,14 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let z = depth.z;
     let m = params.first_map;
-    textureStore(dst0, id.xy, basis_map(m, z));
+    textureStore(dst0, id.xy, csm_basis_map(m, params.terms, z));
     if params.maps > 1u {
-        textureStore(dst1, id.xy, basis_map(m + 1u, z));
+        textureStore(dst1, id.xy, csm_basis_map(m + 1u, params.terms, z));
     }
     if params.maps > 2u {
-        textureStore(dst2, id.xy, basis_map(m + 2u, z));
+        textureStore(dst2, id.xy, csm_basis_map(m + 2u, params.terms, z));
     }
     if params.maps > 3u {
-        textureStore(dst3, id.xy, basis_map(m + 3u, z));
+        textureStore(dst3, id.xy, csm_basis_map(m + 3u, params.terms, z));
     }
 }

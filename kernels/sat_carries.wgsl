@@ -10,6 +10,9 @@
 //                      the column before the tile),
 // with V(tx') = Σ_{ty' < ty} total(tx', ty') the tiles above, from the tiles' totals (their
 // last column of col_part), summed by the workgroup into workgroup memory first.
+// Layered (params.layers = L > 1, src/sat/layers.rs): the edges of L tables are stacked, each
+// table's col_part a band of ⌈height / TILE⌉ rows and its row_part a band of ⌈width / TILE⌉
+// columns; workgroup z carries table z within its bands.
 // #import shared/sat_tile
 // Traffic (the cost model, src/graph/cost): every edge texel read once and every carry written
 // once. Not counted: the row workgroups' re-reads of the tiles' totals above them (at most
@@ -32,13 +35,19 @@
 const CHUNK: u32 = 512u;
 var<workgroup> sh_above: array<vec4<u32>, CHUNK>;
 
-fn column_carries(x: u32, fs: bool) {
+// Tile rows of one table's band (the edges of `layers` tables stacked).
+fn band_tiles(stacked: u32) -> u32 {
+    return stacked / max(params.layers, 1u);
+}
+
+fn column_carries(x: u32, layer: u32, fs: bool) {
     let size = textureDimensions(col_part);
     if x >= size.x {
         return;
     }
+    let tiles = band_tiles(size.y);
     var carry = vec4<u32>(0u);
-    for (var t = 0u; t < size.y; t++) {
+    for (var t = layer * tiles; t < (layer + 1u) * tiles; t++) {
         let p = vec2<u32>(x, t);
         let part = textureLoad(col_part, p, 0);
         textureStore(col_carry, p, carry);
@@ -48,8 +57,10 @@ fn column_carries(x: u32, fs: bool) {
 
 // Rows of tile row `ty`, invocation li on row ty·TILE + li. Every invocation of the workgroup
 // calls it (it has barriers).
-fn row_carries(ty: u32, li: u32, fs: bool) {
-    let tiles = textureDimensions(row_part).x;
+fn row_carries(ty: u32, layer: u32, li: u32, fs: bool) {
+    let tiles = band_tiles(textureDimensions(row_part).x);
+    let first_col = layer * tiles;
+    let first_row = layer * band_tiles(textureDimensions(col_part).y);
     let height = textureDimensions(row_part).y;
     let width = textureDimensions(col_part).x;
     if ty * TILE >= height {
@@ -62,14 +73,14 @@ fn row_carries(ty: u32, li: u32, fs: bool) {
             let last = min((first + k) * TILE + TILE - 1u, width - 1u);
             var above = vec4<u32>(0u);
             for (var t = 0u; t < ty; t++) {
-                above = sat_sum(above, textureLoad(col_part, vec2<u32>(last, t), 0), fs);
+                above = sat_sum(above, textureLoad(col_part, vec2<u32>(last, first_row + t), 0), fs);
             }
             sh_above[k] = above;
         }
         workgroupBarrier();
         if y < height {
             for (var k = 0u; k < CHUNK && first + k < tiles; k++) {
-                let p = vec2<u32>(first + k, y);
+                let p = vec2<u32>(first_col + first + k, y);
                 let part = sat_sum(textureLoad(row_part, p, 0), sh_above[k], fs);
                 textureStore(row_carry, p, carry);
                 carry = sat_sum(carry, part, fs);
@@ -83,8 +94,8 @@ fn row_carries(ty: u32, li: u32, fs: bool) {
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     let fs = params.float_sums != 0u;
     if wg.y == 0u {
-        column_carries(wg.x * WG_SIZE + li, fs);
+        column_carries(wg.x * WG_SIZE + li, wg.z, fs);
     } else {
-        row_carries(wg.x, li, fs);
+        row_carries(wg.x, wg.z, li, fs);
     }
 }

@@ -278,10 +278,16 @@ fn rust_mirrors_match_naga_layouts() {
         Some(size_of::<shadowgraph::render::FrameGpu>() as u32),
         "FrameGpu vs struct Frame"
     );
-    use shadowgraph::technique::{CsmParams, ExpParams, MsmParams, SecondDepthParams, VsmParams};
+    use shadowgraph::technique::{
+        CsmParams, CsmSatParams, ExpParams, MsmParams, SecondDepthParams, VsmParams,
+    };
     for (kernel, rust) in [
         ("second_depth", size_of::<SecondDepthParams>()),
         ("csm", size_of::<CsmParams>()),
+        ("csm_sat_tile_sums", size_of::<CsmSatParams>()),
+        ("csm_sat_tile_sums_f32", size_of::<CsmSatParams>()),
+        ("csm_sat_tiles", size_of::<CsmSatParams>()),
+        ("csm_sat_tiles_f32", size_of::<CsmSatParams>()),
         ("vsm", size_of::<VsmParams>()),
         ("evsm", size_of::<ExpParams>()),
         ("esm", size_of::<ExpParams>()),
@@ -290,7 +296,7 @@ fn rust_mirrors_match_naga_layouts() {
         let wgsl = kernels::resolve(kernel, None).unwrap();
         let (m, _) = kernels::reflect(kernel, &wgsl).unwrap();
         assert_eq!(
-            struct_size(&m, "Params"),
+            struct_size(&m, "Params").or(struct_size(&m, "CsmSatParams")),
             Some(rust as u32),
             "Rust params vs {kernel}'s Params"
         );

@@ -566,8 +566,8 @@ fn plan_contains_only_what_techniques_need() {
 
 /// The blocker kernels are planned only for lights that ask for soft shadows: every bundled
 /// and technique scene's lights, and one plan mixing CSM, CSSM, VSM, VSSM and MSM lights.
-/// A CSSM light plans its ⌈M/2⌉ basis maps and ⌈(2M + 1)/4⌉ CSM-Z maps, each encoded once
-/// and summed by five SAT passes, and nothing else; VSSM and soft MSM plan exactly the
+/// A CSSM light plans the tables of its ⌈M/2⌉ basis maps and ⌈(2M + 1)/4⌉ CSM-Z maps as one
+/// layered table (2 + ⌈maps / 4⌉ passes, the maps never stored), and nothing else; VSSM and soft MSM plan exactly the
 /// encoding of their hard counterparts and one table.
 #[test]
 fn blocker_kernels_are_planned_only_for_soft_lights() {
@@ -606,26 +606,34 @@ fn blocker_kernels_are_planned_only_for_soft_lights() {
             .map(|s| s.node.kernel.as_str())
             .collect();
         let what = format!("light {i} ({})", l.shadow.technique.name());
-        // CSM-Z maps written (by `csm` dispatches; a table's resources end in `.sat…`).
+        // CSM-Z maps or their tables written (`light{i}.csm_z<k>` or `light{i}.csm_z<k>.sat`).
         let blocker = sp
             .plan
             .steps
             .iter()
             .filter(|s| s.node.light == Some(i))
             .flat_map(|s| &s.node.outputs)
-            .filter(|(_, r)| r.rsplit('.').next().is_some_and(|n| n.starts_with("csm_z")))
+            .filter(|(_, r)| {
+                let r = r.strip_suffix(".sat").unwrap_or(r);
+                r.rsplit('.').next().is_some_and(|n| n.starts_with("csm_z"))
+            })
             .count();
         let expected: Option<Vec<&str>> = match l.shadow.technique {
             Technique::Cssm { soft, terms, .. } => {
                 let basis = shadowgraph::technique::csm_maps(terms) as usize;
                 let z = shadowgraph::technique::csm_z_maps(terms) as usize;
-                assert_eq!(blocker, z, "{what}: CSM-Z maps");
-                // Up to four maps a `csm` dispatch, one read of the depth each.
-                let per = shadowgraph::technique::CSM_OUTPUTS as usize;
-                let mut v = vec!["csm"; (basis + z).div_ceil(per)];
-                for _ in 0..basis + z {
-                    v.extend(sat(soft.sums));
-                }
+                assert_eq!(blocker, z, "{what}: CSM-Z tables");
+                // One layered table (`sat::layers`): the edges of every layer from the depth,
+                // the carries, and four tables a dispatch; no basis map stored.
+                let per = shadowgraph::sat::layers::LAYERED_SAT_OUTPUTS as usize;
+                let (sums, tiles) = match soft.sums {
+                    shadowgraph::sat::SatVariant::Fixed => ("csm_sat_tile_sums", "csm_sat_tiles"),
+                    shadowgraph::sat::SatVariant::Float => {
+                        ("csm_sat_tile_sums_f32", "csm_sat_tiles_f32")
+                    }
+                };
+                let mut v = vec![sums, "sat_carries"];
+                v.extend(vec![tiles; (basis + z).div_ceil(per)]);
                 Some(v)
             }
             Technique::Vssm { .. } | Technique::MsmSoft { .. } => {

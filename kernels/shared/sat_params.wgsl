@@ -12,7 +12,7 @@ struct SatParams {
     channels: u32,       // channels of the representation that are used; the others are 0
     float_sums: u32,     // 1: f32 variant (values are f32 bits), 0: u32 fixed point
     axis: u32,           // sat_carry (five-pass baseline): 0 scans rows of block totals, 1 columns
-    _pad: u32,
+    layers: u32,         // sat_carries: tables stacked in the edges (src/sat/layers.rs; 0 or 1: one)
 }
 
 // A representation texel in the variant's domain: (v − offset)·scale, clamped to ±limit,

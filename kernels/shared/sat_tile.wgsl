@@ -4,6 +4,8 @@
 // through their sub-blocks' edge sums (O(SUB) values for SUB² texels). No function returns an
 // array: llvmpipe copies such returns through memory, twenty times slower than the sweep.
 // #import shared/sat_params
+// #import shared/csm_maps
+// #import shared/linear_depth
 
 // Keep in sync with `SAT_TILE` in src/sat.rs.
 const SUB: u32 = 8u;
@@ -28,15 +30,48 @@ fn sat_sub_origin(tile: vec2<u32>, li: u32) -> vec2<u32> {
     return tile * TILE + vec2<u32>(li % GRID, li / GRID) * SUB;
 }
 
-// The encoded texel `q` of `src` (`size` its size), 0 outside the map (the load is clamped to
-// the map and its value discarded, so no invocation branches).
+// Where a tile pass's texels come from: the representation `src` holds (`SAT_STORED`), or the
+// layered CSM / CSM-Z tables' (src/sat/layers.rs): `src` is the depth buffer and the texel is
+// basis map `layer` of the light's sequence at its linear depth (shared/csm_maps), rounded
+// to f16 where the map would be stored so, computed on the fly and never stored. The tile
+// kernels of the representation pass the constant `SAT_STORED`, so the branch folds away.
+struct SatSource {
+    csm: bool,           // the CSM basis of the depth; false: the texel as stored
+    f16: bool,           // round each basis value to f16
+    layer: u32,          // the basis map (CSM's ⌈M/2⌉, then CSM-Z's)
+    terms: u32,          // M
+    depth: DepthParams,  // the depth buffer's linearization
+    band: vec2<u32>,     // this table's carries start at this (tile column, tile row)
+}
+
+const SAT_STORED: SatSource =
+    SatSource(false, false, 0u, 0u, DepthParams(0u, 0.0, 1.0, 0u), vec2<u32>(0u));
+
+// Non-finite depth texels this invocation's `sat_texel` replaced (CSM sources; the first
+// tile pass counts layer 0's).
+var<private> sat_non_finite: u32;
+
+// The encoded texel `q` of `src` (`size` its size) read as `s` says, 0 outside the map (the
+// load is clamped to the map and its value discarded, so no invocation branches).
 fn sat_texel(
     src: texture_2d<f32>,
     q: vec2<u32>,
     size: vec2<u32>,
     p: SatParams,
     fs: bool,
+    s: SatSource,
 ) -> vec4<u32> {
-    let e = sat_encode_as(textureLoad(src, min(q, size - 1u), 0), p, fs);
-    return select(vec4<u32>(0u), e, all(q < size));
+    let inside = all(q < size);
+    var v = textureLoad(src, min(q, size - 1u), 0);
+    if s.csm {
+        let raw = v.r;
+        if inside && !depth_is_finite(raw) {
+            sat_non_finite += 1u;
+        }
+        v = csm_basis_map(s.layer, s.terms, linear_depth(raw, s.depth));
+        if s.f16 {
+            v = vec4<f32>(unpack2x16float(pack2x16float(v.xy)), unpack2x16float(pack2x16float(v.zw)));
+        }
+    }
+    return select(vec4<u32>(0u), sat_encode_as(v, p, fs), inside);
 }

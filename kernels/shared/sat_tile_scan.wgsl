@@ -1,5 +1,6 @@
 // The table of one tile with its carries (import-only module of `sat_tiles` and
-// `sat_tiles_f32`, pass 3 of 3). A table texel (x, y) of tile (tx, ty) is the sum of three
+// `sat_tiles_f32`, and of the layered `csm_sat_tiles*`, pass 3 of 3); the carries of the
+// source's band (`SatSource.band`). A table texel (x, y) of tile (tx, ty) is the sum of three
 // disjoint parts of [0, x] × [0, y]:
 //   the tile's own inclusive table at (x, y)                       (registers + workgroup),
 //   col_carry(x, ty): columns tx·TILE ..= x, every row above the tile      (pass 2),
@@ -27,12 +28,13 @@ fn sat_sweep_row(
     j: u32,
     p: SatParams,
     fs: bool,
+    s: SatSource,
     col: ptr<function, array<vec4<u32>, SUB>>,
 ) {
     let size = textureDimensions(src);
     var run = vec4<u32>(0u);
     for (var i = 0u; i < SUB; i++) {
-        run = sat_sum(run, sat_texel(src, origin + vec2<u32>(i, j), size, p, fs), fs);
+        run = sat_sum(run, sat_texel(src, origin + vec2<u32>(i, j), size, p, fs, s), fs);
         (*col)[i] = sat_sum((*col)[i], run, fs);
     }
 }
@@ -46,6 +48,7 @@ fn sat_tile_prepare(
     col_carry: texture_2d<u32>,
     p: SatParams,
     fs: bool,
+    s: SatSource,
     tile: vec2<u32>,
     li: u32,
     col_add: ptr<function, array<vec4<u32>, SUB>>,
@@ -56,7 +59,7 @@ fn sat_tile_prepare(
     let origin = sat_sub_origin(tile, li);
     var col: array<vec4<u32>, SUB>;
     for (var j = 0u; j < SUB; j++) {
-        sat_sweep_row(src, origin, j, p, fs, &col);
+        sat_sweep_row(src, origin, j, p, fs, s, &col);
         if a < SIDE {
             sh_right[(b * SUB + j) * SIDE + a] = col[SUB - 1u];
         }
@@ -90,7 +93,7 @@ fn sat_tile_prepare(
     workgroupBarrier();
     for (var i = 0u; i < SUB; i++) {
         let x = min(origin.x + i, size.x - 1u);
-        (*col_add)[i] = textureLoad(col_carry, vec2<u32>(x, tile.y), 0);
+        (*col_add)[i] = textureLoad(col_carry, vec2<u32>(x, s.band.y + tile.y), 0);
         if b > 0u {
             (*col_add)[i] = sat_sum((*col_add)[i], sh_bottom[(a * SUB + i) * SIDE + b - 1u], fs);
         }
@@ -102,6 +105,7 @@ fn sat_tile_prepare(
 fn sat_row_add(
     row_carry: texture_2d<u32>,
     fs: bool,
+    s: SatSource,
     tile: vec2<u32>,
     li: u32,
     j: u32,
@@ -109,7 +113,7 @@ fn sat_row_add(
     let a = li % GRID;
     let b = li / GRID;
     let y = min(sat_sub_origin(tile, li).y + j, textureDimensions(row_carry).y - 1u);
-    var add = textureLoad(row_carry, vec2<u32>(tile.x, y), 0);
+    var add = textureLoad(row_carry, vec2<u32>(s.band.x + tile.x, y), 0);
     if a > 0u {
         add = sat_sum(add, sh_right[(b * SUB + j) * SIDE + a - 1u], fs);
     }

@@ -1,5 +1,5 @@
 // The edges of one tile's own table (import-only module of `sat_tile_sums` and
-// `sat_tile_sums_f32`, pass 1 of 3): the tile's last row and last column, from one read of
+// `sat_tile_sums_f32`, and of the layered `csm_sat_tile_sums*`, pass 1 of 3): the tile's last row and last column, from one read of
 // the tile. Each invocation sums its sub-block's rows and columns in registers; the edges
 // across the tile come from those partial sums in workgroup memory, two barriers in all.
 // #import shared/sat_tile
@@ -15,9 +15,16 @@ struct SatEdges {
     col: vec4<u32>,
 }
 
-// Invocation li's entries of the edges of tile `tile` of `src` (coded with `p` in the variant
-// `fs`). Every invocation calls it (it has barriers).
-fn sat_tile_edges(src: texture_2d<f32>, p: SatParams, fs: bool, tile: vec2<u32>, li: u32) -> SatEdges {
+// Invocation li's entries of the edges of tile `tile` of `src` (read as `s`, coded with `p`
+// in the variant `fs`). Every invocation calls it (it has barriers).
+fn sat_tile_edges(
+    src: texture_2d<f32>,
+    p: SatParams,
+    fs: bool,
+    s: SatSource,
+    tile: vec2<u32>,
+    li: u32,
+) -> SatEdges {
     let a = li % GRID;
     let b = li / GRID;
     let size = textureDimensions(src);
@@ -29,7 +36,7 @@ fn sat_tile_edges(src: texture_2d<f32>, p: SatParams, fs: bool, tile: vec2<u32>,
     for (var j = 0u; j < SUB; j++) {
         var row = vec4<u32>(0u);
         for (var i = 0u; i < SUB; i++) {
-            let e = sat_texel(src, origin + vec2<u32>(i, j), size, p, fs);
+            let e = sat_texel(src, origin + vec2<u32>(i, j), size, p, fs, s);
             row = sat_sum(row, e, fs);
             col[i] = sat_sum(col[i], e, fs);
         }

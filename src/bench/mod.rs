@@ -12,6 +12,7 @@
 //! runs (after [`WARMUP`] untimed ones) of the summed node times.
 
 mod copy;
+mod csm_chain;
 mod harness;
 mod lookup;
 mod soft;
@@ -134,6 +135,16 @@ pub const CASES: &[BenchCase] = &[
             let maps = ["light0.csm0", "light0.csm1", "light0.csm2", "light0.csm3"];
             chain_graph(n, csm_terms(8), &maps)
         },
+    },
+    // CSSM's prefilter: the layered tables (basis computed in their tile passes) against the
+    // chain before them, until the comparison is recorded.
+    BenchCase {
+        name: "chain cssm 8 terms (depth → 9 tables)",
+        build: csm_chain::layered,
+    },
+    BenchCase {
+        name: "chain cssm 8 terms (9 maps + 27 passes, old)",
+        build: csm_chain::maps_then_tables,
     },
     BenchCase {
         name: "mips rgba32f",

@@ -74,7 +74,15 @@ impl Plan {
         if let Some((_, r)) = n.inputs.iter().chain(&n.outputs).find(|(_, r)| !known(r)) {
             return bad(format!("uses `{r}`, which is not in the plan"));
         }
-        let of = match &n.dispatch {
+        let mut dispatch = &n.dispatch;
+        while let Dispatch::Layers { base, layers } = dispatch {
+            if *layers == 0 || matches!(**base, Dispatch::Several(_)) {
+                return bad("dispatches 0 layers, or several dispatches a layer".into());
+            }
+            dispatch = base;
+        }
+        let of = match dispatch {
+            Dispatch::Layers { .. } => None,
             Dispatch::Texels(r) => Some(r),
             Dispatch::Blocks { of, .. } => Some(of),
             Dispatch::Lines { per_group: 0, .. } => {

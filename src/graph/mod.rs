@@ -37,6 +37,21 @@ pub enum SizeRule {
         /// Block height in texels (0: the whole height).
         y: u32,
     },
+    /// The blocks of [`SizeRule::Blocks`] for `across × down` maps of the size of `of`, laid
+    /// side by side: `[block_count(width, x)·across, block_count(height, y)·down]`. The edges
+    /// of several summed-area tables stacked in one texture ([`crate::sat::layers`]).
+    Stacked {
+        /// The resource whose size this follows.
+        of: String,
+        /// Block width in texels (0: the whole width).
+        x: u32,
+        /// Block height in texels (0: the whole height).
+        y: u32,
+        /// Copies along x.
+        across: u32,
+        /// Copies along y.
+        down: u32,
+    },
 }
 
 /// A named, typed texture in the graph.
@@ -83,6 +98,14 @@ pub enum Dispatch {
         of: String,
         /// Lines per workgroup (the kernel's workgroup size).
         per_group: u32,
+    },
+    /// `base`'s workgroups along x and y, `layers` of them along z (one layer of a stack per
+    /// workgroup z, e.g. the layered summed-area tables of [`crate::sat::layers`]).
+    Layers {
+        /// The dispatch of one layer (not [`Dispatch::Several`]).
+        base: Box<Dispatch>,
+        /// Workgroups along z.
+        layers: u32,
     },
     /// Several dispatches in the node's one compute pass, each with its own parameters, its
     /// bindings of single mip levels and its workgroups: e.g. a mip chain, a few levels per
@@ -148,6 +171,10 @@ impl Dispatch {
             Self::Lines { of, per_group } => {
                 let (w, h) = size(of)?;
                 [block_count(w.max(h), *per_group), 2, 1]
+            }
+            Self::Layers { base, layers } => {
+                let [x, y, _] = base.groups(size, workgroup)?;
+                [x, y, *layers]
             }
             Self::Several(_) => return None,
         })

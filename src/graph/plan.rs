@@ -344,6 +344,24 @@ fn resolve_size(
             let (w, h) = resolve_base(graph, index, of, depth, &bad)?;
             Ok((block_count(w, *x), block_count(h, *y)))
         }
+        SizeRule::Stacked {
+            of,
+            x,
+            y,
+            across,
+            down,
+        } => {
+            let (w, h) = resolve_base(graph, index, of, depth, &bad)?;
+            let times = |n: u32, k: u32| {
+                n.checked_mul(k)
+                    .filter(|&v| v > 0)
+                    .ok_or_else(|| bad(&format!("{n} blocks × {k} copies")))
+            };
+            Ok((
+                times(block_count(w, *x), *across)?,
+                times(block_count(h, *y), *down)?,
+            ))
+        }
     }
 }
 

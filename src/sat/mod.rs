@@ -20,7 +20,9 @@
 //! 8/[`SAT_TILE`] of a table texel for the edges and carries. The table and its intermediates
 //! have the representation's channels (1, 2 or 4: [`SatVariant::format`]).
 //! [`five_pass`] keeps the first design (five scan passes over 4-channel tables) as the
-//! benchmark's baseline.
+//! benchmark's baseline. [`layers`] builds several tables whose tile kernels compute their
+//! representations from one shared source (CSM's and CSSM's basis from the depth), the same
+//! three passes once over all of them.
 //!
 //! Two codings ([`SatVariant`]): **fixed** point, `e = round(clamp((v − offset)·scale, ±limit))`
 //! in wrapping u32, whose window sums are exact whatever the map size, and **float**,
@@ -36,6 +38,7 @@
 //! quantization error (plus 2⁻²⁴·|v − offset| from the subtraction), and so does every mean.
 
 pub mod five_pass;
+pub mod layers;
 
 use crate::error::{Error, Result};
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
@@ -79,8 +82,8 @@ pub struct SatParams {
     pub float_sums: u32,
     /// The five-pass baseline's `sat_carry`: 0 scans along rows, 1 along columns (0 elsewhere).
     pub axis: u32,
-    /// Padding.
-    pub _pad: u32,
+    /// Tables whose edges `sat_carries` finds stacked in its inputs ([`layers`]; 0 or 1: one).
+    pub layers: u32,
 }
 
 /// How values are coded into a table, per channel: everything a lookup needs to decode it
@@ -139,7 +142,7 @@ impl SatCoding {
             channels: channels.clamp(1, 4),
             float_sums: u32::from(self.variant == SatVariant::Float),
             axis,
-            _pad: 0,
+            layers: 1,
         }
     }
 }

@@ -123,7 +123,14 @@ fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
 /// (`light{i}.csm_z<chunk>`, four channels of the sequence `[z, z·sin c₁z, z·cos c₁z, …]`
 /// each), the complementary basis its blocker search filters. `kernels/csm.wgsl` writes up
 /// to [`CSM_OUTPUTS`] of them from one read of the depth (nodes `light{i}.csm.<g>`).
+///
+/// Through a summed-area table (the `sat` filter, CSSM) the maps are not stored: their tables
+/// are built by [`super::csm_sat::csm_sat_nodes`], the basis computed from the depth in the
+/// tables' own tile passes.
 pub(super) fn csm_nodes(n: &mut LightNodes, storage: Storage, terms: u32, z: bool) -> Vec<String> {
+    if let Ok(Some(coding)) = super::light_gpu::sat_coding(n.light) {
+        return super::csm_sat::csm_sat_nodes(n, storage, terms, z, coding);
+    }
     let z_maps = if z { csm_z_maps(terms) } else { 0 };
     let z_channels = csm_z_channels(terms);
     let maps: Vec<(String, wgpu::TextureFormat)> = (0..csm_maps(terms))

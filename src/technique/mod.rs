@@ -6,6 +6,7 @@
 //! `nodes.rs`, `light_gpu.rs` and `shade.rs`.
 
 mod csm;
+mod csm_sat;
 mod cssm;
 mod esm;
 mod evsm;
@@ -33,6 +34,7 @@ pub use crate::gpu_data::{
 pub use crate::model::mip_levels;
 use crate::model::{Light, ParamSource, ParamSpec, ParamValues, Technique};
 pub use csm::{csm_maps, csm_z_channels, csm_z_maps};
+pub use csm_sat::{CsmBasis, CsmSatParams, add_csm_tables};
 use light_gpu::unit_range;
 pub use light_gpu::{sat_coding, sat_variant, soft_lookup_area, soft_max_width, soft_width_cap};
 pub use msm::msm_quantized;

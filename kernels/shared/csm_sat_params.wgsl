@@ -1,0 +1,29 @@
+// Parameters of the layered CSM / CSM-Z summed-area tables (import-only module of
+// `csm_sat_tile_sums`, `csm_sat_tiles` and their f32 variants; src/sat/layers.rs): the tile
+// passes read the depth buffer and compute their layer's basis map on the fly (`SatSource`,
+// shared/sat_tile), so the basis maps are never stored. Layer L (workgroup z = L − first_map)
+// is map L of the light's sequence; its edges and carries are band L of the stacked
+// intermediates (⌈height / TILE⌉ rows of col_part / col_carry, ⌈width / TILE⌉ columns of
+// row_part / row_carry a band).
+// #import shared/sat_tile
+
+// Keep in sync with `CsmSatParams` in src/technique/csm_sat.rs.
+struct CsmSatParams {
+    sat: SatParams,       // the tables' coding (channels 4; sat.layers: every layer of the stack)
+    depth: DepthParams,   // the depth buffer's linearization
+    first_map: u32,       // the layer workgroup z = 0 computes
+    maps: u32,            // layers of this dispatch (workgroups along z)
+    terms: u32,           // M
+    f16: u32,             // 1: round each basis value to f16, as an rgba16float map would hold it
+}
+
+// Tiles of a `size` map along x and y: the width of a band of row_part, the height of one of
+// col_part.
+fn csm_sat_tiles_of(size: vec2<u32>) -> vec2<u32> {
+    return (size + vec2<u32>(TILE - 1u)) / TILE;
+}
+
+// Layer `layer`'s source, for a map of `tiles` tiles.
+fn csm_sat_source(p: CsmSatParams, layer: u32, tiles: vec2<u32>) -> SatSource {
+    return SatSource(true, p.f16 != 0u, layer, p.terms, p.depth, layer * tiles);
+}

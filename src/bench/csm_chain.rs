@@ -1,0 +1,87 @@
+//! CSSM's prefilter (depth → the nine tables of M = 8) as the shipped graph builds it — one
+//! layered table whose tile passes compute the basis from the depth ([`crate::sat::layers`])
+//! — and as builds before it did: `csm` storing the basis maps four a dispatch, then three
+//! table passes per map. The old chain stays a bench case until the comparison is recorded.
+
+use super::{BenchGraph, bench_light, chain_graph, named};
+use crate::gpu_data::{CSM_OUTPUTS, CsmParams, LinearizeParams};
+use crate::graph::{Dispatch, Graph, Node, SizeRule};
+use crate::kernels::KernelId;
+use crate::model::{ParamValue, Storage, Technique};
+use crate::sat::{SatCoding, add_sat};
+use crate::technique::{self, csm_maps, csm_z_channels, csm_z_maps, moments_format};
+
+/// Terms of the CSSM chains timed.
+const TERMS: u32 = 8;
+
+fn cssm() -> Technique {
+    named("cssm", &[("terms", ParamValue::Int(TERMS))])
+}
+
+/// The tables the shading of CSSM M = 8 reads: 4 CSM then 5 CSM-Z.
+fn tables() -> Vec<String> {
+    (0..csm_maps(TERMS))
+        .map(|k| format!("light0.csm{k}.sat"))
+        .chain((0..csm_z_maps(TERMS)).map(|k| format!("light0.csm_z{k}.sat")))
+        .collect()
+}
+
+/// The shipped chain: 2 + ⌈9 / 4⌉ = 5 dispatches.
+pub(super) fn layered(n: u32) -> BenchGraph {
+    let names = tables();
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    chain_graph(n, cssm(), &names)
+}
+
+/// The chain before the layered tables: `csm` writes the nine basis maps (rgba32float, the
+/// last r32float) four a dispatch from the depth, and each map gets the three passes of
+/// [`add_sat`]: 30 dispatches.
+pub(super) fn maps_then_tables(n: u32) -> BenchGraph {
+    let light = bench_light(n, cssm());
+    let coding = technique::sat_coding(&light)
+        .ok()
+        .flatten()
+        .unwrap_or_else(|| SatCoding::fixed(64 * 64, [-1.0; 4], [1.0; 4]).expect("valid coding"));
+    let mut graph = Graph::default();
+    let depth = graph.import("light0.depth", wgpu::TextureFormat::R32Float, n, n, Some(0));
+    let z_channels = csm_z_channels(TERMS);
+    let maps: Vec<(String, u32)> = (0..csm_maps(TERMS))
+        .map(|k| (format!("light0.csm{k}"), 4))
+        .chain(
+            (0..csm_z_maps(TERMS))
+                .map(|k| (format!("light0.csm_z{k}"), (z_channels - 4 * k).min(4))),
+        )
+        .collect();
+    let mut outputs = Vec::new();
+    for (g, group) in maps.chunks(CSM_OUTPUTS as usize).enumerate() {
+        let mut written = Vec::new();
+        for (name, channels) in group {
+            let size = SizeRule::Reduced {
+                of: depth.clone(),
+                shift: 0,
+            };
+            let format = moments_format(Storage::F32, *channels);
+            written.push(graph.resource(name.clone(), format, size, Some(0)));
+        }
+        let params = CsmParams {
+            depth: LinearizeParams::new(&light),
+            first_map: g as u32 * CSM_OUTPUTS,
+            maps: group.len() as u32,
+            terms: TERMS,
+            _pad: 0,
+        };
+        graph.node(Node {
+            name: format!("light0.csm.{g}"),
+            kernel: KernelId::Csm,
+            inputs: vec![("src".into(), depth.clone())],
+            outputs: (0..written.len())
+                .map(|j| (format!("dst{j}"), written[j].clone()))
+                .collect(),
+            params: bytemuck::bytes_of(&params).to_vec(),
+            dispatch: Dispatch::Texels(written[0].clone()),
+            light: Some(0),
+        });
+        outputs.extend(written.iter().map(|m| add_sat(&mut graph, 0, m, &coding)));
+    }
+    BenchGraph { graph, outputs }
+}

@@ -1,0 +1,127 @@
+//! CSM and CSSM through summed-area tables, the basis never stored: the layered tables of
+//! [`crate::sat::layers`] whose tile kernels (`kernels/csm_sat_tile_sums.wgsl`,
+//! `kernels/csm_sat_tiles.wgsl` and their f32 variants) compute each basis map from the depth
+//! on the fly, one layer a map of the light's sequence (`kernels/shared/csm_basis.wgsl`).
+
+use super::csm::{csm_maps, csm_z_channels, csm_z_maps};
+use super::nodes::{LightNodes, moments_format};
+use crate::gpu_data::LinearizeParams;
+use crate::graph::{Graph, SizeRule};
+use crate::kernels::KernelId;
+use crate::model::Storage;
+use crate::sat::layers::{LayeredSat, add_layered_sat};
+use crate::sat::{SatCoding, SatParams, SatVariant};
+
+/// Parameters of the layered CSM table kernels (mirrors `CsmSatParams` in
+/// `kernels/shared/csm_sat_params.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct CsmSatParams {
+    /// The tables' coding (`layers`: every layer of the stack).
+    pub sat: SatParams,
+    /// The depth buffer's linearization.
+    pub depth: LinearizeParams,
+    /// The map of the light's sequence workgroup z = 0 computes (z adds to it).
+    pub first_map: u32,
+    /// Maps this dispatch computes (workgroups along z).
+    pub maps: u32,
+    /// Total terms M.
+    pub terms: u32,
+    /// 1: each basis value rounded to f16, as f16 storage of the map would hold it.
+    pub f16: u32,
+}
+
+/// What the layered tables of one light's basis hold ([`add_csm_tables`]).
+#[derive(Clone, Copy, Debug)]
+pub struct CsmBasis {
+    /// Terms M.
+    pub terms: u32,
+    /// With the CSM-Z maps (CSSM's blocker search), after the ⌈M/2⌉ CSM maps.
+    pub z: bool,
+    /// The representation's storage: f16 rounds every basis value as an f16 map would.
+    pub storage: Storage,
+    /// The depth buffer's linearization.
+    pub depth: LinearizeParams,
+}
+
+/// Light `light`'s basis maps as `(resource, channels)`: `light{light}.csm<chunk>` (two terms
+/// each), then with `z` `light{light}.csm_z<chunk>` (four channels of the CSM-Z sequence each).
+/// They are declared, the size of `depth`, in the format an f32 or f16 map of their channels
+/// would have (what `map_channels` reads), but never planned: only their tables are.
+fn basis_maps(graph: &mut Graph, light: usize, depth: &str, b: &CsmBasis) -> Vec<(String, u32)> {
+    let z_maps = if b.z { csm_z_maps(b.terms) } else { 0 };
+    let z_channels = csm_z_channels(b.terms);
+    (0..csm_maps(b.terms))
+        .map(|chunk| (format!("csm{chunk}"), 2 * (b.terms - 2 * chunk).min(2)))
+        .chain((0..z_maps).map(|chunk| (format!("csm_z{chunk}"), (z_channels - 4 * chunk).min(4))))
+        .map(|(name, channels)| {
+            let size = SizeRule::Reduced {
+                of: depth.to_string(),
+                shift: 0,
+            };
+            let format = moments_format(b.storage, channels);
+            let map = graph.resource(format!("light{light}.{name}"), format, size, Some(light));
+            (map, channels)
+        })
+        .collect()
+}
+
+/// Adds the summed-area tables of light `light`'s basis maps (`b`; the maps as in
+/// `basis_maps`, each table `<map>.sat`) coded as `coding` to `graph`, computed from the
+/// imported depth `depth` (read as `texture_2d<f32>`: a depth or an r32float texture) by one
+/// layered table ([`add_layered_sat`]): `2 + ⌈maps / 4⌉` dispatches, the depth read once a
+/// layer in each tile pass. Returns the tables, CSM's then CSM-Z's.
+pub fn add_csm_tables(
+    graph: &mut Graph,
+    light: usize,
+    depth: &str,
+    b: &CsmBasis,
+    coding: SatCoding,
+) -> Vec<String> {
+    let tables = basis_maps(graph, light, depth, b);
+    let (lin, terms) = (b.depth, b.terms);
+    let f16 = u32::from(b.storage == Storage::F16);
+    let params = move |sat: SatParams, first_map: u32, maps: u32| {
+        let p = CsmSatParams {
+            sat,
+            depth: lin,
+            first_map,
+            maps,
+            terms,
+            f16,
+        };
+        bytemuck::bytes_of(&p).to_vec()
+    };
+    let kernels = match coding.variant {
+        SatVariant::Fixed => [KernelId::CsmSatTileSums, KernelId::CsmSatTiles],
+        SatVariant::Float => [KernelId::CsmSatTileSumsF32, KernelId::CsmSatTilesF32],
+    };
+    let prefix = format!("light{light}.csm");
+    let sat = LayeredSat {
+        source: depth,
+        prefix: &prefix,
+        tables: &tables,
+        kernels,
+        params: &params,
+        coding,
+    };
+    add_layered_sat(graph, light, &sat)
+}
+
+/// [`add_csm_tables`] for the light of `n`, from its depth.
+pub(super) fn csm_sat_nodes(
+    n: &mut LightNodes,
+    storage: Storage,
+    terms: u32,
+    z: bool,
+    coding: SatCoding,
+) -> Vec<String> {
+    let b = CsmBasis {
+        terms,
+        z,
+        storage,
+        depth: n.lin,
+    };
+    let depth = n.depth.clone();
+    add_csm_tables(n.graph, n.i, &depth, &b, coding)
+}

@@ -1,0 +1,283 @@
+//! The layered summed-area tables of the CSM and CSM-Z basis (`technique::add_csm_tables`,
+//! `sat::layers`): the tile passes compute each basis map from the depth on the fly, so the
+//! table's input is no longer a stored map but the basis the kernel computes. The contract
+//! tested here: every table, decoded texel by texel (each texel's 1×1 window, which determines
+//! the whole table), is the f64 basis (`cpu::csm`, `cpu::csm_z`) of the f64 linear depth
+//! within the basis' f32 error and the coding's quantization; in fixed point its windows are
+//! exact sums of those codes (wrapping u32, as the integer reference `cpu::sat::sat_fixed`
+//! sums them), in f32 every table texel is within the scan's rounding bound of the f64 table.
+//! Random depth with NaN and ±Inf texels (counted once), ragged tiles, both variants, CSM
+//! alone and CSSM's CSM + CSM-Z, f32 and f16 storage.
+
+mod common;
+
+use std::collections::HashMap;
+
+use rand::Rng;
+use shadowgraph::cpu::{self, Texels, sat as reference};
+use shadowgraph::exec::Executor;
+use shadowgraph::gpu::{Gpu, read_texture, submit_and_wait, write_texture};
+use shadowgraph::graph::{Graph, plan, texel_bytes};
+use shadowgraph::sat::layers::LAYERED_SAT_OUTPUTS;
+use shadowgraph::sat::{SatCoding, SatVariant, decode_table, float_sum_depth, lookup_area};
+use shadowgraph::scene::Storage;
+use shadowgraph::technique::{CsmBasis, LinearizeParams, add_csm_tables, csm_maps, csm_z_maps};
+
+/// f32's unit roundoff.
+const U: f64 = 1.0 / (1u64 << 24) as f64;
+
+/// One case: map size, terms, CSM-Z maps too, coding variant, storage, non-finite texels.
+struct Case {
+    w: usize,
+    h: usize,
+    terms: u32,
+    z: bool,
+    variant: SatVariant,
+    storage: Storage,
+    bad: usize,
+}
+
+/// An orthographic depth buffer (linear already): smooth ramps with steps, values over
+/// [0, 1], and `bad` NaN / ±Inf texels; with the f64 linear depth (non-finite → 1.0).
+fn depth(rng: &mut impl Rng, w: usize, h: usize, bad: usize) -> (Vec<f32>, Texels) {
+    let (a, b): (f32, f32) = (rng.random_range(-0.4..0.4), rng.random_range(-0.4..0.4));
+    let mut raw: Vec<f32> = (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f32 / w as f32, (i / w) as f32 / h as f32);
+            let step = if rng.random_bool(0.1) { -0.3 } else { 0.0 };
+            (0.5 + a * x + b * y + step + rng.random_range(-0.05..0.05)).clamp(0.0, 1.0)
+        })
+        .collect();
+    for k in 0..bad {
+        let at = rng.random_range(0..raw.len());
+        raw[at] = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY][k % 3];
+    }
+    let data = raw
+        .iter()
+        .map(|&d| if d.is_finite() { f64::from(d) } else { 1.0 })
+        .collect();
+    (
+        raw,
+        Texels {
+            width: w,
+            height: h,
+            channels: 1,
+            data,
+        },
+    )
+}
+
+/// The tables of `case` on the GPU (every planned texture poisoned first, all bits set), as
+/// raw words, with the plan's step count and each step's non-finite count.
+fn run(g: &Gpu, case: &Case, raw: &[f32], coding: SatCoding) -> (Vec<Vec<u32>>, usize, Vec<u32>) {
+    let mut graph = Graph::default();
+    let (w, h) = (case.w as u32, case.h as u32);
+    graph.import("in", wgpu::TextureFormat::R32Float, w, h, Some(0));
+    let basis = CsmBasis {
+        terms: case.terms,
+        z: case.z,
+        storage: case.storage,
+        depth: LinearizeParams::ORTHOGRAPHIC,
+    };
+    let tables = add_csm_tables(&mut graph, 0, "in", &basis, coding);
+    let names: Vec<&str> = tables.iter().map(String::as_str).collect();
+    let plan = plan(&graph, &names).expect("plan");
+    let input = g.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("test.csm_sat.depth"),
+        size: wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::R32Float,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    write_texture(&g.queue, &input, bytemuck::cast_slice(raw));
+    let imports = HashMap::from([("in".to_string(), input)]);
+    let mut exec = Executor::new();
+    let mut enc = g.device.create_command_encoder(&Default::default());
+    let out = exec
+        .record(&g.device, &mut enc, &plan, &imports, None)
+        .expect("record");
+    for (name, t) in &out.textures {
+        if name != "in" {
+            let bytes = texel_bytes(t.format()) as usize * (t.width() * t.height()) as usize;
+            write_texture(&g.queue, t, &vec![0xFF; bytes]);
+        }
+    }
+    out.copy_stats(&mut enc);
+    submit_and_wait(&g.device, &g.queue, enc, "csm_sat").expect("run");
+    let words = tables
+        .iter()
+        .map(|t| {
+            let bytes = read_texture(&g.device, &g.queue, &out.textures[t], 0).expect("read");
+            bytemuck::cast_slice(&bytes).to_vec()
+        })
+        .collect();
+    let stats = out.read_stats(&g.device).expect("stats");
+    (words, plan.steps.len(), stats.iter().map(|s| s.1).collect())
+}
+
+/// Per table, the f64 basis of `lin`: its channels of the CSM sequence (2M) then, with `z`,
+/// of the CSM-Z sequence (2M + 1), four a table.
+fn basis(lin: &Texels, terms: u32, z: bool) -> Vec<Texels> {
+    let chunks = |t: Texels, maps: u32| -> Vec<Texels> {
+        (0..maps as usize)
+            .map(|m| {
+                let n = (t.channels - 4 * m).min(4);
+                let data = t
+                    .data
+                    .chunks(t.channels)
+                    .flat_map(|c| c[4 * m..4 * m + n].to_vec())
+                    .collect();
+                Texels {
+                    channels: n,
+                    data,
+                    ..t.clone()
+                }
+            })
+            .collect()
+    };
+    let mut out = chunks(cpu::csm::csm(lin, terms), csm_maps(terms));
+    if z {
+        out.extend(chunks(cpu::csm_z::csm_z(lin, terms), csm_z_maps(terms)));
+    }
+    out
+}
+
+/// The GPU's basis values against f64: Vulkan's sin/cos is within 2⁻¹¹ absolute on
+/// [−π, π] (the kernel reduces its argument there); forming and reducing the argument (2k − 1)·z ≤
+/// 2M − 1 rounds it by ≤ 2·U·(2M − 1), moved by π (slope ≤ 1); the CSM-Z product (|z| ≤ 1)
+/// adds a rounding; f16 storage rounds each value by 2⁻¹¹ relative.
+fn basis_tolerance(terms: u32, storage: Storage, v: f64) -> f64 {
+    let f16 = if storage == Storage::F16 {
+        2f64.powi(-11) * v.abs()
+    } else {
+        0.0
+    };
+    2f64.powi(-11) + 2.0 * U * f64::from(2 * terms - 1) * std::f64::consts::PI + U + f16
+}
+
+fn check(g: &Gpu, seed: u64, case: &Case) {
+    let what = format!(
+        "{}×{} M = {} z {} {:?} {:?}",
+        case.w, case.h, case.terms, case.z, case.variant, case.storage
+    );
+    let mut rng = common::rng(seed);
+    let (raw, lin) = depth(&mut rng, case.w, case.h, case.bad);
+    let coding = match case.variant {
+        SatVariant::Fixed => SatCoding::fixed(lookup_area(24.0, 24.0), [-1.0; 4], [1.0; 4]),
+        SatVariant::Float => SatCoding::float([-1.0; 4], [1.0; 4]),
+    }
+    .expect("coding");
+    let (tables, steps, stats) = run(g, case, &raw, coding);
+    let want = basis(&lin, case.terms, case.z);
+    assert_eq!(tables.len(), want.len(), "{what}: tables");
+    // The edges of every layer, the carries, four tables a dispatch.
+    let per = LAYERED_SAT_OUTPUTS as usize;
+    assert_eq!(steps, 2 + want.len().div_ceil(per), "{what}: dispatches");
+    // Pass 1's layer 0 counts each non-finite texel once; nothing else counts.
+    assert_eq!(stats, vec![case.bad as u32], "{what}: non-finite count");
+    let texels = case.w * case.h;
+    for (m, (words, v)) in tables.iter().zip(&want).enumerate() {
+        let n = v.channels;
+        // The format has the channels, or four for three (no three-channel format); the
+        // fourth is 0 (the kernel's basis is 0 past the sequence).
+        let stride = if n == 3 { 4 } else { n };
+        assert_eq!(words.len(), texels * stride, "{what} table {m}: channels");
+        assert!(
+            words.chunks(stride).all(|t| t[n..].iter().all(|&w| w == 0)),
+            "{what} table {m}: unused channel"
+        );
+        let decoded = decode_table(words, case.w, case.h, &coding, n);
+        let mut tol: Vec<f64> = v
+            .data
+            .iter()
+            .map(|&x| basis_tolerance(case.terms, case.storage, x))
+            .collect();
+        if case.variant == SatVariant::Fixed {
+            // Each code is rounded (½/scale; one scale for every channel of [−1, 1]) from the
+            // f32 value less the offset (0 here); decoding rounds to f32 once more.
+            assert!(coding.scale.iter().all(|&s| s == coding.scale[0]));
+            let quantum = 0.5 / f64::from(coding.scale[0]);
+            tol.iter_mut().for_each(|t| *t += quantum + U);
+            common::assert_within(&format!("{what} table {m}"), &decoded, &v.data, &tol);
+        } else {
+            check_float(&format!("{what} table {m}"), words, v, &coding, &tol);
+        }
+    }
+}
+
+/// The f32 table against the f64 table of the f64 basis: within the scan tree's rounding,
+/// `float_sum_depth`·U·Σ|x| over each texel's rectangle, plus the basis error summed over it.
+fn check_float(what: &str, words: &[u32], v: &Texels, coding: &SatCoding, basis_tol: &[f64]) {
+    let exact = reference::sat(&reference::scaled_texels(v, coding));
+    let abs = reference::sat(&Texels {
+        data: v.data.iter().map(|x| x.abs()).collect(),
+        ..v.clone()
+    });
+    let errors = reference::sat(&Texels {
+        data: basis_tol.to_vec(),
+        ..v.clone()
+    });
+    let depth = f64::from(float_sum_depth(v.width as u32, v.height as u32));
+    let n = v.channels;
+    let stride = words.len() / (v.width * v.height);
+    let got: Vec<f32> = words
+        .chunks(stride)
+        .flat_map(|t| t[..n].iter().map(|&b| f32::from_bits(b)))
+        .collect();
+    let mut want = Vec::with_capacity(got.len());
+    let mut tol = Vec::with_capacity(got.len());
+    for i in 0..v.width * v.height {
+        for c in 0..n {
+            want.push(exact.data[i * 4 + c]);
+            tol.push(depth * U * abs.data[i * n + c] + errors.data[i * n + c]);
+        }
+    }
+    common::assert_within(what, &got, &want, &tol);
+}
+
+#[test]
+fn layered_csm_tables_match_the_f64_basis() {
+    let g = common::gpu();
+    let cases = [
+        // CSSM M = 8 (4 + 5 tables, three pass-3 dispatches), 4 × 3 tiles, the last ragged.
+        Case {
+            w: 200,
+            h: 130,
+            terms: 8,
+            z: true,
+            variant: SatVariant::Fixed,
+            storage: Storage::F32,
+            bad: 7,
+        },
+        // Odd M: the last CSM table two channels, the last CSM-Z one three; f32 sums.
+        Case {
+            w: 70,
+            h: 150,
+            terms: 3,
+            z: true,
+            variant: SatVariant::Float,
+            storage: Storage::F32,
+            bad: 2,
+        },
+        // CSM alone, M = 16 (8 tables, two dispatches), one exact tile, f16 storage.
+        Case {
+            w: 64,
+            h: 64,
+            terms: 16,
+            z: false,
+            variant: SatVariant::Fixed,
+            storage: Storage::F16,
+            bad: 1,
+        },
+    ];
+    for (k, case) in cases.iter().enumerate() {
+        check(&g, 0xC55 + k as u64, case);
+    }
+}
