@@ -812,6 +812,10 @@ fn every_technique_renders_every_bundled_scene() {
             (scene.width, scene.height) = (120, 90);
             for l in &mut scene.lights {
                 l.shadow.technique = t;
+                // Soft techniques refuse cascades (`params::cascade_support`): one map.
+                if shadowgraph::technique::params::cascade_support(&t).is_err() {
+                    l.shadow.cascades = shadowgraph::model::Cascades::SINGLE;
+                }
                 l.shadow_map = l.shadow_map.min(512);
                 // PCSS and the soft techniques model an area light (scenes require a size).
                 if t.soft().is_some() && l.size <= 0.0 {

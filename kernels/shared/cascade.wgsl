@@ -1,6 +1,7 @@
 // Cascaded shadow maps of a directional light (import-only module): which cascade a receiver
 // reads, by its view distance from the camera, and how far into the blend band toward the
 // next cascade it is. `src/cpu/cascade.rs` is its f64 reference.
+// #import shared/light
 
 struct CascadePick {
     index: u32,  // the cascade whose range holds the receiver (the last beyond it)

@@ -56,7 +56,7 @@ pub fn view_range(scene: &Scene) -> Result<(f32, f32)> {
         hi = hi.max(d);
     }
     let near = lo.max(CAMERA_NEAR);
-    if !(hi > near * 1.001) {
+    if hi.is_nan() || hi <= near * 1.001 {
         return Err(Error::Invalid(
             "cascades: no geometry lies in front of the camera".into(),
         ));
@@ -88,6 +88,13 @@ pub fn drawn_lights(scene: &Scene) -> Result<DrawnLights> {
         if c.count <= 1 || !matches!(light.kind, LightKind::Directional { .. }) {
             continue;
         }
+        crate::technique::params::cascade_support(&light.shadow.technique).map_err(|why| {
+            Error::Invalid(format!(
+                "light[{i}]: {} cascades of technique \"{}\": {why}",
+                c.count,
+                light.shadow.technique.name()
+            ))
+        })?;
         let camera = cascade_camera(scene)?;
         let slices = fit_slices(
             &camera,
