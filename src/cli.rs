@@ -8,7 +8,7 @@ use crate::gpu::Gpu;
 use crate::graph::cost::fetches::Fetches;
 use crate::io::{deinterleave, write_exr, write_png};
 use crate::kernels;
-use crate::render::{Frame, RenderOptions, Renderer, plan_lights};
+use crate::render::{DrawnLights, Frame, RenderOptions, Renderer, drawn_lights, plan_lights};
 use crate::scene::{Light, Scene};
 use crate::technique;
 
@@ -16,17 +16,18 @@ use crate::technique;
 /// per texel and its visibility function's fetches per pixel (no GPU needed).
 pub fn plan(scene: &Path, dot: bool) -> Result<String> {
     let scene = Scene::load(scene)?;
-    let sp = plan_lights(&scene.lights)?;
+    let drawn = drawn_lights(&scene)?;
+    let sp = plan_lights(&drawn.lights)?;
     if dot {
         return Ok(sp.plan.to_dot());
     }
-    let labels: Vec<String> = scene.lights.iter().map(|l| l.label()).collect();
-    let fetches = shading_fetches(&scene.lights)?;
-    let per_light = (0..scene.lights.len())
+    let labels = drawn_labels(&scene, &drawn);
+    let fetches = shading_fetches(&drawn.lights)?;
+    let per_light = (0..drawn.lights.len())
         .map(|i| {
             let mut s = sp.plan.cost_text(i)?;
             let _ = writeln!(s, "    raster: {}", raster_passes(&sp.plan, i));
-            let name = scene.lights[i].shadow.technique.name();
+            let name = drawn.lights[i].shadow.technique.name();
             let _ = writeln!(s, "    shade: {name} {} fetches/pixel", fetches[i]);
             Ok(s)
         })
@@ -51,6 +52,41 @@ fn raster_passes(plan: &crate::graph::Plan, i: usize) -> String {
         );
     }
     s
+}
+
+/// One label per drawn light: a cascade names its scene light, its view-distance range and
+/// its half-width (the renderer draws cascade 0 in the scene light's place and the others
+/// after every scene light).
+fn drawn_labels(scene: &Scene, drawn: &DrawnLights) -> Vec<String> {
+    let ranges = |i: usize| -> Vec<(f32, f32)> {
+        let c = scene.lights[i].shadow.cascades;
+        let Ok(camera) = crate::render::cascade_camera(scene) else {
+            return Vec::new();
+        };
+        let fars =
+            crate::model::cascades::split_distances(camera.near, camera.far, c.count, c.lambda)
+                .unwrap_or_default();
+        let nears = std::iter::once(camera.near).chain(fars.iter().copied());
+        nears.zip(fars.iter().copied()).collect()
+    };
+    (0..drawn.lights.len())
+        .map(|k| {
+            let (i, c) = drawn.owner(k);
+            let light = &drawn.lights[k];
+            match drawn.groups.iter().find(|g| g.light == i) {
+                None => light.label(),
+                Some(g) => {
+                    let (near, far) = ranges(i).get(c).copied().unwrap_or((0.0, 0.0));
+                    format!(
+                        "{}, cascade {c} of {} of light {i} (view distances {near:.2}–{far:.2}, half-width {:.3})",
+                        light.label(),
+                        g.count,
+                        0.5 * light.width_at_unit()
+                    )
+                }
+            }
+        })
+        .collect()
 }
 
 /// Per light, the texture fetches per pixel of its visibility function in the shading kernel

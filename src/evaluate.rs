@@ -310,6 +310,10 @@ pub fn evaluate(
         for l in &mut s.lights {
             l.shadow.technique = c.technique;
             l.shadow_map = c.shadow_map;
+            // A technique that refuses cascades (the soft ones) runs on the light's one map.
+            if crate::technique::params::cascade_support(&c.technique).is_err() {
+                l.shadow.cascades = crate::model::Cascades::SINGLE;
+            }
         }
         let linear = match linear.entry(c.shadow_map) {
             std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),

@@ -106,6 +106,22 @@ pub struct LightGpu {
     /// Distance from the light's position to its target (the directional emitter's rays run
     /// from each emitter point to the target, as in `truth::emitter`).
     pub target_distance: f32,
+    /// Cascades (appended): the camera's eye, from which a pixel's view distance is measured.
+    pub cascade_eye: [f32; 3],
+    /// Cascades of this directional light (0 or 1: one map; this entry is cascade 0).
+    pub cascade_count: u32,
+    /// Cascades: the camera's unit forward direction.
+    pub cascade_forward: [f32; 3],
+    /// Cascades: index in the shading pass's lights of cascade 1 (the rest follow).
+    pub cascade_first: u32,
+    /// Cascades: the view distance the first cascade starts at.
+    pub cascade_near: f32,
+    /// Cascades: the blend band, a fraction of each cascade's view-distance range.
+    pub cascade_blend: f32,
+    /// Padding.
+    pub cascade_pad: [f32; 2],
+    /// Cascades: each cascade's far view distance, cascade `c` at `[c / 4][c % 4]`.
+    pub cascade_far: [[f32; 4]; 2],
 }
 
 /// Technique id of `hard` (`LightGpu::technique`; `TECHNIQUE_HARD` in

@@ -2,12 +2,14 @@
 //! the generated shading kernel ([`Renderer`]). Also [`probe`], which evaluates visibility at
 //! given points on given maps (how tests compare the GPU to the f64 references).
 
+mod cascade;
 mod probe;
 mod renderer;
 mod targets;
 
 use bytemuck::Zeroable;
 
+pub use self::cascade::{DrawnLights, cascade_camera, drawn_lights, view_range};
 pub use self::probe::{ProbeMap, probe};
 pub use self::renderer::{Renderer, ShadowRaster};
 use crate::error::{Error, Result};
@@ -100,9 +102,22 @@ pub fn check_render(device: &wgpu::Device, scene: &Scene, opts: &RenderOptions) 
             opts.repeat
         )));
     }
-    let sp = plan_lights_for(&scene.lights, opts)?;
+    let drawn = drawn_lights(scene)?;
+    let sp = plan_lights_for(&drawn.lights, opts)?;
+    // A cascaded scene is checked as the lights it draws (its visibility buffer counted for
+    // every cascade: an over-estimate).
+    let expanded;
+    let checked = if drawn.groups.is_empty() {
+        scene
+    } else {
+        expanded = Scene {
+            lights: drawn.lights.clone(),
+            ..scene.clone()
+        };
+        &expanded
+    };
     crate::limits::check_scene(
-        scene,
+        checked,
         &sp,
         &device.limits(),
         device.features(),
@@ -283,7 +298,7 @@ pub fn read_sat_map(
 fn read_extras(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
-    scene: &Scene,
+    drawn: &DrawnLights,
     sp: &ScenePlan,
     outputs: &Outputs,
     targets: &targets::Targets,
@@ -299,8 +314,8 @@ fn read_extras(
     frame.position = bytemuck::cast_slice(&read_texture(device, queue, &targets.gpos, 0)?).to_vec();
     frame.normal = bytemuck::cast_slice(&read_texture(device, queue, &targets.gnorm, 0)?).to_vec();
     for (i, input) in sp.shade_inputs.iter().enumerate() {
-        let coding = technique::sat_coding(&scene.lights[i])?;
-        let channels = technique::map_channels(&scene.lights[i]);
+        let coding = technique::sat_coding(&drawn.lights[i])?;
+        let channels = technique::map_channels(&drawn.lights[i]);
         let maps = input
             .maps
             .iter()

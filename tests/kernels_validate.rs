@@ -26,6 +26,7 @@ fn light(technique: Technique) -> Light {
             slope_bias: 1.0,
             normal_bias: 1.0,
             receiver_plane: 0.0,
+            cascades: shadowgraph::model::Cascades::SINGLE,
         },
     }
 }

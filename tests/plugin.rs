@@ -289,6 +289,11 @@ fn stage_outputs_equal_the_renderers() {
         let vertices = scene.vertices();
         let lights = scene.lights.len();
         for (li, light) in scene.lights.iter().enumerate() {
+            if light.shadow.cascades.count > 1 {
+                // The renderer draws a cascaded light as one map per cascade (tests/scenes.rs
+                // checks them per pixel); a host fits its own (`prefilter::cascades`).
+                continue;
+            }
             let what = format!("{name} light {li} ({})", light.shadow.technique.name());
             let params = LightParams::from_light(light);
             let depth = host_depth(

@@ -691,6 +691,7 @@ fn plans_hold_exactly_what_each_light_needs() {
             slope_bias: 1.0,
             normal_bias: 1.0,
             receiver_plane: 0.0,
+            cascades: shadowgraph::model::Cascades::SINGLE,
         },
     };
     let blur = Filter::Blur {

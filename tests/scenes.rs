@@ -7,9 +7,8 @@ use std::path::{Path, PathBuf};
 
 use shadowgraph::Error;
 use shadowgraph::cpu::{self, Map, Texels};
-use shadowgraph::render::{RenderOptions, Renderer};
+use shadowgraph::render::{DrawnLights, RenderOptions, Renderer, drawn_lights};
 use shadowgraph::scene::{PcfKernel, Scene, Technique};
-use shadowgraph::technique::LightGpu;
 
 fn scenes() -> Vec<PathBuf> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
@@ -27,18 +26,19 @@ fn scenes() -> Vec<PathBuf> {
     v
 }
 
-/// Reference visibility of light `li` at pixel `px` and its tolerance, if robust (soft
-/// techniques: also where the propagated errors could flip the blocker threshold).
+/// Reference visibility of drawn light `k` (a scene light, or one of a cascaded light's
+/// cascades) at pixel `px` and its tolerance, if robust (soft techniques: also where the
+/// propagated errors could flip the blocker threshold).
 fn pixel_reference(
     scene: &Scene,
     frame: &shadowgraph::render::Frame,
     moments: &[Texels],
     soft: Option<&common::soft::SoftInputs>,
-    li: usize,
+    (drawn, k): (&DrawnLights, usize),
     px: usize,
 ) -> Option<(f64, f64)> {
-    let light = &scene.lights[li];
-    let lg = LightGpu::new(light);
+    let light = &drawn.lights[k];
+    let lg = drawn.gpu[k];
     let p = &frame.position[4 * px..4 * px + 3];
     let n = &frame.normal[4 * px..4 * px + 3];
     let p = glam::DVec3::new(p[0].into(), p[1].into(), p[2].into());
@@ -69,7 +69,7 @@ fn pixel_reference(
     let size = light.shadow_map as usize;
     let map = Map {
         size,
-        texels: &frame.shade_maps[li].data,
+        texels: &frame.shade_maps[k].data,
     };
     let vis = |t: &cpu::light::LightSample| {
         if let Some(soft) = soft {
@@ -201,6 +201,7 @@ fn every_scene_renders_and_matches_the_references() {
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let name = path.file_name().unwrap().to_string_lossy().to_string();
         let lights = scene.lights.len();
+        let drawn = drawn_lights(&scene).expect("drawn lights");
         assert!(
             frame
                 .visibility
@@ -221,6 +222,10 @@ fn every_scene_renders_and_matches_the_references() {
             "{name}: rasterized non-finite depth"
         );
         for li in 0..lights {
+            if drawn.groups.iter().any(|g| g.light == li) {
+                cascades::check_light(&scene, &frame, &drawn, li);
+                continue;
+            }
             check_prefilter_chain(&scene, &frame, li);
             let sm = &frame.shade_maps[li];
             let level0 =
@@ -243,7 +248,7 @@ fn every_scene_renders_and_matches_the_references() {
                 }
                 covered += 1;
                 if let Some((r, t)) =
-                    pixel_reference(&scene, &frame, &moments, soft.as_ref(), li, px)
+                    pixel_reference(&scene, &frame, &moments, soft.as_ref(), (&drawn, li), px)
                 {
                     gpu_v.push(frame.visibility[px * lights + li]);
                     ref_v.push(r);
@@ -823,6 +828,10 @@ fn every_technique_renders_every_bundled_scene() {
             (scene.width, scene.height) = (120, 90);
             for l in &mut scene.lights {
                 l.shadow.technique = t;
+                // Soft techniques refuse cascades (`params::cascade_support`): one map.
+                if shadowgraph::technique::params::cascade_support(&t).is_err() {
+                    l.shadow.cascades = shadowgraph::model::Cascades::SINGLE;
+                }
                 l.shadow_map = l.shadow_map.min(512);
                 // PCSS and the soft techniques model an area light (scenes require a size).
                 if t.soft().is_some() && l.size <= 0.0 {
@@ -854,5 +863,175 @@ fn every_technique_renders_every_bundled_scene() {
                 "{what}: no shadow at all"
             );
         }
+    }
+}
+
+/// A cascaded directional light: every pixel's visibility against the f64 pick of its cascade
+/// (`cpu::cascade`) and the per-cascade references on the maps the GPU made, blended in f64.
+mod cascades {
+    use super::*;
+
+    /// The maps a cascade's visibility reads (with the mips filter, the chain rebuilt in f64).
+    fn moments(frame: &shadowgraph::render::Frame, technique: Technique, k: usize) -> Vec<Texels> {
+        let sm = &frame.shade_maps[k];
+        let level0 = Texels::from_f32(sm.width as usize, sm.height as usize, sm.channels, &sm.data);
+        match technique.filter() {
+            Some(shadowgraph::scene::Filter::Mips { .. }) => {
+                cpu::mips::mip_chain(&level0, matches!(technique, Technique::Esm { .. }))
+            }
+            _ => vec![level0],
+        }
+    }
+
+    /// Checks light `li`'s visibility at every robust covered pixel. Tolerance: each cascade's
+    /// own (as for a single map), blended with the pick's weights, plus the f32 error of the
+    /// blend weight — the view distance's rounding, 8 · 2⁻²⁴ of the distances involved, over
+    /// the band — times the two cascades' difference. Pixels within that rounding of a split
+    /// (where f32 may pick the other cascade) are skipped; at least 1% of the checked pixels
+    /// lie inside a blend band.
+    pub fn check_light(
+        scene: &Scene,
+        frame: &shadowgraph::render::Frame,
+        drawn: &DrawnLights,
+        li: usize,
+    ) {
+        let group = drawn
+            .groups
+            .iter()
+            .find(|g| g.light == li)
+            .expect("cascaded");
+        let technique = scene.lights[li].shadow.technique;
+        let maps: Vec<Vec<Texels>> = (0..group.count)
+            .map(|c| moments(frame, technique, group.index(c)))
+            .collect();
+        let lg = drawn.gpu[li];
+        let lights = scene.lights.len();
+        let (mut gpu_v, mut ref_v, mut tol, mut covered, mut banded) =
+            (Vec::new(), Vec::new(), Vec::new(), 0, 0);
+        let mut used = vec![0usize; group.count];
+        for px in 0..(frame.width * frame.height) as usize {
+            if frame.position[4 * px + 3] == 0.0 {
+                continue;
+            }
+            covered += 1;
+            let q = &frame.position[4 * px..4 * px + 3];
+            let p = glam::DVec3::new(q[0].into(), q[1].into(), q[2].into());
+            let pick = cpu::cascade::pick(&lg, p);
+            let eye = glam::DVec3::from_array(lg.cascade_eye.map(f64::from));
+            let rounding =
+                8.0 * 2f64.powi(-24) * (pick.distance.abs() + pick.far + p.length() + eye.length());
+            // Within f32's rounding of a split the GPU may pick the neighbour: skipped.
+            let split_near = (0..group.count - 1)
+                .any(|c| (pick.distance - cpu::cascade::cascade_far(&lg, c)).abs() < rounding);
+            if split_near {
+                continue;
+            }
+            let reference = |c: usize| {
+                pixel_reference(scene, frame, &maps[c], None, (drawn, group.index(c)), px)
+            };
+            let Some((v0, t0)) = reference(pick.index) else {
+                continue;
+            };
+            let in_band = pick.band > 0.0 && pick.distance > pick.far - pick.band - rounding;
+            let (v, t) = if in_band {
+                let Some((v1, t1)) = reference(pick.index + 1) else {
+                    continue;
+                };
+                banded += 1;
+                let dt = rounding / pick.band;
+                let w = pick.blend;
+                (
+                    v0 + (v1 - v0) * w,
+                    (1.0 - w) * t0 + w * t1 + (v1 - v0).abs() * dt + 1e-6,
+                )
+            } else {
+                (v0, t0)
+            };
+            used[pick.index] += 1;
+            gpu_v.push(frame.visibility[px * lights + li]);
+            ref_v.push(v);
+            tol.push(t);
+        }
+        let what = format!("light {li} in {} cascades", group.count);
+        assert!(
+            gpu_v.len() * 10 >= covered * 9,
+            "{what}: only {} of {covered} pixels robust",
+            gpu_v.len()
+        );
+        assert!(
+            used.iter().all(|&n| n > 0),
+            "{what}: a cascade shades no pixel ({used:?})"
+        );
+        assert!(
+            banded * 100 >= gpu_v.len(),
+            "{what}: only {banded} of {} pixels in a blend band",
+            gpu_v.len()
+        );
+        let shadowed = ref_v.iter().filter(|&&v| v < 0.5).count();
+        assert!(
+            shadowed * 200 > ref_v.len(),
+            "{what}: casts almost no shadow ({shadowed} pixels)"
+        );
+        common::assert_within(&what, &gpu_v, &ref_v, &tol);
+    }
+}
+
+/// The cascaded street view with the other techniques that take cascades: each cascade's map
+/// prefiltered by the same graph (hard; VSM blurred; MSM through a float table; ESM mipmapped),
+/// every pixel against the f64 pick and references (`cascades::check_light`).
+#[test]
+fn cascaded_techniques_match_the_references() {
+    use shadowgraph::scene::{BlurKernel, Filter, Prefilter, Storage};
+    let g = common::gpu();
+    let mut renderer = Renderer::new(&g.device);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/city_street.toml");
+    let mut scene = Scene::load(&path).expect("scene loads");
+    let blur = Filter::Blur {
+        radius: 2.0,
+        sigma: 1.0,
+        kernel: BlurKernel::Gaussian,
+    };
+    let table = Filter::Sat {
+        width: 3.0,
+        variant: shadowgraph::sat::SatVariant::Float,
+    };
+    let pre = |storage, filter| Prefilter { storage, filter };
+    for t in [
+        Technique::Hard,
+        Technique::Vsm {
+            prefilter: pre(Storage::F32, blur),
+            bleed: 0.2,
+            min_variance: 1e-5,
+        },
+        Technique::Msm {
+            prefilter: pre(Storage::F32, table),
+            hausdorff: false,
+            moment_bias: 3e-5,
+            bleed: 0.0,
+        },
+        Technique::Esm {
+            filter: Filter::Mips {
+                width: 2.0,
+                max_anisotropy: 0,
+            },
+            exponent: 40.0,
+        },
+    ] {
+        scene.lights[0].shadow.technique = t;
+        let frame = renderer
+            .render(
+                &g.device,
+                &g.queue,
+                &scene,
+                RenderOptions {
+                    aux: true,
+                    repeat: 1,
+                    dump: false,
+                },
+            )
+            .unwrap_or_else(|e| panic!("{}: {e}", t.name()));
+        let drawn = drawn_lights(&scene).expect("drawn lights");
+        assert_eq!(drawn.lights.len(), 4, "{}: four cascades drawn", t.name());
+        cascades::check_light(&scene, &frame, &drawn, 0);
     }
 }

@@ -51,6 +51,14 @@ struct Light {
     smrt_steps: u32,         // smrt: depth-map samples per ray
     smrt_max_slope: f32,     // smrt: cap on the receding slope extrapolated behind an occluder
     target_distance: f32,    // position–target distance (directional emitter rays, smrt)
+    cascade_eye: vec3<f32>,  // cascades (directional): the camera's eye
+    cascade_count: u32,      // cascades: 0 or 1 one map; N: this entry is cascade 0 of N
+    cascade_forward: vec3<f32>, // cascades: the camera's unit forward direction
+    cascade_first: u32,      // cascades: index in `lights` of cascade 1 (the rest follow)
+    cascade_near: f32,       // cascades: view distance the first cascade starts at
+    cascade_blend: f32,      // cascades: blend band, fraction of each cascade's range
+    cascade_pad: vec2<f32>,
+    cascade_far: array<vec4<f32>, 2>, // cascades: far view distance of cascade c at [c / 4][c % 4]
 }
 
 // `Light::technique` (keep in sync with the `TECHNIQUE_*` constants of src/gpu_data.rs; a test

@@ -327,6 +327,7 @@ fn bench_light(n: u32, technique: Technique) -> Light {
             slope_bias: 0.0,
             normal_bias: 0.0,
             receiver_plane: 0.0,
+            cascades: crate::model::Cascades::SINGLE,
         },
     }
 }

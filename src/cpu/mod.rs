@@ -3,6 +3,7 @@
 
 pub mod blocker;
 pub mod blur;
+pub mod cascade;
 pub mod csm;
 pub mod csm_z;
 pub mod esm;

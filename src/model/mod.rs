@@ -3,6 +3,7 @@
 //! scene parser (`scene`), the plug-in's config (`prefilter`) and the technique registry
 //! (`technique`) all build or read these values.
 
+pub mod cascades;
 mod defaults;
 mod params;
 mod sat_variant;
@@ -17,6 +18,7 @@ pub use params::{
 
 use glam::{Mat4, Vec3};
 
+pub use cascades::Cascades;
 pub use sat_variant::SatVariant;
 
 /// A perspective camera.
@@ -380,6 +382,8 @@ pub struct Shadow {
     /// Receiver-plane depth bias: the cap on each tap's depth correction along the receiver's
     /// plane, linear depth units; 0 off (`bias_mode = "constant"`).
     pub receiver_plane: f32,
+    /// Cascades of a directional light ([`Cascades::SINGLE`]: one map).
+    pub cascades: Cascades,
 }
 
 /// A light.

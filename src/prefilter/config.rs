@@ -501,6 +501,7 @@ impl LightParams {
                 slope_bias: 0.0,
                 normal_bias: config.normal_bias,
                 receiver_plane: config.receiver_plane,
+                cascades: crate::model::Cascades::SINGLE,
             },
         }
     }

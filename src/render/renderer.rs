@@ -20,6 +20,7 @@ pub use raster::ShadowRaster;
 pub(super) use raster::depth_only_view;
 use raster::{clear_depth, raster_pass};
 
+use super::cascade::{DrawnLights, drawn_lights};
 use super::targets::{TargetKey, Targets};
 use super::{Frame, RenderOptions, ScenePlan, check_render, plan_lights_for};
 
@@ -89,16 +90,17 @@ impl Renderer {
         &mut self,
         device: &wgpu::Device,
         scene: &Scene,
+        drawn: &DrawnLights,
         vertices: usize,
     ) -> Result<Targets> {
-        let key = TargetKey::new(scene, vertices);
+        let key = TargetKey::new(scene, drawn, vertices);
         if let Some(t) = self.targets.take().filter(|t| t.key == key) {
             return Ok(t);
         }
         // The shading bind groups refer to the old targets; both go before new ones are made.
         self.binding = None;
         let mut raster_layouts = Vec::new();
-        for l in &scene.lights {
+        for l in &drawn.lights {
             let first = self.shadow_pipeline(device, l.shadow.slope_bias)?.1.clone();
             let peel = if technique::peels(&l.shadow.technique) {
                 Some(self.peel_pipeline(device, l.shadow.slope_bias)?.1.clone())
@@ -118,11 +120,25 @@ impl Renderer {
         device: &wgpu::Device,
         lights: &[Light],
     ) -> Result<Arc<ComputeKernel>> {
-        self.executor
-            .kernels
-            .get_keyed(device, &technique::shade_key(lights), "shade", || {
-                technique::shading_block(lights)
-            })
+        self.shade_kernel_cascaded(device, lights, &[])
+    }
+
+    /// [`Renderer::shade_kernel`] for drawn lights with cascades
+    /// ([`technique::shading_block_cascaded`]).
+    fn shade_kernel_cascaded(
+        &mut self,
+        device: &wgpu::Device,
+        lights: &[Light],
+        groups: &[technique::CascadeGroup],
+    ) -> Result<Arc<ComputeKernel>> {
+        let key = if groups.is_empty() {
+            technique::shade_key(lights)
+        } else {
+            technique::shade_key_cascaded(lights, groups)
+        };
+        self.executor.kernels.get_keyed(device, &key, "shade", || {
+            technique::shading_block_cascaded(lights, groups)
+        })
     }
 
     /// Makes `wgsl` (the shading kernel rewritten with the same bindings) the kernel
@@ -148,15 +164,16 @@ impl Renderer {
         opts: RenderOptions,
     ) -> Result<Frame> {
         check_render(device, scene, &opts)?;
-        let mut sp = plan_lights_for(&scene.lights, &opts)?;
+        let drawn = drawn_lights(scene)?;
+        let mut sp = plan_lights_for(&drawn.lights, &opts)?;
         if opts.dump {
             // Everything is read back after the frame: no resource may share a texture.
             sp.plan = sp.plan.unaliased();
         }
         let vertices = scene.vertices();
-        let mut targets = self.take_targets(device, scene, vertices.len())?;
-        targets.upload(queue, scene, &vertices);
-        let run = self.frames(device, queue, &sp, &targets, scene, opts.repeat.max(1));
+        let mut targets = self.take_targets(device, scene, &drawn, vertices.len())?;
+        targets.upload(queue, scene, &drawn, &vertices);
+        let run = self.frames(device, queue, &sp, &targets, &drawn, opts.repeat.max(1));
         let read = run.and_then(|(timings, wall_ms, outputs)| {
             let (rgba, visibility) = targets.read_back(device, queue)?;
             let sanitized = outputs.read_stats(device)?;
@@ -178,7 +195,7 @@ impl Renderer {
                 linear_maps: Vec::new(),
                 resources: Vec::new(),
             };
-            super::read_extras(device, queue, scene, &sp, &outputs, &targets, opts, frame)
+            super::read_extras(device, queue, &drawn, &sp, &outputs, &targets, opts, frame)
         });
         self.targets = Some(targets);
         read
@@ -194,12 +211,12 @@ impl Renderer {
         queue: &wgpu::Queue,
         sp: &ScenePlan,
         targets: &Targets,
-        scene: &Scene,
+        drawn: &DrawnLights,
         repeat: u32,
     ) -> Result<(Vec<Vec<(String, f64)>>, Vec<f64>, Outputs)> {
-        let kernel = self.shade_kernel(device, &scene.lights)?;
+        let kernel = self.shade_kernel_cascaded(device, &drawn.lights, &drawn.groups)?;
         let peels = targets.lights.iter().filter(|t| t.peel.is_some()).count();
-        let spans = (scene.lights.len() + peels) as u32 + sp.plan.steps.len() as u32 + 2;
+        let spans = (drawn.lights.len() + peels) as u32 + sp.plan.steps.len() as u32 + 2;
         let mut timer = match self.timer.take() {
             Some(t) if t.span_capacity() >= spans => Some(t),
             _ => GpuTimer::new(device, queue, spans),
@@ -215,7 +232,7 @@ impl Renderer {
                 &mut enc,
                 sp,
                 targets,
-                scene,
+                &drawn.lights,
                 &kernel,
                 timer.as_mut(),
             )?;
@@ -248,11 +265,11 @@ impl Renderer {
         enc: &mut wgpu::CommandEncoder,
         sp: &ScenePlan,
         targets: &Targets,
-        scene: &Scene,
+        lights: &[Light],
         kernel: &Arc<ComputeKernel>,
         mut timer: Option<&mut GpuTimer>,
     ) -> Result<Outputs> {
-        for (l, t) in scene.lights.iter().zip(&targets.lights) {
+        for (l, t) in lights.iter().zip(&targets.lights) {
             let (pipeline, _) = self.shadow_pipeline(device, l.shadow.slope_bias)?;
             raster_pass(
                 enc,

@@ -12,6 +12,7 @@ use crate::scene::{Scene, Vertex};
 use crate::technique::{self, LightGpu};
 
 use super::FrameGpu;
+use super::cascade::DrawnLights;
 
 /// Usage of textures the renderer writes and later reads back or samples.
 pub(super) const TARGET: wgpu::TextureUsages = wgpu::TextureUsages::RENDER_ATTACHMENT
@@ -24,10 +25,12 @@ pub(super) const TARGET: wgpu::TextureUsages = wgpu::TextureUsages::RENDER_ATTAC
 pub(super) struct TargetKey {
     /// Image size.
     pub size: (u32, u32),
-    /// Per light: shadow-map side and slope-scaled bias (its raster pipeline's key).
+    /// Per drawn light: shadow-map side and slope-scaled bias (its raster pipeline's key).
     pub lights: Vec<(u32, u32)>,
     /// Per light: whether it rasterizes a second, peeled depth ([`technique::peels`]).
     pub peels: Vec<bool>,
+    /// The scene's lights: the visibility channels.
+    pub visible: usize,
     /// Vertex buffer bytes.
     pub vertex_bytes: u64,
     /// Materials.
@@ -35,20 +38,21 @@ pub(super) struct TargetKey {
 }
 
 impl TargetKey {
-    /// The key of `scene` with `vertices`.
-    pub fn new(scene: &Scene, vertices: usize) -> Self {
+    /// The key of `scene` drawing `drawn` with `vertices`.
+    pub fn new(scene: &Scene, drawn: &DrawnLights, vertices: usize) -> Self {
         Self {
             size: (scene.width, scene.height),
-            lights: scene
+            lights: drawn
                 .lights
                 .iter()
                 .map(|l| (l.shadow_map, l.shadow.slope_bias.to_bits()))
                 .collect(),
-            peels: scene
+            peels: drawn
                 .lights
                 .iter()
                 .map(|l| technique::peels(&l.shadow.technique))
                 .collect(),
+            visible: drawn.visible,
             vertex_bytes: (vertices * std::mem::size_of::<Vertex>()) as u64,
             materials: scene.objects.len(),
         }
@@ -296,7 +300,7 @@ impl Targets {
         }
         let color = color_target(device, size);
         let pixels = u64::from(size.0) * u64::from(size.1);
-        let vis_bytes = pixels * key.lights.len().max(1) as u64 * 4;
+        let vis_bytes = pixels * key.visible.max(1) as u64 * 4;
         let light_bytes = (key.lights.len() * std::mem::size_of::<LightGpu>()) as u64;
         let frame_bytes = std::mem::size_of::<FrameGpu>() as u64;
         Self {
@@ -360,7 +364,13 @@ impl Targets {
 
     /// Writes `scene`'s data into the kept buffers (staged by the queue before the next
     /// submission): vertices, materials, lights, the frame constants and every view·projection.
-    pub fn upload(&mut self, queue: &wgpu::Queue, scene: &Scene, vertices: &[Vertex]) {
+    pub fn upload(
+        &mut self,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+        drawn: &DrawnLights,
+        vertices: &[Vertex],
+    ) {
         queue.write_buffer(&self.vertices, 0, bytemuck::cast_slice(vertices));
         self.vertex_count = vertices.len() as u32;
         let materials: Vec<[f32; 4]> = scene
@@ -369,8 +379,7 @@ impl Targets {
             .map(|o| o.color.extend(1.0).to_array())
             .collect();
         queue.write_buffer(&self.materials, 0, bytemuck::cast_slice(&materials));
-        let lights: Vec<LightGpu> = scene.lights.iter().map(LightGpu::new).collect();
-        queue.write_buffer(&self.light_data, 0, bytemuck::cast_slice(&lights));
+        queue.write_buffer(&self.light_data, 0, bytemuck::cast_slice(&drawn.gpu));
         let frame = FrameGpu::new(scene, scene.width, scene.height);
         queue.write_buffer(&self.frame, 0, bytemuck::bytes_of(&frame));
         let camera = scene
@@ -378,7 +387,7 @@ impl Targets {
             .view_proj(scene.width as f32 / scene.height as f32)
             .to_cols_array();
         queue.write_buffer(&self.camera, 0, bytemuck::cast_slice(&camera));
-        for (t, l) in self.lights.iter().zip(&scene.lights) {
+        for (t, l) in self.lights.iter().zip(&drawn.lights) {
             let vp = (l.projection() * l.view()).to_cols_array();
             queue.write_buffer(&t.view_proj, 0, bytemuck::cast_slice(&vp));
         }
@@ -419,7 +428,7 @@ impl Targets {
             .flat_map(|r| &r[..4 * w as usize])
             .copied()
             .collect();
-        let pixels = (u64::from(w) * u64::from(h)) as usize * self.key.lights.len();
+        let pixels = (u64::from(w) * u64::from(h)) as usize * self.key.visible;
         let mut vis: Vec<f32> =
             bytemuck::cast_slice(&read_buffer(device, &self.visibility_readback)?).to_vec();
         vis.truncate(pixels);

@@ -106,6 +106,12 @@ pub struct ShadowFile {
     pub bias_mode: Option<Spanned<String>>,
     /// Cap on a tap's receiver-plane depth correction (linear depth units).
     pub receiver_plane_cap: Option<Spanned<f64>>,
+    /// Directional lights: number of cascades (1: one map).
+    pub cascades: Option<Spanned<i64>>,
+    /// The practical split's blend of logarithmic and uniform.
+    pub cascade_lambda: Option<Spanned<f64>>,
+    /// The blend band between neighbouring cascades, a fraction of each one's range.
+    pub cascade_blend: Option<Spanned<f64>>,
     /// PCF radius in texels.
     pub radius: Option<Spanned<i64>>,
     /// PCF weights: `box`, `tent` or `hardware`.

@@ -167,8 +167,24 @@ fn light(ctx: &Ctx, i: usize, l: &LightFile) -> Result<Light> {
             slope_bias: 1.0,
             normal_bias: 1.0,
             receiver_plane: 0.0,
+            cascades: crate::model::Cascades::SINGLE,
         },
     };
+    if shadow.cascades.count > 1 && matches!(kind, LightKind::Spot { .. }) {
+        let span = l
+            .shadow
+            .as_ref()
+            .and_then(|s| s.cascades.as_ref())
+            .map(|v| v.span());
+        return Err(ctx.err(
+            span,
+            format!(
+                "`{}` = {} needs a directional light: cascades split a sun's view range, a spot light has one frustum",
+                key("shadow.cascades"),
+                shadow.cascades.count
+            ),
+        ));
+    }
     if crate::technique::of(&shadow.technique).area_light && size <= 0.0 {
         let span = l.size.as_ref().map(|s| s.span()).or(Some(l.kind.span()));
         return Err(ctx.err(

@@ -9,7 +9,10 @@ use super::ctx::Ctx;
 use super::format::ShadowFile;
 use crate::error::{Error, Result};
 use crate::model::{ParamSource, ParamValue};
-use crate::technique::{self, ClampReason, REGISTRY, params::COMMON};
+use crate::technique::{
+    self, ClampReason, REGISTRY,
+    params::{CASCADES, COMMON},
+};
 
 /// A key's value as written.
 enum Raw<'a> {
@@ -103,6 +106,9 @@ fn raw<'a>(s: &'a ShadowFile, key: &str) -> Option<Raw<'a>> {
         "rays" => i(&s.rays),
         "steps" => i(&s.steps),
         "max_slope" => n(&s.max_slope),
+        "cascades" => i(&s.cascades),
+        "cascade_lambda" => n(&s.cascade_lambda),
+        "cascade_blend" => n(&s.cascade_blend),
         _ => None,
     }
 }
@@ -211,6 +217,18 @@ pub(super) fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
     let receiver_plane =
         technique::params::receiver_plane(&crate::model::check(def.params, &table)?);
     let common = crate::model::check(&[COMMON], &table)?;
+    let cascades = technique::params::cascades(&crate::model::check(&[CASCADES], &table)?);
+    if cascades.count > 1 {
+        if let Err(why) = technique::params::cascade_support(&technique) {
+            return Err(table.not_applicable(
+                "cascades",
+                &format!(
+                    "= {} does not apply to technique \"{name}\": {why}",
+                    cascades.count
+                ),
+            ));
+        }
+    }
     let float = |k| match common.get(k) {
         Some(ParamValue::Float(v)) => v,
         _ => 0.0,
@@ -221,5 +239,6 @@ pub(super) fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
         slope_bias: float("slope_bias"),
         normal_bias: float("normal_bias"),
         receiver_plane,
+        cascades,
     })
 }

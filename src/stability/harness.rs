@@ -243,6 +243,7 @@ pub(crate) fn light(kind: LightKind, technique: Technique, map: u32, bias: f32) 
             slope_bias: 0.0,
             normal_bias: 1.0,
             receiver_plane: 0.0,
+            cascades: crate::model::Cascades::SINGLE,
         },
     }
 }

@@ -5,6 +5,7 @@
 //! it. The graph nodes, GPU fields and visibility calls of every technique are in
 //! `nodes.rs`, `light_gpu.rs` and `shade.rs`.
 
+mod cascade_shade;
 mod csm;
 mod csm_sat;
 mod cssm;
@@ -33,6 +34,7 @@ pub use crate::gpu_data::{
 };
 pub use crate::model::mip_levels;
 use crate::model::{Light, ParamSource, ParamSpec, ParamValues, Technique};
+pub use cascade_shade::{CascadeGroup, shade_key_cascaded};
 pub use csm::{csm_maps, csm_z_channels, csm_z_maps};
 pub use csm_sat::{CsmBasis, CsmSatParams, add_csm_tables};
 use light_gpu::unit_range;
@@ -43,7 +45,9 @@ pub use nodes::{add_light_nodes, depth_name, linear_name, map_channels, map_type
 pub use params::{Clamp, ClampReason, sat_exponent_limit};
 pub use reference::parameters_markdown;
 pub use second_depth::{peels, second_depth_name};
-pub use shade::{ShadeInput, VisibilityBody, shade_key, shading_block, visibility_body};
+pub use shade::{
+    ShadeInput, VisibilityBody, shade_key, shading_block, shading_block_cascaded, visibility_body,
+};
 pub use sweep_plan::{SweepPlan, SweepVariant, SweptStorages, SweptTerms};
 
 /// One technique as the front ends see it (a struct of plain functions, so the registry is a

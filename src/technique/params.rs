@@ -538,3 +538,64 @@ pub fn sat_exponent_limit(filter: &Filter, esm: bool) -> Option<f32> {
     let c = 0.5 * (f64::from(1u32 << 22) / area).ln().max(0.02);
     Some(if esm { 4.0 * c } else { c } as f32)
 }
+
+/// The cascade keys of a directional light (checked for every technique; only a directional
+/// light with a technique [`cascade_support`] accepts may ask for more than one).
+pub const CASCADES: &[ParamSpec] = &[
+    int(
+        "cascades",
+        1,
+        crate::model::cascades::MAX_CASCADES as i64,
+        1,
+        "directional lights: cascades split the camera's view range (1: one map over the light's extent); each cascade is its own `shadow_map`² map, prefiltered by the same graph",
+    ),
+    float(
+        "cascade_lambda",
+        0.0,
+        1.0,
+        0.5,
+        "the practical split: 0 uniform, 1 logarithmic, between a blend of the two",
+    ),
+    float(
+        "cascade_blend",
+        0.0,
+        0.5,
+        0.1,
+        "blend band at the far end of each cascade but the last, as a fraction of its view-distance range: the visibility fades to the next cascade's across it",
+    ),
+];
+
+/// `Shadow::cascades` of checked [`CASCADES`] values.
+pub fn cascades(v: &ParamValues) -> crate::model::Cascades {
+    let mut c = crate::model::Cascades::SINGLE;
+    if let Some(ParamValue::Int(n)) = v.get("cascades") {
+        c.count = n;
+    }
+    if let Some(ParamValue::Float(x)) = v.get("cascade_lambda") {
+        c.lambda = x;
+    }
+    if let Some(ParamValue::Float(x)) = v.get("cascade_blend") {
+        c.blend = x;
+    }
+    c
+}
+
+/// Whether a technique works in cascades: `Err` says why not. A soft technique's penumbra is
+/// a light-size estimate in one map's texels and UV (`max_search`, the blocker search, SMRT's
+/// rays), whose scale changes from one cascade to the next, so its shadow would jump at each
+/// split: those are refused rather than blended.
+pub fn cascade_support(t: &crate::model::Technique) -> Result<(), &'static str> {
+    use crate::model::Technique as T;
+    match t {
+        T::Hard | T::Pcf { .. } | T::Vsm { .. } | T::Evsm { .. } | T::Esm { .. } => Ok(()),
+        T::Msm { .. } | T::Csm { .. } => Ok(()),
+        T::Pcss { .. } | T::Smrt { .. } | T::Cssm { .. } | T::Vssm { .. } | T::MsmSoft { .. } => {
+            Err(
+                "soft techniques size their penumbra in one map's texels, which change from one cascade to the next; use hard, pcf, vsm, evsm2, evsm4, esm, msm or csm",
+            )
+        }
+        T::Midpoint { .. } | T::SecondDepth { .. } => {
+            Err("second-depth techniques are not yet drawn in cascades; use hard, pcf, vsm, evsm2, evsm4, esm, msm or csm")
+        }
+    }
+}

@@ -19,6 +19,12 @@ pub fn parameters_markdown() -> String {
          ## Every technique\n\n",
     );
     table(&mut s, &[params::COMMON]);
+    s.push_str(
+        "\n## Directional cascades\n\nKeys of every technique's table on a directional light; \
+         more than one cascade is refused for a spot light and for the soft techniques (`pcss`, \
+         `smrt`, `cssm`, `vssm`, `msm_soft`) — see [Cascades](SCENES.md#cascades).\n\n",
+    );
+    table(&mut s, &[params::CASCADES]);
     for def in REGISTRY {
         let _ = write!(s, "\n## `{}`\n\n{}\n\n", def.name, def.doc);
         if def.params.iter().all(|t| t.is_empty()) {

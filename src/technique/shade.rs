@@ -8,6 +8,7 @@ use crate::graph::Graph;
 use crate::model::{Filter, Light};
 use crate::sat::SatVariant;
 
+use super::cascade_shade::{CASCADE_MODULE, CascadeGroup, cascade_functions};
 use super::light_gpu::sat_variant;
 use super::nodes::add_light_nodes;
 
@@ -150,6 +151,16 @@ pub fn shade_key(lights: &[Light]) -> String {
 /// light index. A receiver that faces away from a light reads 0 and one outside its map 1,
 /// without a lookup (`light_faces`, `LightSample::inside`).
 pub fn shading_block(lights: &[Light]) -> String {
+    shading_block_cascaded(lights, &[])
+}
+
+/// [`shading_block`] where the lights `groups` name are cascaded: `lights` holds the scene's
+/// lights (a cascaded one as its cascade 0) followed by every group's further cascades, each
+/// a light of its own (bindings and visibility function); `light_visibility` dispatches on the
+/// scene's lights only, and a cascaded light's case picks its cascade per pixel
+/// ([`super::cascade_shade`]).
+pub fn shading_block_cascaded(lights: &[Light], groups: &[CascadeGroup]) -> String {
+    let visible = lights.len() - groups.iter().map(|g| g.extra()).sum::<usize>();
     let mut imports: Vec<&str> = Vec::new();
     let mut bindings = String::new();
     let mut cases = String::new();
@@ -182,21 +193,20 @@ pub fn shading_block(lights: &[Light]) -> String {
             "fn light{i}_visibility(l: Light, s: LightSample) -> f32 {{\n    {}\n}}",
             vis.body
         );
-        // Only anisotropic mip lookups read the footprint (two more projections per pixel).
-        let footprint = match light.shadow.technique.filter() {
-            Some(Filter::Mips { max_anisotropy, .. }) if max_anisotropy > 0 => {
-                "\n            s.footprint = light_footprint(l, s, p, n, dpdx, dpdy);"
+        if i >= visible {
+            continue;
+        }
+        let body = match groups.iter().find(|g| g.light == i) {
+            Some(g) => {
+                functions.push_str(&cascade_functions(g, lights));
+                if !imports.contains(&CASCADE_MODULE) {
+                    imports.push(CASCADE_MODULE);
+                }
+                format!("\n            return light{i}_cascaded(p, n, dpdx, dpdy);")
             }
-            _ => "",
+            None => light_case(i, light),
         };
-        let _ = writeln!(
-            cases,
-            "        case {i}u: {{\n            let l = lights[{i}];\n            \
-             if !light_faces(l, p, n) {{\n                return 0.0;\n            }}\n            \
-             var s = light_sample(l, p, n);\n            \
-             if !s.inside {{\n                return 1.0;\n            }}{footprint}\n            \
-             return light{i}_visibility(l, s);\n        }}"
-        );
+        let _ = writeln!(cases, "        case {i}u: {{{body}\n        }}");
     }
     let mut s = String::new();
     for m in imports {
@@ -209,4 +219,23 @@ pub fn shading_block(lights: &[Light]) -> String {
         "fn light_visibility(i: u32, p: vec3<f32>, n: vec3<f32>, dpdx: vec3<f32>, dpdy: vec3<f32>) -> f32 {{\n    switch i {{\n{cases}        default: {{ return 1.0; }}\n    }}\n}}\n"
     );
     s
+}
+
+/// The statements of light `i`'s case: whether the receiver faces it, where it lands in the
+/// map, and its visibility function.
+pub(super) fn light_case(i: usize, light: &Light) -> String {
+    // Only anisotropic mip lookups read the footprint (two more projections per pixel).
+    let footprint = match light.shadow.technique.filter() {
+        Some(Filter::Mips { max_anisotropy, .. }) if max_anisotropy > 0 => {
+            "\n            s.footprint = light_footprint(l, s, p, n, dpdx, dpdy);"
+        }
+        _ => "",
+    };
+    format!(
+        "\n            let l = lights[{i}];\n            \
+         if !light_faces(l, p, n) {{\n                return 0.0;\n            }}\n            \
+         var s = light_sample(l, p, n);\n            \
+         if !s.inside {{\n                return 1.0;\n            }}{footprint}\n            \
+         return light{i}_visibility(l, s);"
+    )
 }

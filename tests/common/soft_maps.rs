@@ -154,6 +154,7 @@ pub fn light(kind: LightKind, technique: Technique) -> Light {
             slope_bias: 0.0,
             normal_bias: 1.0,
             receiver_plane: 0.0,
+            cascades: shadowgraph::model::Cascades::SINGLE,
         },
     }
 }

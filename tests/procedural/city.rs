@@ -20,22 +20,69 @@ const PALETTE: [[f64; 3]; 5] = [
 
 /// The scene file.
 pub fn scene() -> String {
-    let pitch = BLOCK + STREET;
-    let span = BLOCKS as f64 * pitch - STREET;
     let mut t = Toml::new(
         &[
             "Demonstrates a wide depth range under one large directional light: a city of 4 x 4 \
              blocks with buildings 1.5 to 19 units tall seen from above one corner, the nearest \
              street 44 units from the camera and the farthest 91.",
-            "No cascades yet: one 1024^2 map covers the whole city and its shadows (5.5 cm texels), \
-             so near buildings get no finer shadows than far ones; the frustum is fitted to the \
-             city, not to the view. Cascades would split it by camera distance.",
+            "One 1024^2 map covers the whole city and its shadows (5.5 cm texels), so near \
+             buildings get no finer shadows than far ones; the frustum is fitted to the city, \
+             not to the view. `city_street.toml` is the same city from the street, in cascades.",
         ],
         [0.12, 0.12, 0.14],
         (480, 360),
         [0.6, 0.7, 0.85],
         ([36.0, 33.0, 44.0], [1.0, 0.0, -1.0], 45.0),
     );
+    sun(
+        &mut t,
+        1024,
+        vec![
+            "technique = \"msm\"".into(),
+            "format = \"f16\"                        # 16-bit quantized moments over a wide depth range"
+                .into(),
+            "filter = \"sat\"".into(),
+            "filter_width = 3.0".into(),
+            "bias = 0.001".into(),
+        ],
+    );
+    city(t)
+}
+
+/// `scenes/city_street.toml`: the same city seen from a street corner, the nearest facade a
+/// few units from the camera and the far side of the city 60 away, under the same sun in four
+/// cascades of 512² (the memory of one 1024² map).
+pub fn street_scene() -> String {
+    let mut t = Toml::new(
+        &[
+            "Demonstrates cascaded shadow maps: the city of `city.toml` seen from a street corner at \
+             head height, the view running from ~1 unit to ~70 across the city.",
+            "Four 512^2 cascades (the memory of one 1024^2 map) split the camera's view range with \
+             the practical split (lambda 0.7) and blend over the last 10% of each; with \
+             `cascades = 1` the one map spans the whole city (5.5 cm texels at 1024^2).",
+        ],
+        [0.12, 0.12, 0.14],
+        (480, 360),
+        [0.6, 0.7, 0.85],
+        ([0.8, 2.5, 26.0], [-2.5, 1.0, -20.0], 60.0),
+    );
+    sun(
+        &mut t,
+        512,
+        vec![
+            "technique = \"pcf\"".into(),
+            "radius = 1".into(),
+            "bias = 0.001".into(),
+            "cascades = 4".into(),
+            "cascade_lambda = 0.7".into(),
+            "cascade_blend = 0.1".into(),
+        ],
+    );
+    city(t)
+}
+
+/// The sun both views share, with a `map`² map and these `[light.shadow]` lines.
+fn sun(t: &mut Toml, map: u32, shadow: Vec<String>) {
     t.sun(&Sun {
         comment: vec![
             "Sun 45 degrees up, from the left and in front: shadows as long as the buildings are"
@@ -56,15 +103,15 @@ pub fn scene() -> String {
         size: 2.0,
         color: [1.0, 0.96, 0.88],
         intensity: 1.2,
-        shadow: vec![
-            "technique = \"msm\"".into(),
-            "format = \"f16\"                        # 16-bit quantized moments over a wide depth range"
-                .into(),
-            "filter = \"sat\"".into(),
-            "filter_width = 3.0".into(),
-            "bias = 0.001".into(),
-        ],
+        shadow_map: map,
+        shadow,
     });
+}
+
+/// The ground and the blocks.
+fn city(mut t: Toml) -> String {
+    let pitch = BLOCK + STREET;
+    let span = BLOCKS as f64 * pitch - STREET;
     t.object(
         "plane",
         &[

@@ -49,6 +49,7 @@ pub fn scene() -> String {
         size: 0.8,
         color: [1.0, 0.86, 0.7],
         intensity: 1.3,
+        shadow_map: 1024,
         shadow: vec![
             "technique = \"pcss\"".into(),
             "blocker_samples = 16".into(),

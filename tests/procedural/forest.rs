@@ -41,6 +41,7 @@ pub fn scene() -> String {
         size: 1.5,
         color: [1.0, 0.95, 0.85],
         intensity: 1.1,
+        shadow_map: 1024,
         shadow: vec![
             "technique = \"pcss\"".into(),
             "blocker_samples = 16".into(),

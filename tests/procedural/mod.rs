@@ -24,6 +24,7 @@ pub fn files() -> Vec<(&'static str, Vec<u8>)> {
         ("forest.toml", forest::scene().into_bytes()),
         ("colonnade.toml", colonnade::scene().into_bytes()),
         ("city.toml", city::scene().into_bytes()),
+        ("city_street.toml", city::street_scene().into_bytes()),
         ("meshes/canopy.gltf", gltf.into_bytes()),
         ("meshes/canopy.bin", bin),
     ]
@@ -105,6 +106,8 @@ pub struct Sun {
     pub color: [f64; 3],
     /// Intensity.
     pub intensity: f64,
+    /// Shadow-map side.
+    pub shadow_map: u32,
     /// `[light.shadow]` lines.
     pub shadow: Vec<String>,
 }
@@ -165,7 +168,7 @@ impl Toml {
         let _ = writeln!(
             s,
             "[[light]]\nkind = \"directional\"\nposition = {}\ntarget = {}\nextent = {}\n\
-             near = {}\nfar = {}\nsize = {}\ncolor = {}\nintensity = {}\nshadow_map = 1024",
+             near = {}\nfar = {}\nsize = {}\ncolor = {}\nintensity = {}\nshadow_map = {}",
             v3(sun.position()),
             v3(sun.target),
             num(sun.extent),
@@ -173,7 +176,8 @@ impl Toml {
             num(sun.far),
             num(sun.size),
             v3(sun.color),
-            num(sun.intensity)
+            num(sun.intensity),
+            sun.shadow_map
         );
         let _ = writeln!(s, "\n[light.shadow]");
         for line in &sun.shadow {

@@ -1,0 +1,190 @@
+//! Cascaded shadow maps for a directional light, the math both the renderer and the plug-in's
+//! host helper (`prefilter::cascades`) use: the practical split of the camera's view range,
+//! and each slice's bounding sphere with its centre snapped to the cascade's texel grid in the
+//! light's fixed orientation (so a world point keeps its place within a texel as the camera
+//! moves, and the half-width does not change as it turns).
+
+use glam::{Mat4, Vec3};
+
+use crate::error::StageError;
+
+/// Cascades one light may have.
+pub const MAX_CASCADES: u32 = 8;
+
+/// How a directional light's shadow is split into cascades (`[light.shadow]` keys `cascades`,
+/// `cascade_lambda`, `cascade_blend`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cascades {
+    /// Number of cascades, 1–[`MAX_CASCADES`]; 1 is the light's single map.
+    pub count: u32,
+    /// 0: uniform split, 1: logarithmic; the practical split blends the two.
+    pub lambda: f32,
+    /// The blend band at the far end of each cascade but the last, as a fraction of the
+    /// cascade's view-distance range: across it the visibility fades to the next cascade's.
+    pub blend: f32,
+}
+
+impl Cascades {
+    /// One map: no cascades.
+    pub const SINGLE: Self = Self {
+        count: 1,
+        lambda: 0.5,
+        blend: 0.1,
+    };
+}
+
+/// The camera the cascades cover.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CascadeCamera {
+    /// World → camera view (right-handed, looking down −Z).
+    pub view: Mat4,
+    /// Full vertical field of view, radians.
+    pub fov_y: f32,
+    /// Width / height.
+    pub aspect: f32,
+    /// The view distance the first cascade starts at.
+    pub near: f32,
+    /// The view distance the last cascade ends at (the shadow distance).
+    pub far: f32,
+}
+
+/// One cascade's slice of the camera's view and the sphere that bounds it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CascadeSlice {
+    /// The view distance it starts at.
+    pub near: f32,
+    /// The view distance it ends at.
+    pub far: f32,
+    /// The bounding sphere's centre (world), snapped to the cascade's texel grid across the
+    /// light's direction.
+    pub center: Vec3,
+    /// The bounding sphere's radius: the cascade map's half-width.
+    pub radius: f32,
+}
+
+fn bad(field: &'static str, message: String) -> StageError {
+    StageError::Config {
+        field: field.into(),
+        message,
+    }
+}
+
+/// The far distance of each cascade, the practical split (Zhang et al. 2006):
+/// `d_i = λ · n · (f / n)^(i / N) + (1 − λ) · (n + (f − n) · i / N)`, `i = 1 … N`; the last is `far`.
+pub fn split_distances(
+    near: f32,
+    far: f32,
+    count: u32,
+    lambda: f32,
+) -> Result<Vec<f32>, StageError> {
+    if !(1..=MAX_CASCADES).contains(&count) {
+        return Err(bad(
+            "cascades",
+            format!("{count} is outside 1..={MAX_CASCADES}"),
+        ));
+    }
+    if !(0.0..=1.0).contains(&lambda) {
+        return Err(bad("cascade_lambda", format!("{lambda} is outside [0, 1]")));
+    }
+    if !(near.is_finite() && far.is_finite() && near > 0.0 && far > near) {
+        return Err(bad(
+            "cascade near/far",
+            format!("need 0 < near < far, finite; got near {near}, far {far}"),
+        ));
+    }
+    let (n, f) = (f64::from(near), f64::from(far));
+    Ok((1..=count)
+        .map(|i| {
+            let t = f64::from(i) / f64::from(count);
+            let log = n * (f / n).powf(t);
+            let uniform = n + (f - n) * t;
+            (f64::from(lambda) * log + (1.0 - f64::from(lambda)) * uniform) as f32
+        })
+        .collect())
+}
+
+/// The light's fixed orientation for `direction` (unit): what texel snapping is done in.
+pub fn light_rotation(direction: Vec3) -> (Mat4, Vec3) {
+    let up = if direction.y.abs() > 0.99 {
+        Vec3::Z
+    } else {
+        Vec3::Y
+    };
+    (Mat4::look_to_rh(Vec3::ZERO, direction, up), up)
+}
+
+/// The slices of `camera`'s view for `count` cascades split with `lambda`, each with its
+/// bounding sphere snapped to the grid of a `map_size`² map in the orientation of a light
+/// shining along `direction`.
+pub fn fit_slices(
+    camera: &CascadeCamera,
+    direction: Vec3,
+    count: u32,
+    lambda: f32,
+    map_size: u32,
+) -> Result<Vec<CascadeSlice>, StageError> {
+    if !direction.is_finite() || direction.length_squared() < 1e-12 {
+        return Err(bad("direction", format!("{direction} is not a direction")));
+    }
+    if !(camera.fov_y > 0.0
+        && camera.fov_y < 3.1
+        && camera.aspect > 0.0
+        && camera.aspect.is_finite())
+    {
+        return Err(bad(
+            "camera",
+            format!(
+                "fov_y {} and aspect {} must be positive (fov below π)",
+                camera.fov_y, camera.aspect
+            ),
+        ));
+    }
+    if map_size == 0 {
+        return Err(bad("map_size", "need map_size > 0".into()));
+    }
+    let fars = split_distances(camera.near, camera.far, count, lambda)?;
+    let to_world = camera.view.inverse();
+    let (rotation, _) = light_rotation(direction.normalize());
+    let mut near = camera.near;
+    let mut out = Vec::with_capacity(fars.len());
+    for far in fars {
+        let (center, radius) = slice_sphere(camera, near, far);
+        let texel = 2.0 * radius / map_size as f32;
+        let c = rotation.transform_point3(to_world.transform_point3(center));
+        let snapped = Vec3::new(
+            (c.x / texel).round() * texel,
+            (c.y / texel).round() * texel,
+            c.z,
+        );
+        out.push(CascadeSlice {
+            near,
+            far,
+            center: rotation.inverse().transform_point3(snapped),
+            radius,
+        });
+        near = far;
+    }
+    Ok(out)
+}
+
+/// The bounding sphere of the frustum slice between view distances `near` and `far`, in view
+/// space: centred on the view axis, through the far corners and (where they are farther) the
+/// near ones. It depends only on the slice's shape, so turning the camera does not change the
+/// radius. Rounded up to 1/64 of itself's binary order so float noise cannot change it.
+fn slice_sphere(camera: &CascadeCamera, near: f32, far: f32) -> (Vec3, f32) {
+    let t = (0.5 * camera.fov_y).tan();
+    // Squared half-diagonal of a slice rectangle per unit distance.
+    let k = t * t * (1.0 + camera.aspect * camera.aspect);
+    // Centre at distance z on the axis, equidistant from a near and a far corner:
+    // (z − n)² + k n² = (f − z)² + k f²  ⇒  z = (f + n)(1 + k) / 2.
+    let z = (0.5 * (far + near) * (1.0 + k)).min(far);
+    let r2 = ((far - z).powi(2) + k * far * far).max((z - near).powi(2) + k * near * near);
+    let radius = quantize_up(r2.sqrt());
+    (Vec3::new(0.0, 0.0, -z), radius)
+}
+
+/// `r` rounded up to a multiple of 2^(⌊log2 r⌋ − 6).
+fn quantize_up(r: f32) -> f32 {
+    let quantum = 2f32.powi(r.log2().floor() as i32 - 6);
+    (r / quantum).ceil() * quantum
+}
