@@ -1,10 +1,11 @@
-// Rasterized depth → exponential variance moments (Lauritzen): z' = 2z − 1 ∈ [−1, 1],
-//   pos = exp(c⁺ z'),  neg = −exp(−c⁻ z'),  stored (pos, pos², neg, neg²).
+// Rasterized depth → exponential variance moments (shared/evsm_moments), unfiltered: the map a
+// summed-area table, a mip chain or no filter reads (a blur reads the depth itself: `evsm_blur`).
 // EVSM2 binds an rg32float (or rgba16float) output and keeps (pos, pos²); EVSM4 keeps all four.
 // The scene clamps c to the storage's limit (42 for f32, 5.54 for f16) so pos² stays finite.
 
 // #import shared/exp_params
 // #import shared/linear_depth
+// #import shared/evsm_moments
 
 // Traffic (the cost model, src/graph/cost): one texel in, one out.
 // #traffic src: all
@@ -27,8 +28,5 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if !depth.finite {
         atomicAdd(&stats[0], 1u);
     }
-    let w = 2.0 * depth.z - 1.0;
-    let pos = exp(params.exp_pos * w);
-    let neg = -exp(-params.exp_neg * w);
-    textureStore(dst, id.xy, vec4<f32>(pos, pos * pos, neg, neg * neg));
+    textureStore(dst, id.xy, evsm_moments(depth.z, params.exp_pos, params.exp_neg));
 }

@@ -1,10 +1,12 @@
-// Rasterized depth → four moments (z, z², z³, z⁴) for moment shadow maps (Peters & Klein 2015).
+// Rasterized depth → four moments (z, z², z³, z⁴) for moment shadow maps (Peters & Klein 2015),
+// unfiltered: the map a summed-area table, a mip chain or no filter reads (a blur reads the depth
+// itself: `msm_blur`).
 // f32 storage keeps the raw powers; 16-bit storage (rgba16unorm, rgba16float) keeps the
 // optimized quantization of the paper's section 4.3: an affine map that spreads the moments of
 // any z ∈ [0, 1] over [0, 1] so 16 bits lose the least (shared/msm_quantize).
 // Storage: rgba32float by default; the executor re-declares `dst` for the bound format.
 
-// #import shared/msm_quantize
+// #import shared/msm_moments
 // #import shared/linear_depth
 
 // Keep in sync with `MsmParams` in src/gpu_data.rs.
@@ -37,11 +39,5 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if !depth.finite {
         atomicAdd(&stats[0], 1u);
     }
-    let z = depth.z;
-    let z2 = z * z;
-    var b = vec4<f32>(z, z2, z2 * z, z2 * z2);
-    if params.quantized == 1u {
-        b = msm_quantize(b);
-    }
-    textureStore(dst, id.xy, b);
+    textureStore(dst, id.xy, msm_moments(depth.z, params.quantized == 1u));
 }

@@ -1,15 +1,12 @@
-// Rasterized depth → variance-shadow-map moments (Donnelly & Lauritzen 2006):
-//   (z, z² + ¼ (∂z/∂x² + ∂z/∂y²))
-// The derivative term (GPU Gems 3, ch. 8) is the variance of a planar surface across one
-// texel, so a lit plane is not self-shadowed. In compute there is no rasterizer derivative:
-// each partial is the smaller in magnitude of the forward and backward difference, so a
-// silhouette (a jump on one side only) does not inflate the variance of the surface beside it.
+// Rasterized depth → variance-shadow-map moments (shared/vsm_moments), unfiltered: the map a
+// summed-area table, a mip chain or no filter reads (a blur reads the depth itself: `vsm_blur`).
 // The depth is linearized here (shared/linear_depth), texel by texel as it is read: no linear
 // map is written in between. Non-finite depth becomes 1.0 and is counted once, at the texel's own
 // invocation.
 // Storage: rg32float by default; the executor re-declares `dst` for f16 (rgba16float).
 
 // #import shared/linear_depth
+// #import shared/vsm_moments
 
 // Keep in sync with `VsmParams` in src/gpu_data.rs.
 struct Params {
@@ -32,13 +29,6 @@ fn depth_at(p: vec2<i32>, size: vec2<i32>) -> f32 {
     return linear_depth(textureLoad(src, clamp(p, vec2<i32>(0), size - 1), 0).r, params.depth);
 }
 
-// The one-sided difference of smaller magnitude.
-fn partial(z: f32, before: f32, after: f32) -> f32 {
-    let forward = after - z;
-    let backward = z - before;
-    return select(backward, forward, abs(forward) < abs(backward));
-}
-
 @compute @workgroup_size(WG_SIZE, WG_SIZE)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = vec2<i32>(textureDimensions(src));
@@ -51,7 +41,12 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         atomicAdd(&stats[0], 1u);
     }
     let z = depth.z;
-    let dx = partial(z, depth_at(p - vec2<i32>(1, 0), size), depth_at(p + vec2<i32>(1, 0), size));
-    let dy = partial(z, depth_at(p - vec2<i32>(0, 1), size), depth_at(p + vec2<i32>(0, 1), size));
-    textureStore(dst, p, vec4<f32>(z, z * z + 0.25 * (dx * dx + dy * dy), 0.0, 0.0));
+    let m = vsm_moments(
+        z,
+        depth_at(p - vec2<i32>(1, 0), size),
+        depth_at(p + vec2<i32>(1, 0), size),
+        depth_at(p - vec2<i32>(0, 1), size),
+        depth_at(p + vec2<i32>(0, 1), size)
+    );
+    textureStore(dst, p, vec4<f32>(m, 0.0, 0.0));
 }

@@ -4,6 +4,12 @@ use crate::graph::{Dispatch, Graph, LevelView, Node, SizeRule, SubDispatch};
 use crate::kernels::KernelId;
 use crate::model::{BlurKernel, Filter};
 
+mod encode_blur;
+
+pub use self::encode_blur::{
+    ENCODE_BLUR_ROW, ENCODE_BLUR_TILE, ENCODE_BLUR_TILE_RADIUS, EncodeBlur, add_encode_blur,
+};
+
 /// Taps each side the blur kernel's weight table holds.
 pub const MAX_BLUR_RADIUS: u32 = 32;
 
@@ -101,44 +107,59 @@ pub fn add_filter(
             kernel,
         } => (radius, sigma, kernel),
     };
-    let (kernel_id, col_per) = match mode {
-        BlurMode::Linear => (KernelId::Blur, BLUR_COL_PER),
-        BlurMode::LogSumExp => (KernelId::BlurLog, BLUR_PER_INVOCATION),
-    };
     let mut src = input.to_string();
     for (axis, pass) in [(0, "blur_h"), (1, "blur_v")] {
-        let out = graph.resource(
-            format!("{input}.{pass}"),
-            format,
-            SizeRule::Reduced {
-                of: input.to_string(),
-                shift: 0,
-            },
-            Some(light),
-        );
-        graph.node(Node {
-            name: format!("{input}.{pass}"),
-            kernel: kernel_id,
-            inputs: vec![("src".into(), src)],
-            outputs: vec![("dst".into(), out.clone())],
-            params: bytemuck::bytes_of(&BlurParams::new(axis, radius, sigma, kernel, mode))
-                .to_vec(),
-            // Rows: a workgroup per BLUR_GROUP · PER texels of a row; columns: a workgroup per
-            // BLUR_GROUP columns × the kernel's rows per column invocation.
-            dispatch: Dispatch::Blocks {
-                of: out.clone(),
-                x: if axis == 0 {
-                    BLUR_GROUP * BLUR_PER_INVOCATION
-                } else {
-                    BLUR_GROUP
-                },
-                y: if axis == 0 { 1 } else { col_per },
-            },
-            light: Some(light),
-        });
-        src = out;
+        let params = BlurParams::new(axis, radius, sigma, kernel, mode);
+        let name = format!("{input}.{pass}");
+        src = add_blur_pass(graph, light, [&src, input, &name], format, params);
     }
     src
+}
+
+/// Adds the node of one pass of `blur` or `blur_log` (by `params.mode`) along `params.axis`:
+/// `[src, shape, name]` reads `src` and writes `name`, of `format` and the size of `shape`;
+/// returns `name`.
+fn add_blur_pass(
+    graph: &mut Graph,
+    light: usize,
+    [src, shape, name]: [&str; 3],
+    format: wgpu::TextureFormat,
+    params: BlurParams,
+) -> String {
+    let (kernel_id, col_per) = match params.mode {
+        0 => (KernelId::Blur, BLUR_COL_PER),
+        _ => (KernelId::BlurLog, BLUR_PER_INVOCATION),
+    };
+    let out = graph.resource(
+        name.to_string(),
+        format,
+        SizeRule::Reduced {
+            of: shape.to_string(),
+            shift: 0,
+        },
+        Some(light),
+    );
+    let axis = params.axis;
+    graph.node(Node {
+        name: name.to_string(),
+        kernel: kernel_id,
+        inputs: vec![("src".into(), src.to_string())],
+        outputs: vec![("dst".into(), out.clone())],
+        params: bytemuck::bytes_of(&params).to_vec(),
+        // Rows: a workgroup per BLUR_GROUP · PER texels of a row; columns: a workgroup per
+        // BLUR_GROUP columns × the kernel's rows per column invocation.
+        dispatch: Dispatch::Blocks {
+            of: out.clone(),
+            x: if axis == 0 {
+                BLUR_GROUP * BLUR_PER_INVOCATION
+            } else {
+                BLUR_GROUP
+            },
+            y: if axis == 0 { 1 } else { col_per },
+        },
+        light: Some(light),
+    });
+    out
 }
 
 /// Parameters of `kernels/mips.wgsl` (mirrors its `Params`): one per dispatch of a mip chain

@@ -60,7 +60,7 @@ pub fn plan_lights(lights: &[Light]) -> Result<ScenePlan> {
 /// [`plan_lights`] for a render with `opts`: with `opts.aux` or `opts.dump`, each light's
 /// linear depth map ([`technique::linear_name`]) is an output too ([`Frame::linear_maps`],
 /// the dump; the encodings linearize the depth themselves, so it is planned only when asked
-/// for).
+/// for), and with `opts.dump` every map any node writes.
 pub fn plan_lights_for(lights: &[Light], opts: &RenderOptions) -> Result<ScenePlan> {
     let mut graph = Graph::default();
     let mut shade_inputs = Vec::new();
@@ -69,10 +69,19 @@ pub fn plan_lights_for(lights: &[Light], opts: &RenderOptions) -> Result<ScenePl
         shade_inputs.push(technique::add_light_nodes(&mut graph, i, l));
     }
     let linear: Vec<String> = (0..lights.len()).map(technique::linear_name).collect();
+    // The dump also asks for every map a node writes: the unfused encodings beside the fused
+    // encode-and-blur kernels' outputs (`light{i}.vsm` beside `light{i}.vsm.blur`).
+    let written: Vec<&str> = graph
+        .nodes
+        .iter()
+        .flat_map(|n| n.outputs.iter().map(|(_, r)| r.as_str()))
+        .filter(|_| opts.dump)
+        .collect();
     let diagnostics = linear
         .iter()
         .filter(|_| opts.aux || opts.dump)
-        .map(String::as_str);
+        .map(String::as_str)
+        .chain(written);
     let outputs: Vec<&str> = shade_inputs
         .iter()
         .flat_map(|s| s.maps.iter().map(String::as_str))

@@ -26,9 +26,13 @@ fn scene(name: &str) -> Scene {
 /// One node of a hand count: name suffix, dispatches, bytes read and written per texel.
 type Row = (&'static str, u32, f64, f64);
 
-/// Checks light 0's traffic in `scene` against `rows` (in plan order) and the totals.
+/// Checks light 0's traffic in scene file `name` against `rows` (in plan order) and the totals.
 fn assert_traffic(name: &str, rows: &[Row], total: f64, ideal: f64) {
-    let s = scene(name);
+    assert_scene_traffic(name, &scene(name), rows, total, ideal);
+}
+
+/// [`assert_traffic`] of the loaded scene `s` (`name` labels failures).
+fn assert_scene_traffic(name: &str, s: &Scene, rows: &[Row], total: f64, ideal: f64) {
     let plan = plan_lights(&s.lights).expect("plan").plan;
     let texels = cost::map_texels(&plan, 0);
     let nodes = cost::light_traffic(&plan, 0).expect("traffic");
@@ -58,26 +62,44 @@ fn assert_traffic(name: &str, rows: &[Row], total: f64, ideal: f64) {
     );
 }
 
-/// `vsm.toml`: a 512² map, f32 moments, a Gaussian blur of radius 3.
+/// `vsm.toml`: a 512² map, f32 moments, a Gaussian blur of radius 3: one dispatch, the
+/// encoding fused into both blur passes (issue 15's target: ≤ 2 dispatches, ≤ 28 B/texel).
 #[test]
 fn vsm_with_blur_moves_what_the_hand_count_says() {
     assert_traffic(
         "techniques/vsm.toml",
         &[
-            // The encoding reads the depth32float buffer itself (linearize fused): 16×16
-            // workgroups load their tile and the 4×16 texels of its cross-shaped halo (the
-            // four neighbours of the derivatives): 320/256 × 4 B; rg32float out.
-            ("vsm", 1, 5.0, 8.0),
-            // A row workgroup loads 64 × 8 texels of a row and 3 more on either side:
-            // 518/512 × 8 B.
-            ("blur_h", 1, 8.09375, 8.0),
-            // A column workgroup loads 64 columns of 32 + 2 × 3 texels (BLUR_COL_PER rows an
-            // invocation): 2432/2048 × 8 B.
-            ("blur_v", 1, 9.5, 8.0),
+            // `vsm_blur` reads the depth32float buffer itself: a 16 × 16 tile with a halo of
+            // r + 1 = 4 texels each side, (16 + 8)² / 256 × 4 B; rg32float out once.
+            ("vsm.blur", 1, 9.0, 8.0),
         ],
-        // 13 + 16.09375 + 17.5
-        46.59375,
+        17.0,
         // one read of the depth (4 B) + one write of the blurred moments (8 B)
+        12.0,
+    );
+}
+
+/// `vsm.toml` with a blur of radius 12, past the one-dispatch tile's 8: two dispatches, the
+/// encoding fused into the horizontal pass, then `blur`'s vertical pass.
+#[test]
+fn vsm_with_a_wide_blur_takes_two_dispatches() {
+    let path = scene_path("techniques/vsm.toml");
+    let text = std::fs::read_to_string(&path)
+        .expect("vsm.toml")
+        .replace("filter_radius = 3", "filter_radius = 12")
+        .replace("filter_sigma = 1.5", "filter_sigma = 6");
+    let s = Scene::parse(&path, &text).expect("parse");
+    assert_scene_traffic(
+        "vsm.toml at r = 12",
+        &s,
+        &[
+            // A row workgroup loads three rows (the derivatives' neighbours) of 256 + 2 × 13
+            // depths: 846/256 × 4 B; rg32float out.
+            ("vsm.blur_h", 1, 13.21875, 8.0),
+            // A column workgroup loads 64 columns of 32 + 2 × 12 texels: 56/32 × 8 B.
+            ("vsm.blur", 1, 14.0, 8.0),
+        ],
+        43.21875,
         12.0,
     );
 }
@@ -183,8 +205,8 @@ fn plan_prints_traffic_and_fetches() {
     let text = shadowgraph::cli::plan(&scene_path("techniques/vsm.toml"), false).expect("plan");
     for needle in [
         "traffic per texel of the 512² map:",
-        "reads    5.00 B, writes    8.00 B",
-        "total: 3 dispatches, 46.59 B/texel (one read + one write of the result: 12.00 B/texel)",
+        "reads    9.00 B, writes    8.00 B",
+        "total: 1 dispatch, 17.00 B/texel (one read + one write of the result: 12.00 B/texel)",
         "shade: vsm 4 fetches/pixel",
     ] {
         assert!(text.contains(needle), "`{needle}` missing:\n{text}");

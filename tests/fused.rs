@@ -1,6 +1,7 @@
 //! The fused encodings: each reads the rasterized depth and linearizes it itself
-//! (`kernels/shared/linear_depth.wgsl`), and `csm` writes up to four basis maps from one read
-//! (CSSM's tables, which compute the basis in their own passes, are in `tests/csm_sat.rs`).
+//! (`kernels/shared/linear_depth.wgsl`), `csm` writes up to four basis maps from one read
+//! (CSSM's tables, which compute the basis in their own passes, are in `tests/csm_sat.rs`), and
+//! the `*_blur` kernels encode and blur in one dispatch (two past `ENCODE_BLUR_TILE_RADIUS`).
 //! Run through the technique's own graph builder on a perspective (spot) depth buffer with
 //! NaN and ±Inf texels, every map is compared against the f64 pipeline
 //! `cpu::linearize` → the technique's `cpu` encoding, and every step must count each
@@ -18,7 +19,9 @@ use shadowgraph::graph::{Graph, plan, texel_bytes};
 use shadowgraph::scene::{Light, Scene};
 use shadowgraph::technique;
 
-const MAP: u32 = 67;
+/// Not a multiple of the 16 × 16 tiles, and wider than one 256-texel row workgroup, so every
+/// kind of edge of the fused blurs' workgroups is crossed.
+const MAP: u32 = 300;
 /// f32's unit roundoff.
 const U: f64 = 1.0 / (1u64 << 24) as f64;
 /// The perspective linearization is five roundings (`src/stability/stages.rs`, case 7).
@@ -217,4 +220,72 @@ fn csm_writes_basis_maps_from_one_read() {
     // 4 basis maps: one dispatch of four outputs.
     assert_eq!(basis, 4);
     assert_counted("csm", &stats, 1, replaced);
+}
+
+/// The encodings fused into the blur (`vsm_blur`, `evsm_blur`, `msm_blur`) against the f64
+/// composition of the independent references, encoding then both blur passes
+/// (`cpu::vsm_blur` and its siblings), on the random perspective depth with non-finite texels:
+/// at radius 3 (one dispatch, a 16 × 16 tile in workgroup memory) and 12 (past the tile's 8:
+/// the encoding fused into the horizontal pass, then `blur`'s vertical pass).
+#[test]
+fn fused_blurs_match_encode_then_blur() {
+    use shadowgraph::scene::BlurKernel;
+    let raw = raw_depth(12);
+    type Reference = fn(&Texels, f64, f64) -> Texels;
+    // (technique keys, encoding, f64 reference at (radius, σ), the encoding's atol and rtol as
+    // in `fused_encodings_match_linearize_then_encode`).
+    let cases: [(&str, &str, Reference, f64, f64); 4] = [
+        (
+            "technique = \"vsm\"\nformat = \"f32\"",
+            "light0.vsm",
+            |t, r, s| cpu::vsm_blur::vsm_blur(t, r, s, BlurKernel::Gaussian),
+            10.0 * U,
+            2.0 * LINEAR_RTOL + 3.0 * U,
+        ),
+        (
+            "technique = \"evsm2\"\nformat = \"f32\"\nexponent_pos = 5.0",
+            "light0.evsm",
+            |t, r, s| cpu::evsm_blur::evsm_blur(t, [5.0, 5.0], r, s, BlurKernel::Gaussian),
+            0.0,
+            2.0 * (10.0 * LINEAR_RTOL + 13.0 * U),
+        ),
+        (
+            "technique = \"evsm4\"\nformat = \"f32\"\nexponent_pos = 5.0\nexponent_neg = 5.0",
+            "light0.evsm",
+            |t, r, s| cpu::evsm_blur::evsm_blur(t, [5.0, 5.0], r, s, BlurKernel::Gaussian),
+            0.0,
+            2.0 * (10.0 * LINEAR_RTOL + 13.0 * U),
+        ),
+        (
+            "technique = \"msm\"\nformat = \"f32\"",
+            "light0.msm",
+            |t, r, s| cpu::msm_blur::msm_blur(t, false, r, s, BlurKernel::Gaussian),
+            0.0,
+            4.0 * LINEAR_RTOL + 4.0 * U,
+        ),
+    ];
+    for (radius, steps) in [(3u32, 1usize), (12, 1)] {
+        let sigma = f64::from(radius) / 2.0;
+        let filter =
+            format!("\nfilter = \"blur\"\nfilter_radius = {radius}\nfilter_sigma = {sigma}");
+        for (shadow, encoded, reference, atol, rtol) in cases {
+            let light = spot(&format!("{shadow}{filter}"));
+            let map = format!("{encoded}.blur");
+            let what = format!("{map} (r = {radius}, {shadow})");
+            let (maps, stats) = run(&light, &raw, std::slice::from_ref(&map));
+            let (lin, replaced) = linear(&light, &raw);
+            let want = reference(&lin, radius.into(), sigma);
+            let got = &maps[0];
+            let n = want.channels.min(got.channels);
+            let got: Vec<f32> = channels(got, 0, n).iter().map(|&v| v as f32).collect();
+            // The moments of one sign per channel, weighted by positive f32 weights (each
+            // rounded once, u) summing to 1: a pass's sum of r + 1 terms (the centre and r
+            // symmetric pairs, each pair one more addition) is off by at most (r + 3)·u of its
+            // value, and two passes by twice that, on top of the encoding's own error, which the
+            // normalized weights carry through unchanged.
+            let blur_rtol = 2.0 * (f64::from(radius) + 3.0) * U;
+            common::assert_close(&what, &got, &channels(&want, 0, n), atol, rtol + blur_rtol);
+            assert_counted(&what, &stats, steps, replaced);
+        }
+    }
 }

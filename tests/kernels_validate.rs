@@ -226,6 +226,19 @@ fn every_kernel_validates() {
         } else {
             vec![None]
         };
+        // A module its importers complete (`// #completed-by-importer`, e.g.
+        // shared/encode_blur: each kernel gives its encoding and `Params`) validates inside
+        // each kernel that imports it, and at least one must.
+        if s.text.contains("// #completed-by-importer") {
+            let import = format!("// #import {}", s.name);
+            if !SOURCES.iter().any(|k| k.text.contains(&import)) {
+                failures.push(format!(
+                    "{}: completed by importers, but none imports it",
+                    s.name
+                ));
+            }
+            continue;
+        }
         for block in blocks {
             let result = kernels::resolve(s.name, block.as_deref())
                 .and_then(|wgsl| kernels::reflect(s.name, &wgsl).map(|_| ()));
@@ -279,6 +292,7 @@ fn rust_mirrors_match_naga_layouts() {
         Some(size_of::<shadowgraph::render::FrameGpu>() as u32),
         "FrameGpu vs struct Frame"
     );
+    use shadowgraph::filter::BlurParams;
     use shadowgraph::technique::{
         CsmParams, CsmSatParams, ExpParams, MsmParams, SecondDepthParams, VsmParams,
     };
@@ -293,6 +307,13 @@ fn rust_mirrors_match_naga_layouts() {
         ("evsm", size_of::<ExpParams>()),
         ("esm", size_of::<ExpParams>()),
         ("msm", size_of::<MsmParams>()),
+        // The encodings fused into the blur: the encoding's parameters, then the blur's.
+        ("vsm_blur", size_of::<VsmParams>() + size_of::<BlurParams>()),
+        (
+            "evsm_blur",
+            size_of::<ExpParams>() + size_of::<BlurParams>(),
+        ),
+        ("msm_blur", size_of::<MsmParams>() + size_of::<BlurParams>()),
     ] {
         let wgsl = kernels::resolve(kernel, None).unwrap();
         let (m, _) = kernels::reflect(kernel, &wgsl).unwrap();
@@ -475,4 +496,27 @@ fn peel_epsilon_matches_the_wgsl() {
         ref e => panic!("PEEL_EPSILON is {e:?}, not an f32 literal"),
     };
     assert_eq!(value, shadowgraph::technique::PEEL_EPSILON);
+}
+
+#[test]
+fn encode_blur_dispatch_constants_match_the_wgsl() {
+    use shadowgraph::filter::{ENCODE_BLUR_ROW, ENCODE_BLUR_TILE, ENCODE_BLUR_TILE_RADIUS};
+    for kernel in ["vsm_blur", "evsm_blur", "msm_blur"] {
+        let wgsl = kernels::resolve(kernel, None).expect("resolve");
+        let (module, r) = kernels::reflect(kernel, &wgsl).expect("reflect");
+        for (name, rust) in [
+            ("TILE", ENCODE_BLUR_TILE),
+            ("ROW", ENCODE_BLUR_ROW),
+            ("TILE_RADIUS", ENCODE_BLUR_TILE_RADIUS),
+        ] {
+            assert_eq!(wgsl_const(&module, name), Some(rust), "{kernel}: {name}");
+        }
+        // One invocation per output of a tile and of a row.
+        assert_eq!(
+            r.workgroup_size,
+            Some([ENCODE_BLUR_TILE * ENCODE_BLUR_TILE, 1, 1]),
+            "{kernel}: workgroup"
+        );
+        assert_eq!(ENCODE_BLUR_ROW, ENCODE_BLUR_TILE * ENCODE_BLUR_TILE);
+    }
 }

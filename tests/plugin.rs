@@ -455,8 +455,8 @@ fn kernels_are_timed_when_the_device_can() {
     let _ = run_stage(&g, &mut stage, &depth, &params);
     let timings = stage.timings(&g.device).expect("timings");
     let names: Vec<&str> = timings.iter().map(|(n, _)| n.as_str()).collect();
-    // The encoding linearizes the depth itself: no `linearize` step.
-    assert_eq!(names, ["vsm", "vsm.blur_h", "vsm.blur_v"]);
+    // The encoding linearizes the depth itself and is fused into the blur: one step.
+    assert_eq!(names, ["vsm.blur"]);
     assert!(
         timings.iter().all(|(_, ms)| ms.is_finite() && *ms >= 0.0),
         "{timings:?}"

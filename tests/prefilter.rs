@@ -270,7 +270,7 @@ fn blur_of_a_constant_map_is_the_constant_up_to_the_edges() {
 }
 
 #[test]
-fn vsm_light_plans_encode_and_two_blur_passes_only() {
+fn vsm_light_plans_one_fused_encode_and_blur_only() {
     let text = std::fs::read_to_string(
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/techniques/vsm.toml"),
     )
@@ -283,12 +283,11 @@ fn vsm_light_plans_encode_and_two_blur_passes_only() {
         .iter()
         .map(|s| s.node.kernel.as_str())
         .collect();
-    // The encoding linearizes the depth itself: no `linearize` dispatch.
-    assert_eq!(kernels, ["vsm", "blur", "blur"]);
-    assert_eq!(sp.shade_inputs[0].maps, ["light0.vsm.blur_v"]);
-    // The encode's output is dead once blur_h has read it: blur_v (same shape) reuses it.
-    let slot = |r: &str| sp.plan.resource(r).unwrap().slot;
-    assert_eq!(slot("light0.vsm"), slot("light0.vsm.blur_v"));
+    // The encoding linearizes the depth itself and is fused into the blur: one dispatch.
+    assert_eq!(kernels, ["vsm_blur"]);
+    assert_eq!(sp.shade_inputs[0].maps, ["light0.vsm.blur"]);
+    // The unfused encoding stays in the graph for whoever asks, but nothing here does.
+    assert!(sp.plan.resource("light0.vsm").is_none());
 }
 
 #[test]
@@ -747,12 +746,12 @@ fn plans_hold_exactly_what_each_light_needs() {
     // The encodings read the depth themselves: no `linearize` for them.
     assert_eq!(kernels(0), ["linearize"]);
     assert_eq!(kernels(4), ["linearize"]);
-    assert_eq!(kernels(1), ["vsm", "blur", "blur"]);
+    assert_eq!(kernels(1), ["vsm_blur"]);
     assert_eq!(kernels(2), ["msm", "mips"]);
     // CSM with 3 terms: two basis maps, written by one dispatch and each blurred.
     let mut csm_kernels = kernels(3);
     csm_kernels.sort();
     assert_eq!(csm_kernels, ["blur", "blur", "blur", "blur", "csm"]);
     assert_eq!(sp.shade_inputs[3].maps.len(), 2);
-    assert_eq!(sp.plan.steps.len(), 1 + 3 + 2 + 5 + 1);
+    assert_eq!(sp.plan.steps.len(), 1 + 1 + 2 + 5 + 1);
 }

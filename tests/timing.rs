@@ -25,7 +25,7 @@ const FRAMES: usize = 3;
 /// holds the submission and the driver's command translation (about 1 ms on lavapipe against
 /// frames of 60–500 ms), so a true timer sits near 1.0; the old one read 0.45–0.6 with a blur.
 const SUM_TOLERANCE: f64 = 0.25;
-/// Blur radii: the large blur's taps are 65 against 7, so its passes cost 4× or more by the
+/// Blur radii: the large blur's taps are 65 against 7, so its passes cost 2.5× or more by the
 /// wall clock even on loaded cores (at 49 taps the premise read 2.4–3.7× on 2 cores shared
 /// with two builds, and the test missed all its attempts once).
 const SMALL_RADIUS: u32 = 3;
@@ -117,9 +117,11 @@ fn check(cpu: bool, none: &Frames, small: &Frames, large: &Frames) -> Result<(),
     // without it (all else is the same plan).
     let wall = |f: &Frames| median(f.wall.clone());
     let (true_small, true_large) = (wall(small) - wall(none), wall(large) - wall(none));
-    if true_large < 4.0 * true_small {
+    // The small blur is the encoding fused into both passes in workgroup memory, which
+    // llvmpipe runs slowly (2.8–3.1× below the large blur's two passes, measured 2026-11-23).
+    if true_large < 2.5 * true_small {
         misses.push(format!(
-            "premise: the large blur should cost ≥ 4× the small one by the wall clock, got \
+            "premise: the large blur should cost ≥ 2.5× the small one by the wall clock, got \
              {true_large:.1} ms against {true_small:.1} ms"
         ));
     }

@@ -28,6 +28,7 @@ pub use self::lookup::{LOOKUP_WIDTHS, LookupRow, format_lookup_table, lookup_cos
 pub use self::soft::{SOFT_LIGHT_SIZES, SOFT_TECHNIQUES, SoftRow, format_soft_table, soft_cost};
 use crate::error::{Error, Result};
 use crate::exec::Executor;
+use crate::filter::{BlurMode, add_filter};
 use crate::gpu::Gpu;
 use crate::graph::{Graph, Plan, cost};
 use crate::model::ParamValue;
@@ -85,39 +86,94 @@ pub const CASES: &[BenchCase] = &[
     },
     BenchCase {
         name: "vsm",
-        build: |n| stage_graph(n, vsm(), "light0.depth", "light0.vsm"),
+        build: |n| stage_graph(light_graph(n, vsm()), "light0.depth", "light0.vsm"),
     },
     BenchCase {
         name: "evsm4",
-        build: |n| stage_graph(n, evsm4(), "light0.depth", "light0.evsm"),
+        build: |n| stage_graph(light_graph(n, evsm4()), "light0.depth", "light0.evsm"),
     },
     BenchCase {
         name: "esm",
-        build: |n| stage_graph(n, esm(), "light0.depth", "light0.esm"),
+        build: |n| stage_graph(light_graph(n, esm()), "light0.depth", "light0.esm"),
     },
     BenchCase {
         name: "blur rg32f r4",
-        build: |n| stage_graph(n, vsm(), "light0.vsm", "light0.vsm.blur_v"),
+        build: |n| {
+            stage_graph(
+                unfused(n, vsm(), "light0.vsm"),
+                "light0.vsm",
+                "light0.vsm.blur_v",
+            )
+        },
     },
     BenchCase {
         name: "blur rg32f r32",
-        build: |n| stage_graph(n, vsm_blur(32.0), "light0.vsm", "light0.vsm.blur_v"),
+        build: |n| {
+            let graph = unfused(n, vsm_blur(32.0), "light0.vsm");
+            stage_graph(graph, "light0.vsm", "light0.vsm.blur_v")
+        },
     },
     BenchCase {
         name: "blur log r4",
-        build: |n| stage_graph(n, esm(), "light0.esm", "light0.esm.blur_v"),
+        build: |n| stage_graph(light_graph(n, esm()), "light0.esm", "light0.esm.blur_v"),
+    },
+    // Depth → blurred moments: the encoding fused into the blur (issue 15), and the chain it
+    // replaced (encode, blur_h, blur_v: the `(old)` rows) timed beside it.
+    BenchCase {
+        name: "vsm_blur r4",
+        build: |n| chain_graph(n, vsm(), &["light0.vsm.blur"]),
+    },
+    BenchCase {
+        name: "vsm+blur r4 (old)",
+        build: |n| old_chain(n, vsm(), "light0.vsm"),
+    },
+    BenchCase {
+        name: "vsm_blur r32 (2 passes)",
+        build: |n| chain_graph(n, vsm_blur(32.0), &["light0.vsm.blur"]),
+    },
+    BenchCase {
+        name: "vsm+blur r32 (old)",
+        build: |n| old_chain(n, vsm_blur(32.0), "light0.vsm"),
+    },
+    BenchCase {
+        name: "evsm_blur 4 r4",
+        build: |n| chain_graph(n, evsm4(), &["light0.evsm.blur"]),
+    },
+    BenchCase {
+        name: "evsm4+blur r4 (old)",
+        build: |n| old_chain(n, evsm4(), "light0.evsm"),
+    },
+    BenchCase {
+        name: "msm_blur r4",
+        build: |n| chain_graph(n, msm(Storage::F32), &["light0.msm.blur"]),
+    },
+    BenchCase {
+        name: "msm+blur r4 (old)",
+        build: |n| old_chain(n, msm(Storage::F32), "light0.msm"),
     },
     BenchCase {
         name: "msm",
-        build: |n| stage_graph(n, msm(Storage::F32), "light0.depth", "light0.msm"),
+        build: |n| {
+            stage_graph(
+                light_graph(n, msm(Storage::F32)),
+                "light0.depth",
+                "light0.msm",
+            )
+        },
     },
     BenchCase {
         name: "msm f16 quantized",
-        build: |n| stage_graph(n, msm(Storage::F16), "light0.depth", "light0.msm"),
+        build: |n| {
+            stage_graph(
+                light_graph(n, msm(Storage::F16)),
+                "light0.depth",
+                "light0.msm",
+            )
+        },
     },
     BenchCase {
         name: "csm (2 terms)",
-        build: |n| stage_graph(n, csm(), "light0.depth", "light0.csm0"),
+        build: |n| stage_graph(light_graph(n, csm()), "light0.depth", "light0.csm0"),
     },
     // Depth → encoded maps, whatever the dispatches (linearize fused into the encodings, CSM
     // maps four a dispatch since issue 15): timed against the chains of earlier builds.
@@ -148,7 +204,7 @@ pub const CASES: &[BenchCase] = &[
     },
     BenchCase {
         name: "mips rgba32f",
-        build: |n| stage_graph(n, msm_mips(), "light0.msm", "light0.msm.mips"),
+        build: |n| stage_graph(light_graph(n, msm_mips()), "light0.msm", "light0.msm.mips"),
     },
     BenchCase {
         name: "sat fixed",
@@ -247,11 +303,45 @@ fn chain_graph(n: u32, technique: Technique, outputs: &[&str]) -> BenchGraph {
     }
 }
 
-/// The stages of a light's shipped graph between `input` (made an import, its producers
-/// dropped by the planner) and `output`: one kernel or a filter's passes, timed alone.
-fn stage_graph(n: u32, technique: Technique, input: &str, output: &str) -> BenchGraph {
+/// A light's shipped graph at size `n`.
+fn light_graph(n: u32, technique: Technique) -> Graph {
     let mut graph = Graph::default();
     technique::add_light_nodes(&mut graph, 0, &bench_light(n, technique));
+    graph
+}
+
+/// A light's graph with the unfused linear blur over its `encoded` map added
+/// (`<encoded>.blur_h`, `<encoded>.blur_v`): the chain before the encoding was fused into the
+/// blur, and the standalone blur passes other representations still use.
+fn unfused(n: u32, technique: Technique, encoded: &str) -> Graph {
+    let filter = technique.filter();
+    let mut graph = light_graph(n, technique);
+    // The fused blur's nodes go: the fallback's `.blur_h` would clash with the unfused pass's.
+    let fused = format!("{encoded}.blur");
+    graph.nodes.retain(|node| !node.name.starts_with(&fused));
+    graph.resources.retain(|r| !r.name.starts_with(&fused));
+    if let Some(f) = filter {
+        add_filter(&mut graph, 0, encoded, &f, BlurMode::Linear);
+    }
+    graph
+}
+
+/// The unfused chain depth → `encoded` → `.blur_h` → `.blur_v` (see [`unfused`]), its depth
+/// an r32float import as in [`chain_graph`].
+fn old_chain(n: u32, technique: Technique, encoded: &str) -> BenchGraph {
+    let mut graph = unfused(n, technique, encoded);
+    for r in graph.resources.iter_mut().filter(|r| r.imported) {
+        r.format = wgpu::TextureFormat::R32Float;
+    }
+    BenchGraph {
+        graph,
+        outputs: vec![format!("{encoded}.blur_v")],
+    }
+}
+
+/// The stages of `graph` between `input` (made an import, its producers dropped by the
+/// planner) and `output`: one kernel or a filter's passes, timed alone.
+fn stage_graph(mut graph: Graph, input: &str, output: &str) -> BenchGraph {
     for r in graph.resources.iter_mut().filter(|r| r.name == input) {
         r.imported = true;
     }

@@ -8,10 +8,12 @@ pub mod csm;
 pub mod csm_z;
 pub mod esm;
 pub mod evsm;
+pub mod evsm_blur;
 pub mod light;
 pub mod linearize;
 pub mod mips;
 pub mod msm;
+pub mod msm_blur;
 pub mod sat;
 pub mod second_depth;
 pub mod shade;
@@ -28,6 +30,7 @@ pub mod vis_smrt;
 pub mod vis_vsm;
 pub mod vis_vssm;
 pub mod vsm;
+pub mod vsm_blur;
 
 /// A linear depth map on the CPU.
 #[derive(Clone, Debug)]

@@ -327,6 +327,15 @@ pub(crate) fn run_light(
     let linear = technique::linear_name(0);
     let mut outputs: Vec<&str> = input.maps.iter().map(String::as_str).collect();
     outputs.push(&linear);
+    // And every map a node writes: an encoding fused into its blur is judged against the
+    // unfused encoding (the same WGSL function) and, past the one-dispatch radius, its
+    // horizontal pass.
+    outputs.extend(
+        graph
+            .nodes
+            .iter()
+            .flat_map(|n| n.outputs.iter().map(|(_, r)| r.as_str())),
+    );
     let ran = run_graph(gpu, exec, &graph, &outputs, imports, true, Poison::All)?;
     Ok((ran, input.maps))
 }

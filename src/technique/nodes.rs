@@ -1,7 +1,7 @@
 //! The graph nodes a light's technique adds: the imported depth, the linear depth, the
 //! encoding(s) and the filter or summed-area table over them.
 
-use crate::filter::{BlurMode, add_filter};
+use crate::filter::{BlurMode, EncodeBlur, add_encode_blur, add_filter};
 use crate::gpu_data::LinearizeParams;
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
 use crate::kernels::KernelId;
@@ -48,7 +48,10 @@ impl LightNodes<'_> {
     }
 
     /// The encoding `kernel` (raw depth → representation, named after the kernel) with
-    /// `params`, then the light's filter over it in `mode`: what the shading reads.
+    /// `params`, then the light's filter over it in `mode`: what the shading reads. A linear
+    /// blur of an encoding that has a fused kernel ([`fused_blur`]) reads the depth itself
+    /// (`filter::add_encode_blur`); the unfused encoding stays in the graph for whatever else
+    /// reads it (the planner drops it otherwise).
     pub fn encoded(
         &mut self,
         kernel: KernelId,
@@ -65,6 +68,23 @@ impl LightNodes<'_> {
             format,
             params.to_vec(),
         );
+        let fused = fused_blur(kernel).filter(|_| mode == BlurMode::Linear);
+        if let (Some(fused), None, Some(filter)) = (
+            fused,
+            sat_variant(self.light),
+            self.light.shadow.technique.filter(),
+        ) {
+            let e = EncodeBlur {
+                kernel: fused,
+                depth: &self.depth,
+                encoded: &out,
+                format,
+                params,
+            };
+            if let Some(filtered) = add_encode_blur(self.graph, self.i, &e, &filter) {
+                return self.one(filtered);
+            }
+        }
         let filtered = self.filtered(&out, mode);
         self.one(filtered)
     }
@@ -188,6 +208,17 @@ pub fn map_type(light: &Light) -> &'static str {
     match sat_variant(light) {
         Some(SatVariant::Fixed) => "texture_2d<u32>",
         _ => "texture_2d<f32>",
+    }
+}
+
+/// The kernel that fuses encoding `kernel` into a linear blur (`kernels/shared/encode_blur.wgsl`),
+/// if it has one.
+pub fn fused_blur(kernel: KernelId) -> Option<KernelId> {
+    match kernel {
+        KernelId::Vsm => Some(KernelId::VsmBlur),
+        KernelId::Evsm => Some(KernelId::EvsmBlur),
+        KernelId::Msm => Some(KernelId::MsmBlur),
+        _ => None,
     }
 }
 

@@ -142,7 +142,8 @@ fn literal(l: naga::Literal) -> Option<f64> {
     })
 }
 
-/// Reads the scalar field `field` of a value of WGSL struct type `ty` from `bytes` (its
+/// Reads the scalar field `field` (a dotted path into nested structs, e.g. `blur.radius`) of a
+/// value of WGSL struct type `ty` from `bytes` (its
 /// `#[repr(C)]` mirror, laid out as naga lays out the struct).
 pub fn struct_field(
     module: &naga::Module,
@@ -150,19 +151,25 @@ pub fn struct_field(
     bytes: &[u8],
     field: &str,
 ) -> std::result::Result<f64, String> {
-    let naga::TypeInner::Struct { members, .. } = &module.types[ty].inner else {
-        return Err("not a struct".into());
-    };
-    let m = members
-        .iter()
-        .find(|m| m.name.as_deref() == Some(field))
-        .ok_or_else(|| format!("no field `{field}`"))?;
-    let at = m.offset as usize;
+    // A dotted path (`blur.radius`) walks into nested structs, adding their offsets.
+    let mut ty = ty;
+    let mut at = 0usize;
+    for part in field.split('.') {
+        let naga::TypeInner::Struct { members, .. } = &module.types[ty].inner else {
+            return Err(format!("`{field}`: not a struct before `{part}`"));
+        };
+        let m = members
+            .iter()
+            .find(|m| m.name.as_deref() == Some(part))
+            .ok_or_else(|| format!("no field `{field}`"))?;
+        at += m.offset as usize;
+        ty = m.ty;
+    }
     let word: [u8; 4] = bytes
         .get(at..at + 4)
         .and_then(|b| b.try_into().ok())
         .ok_or_else(|| format!("field `{field}` lies past the {} bytes given", bytes.len()))?;
-    match module.types[m.ty].inner {
+    match module.types[ty].inner {
         naga::TypeInner::Scalar(s) if s.width == 4 => Ok(match s.kind {
             naga::ScalarKind::Uint => f64::from(u32::from_le_bytes(word)),
             naga::ScalarKind::Sint => f64::from(i32::from_le_bytes(word)),

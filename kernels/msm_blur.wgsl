@@ -1,0 +1,33 @@
+// Rasterized depth → four moments (shared/msm_moments, quantized for 16-bit storage), blurred,
+// in one pass: the encoding fused into the separable blur (shared/encode_blur). With a radius
+// past TILE_RADIUS it is the first of two passes (encode and blur along x; `blur` along y).
+
+// #import shared/encode_blur
+// #import shared/msm_moments
+
+// Keep in sync with `MsmParams` in src/gpu_data.rs, then `BlurParams` in src/filter.rs.
+struct Params {
+    depth: DepthParams,
+    quantized: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+    blur: BlurSpec,
+}
+
+// Traffic (the cost model, src/graph/cost): a tile workgroup loads its TILE² depths with a halo
+// of r + 1 each side, a row workgroup three rows of ROW + 2r + 2; each output is stored once.
+// #traffic src: select(3 * (ROW + 2 * min(params.blur.radius, MAX_RADIUS) + 2), (TILE + 2 * min(params.blur.radius, TILE_RADIUS) + 2) * (TILE + 2 * min(params.blur.radius, TILE_RADIUS) + 2), params.blur.axis == 2) per group
+// #traffic dst: all
+// #traffic stats: none
+
+const CHANNELS: u32 = 4u;
+
+fn encode(z: f32, left: f32, right: f32, up: f32, down: f32) -> vec4<f32> {
+    return msm_moments(z, params.quantized == 1u);
+}
+
+@compute @workgroup_size(WG_SIZE)
+fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    encode_blur(wg.xy, li);
+}

@@ -1,0 +1,29 @@
+// Rasterized depth → variance-shadow-map moments (shared/vsm_moments), blurred, in one pass:
+// the encoding fused into the separable blur (shared/encode_blur). With a radius past
+// TILE_RADIUS it is the first of two passes (encode and blur along x; `blur` along y).
+
+// #import shared/encode_blur
+// #import shared/vsm_moments
+
+// Keep in sync with `VsmParams` in src/gpu_data.rs, then `BlurParams` in src/filter.rs.
+struct Params {
+    depth: DepthParams,
+    blur: BlurSpec,
+}
+
+// Traffic (the cost model, src/graph/cost): a tile workgroup loads its TILE² depths with a halo
+// of r + 1 each side, a row workgroup three rows of ROW + 2r + 2; each output is stored once.
+// #traffic src: select(3 * (ROW + 2 * min(params.blur.radius, MAX_RADIUS) + 2), (TILE + 2 * min(params.blur.radius, TILE_RADIUS) + 2) * (TILE + 2 * min(params.blur.radius, TILE_RADIUS) + 2), params.blur.axis == 2) per group
+// #traffic dst: all
+// #traffic stats: none
+
+const CHANNELS: u32 = 2u;
+
+fn encode(z: f32, left: f32, right: f32, up: f32, down: f32) -> vec4<f32> {
+    return vec4<f32>(vsm_moments(z, left, right, up, down), 0.0, 0.0);
+}
+
+@compute @workgroup_size(WG_SIZE)
+fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    encode_blur(wg.xy, li);
+}

@@ -1,0 +1,108 @@
+//! An encoding fused into the separable blur (`kernels/shared/encode_blur.wgsl`): the kernel
+//! reads the rasterized depth once, encodes it in workgroup memory and writes the blurred
+//! representation once. One dispatch up to [`ENCODE_BLUR_TILE_RADIUS`] taps each side; past it
+//! two (the encoding fused into the horizontal pass, then `blur`'s vertical pass), because the
+//! tile and its halo no longer fit WebGPU's 16 KiB of workgroup memory.
+
+use super::{BlurMode, BlurParams, add_blur_pass};
+use crate::graph::{Dispatch, Graph, Node, SizeRule};
+use crate::kernels::KernelId;
+use crate::model::Filter;
+
+/// Outputs per side of a two-axis tile (`TILE` in `kernels/shared/encode_blur.wgsl`).
+pub const ENCODE_BLUR_TILE: u32 = 16;
+
+/// Outputs of a one-row workgroup, the two-pass fallback (`ROW`).
+pub const ENCODE_BLUR_ROW: u32 = 256;
+
+/// The largest radius the one-dispatch tile takes (`TILE_RADIUS`): the encoded tile with its
+/// halo, (16 + 2·7)² texels of vec4 in workgroup memory, and its depths, (16 + 2·8)², fit 16 KiB.
+pub const ENCODE_BLUR_TILE_RADIUS: u32 = 7;
+
+/// `BlurParams::axis` of the one-dispatch tile: both axes.
+const BOTH_AXES: u32 = 2;
+
+/// An encoding to fuse into a blur.
+pub struct EncodeBlur<'a> {
+    /// The fused kernel (a `*_blur` kernel importing `shared/encode_blur`).
+    pub kernel: KernelId,
+    /// The rasterized depth it reads.
+    pub depth: &'a str,
+    /// The unfiltered encoding's resource name: the outputs are `<encoded>.blur` (and
+    /// `<encoded>.blur_h` for two passes).
+    pub encoded: &'a str,
+    /// The representation's format.
+    pub format: wgpu::TextureFormat,
+    /// The encoding's parameters (the kernel's `Params` before its `blur` member).
+    pub params: &'a [u8],
+}
+
+/// Adds the nodes of `e` fused into `filter`'s blur, writing `<encoded>.blur` (the depth's
+/// size): the node `<encoded>.blur`, or past [`ENCODE_BLUR_TILE_RADIUS`] the nodes
+/// `<encoded>.blur_h` (the fused kernel, along x) and `<encoded>.blur` (`blur`, along y).
+/// Returns the filtered resource, or `None` when `filter` is no blur.
+pub fn add_encode_blur(
+    graph: &mut Graph,
+    light: usize,
+    e: &EncodeBlur,
+    filter: &Filter,
+) -> Option<String> {
+    let Filter::Blur {
+        radius,
+        sigma,
+        kernel,
+    } = *filter
+    else {
+        return None;
+    };
+    let both = BlurParams::new(BOTH_AXES, radius, sigma, kernel, BlurMode::Linear);
+    let out = format!("{}.blur", e.encoded);
+    if both.radius <= ENCODE_BLUR_TILE_RADIUS {
+        fused_node(graph, light, e, &out, both, ENCODE_BLUR_TILE);
+        return Some(out);
+    }
+    let h = format!("{}.blur_h", e.encoded);
+    fused_node(graph, light, e, &h, BlurParams { axis: 0, ..both }, 0);
+    let v = BlurParams { axis: 1, ..both };
+    Some(add_blur_pass(
+        graph,
+        light,
+        [&h, e.depth, &out],
+        e.format,
+        v,
+    ))
+}
+
+/// The node `name` of `e`'s fused kernel with `blur`: a workgroup per `tile`² outputs, or per
+/// [`ENCODE_BLUR_ROW`] texels of a row when `tile` is 0.
+fn fused_node(
+    graph: &mut Graph,
+    light: usize,
+    e: &EncodeBlur,
+    name: &str,
+    blur: BlurParams,
+    tile: u32,
+) {
+    let out = graph.resource(
+        name.to_string(),
+        e.format,
+        SizeRule::Reduced {
+            of: e.depth.to_string(),
+            shift: 0,
+        },
+        Some(light),
+    );
+    let (x, y) = match tile {
+        0 => (ENCODE_BLUR_ROW, 1),
+        t => (t, t),
+    };
+    graph.node(Node {
+        name: name.to_string(),
+        kernel: e.kernel,
+        inputs: vec![("src".into(), e.depth.to_string())],
+        outputs: vec![("dst".into(), out.clone())],
+        params: [e.params, bytemuck::bytes_of(&blur)].concat(),
+        dispatch: Dispatch::Blocks { of: out, x, y },
+        light: Some(light),
+    });
+}
