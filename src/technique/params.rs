@@ -594,8 +594,8 @@ pub fn cascade_support(t: &crate::model::Technique) -> Result<(), &'static str> 
                 "soft techniques size their penumbra in one map's texels, which change from one cascade to the next; use hard, pcf, vsm, evsm2, evsm4, esm, msm or csm",
             )
         }
-        T::Midpoint { .. } | T::SecondDepth { .. } => {
-            Err("second-depth techniques are not yet drawn in cascades; use hard, pcf, vsm, evsm2, evsm4, esm, msm or csm")
-        }
+        T::Midpoint { .. } | T::SecondDepth { .. } => Err(
+            "second-depth techniques are not yet drawn in cascades; use hard, pcf, vsm, evsm2, evsm4, esm, msm or csm",
+        ),
     }
 }
