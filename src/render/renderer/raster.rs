@@ -159,17 +159,7 @@ impl Renderer {
         device: &wgpu::Device,
         slope: f32,
     ) -> Result<&(wgpu::RenderPipeline, wgpu::BindGroupLayout)> {
-        match self.shadow.entry(slope.to_bits()) {
-            std::collections::hash_map::Entry::Occupied(e) => Ok(e.into_mut()),
-            std::collections::hash_map::Entry::Vacant(e) => {
-                let bias = wgpu::DepthBiasState {
-                    constant: 0,
-                    slope_scale: slope,
-                    clamp: 0.0,
-                };
-                Ok(e.insert(Self::raster_pipeline(device, "shadow_depth", None, bias)?))
-            }
-        }
+        depth_pipeline(&mut self.shadow, device, "shadow_depth", None, slope)
     }
 
     /// The peel pass's pipeline (`shadow_peel`: the second-nearest surface, after the first
@@ -180,22 +170,7 @@ impl Renderer {
         device: &wgpu::Device,
         slope: f32,
     ) -> Result<&(wgpu::RenderPipeline, wgpu::BindGroupLayout)> {
-        match self.peel.entry(slope.to_bits()) {
-            std::collections::hash_map::Entry::Occupied(e) => Ok(e.into_mut()),
-            std::collections::hash_map::Entry::Vacant(e) => {
-                let bias = wgpu::DepthBiasState {
-                    constant: 0,
-                    slope_scale: slope,
-                    clamp: 0.0,
-                };
-                Ok(e.insert(Self::raster_pipeline(
-                    device,
-                    "shadow_peel",
-                    Some(&[]),
-                    bias,
-                )?))
-            }
-        }
+        depth_pipeline(&mut self.peel, device, "shadow_peel", Some(&[]), slope)
     }
 
     /// The G-buffer pipeline and its layout, made once.
@@ -249,6 +224,28 @@ impl Renderer {
         let view = created::view(depth, &Default::default());
         raster_pass(enc, raster.label, pipeline, &bg, &view, vbuf, count, timer);
         Ok(())
+    }
+}
+
+/// Depth raster pipeline `name` (with `fragment` targets) for slope-scaled bias `slope`, from
+/// `cache` (one per distinct value, made once) with its bind group layout.
+fn depth_pipeline<'a>(
+    cache: &'a mut std::collections::HashMap<u32, (wgpu::RenderPipeline, wgpu::BindGroupLayout)>,
+    device: &wgpu::Device,
+    name: &str,
+    fragment: Option<&[Option<wgpu::ColorTargetState>]>,
+    slope: f32,
+) -> Result<&'a (wgpu::RenderPipeline, wgpu::BindGroupLayout)> {
+    match cache.entry(slope.to_bits()) {
+        std::collections::hash_map::Entry::Occupied(e) => Ok(e.into_mut()),
+        std::collections::hash_map::Entry::Vacant(e) => {
+            let bias = wgpu::DepthBiasState {
+                constant: 0,
+                slope_scale: slope,
+                clamp: 0.0,
+            };
+            Ok(e.insert(Renderer::raster_pipeline(device, name, fragment, bias)?))
+        }
     }
 }
 
