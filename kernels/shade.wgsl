@@ -74,9 +74,10 @@ fn pixel_differentials(xy: vec2<u32>, p: vec3<f32>, n: vec3<f32>) -> Differentia
     return out;
 }
 
-// Spot lights light only their cone (soft edge over the outer 10% of the angle).
+// Spot lights light only their cone (soft edge over the outer 10% of the angle); directional
+// and point lights light every direction.
 fn cone(l: Light, p: vec3<f32>) -> f32 {
-    if l.kind == 0u {
+    if l.kind != 1u {
         return 1.0;
     }
     let c = dot(normalize(p - l.position), l.direction);

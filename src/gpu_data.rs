@@ -18,7 +18,7 @@ pub struct LightGpu {
     pub view: [[f32; 4]; 4],
     /// Colour × intensity.
     pub radiance: [f32; 3],
-    /// 0 directional, 1 spot.
+    /// 0 directional, 1 spot, 2 point.
     pub kind: u32,
     /// Light position.
     pub position: [f32; 3],
@@ -119,7 +119,9 @@ pub struct LightGpu {
     /// Cascades: the blend band, a fraction of each cascade's view-distance range.
     pub cascade_blend: f32,
     /// Padding.
-    pub cascade_pad: [f32; 2],
+    /// Map UV per unit of a face's UV: (1, 1) for a one-map light, (1/3, 1/2) for a point
+    /// light's atlas of 3 × 2 faces (offsets in world or face units reach the atlas through it).
+    pub face_uv: [f32; 2],
     /// Cascades: each cascade's far view distance, cascade `c` at `[c / 4][c % 4]`.
     pub cascade_far: [[f32; 4]; 2],
 }
@@ -207,7 +209,7 @@ impl LinearizeParams {
     /// Parameters for `light`'s depth buffer.
     pub fn new(light: &Light) -> Self {
         Self {
-            perspective: u32::from(matches!(light.kind, LightKind::Spot { .. })),
+            perspective: u32::from(!matches!(light.kind, LightKind::Directional { .. })),
             near: light.near,
             far: light.far,
             _pad: 0,

@@ -115,7 +115,7 @@ pub fn relevant(light: &Light, p: DVec3, n: DVec3) -> bool {
     let s = crate::cpu::light::sample(&g, p, DVec3::ZERO);
     let faces = n.dot(crate::cpu::light::to_light(&g, p)) > 0.0;
     let in_cone = match light.kind {
-        LightKind::Directional { .. } => true,
+        LightKind::Directional { .. } | LightKind::Point => true,
         LightKind::Spot { fov_degrees } => {
             let axis = (light.target - light.position).as_dvec3().normalize();
             (p - light.position.as_dvec3()).normalize().dot(axis)
@@ -125,17 +125,24 @@ pub fn relevant(light: &Light, p: DVec3, n: DVec3) -> bool {
     s.inside && faces && in_cone
 }
 
-/// Distance of `p` along `light`'s axis from its position.
+/// Distance of `p` along `light`'s axis from its position (a point light's: along the axis of
+/// the face that sees `p`).
 pub fn axis_distance(light: &Light, p: DVec3) -> f64 {
+    if light.kind == LightKind::Point {
+        return (p - light.position.as_dvec3()).abs().max_element();
+    }
     let (_, _, axis) = emitter::frame(light);
     (p - light.position.as_dvec3()).dot(axis)
 }
 
 /// The default truth resolution for `light` on a device allowing `max` texels a side.
 pub fn default_resolution(light: &Light, max: u32) -> u32 {
+    let (w, _) = light.map_dims();
+    // A point light's atlas is three faces wide.
+    let across = w / light.shadow_map.max(1);
     (2 * light.shadow_map)
-        .clamp(2048, MAX_DEFAULT_RESOLUTION)
-        .min(max)
+        .clamp(2048, MAX_DEFAULT_RESOLUTION / across)
+        .min(max / across)
 }
 
 /// The area-light ground truth of every light of `scene` at the scene's output size, on the
@@ -314,10 +321,13 @@ fn accumulate(
         contents: &vec![0u8; bytes as usize],
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
     });
+    let dims = samples.first().map_or((resolution, resolution), |s| {
+        (s.light.map_size[0] as u32, s.light.map_size[1] as u32)
+    });
     let depth = texture(
         device,
         "shadowgraph.truth.depth",
-        (resolution, resolution),
+        dims,
         wgpu::TextureFormat::Depth32Float,
         wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
     );
@@ -328,7 +338,7 @@ fn accumulate(
         for s in batch {
             let raster = ShadowRaster {
                 label: "truth.shadow_raster",
-                view_proj: s.view_proj,
+                views: &s.views,
                 slope_bias: light.shadow.slope_bias,
             };
             renderer.shadow_raster(

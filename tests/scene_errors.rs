@@ -290,9 +290,106 @@ fn unknown_technique() {
 
 #[test]
 fn unknown_light_kind() {
-    let text = scene_with(&[("kind = \"directional\"", "kind = \"point\"")]);
-    let shown = expect(&text, "kind", &["light[0].kind", "\"point\"", "spot"]);
+    let text = scene_with(&[("kind = \"directional\"", "kind = \"area\"")]);
+    let shown = expect(
+        &text,
+        "kind",
+        &["light[0].kind", "\"area\"", "spot", "point"],
+    );
     assert!(shown.starts_with("inline.toml:13:"), "{shown}");
+}
+
+/// The base scene's light as a point light (no extent, no target needed) with `shadow` lines.
+fn point_scene(shadow: &str, map: u32) -> String {
+    scene_with(&[
+        ("kind = \"directional\"", "kind = \"point\""),
+        ("target = [0.0, 0.0, 0.0]\nextent = 4.0\n", ""),
+        (
+            "far = 20.0\n",
+            &format!("far = 20.0\nshadow_map = {map}\nsize = 0.2\n"),
+        ),
+        ("technique = \"hard\"\n", shadow),
+    ])
+}
+
+#[test]
+fn point_light_loads_without_target_or_extent() {
+    let text = point_scene("technique = \"pcf\"\nradius = 2\n", 256);
+    let scene = parse(&text).expect("a point light needs no target");
+    let light = &scene.lights[0];
+    assert_eq!(light.kind, shadowgraph::scene::LightKind::Point);
+    // PCF radius 2 reads 3 texels around the receiver: a guard band of 4.
+    let layout = light.point_layout().expect("layout");
+    assert_eq!((layout.face, layout.guard), (256, 4));
+    assert_eq!(light.map_dims(), (768, 512));
+}
+
+#[test]
+fn point_light_refuses_what_six_faces_cannot_bound() {
+    // A technique whose rays no guard band bounds.
+    let text = point_scene("technique = \"smrt\"\n", 512);
+    expect(
+        &text,
+        "technique = \"smrt\"",
+        &["light[0].shadow", "point lights", "smrt"],
+    );
+    // A second-depth technique (one peeled map, not six faces).
+    let text = point_scene("technique = \"midpoint\"\n", 512);
+    expect(
+        &text,
+        "technique = \"midpoint\"",
+        &["point lights", "midpoint"],
+    );
+    // Anisotropic mips.
+    let text = point_scene(
+        "technique = \"vsm\"\nfilter = \"mips\"\nfilter_width = 4\nmax_anisotropy = 4\n",
+        512,
+    );
+    expect(
+        &text,
+        "technique = \"vsm\"",
+        &["anisotropic", "max_anisotropy"],
+    );
+    // A blur too wide for the face: guard band 34 needs a face of 136 texels.
+    let text = point_scene(
+        "technique = \"vsm\"\nfilter = \"blur\"\nfilter_radius = 32\nfilter_sigma = 10\n",
+        128,
+    );
+    expect(
+        &text,
+        "technique = \"vsm\"",
+        &["guard band of 34", "at least 136"],
+    );
+    // The receiver-plane bias.
+    let text = point_scene("technique = \"pcf\"\nbias_mode = \"receiver_plane\"\n", 512);
+    expect(
+        &text,
+        "bias_mode",
+        &["light[0].shadow.bias_mode", "point lights"],
+    );
+    // Cascades.
+    let text = point_scene("technique = \"hard\"\ncascades = 2\n", 512);
+    expect(
+        &text,
+        "cascades = 2",
+        &["light[0].shadow.cascades", "directional"],
+    );
+}
+
+#[test]
+fn spot_light_still_needs_a_target() {
+    let text = scene_with(&[
+        ("kind = \"directional\"", "kind = \"spot\""),
+        (
+            "target = [0.0, 0.0, 0.0]\nextent = 4.0\n",
+            "fov_degrees = 60.0\n",
+        ),
+    ]);
+    expect(
+        &text,
+        "kind = \"spot\"",
+        &["light[0].target", "required", "spot"],
+    );
 }
 
 #[test]
@@ -828,6 +925,11 @@ fn bundled_scenes_cast_shadows_the_camera_sees() {
         for (li, light) in s.lights.iter().enumerate() {
             let vp = light.projection() * light.view();
             let in_light = |p: Vec3| {
+                if light.kind == LightKind::Point {
+                    // Six faces see every direction: only the depth range bounds them.
+                    let z = (p - light.position).abs().max_element();
+                    return (light.near..=light.far).contains(&z);
+                }
                 let c = vp * p.extend(1.0);
                 let ndc = c.xyz() / c.w;
                 c.w > 0.0
@@ -849,7 +951,9 @@ fn bundled_scenes_cast_shadows_the_camera_sees() {
                     }
                     let ray = match light.kind {
                         LightKind::Directional { .. } => light.direction(),
-                        LightKind::Spot { .. } => (p - light.position).normalize(),
+                        LightKind::Spot { .. } | LightKind::Point => {
+                            (p - light.position).normalize()
+                        }
                     };
                     assert!(ray.y < 0.0, "{name}: light {li} does not shine down on {p}");
                     let g = p - ray * (p.y / ray.y);

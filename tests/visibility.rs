@@ -20,7 +20,7 @@ const MAP: usize = 61; // not a power of two
 fn light(kind: LightKind, technique: Technique) -> Light {
     let (position, near, far) = match kind {
         LightKind::Directional { .. } => (Vec3::new(-3.0, 10.0, 2.0), 2.0, 20.0),
-        LightKind::Spot { .. } => (Vec3::new(1.0, 8.0, -1.0), 0.5, 20.0),
+        LightKind::Spot { .. } | LightKind::Point => (Vec3::new(1.0, 8.0, -1.0), 0.5, 20.0),
     };
     Light {
         kind,

@@ -9,7 +9,7 @@
 //           width, where it is widest, as PCSS's search: vis_pcss.wgsl), / light_map_width(near);
 //   filter  w   = size·(Z − Z_b)/Z_b at the receiver (PCSS's penumbra, Fernando 2005), with
 //           Z_b = light_linear_to_z(z_avg), / light_map_width(Z);
-// both · map_size, at least 1 texel and at most l.max_width (2·max_search·map_size, the square
+// both · the face's texels (map_size · face_uv), at least 1 texel and at most l.max_width (2·max_search·map_size, the square
 // the fixed-point table is coded for). A NaN width (outside the map, where the result is
 // discarded) reads as 1 texel.
 // #import shared/light
@@ -27,13 +27,13 @@ fn blocker_width(texels: f32, l: Light) -> f32 {
 
 fn blocker_search_width(l: Light, s: LightSample) -> f32 {
     let world = l.size * (s.view_z - l.near) / s.view_z;
-    return blocker_width(world / light_map_width(l, l.near) * l.map_size.x, l);
+    return blocker_width(world / light_map_width(l, l.near) * (l.map_size.x * l.face_uv.x), l);
 }
 
 fn blocker_filter_width(l: Light, s: LightSample, z_avg: f32) -> f32 {
     let z_b = light_linear_to_z(l, z_avg);
     let penumbra = l.size * (s.view_z - z_b) / z_b;
-    return blocker_width(penumbra / light_map_width(l, s.view_z) * l.map_size.x, l);
+    return blocker_width(penumbra / light_map_width(l, s.view_z) * (l.map_size.x * l.face_uv.x), l);
 }
 
 // A soft technique's two table lookups: the search (`sat_search_*`, the square snapped

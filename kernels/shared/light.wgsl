@@ -9,13 +9,13 @@ struct Light {
     view_proj: mat4x4<f32>,  // world → light clip
     view: mat4x4<f32>,       // world → light view
     radiance: vec3<f32>,     // colour × intensity
-    kind: u32,               // 0 directional (orthographic), 1 spot (perspective)
+    kind: u32,               // 0 directional (orthographic), 1 spot (perspective), 2 point (six faces)
     position: vec3<f32>,
     near: f32,
     direction: vec3<f32>,    // unit, light → target
     far: f32,
     map_size: vec2<f32>,     // shadow-map texels
-    width_at_unit: f32,      // map width in world units: directional 2·extent; spot 2·tan(fov/2) per unit distance
+    width_at_unit: f32,      // map (a point light's face) width in world units: directional 2·extent; spot, point 2·tan(fov/2) per unit distance
     size: f32,               // area-light width, world units
     bias: f32,               // constant bias, linear depth units
     normal_bias: f32,        // normal offset, texels, scaled by (1 − N·L)
@@ -57,7 +57,7 @@ struct Light {
     cascade_first: u32,      // cascades: index in `lights` of cascade 1 (the rest follow)
     cascade_near: f32,       // cascades: view distance the first cascade starts at
     cascade_blend: f32,      // cascades: blend band, fraction of each cascade's range
-    cascade_pad: vec2<f32>,
+    face_uv: vec2<f32>,      // map UV per unit of a face's UV: (1, 1); a point light's atlas (1/3, 1/2)
     cascade_far: array<vec4<f32>, 2>, // cascades: far view distance of cascade c at [c / 4][c % 4]
 }
 
@@ -111,10 +111,18 @@ fn light_faces(l: Light, p: vec3<f32>, n: vec3<f32>) -> bool {
     return dot(n, light_to_light(l, p)) > 0.0;
 }
 
+// World size of one texel at view distance z.
+fn light_texel(l: Light, z: f32) -> f32 {
+    return light_map_width(l, z) / (l.map_size.x * l.face_uv.x);
+}
+
 // Projects p, first moved along n by normal_bias texels scaled by (1 − N·L).
 fn light_sample(l: Light, p: vec3<f32>, n: vec3<f32>) -> LightSample {
+    if l.kind == 2u {
+        return point_sample(l, p, n);
+    }
     let z0 = -(l.view * vec4<f32>(p, 1.0)).z;
-    let texel = light_map_width(l, max(z0, l.near)) / l.map_size.x;
+    let texel = light_texel(l, max(z0, l.near));
     let ndl = clamp(dot(n, light_to_light(l, p)), 0.0, 1.0);
     let q = p + n * (l.normal_bias * texel * (1.0 - ndl));
     let clip = l.view_proj * vec4<f32>(q, 1.0);
@@ -133,6 +141,58 @@ fn light_sample(l: Light, p: vec3<f32>, n: vec3<f32>) -> LightSample {
     return s;
 }
 
+// A point light's face for direction d from the light: its major axis and sign, ties to x then
+// y (src/model/point.rs, face_of).
+fn point_face(d: vec3<f32>) -> u32 {
+    let a = abs(d);
+    if a.x >= a.y && a.x >= a.z {
+        return select(0u, 1u, d.x < 0.0);
+    }
+    if a.y >= a.z {
+        return select(2u, 3u, d.y < 0.0);
+    }
+    return select(4u, 5u, d.z < 0.0);
+}
+
+// Direction d in face f's view: (right, up, distance along the face's axis), the view that
+// Mat4::look_at_rh(position, position + forward, up) builds for the faces +X, −X, +Y, −Y, +Z, −Z
+// with up +Y, +Y, +Z, +Z, +Y, +Y (point::face_axes).
+fn point_coords(d: vec3<f32>, f: u32) -> vec3<f32> {
+    switch f {
+        case 0u: { return vec3<f32>(d.z, d.y, d.x); }
+        case 1u: { return vec3<f32>(-d.z, d.y, -d.x); }
+        case 2u: { return vec3<f32>(d.x, d.z, d.y); }
+        case 3u: { return vec3<f32>(-d.x, d.z, -d.y); }
+        case 4u: { return vec3<f32>(-d.x, d.y, d.z); }
+        default: { return vec3<f32>(d.x, d.y, -d.z); }
+    }
+}
+
+// light_sample for a point light: the receiver, moved by the normal offset at the texel size of
+// the face that sees it, is projected into the face that sees the moved point, whose 90° core
+// holds it; the face's tile sits at column f % 3, row f / 3 of the atlas. Its depth is the
+// distance along that face's axis, so every texel a lookup reads around it (within the guard
+// band) was rasterized from the same view.
+fn point_sample(l: Light, p: vec3<f32>, n: vec3<f32>) -> LightSample {
+    let a = abs(p - l.position);
+    let texel = light_texel(l, max(max(a.x, max(a.y, a.z)), l.near));
+    let ndl = clamp(dot(n, light_to_light(l, p)), 0.0, 1.0);
+    let q = p + n * (l.normal_bias * texel * (1.0 - ndl));
+    let d = q - l.position;
+    let f = point_face(d);
+    let c = point_coords(d, f);
+    let t = 0.5 * l.width_at_unit * c.z;
+    let tile = vec2<f32>(0.5 + 0.5 * c.x / t, 0.5 - 0.5 * c.y / t);
+    var s: LightSample;
+    s.uv = (vec2<f32>(f32(f % 3u), f32(f / 3u)) + tile) * l.face_uv;
+    s.view_z = c.z;
+    s.depth = (c.z - l.near) / (l.far - l.near);
+    s.inside = c.z > 0.0 && s.depth >= 0.0 && s.depth <= 1.0;
+    s.footprint = vec4<f32>(0.0);
+    s.depth_slope = vec2<f32>(0.0);
+    return s;
+}
+
 // Receiver-plane depth bias (Isidoro, GDC 2006): the depth of the plane through the receiver q
 // with normal n, per texel of offset in the map. A compute shading pass has no dpdx, so the
 // plane comes from the G-buffer normal: exact for planar receivers. View space v = V q; a point
@@ -148,7 +208,7 @@ fn light_depth_slope(l: Light, q: vec3<f32>, n: vec3<f32>, z: f32) -> vec2<f32> 
     } else {
         per_world = vec2<f32>(-nv.x, nv.y) * (z * z / dot(nv, v));
     }
-    let texel = l.width_at_unit / l.map_size.x;
+    let texel = l.width_at_unit / (l.map_size.x * l.face_uv.x);
     let slope = per_world * texel / (l.far - l.near);
     // Edge-on (n·v or n_z → 0) the slope is unbounded or NaN: the cap bounds each tap instead.
     return select(vec2<f32>(0.0), slope, all(abs(slope) < vec2<f32>(1e30)));

@@ -46,17 +46,14 @@ fn width(texels: f64, l: &LightGpu) -> f64 {
 pub fn search_width(l: &LightGpu, s: &LightSample) -> f64 {
     let near = f64::from(l.near);
     let world = f64::from(l.size) * (s.view_z - near) / s.view_z;
-    width(world / map_width(l, near) * f64::from(l.map_size[0]), l)
+    width(world / map_width(l, near) * face_texels(l), l)
 }
 
 /// `blocker_filter_width`: the PCSS penumbra at the receiver for blockers at `z_avg`.
 pub fn filter_width(l: &LightGpu, s: &LightSample, z_avg: f64) -> f64 {
     let z_b = linear_to_z(l, z_avg);
     let penumbra = f64::from(l.size) * (s.view_z - z_b) / z_b;
-    width(
-        penumbra / map_width(l, s.view_z) * f64::from(l.map_size[0]),
-        l,
-    )
+    width(penumbra / map_width(l, s.view_z) * face_texels(l), l)
 }
 
 /// `blocker_vsm`: Chebyshev's share p of texels at or behind `d`, the rest averaging
@@ -119,4 +116,10 @@ pub fn csm_z_series(zb: &[f64], l: &LightGpu, d: f64) -> f64 {
 pub fn csm_z(below: f64, zsum: f64, d: f64) -> Blocker {
     let share = 0.5 - below;
     Blocker::new(zsum / share.max(MIN_SHARE), share, d)
+}
+
+/// Texels across one face of the map (`map_size · face_uv`: the map's own width but for a
+/// point light's atlas).
+fn face_texels(l: &LightGpu) -> f64 {
+    f64::from(l.map_size[0]) * f64::from(l.face_uv[0])
 }

@@ -3,6 +3,7 @@
 use glam::{DMat4, DVec3, DVec4};
 
 use crate::gpu_data::LightGpu;
+use crate::model::point;
 
 /// Reference of `LightSample`.
 #[derive(Clone, Copy, Debug)]
@@ -51,12 +52,20 @@ pub fn facing(l: &LightGpu, p: DVec3, n: DVec3) -> f64 {
     n.dot(to_light(l, p))
 }
 
+/// `light_texel`: the world size of one texel at view distance `z`.
+pub fn texel(l: &LightGpu, z: f64) -> f64 {
+    map_width(l, z) / (f64::from(l.map_size[0]) * f64::from(l.face_uv[0]))
+}
+
 /// `light_sample`: project `p` after the normal offset along `n`.
 pub fn sample(l: &LightGpu, p: DVec3, n: DVec3) -> LightSample {
+    if l.kind == 2 {
+        return point_sample(l, p, n);
+    }
     let view = mat(&l.view);
     let (near, far) = (f64::from(l.near), f64::from(l.far));
     let z0 = -(view * p.extend(1.0)).z;
-    let texel = map_width(l, z0.max(near)) / f64::from(l.map_size[0]);
+    let texel = texel(l, z0.max(near));
     let ndl = n.dot(to_light(l, p)).clamp(0.0, 1.0);
     let q = p + n * (f64::from(l.normal_bias) * texel * (1.0 - ndl));
     let clip: DVec4 = mat(&l.view_proj) * q.extend(1.0);
@@ -82,6 +91,38 @@ pub fn sample(l: &LightGpu, p: DVec3, n: DVec3) -> LightSample {
     }
 }
 
+/// `point_sample`: a point light's receiver, moved by the normal offset at the texel size of
+/// the face that sees it, projected through the view of the face that sees the moved point
+/// (the matrices the raster pass draws with, `model::point::PointLayout::view`, in f64) into
+/// that face's tile of the atlas.
+pub fn point_sample(l: &LightGpu, p: DVec3, n: DVec3) -> LightSample {
+    let position = v3(l.position);
+    let (near, far) = (f64::from(l.near), f64::from(l.far));
+    let z0 = (p - position).abs().max_element();
+    let ndl = n.dot(to_light(l, p)).clamp(0.0, 1.0);
+    let q = p + n * (f64::from(l.normal_bias) * texel(l, z0.max(near)) * (1.0 - ndl));
+    let f = point::face_of(q - position);
+    let (forward, up) = point::face_axes(f);
+    let view = DMat4::look_at_rh(position, position + forward.as_dvec3(), up.as_dvec3());
+    let v = (view * q.extend(1.0)).truncate();
+    let view_z = -v.z;
+    let t = 0.5 * f64::from(l.width_at_unit) * view_z;
+    let tile = [0.5 + 0.5 * v.x / t, 0.5 - 0.5 * v.y / t];
+    let (col, row) = (f64::from(f % point::COLUMNS), f64::from(f / point::COLUMNS));
+    let depth = (view_z - near) / (far - near);
+    LightSample {
+        uv: [
+            (col + tile[0]) * f64::from(l.face_uv[0]),
+            (row + tile[1]) * f64::from(l.face_uv[1]),
+        ],
+        depth,
+        view_z,
+        inside: view_z > 0.0 && (0.0..=1.0).contains(&depth),
+        footprint: [0.0; 4],
+        depth_slope: [0.0; 2],
+    }
+}
+
 /// `light_depth_slope`: the depth of the plane through `q` with normal `n` per texel of offset
 /// in the map along u and v; 0 where it is not finite (edge-on).
 pub fn depth_slope(l: &LightGpu, q: DVec3, n: DVec3, z: f64) -> [f64; 2] {
@@ -94,7 +135,7 @@ pub fn depth_slope(l: &LightGpu, q: DVec3, n: DVec3, z: f64) -> [f64; 2] {
         let k = z * z / nv.dot(v);
         [-nv.x * k, nv.y * k]
     };
-    let texel = f64::from(l.width_at_unit) / f64::from(l.map_size[0]);
+    let texel = f64::from(l.width_at_unit) / (f64::from(l.map_size[0]) * f64::from(l.face_uv[0]));
     let slope = per_world.map(|w| w * texel / f64::from(l.far - l.near));
     if slope.iter().all(|s| s.abs() < 1e30) {
         slope

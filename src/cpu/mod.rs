@@ -35,24 +35,29 @@ pub mod vsm_blur;
 /// A linear depth map on the CPU.
 #[derive(Clone, Debug)]
 pub struct Map<'a> {
-    /// Side length.
+    /// Width (the side of a square map; a point light's atlas is 3 faces wide, 2 high).
     pub size: usize,
-    /// Row-major texels.
+    /// Row-major texels: `size` a row, as many rows as they fill.
     pub texels: &'a [f32],
 }
 
 impl Map<'_> {
+    /// Rows: `texels.len() / size`.
+    pub fn height(&self) -> usize {
+        self.texels.len() / self.size.max(1)
+    }
+
     /// Depth at texel (x, y), clamped to the edge (`load_depth` in `shared/sampling.wgsl`).
     pub fn load(&self, x: i64, y: i64) -> f64 {
-        let c = |v: i64| v.clamp(0, self.size as i64 - 1) as usize;
-        f64::from(self.texels[c(y) * self.size + c(x)])
+        let cx = x.clamp(0, self.size as i64 - 1) as usize;
+        let cy = y.clamp(0, self.height() as i64 - 1) as usize;
+        f64::from(self.texels[cy * self.size + cx])
     }
 
     /// The texel containing `uv` (`texel_of`).
     pub fn texel_of(&self, uv: [f64; 2]) -> (i64, i64) {
-        let s = self.size as f64;
-        let c = |v: f64| ((v * s).floor() as i64).clamp(0, self.size as i64 - 1);
-        (c(uv[0]), c(uv[1]))
+        let c = |v: f64, n: usize| ((v * n as f64).floor() as i64).clamp(0, n as i64 - 1);
+        (c(uv[0], self.size), c(uv[1], self.height()))
     }
 }
 

@@ -50,7 +50,7 @@ pub fn shade(s: &Shading, position: [f32; 4], normal: [f32; 4], visibility: &[f3
 
 /// `cone`: spot lights light only their cone (soft edge over the outer 10% of the angle).
 fn cone(l: &LightGpu, p: DVec3) -> f64 {
-    if l.kind == 0 {
+    if l.kind != 1 {
         return 1.0;
     }
     let pos = DVec3::new(

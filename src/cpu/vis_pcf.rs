@@ -32,8 +32,8 @@ pub fn vis_pcf(map: &Map, l: &LightGpu, s: &LightSample) -> f64 {
 /// buffer `raw` (clamp-to-edge addressing, texel centres at half-integers).
 pub fn vis_pcf_hardware(raw: &Map, l: &LightGpu, s: &LightSample) -> f64 {
     let reference = linear_to_ndc(l, (s.depth - f64::from(l.bias)).clamp(0.0, 1.0));
-    let n = raw.size as f64;
-    let (fx, fy) = (s.uv[0] * n - 0.5, s.uv[1] * n - 0.5);
+    let (w, h) = (raw.size as f64, raw.height() as f64);
+    let (fx, fy) = (s.uv[0] * w - 0.5, s.uv[1] * h - 0.5);
     let (x0, y0) = (fx.floor(), fy.floor());
     let (ax, ay) = (fx - x0, fy - y0);
     let pass = |x: f64, y: f64| {

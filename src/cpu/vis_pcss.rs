@@ -4,7 +4,7 @@ use super::light::{LightSample, linear_to_z, map_width, receiver_offset, tap_off
 use super::{Map, vogel_disc};
 use crate::gpu_data::LightGpu;
 
-/// Blocker-search radius in UV (`pcss_search_radius`).
+/// Blocker-search radius in face UV (`pcss_search_radius`; map UV · `face_uv`).
 pub fn search_radius(l: &LightGpu, s: &LightSample) -> f64 {
     let world = 0.5 * f64::from(l.size) * (s.view_z - f64::from(l.near)) / s.view_z;
     (world / map_width(l, f64::from(l.near))).min(f64::from(l.max_search))
@@ -18,7 +18,7 @@ pub fn vis_pcss(map: &Map, l: &LightGpu, s: &LightSample) -> f64 {
     let (mut sum, mut count) = (0.0, 0u32);
     for i in 0..l.blocker_samples {
         let o = vogel_disc(i, l.blocker_samples);
-        let (x, y) = map.texel_of([s.uv[0] + search * o[0], s.uv[1] + search * o[1]]);
+        let (x, y) = map.texel_of(offset(l, s, search, o));
         let z = map.load(x, y);
         if z + bias < s.depth + receiver_offset(l, s, tap_offset(l, s, x, y)) {
             sum += z;
@@ -30,15 +30,28 @@ pub fn vis_pcss(map: &Map, l: &LightGpu, s: &LightSample) -> f64 {
     }
     let z_blocker = linear_to_z(l, sum / f64::from(count));
     let penumbra = f64::from(l.size) * (s.view_z - z_blocker) / z_blocker;
-    let radius = (0.5 * penumbra / map_width(l, s.view_z)).max(0.5 / f64::from(l.map_size[0]));
+    let mut radius = (0.5 * penumbra / map_width(l, s.view_z))
+        .max(0.5 / (f64::from(l.map_size[0]) * f64::from(l.face_uv[0])));
+    if l.kind == 2 {
+        // A point light's filter stays within the search cap, hence its faces' guard bands.
+        radius = radius.min(f64::from(l.max_search));
+    }
     let mut lit = 0.0;
     for i in 0..l.filter_samples {
         let o = vogel_disc(i, l.filter_samples);
-        let (x, y) = map.texel_of([s.uv[0] + radius * o[0], s.uv[1] + radius * o[1]]);
+        let (x, y) = map.texel_of(offset(l, s, radius, o));
         let d = s.depth + receiver_offset(l, s, tap_offset(l, s, x, y));
         if d <= map.load(x, y) + bias {
             lit += 1.0;
         }
     }
     lit / f64::from(l.filter_samples)
+}
+
+/// The map UV of a tap `radius` face-UV units from the receiver along unit-disc point `o`.
+fn offset(l: &LightGpu, s: &LightSample, radius: f64, o: [f64; 2]) -> [f64; 2] {
+    [
+        s.uv[0] + radius * f64::from(l.face_uv[0]) * o[0],
+        s.uv[1] + radius * f64::from(l.face_uv[1]) * o[1],
+    ]
 }

@@ -108,13 +108,18 @@ impl Plan {
     /// shading reads, what a single fused kernel would move.
     pub fn cost_text(&self, light: usize) -> Result<String> {
         let nodes = cost::light_traffic(self, light)?;
-        let texels = cost::map_texels(self, light);
+        let (w, h) = cost::map_dims(self, light);
+        let texels = f64::from(w) * f64::from(h);
         let mut s = String::new();
         if nodes.is_empty() {
             return Ok(s);
         }
-        let side = texels.sqrt();
-        let _ = writeln!(s, "    traffic per texel of the {side}² map:");
+        let dims = if w == h {
+            format!("{w}²")
+        } else {
+            format!("{w}×{h}")
+        };
+        let _ = writeln!(s, "    traffic per texel of the {dims} map:");
         let (mut dispatches, mut bytes) = (0, 0.0);
         let width = nodes.iter().map(|(n, _)| n.name.len()).max().unwrap_or(0);
         for (node, t) in &nodes {

@@ -50,7 +50,8 @@ pub fn render_memory(scene: &Scene, plan: &Plan, opts: &RenderOptions) -> Memory
         .iter()
         .map(|l| {
             let maps = 1 + u64::from(technique::peels(&l.shadow.technique));
-            u64::from(l.shadow_map).pow(2) * 4 * maps
+            let (w, h) = l.map_dims();
+            u64::from(w) * u64::from(h) * 4 * maps
         })
         .collect();
     let n = depth.len();
@@ -127,16 +128,31 @@ impl Checker<'_> {
             ("output.height".into(), s.height),
         ];
         for (i, l) in s.lights.iter().enumerate() {
-            sides.push((format!("light[{i}].shadow_map"), l.shadow_map));
+            // A point light's atlas is three faces wide.
+            sides.push((format!("light[{i}].shadow_map"), l.map_dims().0));
         }
         match sides.into_iter().find(|(_, v)| *v > max) {
-            Some((key, v)) => Err(self.err(
-                &key,
-                format!(
-                    "`{key}` = {v} is past this device's largest texture side, {max} \
-                     (max_texture_dimension_2d)"
-                ),
-            )),
+            Some((key, v)) => {
+                let point = key.ends_with("shadow_map")
+                    && s.lights
+                        .iter()
+                        .any(|l| l.map_dims().0 == v && l.map_dims().0 != l.shadow_map);
+                let what = if point {
+                    format!(
+                        "{}: a point light's atlas of three faces, {v} texels wide,",
+                        v / 3
+                    )
+                } else {
+                    format!("{v}")
+                };
+                Err(self.err(
+                    &key,
+                    format!(
+                        "`{key}` = {what} is past this device's largest texture side, {max} \
+                         (max_texture_dimension_2d)"
+                    ),
+                ))
+            }
             None => Ok(()),
         }
     }

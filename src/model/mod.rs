@@ -6,6 +6,7 @@
 pub mod cascades;
 mod defaults;
 mod params;
+pub mod point;
 mod sat_variant;
 
 pub use defaults::{
@@ -55,6 +56,8 @@ pub enum LightKind {
         /// Full cone angle, degrees.
         fov_degrees: f32,
     },
+    /// Omnidirectional: six perspective faces in one atlas ([`point`]).
+    Point,
 }
 
 /// Weights of an N×N PCF window.
@@ -422,7 +425,9 @@ impl Light {
         Mat4::look_at_rh(self.position, self.target, up)
     }
 
-    /// Light view → clip (depth in [0, 1]).
+    /// Light view → clip (depth in [0, 1]); a point light's: each face's, over its widened
+    /// frustum ([`point::PointLayout::projection`]; a 90° face where its technique has no
+    /// layout, which scene validation and the plug-in refuse first).
     pub fn projection(&self) -> Mat4 {
         match self.kind {
             LightKind::Directional { extent } => {
@@ -431,15 +436,68 @@ impl Light {
             LightKind::Spot { fov_degrees } => {
                 Mat4::perspective_rh(fov_degrees.to_radians(), 1.0, self.near, self.far)
             }
+            LightKind::Point => match self.point_layout() {
+                Ok(layout) => layout.projection(self.near, self.far),
+                Err(_) => {
+                    Mat4::perspective_rh(std::f32::consts::FRAC_PI_2, 1.0, self.near, self.far)
+                }
+            },
         }
     }
 
-    /// World width covered by the shadow map at view distance 1 (spot) or at any distance
-    /// (directional): the map spans `width_at_unit * distance` (spot) world units.
+    /// A point light's face layout for its technique ([`point::reach`]); an error for other
+    /// lights or a technique that cannot be bounded to a face.
+    pub fn point_layout(&self) -> Result<point::PointLayout, String> {
+        if self.kind != LightKind::Point {
+            return Err("not a point light".into());
+        }
+        let reach = point::reach(&self.shadow.technique, self.shadow_map)?;
+        point::PointLayout::new(self.shadow_map, reach)
+    }
+
+    /// The shadow map's width and height in texels: `shadow_map`² (a point light's atlas of
+    /// six faces: `3·shadow_map × 2·shadow_map`).
+    pub fn map_dims(&self) -> (u32, u32) {
+        match self.kind {
+            LightKind::Point => (
+                point::COLUMNS * self.shadow_map,
+                point::ROWS * self.shadow_map,
+            ),
+            _ => (self.shadow_map, self.shadow_map),
+        }
+    }
+
+    /// World → clip of each rasterized view of the light with its viewport in the map
+    /// (x, y, width, height in texels): the whole map for one-map lights, the six faces'
+    /// tiles for a point light.
+    pub fn raster_views(&self) -> Vec<([f32; 16], [u32; 4])> {
+        match (self.kind, self.point_layout()) {
+            (LightKind::Point, Ok(layout)) => {
+                let proj = layout.projection(self.near, self.far);
+                (0..point::FACES)
+                    .map(|f| {
+                        let (x, y) = layout.origin(f);
+                        let vp = proj * point::PointLayout::view(self.position, f);
+                        (vp.to_cols_array(), [x, y, layout.face, layout.face])
+                    })
+                    .collect()
+            }
+            _ => {
+                let (w, h) = self.map_dims();
+                let vp = self.projection() * self.view();
+                vec![(vp.to_cols_array(), [0, 0, w, h])]
+            }
+        }
+    }
+
+    /// World width covered by the shadow map at view distance 1 (spot; a point light's face)
+    /// or at any distance (directional): the map spans `width_at_unit * distance` (spot)
+    /// world units.
     pub fn width_at_unit(&self) -> f32 {
         match self.kind {
             LightKind::Directional { extent } => 2.0 * extent,
             LightKind::Spot { fov_degrees } => 2.0 * (0.5 * fov_degrees.to_radians()).tan(),
+            LightKind::Point => 2.0 * self.point_layout().map_or(1.0, |l| l.tan_half),
         }
     }
 
@@ -448,12 +506,13 @@ impl Light {
         let kind = match self.kind {
             LightKind::Directional { .. } => "directional",
             LightKind::Spot { .. } => "spot",
+            LightKind::Point => "point",
         };
-        format!(
-            "{kind}, {} shadows, {}² map",
-            self.shadow.technique.name(),
-            self.shadow_map
-        )
+        let map = match self.kind {
+            LightKind::Point => format!("six {}² faces", self.shadow_map),
+            _ => format!("{}² map", self.shadow_map),
+        };
+        format!("{kind}, {} shadows, {map}", self.shadow.technique.name())
     }
 }
 

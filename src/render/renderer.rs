@@ -17,6 +17,7 @@ use crate::technique;
 mod raster;
 
 pub use raster::ShadowRaster;
+pub(super) use raster::VIEW_BYTES;
 pub(super) use raster::depth_only_view;
 use raster::{clear_depth, raster_pass};
 
@@ -271,6 +272,7 @@ impl Renderer {
     ) -> Result<Outputs> {
         for (l, t) in lights.iter().zip(&targets.lights) {
             let (pipeline, _) = self.shadow_pipeline(device, l.shadow.slope_bias)?;
+            let viewports: Vec<[u32; 4]> = l.raster_views().iter().map(|(_, v)| *v).collect();
             raster_pass(
                 enc,
                 &t.label,
@@ -279,6 +281,7 @@ impl Renderer {
                 &t.view,
                 &targets.vertices,
                 targets.vertex_count,
+                &viewports,
                 timer.as_deref_mut(),
             );
             if let Some(peel) = &t.peel {
@@ -291,6 +294,7 @@ impl Renderer {
                     &peel.view,
                     &targets.vertices,
                     targets.vertex_count,
+                    &viewports,
                     timer.as_deref_mut(),
                 );
             }

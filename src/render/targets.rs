@@ -25,8 +25,9 @@ pub(super) const TARGET: wgpu::TextureUsages = wgpu::TextureUsages::RENDER_ATTAC
 pub(super) struct TargetKey {
     /// Image size.
     pub size: (u32, u32),
-    /// Per drawn light: shadow-map side and slope-scaled bias (its raster pipeline's key).
-    pub lights: Vec<(u32, u32)>,
+    /// Per drawn light: shadow-map width and height (a point light's atlas) and slope-scaled
+    /// bias (its raster pipeline's key).
+    pub lights: Vec<((u32, u32), u32)>,
     /// Per light: whether it rasterizes a second, peeled depth ([`technique::peels`]).
     pub peels: Vec<bool>,
     /// The scene's lights: the visibility channels.
@@ -45,7 +46,7 @@ impl TargetKey {
             lights: drawn
                 .lights
                 .iter()
-                .map(|l| (l.shadow_map, l.shadow.slope_bias.to_bits()))
+                .map(|l| (l.map_dims(), l.shadow.slope_bias.to_bits()))
                 .collect(),
             peels: drawn
                 .lights
@@ -270,25 +271,25 @@ impl Targets {
             uniform_group(device, "shadowgraph.gbuffer", gbuffer_layout, &camera);
         let mut lights = Vec::new();
         let mut imports = HashMap::new();
-        for (i, (&(side, _), (layout, peel_layout))) in
+        for (i, (&(dims, _), (layout, peel_layout))) in
             key.lights.iter().zip(raster_layouts).enumerate()
         {
             let depth = texture(
                 device,
                 "shadowgraph.shadow_map",
-                (side, side),
+                dims,
                 F::Depth32Float,
                 TARGET,
             );
             let view_proj = buffer(
                 device,
                 "shadowgraph.light_view",
-                64,
+                super::renderer::VIEW_BYTES,
                 B::UNIFORM | B::COPY_DST,
             );
             let peel = peel_layout
                 .as_ref()
-                .map(|l| peel_target(device, i, side, l, &view_proj, &depth, &mut imports));
+                .map(|l| peel_target(device, i, dims.0, l, &view_proj, &depth, &mut imports));
             imports.insert(technique::depth_name(i), depth.clone());
             lights.push(LightTarget {
                 label: format!("light{i}.shadow_raster"),
@@ -388,7 +389,7 @@ impl Targets {
             .to_cols_array();
         queue.write_buffer(&self.camera, 0, bytemuck::cast_slice(&camera));
         for (t, l) in self.lights.iter().zip(&drawn.lights) {
-            let vp = (l.projection() * l.view()).to_cols_array();
+            let vp: Vec<f32> = l.raster_views().iter().flat_map(|(m, _)| *m).collect();
             queue.write_buffer(&t.view_proj, 0, bytemuck::cast_slice(&vp));
         }
     }

@@ -64,12 +64,12 @@ pub struct CameraFile {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LightFile {
-    /// `directional` or `spot`.
+    /// `directional`, `spot` or `point`.
     pub kind: Spanned<String>,
     /// Light position (directional: where its orthographic frustum starts).
     pub position: V3,
-    /// Point the light aims at.
-    pub target: V3,
+    /// Point the light aims at (required but for point lights, which light every direction).
+    pub target: Option<V3>,
     /// Spot cone angle (full), degrees.
     pub fov_degrees: Option<Spanned<f64>>,
     /// Directional: half-width of the orthographic frustum.

@@ -124,24 +124,54 @@ fn light(ctx: &Ctx, i: usize, l: &LightFile) -> Result<Light> {
                 fov_degrees: ctx.num(&key("fov_degrees"), f, 1.0, 170.0)?,
             }
         }
+        "point" => {
+            ctx.reject(
+                &key("extent"),
+                &l.extent,
+                "applies to directional lights only",
+            )?;
+            ctx.reject(
+                &key("fov_degrees"),
+                &l.fov_degrees,
+                "applies to spot lights only",
+            )?;
+            LightKind::Point
+        }
         other => {
             return Err(ctx.err(
                 Some(l.kind.span()),
                 format!(
-                    "`{}` = {other:?}: unknown light kind (expected \"directional\" or \"spot\")",
+                    "`{}` = {other:?}: unknown light kind (expected \"directional\", \"spot\" or \"point\")",
                     key("kind")
                 ),
             ));
         }
     };
     let position = ctx.coord(&key("position"), &l.position)?;
-    let target = ctx.coord(&key("target"), &l.target)?;
-    if (target - position).length() < 1e-6 {
-        return Err(ctx.err(
-            Some(l.target.span()),
-            format!("`{}` equals its position", key("target")),
-        ));
-    }
+    let target = match (&l.target, kind) {
+        // A point light lights every direction: its target only orients its emitter's frame.
+        (None, LightKind::Point) => position - Vec3::Y,
+        (None, _) => {
+            return Err(ctx.err(
+                Some(l.kind.span()),
+                format!(
+                    "`{}` is required for a {} light",
+                    key("target"),
+                    l.kind.get_ref()
+                ),
+            ));
+        }
+        (Some(t), _) => {
+            let target = ctx.coord(&key("target"), t)?;
+            if (target - position).length() < 1e-6 {
+                return Err(ctx.err(
+                    Some(t.span()),
+                    format!("`{}` equals its position", key("target")),
+                ));
+            }
+            target
+        }
+    };
     let near = ctx.num_or(&key("near"), &l.near, 1e-6, 1e7, 0.1)?;
     let far = ctx.num_or(&key("far"), &l.far, 1e-6, 1e7, 50.0)?;
     if far <= near {
@@ -170,6 +200,9 @@ fn light(ctx: &Ctx, i: usize, l: &LightFile) -> Result<Light> {
             cascades: crate::model::Cascades::SINGLE,
         },
     };
+    if kind == LightKind::Point {
+        point_support(ctx, i, l, &shadow, shadow_map)?;
+    }
     if shadow.cascades.count > 1 && matches!(kind, LightKind::Spot { .. }) {
         let span = l
             .shadow
@@ -226,4 +259,41 @@ fn light(ctx: &Ctx, i: usize, l: &LightFile) -> Result<Light> {
         shadow_map,
         shadow,
     })
+}
+
+/// What a point light's six faces refuse: cascades, the receiver-plane bias (its plane is
+/// written for one view) and techniques whose reach no guard band bounds
+/// (`model::point::reach`), each naming its key and line.
+fn point_support(ctx: &Ctx, i: usize, l: &LightFile, shadow: &Shadow, face: u32) -> Result<()> {
+    let key = |k: &str| format!("light[{i}].{k}");
+    let file = l.shadow.as_ref();
+    if shadow.cascades.count > 1 {
+        let span = file.and_then(|s| s.cascades.as_ref()).map(|v| v.span());
+        return Err(ctx.err(
+            span,
+            format!(
+                "`{}` = {} needs a directional light: a point light's six faces cover every direction",
+                key("shadow.cascades"),
+                shadow.cascades.count
+            ),
+        ));
+    }
+    if shadow.receiver_plane > 0.0 {
+        let span = file.and_then(|s| s.bias_mode.as_ref()).map(|v| v.span());
+        return Err(ctx.err(
+            span,
+            format!(
+                "`{}` = \"receiver_plane\" is not supported on point lights (the plane is derived for one view, not six faces): use the constant, slope or normal bias",
+                key("shadow.bias_mode")
+            ),
+        ));
+    }
+    let reach = crate::model::point::reach(&shadow.technique, face);
+    if let Err(why) = reach.and_then(|r| crate::model::point::PointLayout::new(face, r)) {
+        let span = file
+            .map(|s| s.technique.span())
+            .or(l.shadow_map.as_ref().map(|v| v.span()));
+        return Err(ctx.err(span, format!("`{}`: {why}", key("shadow"))));
+    }
+    Ok(())
 }

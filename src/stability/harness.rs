@@ -226,7 +226,7 @@ pub(crate) fn poison_texels(gpu: &Gpu, texture: &wgpu::Texture, coords: &[(u32, 
 pub(crate) fn light(kind: LightKind, technique: Technique, map: u32, bias: f32) -> Light {
     let (position, near, far) = match kind {
         LightKind::Directional { .. } => (Vec3::new(-3.0, 10.0, 2.0), 2.0, 20.0),
-        LightKind::Spot { .. } => (Vec3::new(1.0, 8.0, -1.0), 0.5, 20.0),
+        LightKind::Spot { .. } | LightKind::Point => (Vec3::new(1.0, 8.0, -1.0), 0.5, 20.0),
     };
     Light {
         kind,

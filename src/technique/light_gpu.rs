@@ -18,7 +18,10 @@ impl LightGpu {
                 width,
                 max_anisotropy,
             }) => (
-                mip_levels(light.shadow_map, light.shadow_map),
+                {
+                    let (w, h) = light.map_dims();
+                    mip_levels(w, h)
+                },
                 width.max(1.0).log2(),
                 max_anisotropy,
             ),
@@ -27,7 +30,9 @@ impl LightGpu {
         let (kind, cos_outer) = match light.kind {
             LightKind::Directional { .. } => (0, -1.0),
             LightKind::Spot { fov_degrees } => (1, (0.5 * fov_degrees.to_radians()).cos()),
+            LightKind::Point => (2, -1.0),
         };
+        let (map_w, map_h) = light.map_dims();
         let mut g = Self {
             view_proj: (light.projection() * view).to_cols_array_2d(),
             view: view.to_cols_array_2d(),
@@ -37,7 +42,11 @@ impl LightGpu {
             near: light.near,
             direction: light.direction().to_array(),
             far: light.far,
-            map_size: [light.shadow_map as f32; 2],
+            map_size: [map_w as f32, map_h as f32],
+            face_uv: [
+                light.shadow_map as f32 / map_w as f32,
+                light.shadow_map as f32 / map_h as f32,
+            ],
             width_at_unit: light.width_at_unit(),
             size: light.size,
             target_distance: (light.target - light.position).length(),

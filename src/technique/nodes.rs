@@ -146,11 +146,12 @@ impl LightNodes<'_> {
 /// the techniques that shade from the linear depth (hard, PCF but the hardware comparison
 /// sampler, PCSS) or when a caller asks for [`linear_name`] (diagnostics).
 pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput {
+    let (width, height) = light.map_dims();
     let depth = graph.import(
         depth_name(i),
         wgpu::TextureFormat::Depth32Float,
-        light.shadow_map,
-        light.shadow_map,
+        width,
+        height,
         Some(i),
     );
     let lin = LinearizeParams::new(light);

@@ -18,6 +18,14 @@
 //!   emitter in the light's plane (penumbra `size·(Z_r − Z_b)/Z_b`): the two agree for
 //!   blockers at distance `D` and differ by `D / Z_b` elsewhere; the truth keeps the
 //!   directional light's parallel rays, so a size of 0 gives the directional hard shadow.
+//! - **Point**: the emitter is a sphere of diameter `size` (uniform radiance, so each receiver
+//!   sees a uniform disc). Its sample points lie in the ball with density `∝ 1/√(R² − ρ²)`
+//!   ([`ball_point`]), the one density whose projection along *every* direction is uniform
+//!   over the disc of radius R (its Abel transform is constant), so one set of samples, shared
+//!   by all receivers, samples each receiver's disc uniformly. Seen from a receiver at distance
+//!   `D` the disc is a cone, not a parallel projection: the sampled directions are uniform over
+//!   the disc to within a relative `O(R / D)`. Each sample is a point light at `p_k` with the
+//!   light's near and far planes and a hard-shadow atlas of `resolution`² faces.
 
 use glam::{DVec3, Mat4, Vec4};
 
@@ -85,11 +93,45 @@ pub fn frame(light: &Light) -> (DVec3, DVec3, DVec3) {
     (row(0), row(1), -row(2))
 }
 
-/// World position of the emitter point at `offset` (units of `size`).
+/// World position of the emitter point at `offset` (units of `size`; a point light's: the
+/// point of its spherical emitter [`ball_point`] maps the offset to).
 pub fn point(light: &Light, offset: [f64; 2]) -> DVec3 {
-    let (right, up, _) = frame(light);
     let s = f64::from(light.size);
+    if light.kind == LightKind::Point {
+        return light.position.as_dvec3() + s * ball_point(offset);
+    }
+    let (right, up, _) = frame(light);
     light.position.as_dvec3() + s * (offset[0] * right + offset[1] * up)
+}
+
+/// The point of the unit-diameter ball that a point light's emitter sample at `offset`
+/// (`[−½, ½]²`) stands for: its direction from the offset by Lambert's equal-area map
+/// (`cos θ = 2·offset.y`, `φ = 2π(offset.x + ½)`: a stratified square gives stratified
+/// directions), its radius `ρ = ½·F⁻¹(u)` for the radial distribution of the density
+/// `1/√(¼ − ρ²)`, `F(x) = (2/π)(asin x − x√(1 − x²))`, with `u` hashed from the offset's bits
+/// (deterministic, independent of the direction). The centre offset (0, 0) is the centre.
+pub fn ball_point(offset: [f64; 2]) -> DVec3 {
+    if offset == [0.0, 0.0] {
+        return DVec3::ZERO;
+    }
+    let cos_t = (2.0 * offset[1]).clamp(-1.0, 1.0);
+    let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+    let phi = std::f64::consts::TAU * (offset[0] + 0.5);
+    let dir = DVec3::new(sin_t * phi.cos(), cos_t, sin_t * phi.sin());
+    let mut rng = SplitMix64(offset[0].to_bits() ^ offset[1].to_bits().rotate_left(29));
+    let u = rng.unit();
+    let cdf = |x: f64| (x.asin() - x * (1.0 - x * x).sqrt()) / std::f64::consts::FRAC_PI_2;
+    // F is increasing on [0, 1]: bisection to f64 precision.
+    let (mut lo, mut hi) = (0.0f64, 1.0f64);
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if cdf(mid) < u {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (0.5 * (lo + hi)) * dir
 }
 
 /// One emitter sample as the GPU rasterizes and tests it.
@@ -97,8 +139,9 @@ pub fn point(light: &Light, offset: [f64; 2]) -> DVec3 {
 pub struct EmitterSample {
     /// The sample point on the emitter.
     pub point: DVec3,
-    /// World → clip of its shadow map (column-major, as the raster pass takes it).
-    pub view_proj: [f32; 16],
+    /// World → clip of each view of its shadow map (column-major, as the raster pass takes
+    /// it) with the view's viewport: one, or a point light's six faces.
+    pub views: Vec<([f32; 16], [u32; 4])>,
     /// The light the accumulation kernel tests with (`view` is the light's own, so linear
     /// depth is shared by all samples; `view_proj`, `position`, `direction`, `width_at_unit`
     /// and `map_size` are the sample's).
@@ -144,12 +187,28 @@ pub fn samples(
                     l.target += shift;
                     EmitterSample {
                         point: p,
-                        view_proj: (l.projection() * l.view()).to_cols_array(),
+                        views: l.raster_views(),
                         light: LightGpu::new(&l),
                     }
                 })
                 .collect()
         }
+        // Every sample sees all directions: nothing to widen.
+        LightKind::Point => offsets
+            .iter()
+            .map(|&o| {
+                let p = point(light, o);
+                let shift = (p - light.position.as_dvec3()).as_vec3();
+                let mut l = base.clone();
+                l.position += shift;
+                l.target += shift;
+                EmitterSample {
+                    point: p,
+                    views: l.raster_views(),
+                    light: LightGpu::new(&l),
+                }
+            })
+            .collect(),
         LightKind::Directional { extent } => {
             let d = f64::from((light.target - light.position).length());
             if reach > 0.0 {
@@ -194,7 +253,7 @@ pub fn samples(
                         .to_array();
                     EmitterSample {
                         point: p,
-                        view_proj: view_proj.to_cols_array(),
+                        views: vec![(view_proj.to_cols_array(), [0, 0, resolution, resolution])],
                         light: g,
                     }
                 })

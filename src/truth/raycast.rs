@@ -135,7 +135,7 @@ fn seen(bvh: &Bvh, light: &Light, p: DVec3, own: usize, offsets: &[[f64; 2]]) ->
         .filter(|&&off| {
             let q = emitter::point(light, off);
             let (dir, t_max) = match light.kind {
-                LightKind::Spot { .. } => {
+                LightKind::Spot { .. } | LightKind::Point => {
                     let to = q - p;
                     let len = to.length();
                     (to / len, len * (1.0 - near / z).max(0.0))

@@ -137,7 +137,7 @@ pub fn soft(storage: Storage, sums: SatVariant) -> Soft {
 pub fn light(kind: LightKind, technique: Technique) -> Light {
     let (position, near, far, size) = match kind {
         LightKind::Directional { .. } => (Vec3::new(-3.0, 10.0, 2.0), 2.0, 20.0, 2.0),
-        LightKind::Spot { .. } => (Vec3::new(1.0, 8.0, -1.0), 0.5, 20.0, 0.3),
+        LightKind::Spot { .. } | LightKind::Point => (Vec3::new(1.0, 8.0, -1.0), 0.5, 20.0, 0.3),
     };
     Light {
         kind,

@@ -250,6 +250,13 @@ pub fn light_traffic(plan: &Plan, light: usize) -> Result<Vec<(&Node, Traffic)>>
 
 /// Texels of light `light`'s map: its imported (rasterized) resource's, else its largest.
 pub fn map_texels(plan: &Plan, light: usize) -> f64 {
+    let (w, h) = map_dims(plan, light);
+    f64::from(w) * f64::from(h)
+}
+
+/// Width and height of light `light`'s map: its imported (rasterized) resource's, else its
+/// largest; (1, 1) if it has none.
+pub fn map_dims(plan: &Plan, light: usize) -> (u32, u32) {
     let texels = |r: &&super::PlannedResource| f64::from(r.width) * f64::from(r.height);
     let of_light = || {
         plan.resources
@@ -259,7 +266,7 @@ pub fn map_texels(plan: &Plan, light: usize) -> f64 {
     of_light()
         .find(|r| r.resource.imported)
         .or_else(|| of_light().max_by(|a, b| texels(a).total_cmp(&texels(b))))
-        .map_or(1.0, |r| texels(&r))
+        .map_or((1, 1), |r| (r.width, r.height))
 }
 
 /// Bytes per texel of light `light`'s map of one read of its rasterized depth and one write

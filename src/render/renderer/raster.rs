@@ -48,7 +48,13 @@ pub(in crate::render) fn depth_only_view(t: &wgpu::Texture) -> wgpu::TextureView
     )
 }
 
-/// Records a depth-only raster pass: `count` vertices of `vertices` into `depth`.
+/// Bytes of a raster pass's uniform: one world → clip matrix per view it may draw
+/// (`VIEWS` in `kernels/shadow_depth.wgsl`).
+pub(in crate::render) const VIEW_BYTES: u64 = 64 * crate::model::point::FACES as u64;
+
+/// Records a depth-only raster pass: `count` vertices of `vertices` into `depth`, once per
+/// viewport of `viewports` (x, y, width, height in texels), draw `k` with instance `k` (the
+/// matrix the vertex stage picks).
 #[expect(clippy::too_many_arguments, reason = "one raster pass's inputs")]
 pub(super) fn raster_pass(
     enc: &mut wgpu::CommandEncoder,
@@ -58,6 +64,7 @@ pub(super) fn raster_pass(
     depth: &wgpu::TextureView,
     vertices: &wgpu::Buffer,
     count: u32,
+    viewports: &[[u32; 4]],
     timer: Option<&mut GpuTimer>,
 ) {
     if let Some(t) = timer {
@@ -74,7 +81,11 @@ pub(super) fn raster_pass(
     pass.set_pipeline(pipeline);
     pass.set_bind_group(0, bind_group, &[]);
     pass.set_vertex_buffer(0, vertices.slice(..));
-    pass.draw(0..count, 0..1);
+    for (k, &[x, y, w, h]) in (0u32..).zip(viewports) {
+        pass.set_viewport(x as f32, y as f32, w as f32, h as f32, 0.0, 1.0);
+        pass.set_scissor_rect(x, y, w, h);
+        pass.draw(0..count, k..k + 1);
+    }
 }
 
 impl Renderer {
@@ -197,7 +208,7 @@ impl Renderer {
     }
 
     /// Records a depth-only raster pass of the scene's vertices `vbuf` (`count` vertices) into
-    /// `depth` (Depth32Float) with an explicit world → clip matrix: the pipeline and bias the
+    /// `depth` (Depth32Float) with explicit world → clip matrices and viewports: the pipeline and bias the
     /// renderer's own shadow maps use (`truth` rasterizes its emitter samples with it). Each
     /// call makes its own uniform, so that many passes can share one encoder.
     #[expect(clippy::too_many_arguments, reason = "one raster pass's inputs")]
@@ -212,17 +223,32 @@ impl Renderer {
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         let (pipeline, layout) = self.shadow_pipeline(device, raster.slope_bias)?;
+        let mut matrices = vec![0.0f32; (VIEW_BYTES / 4) as usize];
+        for (m, (vp, _)) in matrices.chunks_mut(16).zip(raster.views) {
+            m.copy_from_slice(vp);
+        }
+        let viewports: Vec<[u32; 4]> = raster.views.iter().map(|(_, v)| *v).collect();
         let ubuf = created::buffer_init(
             device,
             &wgpu::util::BufferInitDescriptor {
                 label: Some("shadowgraph.light_view"),
-                contents: bytemuck::cast_slice(&raster.view_proj),
+                contents: bytemuck::cast_slice(&matrices),
                 usage: wgpu::BufferUsages::UNIFORM,
             },
         );
         let bg = uniform_group(device, "shadowgraph.shadow_depth", layout, &ubuf);
         let view = created::view(depth, &Default::default());
-        raster_pass(enc, raster.label, pipeline, &bg, &view, vbuf, count, timer);
+        raster_pass(
+            enc,
+            raster.label,
+            pipeline,
+            &bg,
+            &view,
+            vbuf,
+            count,
+            &viewports,
+            timer,
+        );
         Ok(())
     }
 }
@@ -254,8 +280,10 @@ fn depth_pipeline<'a>(
 pub struct ShadowRaster<'a> {
     /// Pass label (and timer label).
     pub label: &'a str,
-    /// World → clip, column-major (wgpu depth convention: 0 at near, 1 at far).
-    pub view_proj: [f32; 16],
+    /// Each view: world → clip, column-major (wgpu depth convention: 0 at near, 1 at far),
+    /// and its viewport in the map (x, y, width, height in texels): one for a one-map light,
+    /// six for a point light's faces ([`crate::model::Light::raster_views`]).
+    pub views: &'a [([f32; 16], [u32; 4])],
     /// Slope-scaled depth bias (`DepthBiasState::slope_scale`).
     pub slope_bias: f32,
 }
