@@ -31,7 +31,7 @@ fn linear_depth(l: Light, raw: f32) -> f32 {
     if is_finite(raw) {
         let d = clamp(raw, 0.0, 1.0);
         z = d;
-        if l.kind == 1u {
+        if l.kind != 0u {
             z = l.near * d / (l.far * (1.0 - d) + l.near * d);
         }
         z = clamp(z, 0.0, 1.0);

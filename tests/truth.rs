@@ -140,6 +140,13 @@ fn gpu_truth_matches_ray_cast_spot() {
     cross_check("sphere_on_plane.toml", 150);
 }
 
+/// A point light's spherical emitter: the GPU's atlas of six faces per sample against the f64
+/// ray cast to the same sample points.
+#[test]
+fn gpu_truth_matches_ray_cast_point() {
+    cross_check("point.toml", 60);
+}
+
 #[test]
 fn gpu_truth_matches_ray_cast_directional() {
     cross_check("pole.toml", 60);
@@ -148,12 +155,17 @@ fn gpu_truth_matches_ray_cast_directional() {
 /// One sample at the emitter's centre with the light's own map size is the light's hard shadow
 /// map: the truth must equal the renderer's `hard` technique at every relevant pixel, exactly
 /// (same raster pipeline and matrices, the `linearize` formula and `vis_hard`'s comparison
-/// operation for operation). Both the spot and the directional light, at 160×120.
+/// operation for operation). The spot, the directional and the point light, at 160×120.
 #[test]
 fn centre_sample_equals_hard_technique() {
     let g = common::gpu();
     let mut renderer = Renderer::new(&g.device);
-    for name in ["sphere_on_plane.toml", "pole.toml", "stacked.toml"] {
+    for name in [
+        "sphere_on_plane.toml",
+        "pole.toml",
+        "stacked.toml",
+        "point.toml",
+    ] {
         let mut s = scene(name, 160, 120);
         for l in &mut s.lights {
             l.shadow.technique = Technique::Hard;

@@ -235,7 +235,11 @@ fn pcf_stats(
             size: linear.width as usize,
             texels: &linear.data,
         };
-        let g = LightGpu::new(light);
+        // The linear map is a `hard` render's: sample it as that light (the same map for every
+        // technique but a point light's, whose guard band follows its technique).
+        let mut hard = light.clone();
+        hard.shadow.technique = Technique::Hard;
+        let g = LightGpu::new(&hard);
         for px in 0..(frame.width * frame.height) as usize {
             let i = px * lights + li;
             if !truth.mask[i] {
