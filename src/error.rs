@@ -249,6 +249,17 @@ pub enum StageError {
         /// Height.
         height: u32,
     },
+    /// A point light's depth texture is not an atlas of three faces by two.
+    #[error(
+        "depth texture is {width}x{height}; a point light's is an atlas of 3 x 2 square faces \
+         (3N x 2N texels for N-texel faces: `Prefilter::point_views`)"
+    )]
+    DepthNotAtlas {
+        /// Width.
+        width: u32,
+        /// Height.
+        height: u32,
+    },
     /// The depth texture is not a single-sampled 2-D texture (of one or more layers).
     #[error(
         "depth texture must be a single-sampled 2-D texture (a layer of a 2-D array is passed as \

@@ -86,11 +86,21 @@ struct Planned {
     maps: Vec<MapInput>,
 }
 
+/// One face of a point light's depth pass ([`Prefilter::point_views`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointView {
+    /// World → clip of the face (wgpu's depth convention: 0 at near, 1 at far).
+    pub view_proj: Mat4,
+    /// The face's tile in the atlas: x, y, width, height in texels.
+    pub viewport: [u32; 4],
+}
+
 /// What a plan depends on besides the technique: the map size and the linearization.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct PlanKey {
     size: u32,
     perspective: bool,
+    point: bool,
     near: u32,
     far: u32,
 }
@@ -100,6 +110,7 @@ impl PlanKey {
         Self {
             size,
             perspective: light.perspective,
+            point: light.point,
             near: light.near.to_bits(),
             far: light.far.to_bits(),
         }
@@ -224,7 +235,12 @@ impl Prefilter {
             }
             .into());
         }
-        let size = check_depth(depth)?;
+        let size = check_depth(depth, light)?;
+        if light.point {
+            // The faces' guard band is the technique's reach: refuse what six faces cannot
+            // bound before planning.
+            self.point_layout(size)?;
+        }
         let key = PlanKey::new(light, size);
         self.replan(device, slot, key, light)?;
         let config = &self.config;
@@ -261,6 +277,47 @@ impl Prefilter {
             maps,
             light: light.light_gpu(config, size),
         })
+    }
+
+    /// A point light's faces for the host's depth pass into a `3·face × 2·face` depth
+    /// texture: per face (+X, −X, +Y, −Y, +Z, −Z) its world → clip matrix (wgpu's depth
+    /// convention, each frustum widened by the guard band of the stage's technique) and its
+    /// viewport `[x, y, width, height]` in texels; draw the scene once per face with that
+    /// viewport (and scissor), then [`Prefilter::record`] the texture with the same `light`.
+    /// Refused where the technique's reach cannot be bounded to a face (e.g. `smrt`) or the
+    /// guard band leaves less than half the face.
+    pub fn point_views(&self, light: &LightParams, face: u32) -> Result<Vec<PointView>> {
+        if !light.point {
+            return Err(StageError::LightParams {
+                field: "point",
+                message: "point_views needs a point light (`LightParams::point`)".into(),
+            }
+            .into());
+        }
+        light.validate()?;
+        self.point_layout(face)?;
+        Ok(light
+            .scene_light(&self.config, face)
+            .raster_views()
+            .into_iter()
+            .map(|(m, viewport)| PointView {
+                view_proj: Mat4::from_cols_array(&m),
+                viewport,
+            })
+            .collect())
+    }
+
+    /// The face layout of the stage's technique on `face`-texel faces, or why there is none.
+    fn point_layout(&self, face: u32) -> Result<crate::model::point::PointLayout> {
+        crate::model::point::reach(&self.config.technique, face)
+            .and_then(|r| crate::model::point::PointLayout::new(face, r))
+            .map_err(|message| {
+                StageError::Config {
+                    field: "technique".into(),
+                    message,
+                }
+                .into()
+            })
     }
 
     /// The host's WGSL: the technique's visibility function, its maps bound at
@@ -527,7 +584,9 @@ struct MapInput {
 }
 
 /// The side of `depth`, or what makes it unusable.
-fn check_depth(depth: DepthLayer<'_>) -> Result<u32, StageError> {
+/// The map size of `depth` for `light`: its side (square), or a point light's face side (an
+/// atlas of three faces by two).
+fn check_depth(depth: DepthLayer<'_>, light: &LightParams) -> Result<u32, StageError> {
     let DepthLayer {
         texture: depth,
         layer,
@@ -559,13 +618,24 @@ fn check_depth(depth: DepthLayer<'_>) -> Result<u32, StageError> {
     if layer >= layers {
         return Err(StageError::DepthLayer { layer, layers });
     }
-    if depth.width() != depth.height() {
+    let (w, h) = (depth.width(), depth.height());
+    if light.point {
+        let face = h / 2;
+        if face == 0 || w != 3 * face || h != 2 * face {
+            return Err(StageError::DepthNotAtlas {
+                width: w,
+                height: h,
+            });
+        }
+        return Ok(face);
+    }
+    if w != h {
         return Err(StageError::DepthNotSquare {
-            width: depth.width(),
-            height: depth.height(),
+            width: w,
+            height: h,
         });
     }
-    Ok(depth.width())
+    Ok(w)
 }
 
 fn depth_aspect_view(t: &wgpu::Texture) -> wgpu::TextureView {

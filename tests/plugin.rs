@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::host::host_depth;
+use common::host::{host_depth, host_depth_views};
 
 use std::path::{Path, PathBuf};
 
@@ -296,13 +296,27 @@ fn stage_outputs_equal_the_renderers() {
             }
             let what = format!("{name} light {li} ({})", light.shadow.technique.name());
             let params = LightParams::from_light(light);
-            let depth = host_depth(
-                &g,
-                &vertices,
-                &params,
-                light.shadow.slope_bias,
-                light.shadow_map,
-            );
+            let config = PrefilterConfig::from_light(light);
+            // A point light's atlas, drawn face by face with the stage's views.
+            let (w, h) = light.map_dims();
+            let depth = if params.point {
+                let stage = Prefilter::new(&g.device, &config).expect("stage");
+                let views: Vec<(glam::Mat4, [u32; 4])> = stage
+                    .point_views(&params, light.shadow_map)
+                    .expect("point views")
+                    .iter()
+                    .map(|v| (v.view_proj, v.viewport))
+                    .collect();
+                host_depth_views(&g, &vertices, &views, light.shadow.slope_bias, (w, h))
+            } else {
+                host_depth(
+                    &g,
+                    &vertices,
+                    &params,
+                    light.shadow.slope_bias,
+                    light.shadow_map,
+                )
+            };
             let renderer_depth = frame
                 .resources
                 .iter()
@@ -322,11 +336,11 @@ fn stage_outputs_equal_the_renderers() {
             if shadowgraph::technique::peels(&light.shadow.technique) {
                 continue;
             }
-            let mut stage = Prefilter::new(&g.device, &PrefilterConfig::from_light(light))
-                .unwrap_or_else(|e| panic!("{what}: {e}"));
+            let mut stage =
+                Prefilter::new(&g.device, &config).unwrap_or_else(|e| panic!("{what}: {e}"));
             // The renderer's map holds every map's channels side by side (CSM: 2M channels).
             let maps = stage_maps_as_frame(&g, &mut stage, &depth, &params, light);
-            let texels = (light.shadow_map * light.shadow_map) as usize;
+            let texels = (w * h) as usize;
             let concat: Vec<f32> = (0..texels)
                 .flat_map(|t| {
                     maps.iter()

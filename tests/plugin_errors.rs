@@ -313,6 +313,64 @@ fn second_depth_techniques_are_refused_by_the_stage() {
     }
 }
 
+/// A point light's stage: an atlas of the wrong shape, `point_views` of a light that is not a
+/// point light, and a technique six faces cannot bound are each named.
+#[test]
+fn point_light_mistakes_are_named() {
+    let g = common::gpu();
+    let point = LightParams::point(glam::Vec3::new(0.0, 2.0, 0.0), 0.1, 10.0);
+    // A square texture (the face alone), and 3N × 2N but for one texel.
+    for (w, h) in [(64, 64), (192, 127), (193, 128)] {
+        let depth = texture(
+            &g,
+            wgpu::TextureFormat::Depth32Float,
+            (w, h, 1),
+            1,
+            READABLE,
+        );
+        match record_err(&g, &depth, &point) {
+            StageError::DepthNotAtlas { width, height } => assert_eq!((width, height), (w, h)),
+            e => panic!("{w}x{h}: {e}"),
+        }
+    }
+    let stage = Prefilter::new(&g.device, &PrefilterConfig::vsm(64)).expect("stage");
+    match stage.point_views(&light(), 64) {
+        Err(Error::Stage(StageError::LightParams { field, .. })) => assert_eq!(field, "point"),
+        other => panic!("point_views of a directional light: {other:?}"),
+    }
+    // The default blur (radius 2) on 64-texel faces: a guard band of 4; six views.
+    let views = stage.point_views(&point, 64).expect("views");
+    assert_eq!(views.len(), 6);
+    assert_eq!(views[5].viewport, [128, 64, 64, 64]);
+    let smrt = shadowgraph::technique::named("smrt", &[]).expect("smrt");
+    let config = PrefilterConfig::new(smrt, 64).with_light_size(0.2);
+    let stage = Prefilter::new(&g.device, &config).expect("stage");
+    match stage.point_views(&point, 64) {
+        Err(Error::Stage(StageError::Config { field, message })) => {
+            assert_eq!(field, "technique");
+            assert!(message.contains("smrt"), "{message}");
+        }
+        other => panic!("smrt on a point light: {other:?}"),
+    }
+    // A face too small for the guard band: refused by name before anything is planned.
+    let depth = texture(
+        &g,
+        wgpu::TextureFormat::Depth32Float,
+        (24, 16, 1),
+        1,
+        READABLE,
+    );
+    let mut stage = Prefilter::new(&g.device, &PrefilterConfig::vsm(64)).expect("stage");
+    let mut enc = g.device.create_command_encoder(&Default::default());
+    match stage.record(&g.device, &mut enc, &depth, &point) {
+        Err(Error::Stage(StageError::Config { message, .. })) => {
+            assert!(message.contains("guard band"), "{message}")
+        }
+        Err(e) => panic!("8-texel faces: {e}"),
+        Ok(_) => panic!("8-texel faces accepted"),
+    }
+}
+
 /// A device (and queue) of the same adapter with `limits` and no optional features.
 fn device_with(g: &Gpu, limits: wgpu::Limits) -> (wgpu::Device, wgpu::Queue) {
     pollster::block_on(g.adapter.request_device(&wgpu::DeviceDescriptor {

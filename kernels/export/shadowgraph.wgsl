@@ -56,16 +56,17 @@
 //   sg_csm_resolve sg_csm_sin_cos sg_csm_weight sg_csm_z_chunk_of sg_cssm_blocker
 //   sg_cssm_resolve sg_cssm_sharpen sg_level_size sg_light_depth_slope sg_light_faces
 //   sg_light_footprint sg_light_linear_to_ndc sg_light_linear_to_z sg_light_map_width
-//   sg_light_receiver_offset sg_light_sample sg_light_tap_offset sg_light_to_light sg_linstep
-//   sg_load_depth sg_mip_tap_uv sg_mip_taps sg_msm_biased sg_msm_dequantize sg_msm_expect
-//   sg_msm_intensity sg_msm_moments sg_msm_quantize sg_msm_roots sg_msm_soft_blocker
-//   sg_pcss_search_radius sg_sample_bilinear sg_sample_bilinear_log sg_sample_map
-//   sg_sample_map_log sg_sat_box sg_sat_box_fixed sg_sat_box_float sg_sat_clamp
-//   sg_sat_mean_fixed sg_sat_mean_float sg_sat_node_f32 sg_sat_node_u32 sg_sat_nodes sg_sat_rect
-//   sg_sat_sample_fixed sg_sat_sample_float sg_sat_search_fixed sg_sat_search_float
-//   sg_sat_span_weights sg_smrt_emitter_point sg_smrt_ray sg_soft_blockers sg_soft_filter_trips
-//   sg_texel_of sg_trilinear sg_trilinear_log sg_vis_esm sg_vis_esm_of_log sg_vis_esm_of_sat
-//   sg_vis_evsm sg_vis_evsm_of sg_vis_hard sg_vis_msm sg_vis_msm_of sg_vis_msm_soft_fixed
+//   sg_light_receiver_offset sg_light_sample sg_light_tap_offset sg_light_texel
+//   sg_light_to_light sg_linstep sg_load_depth sg_mip_tap_uv sg_mip_taps sg_msm_biased
+//   sg_msm_dequantize sg_msm_expect sg_msm_intensity sg_msm_moments sg_msm_quantize sg_msm_roots
+//   sg_msm_soft_blocker sg_pcss_search_radius sg_point_coords sg_point_face sg_point_sample
+//   sg_sample_bilinear sg_sample_bilinear_log sg_sample_map sg_sample_map_log sg_sat_box
+//   sg_sat_box_fixed sg_sat_box_float sg_sat_clamp sg_sat_mean_fixed sg_sat_mean_float
+//   sg_sat_node_f32 sg_sat_node_u32 sg_sat_nodes sg_sat_rect sg_sat_sample_fixed
+//   sg_sat_sample_float sg_sat_search_fixed sg_sat_search_float sg_sat_span_weights
+//   sg_smrt_emitter_point sg_smrt_ray sg_soft_blockers sg_soft_filter_trips sg_texel_of
+//   sg_trilinear sg_trilinear_log sg_vis_esm sg_vis_esm_of_log sg_vis_esm_of_sat sg_vis_evsm
+//   sg_vis_evsm_of sg_vis_hard sg_vis_msm sg_vis_msm_of sg_vis_msm_soft_fixed
 //   sg_vis_msm_soft_float sg_vis_pcf sg_vis_pcf_hardware sg_vis_pcss sg_vis_smrt sg_vis_vsm
 //   sg_vis_vsm_of sg_vis_vssm_fixed sg_vis_vssm_float sg_vogel_disc sg_vssm_blocker
 
@@ -80,13 +81,13 @@ struct sg_Light {
     view_proj: mat4x4<f32>,  // world → light clip
     view: mat4x4<f32>,       // world → light view
     radiance: vec3<f32>,     // colour × intensity
-    kind: u32,               // 0 directional (orthographic), 1 spot (perspective)
+    kind: u32,               // 0 directional (orthographic), 1 spot (perspective), 2 point (six faces)
     position: vec3<f32>,
     near: f32,
     direction: vec3<f32>,    // unit, light → target
     far: f32,
     map_size: vec2<f32>,     // shadow-map texels
-    width_at_unit: f32,      // map width in world units: directional 2·extent; spot 2·tan(fov/2) per unit distance
+    width_at_unit: f32,      // map (a point light's face) width in world units: directional 2·extent; spot, point 2·tan(fov/2) per unit distance
     size: f32,               // area-light width, world units
     bias: f32,               // constant bias, linear depth units
     normal_bias: f32,        // normal offset, texels, scaled by (1 − N·L)
@@ -128,7 +129,7 @@ struct sg_Light {
     cascade_first: u32,      // cascades: index in `lights` of cascade 1 (the rest follow)
     cascade_near: f32,       // cascades: view distance the first cascade starts at
     cascade_blend: f32,      // cascades: blend band, fraction of each cascade's range
-    cascade_pad: vec2<f32>,
+    face_uv: vec2<f32>,      // map UV per unit of a face's UV: (1, 1); a point light's atlas (1/3, 1/2)
     cascade_far: array<vec4<f32>, 2>, // cascades: far view distance of cascade c at [c / 4][c % 4]
 }
 
@@ -182,10 +183,18 @@ fn sg_light_faces(l: sg_Light, p: vec3<f32>, n: vec3<f32>) -> bool {
     return dot(n, sg_light_to_light(l, p)) > 0.0;
 }
 
+// World size of one texel at view distance z.
+fn sg_light_texel(l: sg_Light, z: f32) -> f32 {
+    return sg_light_map_width(l, z) / (l.map_size.x * l.face_uv.x);
+}
+
 // Projects p, first moved along n by normal_bias texels scaled by (1 − N·L).
 fn sg_light_sample(l: sg_Light, p: vec3<f32>, n: vec3<f32>) -> sg_LightSample {
+    if l.kind == 2u {
+        return sg_point_sample(l, p, n);
+    }
     let z0 = -(l.view * vec4<f32>(p, 1.0)).z;
-    let texel = sg_light_map_width(l, max(z0, l.near)) / l.map_size.x;
+    let texel = sg_light_texel(l, max(z0, l.near));
     let ndl = clamp(dot(n, sg_light_to_light(l, p)), 0.0, 1.0);
     let q = p + n * (l.normal_bias * texel * (1.0 - ndl));
     let clip = l.view_proj * vec4<f32>(q, 1.0);
@@ -204,6 +213,58 @@ fn sg_light_sample(l: sg_Light, p: vec3<f32>, n: vec3<f32>) -> sg_LightSample {
     return s;
 }
 
+// A point light's face for direction d from the light: its major axis and sign, ties to x then
+// y (src/model/point.rs, face_of).
+fn sg_point_face(d: vec3<f32>) -> u32 {
+    let a = abs(d);
+    if a.x >= a.y && a.x >= a.z {
+        return select(0u, 1u, d.x < 0.0);
+    }
+    if a.y >= a.z {
+        return select(2u, 3u, d.y < 0.0);
+    }
+    return select(4u, 5u, d.z < 0.0);
+}
+
+// Direction d in face f's view: (right, up, distance along the face's axis), the view that
+// Mat4::look_at_rh(position, position + forward, up) builds for the faces +X, −X, +Y, −Y, +Z, −Z
+// with up +Y, +Y, +Z, +Z, +Y, +Y (point::face_axes).
+fn sg_point_coords(d: vec3<f32>, f: u32) -> vec3<f32> {
+    switch f {
+        case 0u: { return vec3<f32>(d.z, d.y, d.x); }
+        case 1u: { return vec3<f32>(-d.z, d.y, -d.x); }
+        case 2u: { return vec3<f32>(d.x, d.z, d.y); }
+        case 3u: { return vec3<f32>(-d.x, d.z, -d.y); }
+        case 4u: { return vec3<f32>(-d.x, d.y, d.z); }
+        default: { return vec3<f32>(d.x, d.y, -d.z); }
+    }
+}
+
+// light_sample for a point light: the receiver, moved by the normal offset at the texel size of
+// the face that sees it, is projected into the face that sees the moved point, whose 90° core
+// holds it; the face's tile sits at column f % 3, row f / 3 of the atlas. Its depth is the
+// distance along that face's axis, so every texel a lookup reads around it (within the guard
+// band) was rasterized from the same view.
+fn sg_point_sample(l: sg_Light, p: vec3<f32>, n: vec3<f32>) -> sg_LightSample {
+    let a = abs(p - l.position);
+    let texel = sg_light_texel(l, max(max(a.x, max(a.y, a.z)), l.near));
+    let ndl = clamp(dot(n, sg_light_to_light(l, p)), 0.0, 1.0);
+    let q = p + n * (l.normal_bias * texel * (1.0 - ndl));
+    let d = q - l.position;
+    let f = sg_point_face(d);
+    let c = sg_point_coords(d, f);
+    let t = 0.5 * l.width_at_unit * c.z;
+    let tile = vec2<f32>(0.5 + 0.5 * c.x / t, 0.5 - 0.5 * c.y / t);
+    var s: sg_LightSample;
+    s.uv = (vec2<f32>(f32(f % 3u), f32(f / 3u)) + tile) * l.face_uv;
+    s.view_z = c.z;
+    s.depth = (c.z - l.near) / (l.far - l.near);
+    s.inside = c.z > 0.0 && s.depth >= 0.0 && s.depth <= 1.0;
+    s.footprint = vec4<f32>(0.0);
+    s.depth_slope = vec2<f32>(0.0);
+    return s;
+}
+
 // Receiver-plane depth bias (Isidoro, GDC 2006): the depth of the plane through the receiver q
 // with normal n, per texel of offset in the map. A compute shading pass has no dpdx, so the
 // plane comes from the G-buffer normal: exact for planar receivers. View space v = V q; a point
@@ -219,7 +280,7 @@ fn sg_light_depth_slope(l: sg_Light, q: vec3<f32>, n: vec3<f32>, z: f32) -> vec2
     } else {
         per_world = vec2<f32>(-nv.x, nv.y) * (z * z / dot(nv, v));
     }
-    let texel = l.width_at_unit / l.map_size.x;
+    let texel = l.width_at_unit / (l.map_size.x * l.face_uv.x);
     let slope = per_world * texel / (l.far - l.near);
     // Edge-on (n·v or n_z → 0) the slope is unbounded or NaN: the cap bounds each tap instead.
     return select(vec2<f32>(0.0), slope, all(abs(slope) < vec2<f32>(1e30)));
@@ -719,7 +780,7 @@ fn sg_sat_search_float(map: texture_2d<f32>, l: sg_Light, uv: vec2<f32>, width: 
 //           width, where it is widest, as PCSS's search: vis_pcss.wgsl), / light_map_width(near);
 //   filter  w   = size·(Z − Z_b)/Z_b at the receiver (PCSS's penumbra, Fernando 2005), with
 //           Z_b = light_linear_to_z(z_avg), / light_map_width(Z);
-// both · map_size, at least 1 texel and at most l.max_width (2·max_search·map_size, the square
+// both · the face's texels (map_size · face_uv), at least 1 texel and at most l.max_width (2·max_search·map_size, the square
 // the fixed-point table is coded for). A NaN width (outside the map, where the result is
 // discarded) reads as 1 texel.
 // Moment shadow maps (Peters & Klein 2015), four moments b = (z, z², z³, z⁴) of the filtered
@@ -923,13 +984,13 @@ fn sg_blocker_width(texels: f32, l: sg_Light) -> f32 {
 
 fn sg_blocker_search_width(l: sg_Light, s: sg_LightSample) -> f32 {
     let world = l.size * (s.view_z - l.near) / s.view_z;
-    return sg_blocker_width(world / sg_light_map_width(l, l.near) * l.map_size.x, l);
+    return sg_blocker_width(world / sg_light_map_width(l, l.near) * (l.map_size.x * l.face_uv.x), l);
 }
 
 fn sg_blocker_filter_width(l: sg_Light, s: sg_LightSample, z_avg: f32) -> f32 {
     let z_b = sg_light_linear_to_z(l, z_avg);
     let penumbra = l.size * (s.view_z - z_b) / z_b;
-    return sg_blocker_width(penumbra / sg_light_map_width(l, s.view_z) * l.map_size.x, l);
+    return sg_blocker_width(penumbra / sg_light_map_width(l, s.view_z) * (l.map_size.x * l.face_uv.x), l);
 }
 
 // A soft technique's two table lookups: the search (`sat_search_*`, the square snapped
@@ -1201,6 +1262,9 @@ fn sg_vis_pcf_hardware(map: texture_depth_2d, cmp: sampler_comparison, l: sg_Lig
 // the receiver-plane bias each tap (search and filter) compares the receiver plane's depth at
 // its texel's centre.
 
+// Radii are in units of a face's UV (the map's, but for a point light's atlas, whose UV is
+// face UV · face_uv). On a point light the filter radius is capped at max_search as the search
+// is, so that no tap leaves the face's guard band (src/model/point.rs).
 // Radius (UV) of the blocker search: the cone from the receiver to the light's width, at the
 // near plane where it is widest, capped by max_search.
 fn sg_pcss_search_radius(l: sg_Light, s: sg_LightSample) -> f32 {
@@ -1214,7 +1278,7 @@ fn sg_vis_pcss(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
     var sum = 0.0;
     var count = 0u;
     for (var i = 0u; i < l.blocker_samples; i++) {
-        let t = sg_texel_of(s.uv + search * sg_vogel_disc(i, l.blocker_samples), l.map_size);
+        let t = sg_texel_of(s.uv + search * l.face_uv * sg_vogel_disc(i, l.blocker_samples), l.map_size);
         let z = sg_load_depth(map, t);
         if z + l.bias < s.depth + sg_light_receiver_offset(l, s, sg_light_tap_offset(l, s, t)) {
             sum += z;
@@ -1226,10 +1290,13 @@ fn sg_vis_pcss(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
     }
     let z_blocker = sg_light_linear_to_z(l, sum / f32(count));
     let penumbra_world = l.size * (s.view_z - z_blocker) / z_blocker;
-    let radius = max(0.5 * penumbra_world / sg_light_map_width(l, s.view_z), 0.5 / l.map_size.x);
+    var radius = max(0.5 * penumbra_world / sg_light_map_width(l, s.view_z), 0.5 / (l.map_size.x * l.face_uv.x));
+    if l.kind == 2u {
+        radius = min(radius, l.max_search);
+    }
     var lit = 0.0;
     for (var i = 0u; i < l.filter_samples; i++) {
-        let t = sg_texel_of(s.uv + radius * sg_vogel_disc(i, l.filter_samples), l.map_size);
+        let t = sg_texel_of(s.uv + radius * l.face_uv * sg_vogel_disc(i, l.filter_samples), l.map_size);
         let d = s.depth + sg_light_receiver_offset(l, s, sg_light_tap_offset(l, s, t));
         lit += select(0.0, 1.0, d <= sg_load_depth(map, t) + l.bias);
     }

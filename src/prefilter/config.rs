@@ -359,6 +359,10 @@ pub struct LightParams {
     pub projection: Mat4,
     /// Perspective (spot) rather than orthographic (directional) depth.
     pub perspective: bool,
+    /// A point light ([`LightParams::point`]): six faces in one `3N × 2N` atlas the host
+    /// rasterizes with [`crate::prefilter::Prefilter::point_views`]; `view` gives its position,
+    /// `projection` is not used (each face's is the stage's, widened by its guard band).
+    pub point: bool,
     /// Near plane (view-space distance).
     pub near: f32,
     /// Far plane.
@@ -378,6 +382,7 @@ impl LightParams {
             view,
             projection: Mat4::orthographic_rh(-e, e, -e, e, near, far),
             perspective: false,
+            point: false,
             near,
             far,
             target_distance: 1.0,
@@ -390,6 +395,23 @@ impl LightParams {
             view,
             projection: Mat4::perspective_rh(fov_y_radians, 1.0, near, far),
             perspective: true,
+            point: false,
+            near,
+            far,
+            target_distance: 1.0,
+        }
+    }
+
+    /// A point light at `position`: its shadow map is six perspective faces (+X, −X, +Y, −Y,
+    /// +Z, −Z) in one atlas, three faces wide and two high, each face's frustum widened by the
+    /// technique's guard band; the host draws its depth pass once per face with the matrices
+    /// and viewports of [`crate::prefilter::Prefilter::point_views`].
+    pub fn point(position: Vec3, near: f32, far: f32) -> Self {
+        Self {
+            view: Mat4::from_translation(-position),
+            projection: Mat4::perspective_rh(std::f32::consts::FRAC_PI_2, 1.0, near, far),
+            perspective: true,
+            point: true,
             near,
             far,
             target_distance: 1.0,
@@ -398,10 +420,15 @@ impl LightParams {
 
     /// A scene light's matrices and planes (what shadowgraph's renderer rasterizes with).
     pub fn from_light(light: &Light) -> Self {
+        if light.kind == LightKind::Point {
+            return Self::point(light.position, light.near, light.far)
+                .with_target_distance((light.target - light.position).length());
+        }
         Self {
             view: light.view(),
             projection: light.projection(),
             perspective: matches!(light.kind, LightKind::Spot { .. }),
+            point: false,
             near: light.near,
             far: light.far,
             target_distance: (light.target - light.position).length(),
@@ -444,6 +471,10 @@ impl LightParams {
                 format!("{} must exceed near ({})", self.far, self.near),
             ));
         }
+        // A point light's faces are the stage's own projections.
+        if self.point {
+            return Ok(());
+        }
         // Depth must be 0 at the near plane and 1 at the far one, as `linearize` assumes; w is
         // the distance (perspective) or 1 (orthographic).
         for (plane, z, depth) in [("near", self.near, 0.0), ("far", self.far, 1.0)] {
@@ -470,15 +501,17 @@ impl LightParams {
         Ok(())
     }
 
-    /// The scene light these parameters and `config` describe on `size`² maps (how the stage
-    /// reuses [`crate::technique::add_light_nodes`]).
+    /// The scene light these parameters and `config` describe on `size`² maps (a point
+    /// light's: six `size`² faces; how the stage reuses [`crate::technique::add_light_nodes`]).
     pub fn scene_light(&self, config: &PrefilterConfig, size: u32) -> Light {
         let to_world = self.view.inverse();
         let position = to_world.transform_point3(Vec3::ZERO);
         let forward = to_world.transform_vector3(Vec3::NEG_Z);
         // Symmetric frusta: x_clip = m00·x (orthographic: over w = 1; perspective: over −z).
         let m00 = self.projection.x_axis.x;
-        let kind = if self.perspective {
+        let kind = if self.point {
+            LightKind::Point
+        } else if self.perspective {
             LightKind::Spot {
                 fov_degrees: (2.0 * (1.0 / m00).atan()).to_degrees(),
             }
@@ -513,6 +546,10 @@ impl LightParams {
     pub fn light_gpu(&self, config: &PrefilterConfig, size: u32) -> LightGpu {
         let light = self.scene_light(config, size);
         let mut g = LightGpu::new(&light);
+        if self.point {
+            // The faces' matrices are the stage's (`point_views`); the light is its position.
+            return g;
+        }
         g.view = self.view.to_cols_array_2d();
         g.view_proj = (self.projection * self.view).to_cols_array_2d();
         g.position = light.position.to_array();

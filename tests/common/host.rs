@@ -22,12 +22,31 @@ pub fn host_depth(
     slope_bias: f32,
     size: u32,
 ) -> wgpu::Texture {
+    let vp = light.projection * light.view;
+    host_depth_views(
+        g,
+        vertices,
+        &[(vp, [0, 0, size, size])],
+        slope_bias,
+        (size, size),
+    )
+}
+
+/// [`host_depth`] drawing once per view, each with its own matrix, viewport and scissor (a
+/// point light's faces, `Prefilter::point_views`), into a `width × height` texture.
+pub fn host_depth_views(
+    g: &Gpu,
+    vertices: &[Vertex],
+    views: &[(glam::Mat4, [u32; 4])],
+    slope_bias: f32,
+    (width, height): (u32, u32),
+) -> wgpu::Texture {
     let d = &g.device;
     let depth = d.create_texture(&wgpu::TextureDescriptor {
         label: Some("host.depth"),
         size: wgpu::Extent3d {
-            width: size,
-            height: size,
+            width,
+            height,
             depth_or_array_layers: 1,
         },
         mip_level_count: 1,
@@ -73,24 +92,29 @@ pub fn host_depth(
         multiview_mask: None,
         cache: None,
     });
-    let vp = (light.projection * light.view).to_cols_array();
-    let ubuf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("host.view_proj"),
-        contents: bytemuck::cast_slice(&vp),
-        usage: wgpu::BufferUsages::UNIFORM,
-    });
+    let groups: Vec<(wgpu::BindGroup, [u32; 4])> = views
+        .iter()
+        .map(|(vp, viewport)| {
+            let ubuf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("host.view_proj"),
+                contents: bytemuck::cast_slice(&vp.to_cols_array()),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("host.depth"),
+                layout: &pipeline.get_bind_group_layout(0),
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: ubuf.as_entire_binding(),
+                }],
+            });
+            (bg, *viewport)
+        })
+        .collect();
     let vbuf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("host.vertices"),
         contents: bytemuck::cast_slice(vertices),
         usage: wgpu::BufferUsages::VERTEX,
-    });
-    let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("host.depth"),
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[wgpu::BindGroupEntry {
-            binding: 0,
-            resource: ubuf.as_entire_binding(),
-        }],
     });
     let view = depth.create_view(&Default::default());
     let mut enc = d.create_command_encoder(&Default::default());
@@ -111,9 +135,13 @@ pub fn host_depth(
             multiview_mask: None,
         });
         pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &bg, &[]);
         pass.set_vertex_buffer(0, vbuf.slice(..));
-        pass.draw(0..vertices.len() as u32, 0..1);
+        for (bg, [x, y, w, h]) in &groups {
+            pass.set_viewport(*x as f32, *y as f32, *w as f32, *h as f32, 0.0, 1.0);
+            pass.set_scissor_rect(*x, *y, *w, *h);
+            pass.set_bind_group(0, bg, &[]);
+            pass.draw(0..vertices.len() as u32, 0..1);
+        }
     }
     submit_and_wait(d, &g.queue, enc, "host depth").expect("host depth pass");
     depth
