@@ -30,7 +30,7 @@ pub mod wgsl;
 
 use std::collections::HashMap;
 
-use glam::Mat4;
+use glam::{Mat4, Vec3};
 
 pub use crate::error::StageError;
 /// The light's GPU description the exported WGSL's `Light` mirrors (what
@@ -277,6 +277,27 @@ impl Prefilter {
             maps,
             light: light.light_gpu(config, size),
         })
+    }
+
+    /// The cascades of a directional light shining along `direction` for `camera`, laid out
+    /// by the config's `cascades` (count and split; see [`PrefilterConfig::with_cascades`]) on
+    /// `size`² maps, casters kept `caster_margin` world units toward the light: record cascade
+    /// `k` in light slot `k` with `cascades[k].light`, and give cascade 0's `sg_Light` the pick
+    /// fields ([`cascades::pick_fields`] with the config's blend band).
+    pub fn fit_cascades(
+        &self,
+        camera: &cascades::CascadeCamera,
+        direction: Vec3,
+        caster_margin: f32,
+    ) -> Result<Vec<cascades::Cascade>> {
+        let c = self.config.cascades;
+        let layout = cascades::CascadeLayout {
+            count: c.count,
+            lambda: c.lambda,
+            map_size: self.config.size,
+            caster_margin,
+        };
+        Ok(cascades::fit_cascades(camera, direction, &layout)?)
     }
 
     /// A point light's faces for the host's depth pass into a `3·face × 2·face` depth

@@ -197,3 +197,87 @@ fn cascades_do_not_shimmer() {
         .dot((DVec3::new(2.0, 6.0, 12.0) - DVec3::new(0.0, 0.0, -5.0)).normalize());
     assert!((f64::from(d) - expected).abs() < 1e-4, "{d} vs {expected}");
 }
+
+/// The plug-in's cascade config: a scene light's `cascades` keys carried by
+/// `PrefilterConfig::from_light`, fitted by `Prefilter::fit_cascades` and handed to the exported
+/// `sg_cascade_pick` through `pick_fields`, give the pick fields the renderer gives the same
+/// light (`city_street`: four PCF cascades), so a host's pick and blend band are the
+/// renderer's; bad keys and a soft technique in cascades are named by validation.
+#[test]
+fn the_stages_cascade_config_matches_the_renderers_pick() {
+    use shadowgraph::prefilter::{Prefilter, PrefilterConfig};
+    let g = common::gpu();
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/city_street.toml");
+    let scene = shadowgraph::scene::Scene::load(&path).expect("city_street loads");
+    let light = &scene.lights[0];
+    let config = PrefilterConfig::from_light(light);
+    assert_eq!(config.cascades, light.shadow.cascades);
+    let stage = Prefilter::new(&g.device, &config).expect("stage");
+    let camera = shadowgraph::render::cascade_camera(&scene).expect("camera");
+    let cascades = stage
+        .fit_cascades(&camera, light.direction(), 10.0)
+        .expect("fit");
+    assert_eq!(cascades.len(), 4);
+    let mut first = cascades[0].light.light_gpu(&config, config.size);
+    shadowgraph::prefilter::cascades::pick_fields(
+        &mut first,
+        &camera,
+        &cascades,
+        config.cascades.blend,
+    )
+    .expect("pick fields");
+    let drawn = shadowgraph::render::drawn_lights(&scene).expect("drawn lights");
+    let r = drawn.gpu[0];
+    let close = |a: f32, b: f32| (a - b).abs() <= 1e-6 * a.abs().max(1.0);
+    assert_eq!(first.cascade_count, r.cascade_count);
+    assert!(close(first.cascade_near, r.cascade_near), "near");
+    assert!(close(first.cascade_blend, r.cascade_blend), "blend");
+    for k in 0..3 {
+        assert!(close(first.cascade_eye[k], r.cascade_eye[k]), "eye");
+        assert!(
+            close(first.cascade_forward[k], r.cascade_forward[k]),
+            "forward"
+        );
+    }
+    for c in 0..4 {
+        let (a, b) = (first.cascade_far[c / 4][c % 4], r.cascade_far[c / 4][c % 4]);
+        assert!(close(a, b), "cascade {c} far: stage {a}, renderer {b}");
+    }
+    // Every cascade's light is a valid orthographic light the stage records.
+    for c in &cascades {
+        c.light.validate().expect("cascade light");
+        assert!(!c.light.perspective && !c.light.point);
+    }
+
+    // Validation: the scene's ranges, and soft techniques refuse cascades.
+    for (count, lambda, blend, field) in [
+        (9, 0.5, 0.1, "cascades"),
+        (0, 0.5, 0.1, "cascades"),
+        (4, 1.5, 0.1, "cascade_lambda"),
+        (4, 0.5, 0.7, "cascade_blend"),
+    ] {
+        match PrefilterConfig::vsm(512)
+            .with_cascades(count, lambda, blend)
+            .validated()
+        {
+            Err(StageError::Config { field: f, .. }) => assert_eq!(f, field),
+            other => panic!("({count}, {lambda}, {blend}): {other:?}"),
+        }
+    }
+    match PrefilterConfig::vssm(512, 0.5)
+        .with_cascades(4, 0.5, 0.1)
+        .validated()
+    {
+        Err(StageError::Config { field, message }) => {
+            assert_eq!(field, "cascades");
+            assert!(message.contains("soft techniques"), "{message}");
+        }
+        other => panic!("vssm in cascades: {other:?}"),
+    }
+    assert!(
+        PrefilterConfig::msm(512)
+            .with_cascades(4, 0.75, 0.1)
+            .validated()
+            .is_ok()
+    );
+}

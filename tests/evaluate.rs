@@ -605,3 +605,48 @@ fn soft_techniques_approach_the_area_light_truth() {
         );
     }
 }
+
+/// A cascaded light's memory is every cascade's: `city_street`'s four 256² PCF cascades hold
+/// four depth maps and four linear maps, against one of each with `cascades = 1`, the other
+/// resources alike; a point light's is its 3N × 2N atlas.
+#[test]
+fn memory_counts_every_cascade_and_a_point_lights_atlas() {
+    let g = common::gpu();
+    let opts = EvaluateOptions {
+        image: Some((64, 48)),
+        samples: Some(1),
+        truth_resolution: Some(256),
+        repeat: 1,
+        ..Default::default()
+    };
+    let hard = |size| {
+        vec![Config {
+            label: format!("hard {size}"),
+            technique: Technique::Hard,
+            shadow_map: size,
+            box_width: None,
+        }]
+    };
+    let memory = |scene: &Scene, size| {
+        evaluate(&g, scene, &hard(size), &opts)
+            .expect("evaluate")
+            .0
+            .rows[0]
+            .memory_bytes
+    };
+    let mut street: Scene = scene_for(&scene_path("city_street.toml"), &opts).expect("scene");
+    assert_eq!(street.lights[0].shadow.cascades.count, 4);
+    let four = memory(&street, 256);
+    street.lights[0].shadow.cascades = shadowgraph::model::Cascades::SINGLE;
+    let one = memory(&street, 256);
+    // Each cascade: a Depth32Float map and its R32Float linear map, 4 bytes a texel each.
+    let per_cascade = 2 * 256 * 256 * 4;
+    assert_eq!(
+        four - one,
+        3 * per_cascade,
+        "four cascades {four}, one {one}"
+    );
+    let point: Scene = scene_for(&scene_path("point.toml"), &opts).expect("scene");
+    let atlas = 3 * 128 * 2 * 128 * 4;
+    assert_eq!(memory(&point, 128), 2 * atlas);
+}

@@ -964,7 +964,7 @@ mod cascades {
                 8.0 * 2f64.powi(-24) * (pick.distance.abs() + pick.far + p.length() + eye.length());
             // Within f32's rounding of a split the GPU may pick the neighbour: skipped.
             let split_near = (0..group.count - 1)
-                .any(|c| (pick.distance - cpu::cascade::cascade_far(&lg, c)).abs() < rounding);
+                .any(|c| (pick.distance - cpu::cascade::cascade_far_of(&lg, c)).abs() < rounding);
             if split_near {
                 continue;
             }

@@ -19,7 +19,13 @@
 // parameters. The projection is wgpu's (right-handed, depth 0 at near, 1 at far). Without
 // Rust, fill the fields as `struct sg_Light` below comments them: view_proj = projection · view,
 // position and direction from the inverse view (its origin and −Z), width_at_unit =
-// 2 / projection[0][0], map_size = the map's side, kind 1 for perspective depth.
+// 2 / projection[0][0], map_size = the map's side, kind 1 for perspective depth (2: a point
+// light, `LightParams::point`: its atlas of six faces drawn with `Prefilter::point_views`).
+// A directional light in cascades (`Prefilter::fit_cascades`, one light slot per cascade):
+// `prefilter::cascades::pick_fields` fills cascade 0's sg_Light cascade fields, and
+//   let pick = sg_cascade_pick(l0, p);          // pick.index, pick.blend
+// gives the renderer's choice: cascade pick.index's visibility, mixed toward the next
+// cascade's by pick.blend across the blend band.
 // Prefiltered maps are read with four loads, so no sampler or filterable format is needed;
 // only `sg_vis_pcf_hardware` takes a comparison sampler (linear filtering, compare less-equal).
 //
@@ -45,28 +51,28 @@
 //
 // Names defined here, each with the `sg_` prefix (a host's own names need only avoid
 // `sg_` and `shadowgraph_`):
-//   sg_BLOCKER_MIN_SHARE sg_CSM_PI sg_GOLDEN_ANGLE sg_Light sg_LightSample sg_MSM_B0
-//   sg_MSM_B0_COV sg_MSM_B0_SCHUR sg_MipTaps sg_MsmMoments sg_SAT_MIN_EXTENT sg_SatNodes
-//   sg_SoftLookup sg_TECHNIQUE_CSM sg_TECHNIQUE_CSSM sg_TECHNIQUE_ESM sg_TECHNIQUE_EVSM
-//   sg_TECHNIQUE_HARD sg_TECHNIQUE_MIDPOINT sg_TECHNIQUE_MSM sg_TECHNIQUE_MSM_SOFT
-//   sg_TECHNIQUE_PCF sg_TECHNIQUE_PCSS sg_TECHNIQUE_SECOND_DEPTH sg_TECHNIQUE_SMRT
-//   sg_TECHNIQUE_VSM sg_TECHNIQUE_VSSM sg_bilinear_level sg_bilinear_log_level sg_blocker_csm_z
-//   sg_blocker_filter_width sg_blocker_msm sg_blocker_result sg_blocker_search_width
-//   sg_blocker_vsm sg_blocker_width sg_chebyshev_upper sg_csm_chunk sg_csm_chunk_of
-//   sg_csm_resolve sg_csm_sin_cos sg_csm_weight sg_csm_z_chunk_of sg_cssm_blocker
-//   sg_cssm_resolve sg_cssm_sharpen sg_level_size sg_light_depth_slope sg_light_faces
-//   sg_light_footprint sg_light_linear_to_ndc sg_light_linear_to_z sg_light_map_width
-//   sg_light_receiver_offset sg_light_sample sg_light_tap_offset sg_light_texel
-//   sg_light_to_light sg_linstep sg_load_depth sg_mip_tap_uv sg_mip_taps sg_msm_biased
-//   sg_msm_dequantize sg_msm_expect sg_msm_intensity sg_msm_moments sg_msm_quantize sg_msm_roots
-//   sg_msm_soft_blocker sg_pcss_search_radius sg_point_coords sg_point_face sg_point_sample
-//   sg_sample_bilinear sg_sample_bilinear_log sg_sample_map sg_sample_map_log sg_sat_box
-//   sg_sat_box_fixed sg_sat_box_float sg_sat_clamp sg_sat_mean_fixed sg_sat_mean_float
-//   sg_sat_node_f32 sg_sat_node_u32 sg_sat_nodes sg_sat_rect sg_sat_sample_fixed
-//   sg_sat_sample_float sg_sat_search_fixed sg_sat_search_float sg_sat_span_weights
-//   sg_smrt_emitter_point sg_smrt_ray sg_soft_blockers sg_soft_filter_trips sg_texel_of
-//   sg_trilinear sg_trilinear_log sg_vis_esm sg_vis_esm_of_log sg_vis_esm_of_sat sg_vis_evsm
-//   sg_vis_evsm_of sg_vis_hard sg_vis_msm sg_vis_msm_of sg_vis_msm_soft_fixed
+//   sg_BLOCKER_MIN_SHARE sg_CSM_PI sg_CascadePick sg_GOLDEN_ANGLE sg_Light sg_LightSample
+//   sg_MSM_B0 sg_MSM_B0_COV sg_MSM_B0_SCHUR sg_MipTaps sg_MsmMoments sg_SAT_MIN_EXTENT
+//   sg_SatNodes sg_SoftLookup sg_TECHNIQUE_CSM sg_TECHNIQUE_CSSM sg_TECHNIQUE_ESM
+//   sg_TECHNIQUE_EVSM sg_TECHNIQUE_HARD sg_TECHNIQUE_MIDPOINT sg_TECHNIQUE_MSM
+//   sg_TECHNIQUE_MSM_SOFT sg_TECHNIQUE_PCF sg_TECHNIQUE_PCSS sg_TECHNIQUE_SECOND_DEPTH
+//   sg_TECHNIQUE_SMRT sg_TECHNIQUE_VSM sg_TECHNIQUE_VSSM sg_bilinear_level sg_bilinear_log_level
+//   sg_blocker_csm_z sg_blocker_filter_width sg_blocker_msm sg_blocker_result
+//   sg_blocker_search_width sg_blocker_vsm sg_blocker_width sg_cascade_far_of sg_cascade_pick
+//   sg_chebyshev_upper sg_csm_chunk sg_csm_chunk_of sg_csm_resolve sg_csm_sin_cos sg_csm_weight
+//   sg_csm_z_chunk_of sg_cssm_blocker sg_cssm_resolve sg_cssm_sharpen sg_level_size
+//   sg_light_depth_slope sg_light_faces sg_light_footprint sg_light_linear_to_ndc
+//   sg_light_linear_to_z sg_light_map_width sg_light_receiver_offset sg_light_sample
+//   sg_light_tap_offset sg_light_texel sg_light_to_light sg_linstep sg_load_depth sg_mip_tap_uv
+//   sg_mip_taps sg_msm_biased sg_msm_dequantize sg_msm_expect sg_msm_intensity sg_msm_moments
+//   sg_msm_quantize sg_msm_roots sg_msm_soft_blocker sg_pcss_search_radius sg_point_coords
+//   sg_point_face sg_point_sample sg_sample_bilinear sg_sample_bilinear_log sg_sample_map
+//   sg_sample_map_log sg_sat_box sg_sat_box_fixed sg_sat_box_float sg_sat_clamp
+//   sg_sat_mean_fixed sg_sat_mean_float sg_sat_node_f32 sg_sat_node_u32 sg_sat_nodes sg_sat_rect
+//   sg_sat_sample_fixed sg_sat_sample_float sg_sat_search_fixed sg_sat_search_float
+//   sg_sat_span_weights sg_smrt_emitter_point sg_smrt_ray sg_soft_blockers sg_soft_filter_trips
+//   sg_texel_of sg_trilinear sg_trilinear_log sg_vis_esm sg_vis_esm_of_log sg_vis_esm_of_sat
+//   sg_vis_evsm sg_vis_evsm_of sg_vis_hard sg_vis_msm sg_vis_msm_of sg_vis_msm_soft_fixed
 //   sg_vis_msm_soft_float sg_vis_pcf sg_vis_pcf_hardware sg_vis_pcss sg_vis_smrt sg_vis_vsm
 //   sg_vis_vsm_of sg_vis_vssm_fixed sg_vis_vssm_float sg_vogel_disc sg_vssm_blocker
 
@@ -495,6 +501,44 @@ fn sg_bilinear_log_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> f32
     let sum = (1.0 - a.y) * ((1.0 - a.x) * exp(v00 - m) + a.x * exp(v10 - m))
         + a.y * ((1.0 - a.x) * exp(v01 - m) + a.x * exp(v11 - m));
     return m + log(sum);
+}
+// Cascaded shadow maps of a directional light (import-only module): which cascade a receiver
+// reads, by its view distance from the camera, and how far into the blend band toward the
+// next cascade it is. `src/cpu/cascade.rs` is its f64 reference.
+
+struct sg_CascadePick {
+    index: u32,  // the cascade whose range holds the receiver (the last beyond it)
+    blend: f32,  // 0 outside the band; rises to 1 at the cascade's far end
+}
+
+// Cascade c's far view distance (not `cascade_far`: a member of `Light` by that name).
+fn sg_cascade_far_of(l: sg_Light, c: u32) -> f32 {
+    var far = l.cascade_far;
+    return far[c / 4u][c % 4u];
+}
+
+// The cascade of receiver p: the first whose far distance is at least p's view distance d
+// (the last when d is beyond them all); within the last `cascade_blend` of its range, before
+// the last cascade, the fraction of the band d has crossed.
+fn sg_cascade_pick(l: sg_Light, p: vec3<f32>) -> sg_CascadePick {
+    let d = dot(p - l.cascade_eye, l.cascade_forward);
+    var pick: sg_CascadePick;
+    pick.index = l.cascade_count - 1u;
+    pick.blend = 0.0;
+    var start = l.cascade_near;
+    for (var c = 0u; c + 1u < l.cascade_count; c++) {
+        let far = sg_cascade_far_of(l, c);
+        if d <= far {
+            pick.index = c;
+            let band = l.cascade_blend * (far - start);
+            if band > 0.0 {
+                pick.blend = clamp((d - (far - band)) / band, 0.0, 1.0);
+            }
+            return pick;
+        }
+        start = far;
+    }
+    return pick;
 }
 // Convolution shadow maps (Annen et al. 2007): the step H(z − d) as its Fourier series
 //   f(d, z) ≈ ½ + Σ_k w_k [cos(c_k d) sin(c_k z) − sin(c_k d) cos(c_k z)],

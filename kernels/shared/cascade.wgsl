@@ -8,8 +8,8 @@ struct CascadePick {
     blend: f32,  // 0 outside the band; rises to 1 at the cascade's far end
 }
 
-// Cascade c's far view distance.
-fn cascade_far(l: Light, c: u32) -> f32 {
+// Cascade c's far view distance (not `cascade_far`: a member of `Light` by that name).
+fn cascade_far_of(l: Light, c: u32) -> f32 {
     var far = l.cascade_far;
     return far[c / 4u][c % 4u];
 }
@@ -24,7 +24,7 @@ fn cascade_pick(l: Light, p: vec3<f32>) -> CascadePick {
     pick.blend = 0.0;
     var start = l.cascade_near;
     for (var c = 0u; c + 1u < l.cascade_count; c++) {
-        let far = cascade_far(l, c);
+        let far = cascade_far_of(l, c);
         if d <= far {
             pick.index = c;
             let band = l.cascade_blend * (far - start);

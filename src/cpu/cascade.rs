@@ -22,7 +22,7 @@ pub struct CascadePick {
 }
 
 /// Cascade `c`'s far view distance.
-pub fn cascade_far(l: &LightGpu, c: usize) -> f64 {
+pub fn cascade_far_of(l: &LightGpu, c: usize) -> f64 {
     f64::from(l.cascade_far[c / 4][c % 4])
 }
 
@@ -34,7 +34,7 @@ pub fn pick(l: &LightGpu, p: DVec3) -> CascadePick {
     let count = l.cascade_count as usize;
     let mut start = f64::from(l.cascade_near);
     for c in 0..count.saturating_sub(1) {
-        let far = cascade_far(l, c);
+        let far = cascade_far_of(l, c);
         if d <= far {
             let band = f64::from(l.cascade_blend) * (far - start);
             let blend = if band > 0.0 {
@@ -57,7 +57,7 @@ pub fn pick(l: &LightGpu, p: DVec3) -> CascadePick {
         index: last,
         blend: 0.0,
         distance: d,
-        far: cascade_far(l, last),
+        far: cascade_far_of(l, last),
         band: 0.0,
     }
 }

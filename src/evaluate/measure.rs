@@ -119,8 +119,9 @@ pub fn measure(
         (Some(a), Some(b), Some(c)) => Some(a + b + c),
         _ => None,
     };
-    let plan = plan_lights(&scene.lights)?;
-    // The rasterized maps the plan imports (one depth per light, two where it peels).
+    // The lights the frame drew: a cascaded light's every cascade, each with its own maps.
+    let plan = plan_lights(&crate::render::drawn_lights(scene)?.lights)?;
+    // The rasterized maps the plan imports (one depth per drawn light, two where it peels).
     let depth: u64 = plan
         .plan
         .resources

@@ -15,7 +15,7 @@
 
 use glam::{Mat4, Vec3, Vec4Swizzles};
 
-use super::LightParams;
+use super::{LightGpu, LightParams};
 use crate::error::StageError;
 pub use crate::model::cascades::{CascadeCamera, MAX_CASCADES, split_distances};
 use crate::model::cascades::{fit_slices, light_rotation};
@@ -99,4 +99,39 @@ pub fn fit_cascades(
 /// The view distance of world point `p` for `camera` (what selects its cascade).
 pub fn view_distance(camera: &CascadeCamera, p: Vec3) -> f32 {
     -(camera.view * p.extend(1.0)).xyz().z
+}
+
+/// Fills the cascade fields of `first` (cascade 0's [`LightGpu`], its `PrefilterOutput::light`)
+/// that `sg_cascade_pick` in the exported WGSL reads: the camera's eye and forward direction,
+/// the cascades' count and far view distances, the first cascade's near distance and the
+/// blend band `blend` (a fraction of each cascade's range, as [`super::PrefilterConfig`]'s
+/// `cascades.blend`). The pick then matches the renderer's (`kernels/shared/cascade.wgsl`).
+pub fn pick_fields(
+    first: &mut LightGpu,
+    camera: &CascadeCamera,
+    cascades: &[Cascade],
+    blend: f32,
+) -> Result<(), StageError> {
+    if cascades.is_empty() || cascades.len() > MAX_CASCADES as usize {
+        return Err(StageError::Config {
+            field: "cascades".into(),
+            message: format!("{} cascades: need 1–{MAX_CASCADES}", cascades.len()),
+        });
+    }
+    let to_world = camera.view.inverse();
+    first.cascade_eye = to_world.transform_point3(Vec3::ZERO).to_array();
+    first.cascade_forward = to_world
+        .transform_vector3(Vec3::NEG_Z)
+        .normalize()
+        .to_array();
+    first.cascade_count = cascades.len() as u32;
+    // The renderer's index of cascade 1 among its lights; a host keeps its own.
+    first.cascade_first = 1;
+    first.cascade_near = cascades[0].near;
+    first.cascade_blend = blend;
+    first.cascade_far = [[0.0; 4]; 2];
+    for (k, c) in cascades.iter().enumerate() {
+        first.cascade_far[k / 4][k % 4] = c.far;
+    }
+    Ok(())
 }

@@ -5,11 +5,12 @@
 use glam::{Mat4, Vec3, Vec4};
 
 use super::StageError;
+use crate::model::Cascades;
 use crate::model::{
     BlurKernel, Filter, Light, LightKind, ParamValue, ParamValues, Shadow, Storage, Technique,
 };
 use crate::sat::SatVariant;
-use crate::technique::params::{COMMON, Given, GivenError, filter_values, storage_name};
+use crate::technique::params::{CASCADES, COMMON, Given, GivenError, filter_values, storage_name};
 use crate::technique::{self, LightGpu, TechniqueDef};
 
 /// Largest map side a scene accepts before the device is asked (as `shadow_map` in scenes).
@@ -35,6 +36,10 @@ pub struct PrefilterConfig {
     pub receiver_plane: f32,
     /// Area-light width in world units (PCSS penumbrae; 0 for a point light).
     pub light_size: f32,
+    /// Cascades of a directional light: the scene keys `cascades`, `cascade_lambda` and
+    /// `cascade_blend`, checked by the same table ([`PrefilterConfig::with_cascades`]);
+    /// [`crate::prefilter::Prefilter::fit_cascades`] fits them, one light slot each.
+    pub cascades: Cascades,
     /// A `with_*` call that did not apply to the technique (reported by validation).
     not_applicable: Option<&'static str>,
     /// Whether [`PrefilterConfig::with_moment_bias`] set MSM's bias (else it follows the
@@ -63,6 +68,7 @@ impl PrefilterConfig {
             normal_bias: 1.0,
             receiver_plane: 0.0,
             light_size: 0.0,
+            cascades: Cascades::SINGLE,
             not_applicable: None,
             moment_bias_set: false,
         }
@@ -130,6 +136,19 @@ impl PrefilterConfig {
         self
     }
 
+    /// `count` cascades (1–8; 1: one map) split by the practical split's `lambda` (0 uniform,
+    /// 1 logarithmic) with a blend band of `blend` (0–0.5 of each cascade's range): a scene's
+    /// `cascades`, `cascade_lambda` and `cascade_blend`, checked by validation as a scene's are
+    /// (soft techniques refuse more than one).
+    pub fn with_cascades(mut self, count: u32, lambda: f32, blend: f32) -> Self {
+        self.cascades = Cascades {
+            count,
+            lambda,
+            blend,
+        };
+        self
+    }
+
     /// The technique, map size and shading constants of a scene's light.
     pub fn from_light(light: &Light) -> Self {
         Self {
@@ -139,6 +158,7 @@ impl PrefilterConfig {
             normal_bias: light.shadow.normal_bias,
             receiver_plane: light.shadow.receiver_plane,
             light_size: light.size,
+            cascades: light.shadow.cascades,
             not_applicable: None,
             moment_bias_set: true,
         }
@@ -289,6 +309,21 @@ impl PrefilterConfig {
             values.set("bias_mode", ParamValue::Choice("receiver_plane"));
             values.set("receiver_plane_cap", ParamValue::Float(self.receiver_plane));
             crate::model::check(def.params, &Given(&values)).map_err(given_err)?;
+        }
+        let c = self.cascades;
+        let cascades = ParamValues(vec![
+            ("cascades", ParamValue::Int(c.count)),
+            ("cascade_lambda", ParamValue::Float(c.lambda)),
+            ("cascade_blend", ParamValue::Float(c.blend)),
+        ]);
+        crate::model::check(&[CASCADES], &Given(&cascades)).map_err(given_err)?;
+        if c.count > 1 {
+            technique::params::cascade_support(&self.technique).map_err(|why| {
+                config_err(
+                    "cascades",
+                    format!("{} cascades of technique \"{}\": {why}", c.count, def.name),
+                )
+            })?;
         }
         if !self.light_size.is_finite() || !(0.0..=1e6).contains(&self.light_size) {
             return Err(config_err(

@@ -82,7 +82,13 @@ const LIBRARY_HEADER: &str = "\
 // parameters. The projection is wgpu's (right-handed, depth 0 at near, 1 at far). Without
 // Rust, fill the fields as `struct sg_Light` below comments them: view_proj = projection · view,
 // position and direction from the inverse view (its origin and −Z), width_at_unit =
-// 2 / projection[0][0], map_size = the map's side, kind 1 for perspective depth.
+// 2 / projection[0][0], map_size = the map's side, kind 1 for perspective depth (2: a point
+// light, `LightParams::point`: its atlas of six faces drawn with `Prefilter::point_views`).
+// A directional light in cascades (`Prefilter::fit_cascades`, one light slot per cascade):
+// `prefilter::cascades::pick_fields` fills cascade 0's sg_Light cascade fields, and
+//   let pick = sg_cascade_pick(l0, p);          // pick.index, pick.blend
+// gives the renderer's choice: cascade pick.index's visibility, mixed toward the next
+// cascade's by pick.blend across the blend band.
 // Prefiltered maps are read with four loads, so no sampler or filterable format is needed;
 // only `sg_vis_pcf_hardware` takes a comparison sampler (linear filtering, compare less-equal).
 ";
@@ -100,7 +106,11 @@ fn resolve_modules(label: &str, modules: &[&str]) -> Result<String> {
 /// The modules resolved as the renderer has them, and the names they define (sorted).
 fn resolve_unprefixed(label: &str, modules: &[&str]) -> Result<(String, Vec<String>)> {
     let mut text = String::new();
-    for m in ["shared/light", "shared/sampling"].iter().chain(modules) {
+    // Every export holds the cascade pick, so a host's cascaded light blends as the renderer's.
+    for m in ["shared/light", "shared/sampling", "shared/cascade"]
+        .iter()
+        .chain(modules)
+    {
         let _ = writeln!(text, "// #import {m}");
     }
     let resolved = kernels::resolve_source(label, &text)?;
