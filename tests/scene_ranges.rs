@@ -116,6 +116,18 @@ technique = "evsm4"
 exponent_pos = 30.0
 exponent_neg = 4.0
 
+[[light]]
+kind = "point"
+position = [0.5, 2.5, -0.5]
+near = 0.2
+far = 15.0
+size = 0.2
+shadow_map = 128
+
+[light.shadow]
+technique = "vsm"
+filter_radius = 2.0
+
 [[object]]
 shape = "plane"
 size = [8.0, 8.0]
@@ -271,7 +283,7 @@ fn assert_short_line(shown: &str) {
 #[test]
 fn full_scene_is_valid_and_finite() {
     let s = parse(FULL).expect("FULL parses");
-    assert_eq!((s.lights.len(), s.objects.len()), (6, 4));
+    assert_eq!((s.lights.len(), s.objects.len()), (7, 4));
     assert_finite_scene(&s, "FULL");
     assert!(numeric_keys(FULL).len() > 60);
 }

@@ -166,6 +166,7 @@ const WORDS: &[&str] = &[
     "msm_soft",
     "directional",
     "spot",
+    "point",
     "plane",
     "box",
     "sphere",
