@@ -213,6 +213,33 @@ fn plan_prints_traffic_and_fetches() {
     }
 }
 
+/// A point light's atlas is one map to the graph: `point_vsm.toml`'s six 512² faces are a
+/// 1536×1024 texture, VSM with a radius-3 blur moves the same bytes per texel as on a square
+/// map (the 16 × 16 tiles divide 1536 and 1024), and `plan` names the atlas's shape.
+#[test]
+fn a_point_lights_atlas_is_planned_like_one_map() {
+    assert_traffic(
+        "techniques/point_vsm.toml",
+        &[("vsm.blur", 1, 9.0, 8.0)],
+        17.0,
+        12.0,
+    );
+    let plan = plan_lights(&scene("techniques/point_vsm.toml").lights)
+        .expect("plan")
+        .plan;
+    assert_eq!(cost::map_dims(&plan, 0), (1536, 1024));
+    let text =
+        shadowgraph::cli::plan(&scene_path("techniques/point_vsm.toml"), false).expect("plan");
+    for needle in [
+        "light 0: point, vsm shadows, six 512² faces",
+        "light0.depth             Depth32Float    1536x1024",
+        "traffic per texel of the 1536×1024 map:",
+        "total: 1 dispatch, 17.00 B/texel",
+    ] {
+        assert!(text.contains(needle), "`{needle}` missing:\n{text}");
+    }
+}
+
 /// The resolved WGSL of kernel `name` (the shading kernel with a block of every technique).
 fn resolved(name: &str) -> String {
     let generated = (name == "shade").then(|| {
