@@ -204,6 +204,44 @@ fn memory_estimate_is_the_sum_of_its_parts() {
     assert_eq!(m.total, frame + maps);
 }
 
+/// A point light's atlas is three faces wide and two high: its side past the device's largest
+/// texture side is named by the face size's key and line (a 1024 face is 3072 texels wide,
+/// past a 2048 limit that the face itself fits), and its memory is the atlas's.
+#[test]
+fn a_point_lights_atlas_is_checked_whole() {
+    let point =
+        "\n[[light]]\nkind = \"point\"\nposition = [0.0, 3.0, 0.0]\nnear = 0.2\nfar = 20.0\n\
+                 shadow_map = 1024\n\n[light.shadow]\ntechnique = \"pcf\"\n"
+            .to_string();
+    let (text, s) = scene(64, 48, &[point]);
+    let sp = plan_lights(&s.lights).unwrap();
+    let limits = wgpu::Limits {
+        max_texture_dimension_2d: 2048,
+        ..wgpu::Limits::default()
+    };
+    let shown = shadowgraph::limits::check_scene(
+        &s,
+        &sp,
+        &limits,
+        wgpu::Features::empty(),
+        &RenderOptions::default(),
+        1 << 30,
+    )
+    .expect_err("a 3072-wide atlas on a 2048 device")
+    .to_string();
+    let line = nth_line(&text, "shadow_map", 0);
+    assert!(
+        shown.starts_with(&format!("limits.toml:{line}:"))
+            && shown.contains("light[0].shadow_map` = 1024")
+            && shown.contains("3072 texels wide")
+            && shown.contains("max_texture_dimension_2d"),
+        "{shown}"
+    );
+    let m = shadowgraph::limits::render_memory(&s, &sp.plan, &RenderOptions::default());
+    // The atlas's depth and its linear map (PCF reads the linear depth).
+    assert_eq!(m.lights, vec![2 * 3072 * 2048 * 4]);
+}
+
 /// A second-depth light counts its peeled second depth map too: two depth maps and the
 /// comparison map, by hand.
 #[test]

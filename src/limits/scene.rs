@@ -123,32 +123,28 @@ impl Checker<'_> {
     fn sides(&self) -> Result<()> {
         let max = self.limits.max_texture_dimension_2d;
         let s = self.scene;
-        let mut sides = vec![
-            ("output.width".to_string(), s.width),
-            ("output.height".into(), s.height),
+        // (key, texels, what the texels are when they are not the key's value)
+        let mut sides: Vec<(String, u32, Option<String>)> = vec![
+            ("output.width".to_string(), s.width, None),
+            ("output.height".into(), s.height, None),
         ];
         for (i, l) in s.lights.iter().enumerate() {
+            let (w, _) = l.map_dims();
             // A point light's atlas is three faces wide.
-            sides.push((format!("light[{i}].shadow_map"), l.map_dims().0));
+            let what = (w != l.shadow_map)
+                .then(|| format!("a point light's atlas of three faces is {w} texels wide, which"));
+            sides.push((format!("light[{i}].shadow_map"), w, what));
         }
-        match sides.into_iter().find(|(_, v)| *v > max) {
-            Some((key, v)) => {
-                let point = key.ends_with("shadow_map")
-                    && s.lights
-                        .iter()
-                        .any(|l| l.map_dims().0 == v && l.map_dims().0 != l.shadow_map);
-                let what = if point {
-                    format!(
-                        "{}: a point light's atlas of three faces, {v} texels wide,",
-                        v / 3
-                    )
-                } else {
-                    format!("{v}")
+        match sides.into_iter().find(|(_, v, _)| *v > max) {
+            Some((key, v, what)) => {
+                let shown = match what {
+                    Some(what) => format!("`{key}` = {}: {what}", v / 3),
+                    None => format!("`{key}` = {v}"),
                 };
                 Err(self.err(
                     &key,
                     format!(
-                        "`{key}` = {what} is past this device's largest texture side, {max} \
+                        "{shown} is past this device's largest texture side, {max} \
                          (max_texture_dimension_2d)"
                     ),
                 ))
