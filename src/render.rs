@@ -42,6 +42,19 @@ impl FrameGpu {
     }
 }
 
+/// A point light whose technique its faces cannot bound (`model::point::reach`), or whose
+/// guard band leaves less than half a face, is refused: scene files are checked when they
+/// load, this catches a light built or changed in code.
+pub(crate) fn check_point(i: usize, light: &Light) -> Result<()> {
+    if light.kind != crate::model::LightKind::Point {
+        return Ok(());
+    }
+    light
+        .point_layout()
+        .map(|_| ())
+        .map_err(|why| Error::Invalid(format!("light[{i}]: {why}")))
+}
+
 /// The graph of a scene, its plan, and what the shading pass reads per light.
 pub struct ScenePlan {
     /// Every node the scene's lights could use.
@@ -65,6 +78,7 @@ pub fn plan_lights_for(lights: &[Light], opts: &RenderOptions) -> Result<ScenePl
     let mut graph = Graph::default();
     let mut shade_inputs = Vec::new();
     for (i, l) in lights.iter().enumerate() {
+        check_point(i, l)?;
         technique::sat_coding(l).map_err(|e| Error::Invalid(format!("light[{i}]: {e}")))?;
         shade_inputs.push(technique::add_light_nodes(&mut graph, i, l));
     }
