@@ -443,6 +443,35 @@ pub fn f16_to_f32(h: u16) -> f32 {
     f32::from_bits(bits)
 }
 
+/// Reads mip `mip` of the texture of a graph resource of `format` as f32 values (`channels`
+/// per texel, row-major): a [`crate::graph::PACKED_F16X2`] resource's `r32uint` words are
+/// unpacked into its two f16 values, any other as [`read_float_texture`] reads it.
+pub fn read_resource_texture(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+    mip: u32,
+    format: wgpu::TextureFormat,
+) -> Result<(usize, Vec<f32>)> {
+    if !crate::graph::is_packed(format) {
+        return read_float_texture(device, queue, texture, mip);
+    }
+    let raw = read_texture(device, queue, texture, mip)?;
+    let words: Vec<u32> = raw
+        .chunks_exact(4)
+        .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect();
+    Ok((2, unpack_f16x2(&words)))
+}
+
+/// `pack2x16float` words → their two halves as f32 (low half first, as `unpack2x16float`).
+pub fn unpack_f16x2(words: &[u32]) -> Vec<f32> {
+    words
+        .iter()
+        .flat_map(|w| [f16_to_f32(*w as u16), f16_to_f32((*w >> 16) as u16)])
+        .collect()
+}
+
 /// Reads mip `mip` of a float texture as f32 values (`channels` per texel, row-major).
 pub fn read_float_texture(
     device: &wgpu::Device,
