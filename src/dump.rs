@@ -351,7 +351,7 @@ fn write_resource(
             file,
             light: res.light,
             producer: res.producer.clone(),
-            format: format!("{:?}", res.format),
+            format: crate::graph::format_label(res.format),
             width: map.width,
             height: map.height,
             mip_level: level,

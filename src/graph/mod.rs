@@ -312,6 +312,16 @@ pub fn texture_format(format: wgpu::TextureFormat) -> wgpu::TextureFormat {
     }
 }
 
+/// How `plan` and the dump's manifest name a resource's format: its texture's format, and for
+/// packed f16 pairs ([`PACKED_F16X2`]) what its words hold (`R32Uint f16x2`).
+pub fn format_label(format: wgpu::TextureFormat) -> String {
+    if is_packed(format) {
+        format!("{:?} f16x2", texture_format(format))
+    } else {
+        format!("{format:?}")
+    }
+}
+
 /// Bytes of one texel of `format` (0 where the format has no fixed size).
 pub fn texel_bytes(format: wgpu::TextureFormat) -> u64 {
     u64::from(

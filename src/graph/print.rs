@@ -74,7 +74,7 @@ impl Plan {
                     s,
                     "      {:<24} {:<14} {:>5}x{:<5} {:>10}  ({role}{out})",
                     r.resource.name,
-                    format_label(r.resource.format),
+                    super::format_label(r.resource.format),
                     r.width,
                     r.height,
                     human_bytes(r.bytes)
@@ -149,7 +149,7 @@ impl Plan {
                 s,
                 "  \"{0}\" [shape=box, label=\"{0}\\n{1} {2}x{3}\"];",
                 r.resource.name,
-                format_label(r.resource.format),
+                super::format_label(r.resource.format),
                 r.width,
                 r.height
             );
@@ -174,15 +174,5 @@ impl Plan {
         }
         s.push_str("}\n");
         s
-    }
-}
-
-/// How a resource's format is printed: its texture's format, and for packed f16 pairs
-/// ([`super::PACKED_F16X2`]) what its words hold.
-fn format_label(format: wgpu::TextureFormat) -> String {
-    if super::is_packed(format) {
-        format!("{:?} f16x2", super::texture_format(format))
-    } else {
-        format!("{format:?}")
     }
 }
