@@ -85,9 +85,14 @@ fn rewrite_calls(
     Some(out)
 }
 
-/// Whether the function that `before` ends inside has a parameter named `binding`.
+/// Whether the function that `before` ends inside (WGSL functions are module-scope, declared
+/// at the start of a line here) has a parameter named `binding`.
 fn shadowed(before: &str, binding: &str) -> bool {
-    let Some(start) = before.rfind("fn ") else {
+    let Some(start) = before
+        .rfind("\nfn ")
+        .map(|at| at + 1)
+        .or_else(|| before.starts_with("fn ").then_some(0))
+    else {
         return false;
     };
     let header = &before[start..];
