@@ -27,7 +27,7 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l
     let size = textureDimensions(src);
     let tiles = csm_sat_tiles_of(size);
     let source = csm_sat_source(params, layer, tiles);
-    let e = sat_tile_edges(src, params.sat, FLOAT_SUMS, source, wg.xy, li);
+    let e = sat_tile_edges(params.sat, FLOAT_SUMS, source, wg.xy, li);
     if layer == 0u && sat_non_finite > 0u {
         atomicAdd(&stats[0], sat_non_finite);
     }

@@ -21,7 +21,7 @@ const FLOAT_SUMS: bool = false;
 
 @compute @workgroup_size(WG_SIZE)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    let e = sat_tile_edges(src, params, FLOAT_SUMS, SAT_STORED, wg.xy, li);
+    let e = sat_tile_edges(params, FLOAT_SUMS, SAT_STORED, wg.xy, li);
     let size = textureDimensions(src);
     let y = wg.y * TILE + li;
     if y < size.y {

@@ -61,8 +61,9 @@ pub fn channel_stats(values: &[f32]) -> ChannelStats {
 #[derive(Clone, Copy, Debug)]
 pub enum ChannelNaming {
     /// Fixed names, in texel order. A texture with more channels than names stores padding
-    /// (e.g. two moments in `Rgba16Float`, since `rg16float` is no core storage format): the
-    /// extra channels are not dumped.
+    /// (e.g. CSM's last pair of terms in `Rgba16Float`): the extra channels are not dumped.
+    /// Packed f16 pairs (`graph::PACKED_F16X2`, one `r32uint` word a texel) are unpacked on
+    /// readback and dumped as their two float channels.
     Fixed(&'static [&'static str]),
     /// Fourier coefficients split into chunks `<kind><k>` (`csm0`, `csm1`, …): channel pairs
     /// `sin_j`, `cos_j` with `j = k·(channels / 2) + pair + 1` (1-based, as the terms of a
@@ -350,7 +351,7 @@ fn write_resource(
             file,
             light: res.light,
             producer: res.producer.clone(),
-            format: format!("{:?}", res.format),
+            format: crate::graph::format_label(res.format),
             width: map.width,
             height: map.height,
             mip_level: level,

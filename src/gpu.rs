@@ -7,6 +7,9 @@ use std::sync::Arc;
 
 use crate::error::{Error, Result};
 
+mod half;
+pub use half::{f16_to_f32, f32_to_f16, pack_f16x2, unpack_f16x2};
+
 /// A device and queue chosen by shadowgraph (the CLI's way in). Library entry points that run
 /// work take `&wgpu::Device`/`&wgpu::Queue` instead, so a host renderer can pass its own.
 pub struct Gpu {
@@ -425,22 +428,25 @@ pub fn float_channels(format: wgpu::TextureFormat) -> Option<usize> {
     }
 }
 
-/// IEEE half → single.
-pub fn f16_to_f32(h: u16) -> f32 {
-    let sign = u32::from(h >> 15) << 31;
-    let exp = u32::from((h >> 10) & 0x1f);
-    let mant = u32::from(h & 0x3ff);
-    let bits = match (exp, mant) {
-        (0, 0) => sign,
-        (0, m) => {
-            // Subnormal m·2⁻²⁴: shift the leading 1 up to bit 10 (the implicit bit).
-            let shift = m.leading_zeros() - 21;
-            sign | ((113 - shift) << 23) | ((m << shift) & 0x3ff) << 13
-        }
-        (31, m) => sign | 0x7f80_0000 | (m << 13),
-        (e, m) => sign | ((e + 112) << 23) | (m << 13),
-    };
-    f32::from_bits(bits)
+/// Reads mip `mip` of the texture of a graph resource of `format` as f32 values (`channels`
+/// per texel, row-major): a [`crate::graph::PACKED_F16X2`] resource's `r32uint` words are
+/// unpacked into its two f16 values, any other as [`read_float_texture`] reads it.
+pub fn read_resource_texture(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+    mip: u32,
+    format: wgpu::TextureFormat,
+) -> Result<(usize, Vec<f32>)> {
+    if !crate::graph::is_packed(format) {
+        return read_float_texture(device, queue, texture, mip);
+    }
+    let raw = read_texture(device, queue, texture, mip)?;
+    let words: Vec<u32> = raw
+        .chunks_exact(4)
+        .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect();
+    Ok((2, unpack_f16x2(&words)))
 }
 
 /// Reads mip `mip` of a float texture as f32 values (`channels` per texel, row-major).
@@ -478,30 +484,4 @@ pub fn read_float_texture(
         bytemuck::cast_slice(&raw).to_vec()
     };
     Ok((channels, values))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::f16_to_f32;
-
-    /// Every half against its definition: `m·2⁻²⁴` (subnormal), `(1 + m/1024)·2^(e − 15)`,
-    /// infinities and NaNs.
-    #[test]
-    fn f16_to_f32_is_exact_for_every_half() {
-        for h in 0..=u16::MAX {
-            let (e, m) = (i32::from((h >> 10) & 0x1f), f64::from(h & 0x3ff));
-            let sign = if h >> 15 == 1 { -1.0 } else { 1.0 };
-            let want = match e {
-                0 => sign * m * 2f64.powi(-24),
-                31 if m == 0.0 => sign * f64::INFINITY,
-                31 => f64::NAN,
-                _ => sign * (1.0 + m / 1024.0) * 2f64.powi(e - 15),
-            };
-            let got = f64::from(f16_to_f32(h));
-            assert!(
-                got == want || (got.is_nan() && want.is_nan()),
-                "{h:#06x}: {got} vs {want}"
-            );
-        }
-    }
 }

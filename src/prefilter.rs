@@ -59,8 +59,13 @@ pub const DEPTH_FORMATS: [wgpu::TextureFormat; 5] = [
 pub struct OutputMap {
     /// The graph resource (e.g. `light0.vsm.blur_v`).
     pub resource: String,
-    /// Its WGSL binding type (e.g. `texture_2d<f32>`).
+    /// Its WGSL binding type (e.g. `texture_2d<f32>`; `texture_2d<u32>` for packed f16
+    /// moments and fixed-point tables).
     pub wgsl_type: &'static str,
+    /// The resource's format in the graph: [`crate::graph::PACKED_F16X2`] where the texture
+    /// (`r32uint`) holds two f16 moments a texel as `pack2x16float` words (read them back with
+    /// [`crate::gpu::read_resource_texture`]), else the texture's own format.
+    pub format: wgpu::TextureFormat,
     /// The texture: pooled by the stage, valid until the next [`Prefilter::record`]. Textures
     /// of one shape are handed out in any order, so rebuild bind groups from each call's
     /// output (or compare textures, which implement `Eq`).
@@ -540,6 +545,7 @@ impl LightSlot {
                     Ok(OutputMap {
                         resource: m.resource.clone(),
                         wgsl_type: m.wgsl_type,
+                        format: m.format,
                         view: depth_aspect_view(&texture),
                         texture,
                     })
@@ -589,6 +595,9 @@ fn light_maps(graph: &mut Graph, light: &Light) -> Vec<MapInput> {
         .maps
         .into_iter()
         .map(|resource| MapInput {
+            format: graph
+                .find(&resource)
+                .map_or(wgpu::TextureFormat::Depth32Float, |r| r.format),
             resource,
             wgsl_type: input.wgsl_type,
         })
@@ -602,6 +611,8 @@ struct MapInput {
     resource: String,
     /// WGSL type of its binding.
     wgsl_type: &'static str,
+    /// Its format in the graph.
+    format: wgpu::TextureFormat,
 }
 
 /// The side of `depth`, or what makes it unusable.

@@ -258,25 +258,28 @@ impl FloatMap {
         Ok(out)
     }
 
-    /// Reads `texture` (mip 0) back.
+    /// Reads `texture` (mip 0), the texture of graph resource `resource` of `format`, back.
     pub fn read(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         resource: &str,
         texture: &wgpu::Texture,
+        format: wgpu::TextureFormat,
     ) -> Result<Self> {
-        Self::read_level(device, queue, resource, texture, 0)
+        Self::read_level(device, queue, resource, texture, format, 0)
     }
 
-    /// Reads mip `level` of `texture` back.
+    /// Reads mip `level` of `texture` back ([`crate::gpu::read_resource_texture`]).
     pub fn read_level(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         resource: &str,
         texture: &wgpu::Texture,
+        format: wgpu::TextureFormat,
         level: u32,
     ) -> Result<Self> {
-        let (channels, data) = crate::gpu::read_float_texture(device, queue, texture, level)?;
+        let (channels, data) =
+            crate::gpu::read_resource_texture(device, queue, texture, level, format)?;
         Ok(Self {
             resource: resource.to_string(),
             width: (texture.width() >> level).max(1),
@@ -336,6 +339,11 @@ fn read_extras(
     }
     frame.position = bytemuck::cast_slice(&read_texture(device, queue, &targets.gpos, 0)?).to_vec();
     frame.normal = bytemuck::cast_slice(&read_texture(device, queue, &targets.gnorm, 0)?).to_vec();
+    let format_of = |m: &str| {
+        sp.plan
+            .resource(m)
+            .map_or(wgpu::TextureFormat::R32Float, |r| r.resource.format)
+    };
     for (i, input) in sp.shade_inputs.iter().enumerate() {
         let coding = technique::sat_coding(&drawn.lights[i])?;
         let channels = technique::map_channels(&drawn.lights[i]);
@@ -345,7 +353,7 @@ fn read_extras(
             .zip(channels)
             .map(|(m, n)| match &coding {
                 Some(c) => read_sat_map(device, queue, m, &outputs.textures[m], c, n),
-                None => FloatMap::read(device, queue, m, &outputs.textures[m]),
+                None => FloatMap::read(device, queue, m, &outputs.textures[m], format_of(m)),
             })
             .collect::<Result<Vec<_>>>()?;
         frame.shade_maps.push(FloatMap::concat(maps)?);
@@ -358,14 +366,23 @@ fn read_extras(
             let maps = input
                 .maps
                 .iter()
-                .map(|m| FloatMap::read_level(device, queue, m, &outputs.textures[m], level))
+                .map(|m| {
+                    FloatMap::read_level(
+                        device,
+                        queue,
+                        m,
+                        &outputs.textures[m],
+                        format_of(m),
+                        level,
+                    )
+                })
                 .collect::<Result<Vec<_>>>()?;
             mips.push(FloatMap::concat(maps)?);
         }
         frame.shade_mips.push(mips);
         let linear = technique::linear_name(i);
         frame.linear_maps.push(match outputs.textures.get(&linear) {
-            Some(t) => Some(FloatMap::read(device, queue, &linear, t)?),
+            Some(t) => Some(FloatMap::read(device, queue, &linear, t, t.format())?),
             None => None,
         });
     }
@@ -386,7 +403,13 @@ fn dump_resources(
             let t = &outputs.textures[name];
             let levels = (0..t.mip_level_count())
                 .map(|mip| {
-                    let (channels, data) = crate::gpu::read_float_texture(device, queue, t, mip)?;
+                    let (channels, data) = crate::gpu::read_resource_texture(
+                        device,
+                        queue,
+                        t,
+                        mip,
+                        r.resource.format,
+                    )?;
                     Ok(FloatMap {
                         resource: name.clone(),
                         width: (t.width() >> mip).max(1),

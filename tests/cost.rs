@@ -122,6 +122,50 @@ fn vsm_with_mips_moves_every_level() {
     );
 }
 
+/// `vsm_f16.toml`: VSM's two moments in f16, a box blur of radius 2.5 (3 taps each side): the
+/// fused kernel as in `vsm.toml`, the moments written packed, two f16 in one r32uint word.
+#[test]
+fn vsm_f16_writes_four_bytes_a_texel() {
+    assert_traffic(
+        "techniques/vsm_f16.toml",
+        &[
+            // The depth tile with its halo of 4 (9 B, as in `vsm.toml`); 4 B out, not the 8 of
+            // rgba16float (before the packing) or rg32float.
+            ("vsm.blur", 1, 9.0, 4.0),
+        ],
+        13.0,
+        // one read of the depth (4 B) + one write of the packed moments (4 B)
+        8.0,
+    );
+    let plan = plan_lights(&scene("techniques/vsm_f16.toml").lights)
+        .expect("plan")
+        .plan;
+    let blurred = plan.resource("light0.vsm.blur").expect("planned");
+    assert_eq!(blurred.resource.format, shadowgraph::graph::PACKED_F16X2);
+    assert_eq!(blurred.bytes, 512 * 512 * 4);
+}
+
+/// `vsm_mips.toml` in f16: every level of the chain packed, 4 B a texel.
+#[test]
+fn vsm_f16_mips_move_half_the_bytes() {
+    let path = scene_path("techniques/vsm_mips.toml");
+    let text = std::fs::read_to_string(&path)
+        .expect("vsm_mips.toml")
+        .replace("filter = \"mips\"", "format = \"f16\"\nfilter = \"mips\"");
+    let s = Scene::parse(&path, &text).expect("parse");
+    let level = |k: i32| 4.0 / 4f64.powi(k); // packed bytes of level k per level-0 texel
+    assert_scene_traffic(
+        "vsm_mips.toml in f16",
+        &s,
+        &[
+            ("vsm", 1, 5.0, 4.0),
+            ("vsm.mips", 2, 4.0 + level(6), (0..10).map(level).sum()),
+        ],
+        9.0 + 4.0 + level(6) + (0..10).map(level).sum::<f64>(),
+        4.0 + (0..10).map(level).sum::<f64>(),
+    );
+}
+
 /// A summed-area table at 512² of a representation of `src` bytes per texel into a table of
 /// `table` bytes per texel, in 64 × 64 tiles (8 × 8 of them): the three passes.
 fn sat_rows(src: f64, table: f64) -> [Row; 3] {
@@ -188,6 +232,8 @@ fn cssm_moves_what_the_hand_count_says() {
 fn shading_fetches_match_the_hand_counts() {
     for (name, fetches) in [
         ("techniques/vsm.toml", 4.0),
+        // Packed f16 moments: the same four loads, each one word unpacked.
+        ("techniques/vsm_f16.toml", 4.0),
         ("techniques/msm_sat.toml", 16.0),
         ("techniques/cssm.toml", 100.0),
         ("sphere_on_plane.toml", 48.0),
@@ -208,6 +254,15 @@ fn plan_prints_traffic_and_fetches() {
         "reads    9.00 B, writes    8.00 B",
         "total: 1 dispatch, 17.00 B/texel (one read + one write of the result: 12.00 B/texel)",
         "shade: vsm 4 fetches/pixel",
+    ] {
+        assert!(text.contains(needle), "`{needle}` missing:\n{text}");
+    }
+    let text = shadowgraph::cli::plan(&scene_path("techniques/vsm_f16.toml"), false).expect("plan");
+    for needle in [
+        "light0.vsm.blur          R32Uint f16x2    512x512      1.0 MiB",
+        "reads    9.00 B, writes    4.00 B",
+        "total: 1 dispatch, 13.00 B/texel (one read + one write of the result: 8.00 B/texel)",
+        "memory: 1.0 MiB in 1 pooled texture(s)",
     ] {
         assert!(text.contains(needle), "`{needle}` missing:\n{text}");
     }

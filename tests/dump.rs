@@ -236,6 +236,47 @@ fn variance_view_is_clamped_sigma_squared_of_each_vsm_map() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// An f16 VSM map, stored as pack2x16float words in an r32uint texture, is dumped unpacked:
+/// its two named float channels, every value an f16 value, the manifest naming the packing.
+#[test]
+fn packed_f16_moments_are_dumped_as_named_float_channels() {
+    let g = common::gpu();
+    let dir = temp_dir("f16");
+    dump::dump(&g, &scene("techniques/vsm_f16.toml"), &dir, None).expect("dump");
+    let m = manifest(&dir);
+    let e = entry(&m, "light0.vsm.blur.exr");
+    assert_eq!(e["format"].as_str(), Some("R32Uint f16x2"));
+    let blur = read_exr(&dir.join("light0.vsm.blur.exr"));
+    let names: BTreeSet<&str> = blur.keys().map(String::as_str).collect();
+    assert_eq!(names, BTreeSet::from(["z", "z2"]));
+    // An f16 value: 10 mantissa bits (13 low f32 bits zero) when normal, a multiple of 2⁻²⁴
+    // below 2⁻¹⁴.
+    let is_f16 = |v: f32| {
+        if v.abs() >= 2f32.powi(-14) {
+            v.to_bits() & 0x1fff == 0
+        } else {
+            (v * 2f32.powi(24)).fract() == 0.0
+        }
+    };
+    let linear = &read_exr(&dir.join("light0.linear.exr"))["z"];
+    for (c, values) in &blur {
+        assert!(values.iter().all(|&v| is_f16(v)), "{c}: not f16 values");
+    }
+    // The blurred mean depth stays within the map's depth range, and z² ≥ z̄² − f16 rounding.
+    let (lo, hi) = linear
+        .iter()
+        .fold((f32::MAX, f32::MIN), |(a, b), &v| (a.min(v), b.max(v)));
+    for (z, z2) in blur["z"].iter().zip(&blur["z2"]) {
+        assert!(
+            (lo - 1e-3..=hi + 1e-3).contains(z),
+            "{z} outside [{lo}, {hi}]"
+        );
+        assert!(*z2 >= z * z * (1.0 - 3e-3) - 1e-4, "z2 {z2} < z² {}", z * z);
+    }
+    assert!(dir.join("light0.vsm.blur.variance.exr").is_file());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Each resource is dumped as its producer left it, not as a later resource that reused its
 /// pooled texture: the VSM z moment is the linear depth itself, and its blur differs.
 #[test]

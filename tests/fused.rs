@@ -14,7 +14,7 @@ use std::collections::HashMap;
 use rand::Rng;
 use shadowgraph::cpu::{self, Texels};
 use shadowgraph::exec::Executor;
-use shadowgraph::gpu::{read_float_texture, submit_and_wait, write_texture};
+use shadowgraph::gpu::{read_resource_texture, submit_and_wait, write_texture};
 use shadowgraph::graph::{Graph, plan, texel_bytes};
 use shadowgraph::scene::{Light, Scene};
 use shadowgraph::technique;
@@ -93,8 +93,10 @@ fn run(light: &Light, raw: &[f32], outputs: &[String]) -> (Vec<Texels>, Vec<(Str
     let maps = outputs
         .iter()
         .map(|name| {
-            let (c, v) =
-                read_float_texture(&g.device, &g.queue, &out.textures[name], 0).expect("read back");
+            // Packed f16 pairs unpacked (0xFF words: two NaN halves, so the poison shows).
+            let format = plan.resource(name).expect("planned").resource.format;
+            let (c, v) = read_resource_texture(&g.device, &g.queue, &out.textures[name], 0, format)
+                .expect("read back");
             Texels::from_f32(MAP as usize, MAP as usize, c, &v)
         })
         .collect();
@@ -170,7 +172,33 @@ fn fused_encodings_match_linearize_then_encode() {
             LINEAR_RTOL + U,
         ),
     ];
-    for (shadow, map, encode, atol, rtol) in cases {
+    // VSM and EVSM2 in f16, packed: one f16 store of the moments (2⁻¹⁰ relative, 2⁻¹⁴
+    // absolute: see `fused_blurs_match_encode_then_blur`).
+    let f16: [(&str, &str, Encoding, f64, f64); 2] = [
+        (
+            "technique = \"vsm\"\nformat = \"f16\"",
+            "light0.vsm",
+            cpu::vsm::vsm,
+            10.0 * U + 2f64.powi(-14),
+            2.0 * LINEAR_RTOL + 3.0 * U + 2f64.powi(-10),
+        ),
+        (
+            "technique = \"evsm2\"\nformat = \"f16\"\nexponent_pos = 5.0",
+            "light0.evsm",
+            |t| {
+                let m = cpu::evsm::evsm(t, 5.0, 5.0);
+                let data = m.data.chunks(m.channels).flat_map(|c| c[..2].to_vec());
+                Texels {
+                    channels: 2,
+                    data: data.collect(),
+                    ..m
+                }
+            },
+            2f64.powi(-14),
+            2.0 * (10.0 * LINEAR_RTOL + 13.0 * U) + 2f64.powi(-10),
+        ),
+    ];
+    for (shadow, map, encode, atol, rtol) in cases.into_iter().chain(f16) {
         let light = spot(shadow);
         let (maps, stats) = run(&light, &raw, &[map.to_string()]);
         let (lin, replaced) = linear(&light, &raw);
@@ -264,12 +292,49 @@ fn fused_blurs_match_encode_then_blur() {
             4.0 * LINEAR_RTOL + 4.0 * U,
         ),
     ];
+    // The two-moment encodings in f16, packed two to an r32uint word: the same references,
+    // plus f16 rounding at each store (one for the fused kernel at r = 3, two at r = 12, the
+    // horizontal pass's and the vertical pass's); each may lose a whole ulp (Vulkan lets the
+    // conversion round toward zero), 2⁻¹⁰ relative, and a value below f16's smallest normal
+    // may be flushed, 2⁻¹⁴ absolute (EVSM's squared moments reach e⁻¹⁰ ≈ 4.5·10⁻⁵).
+    let f16_cases: [(&str, &str, Reference, f64, f64); 2] = [
+        (
+            "technique = \"vsm\"\nformat = \"f16\"",
+            "light0.vsm",
+            cases[0].2,
+            10.0 * U,
+            2.0 * LINEAR_RTOL + 3.0 * U,
+        ),
+        (
+            "technique = \"evsm2\"\nformat = \"f16\"\nexponent_pos = 5.0",
+            "light0.evsm",
+            cases[1].2,
+            0.0,
+            2.0 * (10.0 * LINEAR_RTOL + 13.0 * U),
+        ),
+    ];
     for (radius, steps) in [(3u32, 1usize), (12, 1)] {
         let sigma = f64::from(radius) / 2.0;
         let filter =
             format!("\nfilter = \"blur\"\nfilter_radius = {radius}\nfilter_sigma = {sigma}");
-        for (shadow, encoded, reference, atol, rtol) in cases {
+        let stores = if radius > 8 { 2.0 } else { 1.0 };
+        let f16 = f16_cases.iter().map(|&(s, e, r, atol, rtol)| {
+            (
+                s,
+                e,
+                r,
+                atol + 2f64.powi(-14),
+                rtol + stores * 2f64.powi(-10),
+            )
+        });
+        for (shadow, encoded, reference, atol, rtol) in cases.into_iter().chain(f16) {
             let light = spot(&format!("{shadow}{filter}"));
+            // f16 two moments are stored packed, 4 bytes a texel, not in rgba16float.
+            assert_eq!(
+                technique::maps_packed(&light),
+                shadow.contains("f16"),
+                "{shadow}: packed maps"
+            );
             let map = format!("{encoded}.blur");
             let what = format!("{map} (r = {radius}, {shadow})");
             let (maps, stats) = run(&light, &raw, std::slice::from_ref(&map));

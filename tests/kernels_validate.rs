@@ -396,6 +396,52 @@ fn storage_format_variants_validate() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
+/// The packed variant (`exec::packed`) of every kernel that writes or reads a two-moment
+/// representation in f16 (`graph::PACKED_F16X2`, an r32uint texture bound to a float binding)
+/// validates: the encodings, the fused blurs, the blur passes, the mip chain and the summed-area
+/// tables' tile passes, each re-declared and rewritten as the executor does.
+#[test]
+fn packed_f16_variants_validate() {
+    let packed = shadowgraph::graph::texture_format(shadowgraph::graph::PACKED_F16X2);
+    let mut failures = Vec::new();
+    let mut rewritten = 0;
+    for kernel in [
+        "vsm",
+        "evsm",
+        "vsm_blur",
+        "evsm_blur",
+        "blur",
+        "mips",
+        "sat_tile_sums",
+        "sat_tile_sums_f32",
+        "sat_tiles",
+        "sat_tiles_f32",
+    ] {
+        // The depth the encodings read stays float; every other float texture is packed.
+        let src = !kernel.starts_with("vsm") && !kernel.starts_with("evsm");
+        let mut bound: Vec<(String, wgpu::TextureFormat)> =
+            (0..7).map(|k| (format!("dst{k}"), packed)).collect();
+        bound.push(("dst".into(), packed));
+        if src {
+            bound.push(("src".into(), packed));
+        }
+        if kernel.starts_with("sat") {
+            bound.retain(|(b, _)| b == "src");
+        }
+        match shadowgraph::exec::specialized_source(kernel, &bound) {
+            Ok(wgsl) => {
+                rewritten += usize::from(wgsl.contains("pack_f16x2("));
+                if let Err(e) = kernels::reflect(kernel, &wgsl) {
+                    failures.push(format!("{kernel}: {e}"));
+                }
+            }
+            Err(e) => failures.push(format!("{kernel}: {e}")),
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    assert_eq!(rewritten, 10, "every variant packs or unpacks");
+}
+
 /// Every compute kernel fits WebGPU's default limits (what `wgpu::Limits::default()` asks
 /// for), so a host's ordinary device runs the stage: workgroup shape and memory (16 KiB),
 /// bindings. The known exception, the mip chain: a dispatch binds seven storage textures (level

@@ -10,7 +10,7 @@ use common::host::{host_depth, host_depth_views};
 use std::path::{Path, PathBuf};
 
 use shadowgraph::exec::ComputeKernel;
-use shadowgraph::gpu::{Gpu, read_float_texture, submit_and_wait};
+use shadowgraph::gpu::{Gpu, read_float_texture, read_resource_texture, submit_and_wait};
 use shadowgraph::prefilter::{LightParams, Prefilter, PrefilterConfig, StageError};
 use shadowgraph::render::{Frame, RenderOptions, Renderer};
 use shadowgraph::scene::Scene;
@@ -44,7 +44,10 @@ fn run_stage_channels(
     submit_and_wait(&g.device, &g.queue, enc, "stage").expect("submit");
     out.maps
         .iter()
-        .map(|m| read_float_texture(&g.device, &g.queue, &m.texture, 0).expect("readback"))
+        .map(|m| {
+            // Packed f16 moments (an r32uint texture) unpacked, as the renderer reads its own.
+            read_resource_texture(&g.device, &g.queue, &m.texture, 0, m.format).expect("readback")
+        })
         .collect()
 }
 

@@ -119,6 +119,34 @@ fn host_shader_including_the_library_validates() {
     }
 }
 
+/// Two f16 moments (VSM, EVSM2) come packed in an r32uint texture: the host block binds it as
+/// `texture_2d<u32>` and reads it through `sg_sample_map_packed`; four (EVSM4) stay
+/// rgba16float, a `texture_2d<f32>`.
+#[test]
+fn host_block_binds_packed_f16_moments_as_u32() {
+    for (config, packed) in [
+        (PrefilterConfig::vsm(64).with_storage(Storage::F16), true),
+        (PrefilterConfig::evsm2(64).with_storage(Storage::F16), true),
+        (PrefilterConfig::evsm4(64).with_storage(Storage::F16), false),
+        (PrefilterConfig::vsm(64), false),
+    ] {
+        let t = config.technique;
+        let block = wgsl::host_block(&t, 0, 0).expect("host block");
+        let bound = if packed {
+            "var shadowgraph_map0: texture_2d<u32>;"
+        } else {
+            "var shadowgraph_map0: texture_2d<f32>;"
+        };
+        assert!(block.contains(bound), "{}: {block}", t.name());
+        assert_eq!(
+            block.contains("sg_sample_map_packed(shadowgraph_map0"),
+            packed,
+            "{}: {block}",
+            t.name()
+        );
+    }
+}
+
 #[test]
 fn host_block_of_every_technique_validates_with_its_bindings() {
     let mut failures = Vec::new();

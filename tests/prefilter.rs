@@ -8,7 +8,7 @@ use std::collections::HashMap;
 use rand::Rng;
 use shadowgraph::cpu::{self, Texels};
 use shadowgraph::exec::Executor;
-use shadowgraph::gpu::{Gpu, read_float_texture, submit_and_wait, write_texture};
+use shadowgraph::gpu::{Gpu, read_resource_texture, submit_and_wait, write_texture};
 use shadowgraph::graph::{Graph, SizeRule, plan};
 use shadowgraph::scene::{BlurKernel, Filter};
 
@@ -49,6 +49,11 @@ fn run_levels(g: &Gpu, graph: &Graph, output: &str, input: wgpu::Texture) -> Vec
     submit_and_wait(&g.device, &g.queue, enc, "warm").unwrap();
     let out_tex = &first.textures[output];
     let (w, h) = (out_tex.width(), out_tex.height());
+    let format = plan.resource(output).expect("planned").resource.format;
+    if shadowgraph::graph::is_packed(format) && out_tex.mip_level_count() == 1 {
+        // Two NaN halves a word.
+        write_texture(&g.queue, out_tex, &vec![0xFF; (w * h) as usize * 4]);
+    }
     let poison_channels = if out_tex.format() == wgpu::TextureFormat::Rg32Float {
         2
     } else {
@@ -71,7 +76,7 @@ fn run_levels(g: &Gpu, graph: &Graph, output: &str, input: wgpu::Texture) -> Vec
     let t = &outputs.textures[output];
     (0..t.mip_level_count())
         .map(|level| {
-            let (c, v) = read_float_texture(&g.device, &g.queue, t, level).unwrap();
+            let (c, v) = read_resource_texture(&g.device, &g.queue, t, level, format).unwrap();
             let (lw, lh) = ((w >> level).max(1), (h >> level).max(1));
             Texels::from_f32(lw as usize, lh as usize, c, &v)
         })
@@ -223,6 +228,13 @@ fn blur_matches_reference_for_each_kernel_and_storage() {
             // the f16 conversion round toward zero — so 3 · 2⁻¹⁰ relative.
             (
                 wgpu::TextureFormat::Rgba16Float,
+                1e-4,
+                3.0 * (2.0f64).powi(-10),
+            ),
+            // The same f16 values packed two to an r32uint word (what `format = "f16"` VSM
+            // stores): the same three roundings.
+            (
+                shadowgraph::graph::PACKED_F16X2,
                 1e-4,
                 3.0 * (2.0f64).powi(-10),
             ),
@@ -669,6 +681,51 @@ fn mip_chain_of_16_bit_maps_matches_reference() {
                 2f64.powi(-9),
             );
         }
+    }
+}
+
+#[test]
+fn mip_chain_of_packed_f16_moments_matches_reference() {
+    let g = common::gpu();
+    let mut rng = common::rng(47);
+    // 200 × 75: an odd level side (its own dispatch); 512²: six levels in one dispatch.
+    for (w, h) in [(200u32, 75u32), (512, 512)] {
+        let lin = random_linear(&mut rng, w as usize, h as usize);
+        let filter = Filter::Mips {
+            width: 1.0,
+            max_anisotropy: 0,
+        };
+        let (graph, out) = vsm_graph(w, h, shadowgraph::graph::PACKED_F16X2, Some(filter));
+        let gpu = run_levels(
+            &g,
+            &graph,
+            &out,
+            upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin),
+        );
+        // Level 0: the moments, stored once in f16 (2⁻¹⁰ relative: Vulkan may round toward
+        // zero; the f32 encoding's 1e-6 below that).
+        let moments = cpu::vsm::vsm(&Texels::from_f32(w as usize, h as usize, 1, &lin));
+        common::assert_close(
+            &format!("{w}x{h} level 0"),
+            &channels(&gpu[0], 2),
+            &moments.data,
+            1e-6,
+            2f64.powi(-10),
+        );
+        // Each level from the level above as stored (f16, unpacked): an f32 mean of f16
+        // values, then one f16 store.
+        for level in 1..gpu.len() {
+            let above = &gpu[level - 1];
+            let want = cpu::mips::reduce(above, gpu[level].width, gpu[level].height, false);
+            common::assert_close(
+                &format!("{w}x{h} level {level}"),
+                &channels(&gpu[level], 2),
+                &want.data,
+                2f64.powi(-15),
+                2f64.powi(-9),
+            );
+        }
+        assert!(gpu.len() > 6, "{w}x{h}: {} levels", gpu.len());
     }
 }
 

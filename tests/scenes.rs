@@ -773,6 +773,16 @@ fn every_technique_renders_every_bundled_scene() {
             bleed: 0.0,
             min_variance: 1e-4,
         },
+        // Two f16 moments packed in r32uint words, blurred (the fused kernel) and read by the
+        // shading through `sample_map_packed`.
+        Technique::Evsm {
+            prefilter: pre(Storage::F16, blur),
+            four: false,
+            exp_pos: 5.0,
+            exp_neg: 5.0,
+            bleed: 0.0,
+            min_variance: 1e-4,
+        },
         Technique::Esm {
             filter: Filter::Mips {
                 width: 3.0,

@@ -28,6 +28,9 @@
 // cascade's by pick.blend across the blend band.
 // Prefiltered maps are read with four loads, so no sampler or filterable format is needed;
 // only `sg_vis_pcf_hardware` takes a comparison sampler (linear filtering, compare less-equal).
+// Two moments in f16 (VSM, EVSM2 with `Storage::F16`, not through a table) come as an r32uint
+// texture, 4 bytes a texel, each word pack2x16float(moments): bind it as texture_2d<u32> and
+// call `sg_vis_vsm_of(sg_sample_map_packed(map, l, s), l, s)` (EVSM2: `sg_vis_evsm_of`).
 //
 // Visibility functions (map binding types as declared):
 //   fn sg_vis_msm(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32
@@ -56,22 +59,24 @@
 //   sg_SatNodes sg_SoftLookup sg_TECHNIQUE_CSM sg_TECHNIQUE_CSSM sg_TECHNIQUE_ESM
 //   sg_TECHNIQUE_EVSM sg_TECHNIQUE_HARD sg_TECHNIQUE_MIDPOINT sg_TECHNIQUE_MSM
 //   sg_TECHNIQUE_MSM_SOFT sg_TECHNIQUE_PCF sg_TECHNIQUE_PCSS sg_TECHNIQUE_SECOND_DEPTH
-//   sg_TECHNIQUE_SMRT sg_TECHNIQUE_VSM sg_TECHNIQUE_VSSM sg_bilinear_level sg_bilinear_log_level
-//   sg_blocker_csm_z sg_blocker_filter_width sg_blocker_msm sg_blocker_result
-//   sg_blocker_search_width sg_blocker_vsm sg_blocker_width sg_cascade_far_of sg_cascade_pick
-//   sg_chebyshev_upper sg_csm_chunk sg_csm_chunk_of sg_csm_resolve sg_csm_sin_cos sg_csm_weight
-//   sg_csm_z_chunk_of sg_cssm_blocker sg_cssm_resolve sg_cssm_sharpen sg_level_size
-//   sg_light_depth_slope sg_light_faces sg_light_footprint sg_light_linear_to_ndc
-//   sg_light_linear_to_z sg_light_map_width sg_light_receiver_offset sg_light_sample
-//   sg_light_tap_offset sg_light_texel sg_light_to_light sg_linstep sg_load_depth sg_mip_tap_uv
-//   sg_mip_taps sg_msm_biased sg_msm_dequantize sg_msm_expect sg_msm_intensity sg_msm_moments
-//   sg_msm_quantize sg_msm_roots sg_msm_soft_blocker sg_pcss_search_radius sg_point_coords
-//   sg_point_face sg_point_sample sg_sample_bilinear sg_sample_bilinear_log sg_sample_map
-//   sg_sample_map_log sg_sat_box sg_sat_box_fixed sg_sat_box_float sg_sat_clamp
-//   sg_sat_mean_fixed sg_sat_mean_float sg_sat_node_f32 sg_sat_node_u32 sg_sat_nodes sg_sat_rect
-//   sg_sat_sample_fixed sg_sat_sample_float sg_sat_search_fixed sg_sat_search_float
-//   sg_sat_span_weights sg_smrt_emitter_point sg_smrt_ray sg_soft_blockers sg_soft_filter_trips
-//   sg_texel_of sg_trilinear sg_trilinear_log sg_vis_esm sg_vis_esm_of_log sg_vis_esm_of_sat
+//   sg_TECHNIQUE_SMRT sg_TECHNIQUE_VSM sg_TECHNIQUE_VSSM sg_bilinear_level
+//   sg_bilinear_level_packed sg_bilinear_log_level sg_blocker_csm_z sg_blocker_filter_width
+//   sg_blocker_msm sg_blocker_result sg_blocker_search_width sg_blocker_vsm sg_blocker_width
+//   sg_cascade_far_of sg_cascade_pick sg_chebyshev_upper sg_csm_chunk sg_csm_chunk_of
+//   sg_csm_resolve sg_csm_sin_cos sg_csm_weight sg_csm_z_chunk_of sg_cssm_blocker
+//   sg_cssm_resolve sg_cssm_sharpen sg_level_size sg_level_size_of sg_light_depth_slope
+//   sg_light_faces sg_light_footprint sg_light_linear_to_ndc sg_light_linear_to_z
+//   sg_light_map_width sg_light_receiver_offset sg_light_sample sg_light_tap_offset
+//   sg_light_texel sg_light_to_light sg_linstep sg_load_depth sg_mip_tap_uv sg_mip_taps
+//   sg_msm_biased sg_msm_dequantize sg_msm_expect sg_msm_intensity sg_msm_moments
+//   sg_msm_quantize sg_msm_roots sg_msm_soft_blocker sg_pack_f16x2 sg_pcss_search_radius
+//   sg_point_coords sg_point_face sg_point_sample sg_sample_bilinear sg_sample_bilinear_log
+//   sg_sample_map sg_sample_map_log sg_sample_map_packed sg_sat_box sg_sat_box_fixed
+//   sg_sat_box_float sg_sat_clamp sg_sat_mean_fixed sg_sat_mean_float sg_sat_node_f32
+//   sg_sat_node_u32 sg_sat_nodes sg_sat_rect sg_sat_sample_fixed sg_sat_sample_float
+//   sg_sat_search_fixed sg_sat_search_float sg_sat_span_weights sg_smrt_emitter_point
+//   sg_smrt_ray sg_soft_blockers sg_soft_filter_trips sg_texel_of sg_trilinear sg_trilinear_log
+//   sg_trilinear_packed sg_unpack_f16x2 sg_vis_esm sg_vis_esm_of_log sg_vis_esm_of_sat
 //   sg_vis_evsm sg_vis_evsm_of sg_vis_hard sg_vis_msm sg_vis_msm_of sg_vis_msm_soft_fixed
 //   sg_vis_msm_soft_float sg_vis_pcf sg_vis_pcf_hardware sg_vis_pcss sg_vis_smrt sg_vis_vsm
 //   sg_vis_vsm_of sg_vis_vssm_fixed sg_vis_vssm_float sg_vogel_disc sg_vssm_blocker
@@ -360,7 +365,12 @@ fn sg_sample_bilinear(map: texture_2d<f32>, uv: vec2<f32>) -> vec4<f32> {
 // textureDimensions(map, level) with one invocation's level when the invocations' levels differ
 // (per-pixel footprints), which sends the others' loads out of range.
 fn sg_level_size(map: texture_2d<f32>, level: i32) -> vec2<f32> {
-    return vec2<f32>(max(textureDimensions(map) >> vec2<u32>(u32(level)), vec2<u32>(1u)));
+    return sg_level_size_of(textureDimensions(map), level);
+}
+
+// The size of mip `level` of a map whose level 0 is `size0` texels.
+fn sg_level_size_of(size0: vec2<u32>, level: i32) -> vec2<f32> {
+    return vec2<f32>(max(size0 >> vec2<u32>(u32(level)), vec2<u32>(1u)));
 }
 
 // `sample_bilinear` on mip `level` (texel centres at (i + ½) / level size).
@@ -501,6 +511,65 @@ fn sg_bilinear_log_level(map: texture_2d<f32>, uv: vec2<f32>, level: i32) -> f32
     let sum = (1.0 - a.y) * ((1.0 - a.x) * exp(v00 - m) + a.x * exp(v10 - m))
         + a.y * ((1.0 - a.x) * exp(v01 - m) + a.x * exp(v11 - m));
     return m + log(sum);
+}
+// `sample_map` for a map of packed f16 pairs (`graph::PACKED_F16X2`: an r32uint texture, each
+// word pack2x16float(moments.xy); import-only module). The same taps and the same arithmetic
+// as shared/sampling on the unpacked texels, so a packed map filters exactly as the
+// rgba16float map of the same f16 values did; written out again because WGSL has no generic
+// over a texture's sample type.
+// Two f16 values a texel in one r32uint word (`graph::PACKED_F16X2`): how a representation of
+// one or two channels at f16 precision is stored in 4 bytes, since `rg16float` is no core
+// WebGPU storage format. Kernels written for float textures are compiled for packed ones by
+// the executor (`exec::packed`), which routes their stores through `pack_f16x2` and their loads
+// through `unpack_f16x2`; the shading reads packed maps through shared/sampling_packed.
+// The value is rounded to f16 once, here, as a store to an rgba16float texture would; channels
+// past the second are dropped, and read back as a two-channel float texture reads (0, 1).
+
+fn sg_pack_f16x2(v: vec4<f32>) -> vec4<u32> {
+    return vec4<u32>(pack2x16float(v.xy), 0u, 0u, 1u);
+}
+
+fn sg_unpack_f16x2(w: vec4<u32>) -> vec4<f32> {
+    return vec4<f32>(unpack2x16float(w.x), 0.0, 1.0);
+}
+
+// `bilinear_level` of a packed map.
+// #fetches sg_bilinear_level_packed: 4
+fn sg_bilinear_level_packed(map: texture_2d<u32>, uv: vec2<f32>, level: i32) -> vec4<f32> {
+    let size = sg_level_size_of(textureDimensions(map), level);
+    let f = uv * size - 0.5;
+    let i = vec2<i32>(floor(f));
+    let a = f - floor(f);
+    let smax = vec2<i32>(size) - 1;
+    let t00 = sg_unpack_f16x2(textureLoad(map, clamp(i, vec2<i32>(0), smax), level));
+    let t10 = sg_unpack_f16x2(textureLoad(map, clamp(i + vec2<i32>(1, 0), vec2<i32>(0), smax), level));
+    let t01 = sg_unpack_f16x2(textureLoad(map, clamp(i + vec2<i32>(0, 1), vec2<i32>(0), smax), level));
+    let t11 = sg_unpack_f16x2(textureLoad(map, clamp(i + vec2<i32>(1, 1), vec2<i32>(0), smax), level));
+    return mix(mix(t00, t10, a.x), mix(t01, t11, a.x), a.y);
+}
+
+// `trilinear` of a packed map.
+// #fetches sg_trilinear_packed: 8
+fn sg_trilinear_packed(map: texture_2d<u32>, l: sg_Light, uv: vec2<f32>, lod_in: f32) -> vec4<f32> {
+    let lod = clamp(lod_in, 0.0, f32(l.mip_levels - 1u));
+    let l0 = i32(floor(lod));
+    let l1 = min(l0 + 1, i32(l.mip_levels) - 1);
+    let v0 = sg_bilinear_level_packed(map, uv, l0);
+    return mix(v0, sg_bilinear_level_packed(map, uv, l1), lod - floor(lod));
+}
+
+// `sample_map` of a packed map: the light's filtered two moments at a receiver (.zw are 0, 1).
+// #fetches sg_sample_map_packed: select(4, 8 * max(l.max_anisotropy, 1), l.mip_levels > 1)
+fn sg_sample_map_packed(map: texture_2d<u32>, l: sg_Light, s: sg_LightSample) -> vec4<f32> {
+    if l.mip_levels <= 1u {
+        return sg_bilinear_level_packed(map, s.uv, 0);
+    }
+    let t = sg_mip_taps(l, s);
+    var sum = vec4<f32>(0.0);
+    for (var k = 0u; k < t.count; k++) {
+        sum += sg_trilinear_packed(map, l, sg_mip_tap_uv(t, s.uv, k), t.lod);
+    }
+    return sum / f32(t.count);
 }
 // Cascaded shadow maps of a directional light (import-only module): which cascade a receiver
 // reads, by its view distance from the camera, and how far into the blend band toward the

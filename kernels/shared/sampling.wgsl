@@ -35,7 +35,12 @@ fn sample_bilinear(map: texture_2d<f32>, uv: vec2<f32>) -> vec4<f32> {
 // textureDimensions(map, level) with one invocation's level when the invocations' levels differ
 // (per-pixel footprints), which sends the others' loads out of range.
 fn level_size(map: texture_2d<f32>, level: i32) -> vec2<f32> {
-    return vec2<f32>(max(textureDimensions(map) >> vec2<u32>(u32(level)), vec2<u32>(1u)));
+    return level_size_of(textureDimensions(map), level);
+}
+
+// The size of mip `level` of a map whose level 0 is `size0` texels.
+fn level_size_of(size0: vec2<u32>, level: i32) -> vec2<f32> {
+    return vec2<f32>(max(size0 >> vec2<u32>(u32(level)), vec2<u32>(1u)));
 }
 
 // `sample_bilinear` on mip `level` (texel centres at (i + ½) / level size).

@@ -46,32 +46,3 @@ struct SatSource {
 
 const SAT_STORED: SatSource =
     SatSource(false, false, 0u, 0u, DepthParams(0u, 0.0, 1.0, 0u), vec2<u32>(0u));
-
-// Non-finite depth texels this invocation's `sat_texel` replaced (CSM sources; the first
-// tile pass counts layer 0's).
-var<private> sat_non_finite: u32;
-
-// The encoded texel `q` of `src` (`size` its size) read as `s` says, 0 outside the map (the
-// load is clamped to the map and its value discarded, so no invocation branches).
-fn sat_texel(
-    src: texture_2d<f32>,
-    q: vec2<u32>,
-    size: vec2<u32>,
-    p: SatParams,
-    fs: bool,
-    s: SatSource,
-) -> vec4<u32> {
-    let inside = all(q < size);
-    var v = textureLoad(src, min(q, size - 1u), 0);
-    if s.csm {
-        let raw = v.r;
-        if inside && !depth_is_finite(raw) {
-            sat_non_finite += 1u;
-        }
-        v = csm_basis_map(s.layer, s.terms, linear_depth(raw, s.depth));
-        if s.f16 {
-            v = vec4<f32>(unpack2x16float(pack2x16float(v.xy)), unpack2x16float(pack2x16float(v.zw)));
-        }
-    }
-    return select(vec4<u32>(0u), sat_encode_as(v, p, fs), inside);
-}

@@ -12,6 +12,9 @@
 // once more here (swept twice, the second time from cache) and the table written once: two
 // reads and one write per texel over the three passes.
 // #import shared/sat_tile
+// #import shared/sat_tile_texel
+// The importing kernel declares `src` (shared/sat_tile_texel):
+// #completed-by-importer
 
 // Row y: at [y · (GRID − 1) + a − 1], the sum of row y over sub-blocks a' < a (a ≥ 1).
 var<workgroup> sh_right: array<vec4<u32>, 448>; // TILE · (GRID − 1)
@@ -23,7 +26,6 @@ const SIDE: u32 = 7u; // GRID − 1
 // Row j of the sub-block at `origin`: its encoded texels prefixed along the row, added to the
 // running column sums `col`, which then hold row j of the sub-block's own inclusive table.
 fn sat_sweep_row(
-    src: texture_2d<f32>,
     origin: vec2<u32>,
     j: u32,
     p: SatParams,
@@ -34,7 +36,7 @@ fn sat_sweep_row(
     let size = textureDimensions(src);
     var run = vec4<u32>(0u);
     for (var i = 0u; i < SUB; i++) {
-        run = sat_sum(run, sat_texel(src, origin + vec2<u32>(i, j), size, p, fs, s), fs);
+        run = sat_sum(run, sat_texel(origin + vec2<u32>(i, j), size, p, fs, s), fs);
         (*col)[i] = sat_sum((*col)[i], run, fs);
     }
 }
@@ -44,7 +46,6 @@ fn sat_sweep_row(
 // the tile's sums above the sub-block up to that column. Sweeps the sub-block once
 // for its edges. Every invocation calls it (it has barriers).
 fn sat_tile_prepare(
-    src: texture_2d<f32>,
     col_carry: texture_2d<u32>,
     p: SatParams,
     fs: bool,
@@ -59,7 +60,7 @@ fn sat_tile_prepare(
     let origin = sat_sub_origin(tile, li);
     var col: array<vec4<u32>, SUB>;
     for (var j = 0u; j < SUB; j++) {
-        sat_sweep_row(src, origin, j, p, fs, s, &col);
+        sat_sweep_row(origin, j, p, fs, s, &col);
         if a < SIDE {
             sh_right[(b * SUB + j) * SIDE + a] = col[SUB - 1u];
         }

@@ -3,6 +3,9 @@
 // the tile. Each invocation sums its sub-block's rows and columns in registers; the edges
 // across the tile come from those partial sums in workgroup memory, two barriers in all.
 // #import shared/sat_tile
+// #import shared/sat_tile_texel
+// The importing kernel declares `src` (shared/sat_tile_texel):
+// #completed-by-importer
 
 // Row y's partial sums, one per sub-block column a, at [y · GRID + a]; then the row's sum in
 // [y · GRID]. sh_bottom likewise per column x and sub-block row b.
@@ -18,7 +21,6 @@ struct SatEdges {
 // Invocation li's entries of the edges of tile `tile` of `src` (read as `s`, coded with `p`
 // in the variant `fs`). Every invocation calls it (it has barriers).
 fn sat_tile_edges(
-    src: texture_2d<f32>,
     p: SatParams,
     fs: bool,
     s: SatSource,
@@ -36,7 +38,7 @@ fn sat_tile_edges(
     for (var j = 0u; j < SUB; j++) {
         var row = vec4<u32>(0u);
         for (var i = 0u; i < SUB; i++) {
-            let e = sat_texel(src, origin + vec2<u32>(i, j), size, p, fs, s);
+            let e = sat_texel(origin + vec2<u32>(i, j), size, p, fs, s);
             row = sat_sum(row, e, fs);
             col[i] = sat_sum(col[i], e, fs);
         }

@@ -10,6 +10,7 @@
 //! levels included. By concern: [`pipelines`] (kernels compiled once and cached), [`pool`]
 //! (textures by shape, the run's outputs), `record` (bind groups and the passes).
 
+mod packed;
 pub mod pipelines;
 pub mod pool;
 mod record;
@@ -21,7 +22,7 @@ pub use crate::error::ExecError;
 use crate::error::Result;
 use crate::graph::{Plan, Slot};
 pub use crate::timer::GpuTimer;
-pub use pipelines::{ComputeKernel, KernelCache, wgsl_storage_format};
+pub use pipelines::{ComputeKernel, KernelCache, specialized_source, wgsl_storage_format};
 pub use pool::{Outputs, TexturePool};
 
 /// Runs plans: owns pipelines, pooled textures and what the last plan's run needs; borrows

@@ -101,8 +101,12 @@ impl KernelCache {
         self.get_generated(device, name, None)
     }
 
-    /// The pipeline of `name` with the storage-texture bindings in `formats` re-declared with
-    /// those formats (a kernel declares a default; a graph may bind another, e.g. f16 moments).
+    /// The pipeline of `name` with the texture bindings in `formats` re-declared for the
+    /// texture formats bound to them (a kernel declares a default; a graph may bind another,
+    /// e.g. f16 moments): a storage texture of another float format is re-typed; a float
+    /// storage texture or float texture bound to an `r32uint` texture holds a
+    /// [`crate::graph::PACKED_F16X2`] representation and is stored packed and read unpacked
+    /// (`exec::packed`).
     pub fn get_specialized(
         &mut self,
         device: &wgpu::Device,
@@ -110,24 +114,7 @@ impl KernelCache {
         formats: &[(String, wgpu::TextureFormat)],
     ) -> Result<Arc<ComputeKernel>> {
         let base = self.get(device, name)?;
-        let mut changes = Vec::new();
-        for (binding, format) in formats {
-            if let Some(b) = base.reflection.binding(binding) {
-                if let wgpu::BindingType::StorageTexture {
-                    format: declared, ..
-                } = b.ty
-                {
-                    if declared != *format {
-                        same_kind(name, binding, declared, *format)?;
-                        changes.push((
-                            binding.as_str(),
-                            wgsl_storage_format(declared)?,
-                            wgsl_storage_format(*format)?,
-                        ));
-                    }
-                }
-            }
-        }
+        let changes = changes(name, &base.reflection, formats)?;
         if changes.is_empty() {
             return Ok(base);
         }
@@ -135,13 +122,7 @@ impl KernelCache {
         if let Some(k) = self.kernels.get(&key) {
             return Ok(k.clone());
         }
-        let mut wgsl = kernels::resolve(name, None)?;
-        for (binding, from, to) in &changes {
-            wgsl = retype_storage(&wgsl, binding, from, to).ok_or_else(|| Error::Kernel {
-                kernel: name.to_string(),
-                message: format!("cannot find the declaration of storage texture `{binding}`"),
-            })?;
-        }
+        let wgsl = apply(name, &changes)?;
         let k = Arc::new(ComputeKernel::new(device, name, &wgsl)?);
         self.kernels.insert(key, k.clone());
         Ok(k)
@@ -242,29 +223,130 @@ pub(super) fn no_layout(kernel: &str) -> Error {
     }
 }
 
-/// Refuses to re-declare storage texture `binding` of kernel `name` as a format of another
-/// texel kind (float and integer texels are not interchangeable in the kernel's arithmetic).
-fn same_kind(
+/// The WGSL of kernel `name` as [`KernelCache::get_specialized`] compiles it for the texture
+/// formats `formats` bound by binding name (no GPU needed: `tests/kernels_validate.rs`
+/// validates every variant a technique can bind).
+pub fn specialized_source(name: &str, formats: &[(String, wgpu::TextureFormat)]) -> Result<String> {
+    let (_, reflection) = kernels::reflect(name, &kernels::resolve(name, None)?)?;
+    apply(name, &changes(name, &reflection, formats)?)
+}
+
+/// The changes binding `formats` to kernel `name` needs.
+fn changes(
+    name: &str,
+    reflection: &Reflection,
+    formats: &[(String, wgpu::TextureFormat)],
+) -> Result<Vec<Change>> {
+    let mut changes = Vec::new();
+    for (binding, format) in formats {
+        if let Some(b) = reflection.binding(binding) {
+            if let Some(change) = change_for(name, binding, b.ty, *format)? {
+                changes.push(change);
+            }
+        }
+    }
+    Ok(changes)
+}
+
+/// Kernel `name`'s resolved WGSL with `changes` applied.
+fn apply(name: &str, changes: &[Change]) -> Result<String> {
+    let mut wgsl = kernels::resolve(name, None)?;
+    for change in changes {
+        wgsl = change.apply(&wgsl).ok_or_else(|| Error::Kernel {
+            kernel: name.to_string(),
+            message: format!(
+                "cannot re-declare `{}` for its bound format",
+                change.binding()
+            ),
+        })?;
+    }
+    Ok(wgsl)
+}
+
+/// How a kernel's binding is re-declared for the texture bound to it.
+#[derive(Debug)]
+enum Change {
+    /// A storage texture of another format of the same texel kind.
+    Retype {
+        binding: String,
+        from: &'static str,
+        to: &'static str,
+    },
+    /// A float storage texture bound to a packed texture.
+    PackStores { binding: String, from: &'static str },
+    /// A float texture bound to a packed texture.
+    UnpackLoads { binding: String },
+}
+
+impl Change {
+    fn binding(&self) -> &str {
+        match self {
+            Change::Retype { binding, .. }
+            | Change::PackStores { binding, .. }
+            | Change::UnpackLoads { binding } => binding,
+        }
+    }
+
+    fn apply(&self, wgsl: &str) -> Option<String> {
+        match self {
+            Change::Retype { binding, from, to } => retype_storage(wgsl, binding, from, to),
+            Change::PackStores { binding, from } => super::packed::pack_stores(wgsl, binding, from),
+            Change::UnpackLoads { binding } => super::packed::unpack_loads(wgsl, binding),
+        }
+    }
+}
+
+/// Whether `format` is a float texel format.
+fn is_float(format: wgpu::TextureFormat) -> bool {
+    matches!(
+        format.sample_type(None, None),
+        Some(wgpu::TextureSampleType::Float { .. })
+    )
+}
+
+/// The change binding `binding` (of type `ty`) of kernel `name` needs for a texture of
+/// `bound` format; refuses a storage texture of another texel kind (float and integer texels
+/// are not interchangeable in the kernel's arithmetic) unless it is the packed f16 word.
+fn change_for(
     name: &str,
     binding: &str,
-    declared: wgpu::TextureFormat,
+    ty: wgpu::BindingType,
     bound: wgpu::TextureFormat,
-) -> Result<()> {
-    let float = |f: wgpu::TextureFormat| {
-        matches!(
-            f.sample_type(None, None),
-            Some(wgpu::TextureSampleType::Float { .. })
-        )
-    };
-    if float(declared) == float(bound) {
-        return Ok(());
+) -> Result<Option<Change>> {
+    let packed = bound == crate::graph::texture_format(crate::graph::PACKED_F16X2);
+    match ty {
+        wgpu::BindingType::StorageTexture {
+            format: declared, ..
+        } if declared != bound => {
+            if packed && is_float(declared) {
+                return Ok(Some(Change::PackStores {
+                    binding: binding.to_string(),
+                    from: wgsl_storage_format(declared)?,
+                }));
+            }
+            if is_float(declared) != is_float(bound) {
+                return Err(Error::Pipeline {
+                    kernel: name.to_string(),
+                    message: format!(
+                        "storage texture `{binding}` is {declared:?}; a {bound:?} texture cannot be bound to it"
+                    ),
+                });
+            }
+            Ok(Some(Change::Retype {
+                binding: binding.to_string(),
+                from: wgsl_storage_format(declared)?,
+                to: wgsl_storage_format(bound)?,
+            }))
+        }
+        wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { .. },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            ..
+        } if packed => Ok(Some(Change::UnpackLoads {
+            binding: binding.to_string(),
+        })),
+        _ => Ok(None),
     }
-    Err(Error::Pipeline {
-        kernel: name.to_string(),
-        message: format!(
-            "storage texture `{binding}` is {declared:?}; a {bound:?} texture cannot be bound to it"
-        ),
-    })
 }
 
 /// The WGSL name of a storage texel format.

@@ -31,7 +31,7 @@ impl TexturePool {
                 mip_level_count: slot.mips,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
-                format: slot.format,
+                format: crate::graph::texture_format(slot.format),
                 usage: wgpu::TextureUsages::STORAGE_BINDING
                     | wgpu::TextureUsages::TEXTURE_BINDING
                     | wgpu::TextureUsages::COPY_SRC

@@ -130,7 +130,10 @@ pub(super) fn compile(
 ) -> Result<()> {
     let base = kernels.get(device, node.kernel.name())?;
     let specs = specs(&base, node)?;
-    let formats = bound_formats(&specs, |r| plan.resource(r).map(|p| p.resource.format));
+    let formats = bound_formats(&specs, |r| {
+        plan.resource(r)
+            .map(|p| crate::graph::texture_format(p.resource.format))
+    });
     kernels.get_specialized(device, node.kernel.name(), &formats)?;
     Ok(())
 }

@@ -21,7 +21,7 @@ impl Plan {
                     s.width, s.height, s.mips
                 ));
             }
-            if crate::exec::wgsl_storage_format(s.format).is_err() {
+            if crate::exec::wgsl_storage_format(super::texture_format(s.format)).is_err() {
                 return bad(format!(
                     "slot {i} has format {:?}, not a storage format",
                     s.format

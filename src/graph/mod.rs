@@ -290,6 +290,38 @@ pub fn block_count(len: u32, block: u32) -> u32 {
     }
 }
 
+/// Two f16 values a texel (`Rg16Float` in a graph): a representation stored in 4 bytes.
+/// `rg16float` is no core WebGPU storage format, so its texture is `r32uint`, each word
+/// `pack2x16float(v.xy)`; kernels compiled for it pack on store and unpack on load
+/// ([`crate::exec::KernelCache::get_specialized`]), the shading reads it through
+/// `kernels/shared/sampling_packed.wgsl`.
+pub const PACKED_F16X2: wgpu::TextureFormat = wgpu::TextureFormat::Rg16Float;
+
+/// Whether a resource of `format` is stored packed ([`PACKED_F16X2`]).
+pub fn is_packed(format: wgpu::TextureFormat) -> bool {
+    format == PACKED_F16X2
+}
+
+/// The format of the texture that holds a resource of `format`: `r32uint` for
+/// [`PACKED_F16X2`], else `format` itself.
+pub fn texture_format(format: wgpu::TextureFormat) -> wgpu::TextureFormat {
+    if is_packed(format) {
+        wgpu::TextureFormat::R32Uint
+    } else {
+        format
+    }
+}
+
+/// How `plan` and the dump's manifest name a resource's format: its texture's format, and for
+/// packed f16 pairs ([`PACKED_F16X2`]) what its words hold (`R32Uint f16x2`).
+pub fn format_label(format: wgpu::TextureFormat) -> String {
+    if is_packed(format) {
+        format!("{:?} f16x2", texture_format(format))
+    } else {
+        format!("{format:?}")
+    }
+}
+
 /// Bytes of one texel of `format` (0 where the format has no fixed size).
 pub fn texel_bytes(format: wgpu::TextureFormat) -> u64 {
     u64::from(

@@ -74,7 +74,7 @@ impl Plan {
                     s,
                     "      {:<24} {:<14} {:>5}x{:<5} {:>10}  ({role}{out})",
                     r.resource.name,
-                    format!("{:?}", r.resource.format),
+                    super::format_label(r.resource.format),
                     r.width,
                     r.height,
                     human_bytes(r.bytes)
@@ -152,8 +152,11 @@ impl Plan {
         for r in &self.resources {
             let _ = writeln!(
                 s,
-                "  \"{0}\" [shape=box, label=\"{0}\\n{1:?} {2}x{3}\"];",
-                r.resource.name, r.resource.format, r.width, r.height
+                "  \"{0}\" [shape=box, label=\"{0}\\n{1} {2}x{3}\"];",
+                r.resource.name,
+                super::format_label(r.resource.format),
+                r.width,
+                r.height
             );
         }
         for st in &self.steps {

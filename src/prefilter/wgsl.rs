@@ -1,5 +1,6 @@
 //! The WGSL a host includes to sample the stage's outputs: the visibility functions of
-//! `kernels/shared/vis_*.wgsl` with `shared/light` and `shared/sampling`, import-resolved.
+//! `kernels/shared/vis_*.wgsl` with `shared/light`, `shared/sampling` and
+//! `shared/sampling_packed` (f16 moments packed in r32uint words), import-resolved.
 //!
 //! What a technique calls and binds comes from [`crate::technique::visibility_body`], the code
 //! the renderer's own shading kernel is completed with, so the host calls exactly what
@@ -91,6 +92,9 @@ const LIBRARY_HEADER: &str = "\
 // cascade's by pick.blend across the blend band.
 // Prefiltered maps are read with four loads, so no sampler or filterable format is needed;
 // only `sg_vis_pcf_hardware` takes a comparison sampler (linear filtering, compare less-equal).
+// Two moments in f16 (VSM, EVSM2 with `Storage::F16`, not through a table) come as an r32uint
+// texture, 4 bytes a texel, each word pack2x16float(moments): bind it as texture_2d<u32> and
+// call `sg_vis_vsm_of(sg_sample_map_packed(map, l, s), l, s)` (EVSM2: `sg_vis_evsm_of`).
 ";
 
 /// Resolves `// #import` lines for `modules`, in order, each once, and gives every name the
@@ -107,9 +111,14 @@ fn resolve_modules(label: &str, modules: &[&str]) -> Result<String> {
 fn resolve_unprefixed(label: &str, modules: &[&str]) -> Result<(String, Vec<String>)> {
     let mut text = String::new();
     // Every export holds the cascade pick, so a host's cascaded light blends as the renderer's.
-    for m in ["shared/light", "shared/sampling", "shared/cascade"]
-        .iter()
-        .chain(modules)
+    for m in [
+        "shared/light",
+        "shared/sampling",
+        "shared/sampling_packed",
+        "shared/cascade",
+    ]
+    .iter()
+    .chain(modules)
     {
         let _ = writeln!(text, "// #import {m}");
     }

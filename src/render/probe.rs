@@ -14,7 +14,8 @@ use super::FrameGpu;
 use super::renderer::{Renderer, ShadeInputs, record_shade};
 
 /// A map handed to [`probe`]: what the light's technique reads (linear depth as R32Float,
-/// moments as Rg32Float, …), never the raw depth of hardware PCF.
+/// moments as Rg32Float, …), never the raw depth of hardware PCF. Two moments of a light that
+/// stores them in f16 are given as Rg32Float too; the probe packs them as the stage does.
 pub struct ProbeMap<'a> {
     /// Side length of level 0.
     pub size: u32,
@@ -91,9 +92,22 @@ pub fn probe(
     let gnorm = points_texture("shadowgraph.probe.normal");
     write_texture(queue, &gpos, bytemuck::cast_slice(&pos));
     write_texture(queue, &gnorm, bytemuck::cast_slice(&nor));
+    // A light whose shading reads packed f16 moments (`technique::maps_packed`) gets its
+    // two-channel maps packed here (exact for values read back from an f16 map).
+    let packed: Vec<bool> = lights
+        .iter()
+        .enumerate()
+        .flat_map(|(i, l)| {
+            let n = technique::add_light_nodes(&mut Graph::default(), i, l)
+                .maps
+                .len();
+            std::iter::repeat_n(technique::maps_packed(l), n)
+        })
+        .collect();
     let mut views = Vec::new();
-    for m in maps {
+    for (m, packed) in maps.iter().zip(packed) {
         let channels = crate::gpu::float_channels(m.format).unwrap_or(0);
+        let packed = packed && channels == 2;
         let side = |l: u32| (m.size >> l).max(1) as usize;
         let texels: usize = (0..m.mips).map(|l| side(l) * side(l)).sum();
         let is_f32 = crate::graph::texel_bytes(m.format) == 4 * channels as u64;
@@ -118,7 +132,11 @@ pub fn probe(
                 mip_level_count: m.mips,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
-                format: m.format,
+                format: if packed {
+                    crate::graph::texture_format(crate::graph::PACKED_F16X2)
+                } else {
+                    m.format
+                },
                 usage,
                 view_formats: &[],
             },
@@ -126,12 +144,13 @@ pub fn probe(
         let mut at = 0;
         for level in 0..m.mips {
             let n = side(level) * side(level) * channels;
-            crate::gpu::write_texture_level(
-                queue,
-                &t,
-                level,
-                bytemuck::cast_slice(&m.data[at..at + n]),
-            );
+            let values = &m.data[at..at + n];
+            let bytes: Vec<u8> = if packed {
+                bytemuck::cast_slice(&crate::gpu::pack_f16x2(values)).to_vec()
+            } else {
+                bytemuck::cast_slice(values).to_vec()
+            };
+            crate::gpu::write_texture_level(queue, &t, level, &bytes);
             at += n;
         }
         views.push(created::view(&t, &Default::default()));

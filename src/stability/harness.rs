@@ -9,7 +9,7 @@ use glam::{DVec3, Vec3};
 use crate::cpu::{self, Texels};
 use crate::error::{Error, Result};
 use crate::exec::{Executor, Outputs};
-use crate::gpu::{Gpu, read_buffer, read_float_texture, submit_and_wait, write_texture_level};
+use crate::gpu::{Gpu, read_buffer, read_resource_texture, submit_and_wait, write_texture_level};
 use crate::graph::{Graph, Plan, plan, texel_bytes};
 use crate::model::{ParamValue, ParamValues};
 use crate::render::{ProbeMap, Renderer, probe};
@@ -125,7 +125,11 @@ impl Ran {
             .textures
             .get(name)
             .ok_or_else(|| Error::Invalid(format!("the plan has no resource `{name}`")))?;
-        let (channels, data) = read_float_texture(&gpu.device, &gpu.queue, t, level)?;
+        let format = self
+            .plan
+            .resource(name)
+            .map_or(t.format(), |r| r.resource.format);
+        let (channels, data) = read_resource_texture(&gpu.device, &gpu.queue, t, level, format)?;
         let (w, h) = ((t.width() >> level).max(1), (t.height() >> level).max(1));
         Ok(Texels::from_f32(w as usize, h as usize, channels, &data))
     }

@@ -9,7 +9,7 @@ use crate::kernels::KernelId;
 use crate::model::{ParamValue, ParamValues, Technique};
 use std::fmt::Write;
 
-use super::nodes::{LightNodes, map_type, moments_format};
+use super::nodes::{LightNodes, float_moments_format, map_type};
 use super::shade::{ShadeInput, VisibilityBody, sat_sample};
 use crate::filter::BlurMode;
 use crate::gpu_data::{CSM_OUTPUTS, CsmParams, LightGpu};
@@ -136,11 +136,17 @@ pub(super) fn csm_nodes(n: &mut LightNodes, storage: Storage, terms: u32, z: boo
     let maps: Vec<(String, wgpu::TextureFormat)> = (0..csm_maps(terms))
         .map(|chunk| {
             let pairs = (terms - 2 * chunk).min(2);
-            (format!("csm{chunk}"), moments_format(storage, 2 * pairs))
+            (
+                format!("csm{chunk}"),
+                float_moments_format(storage, 2 * pairs),
+            )
         })
         .chain((0..z_maps).map(|chunk| {
             let channels = (z_channels - 4 * chunk).min(4);
-            (format!("csm_z{chunk}"), moments_format(storage, channels))
+            (
+                format!("csm_z{chunk}"),
+                float_moments_format(storage, channels),
+            )
         }))
         .collect();
     let mut out = Vec::new();

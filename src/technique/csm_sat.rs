@@ -4,7 +4,7 @@
 //! on the fly, one layer a map of the light's sequence (`kernels/shared/csm_basis.wgsl`).
 
 use super::csm::{csm_maps, csm_z_channels, csm_z_maps};
-use super::nodes::{LightNodes, moments_format};
+use super::nodes::{LightNodes, float_moments_format};
 use crate::gpu_data::LinearizeParams;
 use crate::graph::{Graph, SizeRule};
 use crate::kernels::KernelId;
@@ -59,7 +59,7 @@ fn basis_maps(graph: &mut Graph, light: usize, depth: &str, b: &CsmBasis) -> Vec
                 of: depth.to_string(),
                 shift: 0,
             };
-            let format = moments_format(b.storage, channels);
+            let format = float_moments_format(b.storage, channels);
             let map = graph.resource(format!("light{light}.{name}"), format, size, Some(light));
             (map, channels)
         })

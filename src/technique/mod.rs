@@ -41,7 +41,10 @@ use light_gpu::unit_range;
 pub use light_gpu::{sat_coding, sat_variant, soft_lookup_area, soft_max_width, soft_width_cap};
 pub use msm::msm_quantized;
 pub use nodes::LightNodes;
-pub use nodes::{add_light_nodes, depth_name, linear_name, map_channels, map_type, moments_format};
+pub use nodes::{
+    PACKED_MAP_TYPE, add_light_nodes, depth_name, float_moments_format, linear_name, map_channels,
+    map_type, maps_packed, moments_format,
+};
 pub use params::{Clamp, ClampReason, sat_exponent_limit};
 pub use reference::parameters_markdown;
 pub use second_depth::{peels, second_depth_name};

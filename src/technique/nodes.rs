@@ -40,10 +40,20 @@ pub struct LightNodes<'a> {
 
 impl LightNodes<'_> {
     /// The shading reads `resource` alone, of the light's map type ([`map_type`]).
+    /// A map of packed f16 pairs ([`crate::graph::PACKED_F16X2`]) is bound as
+    /// [`PACKED_MAP_TYPE`].
     pub fn one(&self, resource: String) -> ShadeInput {
+        let packed = self
+            .graph
+            .find(&resource)
+            .is_some_and(|r| crate::graph::is_packed(r.format));
         ShadeInput {
             maps: vec![resource],
-            wgsl_type: map_type(self.light),
+            wgsl_type: if packed {
+                PACKED_MAP_TYPE
+            } else {
+                map_type(self.light)
+            },
         }
     }
 
@@ -203,8 +213,25 @@ pub fn map_channels(light: &Light) -> Vec<usize> {
         .collect()
 }
 
+/// The WGSL type of a map of packed f16 pairs ([`crate::graph::PACKED_F16X2`]), read through
+/// `sample_map_packed` (`kernels/shared/sampling_packed.wgsl`).
+pub const PACKED_MAP_TYPE: &str = "texture_2d<u32>";
+
+/// Whether the shading reads `light`'s maps as packed f16 pairs ([`PACKED_MAP_TYPE`]): f16
+/// storage of a two-moment representation that is not summed into a table.
+pub fn maps_packed(light: &Light) -> bool {
+    let mut graph = Graph::default();
+    let input = add_light_nodes(&mut graph, 0, light);
+    input
+        .maps
+        .first()
+        .and_then(|m| graph.find(m))
+        .is_some_and(|r| crate::graph::is_packed(r.format))
+}
+
 /// The WGSL type of a prefiltered technique's maps: `texture_2d<u32>` for a fixed-point
-/// summed-area table, else `texture_2d<f32>`.
+/// summed-area table, else `texture_2d<f32>` (a map of packed f16 pairs is bound as
+/// [`PACKED_MAP_TYPE`] instead: [`LightNodes::one`]).
 pub fn map_type(light: &Light) -> &'static str {
     match sat_variant(light) {
         Some(SatVariant::Fixed) => "texture_2d<u32>",
@@ -223,13 +250,24 @@ pub fn fused_blur(kernel: KernelId) -> Option<KernelId> {
     }
 }
 
-/// The texel format of a `channels`-channel representation (1–4) at `storage` precision.
+/// The texel format of a `channels`-channel representation (1–4) at `storage` precision: two
+/// f16 channels in 4 bytes ([`crate::graph::PACKED_F16X2`]: `rg16float` is no core storage
+/// format, so an `r32uint` word each), more in `rgba16float`.
 pub fn moments_format(storage: Storage, channels: u32) -> wgpu::TextureFormat {
+    match (storage, channels) {
+        (Storage::F16, 1 | 2) => crate::graph::PACKED_F16X2,
+        _ => float_moments_format(storage, channels),
+    }
+}
+
+/// [`moments_format`] in a float texture format (f16 in `rgba16float` whatever the channels):
+/// for CSM, whose light binds every basis map as one WGSL type although its last map may hold
+/// one pair of terms.
+pub fn float_moments_format(storage: Storage, channels: u32) -> wgpu::TextureFormat {
     match (storage, channels) {
         (Storage::F32, 1) => wgpu::TextureFormat::R32Float,
         (Storage::F32, 2) => wgpu::TextureFormat::Rg32Float,
         (Storage::F32, _) => wgpu::TextureFormat::Rgba32Float,
-        // rg16float is no core storage format; rgba16float is.
         (Storage::F16, _) => wgpu::TextureFormat::Rgba16Float,
         (Storage::Unorm16, _) => wgpu::TextureFormat::Rgba16Unorm,
     }

@@ -79,7 +79,8 @@ pub(super) fn sat_sample(variant: SatVariant, map: &str, width: &str) -> String 
 }
 
 /// A prefiltered technique's visibility: through the `sat` filter, `of(mean, l, s)` of the
-/// map's rectangle mean (and the table lookups' module); else `plain(map, l, s)`.
+/// map's rectangle mean (and the table lookups' module); from packed f16 pairs
+/// `of(sample_map_packed(map, l, s), l, s)`; else `plain(map, l, s)`.
 pub(super) fn prefiltered(
     light: &Light,
     maps: &[String],
@@ -95,6 +96,13 @@ pub(super) fn prefiltered(
                 format!("return {of}({mean}, l, s);"),
             )
         }
+        _ if super::nodes::maps_packed(light) => VisibilityBody::simple(
+            vec![module, "shared/sampling_packed"],
+            format!(
+                "return {of}(sample_map_packed({}, l, s), l, s);",
+                first(maps)
+            ),
+        ),
         _ => call(module, plain, maps),
     }
 }

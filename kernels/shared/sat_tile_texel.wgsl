@@ -1,0 +1,40 @@
+// A tile pass's texel (import-only module of shared/sat_tile_sums and shared/sat_tile_scan,
+// apart from shared/sat_tile because it reads the importing kernel's `src` binding, which the
+// carries kernel, importing shared/sat_tile for `SatSource`, does not have). The importing
+// kernel declares `src: texture_2d<f32>`:
+// #completed-by-importer
+// #import shared/sat_tile
+// #import shared/csm_maps
+// #import shared/linear_depth
+
+// Non-finite depth texels this invocation's `sat_texel` replaced (CSM sources; the first
+// tile pass counts layer 0's).
+var<private> sat_non_finite: u32;
+
+// The encoded texel `q` of `src` (`size` its size) read as `s` says, 0 outside the map (the
+// load is clamped to the map and its value discarded, so no invocation branches).
+// `src` is the importing kernel's binding, read here and not passed down: the executor's
+// packed variant (src/exec/packed.rs) re-declares it `texture_2d<u32>` and unpacks this load
+// when the representation is f16 pairs in r32uint words, which a `texture_2d<f32>` parameter
+// would not let it do.
+fn sat_texel(
+    q: vec2<u32>,
+    size: vec2<u32>,
+    p: SatParams,
+    fs: bool,
+    s: SatSource,
+) -> vec4<u32> {
+    let inside = all(q < size);
+    var v = textureLoad(src, min(q, size - 1u), 0);
+    if s.csm {
+        let raw = v.r;
+        if inside && !depth_is_finite(raw) {
+            sat_non_finite += 1u;
+        }
+        v = csm_basis_map(s.layer, s.terms, linear_depth(raw, s.depth));
+        if s.f16 {
+            v = vec4<f32>(unpack2x16float(pack2x16float(v.xy)), unpack2x16float(pack2x16float(v.zw)));
+        }
+    }
+    return select(vec4<u32>(0u), sat_encode_as(v, p, fs), inside);
+}
