@@ -32,12 +32,13 @@ mod html;
 mod measure;
 mod output;
 mod stats;
+pub mod summary;
 mod svg;
 mod sweep;
 
 pub use flip::{Shader, flip_map, flip_stats, to_unorm8};
 pub use stats::{EDGE_BAND, ErrorStats, PENUMBRA_HIGH, PENUMBRA_LOW, Region, Regions};
-pub use svg::{Metric, front, pareto};
+pub use svg::{Metric, front, pareto, pareto_front};
 use sweep::storage_name;
 pub use sweep::{Config, FILTERS, FilterOfWidth, sweep};
 

@@ -81,10 +81,19 @@ pub fn colour(technique: &str) -> RGBColor {
 /// Indices of the rows on the Pareto front of (total time, `metric`), fastest first: a row
 /// is on it when no row is at most as slow and at most as wrong, and better in one.
 pub fn front(rows: &[Row], metric: Metric) -> Vec<usize> {
-    let mut timed: Vec<usize> = (0..rows.len())
-        .filter(|&i| rows[i].total_ms.is_some())
+    let points: Vec<(Option<f64>, f64)> =
+        rows.iter().map(|r| (r.total_ms, metric.value(r))).collect();
+    pareto_front(&points)
+}
+
+/// Indices of the points `(time, error)` on their Pareto front, fastest first (points without
+/// a time are left out): what [`front`] computes for a report's rows, and the README's summary
+/// for the committed reports' (`evaluate::summary`).
+pub fn pareto_front(points: &[(Option<f64>, f64)]) -> Vec<usize> {
+    let mut timed: Vec<usize> = (0..points.len())
+        .filter(|&i| points[i].0.is_some())
         .collect();
-    let key = |i: usize| (rows[i].total_ms.unwrap_or(0.0), metric.value(&rows[i]));
+    let key = |i: usize| (points[i].0.unwrap_or(0.0), points[i].1);
     timed.sort_by(|&a, &b| {
         key(a)
             .partial_cmp(&key(b))
@@ -93,8 +102,8 @@ pub fn front(rows: &[Row], metric: Metric) -> Vec<usize> {
     let mut out = Vec::new();
     let mut best = f64::INFINITY;
     for i in timed {
-        if metric.value(&rows[i]) < best {
-            best = metric.value(&rows[i]);
+        if points[i].1 < best {
+            best = points[i].1;
             out.push(i);
         }
     }

@@ -1,0 +1,16 @@
+//! Prints the README's table of Pareto fronts for the reports under a directory
+//! (`benches/evaluation` by default): per scene, the techniques on the front of total time
+//! against the penumbra error and against FLIP, fastest first.
+//!
+//!     cargo run --release --example fronts_table -- [DIR]
+
+fn main() -> anyhow::Result<()> {
+    let dir = std::env::args()
+        .nth(1)
+        .unwrap_or_else(|| "benches/evaluation".into());
+    print!(
+        "{}",
+        shadowgraph::evaluate::summary::fronts_table_of(std::path::Path::new(&dir))?
+    );
+    Ok(())
+}
