@@ -366,10 +366,15 @@ impl Checker<'_> {
             .max_by_key(|&(_, b)| b)
             .unwrap_or((0, 0));
         let (key, part) = if most >= m.frame {
-            let n = self.scene.lights.get(i).map_or(0, |l| l.shadow_map);
+            let maps = match self.scene.lights.get(i) {
+                Some(l) if l.kind == crate::model::LightKind::Point => {
+                    format!("six {}² faces", l.shadow_map)
+                }
+                l => format!("{}² maps", l.map_or(0, |l| l.shadow_map)),
+            };
             (
                 format!("light[{i}].shadow_map"),
-                format!("`light[{i}]`'s {n}² maps: {}", human_bytes(most)),
+                format!("`light[{i}]`'s {maps}: {}", human_bytes(most)),
             )
         } else {
             (
