@@ -127,6 +127,11 @@ pub const CASES: &[BenchCase] = &[
         name: "vsm+blur r4 (old)",
         build: |n| old_chain(n, vsm(), "light0.vsm"),
     },
+    // Two f16 moments packed in one r32uint word (4 B/texel): against the f32 rows above.
+    BenchCase {
+        name: "vsm_blur r4 f16 (packed)",
+        build: |n| chain_graph(n, vsm_f16(), &["light0.vsm.blur"]),
+    },
     BenchCase {
         name: "vsm_blur r32 (2 passes)",
         build: |n| chain_graph(n, vsm_blur(32.0), &["light0.vsm.blur"]),
@@ -247,6 +252,18 @@ fn vsm_blur(radius: f32) -> Technique {
         &[
             ("filter_radius", ParamValue::Float(radius)),
             ("filter_sigma", ParamValue::Float(radius / 2.0)),
+        ],
+    )
+}
+
+/// [`vsm`] with f16 moments (stored packed, two in a 32-bit word).
+fn vsm_f16() -> Technique {
+    named(
+        "vsm",
+        &[
+            ("filter_radius", ParamValue::Float(4.0)),
+            ("filter_sigma", ParamValue::Float(2.0)),
+            ("format", ParamValue::Choice("f16")),
         ],
     )
 }
@@ -501,9 +518,12 @@ pub fn measure(
                 repeat,
             )?;
             let output = built.outputs.first().and_then(|o| plan.resource(o));
-            let format = output.map(|r| r.resource.format).ok_or_else(|| {
-                Error::Invalid(format!("benchmark `{}` plans no output", case.name))
-            })?;
+            // The texture's own format (a packed f16 pair is an r32uint texture).
+            let format = output
+                .map(|r| crate::graph::texture_format(r.resource.format))
+                .ok_or_else(|| {
+                    Error::Invalid(format!("benchmark `{}` plans no output", case.name))
+                })?;
             let copy_gbps = copies.get(&format).copied().ok_or_else(|| {
                 Error::Invalid(format!(
                     "benchmark `{}` writes {}, which has no texture copy row (COPY_FORMATS)",
