@@ -5,7 +5,7 @@
 use std::fmt::Write;
 
 use crate::graph::Graph;
-use crate::model::{Filter, Light};
+use crate::model::{Filter, Light, LightKind};
 use crate::sat::SatVariant;
 
 use super::cascade_shade::{CASCADE_MODULE, CascadeGroup, cascade_functions};
@@ -140,9 +140,14 @@ pub fn shade_key(lights: &[Light]) -> String {
             matches!(t.filter(), Some(Filter::Mips { max_anisotropy, .. }) if max_anisotropy > 0);
         let def = super::of(t);
         let input = add_light_nodes(&mut Graph::default(), i, light);
+        let point = if light.kind == LightKind::Point {
+            " point"
+        } else {
+            ""
+        };
         let _ = write!(
             key,
-            "|{} {table} {} {} {}x{}",
+            "|{}{point} {table} {} {} {}x{}",
             def.name,
             u8::from(footprint),
             (def.variant)(t),
@@ -239,10 +244,16 @@ pub(super) fn light_case(i: usize, light: &Light) -> String {
         }
         _ => "",
     };
+    // The projection of the light's kind, chosen here rather than branched on per pixel.
+    let sample = if light.kind == LightKind::Point {
+        "point_sample"
+    } else {
+        "map_sample"
+    };
     format!(
         "\n            let l = lights[{i}];\n            \
          if !light_faces(l, p, n) {{\n                return 0.0;\n            }}\n            \
-         var s = light_sample(l, p, n);\n            \
+         var s = {sample}(l, p, n);\n            \
          if !s.inside {{\n                return 1.0;\n            }}{footprint}\n            \
          return light{i}_visibility(l, s);"
     )
