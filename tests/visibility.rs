@@ -286,6 +286,67 @@ fn receiver_plane_slope_is_the_planes_depth() {
     }
 }
 
+/// [`receiver_plane_slope_is_the_planes_depth`] for a point light: the slope in the view of
+/// the face that sees the receiver (first order, as the spot light's), for 2000 receivers
+/// around the light with random normals facing it; moves that cross into another face are
+/// not compared.
+#[test]
+fn receiver_plane_slope_is_the_planes_depth_on_every_face() {
+    let mut rng = common::rng(51);
+    let mut l = light(LightKind::Point, Technique::Hard);
+    (l.shadow.normal_bias, l.shadow.receiver_plane) = (0.0, 0.02);
+    let g = LightGpu::new(&l);
+    let (size, centre) = (g.map_size, l.position.as_dvec3());
+    let mut faces = [0usize; 6];
+    for _ in 0..2000 {
+        let dir = glam::DVec3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        );
+        if dir.length() < 0.1 {
+            continue;
+        }
+        let p = centre + dir.normalize() * rng.random_range(2.0..8.0);
+        let to_light = (centre - p).normalize();
+        let n = (to_light
+            + 0.7
+                * glam::DVec3::new(
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-1.0..1.0),
+                ))
+        .normalize();
+        if n.dot(to_light) < 0.2 {
+            continue;
+        }
+        let s = cpu::light::sample(&g, p, n);
+        let tile = |uv: [f64; 2]| ((uv[0] * 3.0).floor(), (uv[1] * 2.0).floor());
+        let texel = f64::from(g.width_at_unit) * s.view_z / MAP as f64;
+        let along = n.any_orthonormal_pair();
+        let (a, b) = (rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+        let q = p + (along.0 * a + along.1 * b) * (3.0 * texel * 1e-3);
+        let t = cpu::light::sample(&g, q, n);
+        if tile(s.uv) != tile(t.uv) {
+            continue;
+        }
+        let (fx, fy) = tile(s.uv);
+        faces[(fy * 3.0 + fx) as usize] += 1;
+        let moved = [
+            (t.uv[0] - s.uv[0]) * f64::from(size[0]),
+            (t.uv[1] - s.uv[1]) * f64::from(size[1]),
+        ];
+        let predicted = s.depth_slope[0] * moved[0] + s.depth_slope[1] * moved[1];
+        let actual = t.depth - s.depth;
+        assert!(
+            (predicted - actual).abs() <= 1e-3 * actual.abs() + 1e-9,
+            "point, face tile {:?}: predicted {predicted}, actual {actual}",
+            tile(s.uv)
+        );
+    }
+    assert!(faces.iter().all(|&n| n > 100), "faces compared: {faces:?}");
+}
+
 #[test]
 fn pcss_matches_reference() {
     let t = Technique::Pcss {

@@ -199,6 +199,12 @@ fn point_sample(l: Light, p: vec3<f32>, n: vec3<f32>) -> LightSample {
     s.inside = c.z > 0.0 && s.depth >= 0.0 && s.depth <= 1.0;
     s.footprint = vec4<f32>(0.0);
     s.depth_slope = vec2<f32>(0.0);
+    if l.receiver_plane > 0.0 {
+        // The face's view space: point_coords gives (x, y, distance) and looks down −z.
+        let nf = point_coords(n, f);
+        let v = vec3<f32>(c.x, c.y, -c.z);
+        s.depth_slope = light_depth_slope_view(l, v, vec3<f32>(nf.x, nf.y, -nf.z), c.z, true);
+    }
     return s;
 }
 
@@ -211,8 +217,14 @@ fn point_sample(l: Light, p: vec3<f32>, n: vec3<f32>) -> LightSample {
 fn light_depth_slope(l: Light, q: vec3<f32>, n: vec3<f32>, z: f32) -> vec2<f32> {
     let v = (l.view * vec4<f32>(q, 1.0)).xyz;
     let nv = (l.view * vec4<f32>(n, 0.0)).xyz;
+    return light_depth_slope_view(l, v, nv, z, l.kind != 0u);
+}
+
+// light_depth_slope of the receiver at v with normal nv, both in the view the map was drawn
+// from (a point light's: its face's), perspective or orthographic.
+fn light_depth_slope_view(l: Light, v: vec3<f32>, nv: vec3<f32>, z: f32, perspective: bool) -> vec2<f32> {
     var per_world: vec2<f32>;
-    if l.kind == 0u {
+    if !perspective {
         per_world = vec2<f32>(nv.x, -nv.y) / nv.z;
     } else {
         per_world = vec2<f32>(-nv.x, nv.y) * (z * z / dot(nv, v));

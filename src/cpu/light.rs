@@ -110,6 +110,12 @@ pub fn point_sample(l: &LightGpu, p: DVec3, n: DVec3) -> LightSample {
     let tile = [0.5 + 0.5 * v.x / t, 0.5 - 0.5 * v.y / t];
     let (col, row) = (f64::from(f % point::COLUMNS), f64::from(f / point::COLUMNS));
     let depth = (view_z - near) / (far - near);
+    let depth_slope = if l.receiver_plane > 0.0 {
+        let nv = (view * n.extend(0.0)).truncate();
+        depth_slope_view(l, v, nv, view_z, true)
+    } else {
+        [0.0; 2]
+    };
     LightSample {
         uv: [
             (col + tile[0]) * f64::from(l.face_uv[0]),
@@ -119,7 +125,7 @@ pub fn point_sample(l: &LightGpu, p: DVec3, n: DVec3) -> LightSample {
         view_z,
         inside: view_z > 0.0 && (0.0..=1.0).contains(&depth),
         footprint: [0.0; 4],
-        depth_slope: [0.0; 2],
+        depth_slope,
     }
 }
 
@@ -129,7 +135,13 @@ pub fn depth_slope(l: &LightGpu, q: DVec3, n: DVec3, z: f64) -> [f64; 2] {
     let view = mat(&l.view);
     let v = (view * q.extend(1.0)).truncate();
     let nv = (view * n.extend(0.0)).truncate();
-    let per_world = if l.kind == 0 {
+    depth_slope_view(l, v, nv, z, l.kind != 0)
+}
+
+/// `light_depth_slope_view`: [`depth_slope`] of the receiver at `v` with normal `nv` in the
+/// view its map was drawn from (a point light's face's).
+pub fn depth_slope_view(l: &LightGpu, v: DVec3, nv: DVec3, z: f64, perspective: bool) -> [f64; 2] {
+    let per_world = if !perspective {
         [nv.x / nv.z, -nv.y / nv.z]
     } else {
         let k = z * z / nv.dot(v);

@@ -261,8 +261,8 @@ fn light(ctx: &Ctx, i: usize, l: &LightFile) -> Result<Light> {
     })
 }
 
-/// What a point light's six faces refuse: cascades, the receiver-plane bias (its plane is
-/// written for one view) and techniques whose reach no guard band bounds
+/// What a point light's six faces refuse: cascades and techniques whose reach no guard band
+/// bounds
 /// (`model::point::reach`), each naming its key and line.
 fn point_support(ctx: &Ctx, i: usize, l: &LightFile, shadow: &Shadow, face: u32) -> Result<()> {
     let key = |k: &str| format!("light[{i}].{k}");
@@ -275,16 +275,6 @@ fn point_support(ctx: &Ctx, i: usize, l: &LightFile, shadow: &Shadow, face: u32)
                 "`{}` = {} needs a directional light: a point light's six faces cover every direction",
                 key("shadow.cascades"),
                 shadow.cascades.count
-            ),
-        ));
-    }
-    if shadow.receiver_plane > 0.0 {
-        let span = file.and_then(|s| s.bias_mode.as_ref()).map(|v| v.span());
-        return Err(ctx.err(
-            span,
-            format!(
-                "`{}` = \"receiver_plane\" is not supported on point lights (the plane is derived for one view, not six faces): use the constant, slope or normal bias",
-                key("shadow.bias_mode")
             ),
         ));
     }
