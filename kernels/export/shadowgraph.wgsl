@@ -65,21 +65,22 @@
 //   sg_cascade_far_of sg_cascade_pick sg_chebyshev_upper sg_csm_chunk sg_csm_chunk_of
 //   sg_csm_resolve sg_csm_sin_cos sg_csm_weight sg_csm_z_chunk_of sg_cssm_blocker
 //   sg_cssm_resolve sg_cssm_sharpen sg_level_size sg_level_size_of sg_light_depth_slope
-//   sg_light_faces sg_light_footprint sg_light_linear_to_ndc sg_light_linear_to_z
-//   sg_light_map_width sg_light_receiver_offset sg_light_sample sg_light_tap_offset
-//   sg_light_texel sg_light_to_light sg_linstep sg_load_depth sg_map_sample sg_mip_tap_uv
-//   sg_mip_taps sg_msm_biased sg_msm_dequantize sg_msm_expect sg_msm_intensity sg_msm_moments
-//   sg_msm_quantize sg_msm_roots sg_msm_soft_blocker sg_pack_f16x2 sg_pcss_search_radius
-//   sg_point_coords sg_point_face sg_point_sample sg_sample_bilinear sg_sample_bilinear_log
-//   sg_sample_map sg_sample_map_log sg_sample_map_packed sg_sat_box sg_sat_box_fixed
-//   sg_sat_box_float sg_sat_clamp sg_sat_mean_fixed sg_sat_mean_float sg_sat_node_f32
-//   sg_sat_node_u32 sg_sat_nodes sg_sat_rect sg_sat_sample_fixed sg_sat_sample_float
-//   sg_sat_search_fixed sg_sat_search_float sg_sat_span_weights sg_smrt_emitter_point
-//   sg_smrt_ray sg_soft_blockers sg_soft_filter_trips sg_texel_of sg_trilinear sg_trilinear_log
-//   sg_trilinear_packed sg_unpack_f16x2 sg_vis_esm sg_vis_esm_of_log sg_vis_esm_of_sat
-//   sg_vis_evsm sg_vis_evsm_of sg_vis_hard sg_vis_msm sg_vis_msm_of sg_vis_msm_soft_fixed
-//   sg_vis_msm_soft_float sg_vis_pcf sg_vis_pcf_hardware sg_vis_pcss sg_vis_smrt sg_vis_vsm
-//   sg_vis_vsm_of sg_vis_vssm_fixed sg_vis_vssm_float sg_vogel_disc sg_vssm_blocker
+//   sg_light_depth_slope_view sg_light_faces sg_light_footprint sg_light_linear_to_ndc
+//   sg_light_linear_to_z sg_light_map_width sg_light_receiver_offset sg_light_sample
+//   sg_light_tap_offset sg_light_texel sg_light_to_light sg_linstep sg_load_depth sg_map_sample
+//   sg_mip_tap_uv sg_mip_taps sg_msm_biased sg_msm_dequantize sg_msm_expect sg_msm_intensity
+//   sg_msm_moments sg_msm_quantize sg_msm_roots sg_msm_soft_blocker sg_pack_f16x2
+//   sg_pcss_search_radius sg_point_coords sg_point_face sg_point_sample sg_sample_bilinear
+//   sg_sample_bilinear_log sg_sample_map sg_sample_map_log sg_sample_map_packed sg_sat_box
+//   sg_sat_box_fixed sg_sat_box_float sg_sat_clamp sg_sat_mean_fixed sg_sat_mean_float
+//   sg_sat_node_f32 sg_sat_node_u32 sg_sat_nodes sg_sat_rect sg_sat_sample_fixed
+//   sg_sat_sample_float sg_sat_search_fixed sg_sat_search_float sg_sat_span_weights
+//   sg_smrt_emitter_point sg_smrt_ray sg_soft_blockers sg_soft_filter_trips sg_texel_of
+//   sg_trilinear sg_trilinear_log sg_trilinear_packed sg_unpack_f16x2 sg_vis_esm
+//   sg_vis_esm_of_log sg_vis_esm_of_sat sg_vis_evsm sg_vis_evsm_of sg_vis_hard sg_vis_msm
+//   sg_vis_msm_of sg_vis_msm_soft_fixed sg_vis_msm_soft_float sg_vis_pcf sg_vis_pcf_hardware
+//   sg_vis_pcss sg_vis_smrt sg_vis_vsm sg_vis_vsm_of sg_vis_vssm_fixed sg_vis_vssm_float
+//   sg_vogel_disc sg_vssm_blocker
 
 // Shared light description and light-space helpers (import-only module).
 //
@@ -282,6 +283,12 @@ fn sg_point_sample(l: sg_Light, p: vec3<f32>, n: vec3<f32>) -> sg_LightSample {
     s.inside = c.z > 0.0 && s.depth >= 0.0 && s.depth <= 1.0;
     s.footprint = vec4<f32>(0.0);
     s.depth_slope = vec2<f32>(0.0);
+    if l.receiver_plane > 0.0 {
+        // The face's view space: point_coords gives (x, y, distance) and looks down −z.
+        let nf = sg_point_coords(n, f);
+        let v = vec3<f32>(c.x, c.y, -c.z);
+        s.depth_slope = sg_light_depth_slope_view(l, v, vec3<f32>(nf.x, nf.y, -nf.z), c.z, true);
+    }
     return s;
 }
 
@@ -294,8 +301,14 @@ fn sg_point_sample(l: sg_Light, p: vec3<f32>, n: vec3<f32>) -> sg_LightSample {
 fn sg_light_depth_slope(l: sg_Light, q: vec3<f32>, n: vec3<f32>, z: f32) -> vec2<f32> {
     let v = (l.view * vec4<f32>(q, 1.0)).xyz;
     let nv = (l.view * vec4<f32>(n, 0.0)).xyz;
+    return sg_light_depth_slope_view(l, v, nv, z, l.kind != 0u);
+}
+
+// light_depth_slope of the receiver at v with normal nv, both in the view the map was drawn
+// from (a point light's: its face's), perspective or orthographic.
+fn sg_light_depth_slope_view(l: sg_Light, v: vec3<f32>, nv: vec3<f32>, z: f32, perspective: bool) -> vec2<f32> {
     var per_world: vec2<f32>;
-    if l.kind == 0u {
+    if !perspective {
         per_world = vec2<f32>(nv.x, -nv.y) / nv.z;
     } else {
         per_world = vec2<f32>(-nv.x, nv.y) * (z * z / dot(nv, v));
