@@ -286,7 +286,7 @@ fn a_point_lights_atlas_is_planned_like_one_map() {
     let text =
         shadowgraph::cli::plan(&scene_path("techniques/point_vsm.toml"), false).expect("plan");
     for needle in [
-        "light 0: point, vsm shadows, six 512² faces",
+        "light 0: point, vsm shadows, six 512² faces, guard band 5 texels (90° cores of 502²)",
         "light0.depth             Depth32Float    1536x1024",
         "traffic per texel of the 1536×1024 map:",
         "total: 1 dispatch, 17.00 B/texel",

@@ -509,7 +509,15 @@ impl Light {
             LightKind::Point => "point",
         };
         let map = match self.kind {
-            LightKind::Point => format!("six {}² faces", self.shadow_map),
+            LightKind::Point => match self.point_layout() {
+                Ok(l) => format!(
+                    "six {}² faces, guard band {} texels (90° cores of {}²)",
+                    l.face,
+                    l.guard,
+                    l.face - 2 * l.guard
+                ),
+                Err(_) => format!("six {}² faces", self.shadow_map),
+            },
             _ => format!("{}² map", self.shadow_map),
         };
         format!("{kind}, {} shadows, {map}", self.shadow.technique.name())
