@@ -241,11 +241,6 @@ impl Prefilter {
             .into());
         }
         let size = check_depth(depth, light)?;
-        if light.point {
-            // The faces' guard band is the technique's reach: refuse what six faces cannot
-            // bound before planning.
-            self.point_layout(size)?;
-        }
         let key = PlanKey::new(light, size);
         self.replan(device, slot, key, light)?;
         let config = &self.config;
@@ -370,6 +365,11 @@ impl Prefilter {
         let current = self.lights[slot].as_ref().map(|l| l.planned.key);
         if current == Some(key) {
             return Ok(());
+        }
+        if light.point {
+            // The faces' guard band is the technique's reach: refuse what six faces cannot
+            // bound before planning.
+            self.point_layout(key.size)?;
         }
         let planned = plan_for(&self.config, light, key.size)?;
         let resized = current.is_none_or(|k| k.size != key.size);

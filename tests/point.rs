@@ -198,16 +198,13 @@ fn shadows_across_face_edges_match_the_ray_cast() {
 }
 
 fn vsm_blur(radius: f32) -> Technique {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/techniques/point_vsm.toml");
-    let mut t = Scene::load(&path).expect("point_vsm.toml").lights[0]
-        .shadow
-        .technique;
-    if let Technique::Vsm { prefilter, .. } = &mut t {
-        prefilter.filter = Filter::Blur {
-            radius,
-            sigma: 0.5 * radius,
-            kernel: shadowgraph::scene::BlurKernel::Gaussian,
-        };
-    }
-    t
+    use shadowgraph::model::ParamValue;
+    shadowgraph::technique::named(
+        "vsm",
+        &[
+            ("filter_radius", ParamValue::Float(radius)),
+            ("filter_sigma", ParamValue::Float(0.5 * radius)),
+        ],
+    )
+    .expect("vsm with a blur")
 }

@@ -196,19 +196,12 @@ fn pixel_reference(
 /// the two lookups differ by resampling, not by a seam; tests/point.rs checks those receivers
 /// against the ray cast.
 fn point_face_tie(lg: &shadowgraph::technique::LightGpu, p: glam::DVec3, n: glam::DVec3) -> bool {
-    // The moved receiver, as `cpu::light::point_sample` moves it.
     let pos = glam::DVec3::new(
         lg.position[0].into(),
         lg.position[1].into(),
         lg.position[2].into(),
     );
-    let z0 = (p - pos).abs().max_element();
-    let ndl = n.dot(cpu::light::to_light(lg, p)).clamp(0.0, 1.0);
-    let q = p + n
-        * (f64::from(lg.normal_bias)
-            * cpu::light::texel(lg, z0.max(f64::from(lg.near)))
-            * (1.0 - ndl));
-    let mut a = (q - pos).abs().to_array();
+    let mut a = (cpu::light::point_moved(lg, p, n) - pos).abs().to_array();
     a.sort_by(f64::total_cmp);
     a[2] - a[1] < 1e-5 * a[2]
 }

@@ -98,9 +98,7 @@ pub fn sample(l: &LightGpu, p: DVec3, n: DVec3) -> LightSample {
 pub fn point_sample(l: &LightGpu, p: DVec3, n: DVec3) -> LightSample {
     let position = v3(l.position);
     let (near, far) = (f64::from(l.near), f64::from(l.far));
-    let z0 = (p - position).abs().max_element();
-    let ndl = n.dot(to_light(l, p)).clamp(0.0, 1.0);
-    let q = p + n * (f64::from(l.normal_bias) * texel(l, z0.max(near)) * (1.0 - ndl));
+    let q = point_moved(l, p, n);
     let f = point::face_of(q - position);
     let (forward, up) = point::face_axes(f);
     let view = DMat4::look_at_rh(position, position + forward.as_dvec3(), up.as_dvec3());
@@ -127,6 +125,15 @@ pub fn point_sample(l: &LightGpu, p: DVec3, n: DVec3) -> LightSample {
         footprint: [0.0; 4],
         depth_slope,
     }
+}
+
+/// A point light's receiver `p` moved along `n` by the normal offset at the texel size of the
+/// face that sees `p`: the point `point_sample` projects (its face is the major axis of the
+/// result's direction from the light).
+pub fn point_moved(l: &LightGpu, p: DVec3, n: DVec3) -> DVec3 {
+    let z0 = (p - v3(l.position)).abs().max_element();
+    let ndl = n.dot(to_light(l, p)).clamp(0.0, 1.0);
+    p + n * (f64::from(l.normal_bias) * texel(l, z0.max(f64::from(l.near))) * (1.0 - ndl))
 }
 
 /// `light_depth_slope`: the depth of the plane through `q` with normal `n` per texel of offset

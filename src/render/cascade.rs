@@ -84,7 +84,6 @@ pub fn drawn_lights(scene: &Scene) -> Result<DrawnLights> {
     let mut groups = Vec::new();
     let visible = lights.len();
     for (i, light) in scene.lights.iter().enumerate() {
-        super::check_point(i, light)?;
         let c = light.shadow.cascades;
         if c.count <= 1 || !matches!(light.kind, LightKind::Directional { .. }) {
             continue;

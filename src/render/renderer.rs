@@ -272,7 +272,6 @@ impl Renderer {
     ) -> Result<Outputs> {
         for (l, t) in lights.iter().zip(&targets.lights) {
             let (pipeline, _) = self.shadow_pipeline(device, l.shadow.slope_bias)?;
-            let viewports: Vec<[u32; 4]> = l.raster_views().iter().map(|(_, v)| *v).collect();
             raster_pass(
                 enc,
                 &t.label,
@@ -281,7 +280,7 @@ impl Renderer {
                 &t.view,
                 &targets.vertices,
                 targets.vertex_count,
-                &viewports,
+                &t.viewports,
                 timer.as_deref_mut(),
             );
             if let Some(peel) = &t.peel {
@@ -294,7 +293,7 @@ impl Renderer {
                     &peel.view,
                     &targets.vertices,
                     targets.vertex_count,
-                    &viewports,
+                    &t.viewports,
                     timer.as_deref_mut(),
                 );
             }

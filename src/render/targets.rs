@@ -71,6 +71,9 @@ pub(super) struct LightTarget {
     pub view_proj: wgpu::Buffer,
     /// Binds `view_proj` for the light's raster pipeline.
     pub bind_group: wgpu::BindGroup,
+    /// Each view's viewport in the map, draw `k` with matrix `k` of `view_proj`: the whole map,
+    /// or a point light's six faces (set with the matrices by [`Targets::upload`]).
+    pub viewports: Vec<[u32; 4]>,
     /// Its peel pass, where its technique reads a second depth.
     pub peel: Option<PeelTarget>,
 }
@@ -296,6 +299,7 @@ impl Targets {
                 view: created::view(&depth, &Default::default()),
                 bind_group: uniform_group(device, "shadowgraph.shadow_depth", layout, &view_proj),
                 view_proj,
+                viewports: Vec::new(),
                 peel,
             });
         }
@@ -388,9 +392,11 @@ impl Targets {
             .view_proj(scene.width as f32 / scene.height as f32)
             .to_cols_array();
         queue.write_buffer(&self.camera, 0, bytemuck::cast_slice(&camera));
-        for (t, l) in self.lights.iter().zip(&drawn.lights) {
-            let vp: Vec<f32> = l.raster_views().iter().flat_map(|(m, _)| *m).collect();
+        for (t, l) in self.lights.iter_mut().zip(&drawn.lights) {
+            let views = l.raster_views();
+            let vp: Vec<f32> = views.iter().flat_map(|(m, _)| *m).collect();
             queue.write_buffer(&t.view_proj, 0, bytemuck::cast_slice(&vp));
+            t.viewports = views.iter().map(|(_, v)| *v).collect();
         }
     }
 
