@@ -85,7 +85,8 @@ enum Command {
         #[arg(long, value_parser = clap::value_parser!(u32).range(16..=32768))]
         map: Option<u32>,
         /// Time only the kernels whose name contains one of these (e.g. `sat,mips`); the
-        /// texture copies, their yardsticks, always run.
+        /// texture copies, their yardsticks, always run. With `--lookup`: only these soft
+        /// configurations (e.g. `cssm`), and PCSS 16+32, their yardstick.
         #[arg(long, value_delimiter = ',')]
         only: Vec<String>,
     },
@@ -245,8 +246,14 @@ fn run(args: Args) -> Result<()> {
                             &rows
                         )
                     );
-                    let soft =
-                        shadowgraph::bench::soft_cost(&gpu, &light_sizes, repeat, image, map)?;
+                    let soft = shadowgraph::bench::soft_cost(
+                        &gpu,
+                        &light_sizes,
+                        repeat,
+                        image,
+                        map,
+                        &only,
+                    )?;
                     print!(
                         "\n{}",
                         shadowgraph::bench::format_soft_table(

@@ -93,7 +93,7 @@ fn bad_scene_path_is_an_error_naming_the_file() {
 #[test]
 fn soft_benchmark_reports_every_configuration() {
     let g = common::gpu();
-    let rows = shadowgraph::bench::soft_cost(&g, &[0.5, 1.0], 1, Some((48, 36)), Some(128))
+    let rows = shadowgraph::bench::soft_cost(&g, &[0.5, 1.0], 1, Some((48, 36)), Some(128), &[])
         .expect("soft bench");
     let names: Vec<&str> = rows.iter().map(|r| r.technique.as_str()).collect();
     let want: Vec<&str> = shadowgraph::bench::SOFT_TECHNIQUES
@@ -130,6 +130,15 @@ fn soft_benchmark_reports_every_configuration() {
         table.contains("prefilter ms") && table.contains("wall ms"),
         "{table}"
     );
+    // `--only` keeps the named configurations and the yardstick, whose ratios stay 1.
+    let only = ["cssm".to_string()];
+    let some = shadowgraph::bench::soft_cost(&g, &[0.5], 1, Some((48, 36)), Some(128), &only)
+        .expect("soft bench, only cssm");
+    let names: Vec<&str> = some.iter().map(|r| r.technique.as_str()).collect();
+    assert_eq!(names, ["pcss 16+32", "cssm M=8"]);
+    let table = shadowgraph::bench::format_soft_table("test", true, 1, &[0.5], &some);
+    let pcss = table.lines().find(|l| l.starts_with("pcss 16+32")).unwrap();
+    assert!(pcss.contains("( 1.00)"), "{table}");
 }
 
 /// `bench --lookup`: one row per width with positive, finite times for the three lookups;

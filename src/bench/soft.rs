@@ -108,13 +108,15 @@ fn shading_fetches(scene: &Scene) -> Result<f64> {
 /// configuration alike while each timed frame follows frames of its own configuration.
 ///
 /// `image` shades at that size instead of the scene's 200×150, and `map` renders the light's
-/// shadow map at that size instead of the scene's 512².
+/// shadow map at that size instead of the scene's 512². A non-empty `only` keeps the
+/// configurations whose name contains one of its strings, and the yardstick.
 pub fn soft_cost(
     gpu: &Gpu,
     sizes: &[f32],
     repeat: u32,
     image: Option<(u32, u32)>,
     map: Option<u32>,
+    only: &[String],
 ) -> Result<Vec<SoftRow>> {
     if sizes.is_empty() || repeat == 0 {
         return Err(Error::Invalid(
@@ -133,8 +135,16 @@ pub fn soft_cost(
                 .to_string(),
         ));
     }
+    let picked: Vec<&(&str, &str)> = SOFT_TECHNIQUES
+        .iter()
+        .enumerate()
+        .filter(|(k, (name, _))| {
+            *k == YARDSTICK || only.is_empty() || only.iter().any(|o| name.contains(o.as_str()))
+        })
+        .map(|(_, t)| t)
+        .collect();
     let mut scenes = Vec::new();
-    for (_, shadow) in SOFT_TECHNIQUES {
+    for (_, shadow) in &picked {
         let mut base = scene_with(shadow)?;
         if let Some((w, h)) = image {
             (base.width, base.height) = (w, h);
@@ -185,7 +195,7 @@ pub fn soft_cost(
         }
     }
     let mut rows = Vec::new();
-    for (k, (name, _)) in SOFT_TECHNIQUES.iter().enumerate() {
+    for (k, (name, _)) in picked.iter().enumerate() {
         let at = k * sizes.len();
         rows.push(SoftRow {
             technique: name.to_string(),
@@ -242,7 +252,9 @@ pub fn format_soft_table(
         "  {:>13}  {:>9}  {:>9}",
         "prefilter ms", "frame ms", "wall ms"
     );
-    let yardstick = rows.get(YARDSTICK);
+    let yardstick = rows
+        .iter()
+        .find(|r| r.technique == SOFT_TECHNIQUES[YARDSTICK].0);
     for r in rows {
         let _ = write!(s, "{:<11} {:>10}", r.technique, r.fetches);
         for (i, ms) in r.shade_ms.iter().enumerate() {
