@@ -531,6 +531,7 @@ pub fn measure(
                 r.ratio = r.gbps / buffer_gbps;
                 r.yardstick = "copy buffer".into();
                 copies.push(r);
+                executor.release_textures();
             }
             Ok(copies)
         };
@@ -557,6 +558,7 @@ pub fn measure(
                     Error::Invalid(format!("benchmark `{}` plans no output", case.name))
                 })?;
             cases_rows.push((format, row(case.name, format_name(format), n, &plan, ms)?));
+            executor.release_textures();
         }
         // The copies again: each format's row keeps the faster of its two runs.
         for (k, again) in time_copies(&mut executor)?.into_iter().enumerate() {
@@ -665,6 +667,37 @@ mod tests {
             Ok(g) => g,
             Err(e) => panic!("GPU tests need an adapter (lavapipe on CI): {e}"),
         }
+    }
+
+    /// `Executor::release_textures` (called after each case) drops every pooled texture and
+    /// keeps the compiled kernels: the case runs again making its textures anew and no pipeline.
+    #[test]
+    fn a_released_executor_makes_textures_again_and_keeps_kernels() {
+        let gpu = gpu();
+        let built = |name: &str| (CASES.iter().find(|c| c.name == name).unwrap().build)(64);
+        let (sat, msm) = (built("sat fixed"), built("msm"));
+        let mut executor = Executor::new();
+        let time = |executor: &mut Executor, b: &BenchGraph| {
+            time_graph(&gpu.device, &gpu.queue, executor, &b.graph, &b.outputs, 1).unwrap();
+            executor.texture_count()
+        };
+        let own = time(&mut executor, &msm);
+        time(&mut executor, &sat);
+        // The pool keeps msm's textures beside sat's.
+        let held = time(&mut executor, &msm);
+        assert!(held > own, "{held} {own}");
+        executor.release_textures();
+        assert_eq!(executor.texture_count(), 0);
+        let before = crate::created::created();
+        let again = time(&mut executor, &msm);
+        let after = crate::created::created();
+        assert_eq!(after.pipelines, before.pipelines, "kernels kept");
+        assert_eq!(
+            after.textures - before.textures,
+            own as u64,
+            "textures made again"
+        );
+        assert_eq!(again, own);
     }
 
     /// `only` keeps the cases whose name contains one of its strings (the copies stay: they
