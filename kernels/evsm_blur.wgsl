@@ -23,6 +23,15 @@ struct Params {
 // #traffic stats: none
 
 const CHANNELS: u32 = 4u;
+alias Texel = vec4<f32>;
+
+fn texel_of(v: vec4<f32>) -> Texel {
+    return v;
+}
+
+fn texel_out(t: Texel) -> vec4<f32> {
+    return t;
+}
 
 fn encode(z: f32, left: f32, right: f32, up: f32, down: f32) -> vec4<f32> {
     return evsm_moments(z, params.exp_pos, params.exp_neg);

@@ -18,6 +18,15 @@ struct Params {
 // #traffic stats: none
 
 const CHANNELS: u32 = 2u;
+alias Texel = vec2<f32>;
+
+fn texel_of(v: vec4<f32>) -> Texel {
+    return v.xy;
+}
+
+fn texel_out(t: Texel) -> vec4<f32> {
+    return vec4<f32>(t, 0.0, 0.0);
+}
 
 fn encode(z: f32, left: f32, right: f32, up: f32, down: f32) -> vec4<f32> {
     return vec4<f32>(vsm_moments(z, left, right, up, down), 0.0, 0.0);

@@ -80,6 +80,15 @@ enum Command {
         /// 400x300 and 200x150, small for a CPU driver; a GPU wants 1920x1080).
         #[arg(long, value_parser = parse_size)]
         image: Option<(u32, u32)>,
+        /// With `--lookup`: render the light's shadow map at this size, texels a side
+        /// (default: the scenes' own, 512).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(16..=32768))]
+        map: Option<u32>,
+        /// Time only the kernels whose name contains one of these (e.g. `sat,mips`); the
+        /// texture copies, their yardsticks, always run. With `--lookup`: only these soft
+        /// configurations (e.g. `cssm`), and PCSS 16+32, their yardstick.
+        #[arg(long, value_delimiter = ',')]
+        only: Vec<String>,
     },
     /// Sweep techniques and their accuracy knobs, time each on the GPU and measure its error
     /// against ground truth: report.html/.md/.csv/.json, pareto{,_penumbra,_flip}.svg, grid.png
@@ -220,11 +229,13 @@ fn run(args: Args) -> Result<()> {
             lookup,
             light_sizes,
             image,
+            map,
+            only,
         } => {
             let gpu = Gpu::new()?;
             match lookup {
                 Some(widths) => {
-                    let rows = shadowgraph::bench::lookup_cost(&gpu, &widths, repeat, image)?;
+                    let rows = shadowgraph::bench::lookup_cost(&gpu, &widths, repeat, image, map)?;
                     let cpu = gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu;
                     print!(
                         "{}",
@@ -235,7 +246,14 @@ fn run(args: Args) -> Result<()> {
                             &rows
                         )
                     );
-                    let soft = shadowgraph::bench::soft_cost(&gpu, &light_sizes, repeat, image)?;
+                    let soft = shadowgraph::bench::soft_cost(
+                        &gpu,
+                        &light_sizes,
+                        repeat,
+                        image,
+                        map,
+                        &only,
+                    )?;
                     print!(
                         "\n{}",
                         shadowgraph::bench::format_soft_table(
@@ -247,7 +265,7 @@ fn run(args: Args) -> Result<()> {
                         )
                     );
                 }
-                None => print!("{}", shadowgraph::bench::run(&gpu, &sizes, repeat)?),
+                None => print!("{}", shadowgraph::bench::run(&gpu, &sizes, repeat, &only)?),
             }
         }
         Command::Stability { large } => {

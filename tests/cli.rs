@@ -85,13 +85,69 @@ fn bad_scene_path_is_an_error_naming_the_file() {
     assert!(e.contains("no/such/scene.toml"), "{e}");
 }
 
+/// `bench --lookup`'s soft table: one row per configuration with positive, finite shading
+/// times per light size; the prefilter's time is the light's passes after its raster (tables
+/// for the soft techniques, none of them for `hard`'s one-pass linearization to outweigh), the
+/// frame's passes add up to at least shade + prefilter, and `--image` and `--map` reach the
+/// scene and the table's header.
+#[test]
+fn soft_benchmark_reports_every_configuration() {
+    let g = common::gpu();
+    let rows = shadowgraph::bench::soft_cost(&g, &[0.5, 1.0], 1, Some((48, 36)), Some(128), &[])
+        .expect("soft bench");
+    let names: Vec<&str> = rows.iter().map(|r| r.technique.as_str()).collect();
+    let want: Vec<&str> = shadowgraph::bench::SOFT_TECHNIQUES
+        .iter()
+        .map(|(n, _)| *n)
+        .collect();
+    assert_eq!(names, want);
+    for r in &rows {
+        assert_eq!(
+            (r.image, r.map, r.shade_ms.len()),
+            ((48, 36), 128, 2),
+            "{r:?}"
+        );
+        for v in r.shade_ms.iter().chain([&r.frame_ms, &r.wall_ms]) {
+            assert!(v.is_finite() && *v > 0.0, "{r:?}");
+        }
+        assert!(r.prefilter_ms.is_finite() && r.prefilter_ms >= 0.0, "{r:?}");
+        assert!(
+            r.frame_ms >= r.shade_ms[0] + r.prefilter_ms - 1e-9,
+            "the frame's passes include shade and prefilter: {r:?}"
+        );
+    }
+    let tables = |name: &str| rows.iter().find(|r| r.technique == name).unwrap();
+    for soft in ["vssm", "msm_soft", "cssm M=8"] {
+        assert!(
+            tables(soft).prefilter_ms > 0.0,
+            "{soft} builds tables: {:?}",
+            tables(soft)
+        );
+    }
+    let table = shadowgraph::bench::format_soft_table("test", true, 1, &[0.5, 1.0], &rows);
+    assert!(table.contains("(48×36, 128² spot map)"), "{table}");
+    assert!(
+        table.contains("prefilter ms") && table.contains("wall ms"),
+        "{table}"
+    );
+    // `--only` keeps the named configurations and the yardstick, whose ratios stay 1.
+    let only = ["cssm".to_string()];
+    let some = shadowgraph::bench::soft_cost(&g, &[0.5], 1, Some((48, 36)), Some(128), &only)
+        .expect("soft bench, only cssm");
+    let names: Vec<&str> = some.iter().map(|r| r.technique.as_str()).collect();
+    assert_eq!(names, ["pcss 16+32", "cssm M=8"]);
+    let table = shadowgraph::bench::format_soft_table("test", true, 1, &[0.5], &some);
+    let pcss = table.lines().find(|l| l.starts_with("pcss 16+32")).unwrap();
+    assert!(pcss.contains("( 1.00)"), "{table}");
+}
+
 /// `bench --lookup`: one row per width with positive, finite times for the three lookups;
 /// even or out-of-range widths are errors naming the width. (The times themselves are the
 /// benchmark's business, not a test's.)
 #[test]
 fn lookup_benchmark_reports_every_width() {
     let g = common::gpu();
-    let rows = shadowgraph::bench::lookup_cost(&g, &[3, 9], 1, None).expect("lookup bench");
+    let rows = shadowgraph::bench::lookup_cost(&g, &[3, 9], 1, None, None).expect("lookup bench");
     assert_eq!(rows.iter().map(|r| r.width).collect::<Vec<_>>(), vec![3, 9]);
     for r in &rows {
         for v in [r.pcf_ms, r.sat_fixed_ms, r.sat_float_ms] {
@@ -105,12 +161,13 @@ fn lookup_benchmark_reports_every_width() {
     );
     assert!(rows.iter().all(|r| r.image == (400, 300)), "{rows:?}");
     // `--image` shades at the size asked for, and the table says so.
-    let small = shadowgraph::bench::lookup_cost(&g, &[3], 1, Some((64, 48))).expect("at 64x48");
-    assert_eq!(small[0].image, (64, 48));
+    let small =
+        shadowgraph::bench::lookup_cost(&g, &[3], 1, Some((64, 48)), Some(256)).expect("at 64x48");
+    assert_eq!((small[0].image, small[0].map), ((64, 48), 256));
     let table = shadowgraph::bench::format_lookup_table("test", true, 1, &small);
-    assert!(table.contains("(64×48, 512² map)"), "{table}");
+    assert!(table.contains("(64×48, 256² map)"), "{table}");
     for bad in [4, 0, 67] {
-        let e = shadowgraph::bench::lookup_cost(&g, &[bad], 1, None).expect_err("bad width");
+        let e = shadowgraph::bench::lookup_cost(&g, &[bad], 1, None, None).expect_err("bad width");
         assert!(e.to_string().contains(&format!("width {bad}")), "{e}");
     }
 }

@@ -17,7 +17,10 @@
 // Each workgroup counts the non-finite depths of its own outputs, so each is counted once.
 //
 // The importing kernel declares `const CHANNELS` (2 or 4), `struct Params` (its encoding's
-// fields, then `blur: BlurSpec`) and `fn encode(z, left, right, up, down) -> vec4<f32>`:
+// fields, then `blur: BlurSpec`), `fn encode(z, left, right, up, down) -> vec4<f32>`, and the
+// texel its channels need in workgroup memory: `alias Texel` (vec2<f32> for two channels,
+// vec4<f32> for four), `fn texel_of(v: vec4<f32>) -> Texel` and `fn texel_out(t: Texel) ->
+// vec4<f32>` (two channels in vec2s halve the workgroup memory and its traffic):
 // #completed-by-importer
 // Storage: rg32float by default; the executor re-declares `dst` for the bound format.
 
@@ -46,15 +49,15 @@ const MAX_RADIUS: u32 = 32u;
 // Encoded texels an invocation holds between barriers (`encode_tile`: e0 … e3): at least
 // ⌈(TILE + 2·TILE_RADIUS)² / WG_SIZE⌉ of a tile and ⌈(ROW + 2·MAX_RADIUS) / WG_SIZE⌉ of a row.
 // Horizontal sums (`blur_tile`: h0, h1): at least ⌈TILE · (TILE + 2·TILE_RADIUS) / WG_SIZE⌉.
-// Texels of workgroup memory, a vec4 each (one access a tap, whatever the channels): the depth
+// Texels of workgroup memory, a `Texel` each (one access a tap): the depth
 // tile ((TILE + 2·TILE_RADIUS + 2)² = 1024, or three rows of ROW + 2·MAX_RADIUS + 2), the
 // encoded tile ((TILE + 2·TILE_RADIUS)² = 900, or ROW + 2·MAX_RADIUS) and the horizontal sums
-// each fit: 16 KiB.
+// each fit: 16 KiB with four channels, 8 KiB with two.
 const SH_TEXELS: u32 = 1024u;
 
 // The depth tile (in x), then the encoded tile, then the horizontal sums, each over the one
 // before.
-var<workgroup> sh_tile: array<vec4<f32>, SH_TEXELS>;
+var<workgroup> sh_tile: array<Texel, SH_TEXELS>;
 
 // A workgroup's outputs and the extents it works over.
 struct Tile {
@@ -89,12 +92,8 @@ fn blur_weight(i: i32) -> f32 {
     return params.blur.weights[u32(i) / 4u][u32(i) % 4u];
 }
 
-fn sh_get(i: i32) -> vec4<f32> {
+fn sh_get(i: i32) -> Texel {
     return sh_tile[i];
-}
-
-fn sh_put(i: i32, v: vec4<f32>) {
-    sh_tile[i] = v;
 }
 
 // The linear depth at depth-tile index i.
@@ -109,7 +108,7 @@ fn load_depth(t: Tile, li: u32) {
         let p = t.origin - t.r - 1 + vec2<i32>(i % t.dep.x, i / t.dep.x);
         let q = clamp(p, vec2<i32>(0), t.size - 1);
         let raw = textureLoad(src, q, 0).r;
-        sh_tile[i] = vec4<f32>(linear_depth(raw, params.depth), 0.0, 0.0, 0.0);
+        sh_tile[i] = texel_of(vec4<f32>(linear_depth(raw, params.depth), 0.0, 0.0, 0.0));
         let own = all(p == q) && all(p >= t.origin) && all(p < t.origin + t.outs);
         if own && !depth_is_finite(raw) {
             atomicAdd(&stats[0], 1u);
@@ -119,20 +118,20 @@ fn load_depth(t: Tile, li: u32) {
 
 // The encoding of encoded-tile texel i (clamped to the tile: an invocation past its end computes
 // a texel it does not store, so none branches).
-fn encode_at(t: Tile, i: i32) -> vec4<f32> {
+fn encode_at(t: Tile, i: i32) -> Texel {
     let e = min(i, t.enc.x * t.enc.y - 1);
     let d = (e / t.enc.x + 1) * t.dep.x + e % t.enc.x + 1;
-    return encode(
+    return texel_of(encode(
         sh_depth(d),
         sh_depth(d - 1),
         sh_depth(d + 1),
         sh_depth(d - t.dep.x),
         sh_depth(d + t.dep.x)
-    );
+    ));
 }
 
 // Stores v at i if i < n.
-fn put_below(i: i32, n: i32, v: vec4<f32>) {
+fn put_below(i: i32, n: i32, v: Texel) {
     if i < n {
         sh_tile[i] = v;
     }
@@ -158,7 +157,7 @@ fn encode_tile(t: Tile, li: u32) {
 }
 
 // The horizontal sum at output column x of encoded row y.
-fn sum_x(t: Tile, x: i32, y: i32) -> vec4<f32> {
+fn sum_x(t: Tile, x: i32, y: i32) -> Texel {
     let c = y * t.enc.x + x + t.r.x;
     var s = blur_weight(0) * sh_get(c);
     for (var i = 1; i <= t.r.x; i++) {
@@ -167,10 +166,10 @@ fn sum_x(t: Tile, x: i32, y: i32) -> vec4<f32> {
     return s;
 }
 
-fn store(t: Tile, o: vec2<i32>, v: vec4<f32>) {
+fn store(t: Tile, o: vec2<i32>, v: Texel) {
     let p = t.origin + o;
     if all(p < t.size) {
-        textureStore(dst, p, v);
+        textureStore(dst, p, texel_out(v));
     }
 }
 

@@ -32,6 +32,8 @@ pub struct LookupRow {
     pub sat_build_ms: f64,
     /// The image it was shaded at, width × height.
     pub image: (u32, u32),
+    /// The light's shadow-map size it read, texels a side.
+    pub map: u32,
 }
 
 /// The shading pass's cost as the filter widens: for each width in `widths`, the median over
@@ -41,12 +43,14 @@ pub struct LookupRow {
 /// (sixteen with sub-texel edges) whatever the width.
 ///
 /// `image` shades at that size instead of the scene's 400×300 (a GPU's shading pass at that
-/// size is close to its launch floor).
+/// size is close to its launch floor), and `map` renders the light's shadow map at that size
+/// instead of the scene's 512².
 pub fn lookup_cost(
     gpu: &Gpu,
     widths: &[u32],
     repeat: u32,
     image: Option<(u32, u32)>,
+    map: Option<u32>,
 ) -> Result<Vec<LookupRow>> {
     if widths.is_empty() || repeat == 0 {
         return Err(Error::Invalid(
@@ -68,6 +72,9 @@ pub fn lookup_cost(
     let mut base = crate::scene::Scene::parse(std::path::Path::new("vsm.toml"), LOOKUP_SCENE)?;
     if let Some((w, h)) = image {
         (base.width, base.height) = (w, h);
+    }
+    if let Some(n) = map {
+        base.lights[0].shadow_map = n;
     }
     let mut renderer = crate::render::Renderer::new(&gpu.device);
     let mut shade = |technique: Technique| -> Result<(f64, f64)> {
@@ -124,6 +131,7 @@ pub fn lookup_cost(
             sat_float_ms,
             sat_build_ms,
             image: (base.width, base.height),
+            map: base.lights[0].shadow_map,
         });
     }
     Ok(rows)
@@ -133,11 +141,11 @@ pub fn lookup_cost(
 /// (on a CPU adapter only those ratios mean anything).
 pub fn format_lookup_table(device: &str, cpu: bool, repeat: u32, rows: &[LookupRow]) -> String {
     let mut s = String::new();
-    let (w, h) = rows.first().map_or((0, 0), |r| r.image);
+    let ((w, h), map) = rows.first().map_or(((0, 0), 0), |r| (r.image, r.map));
     let _ = writeln!(s, "shading-pass lookup cost on {device}");
     let _ = writeln!(
         s,
-        "scenes/techniques/vsm.toml ({w}×{h}, 512² map); GPU timestamps of the shade pass, median \
+        "scenes/techniques/vsm.toml ({w}×{h}, {map}² map); GPU timestamps of the shade pass, median \
          of {repeat} frame(s) after {WARMUP} warm-up frame(s); (×) = over the first width's time."
     );
     if cpu {

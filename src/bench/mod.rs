@@ -462,17 +462,42 @@ fn row(name: &str, format: String, n: u32, plan: &Plan, ms: f64) -> Result<Bench
     })
 }
 
+/// The cases of [`CASES`] whose name contains one of `only` (all of them when `only` is
+/// empty); a filter that names no case is an error listing the names.
+pub fn select_cases(only: &[String]) -> Result<Vec<&'static BenchCase>> {
+    let picked: Vec<&BenchCase> = CASES
+        .iter()
+        .filter(|c| only.is_empty() || only.iter().any(|o| c.name.contains(o.as_str())))
+        .collect();
+    if picked.is_empty() {
+        let names: Vec<&str> = CASES.iter().map(|c| c.name).collect();
+        return Err(Error::Invalid(format!(
+            "bench --only {}: matches no kernel; the kernels are: {}",
+            only.join(","),
+            names.join("; ")
+        )));
+    }
+    Ok(picked)
+}
+
 /// Times, at every size in `sizes` (`repeat` timed runs each), the buffer copy of an
 /// rgba32-sized map, the texture copy of every format of [`COPY_FORMATS`] (ratio to the
-/// buffer copy), then every case of [`CASES`] (ratio to the texture copy of its output's
-/// format).
+/// buffer copy), then every case of [`CASES`] whose name contains one of `only` (every case
+/// when `only` is empty; ratio to the texture copy of its output's format).
+///
+/// The copies are timed twice, before and after the cases, and each keeps the faster of its
+/// two medians: the yardstick is what the device's copy reaches, and a GPU's clock or a
+/// shared machine's load can slow either run (on an H100 one format's copy read 0.14 ms in one
+/// run and 0.27 ms in the next).
 pub fn measure(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     sizes: &[u32],
     repeat: u32,
+    only: &[String],
 ) -> Result<Vec<BenchRow>> {
     check_args(device, sizes, repeat)?;
+    let cases = select_cases(only)?;
     harness::timer(device, queue, 1)?;
     let mut executor = Executor::new();
     let mut rows = Vec::new();
@@ -490,24 +515,32 @@ pub fn measure(
             ratio: 1.0,
             yardstick: String::new(),
         });
+        let time_copies = |executor: &mut Executor| -> Result<Vec<BenchRow>> {
+            let mut copies = Vec::new();
+            for &format in COPY_FORMATS {
+                let built = copy::copy_texture_graph(n, format);
+                let (plan, ms) = time_graph(
+                    device,
+                    queue,
+                    executor,
+                    &built.graph,
+                    &built.outputs,
+                    repeat,
+                )?;
+                let mut r = row("copy texture", format_name(format), n, &plan, ms)?;
+                r.ratio = r.gbps / buffer_gbps;
+                r.yardstick = "copy buffer".into();
+                copies.push(r);
+                executor.release_textures();
+            }
+            Ok(copies)
+        };
+        let before = time_copies(&mut executor)?;
+        let copies_at = rows.len();
+        rows.extend(before);
         let mut copies: HashMap<wgpu::TextureFormat, f64> = HashMap::new();
-        for &format in COPY_FORMATS {
-            let built = copy::copy_texture_graph(n, format);
-            let (plan, ms) = time_graph(
-                device,
-                queue,
-                &mut executor,
-                &built.graph,
-                &built.outputs,
-                repeat,
-            )?;
-            let mut r = row("copy texture", format_name(format), n, &plan, ms)?;
-            r.ratio = r.gbps / buffer_gbps;
-            r.yardstick = "copy buffer".into();
-            copies.insert(format, r.gbps);
-            rows.push(r);
-        }
-        for case in CASES {
+        let mut cases_rows = Vec::new();
+        for case in &cases {
             let built = (case.build)(n);
             let (plan, ms) = time_graph(
                 device,
@@ -524,14 +557,27 @@ pub fn measure(
                 .ok_or_else(|| {
                     Error::Invalid(format!("benchmark `{}` plans no output", case.name))
                 })?;
+            cases_rows.push((format, row(case.name, format_name(format), n, &plan, ms)?));
+            executor.release_textures();
+        }
+        // The copies again: each format's row keeps the faster of its two runs.
+        for (k, again) in time_copies(&mut executor)?.into_iter().enumerate() {
+            let first = &mut rows[copies_at + k];
+            if again.median_ms < first.median_ms {
+                *first = again;
+            }
+        }
+        for (&format, r) in COPY_FORMATS.iter().zip(&rows[copies_at..]) {
+            copies.insert(format, r.gbps);
+        }
+        for (format, mut r) in cases_rows {
             let copy_gbps = copies.get(&format).copied().ok_or_else(|| {
                 Error::Invalid(format!(
                     "benchmark `{}` writes {}, which has no texture copy row (COPY_FORMATS)",
-                    case.name,
+                    r.kernel,
                     format_name(format)
                 ))
             })?;
-            let mut r = row(case.name, format_name(format), n, &plan, ms)?;
             r.ratio = r.gbps / copy_gbps;
             r.yardstick = format!("copy texture {}", r.format);
             rows.push(r);
@@ -541,8 +587,8 @@ pub fn measure(
 }
 
 /// Runs [`measure`] on `gpu` and formats the report.
-pub fn run(gpu: &Gpu, sizes: &[u32], repeat: u32) -> Result<String> {
-    let rows = measure(&gpu.device, &gpu.queue, sizes, repeat)?;
+pub fn run(gpu: &Gpu, sizes: &[u32], repeat: u32, only: &[String]) -> Result<String> {
+    let rows = measure(&gpu.device, &gpu.queue, sizes, repeat, only)?;
     let cpu = gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu;
     Ok(format_table(&gpu.describe(), cpu, repeat, &rows))
 }
@@ -557,7 +603,8 @@ pub fn format_table(device: &str, cpu: bool, repeat: u32, rows: &[BenchRow]) -> 
          MiB moved: the cost model's bytes (every dispatch's reads and writes, halos and second\n\
          reads included, as `shadowgraph plan` prints them); GB/s = bytes / time; x = GB/s over\n\
          the yardstick's: for a kernel the texture copy of its output's format (16x16\n\
-         workgroups, one load and one store per texel), for a texture copy the buffer copy."
+         workgroups, one load and one store per texel; timed before and after the kernels,\n\
+         the faster run kept), for a texture copy the buffer copy."
     );
     if cpu {
         let _ = writeln!(
@@ -622,12 +669,71 @@ mod tests {
         }
     }
 
+    /// `Executor::release_textures` (called after each case) drops every pooled texture and
+    /// keeps the compiled kernels: the case runs again making its textures anew and no pipeline.
+    #[test]
+    fn a_released_executor_makes_textures_again_and_keeps_kernels() {
+        let gpu = gpu();
+        let built = |name: &str| (CASES.iter().find(|c| c.name == name).unwrap().build)(64);
+        let (sat, msm) = (built("sat fixed"), built("msm"));
+        let mut executor = Executor::new();
+        let time = |executor: &mut Executor, b: &BenchGraph| {
+            time_graph(&gpu.device, &gpu.queue, executor, &b.graph, &b.outputs, 1).unwrap();
+            executor.texture_count()
+        };
+        let own = time(&mut executor, &msm);
+        time(&mut executor, &sat);
+        // The pool keeps msm's textures beside sat's.
+        let held = time(&mut executor, &msm);
+        assert!(held > own, "{held} {own}");
+        executor.release_textures();
+        assert_eq!(executor.texture_count(), 0);
+        let before = crate::created::created();
+        let again = time(&mut executor, &msm);
+        let after = crate::created::created();
+        assert_eq!(after.pipelines, before.pipelines, "kernels kept");
+        assert_eq!(
+            after.textures - before.textures,
+            own as u64,
+            "textures made again"
+        );
+        assert_eq!(again, own);
+    }
+
+    /// `only` keeps the cases whose name contains one of its strings (the copies stay: they
+    /// are the yardsticks); a filter that keeps none is an error naming the kernels.
+    #[test]
+    fn only_keeps_the_named_cases() {
+        let gpu = gpu();
+        let only = vec!["sat fixed".to_string(), "linearize".to_string()];
+        let rows = measure(&gpu.device, &gpu.queue, &[32], 1, &only).unwrap();
+        let kernels: Vec<&str> = rows
+            .iter()
+            .filter(|r| !r.kernel.starts_with("copy"))
+            .map(|r| r.kernel.as_str())
+            .collect();
+        let want: Vec<&str> = CASES
+            .iter()
+            .map(|c| c.name)
+            .filter(|n| n.contains("sat fixed") || n.contains("linearize"))
+            .collect();
+        assert_eq!(kernels, want);
+        assert!(want.len() >= 2, "{want:?}");
+        let copies = rows.iter().filter(|r| r.kernel == "copy texture").count();
+        assert_eq!(copies, COPY_FORMATS.len());
+        let e = measure(&gpu.device, &gpu.queue, &[32], 1, &["no such".to_string()]).unwrap_err();
+        assert!(
+            e.to_string().contains("--only no such: matches no kernel"),
+            "{e}"
+        );
+    }
+
     /// Per size: the buffer copy, a texture copy per format, then every case, each case's
     /// ratio taken to the copy of its output's format and its bytes the cost model's.
     #[test]
     fn measure_reports_copies_then_each_case_per_size() {
         let gpu = gpu();
-        let rows = measure(&gpu.device, &gpu.queue, &[32, 48], 2).unwrap();
+        let rows = measure(&gpu.device, &gpu.queue, &[32, 48], 2, &[]).unwrap();
         let names: Vec<(&str, u32)> = rows.iter().map(|r| (r.kernel.as_str(), r.size)).collect();
         let mut want = Vec::new();
         for n in [32, 48] {
@@ -695,11 +801,17 @@ mod tests {
     fn bad_arguments_are_errors() {
         let gpu = gpu();
         let (d, q) = (&gpu.device, &gpu.queue);
-        assert!(matches!(measure(d, q, &[], 1), Err(Error::Invalid(_))));
-        assert!(matches!(measure(d, q, &[64], 0), Err(Error::Invalid(_))));
-        assert!(matches!(measure(d, q, &[0], 1), Err(Error::Invalid(_))));
+        assert!(matches!(measure(d, q, &[], 1, &[]), Err(Error::Invalid(_))));
         assert!(matches!(
-            measure(d, q, &[u32::MAX], 1),
+            measure(d, q, &[64], 0, &[]),
+            Err(Error::Invalid(_))
+        ));
+        assert!(matches!(
+            measure(d, q, &[0], 1, &[]),
+            Err(Error::Invalid(_))
+        ));
+        assert!(matches!(
+            measure(d, q, &[u32::MAX], 1, &[]),
             Err(Error::Limit { .. })
         ));
     }

@@ -49,8 +49,31 @@ pub struct SoftRow {
     pub fetches: f64,
     /// Per light size (in the order asked for), the shading pass's median GPU time, ms.
     pub shade_ms: Vec<f64>,
+    /// The prefilter's median GPU time (every pass of the light after its raster: encodings,
+    /// blurs, tables, mips), ms, at the first light size (the light's size changes no
+    /// prefilter pass).
+    pub prefilter_ms: f64,
+    /// The whole frame's median GPU time (every timed pass), ms, at the first light size.
+    pub frame_ms: f64,
+    /// The same frames' median wall time from submission to completion, ms: the cross-check
+    /// of the timestamps (it adds the submission's latency).
+    pub wall_ms: f64,
     /// The image it was shaded at, width × height.
     pub image: (u32, u32),
+    /// The light's shadow-map size, texels a side.
+    pub map: u32,
+}
+
+/// Frames a configuration renders back to back in each round; the last one is timed. The first
+/// frame after a change of configuration reads cold caches and, on a GPU, runs at whatever
+/// clock the idle gap before it left: on an H100 at 1920×1080, PCSS 16+32's shading pass read
+/// 0.64 ms as single interleaved frames and 0.15 ms in consecutive frames.
+pub const STEADY_FRAMES: u32 = 3;
+
+/// Whether a timed pass is part of a light's prefilter: a light's pass (`light<i>.…`) other
+/// than its raster.
+fn is_prefilter(pass: &str) -> bool {
+    pass.starts_with("light") && !pass.ends_with(".shadow_raster")
 }
 
 /// The technique scene with `shadow` as its light's `[light.shadow]` table.
@@ -79,16 +102,21 @@ fn shading_fetches(scene: &Scene) -> Result<f64> {
 }
 
 /// The shading pass's cost of every configuration of [`SOFT_TECHNIQUES`] at each light size in
-/// `sizes`: the median over `repeat` frames (after [`WARMUP`] untimed ones) of the `shade`
-/// pass, frames interleaved across configurations (one frame of each in turn), so that a
-/// change of load on a shared machine reaches every configuration alike.
+/// `sizes`: the median over `repeat` rounds (after [`WARMUP`] untimed ones) of the `shade`
+/// pass. Rounds interleave the configurations (each renders [`STEADY_FRAMES`] consecutive
+/// frames in turn, the last timed), so that a change of load on a shared machine reaches every
+/// configuration alike while each timed frame follows frames of its own configuration.
 ///
-/// `image` shades at that size instead of the scene's 200×150.
+/// `image` shades at that size instead of the scene's 200×150, and `map` renders the light's
+/// shadow map at that size instead of the scene's 512². A non-empty `only` keeps the
+/// configurations whose name contains one of its strings, and the yardstick.
 pub fn soft_cost(
     gpu: &Gpu,
     sizes: &[f32],
     repeat: u32,
     image: Option<(u32, u32)>,
+    map: Option<u32>,
+    only: &[String],
 ) -> Result<Vec<SoftRow>> {
     if sizes.is_empty() || repeat == 0 {
         return Err(Error::Invalid(
@@ -107,11 +135,22 @@ pub fn soft_cost(
                 .to_string(),
         ));
     }
+    let picked: Vec<&(&str, &str)> = SOFT_TECHNIQUES
+        .iter()
+        .enumerate()
+        .filter(|(k, (name, _))| {
+            *k == YARDSTICK || only.is_empty() || only.iter().any(|o| name.contains(o.as_str()))
+        })
+        .map(|(_, t)| t)
+        .collect();
     let mut scenes = Vec::new();
-    for (_, shadow) in SOFT_TECHNIQUES {
+    for (_, shadow) in &picked {
         let mut base = scene_with(shadow)?;
         if let Some((w, h)) = image {
             (base.width, base.height) = (w, h);
+        }
+        if let Some(n) = map {
+            base.lights[0].shadow_map = n;
         }
         for &size in sizes {
             let mut scene = base.clone();
@@ -121,26 +160,42 @@ pub fn soft_cost(
     }
     let mut renderer = Renderer::new(&gpu.device);
     let mut times = vec![Vec::new(); scenes.len()];
+    let mut prefilter = vec![Vec::new(); scenes.len()];
+    let mut frame_wall = vec![(Vec::new(), Vec::new()); scenes.len()];
     let opts = RenderOptions {
-        repeat: 1,
+        repeat: STEADY_FRAMES,
         ..Default::default()
     };
-    for frame in 0..WARMUP + repeat {
-        for (scene, t) in scenes.iter().zip(&mut times) {
+    for round in 0..WARMUP + repeat {
+        for (k, scene) in scenes.iter().enumerate() {
             let f = renderer.render(&gpu.device, &gpu.queue, scene, opts)?;
-            let shade = f
+            let (passes, wall) = f
                 .timings
-                .first()
-                .and_then(|passes| passes.iter().find(|(name, _)| name == "shade"))
+                .last()
+                .zip(f.wall_ms.last())
+                .ok_or_else(|| Error::Invalid("the frame has no timed passes".into()))?;
+            let shade = passes
+                .iter()
+                .find(|(name, _)| name == "shade")
                 .map(|(_, ms)| *ms)
                 .ok_or_else(|| Error::Invalid("the frame has no timed `shade` pass".into()))?;
-            if frame >= WARMUP {
-                t.push(shade);
+            if round >= WARMUP {
+                times[k].push(shade);
+                let sum = |keep: &dyn Fn(&str) -> bool| -> f64 {
+                    passes
+                        .iter()
+                        .filter(|(name, _)| keep(name))
+                        .map(|(_, ms)| ms)
+                        .sum()
+                };
+                prefilter[k].push(sum(&is_prefilter));
+                frame_wall[k].0.push(sum(&|_| true));
+                frame_wall[k].1.push(*wall);
             }
         }
     }
     let mut rows = Vec::new();
-    for (k, (name, _)) in SOFT_TECHNIQUES.iter().enumerate() {
+    for (k, (name, _)) in picked.iter().enumerate() {
         let at = k * sizes.len();
         rows.push(SoftRow {
             technique: name.to_string(),
@@ -149,7 +204,11 @@ pub fn soft_cost(
                 .iter_mut()
                 .map(|t| median(t))
                 .collect(),
+            prefilter_ms: median(&mut prefilter[at]),
+            frame_ms: median(&mut frame_wall[at].0),
+            wall_ms: median(&mut frame_wall[at].1),
             image: (scenes[at].width, scenes[at].height),
+            map: scenes[at].lights[0].shadow_map,
         });
     }
     Ok(rows)
@@ -157,7 +216,8 @@ pub fn soft_cost(
 
 /// [`soft_cost`]'s report: one line per technique, its fetches per pixel, then per light size
 /// the shading pass's time and its ratio to PCSS 16+32's at that size (on a CPU adapter only
-/// the ratios mean anything).
+/// the ratios mean anything), and last the prefilter's time and, as the timestamps'
+/// cross-check, the frame's passes against its wall time.
 pub fn format_soft_table(
     device: &str,
     cpu: bool,
@@ -166,13 +226,16 @@ pub fn format_soft_table(
     rows: &[SoftRow],
 ) -> String {
     let mut s = String::new();
-    let (w, h) = rows.first().map_or((0, 0), |r| r.image);
+    let ((w, h), map) = rows.first().map_or(((0, 0), 0), |r| (r.image, r.map));
     let _ = writeln!(s, "soft-shadow shading cost on {device}");
     let _ = writeln!(
         s,
-        "scenes/techniques/cssm.toml ({w}×{h}, 512² spot map), the light's size swept (wider \
-         penumbrae); GPU timestamps of the shade pass, median of {repeat} frame(s) after \
-         {WARMUP} warm-up frame(s), frames interleaved; (×) = over PCSS 16+32 at the same size."
+        "scenes/techniques/cssm.toml ({w}×{h}, {map}² spot map), the light's size swept (wider \
+         penumbrae); GPU timestamps of the shade pass, median of {repeat} round(s) after \
+         {WARMUP} warm-up round(s), configurations interleaved, each round's frame the last of \
+         {STEADY_FRAMES} consecutive ones; (×) = over PCSS 16+32 at the same size; prefilter = every \
+         pass of the light after its raster; frame = all passes, wall = submission to completion \
+         (first size)."
     );
     if cpu {
         let _ = writeln!(
@@ -184,8 +247,14 @@ pub fn format_soft_table(
     for size in sizes {
         let _ = write!(s, "  {:>17}", format!("size {size}"));
     }
-    let _ = writeln!(s);
-    let yardstick = rows.get(YARDSTICK);
+    let _ = writeln!(
+        s,
+        "  {:>13}  {:>9}  {:>9}",
+        "prefilter ms", "frame ms", "wall ms"
+    );
+    let yardstick = rows
+        .iter()
+        .find(|r| r.technique == SOFT_TECHNIQUES[YARDSTICK].0);
     for r in rows {
         let _ = write!(s, "{:<11} {:>10}", r.technique, r.fetches);
         for (i, ms) in r.shade_ms.iter().enumerate() {
@@ -193,7 +262,39 @@ pub fn format_soft_table(
             let ratio = base.map_or(f64::NAN, |b| ms / b);
             let _ = write!(s, "  {:>9.3} ({:>5.2})", ms, ratio);
         }
-        let _ = writeln!(s);
+        let _ = writeln!(
+            s,
+            "  {:>13.3}  {:>9.3}  {:>9.3}",
+            r.prefilter_ms, r.frame_ms, r.wall_ms
+        );
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The prefilter is every timed pass of a vssm frame but the raster, the G-buffer and the
+    /// shading: the encoding and the table's three passes, read off a real frame's names.
+    #[test]
+    fn prefilter_is_the_light_passes_after_its_raster() {
+        let gpu = Gpu::new().expect("GPU tests need an adapter (lavapipe on CI)");
+        let mut scene = scene_with("technique = \"vssm\"").unwrap();
+        (scene.width, scene.height, scene.lights[0].shadow_map) = (32, 24, 64);
+        let frame = Renderer::new(&gpu.device)
+            .render(&gpu.device, &gpu.queue, &scene, RenderOptions::default())
+            .unwrap();
+        let names: Vec<&str> = frame.timings[0].iter().map(|(n, _)| n.as_str()).collect();
+        for pass in ["light0.shadow_raster", "gbuffer", "shade"] {
+            assert!(names.contains(&pass), "{names:?}");
+        }
+        let prefilter: Vec<&str> = names.iter().copied().filter(|n| is_prefilter(n)).collect();
+        let others: Vec<&str> = names.iter().copied().filter(|n| !is_prefilter(n)).collect();
+        assert_eq!(others, ["light0.shadow_raster", "gbuffer", "shade"]);
+        assert!(
+            prefilter.len() >= 2 && prefilter.iter().any(|n| n.contains(".sat")),
+            "{prefilter:?}"
+        );
+    }
 }

@@ -70,6 +70,17 @@ impl Executor {
         self.pool.texture_count() + self.in_use.len()
     }
 
+    /// Drops every pooled texture and what the last run prepared (whose bind groups hold
+    /// them), keeping the compiled kernels: the next run makes its textures again. For a caller
+    /// that moves on between plans of very different sizes and would otherwise keep every
+    /// shape it used: the kernel benchmark releases after each case, so that a case runs beside
+    /// its own textures only, not the gigabytes its predecessors pooled at 8192².
+    pub fn release_textures(&mut self) {
+        self.prepared = None;
+        self.in_use.clear();
+        self.pool = TexturePool::default();
+    }
+
     /// Records `plan` into `encoder`. `imports` gives a texture for every imported resource.
     /// With a `timer`, each node is a span named after it, and the last one ends with the plan.
     /// The first run of a plan makes its textures, buffers and bind groups; later runs of the
