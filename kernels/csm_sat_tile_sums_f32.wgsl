@@ -31,12 +31,12 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l
     if layer == 0u && sat_non_finite > 0u {
         atomicAdd(&stats[0], sat_non_finite);
     }
-    let y = wg.y * TILE + li;
-    if y < size.y {
-        textureStore(row_part, vec2<u32>(source.band.x + wg.x, y), e.row);
-    }
-    let x = wg.x * TILE + li;
-    if x < size.x {
-        textureStore(col_part, vec2<u32>(x, source.band.y + wg.y), e.col);
+    let q = wg.xy * TILE + li % TILE;
+    if li < TILE {
+        if q.y < size.y {
+            textureStore(row_part, vec2<u32>(source.band.x + wg.x, q.y), e);
+        }
+    } else if q.x < size.x {
+        textureStore(col_part, vec2<u32>(q.x, source.band.y + wg.y), e);
     }
 }

@@ -53,12 +53,12 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l
     let size = textureDimensions(src);
     let source = csm_sat_source(params, params.first_map + wg.z, csm_sat_tiles_of(size));
     var col_add: array<vec4<u32>, SUB>;
-    sat_tile_prepare(col_carry, params.sat, fs, source, wg.xy, li, &col_add);
+    sat_tile_prepare(col_carry, row_carry, params.sat, fs, source, wg.xy, li, &col_add);
     let origin = sat_sub_origin(wg.xy, li);
     var col: array<vec4<u32>, SUB>;
     for (var j = 0u; j < SUB; j++) {
         sat_sweep_row(origin, j, params.sat, fs, source, &col);
-        let row_add = sat_row_add(row_carry, fs, source, wg.xy, li, j);
+        let row_add = sat_row_add(fs, li, j);
         for (var i = 0u; i < SUB; i++) {
             let q = origin + vec2<u32>(i, j);
             let sum = sat_sum(sat_sum(col[i], row_add, fs), col_add[i], fs);

@@ -3,8 +3,8 @@
 // gives each column x an invocation:
 //   col_carry(x, ty) = Σ_{ty' < ty} col_part(x, ty')
 //                    = the map above tile row ty, over the tile's columns up to x;
-// workgroup row 1 gives each row y an invocation, the workgroup one tile row (WG_SIZE = TILE
-// rows):
+// workgroup row 1 gives each row y an invocation, the workgroup ROWS = WG_SIZE / TILE tile
+// rows:
 //   row_carry(tx, y) = Σ_{tx' < tx} (row_part(tx', y) + V(tx'))
 //                    = the map left of tile column tx, over every row up to y (the table at
 //                      the column before the tile),
@@ -15,8 +15,10 @@
 // columns; workgroup z carries table z within its bands.
 // #import shared/sat_tile
 // Traffic (the cost model, src/graph/cost): every edge texel read once and every carry written
-// once. Not counted: the row workgroups' re-reads of the tiles' totals above them (at most
-// tiles_x · tiles_y / 2 texels, under 1/TILE² of the map's).
+// once. Not counted: the row workgroups' re-reads of the tiles' totals above them (a
+// workgroup reads at most tiles_x · tiles_y, all of them tiles_x · tiles_y² / (2 · ROWS)
+// texels: at 8192² 1/16 of the map's texels, from cache; a GPU spreads them over 64 lanes a
+// workgroup and 128 workgroups).
 // #traffic col_part: all
 // #traffic row_part: all
 // #traffic col_carry: all
@@ -29,11 +31,13 @@
 @group(0) @binding(4) var<uniform> params: SatParams;
 
 // WG_SIZE (shared/sat_tile) lines a workgroup: keep in sync with `SAT_LINES_PER_GROUP` in
-// src/sat/mod.rs. A row workgroup covers one tile row because WG_SIZE = TILE.
+// src/sat/mod.rs. A row workgroup covers ROWS whole tile rows (WG_SIZE = 2 · TILE).
+const ROWS: u32 = 2u; // WG_SIZE / TILE
 
-// V of up to CHUNK tiles at a time (a 32768-texel row has 512 tiles).
-const CHUNK: u32 = 512u;
-var<workgroup> sh_above: array<vec4<u32>, CHUNK>;
+// V of up to CHUNK tiles at a time (a 8192-texel row has 256 tiles), for each of the
+// workgroup's tile rows: at [r · CHUNK + k], tile first + k for tile row ROWS · wg.x + r.
+const CHUNK: u32 = 256u;
+var<workgroup> sh_above: array<vec4<u32>, 512>; // ROWS · CHUNK
 
 // Tile rows of one table's band (the edges of `layers` tables stacked).
 fn band_tiles(stacked: u32) -> u32 {
@@ -55,18 +59,20 @@ fn column_carries(x: u32, layer: u32, fs: bool) {
     }
 }
 
-// Rows of tile row `ty`, invocation li on row ty·TILE + li. Every invocation of the workgroup
-// calls it (it has barriers).
-fn row_carries(ty: u32, layer: u32, li: u32, fs: bool) {
+// Rows of tile rows ROWS·g .. ROWS·g + ROWS − 1, invocation li on row g·WG_SIZE + li. Every
+// invocation of the workgroup calls it (it has barriers).
+fn row_carries(g: u32, layer: u32, li: u32, fs: bool) {
     let tiles = band_tiles(textureDimensions(row_part).x);
     let first_col = layer * tiles;
     let first_row = layer * band_tiles(textureDimensions(col_part).y);
     let height = textureDimensions(row_part).y;
     let width = textureDimensions(col_part).x;
+    let ty = g * ROWS;
     if ty * TILE >= height {
         return; // a workgroup past the map's rows (workgroup-uniform: no barrier is skipped)
     }
-    let y = ty * TILE + li;
+    let y = g * WG_SIZE + li;
+    let own = (li / TILE) * CHUNK;
     var carry = vec4<u32>(0u);
     for (var first = 0u; first < tiles; first += CHUNK) {
         for (var k = li; k < CHUNK && first + k < tiles; k += WG_SIZE) {
@@ -76,12 +82,18 @@ fn row_carries(ty: u32, layer: u32, li: u32, fs: bool) {
                 above = sat_sum(above, textureLoad(col_part, vec2<u32>(last, first_row + t), 0), fs);
             }
             sh_above[k] = above;
+            // The next tile rows' V adds the tile above them (only those holding map rows).
+            for (var r = 1u; r < ROWS && (ty + r) * TILE < height; r++) {
+                let total = textureLoad(col_part, vec2<u32>(last, first_row + ty + r - 1u), 0);
+                above = sat_sum(above, total, fs);
+                sh_above[r * CHUNK + k] = above;
+            }
         }
         workgroupBarrier();
         if y < height {
             for (var k = 0u; k < CHUNK && first + k < tiles; k++) {
                 let p = vec2<u32>(first_col + first + k, y);
-                let part = sat_sum(textureLoad(row_part, p, 0), sh_above[k], fs);
+                let part = sat_sum(textureLoad(row_part, p, 0), sh_above[own + k], fs);
                 textureStore(row_carry, p, carry);
                 carry = sat_sum(carry, part, fs);
             }

@@ -23,12 +23,12 @@ const FLOAT_SUMS: bool = false;
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     let e = sat_tile_edges(params, FLOAT_SUMS, SAT_STORED, wg.xy, li);
     let size = textureDimensions(src);
-    let y = wg.y * TILE + li;
-    if y < size.y {
-        textureStore(row_part, vec2<u32>(wg.x, y), e.row);
-    }
-    let x = wg.x * TILE + li;
-    if x < size.x {
-        textureStore(col_part, vec2<u32>(x, wg.y), e.col);
+    let q = wg.xy * TILE + li % TILE;
+    if li < TILE {
+        if q.y < size.y {
+            textureStore(row_part, vec2<u32>(wg.x, q.y), e);
+        }
+    } else if q.x < size.x {
+        textureStore(col_part, vec2<u32>(q.x, wg.y), e);
     }
 }

@@ -166,18 +166,21 @@ fn vsm_f16_mips_move_half_the_bytes() {
     );
 }
 
+/// Side of the SAT's tiles (`shadowgraph::sat::SAT_TILE`).
+const SAT_TILE: f64 = 32.0;
+
 /// A summed-area table at 512² of a representation of `src` bytes per texel into a table of
-/// `table` bytes per texel, in 64 × 64 tiles (8 × 8 of them): the three passes.
+/// `table` bytes per texel, in 32 × 32 tiles (16 × 16 of them): the three passes.
 fn sat_rows(src: f64, table: f64) -> [Row; 3] {
     // A tile's last row and last column (pass 1), and as many carries (pass 2): each one
-    // table texel per 64 map texels, twice.
-    let edges = 2.0 * table / 64.0;
+    // table texel per 32 map texels, twice.
+    let edges = 2.0 * table / SAT_TILE;
     [
         // Read the representation, write the tiles' edge sums.
         ("sat.tile_sums", 1, src, edges),
         // Read the edge sums, write the carries.
         ("sat.carries", 1, edges, edges),
-        // Read the representation again and 64 carries of either kind per tile (the same
+        // Read the representation again and 32 carries of either kind per tile (the same
         // bytes as the carries); write the table.
         ("sat", 1, src + edges, table),
     ]
@@ -189,8 +192,8 @@ fn msm_with_sat_moves_what_the_hand_count_says() {
     // The encoding reads the depth32float buffer itself (linearize fused), writes rgba16float.
     let mut rows = vec![("msm", 1, 4.0, 8.0)];
     rows.extend(sat_rows(8.0, 16.0));
-    // 12 + (8.5 + 1 + 24.5) of the table
-    assert_traffic("techniques/msm_sat.toml", &rows, 46.0, 4.0 + 16.0);
+    // 12 + (9 + 2 + 25) of the table
+    assert_traffic("techniques/msm_sat.toml", &rows, 48.0, 4.0 + 16.0);
 }
 
 /// `cssm.toml`: M = 8 terms at 512²: four CSM maps and five CSM-Z maps (four of four
@@ -202,10 +205,10 @@ fn msm_with_sat_moves_what_the_hand_count_says() {
 fn cssm_moves_what_the_hand_count_says() {
     let layers = 9.0;
     // A tile's last row and last column (pass 1) and as many carries (pass 2), one rgba32uint
-    // texel (16 B) per 64 map texels each, twice, for every layer.
-    let edges = layers * 2.0 * 16.0 / 64.0;
-    // Pass 3 reads 64 carries of either kind per tile and layer (1/64 of a texel each, 16 B).
-    let carries = |maps: f64| maps * 2.0 * 16.0 / 64.0;
+    // texel (16 B) per 32 map texels each, twice, for every layer.
+    let edges = layers * 2.0 * 16.0 / SAT_TILE;
+    // Pass 3 reads 32 carries of either kind per tile and layer (1/32 of a texel each, 16 B).
+    let carries = |maps: f64| maps * 2.0 * 16.0 / SAT_TILE;
     let rows: Vec<Row> = vec![
         // The depth32float buffer once a layer; the stacked edges.
         ("csm.sat.tile_sums", 1, layers * 4.0, edges),
@@ -215,9 +218,9 @@ fn cssm_moves_what_the_hand_count_says() {
         ("csm.sat.1", 1, 4.0 * 4.0 + carries(4.0), 4.0 * 16.0),
         ("csm.sat.2", 1, 4.0 + carries(1.0), 4.0),
     ];
-    // 2 × 36 of depth, 3 × 4.5 of edges and carries written and read in pass 2, 2 + 2 + 0.5
-    // of carries read in pass 3, 132 of tables.
-    let total = 72.0 + 13.5 + 4.5 + 132.0;
+    // 2 × 36 of depth, 3 × 9 of edges and carries written and read in pass 2, 4 + 4 + 1 of
+    // carries read in pass 3, 132 of tables.
+    let total = 72.0 + 27.0 + 9.0 + 132.0;
     assert!(rows.len() <= 12 && total <= 300.0, "the issue's target");
     // One read of the depth, one write of eight rgba tables and one r32uint table.
     assert_traffic("techniques/cssm.toml", &rows, total, 4.0 + 8.0 * 16.0 + 4.0);

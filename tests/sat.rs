@@ -286,8 +286,15 @@ fn wgsl_const(module: &naga::Module, name: &str) -> Option<u32> {
 
 #[test]
 fn sat_tile_and_params_match_the_wgsl() {
-    // A row workgroup of `sat_carries` covers one tile row: one invocation per row.
-    assert_eq!(SAT_LINES_PER_GROUP, SAT_TILE);
+    // A row workgroup of `sat_carries` covers whole tile rows (`ROWS` of them), one invocation
+    // per row; the tile kernels' per-line steps take one invocation a tile row or column.
+    assert_eq!(SAT_LINES_PER_GROUP, 2 * SAT_TILE);
+    let wgsl = kernels::resolve("sat_carries", None).unwrap();
+    let (module, _) = kernels::reflect("sat_carries", &wgsl).unwrap();
+    assert_eq!(
+        wgsl_const(&module, "ROWS"),
+        Some(SAT_LINES_PER_GROUP / SAT_TILE)
+    );
     for kernel in [
         "sat_tile_sums",
         "sat_tile_sums_f32",

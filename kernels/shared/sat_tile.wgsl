@@ -3,14 +3,18 @@
 // row with SUB running column sums in registers, so invocations meet in workgroup memory only
 // through their sub-blocks' edge sums (O(SUB) values for SUB² texels). No function returns an
 // array: llvmpipe copies such returns through memory, twenty times slower than the sweep.
+// SUB = 4 (32² tiles) rather than 8 (64²): a GPU runs four times the invocations at once (a
+// 2048² map as 65 536 invocations of 8² texels left an H100 latency bound), while llvmpipe,
+// whose invocations are SIMD lanes over the same texels, does the same work. WG_SIZE = 2 · TILE:
+// the per-line steps (a tile row or column each) guard `li < TILE`.
 // #import shared/sat_params
 // #import shared/csm_maps
 // #import shared/linear_depth
 
-// Keep in sync with `SAT_TILE` in src/sat.rs.
-const SUB: u32 = 8u;
+// Keep in sync with `SAT_TILE` in src/sat/mod.rs.
+const SUB: u32 = 4u;
 const GRID: u32 = 8u;
-const TILE: u32 = 64u; // SUB · GRID
+const TILE: u32 = 32u; // SUB · GRID
 const WG_SIZE: u32 = 64u; // GRID · GRID
 
 // a + b in the variant's arithmetic: wrapping u32, or f32 on the values' bits. The kernels of

@@ -17,11 +17,16 @@
 // #completed-by-importer
 
 // Row y: at [y · (GRID − 1) + a − 1], the sum of row y over sub-blocks a' < a (a ≥ 1).
-var<workgroup> sh_right: array<vec4<u32>, 448>; // TILE · (GRID − 1)
-// Column x: at [x · (GRID − 1) + b − 1], the sum of column x over sub-block rows b' < b with
-// everything left of x in those rows of the tile.
-var<workgroup> sh_bottom: array<vec4<u32>, 448>;
+var<workgroup> sh_right: array<vec4<u32>, 224>; // TILE · (GRID − 1)
+// Column x: at [x · (GRID − 1) + b − 1], the sum of column x over sub-block rows b' < b, each
+// sub-block's own table's last row (its columns up to x); the sub-blocks wholly left of the
+// column's are added apart (`sat_tile_prepare`).
+var<workgroup> sh_bottom: array<vec4<u32>, 224>;
 const SIDE: u32 = 7u; // GRID − 1
+// The tile's carries, one load an invocation (not one per texel row and column of every
+// sub-block, eight times over): at [y] row y's row carry, at [TILE + x] column x's column
+// carry.
+var<workgroup> sh_carry: array<vec4<u32>, 64>; // 2 · TILE = WG_SIZE
 
 // Row j of the sub-block at `origin`: its encoded texels prefixed along the row, added to the
 // running column sums `col`, which then hold row j of the sub-block's own inclusive table.
@@ -47,6 +52,7 @@ fn sat_sweep_row(
 // for its edges. Every invocation calls it (it has barriers).
 fn sat_tile_prepare(
     col_carry: texture_2d<u32>,
+    row_carry: texture_2d<u32>,
     p: SatParams,
     fs: bool,
     s: SatSource,
@@ -58,6 +64,13 @@ fn sat_tile_prepare(
     let b = li / GRID;
     let size = textureDimensions(src);
     let origin = sat_sub_origin(tile, li);
+    // Invocation li's carry: row li (li < TILE), else column li − TILE, clamped to the map.
+    let q = min(tile * TILE + li % TILE, size - 1u);
+    if li < TILE {
+        sh_carry[li] = textureLoad(row_carry, vec2<u32>(s.band.x + tile.x, q.y), 0);
+    } else {
+        sh_carry[li] = textureLoad(col_carry, vec2<u32>(q.x, s.band.y + tile.y), 0);
+    }
     var col: array<vec4<u32>, SUB>;
     for (var j = 0u; j < SUB; j++) {
         sat_sweep_row(origin, j, p, fs, s, &col);
@@ -71,50 +84,47 @@ fn sat_tile_prepare(
         }
     }
     workgroupBarrier();
-    // Row li: the inclusive prefix of its entries is the exclusive prefix of sub-blocks 1 ..
-    // GRID − 1.
-    var left = sh_right[li * SIDE];
-    for (var k = 1u; k < SIDE; k++) {
-        left = sat_sum(left, sh_right[li * SIDE + k], fs);
-        sh_right[li * SIDE + k] = left;
-    }
-    workgroupBarrier();
-    // Column li: each sub-block row's last-row sums plus that sub-row's totals left of the
-    // column's sub-block (row k·SUB + SUB − 1 of sh_right), prefixed.
-    let column_block = li / SUB;
-    var run = vec4<u32>(0u);
-    for (var k = 0u; k < SIDE; k++) {
-        var e = sh_bottom[li * SIDE + k];
-        if column_block > 0u {
-            e = sat_sum(e, sh_right[(k * SUB + SUB - 1u) * SIDE + column_block - 1u], fs);
+    // Line li % TILE (WG_SIZE = 2 · TILE), each in entries only its invocation touches: row li
+    // (li < TILE), whose inclusive prefix is the exclusive prefix of sub-blocks 1 .. GRID − 1;
+    // column li − TILE, likewise down the sub-block rows.
+    let line = li % TILE;
+    if li < TILE {
+        var left = sh_right[line * SIDE];
+        for (var k = 1u; k < SIDE; k++) {
+            left = sat_sum(left, sh_right[line * SIDE + k], fs);
+            sh_right[line * SIDE + k] = left;
         }
-        run = select(sat_sum(run, e, fs), e, k == 0u);
-        sh_bottom[li * SIDE + k] = run;
+    } else {
+        var up = sh_bottom[line * SIDE];
+        for (var k = 1u; k < SIDE; k++) {
+            up = sat_sum(up, sh_bottom[line * SIDE + k], fs);
+            sh_bottom[line * SIDE + k] = up;
+        }
     }
     workgroupBarrier();
+    // The sub-blocks above and to the left, whole: per sub-block row k < b, its totals left of
+    // sub-block column a (row k·SUB + SUB − 1 of sh_right, prefixed). A separate sum, not a
+    // term of the column prefixes, so rows and columns take one phase and two barriers.
+    var corner = vec4<u32>(0u);
+    for (var k = 0u; k < b; k++) {
+        let e = sh_right[(k * SUB + SUB - 1u) * SIDE + max(a, 1u) - 1u];
+        corner = sat_sum(corner, select(vec4<u32>(0u), e, a > 0u), fs);
+    }
     for (var i = 0u; i < SUB; i++) {
-        let x = min(origin.x + i, size.x - 1u);
-        (*col_add)[i] = textureLoad(col_carry, vec2<u32>(x, s.band.y + tile.y), 0);
+        (*col_add)[i] = sh_carry[TILE + a * SUB + i];
         if b > 0u {
-            (*col_add)[i] = sat_sum((*col_add)[i], sh_bottom[(a * SUB + i) * SIDE + b - 1u], fs);
+            let above = sat_sum(sh_bottom[(a * SUB + i) * SIDE + b - 1u], corner, fs);
+            (*col_add)[i] = sat_sum((*col_add)[i], above, fs);
         }
     }
 }
 
 // The row terms of texel row j of invocation li's sub-block: the row carry and the tile's sums
 // left of the sub-block on that row (after `sat_tile_prepare`).
-fn sat_row_add(
-    row_carry: texture_2d<u32>,
-    fs: bool,
-    s: SatSource,
-    tile: vec2<u32>,
-    li: u32,
-    j: u32,
-) -> vec4<u32> {
+fn sat_row_add(fs: bool, li: u32, j: u32) -> vec4<u32> {
     let a = li % GRID;
     let b = li / GRID;
-    let y = min(sat_sub_origin(tile, li).y + j, textureDimensions(row_carry).y - 1u);
-    var add = textureLoad(row_carry, vec2<u32>(s.band.x + tile.x, y), 0);
+    var add = sh_carry[b * SUB + j];
     if a > 0u {
         add = sat_sum(add, sh_right[(b * SUB + j) * SIDE + a - 1u], fs);
     }

@@ -7,26 +7,21 @@
 // The importing kernel declares `src` (shared/sat_tile_texel):
 // #completed-by-importer
 
-// Row y's partial sums, one per sub-block column a, at [y · GRID + a]; then the row's sum in
-// [y · GRID]. sh_bottom likewise per column x and sub-block row b.
-var<workgroup> sh_right: array<vec4<u32>, 512>; // TILE · GRID
-var<workgroup> sh_bottom: array<vec4<u32>, 512>;
+// Row y's partial sums, one per sub-block column a, at [y · GRID + a]; column x's, one per
+// sub-block row b, at [(TILE + x) · GRID + b]; then the line's sum at its first entry. Line li
+// (invocation li's) is row li for li < TILE, column li − TILE after: WG_SIZE = 2 · TILE.
+var<workgroup> sh_lines: array<vec4<u32>, 512>; // 2 · TILE · GRID
 
-// Row li and column li of tile `tile`'s last column and last row.
-struct SatEdges {
-    row: vec4<u32>,
-    col: vec4<u32>,
-}
-
-// Invocation li's entries of the edges of tile `tile` of `src` (read as `s`, coded with `p`
-// in the variant `fs`). Every invocation calls it (it has barriers).
+// Invocation li's entry of the edges of tile `tile` of `src` (read as `s`, coded with `p` in
+// the variant `fs`): for li < TILE row li of the tile's last column, else column li − TILE of
+// its last row. Every invocation calls it (it has barriers).
 fn sat_tile_edges(
     p: SatParams,
     fs: bool,
     s: SatSource,
     tile: vec2<u32>,
     li: u32,
-) -> SatEdges {
+) -> vec4<u32> {
     let a = li % GRID;
     let b = li / GRID;
     let size = textureDimensions(src);
@@ -43,30 +38,26 @@ fn sat_tile_edges(
             col[i] = sat_sum(col[i], e, fs);
         }
         down = sat_sum(down, row, fs);
-        sh_right[(b * SUB + j) * GRID + a] = down;
+        sh_lines[(b * SUB + j) * GRID + a] = down;
     }
     for (var i = 0u; i < SUB; i++) {
         if i > 0u {
             col[i] = sat_sum(col[i - 1u], col[i], fs);
         }
-        sh_bottom[(a * SUB + i) * GRID + b] = col[i];
+        sh_lines[(TILE + a * SUB + i) * GRID + b] = col[i];
     }
     workgroupBarrier();
-    // Tile row li and tile column li, summed across the sub-blocks.
-    var e: SatEdges;
-    e.row = sh_right[li * GRID];
-    e.col = sh_bottom[li * GRID];
+    // Line li summed across the sub-blocks.
+    var e = sh_lines[li * GRID];
     for (var k = 1u; k < GRID; k++) {
-        e.row = sat_sum(e.row, sh_right[li * GRID + k], fs);
-        e.col = sat_sum(e.col, sh_bottom[li * GRID + k], fs);
+        e = sat_sum(e, sh_lines[li * GRID + k], fs);
     }
-    sh_right[li * GRID] = e.row;
-    sh_bottom[li * GRID] = e.col;
+    sh_lines[li * GRID] = e;
     workgroupBarrier();
     // Plus the whole sub-block rows above (columns to the left): their last lines' sums.
-    for (var k = 0u; k < li / SUB; k++) {
-        e.row = sat_sum(e.row, sh_right[(k * SUB + SUB - 1u) * GRID], fs);
-        e.col = sat_sum(e.col, sh_bottom[(k * SUB + SUB - 1u) * GRID], fs);
+    let first = li - li % TILE;
+    for (var k = 0u; k < (li % TILE) / SUB; k++) {
+        e = sat_sum(e, sh_lines[(first + k * SUB + SUB - 1u) * GRID], fs);
     }
     return e;
 }

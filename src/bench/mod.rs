@@ -775,9 +775,12 @@ mod tests {
             plan_bytes(&crate::graph::plan(&built.graph, &outputs).unwrap()).unwrap()
                 / f64::from(n * n)
         };
-        // rg32float moments in twice (2 × 8) and an rg32uint table out (8); a 64² tile's last
+        // rg32float moments in twice (2 × 8) and an rg32uint table out (8); a SAT_TILE² tile's last
         // row and column (2 × 8/64), read and written again as carries, and read once more.
-        assert_eq!(bytes("sat fixed"), 8.0 + 8.0 + 8.0 + 4.0 * 2.0 * 8.0 / 64.0);
+        assert_eq!(
+            bytes("sat fixed"),
+            8.0 + 8.0 + 8.0 + 4.0 * 2.0 * 8.0 / f64::from(crate::sat::SAT_TILE)
+        );
         // The first design: rg32float moments in (8), row scans out (16) and a block total per
         // row (1/32), their carries (2 × 2/32), the row scans again with a row carry per texel
         // (32) and column totals (1/32), the scans a third time with carries (32 + 1/32) and

@@ -193,9 +193,9 @@ mod tests {
             ]
         );
         let size = |n: &str| p.resource(n).map(|r| (r.width, r.height));
-        // 4 × 3 tiles of 64: five bands of 3 rows (col_*) and of 4 columns (row_*).
-        assert_eq!(size("l.sat.col_part"), Some((200, 15)));
-        assert_eq!(size("l.sat.row_carry"), Some((20, 130)));
+        // 7 × 5 tiles of 32: five bands of 5 rows (col_*) and of 7 columns (row_*).
+        assert_eq!(size("l.sat.col_part"), Some((200, 25)));
+        assert_eq!(size("l.sat.row_carry"), Some((35, 130)));
         let format = |n: &str| p.resource(n).map(|r| r.resource.format);
         assert_eq!(format("t0.sat"), Some(wgpu::TextureFormat::Rgba32Uint));
         assert_eq!(format("t4.sat"), Some(wgpu::TextureFormat::R32Uint));
@@ -207,10 +207,10 @@ mod tests {
         assert_eq!(
             groups,
             [
-                Some([4, 3, 5]),
+                Some([7, 5, 5]),
                 Some([4, 2, 5]),
-                Some([4, 3, 4]),
-                Some([4, 3, 1])
+                Some([7, 5, 4]),
+                Some([7, 5, 1])
             ]
         );
         // Every pass codes alike; `sat_carries` sees every layer; pass 3 its first table.

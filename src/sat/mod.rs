@@ -4,7 +4,8 @@
 //! [`add_sat`] adds three passes to a [`Graph`] (after Nehab et al. 2011: read twice, write
 //! once, and no workgroup ever waits on another, so nothing needs the forward-progress
 //! guarantees that Vulkan and WebGPU do not give). The map is cut into tiles of [`SAT_TILE`]²
-//! texels, one workgroup each (64 invocations, each an 8×8 sub-block in registers):
+//! texels, one workgroup each (64 invocations, each a 4×4 sub-block in registers: four times
+//! the invocations of 64² tiles of 8×8, which a GPU needs to hide its latency):
 //!
 //! 1. `sat_tile_sums` / `sat_tile_sums_f32`: read and encode the tile; write the last row and the last column of the
 //!    tile's own table (`.col_part`, `width × ⌈height / SAT_TILE⌉`, and `.row_part`,
@@ -46,9 +47,10 @@ use crate::kernels::KernelId;
 
 /// Side of the square tile one workgroup of `sat_tile_sums` and `sat_tiles` owns (`TILE` in
 /// `kernels/shared/sat_tile.wgsl`; a test checks them against each other).
-pub const SAT_TILE: u32 = 64;
+pub const SAT_TILE: u32 = 32;
 
-/// Lines per `sat_carries` workgroup, one per invocation (its workgroup size).
+/// Lines per `sat_carries` workgroup, one per invocation (its workgroup size, and that of the
+/// tile kernels): a row workgroup covers two tile rows.
 pub const SAT_LINES_PER_GROUP: u32 = 64;
 
 /// The largest `max_area` the fixed-point coding accepts: one unit per texel must fit an i32.
@@ -310,11 +312,13 @@ fn named(pairs: Vec<(&str, &str)>) -> Vec<(String, String)> {
 /// The depth of the f32 table's summation tree for a `width × height` map: every f32 table
 /// texel is a sum of the scaled values over its rectangle in which no value passes through
 /// more than this many roundings, so it is within `d·2⁻²⁴·Σ|x|` of the exact sum. Per pass
-/// (see the kernels): the tile edges 28 (a sub-block's row sums 7, prefixed 7, across the
-/// sub-blocks 7, the sub-rows above 7); a column carry that many plus one per tile above, a
-/// row carry one more per tile above (the tiles' totals) and one per tile to the left; in the
-/// last pass the sub-block's table 14, the sums left of it 20 and above it 27, each added to
-/// its carry, and both sides added: `32 + tiles_x + tiles_y` bounds them all.
+/// (see the kernels; 4×4 sub-blocks, 8×8 of them a tile): the tile edges 20 (a sub-block's
+/// row sums 3, prefixed 3, across the sub-blocks 7, the sub-rows above 7); a column carry
+/// that many plus one per tile above, a row carry one more per tile above (the tiles' totals)
+/// and one per tile to the left; in the last pass the sub-block's table 6, the sums left of
+/// it 12 and above it 20 (its columns' 12 plus the whole sub-blocks above-left, 19), each
+/// added to its carry, and both sides added:
+/// `32 + tiles_x + tiles_y` bounds them all.
 pub fn float_sum_depth(width: u32, height: u32) -> u32 {
     32 + width.div_ceil(SAT_TILE) + height.div_ceil(SAT_TILE)
 }
@@ -449,14 +453,14 @@ mod tests {
         };
         let u = wgpu::TextureFormat::Rg32Uint;
         assert_eq!(size("in.sat"), (3000, 37, u));
-        assert_eq!(size("in.sat.col_part"), (3000, 1, u));
-        assert_eq!(size("in.sat.row_carry"), (47, 37, u));
+        assert_eq!(size("in.sat.col_part"), (3000, 2, u));
+        assert_eq!(size("in.sat.row_carry"), (94, 37, u));
         let params: &SatParams = bytemuck::from_bytes(&p.steps[0].node.params);
         assert_eq!((params.channels, params.float_sums), (2, 0));
         let size = |r: &str| p.resource(r).map(|p| (p.width, p.height));
         assert_eq!(
             p.steps[0].node.dispatch.groups(size, [64, 1, 1]),
-            Some([47, 1, 1])
+            Some([94, 2, 1])
         );
         assert_eq!(
             p.steps[1].node.dispatch.groups(size, [64, 1, 1]),
