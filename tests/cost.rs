@@ -229,8 +229,10 @@ fn cssm_moves_what_the_hand_count_says() {
 /// The hand counts of the shading fetches: one bilinear lookup (4 loads) for VSM with a blur,
 /// one table lookup (16 loads: the 4 × 4 texels around the rectangle's corners) for MSM with
 /// a table, and for CSSM with M = 8 the ⌈M/2⌉ = 4 CSM and ⌈(2M + 1)/4⌉ = 5 CSM-Z tables over
-/// the search square plus the 4 CSM tables over the filter square: 13 × 16 = 208; PCSS 16
-/// blocker + 32 filter taps; anisotropic mips 8 taps of 8 loads (trilinear).
+/// the search square snapped outward (4 loads each) plus the 4 CSM tables over the filter
+/// square with its edges at the nearest texel edges (4 loads each): 13 × 4 = 52; VSSM and soft
+/// MSM one table, 4 + 4; PCSS 16 blocker + 32 filter taps; anisotropic mips 8 taps of 8 loads
+/// (trilinear).
 #[test]
 fn shading_fetches_match_the_hand_counts() {
     for (name, fetches) in [
@@ -238,7 +240,9 @@ fn shading_fetches_match_the_hand_counts() {
         // Packed f16 moments: the same four loads, each one word unpacked.
         ("techniques/vsm_f16.toml", 4.0),
         ("techniques/msm_sat.toml", 16.0),
-        ("techniques/cssm.toml", 100.0),
+        ("techniques/cssm.toml", 52.0),
+        ("techniques/vssm.toml", 8.0),
+        ("techniques/msm_soft.toml", 8.0),
         ("sphere_on_plane.toml", 48.0),
         ("techniques/vsm_mips_aniso.toml", 64.0),
     ] {

@@ -38,7 +38,8 @@ fn blocker_filter_width(l: Light, s: LightSample, z_avg: f32) -> f32 {
 
 // A soft technique's two table lookups: the search (`sat_search_*`, the square snapped
 // outward to texel edges, 4 loads a table) estimates the blockers (soft_blockers); the filter
-// lookup at the penumbra width (16 loads a table), made only where the search found some
+// lookup at the penumbra width (`sat_filter_*`, the square's edges rounded to the nearest
+// texel edges, 4 loads a table), made only where the search found some
 // (share ≥ BLOCKER_MIN_SHARE), sits in a loop of `soft_filter_trips` (0 or 1) trips; elsewhere
 // the receiver is lit after the search. A loop, not a branch: llvmpipe (lavapipe) runs a
 // loop-free branch body (a table lookup's loads) for its whole SIMD group whatever its lanes

@@ -25,6 +25,28 @@ fn sat_sample_float(map: texture_2d<f32>, l: Light, uv: vec2<f32>, width: f32) -
     return sat_mean_float(map, sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
 }
 
+// The square `sat_rect(l, uv, width)` with its edges rounded to the nearest texel edges (ties
+// to even, as `round`), at least one texel wide.
+fn sat_nearest(r: vec4<f32>) -> vec4<f32> {
+    let lo = round(r.xy);
+    return vec4<f32>(lo, max(round(r.zw), lo + 1.0));
+}
+
+// The mean over `sat_rect(l, uv, width)` with its edges rounded to the nearest texel edges
+// (`sat_nearest`, then `sat_box_*`): the soft techniques' filter in four loads. Their box
+// changes width and centre per pixel; moving its edges by at most half a texel moved the mean
+// error against the area-light truth by under 1% (5% in one of 27 configurations) on
+// sphere_on_plane, pole and stacked, where the exact integral (`sat_sample_*`) reads 16.
+// #fetches sat_filter_fixed: 4
+fn sat_filter_fixed(map: texture_2d<u32>, l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
+    return sat_box_fixed(map, sat_nearest(sat_rect(l, uv, width)), l.sat_offset, l.sat_scale);
+}
+
+// #fetches sat_filter_float: 4
+fn sat_filter_float(map: texture_2d<f32>, l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
+    return sat_box_float(map, sat_nearest(sat_rect(l, uv, width)), l.sat_offset, l.sat_scale);
+}
+
 // The mean over `sat_rect(l, uv, width)` snapped outward to texel edges (`sat_box_*`): the
 // blocker search's estimate in four loads.
 // #fetches sat_search_fixed: 4

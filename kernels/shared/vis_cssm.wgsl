@@ -11,7 +11,8 @@
 // CSM-Z tables and `csm_chunk_of` over its basis tables at the search width snapped outward
 // to texel edges (`sat_search_*`, 4 loads a table), which gives `cssm_blocker`; where that
 // finds blockers, a loop of `soft_filter_trips` trips sums the basis tables again at
-// `blocker_filter_width(l, s, b.x)` (16 loads a table) for `cssm_resolve`.
+// `blocker_filter_width(l, s, b.x)`, the square's edges rounded to the nearest texel edges
+// (`sat_filter_*`, 4 loads a table), for `cssm_resolve`.
 // #import shared/light
 // #import shared/sat_lookup
 // #import shared/blocker

@@ -157,6 +157,22 @@ pub fn clamp_rect(rect: [f32; 4], width: usize, height: usize) -> [f32; 4] {
     out
 }
 
+/// The square of `width` texels centred on `uv` (formed in f32 as `sat_rect` forms it) with
+/// its edges rounded to the nearest texel edges, ties to even, at least one texel wide
+/// (`sat_nearest` in `kernels/shared/sat_lookup.wgsl`), before clamping: (x0, y0, x1, y1).
+pub fn nearest_square(map_size: [f32; 2], uv: [f64; 2], width: f64) -> [f32; 4] {
+    let [x0, y0, x1, y1] = square(map_size, uv, width).map(f32::round_ties_even);
+    [x0, y0, x1.max(x0 + 1.0), y1.max(y0 + 1.0)]
+}
+
+/// The square of `width` texels centred on `uv`, formed in f32 as `sat_rect` in
+/// `kernels/shared/sat_lookup.wgsl` forms it: (x0, y0, x1, y1), texel units.
+pub fn square(map_size: [f32; 2], uv: [f64; 2], width: f64) -> [f32; 4] {
+    let (cx, cy) = (uv[0] as f32 * map_size[0], uv[1] as f32 * map_size[1]);
+    let h = 0.5 * width as f32;
+    [cx - h, cy - h, cx + h, cy + h]
+}
+
 /// Mean of `t` (piecewise constant: texel (i, j) covers `[i, i + 1) × [j, j + 1)`) over the
 /// rectangle `rect` in texel units after [`clamp_rect`], by direct f64 integration of the
 /// overlap of every texel; 4 values (channels `t` lacks are 0).
@@ -245,9 +261,15 @@ impl Integral {
     /// The mean over the square of `width` texels centred on `uv`, formed in f32 as
     /// `sat_rect` in `kernels/shared/sat_lookup.wgsl` forms it (`sat_sample_*`).
     pub fn square_mean(&self, map_size: [f32; 2], uv: [f64; 2], width: f64) -> Vec<f64> {
-        let (cx, cy) = (uv[0] as f32 * map_size[0], uv[1] as f32 * map_size[1]);
-        let h = 0.5 * width as f32;
-        self.rect_mean([cx - h, cy - h, cx + h, cy + h])
+        self.rect_mean(square(map_size, uv, width))
+    }
+
+    /// The mean over the square of [`Self::square_mean`] with its edges rounded to the nearest
+    /// texel edges (ties to even, as WGSL's `round`) and at least one texel wide, then
+    /// [`clamp_rect`] (`sat_filter_*`, the soft techniques' filter).
+    pub fn nearest_square_mean(&self, map_size: [f32; 2], uv: [f64; 2], width: f64) -> Vec<f64> {
+        let r = clamp_rect(nearest_square(map_size, uv, width), self.width, self.height);
+        self.rect_mean([r[0].floor(), r[1].floor(), r[2].ceil(), r[3].ceil()])
     }
 
     /// The mean over the square of [`Self::square_mean`] snapped outward to texel edges after

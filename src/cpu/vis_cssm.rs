@@ -35,10 +35,11 @@ pub fn blocker_of(below: f64, zsum: f64, l: &LightGpu, s: &LightSample) -> Block
     blocker::csm_z(below, zsum, s.depth - f64::from(l.bias))
 }
 
-/// The CSM series over the penumbra width of `b`.
+/// The CSM series over the penumbra width of `b`, the square's edges rounded to the nearest
+/// texel edges.
 pub fn filtered(maps: Maps, l: &LightGpu, s: &LightSample, b: Blocker) -> f64 {
     let w = blocker::filter_width(l, s, b.depth);
-    let basis = maps.basis.square_mean(l.map_size, s.uv, w);
+    let basis = maps.basis.nearest_square_mean(l.map_size, s.uv, w);
     super::vis_csm::series(&basis, l, super::vis_csm::shifted_depth(l, s))
 }
 

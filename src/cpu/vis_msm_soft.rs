@@ -18,9 +18,10 @@ pub fn blocker_of(m: &[f64], l: &LightGpu, s: &LightSample) -> Blocker {
     blocker::msm(&super::vis_msm::biased(m, l), s.depth - f64::from(l.bias))
 }
 
-/// The mean moments over the penumbra width of `b`.
+/// The mean moments over the penumbra width of `b`, the square's edges rounded to the nearest
+/// texel edges.
 pub fn filtered(moments: &Integral, l: &LightGpu, s: &LightSample, b: Blocker) -> Vec<f64> {
-    moments.square_mean(l.map_size, s.uv, blocker::filter_width(l, s, b.depth))
+    moments.nearest_square_mean(l.map_size, s.uv, blocker::filter_width(l, s, b.depth))
 }
 
 /// The visibility for blocker estimate `b` (`msm_soft_resolve` after the second lookup).

@@ -14,7 +14,7 @@ use std::fmt::Write;
 
 use super::csm::{csm_gpu, csm_maps, csm_nodes, terms};
 use super::nodes::map_type;
-use super::shade::{ShadeInput, VisibilityBody, sat_sample, table_suffix};
+use super::shade::{ShadeInput, VisibilityBody, table_suffix};
 use crate::model::Light;
 
 const SHARPEN: &[ParamSpec] = &[
@@ -65,9 +65,11 @@ fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
     let suffix = table_suffix(soft.sums);
     let (basis, z) = maps.split_at((csm_maps(terms) as usize).min(maps.len()));
     let search = |m: &str| format!("sat_search_{suffix}({m}, l, s.uv, width)");
-    let sample = |m: &str| sat_sample(soft.sums, m, "look.width");
-    // The search reads every table over the square snapped to texel edges (4 loads each); the
-    // filter reads the basis tables again, in a loop of 0 or 1 trips (`soft_filter_trips`).
+    let sample = |m: &str| format!("sat_filter_{suffix}({m}, l, s.uv, look.width)");
+    // The search reads every table over the square snapped outward to texel edges (4 loads
+    // each); the filter reads the basis tables again over the penumbra square with its edges
+    // rounded to the nearest texel edges (4 loads each), in a loop of 0 or 1 trips
+    // (`soft_filter_trips`).
     let mut body = String::from("let width = blocker_search_width(l, s);\n    var zsum = 0.0;");
     for (chunk, m) in z.iter().enumerate() {
         let _ = write!(
@@ -100,7 +102,7 @@ fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
          return cssm_resolve(sum, look.blocker, l, s);",
     );
     let fetches = format!(
-        "{} * sat_search_{suffix} + {} * sat_sample_{suffix}",
+        "{} * sat_search_{suffix} + {} * sat_filter_{suffix}",
         z.len() + basis.len(),
         basis.len()
     );

@@ -12,6 +12,12 @@
 //! errors, see `combinations`); the tolerance is twice the largest change of each, plus 1e-5
 //! (first-order propagation is not a bound on its own: the factor 2 covers curvature). A point where a perturbation flips whether the
 //! search square holds blockers (a threshold, `BLOCKER_MIN_SHARE`) has no tolerance: `None`.
+//! Nor has one whose filter square has an edge within [`EDGE_MARGIN`] of the point where its
+//! rounding to the nearest texel edge changes (a half texel): the box there jumps by a texel
+//! row or column for a tiny change of the penumbra width, and the GPU's f32 blocker estimate
+//! (a division by the blockers' share, Hamburger's root solve) can land on the other side
+//! (seen: an edge at 29.4992 read as past 29.5). Wider moves of the width, from the
+//! propagated errors, are in the tolerance: `finish` at z_avg ± δz takes the jump.
 
 use shadowgraph::cpu::blocker::Blocker;
 use shadowgraph::cpu::light::LightSample;
@@ -128,7 +134,15 @@ pub struct Chain<'a> {
     pub visibility: &'a dyn Fn(&[f64], f64) -> f64,
     /// The receiver depth's error.
     pub e_depth: f64,
+    /// The filter square's edges before rounding for blockers at this depth
+    /// (`cpu::sat::square`).
+    pub filter_box: &'a dyn Fn(f64) -> [f32; 4],
 }
+
+/// How close to a half texel a filter square's edge may lie before its point is set aside:
+/// 2·10⁻³ texel, 2.5 times the largest GPU–f64 difference of an edge seen (8·10⁻⁴), which sets
+/// aside about 1.6% of points.
+pub const EDGE_MARGIN: f32 = 2e-3;
 
 /// The receiver's UV and the four moved by ±[`UV_ERROR`] on both axes.
 const UV_MOVES: [[f64; 2]; 5] = [
@@ -164,6 +178,10 @@ impl Chain<'_> {
         if !b0.found() {
             return Some(1e-5);
         }
+        let near_half = |x: &f32| (x - x.floor() - 0.5).abs() < EDGE_MARGIN;
+        if (self.filter_box)(b0.depth).iter().any(near_half) {
+            return None;
+        }
         let search = [b0.depth - dz, b0.depth + dz]
             .iter()
             .map(|&z| ((self.finish)(z) - v0).abs())
@@ -180,6 +198,11 @@ impl Chain<'_> {
         }
         Some(1e-5 + 2.0 * (search + last))
     }
+}
+
+/// The filter square's edges (before rounding) at `s` for blockers at depth `z`.
+fn filter_box(l: &LightGpu, s: &LightSample, z: f64) -> [f32; 4] {
+    cpu::sat::square(l.map_size, s.uv, cpu::blocker::filter_width(l, s, z))
 }
 
 /// `s` with its UV moved by `du`.
@@ -217,6 +240,7 @@ pub fn vssm_tolerance(
         e_last: el[..2].to_vec(),
         visibility: &|m, dd| cpu::vis_vsm::vis_vsm_of(m, l, &moved(s, dd)),
         e_depth: depth_error(l, s),
+        filter_box: &|z| filter_box(l, s, z),
     }
     .tolerance(v0)
 }
@@ -279,6 +303,7 @@ pub fn msm_soft_tolerance(
         e_last: el.to_vec(),
         visibility: &|b, dd| cpu::vis_msm::visibility(&msm_bias(l, b), d + dd, l),
         e_depth: depth_error(l, s),
+        filter_box: &|z| filter_box(l, s, z),
     }
     .tolerance(v0)
 }
@@ -337,6 +362,7 @@ pub fn cssm_tolerance(
         e_last: vec![e_sum],
         visibility: &|m, dd| v::resolve(m[0], l, &moved(s, dd), b0),
         e_depth: e_d,
+        filter_box: &|z| filter_box(l, s, z),
     }
     .tolerance(v0)
     .map(|t| t + 2.0 * pow)
