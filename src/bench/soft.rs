@@ -67,7 +67,9 @@ pub struct SoftRow {
 /// Frames a configuration renders back to back in each round; the last one is timed. The first
 /// frame after a change of configuration reads cold caches and, on a GPU, runs at whatever
 /// clock the idle gap before it left: on an H100 at 1920×1080, PCSS 16+32's shading pass read
-/// 0.64 ms as single interleaved frames and 0.15 ms in consecutive frames.
+/// 0.64 ms as single interleaved frames, 0.23 ms as the last of three and 0.15 ms over twenty
+/// consecutive frames, the ratios between techniques within 15% of the twenty's from three on.
+/// Three keep the benchmark's time on a CPU driver within reason.
 pub const STEADY_FRAMES: u32 = 3;
 
 /// Whether a timed pass is part of a light's prefilter: a light's pass (`light<i>.…`) other
