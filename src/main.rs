@@ -74,15 +74,20 @@ enum Command {
         lookup: Option<Vec<u32>>,
         /// With `--lookup`: the light sizes (world units) at which PCSS and the soft techniques
         /// are compared on `scenes/techniques/cssm.toml`.
-        #[arg(long, value_delimiter = ',', default_value = "0.25,0.5,1,2")]
+        #[arg(
+            long,
+            value_delimiter = ',',
+            default_value = "0.25,0.5,1,2",
+            requires = "lookup"
+        )]
         light_sizes: Vec<f32>,
         /// With `--lookup`: shade at this image size, WIDTHxHEIGHT (default: the scenes' own,
         /// 400x300 and 200x150, small for a CPU driver; a GPU wants 1920x1080).
-        #[arg(long, value_parser = parse_size)]
+        #[arg(long, value_parser = parse_size, requires = "lookup")]
         image: Option<(u32, u32)>,
         /// With `--lookup`: render the light's shadow map at this size, texels a side
         /// (default: the scenes' own, 512).
-        #[arg(long, value_parser = clap::value_parser!(u32).range(16..=32768))]
+        #[arg(long, value_parser = clap::value_parser!(u32).range(16..=32768), requires = "lookup")]
         map: Option<u32>,
         /// Time only the kernels whose name contains one of these (e.g. `sat,mips`); the
         /// texture copies, their yardsticks, always run. With `--lookup`: only these soft
@@ -161,11 +166,19 @@ fn main() {
             if e.use_stderr()
                 && e.kind() != clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand =>
         {
+            // clap's message is its first paragraph (the error, then what it names on indented
+            // lines, e.g. a missing argument), before the usage: joined into one line.
             let text = e.to_string();
-            eprintln!(
-                "{}",
-                text.lines().next().unwrap_or("error: invalid arguments")
-            );
+            let first: Vec<&str> = text
+                .lines()
+                .take_while(|l| !l.trim().is_empty())
+                .map(str::trim)
+                .collect();
+            if first.is_empty() {
+                eprintln!("error: invalid arguments");
+            } else {
+                eprintln!("{}", first.join(" "));
+            }
             std::process::exit(1);
         }
         Err(e) => e.exit(),

@@ -119,3 +119,30 @@ fn library_entry_points_check_the_same_bounds() {
     opts.truth_resolution = None;
     shadowgraph::evaluate::check_options(&opts).expect("defaults are valid");
 }
+
+/// The lookup benchmark's options apply to `--lookup` only: given without it they are refused
+/// naming `--lookup` (clap's message on one line), as is a `--map` of 32768 (past lavapipe's
+/// texture side, named as `--map`; past the memory budget where a device allows that side) and
+/// an `--only` that names no soft configuration.
+#[test]
+fn lookup_options_need_the_lookup_and_sane_values() {
+    for extra in [
+        &["--map", "256"][..],
+        &["--image", "64x48"],
+        &["--light-sizes", "0.5"],
+    ] {
+        let mut args = vec!["bench", "--sizes", "64", "--repeat", "1"];
+        args.extend_from_slice(extra);
+        refused(&args, &["required arguments were not provided", "--lookup"]);
+    }
+    refused(
+        &["bench", "--lookup", "3", "--repeat", "1", "--map", "32768"],
+        &["32768"],
+    );
+    refused(
+        &[
+            "bench", "--lookup", "3", "--repeat", "1", "--only", "nosuch",
+        ],
+        &["--only nosuch", "matches no soft configuration", "vssm"],
+    );
+}

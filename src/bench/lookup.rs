@@ -69,6 +69,7 @@ pub fn lookup_cost(
                 .to_string(),
         ));
     }
+    super::check_map(&gpu.device, map)?;
     let mut base = crate::scene::Scene::parse(std::path::Path::new("vsm.toml"), LOOKUP_SCENE)?;
     if let Some((w, h)) = image {
         (base.width, base.height) = (w, h);

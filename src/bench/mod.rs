@@ -635,6 +635,20 @@ pub fn format_table(device: &str, cpu: bool, repeat: u32, rows: &[BenchRow]) -> 
     s
 }
 
+/// A `--map` size the device can make: past its largest texture side it is an error naming
+/// the flag (the scene's own `shadow_map` line would name a key the user did not write).
+fn check_map(device: &wgpu::Device, map: Option<u32>) -> Result<()> {
+    let max = device.limits().max_texture_dimension_2d;
+    match map {
+        Some(n) if n > max => Err(Error::Limit {
+            what: "bench --map (shadow-map side)".into(),
+            requested: u64::from(n),
+            limit: u64::from(max),
+        }),
+        _ => Ok(()),
+    }
+}
+
 fn check_args(device: &wgpu::Device, sizes: &[u32], repeat: u32) -> Result<()> {
     if sizes.is_empty() {
         return Err(Error::Invalid("no benchmark sizes given".into()));

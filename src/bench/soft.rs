@@ -137,14 +137,22 @@ pub fn soft_cost(
                 .to_string(),
         ));
     }
+    super::check_map(&gpu.device, map)?;
+    let named = |name: &str| only.iter().any(|o| name.contains(o.as_str()));
     let picked: Vec<&(&str, &str)> = SOFT_TECHNIQUES
         .iter()
         .enumerate()
-        .filter(|(k, (name, _))| {
-            *k == YARDSTICK || only.is_empty() || only.iter().any(|o| name.contains(o.as_str()))
-        })
+        .filter(|(k, (name, _))| *k == YARDSTICK || only.is_empty() || named(name))
         .map(|(_, t)| t)
         .collect();
+    if !only.is_empty() && !SOFT_TECHNIQUES.iter().any(|(name, _)| named(name)) {
+        let names: Vec<&str> = SOFT_TECHNIQUES.iter().map(|(n, _)| *n).collect();
+        return Err(Error::Invalid(format!(
+            "bench --lookup --only {}: matches no soft configuration; they are: {}",
+            only.join(","),
+            names.join("; ")
+        )));
+    }
     let mut scenes = Vec::new();
     for (_, shadow) in &picked {
         let mut base = scene_with(shadow)?;
