@@ -8,6 +8,8 @@
 //     map from channel 4·(m − ⌈M/2⌉) on, channels past the last zeros. Filtered next to the CSM
 //     basis they give E[f̄(d, z)·z] over any rectangle, f̄ = 1 − f, so the average blocker depth
 //     E[f̄·z] / E[f̄] (shared/blocker.wgsl) is a lookup.
+//   - or, CSSM with `blocker_search = "moments"` (`moments` = 1), one map of the power moments
+//     (z, z², z³, z⁴), whose means give MSM's blocker estimate.
 // This dispatch writes maps first_map … first_map + maps − 1 to dst0 … dst<maps − 1> (the
 // executor binds the unused outputs to the last bound one; they are not stored to). Every value
 // lies in [−1, 1] (|z·sin| ≤ z ≤ 1), so f16 storage keeps them to 2⁻¹¹. The argument is reduced
@@ -24,7 +26,7 @@ struct Params {
     first_map: u32,
     maps: u32,
     terms: u32,
-    _pad: u32,
+    moments: u32,
 }
 
 // Traffic (the cost model, src/graph/cost): one texel in, one out per bound map (an unbound
@@ -57,14 +59,15 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let z = depth.z;
     let m = params.first_map;
-    textureStore(dst0, id.xy, csm_basis_map(m, params.terms, z));
+    let moments = params.moments != 0u;
+    textureStore(dst0, id.xy, csm_basis_map(m, params.terms, moments, z));
     if params.maps > 1u {
-        textureStore(dst1, id.xy, csm_basis_map(m + 1u, params.terms, z));
+        textureStore(dst1, id.xy, csm_basis_map(m + 1u, params.terms, moments, z));
     }
     if params.maps > 2u {
-        textureStore(dst2, id.xy, csm_basis_map(m + 2u, params.terms, z));
+        textureStore(dst2, id.xy, csm_basis_map(m + 2u, params.terms, moments, z));
     }
     if params.maps > 3u {
-        textureStore(dst3, id.xy, csm_basis_map(m + 3u, params.terms, z));
+        textureStore(dst3, id.xy, csm_basis_map(m + 3u, params.terms, moments, z));
     }
 }

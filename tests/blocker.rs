@@ -13,7 +13,7 @@ use shadowgraph::cpu::sat::Integral;
 use shadowgraph::cpu::{self, Texels};
 use shadowgraph::gpu::Gpu;
 use shadowgraph::sat::SatVariant;
-use shadowgraph::scene::Storage;
+use shadowgraph::scene::{CssmSearch, Storage};
 use shadowgraph::technique::{LightGpu, sat_coding};
 
 /// Runs the `csm` kernel's CSM-Z maps (one map a dispatch) for every chunk of `terms` terms at `storage` over `input`
@@ -56,7 +56,7 @@ fn csm_z_on_gpu(
                 first_map: csm_maps(terms) + chunk,
                 maps: 1,
                 terms,
-                _pad: 0,
+                moments: 0,
             })
             .to_vec(),
             dispatch: Dispatch::Texels(out.clone()),
@@ -418,7 +418,7 @@ fn blocker_estimates_match_reference() {
     // CSM-Z (M = 3: two basis tables, two CSM-Z tables): the series E[f] − ½ and E[f̄·z]
     // themselves, then the estimate from them.
     let terms = 3;
-    let l = common::soft_maps::light(DIR, cssm(terms, 0.0, 0.0));
+    let l = common::soft_maps::light(DIR, cssm(terms, 0.0, 0.0, CssmSearch::CsmZ));
     let lg = LightGpu::new(&l);
     let coding = sat_coding(&l).expect("coding").expect("table");
     let basis = tables(&rounded(cpu::csm::csm(&lin, terms)), &coding);

@@ -117,7 +117,7 @@ fn soft_benchmark_reports_every_configuration() {
         );
     }
     let tables = |name: &str| rows.iter().find(|r| r.technique == name).unwrap();
-    for soft in ["vssm", "msm_soft", "cssm M=8"] {
+    for soft in ["vssm", "msm_soft", "cssm M=8", "cssm M=8 csm_z"] {
         assert!(
             tables(soft).prefilter_ms > 0.0,
             "{soft} builds tables: {:?}",
@@ -135,7 +135,7 @@ fn soft_benchmark_reports_every_configuration() {
     let some = shadowgraph::bench::soft_cost(&g, &[0.5], 1, Some((48, 36)), Some(128), &only)
         .expect("soft bench, only cssm");
     let names: Vec<&str> = some.iter().map(|r| r.technique.as_str()).collect();
-    assert_eq!(names, ["pcss 16+32", "cssm M=8"]);
+    assert_eq!(names, ["pcss 16+32", "cssm M=8", "cssm M=8 csm_z"]);
     let table = shadowgraph::bench::format_soft_table("test", true, 1, &[0.5], &some);
     let pcss = table.lines().find(|l| l.starts_with("pcss 16+32")).unwrap();
     assert!(pcss.contains("( 1.00)"), "{table}");

@@ -196,24 +196,46 @@ fn msm_with_sat_moves_what_the_hand_count_says() {
     assert_traffic("techniques/msm_sat.toml", &rows, 48.0, 4.0 + 16.0);
 }
 
-/// `cssm.toml`: M = 8 terms at 512²: four CSM maps and five CSM-Z maps (four of four
-/// channels, the 17th channel alone), never stored: their nine tables (eight rgba32uint, one
-/// r32uint) are built as one layered table (`sat::layers`), whose tile passes compute each
-/// layer's basis from the depth (linearize fused), and whose edges are stacked. The issue's
-/// target: at most 12 dispatches and 300 B/texel.
+/// `cssm.toml`: M = 8 terms at 512². With the default moment search, four CSM maps and the
+/// power moments' map; with the paper's CSM-Z search, the four CSM maps and five CSM-Z maps
+/// (four of four channels, the 17th channel alone). Never stored: their tables (rgba32uint,
+/// the 17th channel's r32uint) are built as one layered table (`sat::layers`), whose tile
+/// passes compute each layer's basis from the depth (linearize fused), and whose edges are
+/// stacked. The target: at most 12 dispatches and 300 B/texel.
 #[test]
 fn cssm_moves_what_the_hand_count_says() {
-    let layers = 9.0;
     // A tile's last row and last column (pass 1) and as many carries (pass 2), one rgba32uint
     // texel (16 B) per 32 map texels each, twice, for every layer.
-    let edges = layers * 2.0 * 16.0 / SAT_TILE;
+    let edges = |layers: f64| layers * 2.0 * 16.0 / SAT_TILE;
     // Pass 3 reads 32 carries of either kind per tile and layer (1/32 of a texel each, 16 B).
     let carries = |maps: f64| maps * 2.0 * 16.0 / SAT_TILE;
+
+    // Moments: five layers, two pass-3 dispatches.
     let rows: Vec<Row> = vec![
         // The depth32float buffer once a layer; the stacked edges.
-        ("csm.sat.tile_sums", 1, layers * 4.0, edges),
-        ("csm.sat.carries", 1, edges, edges),
+        ("csm.sat.tile_sums", 1, 5.0 * 4.0, edges(5.0)),
+        ("csm.sat.carries", 1, edges(5.0), edges(5.0)),
         // Four tables a dispatch: the depth again once a layer, their carries, the tables.
+        ("csm.sat.0", 1, 4.0 * 4.0 + carries(4.0), 4.0 * 16.0),
+        ("csm.sat.1", 1, 4.0 + carries(1.0), 16.0),
+    ];
+    // 2 × 20 of depth, 3 × 5 of edges and carries written and read in pass 2, 4 + 1 of
+    // carries read in pass 3, 80 of tables.
+    let total = 40.0 + 15.0 + 5.0 + 80.0;
+    assert!(rows.len() <= 12 && total <= 300.0, "the issue's target");
+    // One read of the depth, one write of five rgba tables.
+    assert_traffic("techniques/cssm.toml", &rows, total, 4.0 + 5.0 * 16.0);
+
+    // CSM-Z: nine layers, three pass-3 dispatches.
+    let path = scene_path("techniques/cssm.toml");
+    let text = std::fs::read_to_string(&path).expect("cssm.toml").replace(
+        "technique = \"cssm\"",
+        "technique = \"cssm\"\nblocker_search = \"csm_z\"",
+    );
+    let s = Scene::parse(&path, &text).expect("parse");
+    let rows: Vec<Row> = vec![
+        ("csm.sat.tile_sums", 1, 9.0 * 4.0, edges(9.0)),
+        ("csm.sat.carries", 1, edges(9.0), edges(9.0)),
         ("csm.sat.0", 1, 4.0 * 4.0 + carries(4.0), 4.0 * 16.0),
         ("csm.sat.1", 1, 4.0 * 4.0 + carries(4.0), 4.0 * 16.0),
         ("csm.sat.2", 1, 4.0 + carries(1.0), 4.0),
@@ -223,14 +245,15 @@ fn cssm_moves_what_the_hand_count_says() {
     let total = 72.0 + 27.0 + 9.0 + 132.0;
     assert!(rows.len() <= 12 && total <= 300.0, "the issue's target");
     // One read of the depth, one write of eight rgba tables and one r32uint table.
-    assert_traffic("techniques/cssm.toml", &rows, total, 4.0 + 8.0 * 16.0 + 4.0);
+    assert_scene_traffic("cssm.toml, csm_z", &s, &rows, total, 4.0 + 8.0 * 16.0 + 4.0);
 }
 
 /// The hand counts of the shading fetches: one bilinear lookup (4 loads) for VSM with a blur,
 /// one table lookup (16 loads: the 4 × 4 texels around the rectangle's corners) for MSM with
-/// a table, and for CSSM with M = 8 the ⌈M/2⌉ = 4 CSM and ⌈(2M + 1)/4⌉ = 5 CSM-Z tables over
-/// the search square snapped outward (4 loads each) plus the 4 CSM tables over the filter
-/// square with its edges at the nearest texel edges (4 loads each): 13 × 4 = 52; VSSM and soft
+/// a table, and for CSSM with M = 8 the power moments' table over the search square snapped
+/// outward (4 loads) plus the ⌈M/2⌉ = 4 CSM tables over the filter square with its edges at
+/// the nearest texel edges (4 loads each): 5 × 4 = 20 (with the CSM-Z search, the 4 CSM and
+/// ⌈(2M + 1)/4⌉ = 5 CSM-Z tables over the search square too: 13 × 4 = 52); VSSM and soft
 /// MSM one table, 4 + 4; PCSS 16 blocker + 32 filter taps; anisotropic mips 8 taps of 8 loads
 /// (trilinear).
 #[test]
@@ -240,7 +263,7 @@ fn shading_fetches_match_the_hand_counts() {
         // Packed f16 moments: the same four loads, each one word unpacked.
         ("techniques/vsm_f16.toml", 4.0),
         ("techniques/msm_sat.toml", 16.0),
-        ("techniques/cssm.toml", 52.0),
+        ("techniques/cssm.toml", 20.0),
         ("techniques/vssm.toml", 8.0),
         ("techniques/msm_soft.toml", 8.0),
         ("sphere_on_plane.toml", 48.0),
@@ -250,6 +273,14 @@ fn shading_fetches_match_the_hand_counts() {
         let got = shadowgraph::cli::shading_fetches(&s.lights).expect("fetches");
         assert_eq!(got, [fetches], "{name}");
     }
+    let path = scene_path("techniques/cssm.toml");
+    let text = std::fs::read_to_string(&path).expect("cssm.toml").replace(
+        "technique = \"cssm\"",
+        "technique = \"cssm\"\nblocker_search = \"csm_z\"",
+    );
+    let s = Scene::parse(&path, &text).expect("parse");
+    let got = shadowgraph::cli::shading_fetches(&s.lights).expect("fetches");
+    assert_eq!(got, [52.0], "cssm.toml, csm_z");
 }
 
 /// `plan` prints each node's traffic, the closing total and the shading fetches.

@@ -7,7 +7,8 @@
 //! exact sums of those codes (wrapping u32, as the integer reference `cpu::sat::sat_fixed`
 //! sums them), in f32 every table texel is within the scan's rounding bound of the f64 table.
 //! Random depth with NaN and ±Inf texels (counted once), ragged tiles, both variants, CSM
-//! alone and CSSM's CSM + CSM-Z, f32 and f16 storage.
+//! alone, CSSM's CSM + CSM-Z and CSSM's CSM + power moments (`cpu::msm`), f32 and f16
+//! storage.
 
 mod common;
 
@@ -20,18 +21,19 @@ use shadowgraph::gpu::{Gpu, read_texture, submit_and_wait, write_texture};
 use shadowgraph::graph::{Graph, plan, texel_bytes};
 use shadowgraph::sat::layers::LAYERED_SAT_OUTPUTS;
 use shadowgraph::sat::{SatCoding, SatVariant, decode_table, float_sum_depth, lookup_area};
-use shadowgraph::scene::Storage;
+use shadowgraph::scene::{CssmSearch, Storage};
 use shadowgraph::technique::{CsmBasis, LinearizeParams, add_csm_tables, csm_maps, csm_z_maps};
 
 /// f32's unit roundoff.
 const U: f64 = 1.0 / (1u64 << 24) as f64;
 
-/// One case: map size, terms, CSM-Z maps too, coding variant, storage, non-finite texels.
+/// One case: map size, terms, the blocker search's maps too, coding variant, storage,
+/// non-finite texels.
 struct Case {
     w: usize,
     h: usize,
     terms: u32,
-    z: bool,
+    search: Option<CssmSearch>,
     variant: SatVariant,
     storage: Storage,
     bad: usize,
@@ -75,7 +77,7 @@ fn run(g: &Gpu, case: &Case, raw: &[f32], coding: SatCoding) -> (Vec<Vec<u32>>, 
     graph.import("in", wgpu::TextureFormat::R32Float, w, h, Some(0));
     let basis = CsmBasis {
         terms: case.terms,
-        z: case.z,
+        search: case.search,
         storage: case.storage,
         depth: LinearizeParams::ORTHOGRAPHIC,
     };
@@ -122,9 +124,9 @@ fn run(g: &Gpu, case: &Case, raw: &[f32], coding: SatCoding) -> (Vec<Vec<u32>>, 
     (words, plan.steps.len(), stats.iter().map(|s| s.1).collect())
 }
 
-/// Per table, the f64 basis of `lin`: its channels of the CSM sequence (2M) then, with `z`,
-/// of the CSM-Z sequence (2M + 1), four a table.
-fn basis(lin: &Texels, terms: u32, z: bool) -> Vec<Texels> {
+/// Per table, the f64 basis of `lin`: its channels of the CSM sequence (2M) then, with
+/// `search`, of the CSM-Z sequence (2M + 1), four a table, or the four power moments.
+fn basis(lin: &Texels, terms: u32, search: Option<CssmSearch>) -> Vec<Texels> {
     let chunks = |t: Texels, maps: u32| -> Vec<Texels> {
         (0..maps as usize)
             .map(|m| {
@@ -143,8 +145,12 @@ fn basis(lin: &Texels, terms: u32, z: bool) -> Vec<Texels> {
             .collect()
     };
     let mut out = chunks(cpu::csm::csm(lin, terms), csm_maps(terms));
-    if z {
-        out.extend(chunks(cpu::csm_z::csm_z(lin, terms), csm_z_maps(terms)));
+    match search {
+        Some(CssmSearch::CsmZ) => {
+            out.extend(chunks(cpu::csm_z::csm_z(lin, terms), csm_z_maps(terms)));
+        }
+        Some(CssmSearch::Moments) => out.push(cpu::msm::msm(lin, false)),
+        None => {}
     }
     out
 }
@@ -154,18 +160,28 @@ fn basis(lin: &Texels, terms: u32, z: bool) -> Vec<Texels> {
 /// 2M − 1 rounds it by ≤ 2·U·(2M − 1), moved by π (slope ≤ 1); the CSM-Z product (|z| ≤ 1)
 /// adds a rounding; f16 storage rounds each value by 2⁻¹¹ relative.
 fn basis_tolerance(terms: u32, storage: Storage, v: f64) -> f64 {
-    let f16 = if storage == Storage::F16 {
+    2f64.powi(-11) + 2.0 * U * f64::from(2 * terms - 1) * std::f64::consts::PI + U + f16(storage, v)
+}
+
+/// f16 storage's rounding of `v` (2⁻¹¹ relative), 0 for f32.
+fn f16(storage: Storage, v: f64) -> f64 {
+    if storage == Storage::F16 {
         2f64.powi(-11) * v.abs()
     } else {
         0.0
-    };
-    2f64.powi(-11) + 2.0 * U * f64::from(2 * terms - 1) * std::f64::consts::PI + U + f16
+    }
+}
+
+/// The GPU's power moments against f64: the depth texel is exact (orthographic), z², z³ = z²·z
+/// and z⁴ = z²·z² round at most three times (3U relative), then f16 storage.
+fn moment_tolerance(storage: Storage, v: f64) -> f64 {
+    3.0 * U * v.abs() + f16(storage, v)
 }
 
 fn check(g: &Gpu, seed: u64, case: &Case) {
     let what = format!(
-        "{}×{} M = {} z {} {:?} {:?}",
-        case.w, case.h, case.terms, case.z, case.variant, case.storage
+        "{}×{} M = {} search {:?} {:?} {:?}",
+        case.w, case.h, case.terms, case.search, case.variant, case.storage
     );
     let mut rng = common::rng(seed);
     let (raw, lin) = depth(&mut rng, case.w, case.h, case.bad);
@@ -175,7 +191,8 @@ fn check(g: &Gpu, seed: u64, case: &Case) {
     }
     .expect("coding");
     let (tables, steps, stats) = run(g, case, &raw, coding);
-    let want = basis(&lin, case.terms, case.z);
+    let want = basis(&lin, case.terms, case.search);
+    let moments = case.search == Some(CssmSearch::Moments);
     assert_eq!(tables.len(), want.len(), "{what}: tables");
     // The edges of every layer, the carries, four tables a dispatch.
     let per = LAYERED_SAT_OUTPUTS as usize;
@@ -194,10 +211,17 @@ fn check(g: &Gpu, seed: u64, case: &Case) {
             "{what} table {m}: unused channel"
         );
         let decoded = decode_table(words, case.w, case.h, &coding, n);
+        let power = moments && m == want.len() - 1;
         let mut tol: Vec<f64> = v
             .data
             .iter()
-            .map(|&x| basis_tolerance(case.terms, case.storage, x))
+            .map(|&x| {
+                if power {
+                    moment_tolerance(case.storage, x)
+                } else {
+                    basis_tolerance(case.terms, case.storage, x)
+                }
+            })
             .collect();
         if case.variant == SatVariant::Fixed {
             // Each code is rounded (½/scale; one scale for every channel of [−1, 1]) from the
@@ -251,7 +275,7 @@ fn layered_csm_tables_match_the_f64_basis() {
             w: 200,
             h: 130,
             terms: 8,
-            z: true,
+            search: Some(CssmSearch::CsmZ),
             variant: SatVariant::Fixed,
             storage: Storage::F32,
             bad: 7,
@@ -261,7 +285,7 @@ fn layered_csm_tables_match_the_f64_basis() {
             w: 70,
             h: 150,
             terms: 3,
-            z: true,
+            search: Some(CssmSearch::CsmZ),
             variant: SatVariant::Float,
             storage: Storage::F32,
             bad: 2,
@@ -271,10 +295,30 @@ fn layered_csm_tables_match_the_f64_basis() {
             w: 64,
             h: 64,
             terms: 16,
-            z: false,
+            search: None,
             variant: SatVariant::Fixed,
             storage: Storage::F16,
             bad: 1,
+        },
+        // CSSM M = 8 with the moment search (4 + 1 tables, two pass-3 dispatches).
+        Case {
+            w: 200,
+            h: 130,
+            terms: 8,
+            search: Some(CssmSearch::Moments),
+            variant: SatVariant::Fixed,
+            storage: Storage::F32,
+            bad: 3,
+        },
+        // The moment search at odd M, f32 sums, f16 storage.
+        Case {
+            w: 90,
+            h: 70,
+            terms: 5,
+            search: Some(CssmSearch::Moments),
+            variant: SatVariant::Float,
+            storage: Storage::F16,
+            bad: 2,
         },
     ];
     for (k, case) in cases.iter().enumerate() {

@@ -111,6 +111,7 @@ fn all_techniques() -> Vec<Technique> {
             scale: 2.0,
             sharpen: 2.0,
             sharpen_falloff: 50.0,
+            search: shadowgraph::scene::CssmSearch::Moments,
         },
         Technique::Cssm {
             soft: soft(Storage::F16, SatVariant::Float),
@@ -120,6 +121,7 @@ fn all_techniques() -> Vec<Technique> {
             scale: 2.0,
             sharpen: 0.0,
             sharpen_falloff: 0.0,
+            search: shadowgraph::scene::CssmSearch::CsmZ,
         },
         Technique::Vssm {
             soft: soft(Storage::F32, SatVariant::Fixed),

@@ -517,7 +517,7 @@ fn csm_basis_matches_reference() {
             first_map: (first_term - 1) / 2,
             maps: 1,
             terms,
-            _pad: 0,
+            moments: 0,
         })
         .to_vec();
         let (graph, out) = encode_graph("csm", params, w, h, format, None, BlurMode::Linear);
@@ -549,6 +549,32 @@ fn csm_basis_matches_reference() {
             rtol,
         );
     }
+    // With `moments` (CSSM's moment search) the map after the basis is (z, z², z³, z⁴): three
+    // f32 roundings at most (z² then z³ = z²·z, z⁴ = z²·z²).
+    let params = bytemuck::bytes_of(&CsmParams {
+        depth: shadowgraph::technique::LinearizeParams::ORTHOGRAPHIC,
+        first_map: shadowgraph::technique::csm_maps(terms),
+        maps: 1,
+        terms,
+        moments: 1,
+    })
+    .to_vec();
+    let format = wgpu::TextureFormat::Rgba32Float;
+    let (graph, out) = encode_graph("csm", params, w, h, format, None, BlurMode::Linear);
+    let gpu = run(
+        &g,
+        &graph,
+        &out,
+        upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin),
+    );
+    let want = cpu::msm::msm(&input, false);
+    common::assert_close(
+        "csm moments map",
+        &channels(&gpu, 4),
+        &want.data,
+        0.0,
+        3.0 * 2f64.powi(-24),
+    );
 }
 
 #[test]

@@ -1125,6 +1125,7 @@ fn soft_techniques_keys_defaults_and_errors() {
             scale: 2.0,
             sharpen: shadowgraph::scene::DEFAULT_SHARPEN,
             sharpen_falloff: shadowgraph::scene::DEFAULT_SHARPEN_FALLOFF,
+            search: shadowgraph::scene::CssmSearch::Moments,
         }
     );
     let s = parse(&soft("technique = \"vssm\"", "size = 0.5")).expect("vssm parses");

@@ -406,10 +406,20 @@ fn check_prefilter_chain(scene: &Scene, frame: &shadowgraph::render::Frame, li: 
                     1e-6,
                 )
             }
-            // The CSM basis (2M channels) then the CSM-Z basis (2M + 1).
-            Technique::Cssm { soft, terms, .. } => {
+            // The CSM basis (2M channels) then the search's: the power moments (4) or the
+            // CSM-Z basis (2M + 1).
+            Technique::Cssm {
+                soft,
+                terms,
+                search,
+                ..
+            } => {
                 let f = move |t: &Texels| {
-                    let (a, b) = (cpu::csm::csm(t, terms), cpu::csm_z::csm_z(t, terms));
+                    let a = cpu::csm::csm(t, terms);
+                    let b = match search {
+                        shadowgraph::scene::CssmSearch::Moments => cpu::msm::msm(t, false),
+                        shadowgraph::scene::CssmSearch::CsmZ => cpu::csm_z::csm_z(t, terms),
+                    };
                     let data = a
                         .data
                         .chunks(a.channels)
@@ -422,9 +432,13 @@ fn check_prefilter_chain(scene: &Scene, frame: &shadowgraph::render::Frame, li: 
                         ..a
                     }
                 };
+                let search_channels = match search {
+                    shadowgraph::scene::CssmSearch::Moments => 4,
+                    shadowgraph::scene::CssmSearch::CsmZ => 2 * terms as usize + 1,
+                };
                 (
                     Box::new(f) as Box<dyn Fn(&Texels) -> Texels>,
-                    4 * terms as usize + 1,
+                    2 * terms as usize + search_channels,
                     Filter::None,
                     soft.storage,
                     false,
@@ -655,14 +669,26 @@ fn blocker_kernels_are_planned_only_for_soft_lights() {
             .flat_map(|s| &s.node.outputs)
             .filter(|(_, r)| {
                 let r = r.strip_suffix(".sat").unwrap_or(r);
-                r.rsplit('.').next().is_some_and(|n| n.starts_with("csm_z"))
+                r.rsplit('.')
+                    .next()
+                    .is_some_and(|n| n.starts_with("csm_z") || n == "csm_moments")
             })
             .count();
         let expected: Option<Vec<&str>> = match l.shadow.technique {
-            Technique::Cssm { soft, terms, .. } => {
+            Technique::Cssm {
+                soft,
+                terms,
+                search,
+                ..
+            } => {
                 let basis = shadowgraph::technique::csm_maps(terms) as usize;
-                let z = shadowgraph::technique::csm_z_maps(terms) as usize;
-                assert_eq!(blocker, z, "{what}: CSM-Z tables");
+                let z = match search {
+                    shadowgraph::scene::CssmSearch::CsmZ => {
+                        shadowgraph::technique::csm_z_maps(terms) as usize
+                    }
+                    shadowgraph::scene::CssmSearch::Moments => 1,
+                };
+                assert_eq!(blocker, z, "{what}: the blocker search's tables");
                 // One layered table (`sat::layers`): the edges of every layer from the depth,
                 // the carries, and four tables a dispatch; no basis map stored.
                 let per = shadowgraph::sat::layers::LAYERED_SAT_OUTPUTS as usize;
@@ -846,6 +872,7 @@ fn every_technique_renders_every_bundled_scene() {
             scale: 2.0,
             sharpen: shadowgraph::scene::DEFAULT_SHARPEN,
             sharpen_falloff: shadowgraph::scene::DEFAULT_SHARPEN_FALLOFF,
+            search: shadowgraph::scene::CssmSearch::CsmZ,
         },
         Technique::Vssm {
             soft: soft(Storage::F16, shadowgraph::sat::SatVariant::Float),

@@ -18,7 +18,7 @@ use shadowgraph::cpu::{self, Texels};
 use shadowgraph::gpu::Gpu;
 use shadowgraph::render::{ProbeMap, Renderer, probe};
 use shadowgraph::sat::SatVariant;
-use shadowgraph::scene::{Light, Scene, Storage, Technique};
+use shadowgraph::scene::{CssmSearch, Light, Scene, Storage, Technique};
 use shadowgraph::technique::{LightGpu, sat_coding};
 
 /// A world point with random light-space UV and linear depth, normal facing the light.
@@ -222,39 +222,48 @@ fn msm_soft_matches_reference() {
 #[test]
 fn cssm_matches_reference() {
     // Tolerance: the series carry the device's measured sin/cos error (checked against
-    // Vulkan's 2⁻¹¹ first) and the means' errors per term; then as VSSM's, plus the f32
-    // exp2/log2 of the sharpening v^p. Sharpening A = 3, B = 10 per depth unit, so that most
-    // penumbra points are sharpened noticeably.
+    // Vulkan's 2⁻¹¹ first) and the means' errors per term; the moment search's means their
+    // tables' error as msm_soft's do; then as VSSM's, plus the f32 exp2/log2 of the sharpening
+    // v^p. Sharpening A = 3, B = 10 per depth unit, so that most penumbra points are sharpened
+    // noticeably. Both blocker searches: the moments (the default) and the paper's CSM-Z.
     let g = common::gpu();
     let e_trig = trig_error(&g);
     eprintln!("device sin/cos error (×2 + 2⁻²⁴): {e_trig:.2e}");
-    for (terms, seed) in [(4, 220), (7, 221)] {
+    for (terms, seed, kind) in [
+        (4, 220, CssmSearch::Moments),
+        (7, 221, CssmSearch::Moments),
+        (4, 222, CssmSearch::CsmZ),
+        (7, 223, CssmSearch::CsmZ),
+    ] {
         let seen = check_soft(
             &g,
-            cssm(terms, 3.0, 10.0),
+            cssm(terms, 3.0, 10.0, kind),
             seed,
             &|lin| {
-                vec![
-                    rounded(cpu::csm::csm(lin, terms)),
-                    rounded(cpu::csm_z::csm_z(lin, terms)),
-                ]
+                let search = match kind {
+                    CssmSearch::Moments => cpu::msm::msm(lin, false),
+                    CssmSearch::CsmZ => cpu::csm_z::csm_z(lin, terms),
+                };
+                vec![rounded(cpu::csm::csm(lin, terms)), rounded(search)]
             },
             &|t, l, s| {
                 let maps = cpu::vis_cssm::Maps {
                     basis: &t[0],
-                    z: &t[1],
+                    search: &t[1],
+                    kind,
                 };
                 cpu::vis_cssm::vis_cssm(maps, l, s)
             },
             &|t, e, l, s, v| {
                 let maps = cpu::vis_cssm::Maps {
                     basis: &t[0],
-                    z: &t[1],
+                    search: &t[1],
+                    kind,
                 };
                 common::soft::cssm_tolerance(maps, (&e[0], &e[1]), e_trig, l, s, v)
             },
         );
-        eprintln!("cssm M = {terms}: {seen}");
+        eprintln!("cssm M = {terms} {}: {seen}", kind.name());
     }
 }
 

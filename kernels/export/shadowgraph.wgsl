@@ -64,23 +64,24 @@
 //   sg_blocker_msm sg_blocker_result sg_blocker_search_width sg_blocker_vsm sg_blocker_width
 //   sg_cascade_far_of sg_cascade_pick sg_chebyshev_upper sg_csm_chunk sg_csm_chunk_of
 //   sg_csm_resolve sg_csm_sin_cos sg_csm_weight sg_csm_z_chunk_of sg_cssm_blocker
-//   sg_cssm_resolve sg_cssm_sharpen sg_level_size sg_level_size_of sg_light_depth_slope
-//   sg_light_depth_slope_view sg_light_faces sg_light_footprint sg_light_linear_to_ndc
-//   sg_light_linear_to_z sg_light_map_width sg_light_receiver_offset sg_light_sample
-//   sg_light_tap_offset sg_light_texel sg_light_to_light sg_linstep sg_load_depth sg_map_sample
-//   sg_mip_tap_uv sg_mip_taps sg_msm_biased sg_msm_dequantize sg_msm_expect sg_msm_intensity
-//   sg_msm_moments sg_msm_quantize sg_msm_roots sg_msm_soft_blocker sg_pack_f16x2
-//   sg_pcss_search_radius sg_point_coords sg_point_face sg_point_sample sg_sample_bilinear
-//   sg_sample_bilinear_log sg_sample_map sg_sample_map_log sg_sample_map_packed sg_sat_box
-//   sg_sat_box_fixed sg_sat_box_float sg_sat_clamp sg_sat_filter_fixed sg_sat_filter_float
-//   sg_sat_mean_fixed sg_sat_mean_float sg_sat_nearest sg_sat_node_f32 sg_sat_node_u32
-//   sg_sat_nodes sg_sat_rect sg_sat_sample_fixed sg_sat_sample_float sg_sat_search_fixed
-//   sg_sat_search_float sg_sat_span_weights sg_smrt_emitter_point sg_smrt_ray sg_soft_blockers
-//   sg_soft_filter_trips sg_texel_of sg_trilinear sg_trilinear_log sg_trilinear_packed
-//   sg_unpack_f16x2 sg_vis_esm sg_vis_esm_of_log sg_vis_esm_of_sat sg_vis_evsm sg_vis_evsm_of
-//   sg_vis_hard sg_vis_msm sg_vis_msm_of sg_vis_msm_soft_fixed sg_vis_msm_soft_float sg_vis_pcf
-//   sg_vis_pcf_hardware sg_vis_pcss sg_vis_smrt sg_vis_vsm sg_vis_vsm_of sg_vis_vssm_fixed
-//   sg_vis_vssm_float sg_vogel_disc sg_vssm_blocker
+//   sg_cssm_blocker_moments sg_cssm_resolve sg_cssm_sharpen sg_level_size sg_level_size_of
+//   sg_light_depth_slope sg_light_depth_slope_view sg_light_faces sg_light_footprint
+//   sg_light_linear_to_ndc sg_light_linear_to_z sg_light_map_width sg_light_receiver_offset
+//   sg_light_sample sg_light_tap_offset sg_light_texel sg_light_to_light sg_linstep
+//   sg_load_depth sg_map_sample sg_mip_tap_uv sg_mip_taps sg_msm_biased sg_msm_dequantize
+//   sg_msm_expect sg_msm_intensity sg_msm_moments sg_msm_quantize sg_msm_roots
+//   sg_msm_soft_blocker sg_pack_f16x2 sg_pcss_search_radius sg_point_coords sg_point_face
+//   sg_point_sample sg_sample_bilinear sg_sample_bilinear_log sg_sample_map sg_sample_map_log
+//   sg_sample_map_packed sg_sat_box sg_sat_box_fixed sg_sat_box_float sg_sat_clamp
+//   sg_sat_filter_fixed sg_sat_filter_float sg_sat_mean_fixed sg_sat_mean_float sg_sat_nearest
+//   sg_sat_node_f32 sg_sat_node_u32 sg_sat_nodes sg_sat_rect sg_sat_sample_fixed
+//   sg_sat_sample_float sg_sat_search_fixed sg_sat_search_float sg_sat_span_weights
+//   sg_smrt_emitter_point sg_smrt_ray sg_soft_blockers sg_soft_filter_trips sg_texel_of
+//   sg_trilinear sg_trilinear_log sg_trilinear_packed sg_unpack_f16x2 sg_vis_esm
+//   sg_vis_esm_of_log sg_vis_esm_of_sat sg_vis_evsm sg_vis_evsm_of sg_vis_hard sg_vis_msm
+//   sg_vis_msm_of sg_vis_msm_soft_fixed sg_vis_msm_soft_float sg_vis_pcf sg_vis_pcf_hardware
+//   sg_vis_pcss sg_vis_smrt sg_vis_vsm sg_vis_vsm_of sg_vis_vssm_fixed sg_vis_vssm_float
+//   sg_vogel_disc sg_vssm_blocker
 
 // Shared light description and light-space helpers (import-only module).
 //
@@ -692,9 +693,11 @@ fn sg_csm_resolve(sum: f32, l: sg_Light) -> f32 {
 // where the smooth Fourier step leaks light and the penumbra is narrow, the darkening is
 // strongest; it fades as the receiver leaves its blockers. A square without blockers
 // (share < BLOCKER_MIN_SHARE) is lit.
-// The shading block (technique::cssm's `visibility`) sums `csm_z_chunk_of` over the light's
-// CSM-Z tables and `csm_chunk_of` over its basis tables at the search width snapped outward
-// to texel edges (`sat_search_*`, 4 loads a table), which gives `cssm_blocker`; where that
+// The shading block (technique::cssm's `visibility`) reads, at the search width snapped
+// outward to texel edges (`sat_search_*`, 4 loads a table), either (`blocker_search =
+// "moments"`, the default) the power moments' table, which gives `cssm_blocker_moments`, or
+// (`"csm_z"`, the paper's) sums `csm_z_chunk_of` over the light's CSM-Z tables and
+// `csm_chunk_of` over its basis tables, which gives `cssm_blocker`; where that
 // finds blockers, a loop of `soft_filter_trips` trips sums the basis tables again at
 // `blocker_filter_width(l, s, b.x)`, the square's edges rounded to the nearest texel edges
 // (`sat_filter_*`, 4 loads a table), for `cssm_resolve`.
@@ -1265,6 +1268,13 @@ fn sg_blocker_csm_z(below: f32, zsum: f32, d: f32) -> vec2<f32> {
 
 fn sg_cssm_blocker(below: f32, zsum: f32, l: sg_Light, s: sg_LightSample) -> vec2<f32> {
     return sg_blocker_csm_z(below, zsum, s.depth - l.bias);
+}
+
+// `blocker_search = "moments"`: from the power moments (z, z², z³, z⁴) over the search square,
+// biased by `l.moment_bias` and projected onto valid moments as MSM's raw moments are,
+// msm_soft's three-point estimate (blocker_msm).
+fn sg_cssm_blocker_moments(m: vec4<f32>, l: sg_Light, s: sg_LightSample) -> vec2<f32> {
+    return sg_blocker_msm(sg_msm_moments(m, l.moment_bias, true), s.depth - l.bias);
 }
 
 // v^p for v in [0, 1], p ≥ 1 (0 at v = 0, where log2 is −∞).

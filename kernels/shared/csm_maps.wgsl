@@ -11,7 +11,7 @@
 // z·cos of term 2j + 1, z·sin of term 2j + 2.
 // Branch-free, three (sin, cos) pairs whichever the map: a software rasterizer runs both
 // sides of a branch on the map index, and a GPU's workgroups of one layer agree on it anyway.
-fn csm_basis_map(m: u32, terms: u32, z: f32) -> vec4<f32> {
+fn csm_basis_map(m: u32, terms: u32, moments: bool, z: f32) -> vec4<f32> {
     let basis_maps = (terms + 1u) / 2u;
     let csm = m < basis_maps;
     let j = m - min(m, basis_maps);
@@ -26,5 +26,8 @@ fn csm_basis_map(m: u32, terms: u32, z: f32) -> vec4<f32> {
     let term = vec4<u32>(k, k, k + 1u, k + 1u);
     let channel = 4u * j + vec4<u32>(0u, 1u, 2u, 3u);
     let keep = select(channel <= vec4<u32>(2u * terms), term <= vec4<u32>(terms), csm);
-    return select(vec4<f32>(0.0), select(z_seq, basis, csm), keep);
+    let z2 = z * z;
+    let power = vec4<f32>(z, z2, z2 * z, z2 * z2);
+    let rest = select(select(vec4<f32>(0.0), z_seq, keep), power, moments);
+    return select(rest, select(vec4<f32>(0.0), basis, keep), csm);
 }

@@ -15,6 +15,10 @@ struct CsmSatParams {
     maps: u32,            // layers of this dispatch (workgroups along z)
     terms: u32,           // M
     f16: u32,             // 1: round each basis value to f16, as an rgba16float map would hold it
+    moments: u32,         // 1: the layer after CSM's is the power moments (CSSM's moment search)
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // Tiles of a `size` map along x and y: the width of a band of row_part, the height of one of
@@ -25,5 +29,5 @@ fn csm_sat_tiles_of(size: vec2<u32>) -> vec2<u32> {
 
 // Layer `layer`'s source, for a map of `tiles` tiles.
 fn csm_sat_source(p: CsmSatParams, layer: u32, tiles: vec2<u32>) -> SatSource {
-    return SatSource(true, p.f16 != 0u, layer, p.terms, p.depth, layer * tiles);
+    return SatSource(true, p.f16 != 0u, layer, p.terms, p.moments != 0u, p.depth, layer * tiles);
 }

@@ -44,9 +44,10 @@ struct SatSource {
     f16: bool,           // round each basis value to f16
     layer: u32,          // the basis map (CSM's ⌈M/2⌉, then CSM-Z's)
     terms: u32,          // M
+    moments: bool,       // the map after CSM's is the power moments (CSSM's moment search)
     depth: DepthParams,  // the depth buffer's linearization
     band: vec2<u32>,     // this table's carries start at this (tile column, tile row)
 }
 
 const SAT_STORED: SatSource =
-    SatSource(false, false, 0u, 0u, DepthParams(0u, 0.0, 1.0, 0u), vec2<u32>(0u));
+    SatSource(false, false, 0u, 0u, false, DepthParams(0u, 0.0, 1.0, 0u), vec2<u32>(0u));

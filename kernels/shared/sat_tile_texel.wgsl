@@ -31,7 +31,7 @@ fn sat_texel(
         if inside && !depth_is_finite(raw) {
             sat_non_finite += 1u;
         }
-        v = csm_basis_map(s.layer, s.terms, linear_depth(raw, s.depth));
+        v = csm_basis_map(s.layer, s.terms, s.moments, linear_depth(raw, s.depth));
         if s.f16 {
             v = vec4<f32>(unpack2x16float(pack2x16float(v.xy)), unpack2x16float(pack2x16float(v.zw)));
         }

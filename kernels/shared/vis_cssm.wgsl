@@ -7,9 +7,11 @@
 // where the smooth Fourier step leaks light and the penumbra is narrow, the darkening is
 // strongest; it fades as the receiver leaves its blockers. A square without blockers
 // (share < BLOCKER_MIN_SHARE) is lit.
-// The shading block (technique::cssm's `visibility`) sums `csm_z_chunk_of` over the light's
-// CSM-Z tables and `csm_chunk_of` over its basis tables at the search width snapped outward
-// to texel edges (`sat_search_*`, 4 loads a table), which gives `cssm_blocker`; where that
+// The shading block (technique::cssm's `visibility`) reads, at the search width snapped
+// outward to texel edges (`sat_search_*`, 4 loads a table), either (`blocker_search =
+// "moments"`, the default) the power moments' table, which gives `cssm_blocker_moments`, or
+// (`"csm_z"`, the paper's) sums `csm_z_chunk_of` over the light's CSM-Z tables and
+// `csm_chunk_of` over its basis tables, which gives `cssm_blocker`; where that
 // finds blockers, a loop of `soft_filter_trips` trips sums the basis tables again at
 // `blocker_filter_width(l, s, b.x)`, the square's edges rounded to the nearest texel edges
 // (`sat_filter_*`, 4 loads a table), for `cssm_resolve`.
@@ -20,6 +22,13 @@
 
 fn cssm_blocker(below: f32, zsum: f32, l: Light, s: LightSample) -> vec2<f32> {
     return blocker_csm_z(below, zsum, s.depth - l.bias);
+}
+
+// `blocker_search = "moments"`: from the power moments (z, z², z³, z⁴) over the search square,
+// biased by `l.moment_bias` and projected onto valid moments as MSM's raw moments are,
+// msm_soft's three-point estimate (blocker_msm).
+fn cssm_blocker_moments(m: vec4<f32>, l: Light, s: LightSample) -> vec2<f32> {
+    return blocker_msm(msm_moments(m, l.moment_bias, true), s.depth - l.bias);
 }
 
 // v^p for v in [0, 1], p ≥ 1 (0 at v = 0, where log2 is −∞).

@@ -1,43 +1,59 @@
-//! CSSM's prefilter (depth → the nine tables of M = 8) as the shipped graph builds it — one
-//! layered table whose tile passes compute the basis from the depth ([`crate::sat::layers`])
-//! — and as builds before it did: `csm` storing the basis maps four a dispatch, then three
-//! table passes per map. The old chain stays a bench case until the comparison is recorded.
+//! CSSM's prefilter at M = 8 as the shipped graph builds it — one layered table whose tile
+//! passes compute the basis from the depth ([`crate::sat::layers`]): five tables with the
+//! default moment search, nine with the paper's CSM-Z search — and as builds before it did:
+//! `csm` storing the nine basis maps four a dispatch, then three table passes per map. The old
+//! chain stays a bench case until the comparison is recorded.
 
 use super::{BenchGraph, bench_light, chain_graph, named};
 use crate::gpu_data::{CSM_OUTPUTS, CsmParams, LinearizeParams};
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
 use crate::kernels::KernelId;
-use crate::model::{ParamValue, Storage, Technique};
+use crate::model::{CssmSearch, ParamValue, Storage, Technique};
 use crate::sat::{SatCoding, add_sat};
 use crate::technique::{self, csm_maps, csm_z_channels, csm_z_maps, moments_format};
 
 /// Terms of the CSSM chains timed.
 const TERMS: u32 = 8;
 
-fn cssm() -> Technique {
-    named("cssm", &[("terms", ParamValue::Int(TERMS))])
+fn cssm(search: CssmSearch) -> Technique {
+    named(
+        "cssm",
+        &[
+            ("terms", ParamValue::Int(TERMS)),
+            ("blocker_search", ParamValue::Choice(search.name())),
+        ],
+    )
 }
 
-/// The tables the shading of CSSM M = 8 reads: 4 CSM then 5 CSM-Z.
-fn tables() -> Vec<String> {
-    (0..csm_maps(TERMS))
-        .map(|k| format!("light0.csm{k}.sat"))
-        .chain((0..csm_z_maps(TERMS)).map(|k| format!("light0.csm_z{k}.sat")))
+/// The tables the shading of CSSM M = 8 reads: 4 CSM then the search's (1 or 5).
+fn tables(search: CssmSearch) -> Vec<String> {
+    technique::basis_sequence(TERMS, Some(search))
+        .into_iter()
+        .map(|(name, _)| format!("light0.{name}.sat"))
         .collect()
 }
 
-/// The shipped chain: 2 + ⌈9 / 4⌉ = 5 dispatches.
-pub(super) fn layered(n: u32) -> BenchGraph {
-    let names = tables();
+fn layered_of(n: u32, search: CssmSearch) -> BenchGraph {
+    let names = tables(search);
     let names: Vec<&str> = names.iter().map(String::as_str).collect();
-    chain_graph(n, cssm(), &names)
+    chain_graph(n, cssm(search), &names)
+}
+
+/// The shipped chain with the moment search: 2 + ⌈5 / 4⌉ = 4 dispatches.
+pub(super) fn layered(n: u32) -> BenchGraph {
+    layered_of(n, CssmSearch::Moments)
+}
+
+/// The shipped chain with the CSM-Z search: 2 + ⌈9 / 4⌉ = 5 dispatches.
+pub(super) fn layered_csm_z(n: u32) -> BenchGraph {
+    layered_of(n, CssmSearch::CsmZ)
 }
 
 /// The chain before the layered tables: `csm` writes the nine basis maps (rgba32float, the
 /// last r32float) four a dispatch from the depth, and each map gets the three passes of
 /// [`add_sat`]: 30 dispatches.
 pub(super) fn maps_then_tables(n: u32) -> BenchGraph {
-    let light = bench_light(n, cssm());
+    let light = bench_light(n, cssm(CssmSearch::CsmZ));
     let coding = technique::sat_coding(&light)
         .ok()
         .flatten()
@@ -68,7 +84,7 @@ pub(super) fn maps_then_tables(n: u32) -> BenchGraph {
             first_map: g as u32 * CSM_OUTPUTS,
             maps: group.len() as u32,
             terms: TERMS,
-            _pad: 0,
+            moments: 0,
         };
         graph.node(Node {
             name: format!("light0.csm.{g}"),

@@ -200,8 +200,12 @@ pub const CASES: &[BenchCase] = &[
     // CSSM's prefilter: the layered tables (basis computed in their tile passes) against the
     // chain before them, until the comparison is recorded.
     BenchCase {
-        name: "chain cssm 8 terms (depth → 9 tables)",
+        name: "chain cssm 8 terms (depth → 5 tables)",
         build: csm_chain::layered,
+    },
+    BenchCase {
+        name: "chain cssm 8 terms csm_z (depth → 9 tables)",
+        build: csm_chain::layered_csm_z,
     },
     BenchCase {
         name: "chain cssm 8 terms (9 maps + 27 passes, old)",

@@ -34,6 +34,10 @@ pub const SOFT_TECHNIQUES: &[(&str, &str)] = &[
     ("vssm", "technique = \"vssm\""),
     ("msm_soft", "technique = \"msm_soft\""),
     ("cssm M=8", "technique = \"cssm\"\nterms = 8"),
+    (
+        "cssm M=8 csm_z",
+        "technique = \"cssm\"\nterms = 8\nblocker_search = \"csm_z\"",
+    ),
     ("smrt 7x8", "technique = \"smrt\"\nrays = 7\nsteps = 8"),
 ];
 
@@ -253,7 +257,14 @@ pub fn format_soft_table(
             "NOTE: this adapter is a CPU device (software Vulkan): only the ratios mean anything."
         );
     }
-    let _ = write!(s, "{:<11} {:>10}", "technique", "fetches/px");
+    // The name column fits the longest configuration's name.
+    let name = rows
+        .iter()
+        .map(|r| r.technique.chars().count())
+        .max()
+        .unwrap_or(0)
+        .max("technique".len());
+    let _ = write!(s, "{:<name$} {:>10}", "technique", "fetches/px");
     for size in sizes {
         let _ = write!(s, "  {:>17}", format!("size {size}"));
     }
@@ -266,7 +277,7 @@ pub fn format_soft_table(
         .iter()
         .find(|r| r.technique == SOFT_TECHNIQUES[YARDSTICK].0);
     for r in rows {
-        let _ = write!(s, "{:<11} {:>10}", r.technique, r.fetches);
+        let _ = write!(s, "{:<name$} {:>10}", r.technique, r.fetches);
         for (i, ms) in r.shade_ms.iter().enumerate() {
             let base = yardstick.and_then(|y| y.shade_ms.get(i)).copied();
             let ratio = base.map_or(f64::NAN, |b| ms / b);

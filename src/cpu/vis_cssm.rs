@@ -1,38 +1,52 @@
 //! Reference of `kernels/shared/vis_cssm.wgsl` (with the body `technique::visibility_body`
-//! generates around it), in the three steps of [`super::vis_vssm`]: the CSM and CSM-Z series
-//! over the search square, the blocker estimate, the sharpened CSM visibility at the penumbra
-//! width.
+//! generates around it), in the three steps of [`super::vis_vssm`]: the search's means over
+//! the search square (the power moments, or the CSM and CSM-Z series), the blocker estimate,
+//! the sharpened CSM visibility at the penumbra width.
 
 use super::blocker::{self, Blocker};
 use super::light::LightSample;
 use super::sat::Integral;
 use crate::gpu_data::LightGpu;
+use crate::model::CssmSearch;
 
 /// A CSSM light's representations, each per texel as its tables sum them.
 #[derive(Clone, Copy, Debug)]
 pub struct Maps<'a> {
     /// The CSM basis, `2M` channels or more (sin, cos per term; padding zeros after).
     pub basis: &'a Integral,
-    /// The CSM-Z basis, `2M + 1` channels or more (`kernels/csm_z.wgsl`'s order).
-    pub z: &'a Integral,
+    /// The blocker search's representation: the power moments `(z, z², z³, z⁴)`
+    /// ([`CssmSearch::Moments`]) or the CSM-Z basis, `2M + 1` channels or more
+    /// (`kernels/shared/csm_maps.wgsl`'s order; [`CssmSearch::CsmZ`]).
+    pub search: &'a Integral,
+    /// Which of the two `search` holds.
+    pub kind: CssmSearch,
 }
 
-/// The two series over the search square snapped outward to texel edges: `(below, zsum)` =
-/// (E[f] − ½, E[f̄·z]).
-pub fn search(maps: Maps, l: &LightGpu, s: &LightSample) -> (f64, f64) {
+/// The search's means over the search square snapped outward to texel edges: the four
+/// moments, or the two series `[below, zsum]` = [E[f] − ½, E[f̄·z]].
+pub fn search(maps: Maps, l: &LightGpu, s: &LightSample) -> Vec<f64> {
     let w = blocker::search_width(l, s);
-    let d = super::vis_csm::shifted_depth(l, s);
-    let basis = maps.basis.snapped_square_mean(l.map_size, s.uv, w);
-    let z = maps.z.snapped_square_mean(l.map_size, s.uv, w);
-    (
-        super::vis_csm::series(&basis, l, d),
-        blocker::csm_z_series(&z, l, d),
-    )
+    let means = maps.search.snapped_square_mean(l.map_size, s.uv, w);
+    match maps.kind {
+        CssmSearch::Moments => means,
+        CssmSearch::CsmZ => {
+            let d = super::vis_csm::shifted_depth(l, s);
+            let basis = maps.basis.snapped_square_mean(l.map_size, s.uv, w);
+            vec![
+                super::vis_csm::series(&basis, l, d),
+                blocker::csm_z_series(&means, l, d),
+            ]
+        }
+    }
 }
 
-/// `cssm_blocker`.
-pub fn blocker_of(below: f64, zsum: f64, l: &LightGpu, s: &LightSample) -> Blocker {
-    blocker::csm_z(below, zsum, s.depth - f64::from(l.bias))
+/// `cssm_blocker_moments` or `cssm_blocker` from [`search`]'s means.
+pub fn blocker_of(kind: CssmSearch, m: &[f64], l: &LightGpu, s: &LightSample) -> Blocker {
+    let d = s.depth - f64::from(l.bias);
+    match kind {
+        CssmSearch::Moments => blocker::msm(&super::vis_msm::biased(m, l), d),
+        CssmSearch::CsmZ => blocker::csm_z(m[0], m[1], d),
+    }
 }
 
 /// The CSM series over the penumbra width of `b`, the square's edges rounded to the nearest
@@ -64,6 +78,6 @@ pub fn finish(maps: Maps, l: &LightGpu, s: &LightSample, b: Blocker) -> f64 {
 
 /// CSSM visibility.
 pub fn vis_cssm(maps: Maps, l: &LightGpu, s: &LightSample) -> f64 {
-    let (below, zsum) = search(maps, l, s);
-    finish(maps, l, s, blocker_of(below, zsum, l, s))
+    let means = search(maps, l, s);
+    finish(maps, l, s, blocker_of(maps.kind, &means, l, s))
 }

@@ -22,6 +22,28 @@ use glam::{Mat4, Vec3};
 pub use cascades::Cascades;
 pub use sat_variant::SatVariant;
 
+/// CSSM's blocker search (`blocker_search`): which table's means over the search square give
+/// the blocker share and average depth.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum CssmSearch {
+    /// The four power moments `(z, z², z³, z⁴)` in one table, MSM's three-point estimate
+    /// (`msm_soft`'s search): one table read at the search width.
+    Moments,
+    /// The paper's CSM-Z basis `[z, z·sin c_k z, z·cos c_k z]` with CSM's basis: `E[f̄·z] /
+    /// E[f̄]`, ⌈M/2⌉ + ⌈(2M + 1)/4⌉ tables read at the search width.
+    CsmZ,
+}
+
+impl CssmSearch {
+    /// The scene key's value.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Moments => "moments",
+            Self::CsmZ => "csm_z",
+        }
+    }
+}
+
 /// A perspective camera.
 #[derive(Clone, Debug)]
 pub struct Camera {
@@ -246,6 +268,8 @@ pub enum Technique {
         sharpen: f32,
         /// Sharpening falloff B per linear depth unit of `d − z_avg`.
         sharpen_falloff: f32,
+        /// Where the blocker search's means come from.
+        search: CssmSearch,
     },
     /// Variance soft shadow maps (Yang et al. 2010): from the VSM moments over the search
     /// square, the Chebyshev share p of lit texels and `z_avg = (μ − p·d)/(1 − p)`; then VSM

@@ -6,7 +6,7 @@ use super::sweep_plan::{SweepPlan, SweptStorages, SweptTerms};
 use super::{TechniqueDef, no_clamp};
 use crate::gpu_data::TECHNIQUE_CSM;
 use crate::kernels::KernelId;
-use crate::model::{ParamValue, ParamValues, Technique};
+use crate::model::{CssmSearch, ParamValue, ParamValues, Technique};
 use std::fmt::Write;
 
 use super::nodes::{LightNodes, float_moments_format, map_type};
@@ -58,6 +58,33 @@ pub fn csm_z_channels(terms: u32) -> u32 {
 /// Four-channel CSM-Z maps CSSM with `terms` terms needs.
 pub fn csm_z_maps(terms: u32) -> u32 {
     csm_z_channels(terms).div_ceil(4)
+}
+
+/// The maps after the CSM basis for CSSM's blocker search, `(name, channels)`: the CSM-Z maps
+/// `csm_z<chunk>` (four channels of `[z, z·sin c₁z, z·cos c₁z, …]` each), or the power
+/// moments' map `csm_moments` (`(z, z², z³, z⁴)`).
+pub fn search_maps(terms: u32, search: CssmSearch) -> Vec<(String, u32)> {
+    match search {
+        CssmSearch::CsmZ => {
+            let channels = csm_z_channels(terms);
+            (0..csm_z_maps(terms))
+                .map(|chunk| (format!("csm_z{chunk}"), (channels - 4 * chunk).min(4)))
+                .collect()
+        }
+        CssmSearch::Moments => vec![("csm_moments".to_string(), 4)],
+    }
+}
+
+/// The light's maps in order, `(name, channels)`: the ⌈M/2⌉ CSM basis maps `csm<chunk>`, then
+/// with `search` (CSSM) its [`search_maps`].
+pub fn basis_sequence(terms: u32, search: Option<CssmSearch>) -> Vec<(String, u32)> {
+    let mut maps: Vec<(String, u32)> = (0..csm_maps(terms))
+        .map(|chunk| (format!("csm{chunk}"), 2 * (terms - 2 * chunk).min(2)))
+        .collect();
+    if let Some(search) = search {
+        maps.extend(search_maps(terms, search));
+    }
+    maps
 }
 
 /// The series' GPU fields (`csm`, `cssm`).
@@ -119,35 +146,26 @@ fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
 }
 
 /// The filtered maps of light `i`'s convolution basis: the CSM basis maps
-/// (`light{i}.csm<chunk>`, two terms each), then with `z` (CSSM) the CSM-Z maps
-/// (`light{i}.csm_z<chunk>`, four channels of the sequence `[z, z·sin c₁z, z·cos c₁z, …]`
-/// each), the complementary basis its blocker search filters. `kernels/csm.wgsl` writes up
+/// (`light{i}.csm<chunk>`, two terms each), then with `search` (CSSM) the maps its blocker
+/// search filters ([`search_maps`]: the CSM-Z maps `light{i}.csm_z<chunk>` or the power
+/// moments `light{i}.csm_moments`). `kernels/csm.wgsl` writes up
 /// to [`CSM_OUTPUTS`] of them from one read of the depth (nodes `light{i}.csm.<g>`).
 ///
 /// Through a summed-area table (the `sat` filter, CSSM) the maps are not stored: their tables
 /// are built by [`super::csm_sat::csm_sat_nodes`], the basis computed from the depth in the
 /// tables' own tile passes.
-pub(super) fn csm_nodes(n: &mut LightNodes, storage: Storage, terms: u32, z: bool) -> Vec<String> {
+pub(super) fn csm_nodes(
+    n: &mut LightNodes,
+    storage: Storage,
+    terms: u32,
+    search: Option<CssmSearch>,
+) -> Vec<String> {
     if let Ok(Some(coding)) = super::light_gpu::sat_coding(n.light) {
-        return super::csm_sat::csm_sat_nodes(n, storage, terms, z, coding);
+        return super::csm_sat::csm_sat_nodes(n, storage, terms, search, coding);
     }
-    let z_maps = if z { csm_z_maps(terms) } else { 0 };
-    let z_channels = csm_z_channels(terms);
-    let maps: Vec<(String, wgpu::TextureFormat)> = (0..csm_maps(terms))
-        .map(|chunk| {
-            let pairs = (terms - 2 * chunk).min(2);
-            (
-                format!("csm{chunk}"),
-                float_moments_format(storage, 2 * pairs),
-            )
-        })
-        .chain((0..z_maps).map(|chunk| {
-            let channels = (z_channels - 4 * chunk).min(4);
-            (
-                format!("csm_z{chunk}"),
-                float_moments_format(storage, channels),
-            )
-        }))
+    let maps: Vec<(String, wgpu::TextureFormat)> = basis_sequence(terms, search)
+        .into_iter()
+        .map(|(name, channels)| (name, float_moments_format(storage, channels)))
         .collect();
     let mut out = Vec::new();
     for (g, group) in maps.chunks(CSM_OUTPUTS as usize).enumerate() {
@@ -161,7 +179,7 @@ pub(super) fn csm_nodes(n: &mut LightNodes, storage: Storage, terms: u32, z: boo
             first_map: g as u32 * CSM_OUTPUTS,
             maps: group.len() as u32,
             terms,
-            _pad: 0,
+            moments: u32::from(search == Some(CssmSearch::Moments)),
         };
         let written: Vec<String> = outputs.iter().map(|(_, r)| r.clone()).collect();
         let name = format!("light{}.csm.{g}", n.i);
@@ -197,7 +215,7 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
         Technique::Csm {
             prefilter, terms, ..
         } => ShadeInput {
-            maps: csm_nodes(n, prefilter.storage, terms, false),
+            maps: csm_nodes(n, prefilter.storage, terms, None),
             wgsl_type: map_type(n.light),
         },
         _ => n.one(n.depth.clone()),

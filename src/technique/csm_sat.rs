@@ -3,12 +3,12 @@
 //! `kernels/csm_sat_tiles.wgsl` and their f32 variants) compute each basis map from the depth
 //! on the fly, one layer a map of the light's sequence (`kernels/shared/csm_basis.wgsl`).
 
-use super::csm::{csm_maps, csm_z_channels, csm_z_maps};
+use super::csm::basis_sequence;
 use super::nodes::{LightNodes, float_moments_format};
 use crate::gpu_data::LinearizeParams;
 use crate::graph::{Graph, SizeRule};
 use crate::kernels::KernelId;
-use crate::model::Storage;
+use crate::model::{CssmSearch, Storage};
 use crate::sat::layers::{LayeredSat, add_layered_sat};
 use crate::sat::{SatCoding, SatParams, SatVariant};
 
@@ -29,6 +29,10 @@ pub struct CsmSatParams {
     pub terms: u32,
     /// 1: each basis value rounded to f16, as f16 storage of the map would hold it.
     pub f16: u32,
+    /// 1: the layer after CSM's is the power moments (CSSM's moment search).
+    pub moments: u32,
+    /// Padding to 16 bytes.
+    pub _pad: [u32; 3],
 }
 
 /// What the layered tables of one light's basis hold ([`add_csm_tables`]).
@@ -36,8 +40,9 @@ pub struct CsmSatParams {
 pub struct CsmBasis {
     /// Terms M.
     pub terms: u32,
-    /// With the CSM-Z maps (CSSM's blocker search), after the ⌈M/2⌉ CSM maps.
-    pub z: bool,
+    /// With the maps of CSSM's blocker search (the CSM-Z maps or the power moments), after
+    /// the ⌈M/2⌉ CSM maps.
+    pub search: Option<CssmSearch>,
     /// The representation's storage: f16 rounds every basis value as an f16 map would.
     pub storage: Storage,
     /// The depth buffer's linearization.
@@ -45,15 +50,12 @@ pub struct CsmBasis {
 }
 
 /// Light `light`'s basis maps as `(resource, channels)`: `light{light}.csm<chunk>` (two terms
-/// each), then with `z` `light{light}.csm_z<chunk>` (four channels of the CSM-Z sequence each).
+/// each), then with `search` its maps (`technique::csm::search_maps`).
 /// They are declared, the size of `depth`, in the format an f32 or f16 map of their channels
 /// would have (what `map_channels` reads), but never planned: only their tables are.
 fn basis_maps(graph: &mut Graph, light: usize, depth: &str, b: &CsmBasis) -> Vec<(String, u32)> {
-    let z_maps = if b.z { csm_z_maps(b.terms) } else { 0 };
-    let z_channels = csm_z_channels(b.terms);
-    (0..csm_maps(b.terms))
-        .map(|chunk| (format!("csm{chunk}"), 2 * (b.terms - 2 * chunk).min(2)))
-        .chain((0..z_maps).map(|chunk| (format!("csm_z{chunk}"), (z_channels - 4 * chunk).min(4))))
+    basis_sequence(b.terms, b.search)
+        .into_iter()
         .map(|(name, channels)| {
             let size = SizeRule::Reduced {
                 of: depth.to_string(),
@@ -70,7 +72,7 @@ fn basis_maps(graph: &mut Graph, light: usize, depth: &str, b: &CsmBasis) -> Vec
 /// `basis_maps`, each table `<map>.sat`) coded as `coding` to `graph`, computed from the
 /// imported depth `depth` (read as `texture_2d<f32>`: a depth or an r32float texture) by one
 /// layered table ([`add_layered_sat`]): `2 + ⌈maps / 4⌉` dispatches, the depth read once a
-/// layer in each tile pass. Returns the tables, CSM's then CSM-Z's.
+/// layer in each tile pass. Returns the tables, CSM's then the search's.
 pub fn add_csm_tables(
     graph: &mut Graph,
     light: usize,
@@ -81,6 +83,7 @@ pub fn add_csm_tables(
     let tables = basis_maps(graph, light, depth, b);
     let (lin, terms) = (b.depth, b.terms);
     let f16 = u32::from(b.storage == Storage::F16);
+    let moments = u32::from(b.search == Some(CssmSearch::Moments));
     let params = move |sat: SatParams, first_map: u32, maps: u32| {
         let p = CsmSatParams {
             sat,
@@ -89,6 +92,8 @@ pub fn add_csm_tables(
             maps,
             terms,
             f16,
+            moments,
+            _pad: [0; 3],
         };
         bytemuck::bytes_of(&p).to_vec()
     };
@@ -113,12 +118,12 @@ pub(super) fn csm_sat_nodes(
     n: &mut LightNodes,
     storage: Storage,
     terms: u32,
-    z: bool,
+    search: Option<CssmSearch>,
     coding: SatCoding,
 ) -> Vec<String> {
     let b = CsmBasis {
         terms,
-        z,
+        search,
         storage,
         depth: n.lin,
     };

@@ -3,12 +3,13 @@
 //! then the selective sharpening `v^p`, `p = 1 + A·exp(−B (d − z_avg))`.
 
 use super::csm::series_values;
-use super::params::{CSM, FLOAT_FORMAT, SOFT, float, soft, soft_values};
+use super::params::{CSM, FLOAT_FORMAT, SOFT, choice, float, soft, soft_values};
 use super::sweep_plan::{SweepPlan, SweepVariant};
 use super::{TechniqueDef, no_clamp};
 use crate::gpu_data::TECHNIQUE_CSSM;
 use crate::model::{
-    DEFAULT_SHARPEN, DEFAULT_SHARPEN_FALLOFF, ParamSpec, ParamValue, ParamValues, Technique,
+    CssmSearch, DEFAULT_SHARPEN, DEFAULT_SHARPEN_FALLOFF, ParamSpec, ParamValue, ParamValues,
+    Technique, default_soft_moment_bias,
 };
 use std::fmt::Write;
 
@@ -32,6 +33,13 @@ const SHARPEN: &[ParamSpec] = &[
         DEFAULT_SHARPEN_FALLOFF,
         "sharpening falloff B per linear depth unit of d − z_avg",
     ),
+    choice(
+        "blocker_search",
+        &["moments", "csm_z"],
+        "moments",
+        "blocker search: the four power moments in one table (msm_soft's estimate) or the \
+         paper's CSM-Z basis",
+    ),
 ];
 
 fn values(t: &Technique) -> ParamValues {
@@ -44,52 +52,73 @@ fn values(t: &Technique) -> ParamValues {
         scale,
         sharpen,
         sharpen_falloff,
+        search,
     } = t
     {
         soft_values(soft, &mut out);
         series_values(*terms, *attenuation, *offset, *scale, &mut out);
         out.set("sharpen", ParamValue::Float(*sharpen));
         out.set("sharpen_falloff", ParamValue::Float(*sharpen_falloff));
+        out.set("blocker_search", ParamValue::Choice(search.name()));
     }
     out
 }
 
-/// The table means over the blocker-search square snapped to texel edges (the CSM-Z maps,
-/// the maps after the first ⌈M/2⌉, and the basis maps), the blocker estimate, and only where
-/// that finds blockers the basis maps' means over the penumbra width, with the fetch count of
-/// the loop.
+/// The blocker search over the search square snapped outward to texel edges (the power
+/// moments' table, or the CSM-Z tables and the basis tables), the blocker estimate, and only
+/// where that finds blockers the basis tables' means over the penumbra width, with the fetch
+/// count of the loop.
 fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
-    let Technique::Cssm { terms, soft, .. } = light.shadow.technique else {
+    let Technique::Cssm {
+        terms,
+        soft,
+        search: kind,
+        ..
+    } = light.shadow.technique
+    else {
         return VisibilityBody::simple(vec!["shared/vis_cssm"], String::new());
     };
     let suffix = table_suffix(soft.sums);
     let (basis, z) = maps.split_at((csm_maps(terms) as usize).min(maps.len()));
     let search = |m: &str| format!("sat_search_{suffix}({m}, l, s.uv, width)");
     let sample = |m: &str| format!("sat_filter_{suffix}({m}, l, s.uv, look.width)");
-    // The search reads every table over the square snapped outward to texel edges (4 loads
-    // each); the filter reads the basis tables again over the penumbra square with its edges
+    // The search reads its tables over the square snapped outward to texel edges (4 loads
+    // each); the filter reads the basis tables over the penumbra square with its edges
     // rounded to the nearest texel edges (4 loads each), in a loop of 0 or 1 trips
     // (`soft_filter_trips`).
-    let mut body = String::from("let width = blocker_search_width(l, s);\n    var zsum = 0.0;");
-    for (chunk, m) in z.iter().enumerate() {
-        let _ = write!(
-            body,
-            "\n    zsum += csm_z_chunk_of({}, {chunk}u, l, s);",
-            search(m)
-        );
-    }
-    body.push_str("\n    var below = 0.0;");
-    for (chunk, m) in basis.iter().enumerate() {
-        let _ = write!(
-            body,
-            "\n    below += csm_chunk_of({}, {chunk}u, l, s);",
-            search(m)
-        );
-    }
-    body.push_str(
-        "\n    let look = soft_blockers(cssm_blocker(below, zsum, l, s), l, s);\n    \
-         var sum = 0.0;\n    for (var k = 0u; k < soft_filter_trips(look); k++) {",
-    );
+    let mut body = String::from("let width = blocker_search_width(l, s);");
+    let searched = match kind {
+        CssmSearch::Moments => {
+            let m = z.first().map_or("", String::as_str);
+            let _ = write!(
+                body,
+                "\n    let look = soft_blockers(cssm_blocker_moments({}, l, s), l, s);",
+                search(m)
+            );
+            z.len()
+        }
+        CssmSearch::CsmZ => {
+            body.push_str("\n    var zsum = 0.0;");
+            for (chunk, m) in z.iter().enumerate() {
+                let _ = write!(
+                    body,
+                    "\n    zsum += csm_z_chunk_of({}, {chunk}u, l, s);",
+                    search(m)
+                );
+            }
+            body.push_str("\n    var below = 0.0;");
+            for (chunk, m) in basis.iter().enumerate() {
+                let _ = write!(
+                    body,
+                    "\n    below += csm_chunk_of({}, {chunk}u, l, s);",
+                    search(m)
+                );
+            }
+            body.push_str("\n    let look = soft_blockers(cssm_blocker(below, zsum, l, s), l, s);");
+            z.len() + basis.len()
+        }
+    };
+    body.push_str("\n    var sum = 0.0;\n    for (var k = 0u; k < soft_filter_trips(look); k++) {");
     for (chunk, m) in basis.iter().enumerate() {
         let _ = write!(
             body,
@@ -102,8 +131,7 @@ fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
          return cssm_resolve(sum, look.blocker, l, s);",
     );
     let fetches = format!(
-        "{} * sat_search_{suffix} + {} * sat_filter_{suffix}",
-        z.len() + basis.len(),
+        "{searched} * sat_search_{suffix} + {} * sat_filter_{suffix}",
         basis.len()
     );
     VisibilityBody {
@@ -127,6 +155,10 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
         scale: v.float("scale"),
         sharpen: v.float("sharpen"),
         sharpen_falloff: v.float("sharpen_falloff"),
+        search: match v.choice("blocker_search") {
+            "csm_z" => CssmSearch::CsmZ,
+            _ => CssmSearch::Moments,
+        },
     },
     values,
     gpu: |t, g| {
@@ -134,23 +166,31 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
         if let Technique::Cssm {
             sharpen,
             sharpen_falloff,
+            soft,
             ..
         } = *t
         {
             g.sharpen = sharpen;
             g.sharpen_falloff = sharpen_falloff;
+            // The moment search's bias: msm_soft's default for the storage.
+            g.moment_bias = default_soft_moment_bias(soft.storage);
         }
     },
     nodes: |n| match n.light.shadow.technique {
-        Technique::Cssm { soft, terms, .. } => ShadeInput {
-            maps: csm_nodes(n, soft.storage, terms, true),
+        Technique::Cssm {
+            soft,
+            terms,
+            search,
+            ..
+        } => ShadeInput {
+            maps: csm_nodes(n, soft.storage, terms, Some(search)),
             wgsl_type: map_type(n.light),
         },
         _ => n.one(n.depth.clone()),
     },
     visibility,
     variant: terms,
-    // The CSM basis and the CSM-Z basis (z, z·sin, z·cos).
+    // The CSM basis, the CSM-Z basis (z, z·sin, z·cos) and the power moments.
     value_range: |_| ([-1.0; 4], [1.0; 4]),
     clamp: no_clamp,
     area_light: true,
@@ -171,6 +211,14 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
             SweepVariant {
                 label: "cssm M16",
                 values: &[("terms", ParamValue::Int(16))],
+                storage: None,
+            },
+            SweepVariant {
+                label: "cssm M8 csm_z",
+                values: &[
+                    ("terms", ParamValue::Int(8)),
+                    ("blocker_search", ParamValue::Choice("csm_z")),
+                ],
                 storage: None,
             },
         ],

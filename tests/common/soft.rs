@@ -24,6 +24,7 @@ use shadowgraph::cpu::light::LightSample;
 use shadowgraph::cpu::sat::Integral;
 use shadowgraph::cpu::{self, Texels};
 use shadowgraph::sat::{SatCoding, SatVariant};
+use shadowgraph::scene::CssmSearch;
 use shadowgraph::technique::{LightGpu, MSM_QUANTIZED};
 
 const ULP: f64 = 1.0 / 16_777_216.0; // 2⁻²⁴
@@ -323,8 +324,9 @@ pub fn cssm_tolerance(
     v0: f64,
 ) -> Option<f64> {
     use cpu::vis_cssm as v;
-    let (below, zsum) = v::search(maps, l, s);
-    let b0 = v::blocker_of(below, zsum, l, s);
+    let kind = maps.kind;
+    let search0 = v::search(maps, l, s);
+    let b0 = v::blocker_of(kind, &search0, l, s);
     let terms = l.csm_terms;
     let e_d = depth_error(l, s);
     let e_factor = e_trig + std::f64::consts::PI * f64::from(2 * terms - 1) * e_d;
@@ -336,9 +338,18 @@ pub fn cssm_tolerance(
             + 8.0 * f64::from(terms) * ULP
     };
     let ws = cpu::blocker::search_width(l, s);
-    let e_below = series_error(err.0.mean(l, s, ws));
-    let ez = err.1.mean(l, s, ws);
-    let e_zsum = series_error(ez) + 0.5 * ez[0];
+    // The moment search's means carry their tables' error as msm_soft's raw moments do; the
+    // CSM-Z search's two series carry theirs per term, E[z]'s mean error ½-weighted.
+    let e_search = match kind {
+        CssmSearch::Moments => msm_moment_error(l, &search0, err.1.mean(l, s, ws)).to_vec(),
+        CssmSearch::CsmZ => {
+            let ez = err.1.mean(l, s, ws);
+            vec![
+                series_error(err.0.mean(l, s, ws)),
+                series_error(ez) + 0.5 * ez[0],
+            ]
+        }
+    };
     let width = cpu::blocker::filter_width(l, s, b0.depth);
     let sum = v::filtered(maps, l, s, b0);
     let e_sum = series_error(err.0.mean(l, s, width));
@@ -351,12 +362,9 @@ pub fn cssm_tolerance(
         0.0
     };
     Chain {
-        search: &|du| {
-            let (below, zsum) = v::search(maps, l, &shifted(s, du));
-            vec![below, zsum]
-        },
-        e_search: vec![e_below, e_zsum],
-        blocker: &|m, dd| v::blocker_of(m[0], m[1], l, &moved(s, dd)),
+        search: &|du| v::search(maps, l, &shifted(s, du)),
+        e_search,
+        blocker: &|m, dd| v::blocker_of(kind, m, l, &moved(s, dd)),
         finish: &|z| v::finish(maps, l, s, Blocker { depth: z, ..b0 }),
         last: &|du| vec![v::filtered(maps, l, &shifted(s, du), b0)],
         e_last: vec![e_sum],
@@ -370,26 +378,21 @@ pub fn cssm_tolerance(
 
 /// A CSSM light's shade map (its tables' values side by side, `technique::map_channels`
 /// each, as `Frame::shade_maps` holds them) split into the CSM basis (2M channels) and the
-/// CSM-Z basis (2M + 1), padding dropped.
+/// search's representation (the four power moments, or the CSM-Z basis's 2M + 1), padding
+/// dropped.
 pub fn split_cssm(light: &shadowgraph::scene::Light, map: &Texels) -> (Texels, Texels) {
-    let shadowgraph::scene::Technique::Cssm { terms, .. } = light.shadow.technique else {
+    let shadowgraph::scene::Technique::Cssm { terms, search, .. } = light.shadow.technique else {
         panic!("not a CSSM light");
     };
     let stored = shadowgraph::technique::map_channels(light);
     let basis_maps = shadowgraph::technique::csm_maps(terms) as usize;
-    // (first stored channel, logical channels) of every table, in binding order.
+    let logical = shadowgraph::technique::basis_sequence(terms, Some(search));
+    // (is a basis table, first stored channel, logical channels) of every table, in binding
+    // order.
     let mut first = 0;
     let mut parts = Vec::new();
     for (k, &n) in stored.iter().enumerate() {
-        let (j, total) = if k < basis_maps {
-            (k, 2 * terms as usize)
-        } else {
-            (
-                k - basis_maps,
-                shadowgraph::technique::csm_z_channels(terms) as usize,
-            )
-        };
-        parts.push((k < basis_maps, first, (total - 4 * j).min(4)));
+        parts.push((k < basis_maps, first, logical[k].1 as usize));
         first += n;
     }
     let pick = |basis: bool| {
@@ -416,7 +419,7 @@ pub fn split_cssm(light: &shadowgraph::scene::Light, map: &Texels) -> (Texels, T
 
 /// What a soft light's f64 reference reads, prepared once per light from its shade map (the
 /// tables' values side by side, as `Frame::shade_maps` holds them): the integral images (CSSM:
-/// the basis, then the CSM-Z basis), their errors and the device's sin/cos error. `None` for
+/// the basis, then the search's representation), their errors and the device's sin/cos error. `None` for
 /// a light whose technique is not soft.
 pub struct SoftInputs {
     light: shadowgraph::scene::Light,
@@ -449,9 +452,14 @@ impl SoftInputs {
     }
 
     fn cssm(&self) -> cpu::vis_cssm::Maps<'_> {
+        let shadowgraph::scene::Technique::Cssm { search: kind, .. } = self.light.shadow.technique
+        else {
+            panic!("not a CSSM light");
+        };
         cpu::vis_cssm::Maps {
             basis: &self.integrals[0],
-            z: &self.integrals[1],
+            search: &self.integrals[1],
+            kind,
         }
     }
 

@@ -7,7 +7,7 @@ use glam::Vec3;
 use shadowgraph::cpu::{self, Texels};
 use shadowgraph::gpu::Gpu;
 use shadowgraph::sat::{SatCoding, SatVariant};
-use shadowgraph::scene::{Light, LightKind, Shadow, Soft, Storage, Technique};
+use shadowgraph::scene::{CssmSearch, Light, LightKind, Shadow, Soft, Storage, Technique};
 
 const ULP: f64 = 1.0 / 16_777_216.0; // 2⁻²⁴
 
@@ -55,7 +55,7 @@ pub fn trig_error(g: &Gpu) -> f64 {
                 first_map: group * per,
                 maps: slots.len() as u32,
                 terms,
-                _pad: 0,
+                moments: 0,
             })
             .to_vec(),
             outputs: slots,
@@ -249,8 +249,8 @@ pub fn msm_soft(storage: Storage, hausdorff: bool) -> Technique {
     }
 }
 
-/// CSSM with `terms` terms, offset ½/M, scale 2 and the given sharpening.
-pub fn cssm(terms: u32, sharpen: f32, sharpen_falloff: f32) -> Technique {
+/// CSSM with `terms` terms, offset ½/M, scale 2, the given sharpening and blocker search.
+pub fn cssm(terms: u32, sharpen: f32, sharpen_falloff: f32, search: CssmSearch) -> Technique {
     Technique::Cssm {
         soft: soft(Storage::F32, SatVariant::Fixed),
         terms,
@@ -259,5 +259,6 @@ pub fn cssm(terms: u32, sharpen: f32, sharpen_falloff: f32) -> Technique {
         scale: 2.0,
         sharpen,
         sharpen_falloff,
+        search,
     }
 }

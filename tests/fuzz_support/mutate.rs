@@ -132,6 +132,7 @@ pub const KEYS: &[(&str, &[&str])] = &[
             "scale",
             "sharpen",
             "sharpen_falloff",
+            "blocker_search",
         ],
     ),
     (
