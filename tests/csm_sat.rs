@@ -22,7 +22,9 @@ use shadowgraph::graph::{Graph, plan, texel_bytes};
 use shadowgraph::sat::layers::LAYERED_SAT_OUTPUTS;
 use shadowgraph::sat::{SatCoding, SatVariant, decode_table, float_sum_depth, lookup_area};
 use shadowgraph::scene::{CssmSearch, Storage};
-use shadowgraph::technique::{CsmBasis, LinearizeParams, add_csm_tables, csm_maps, csm_z_maps};
+use shadowgraph::technique::{
+    CsmBasis, LinearizeParams, MsmTable, add_csm_tables, add_msm_table, csm_maps, csm_z_maps,
+};
 
 /// f32's unit roundoff.
 const U: f64 = 1.0 / (1u64 << 24) as f64;
@@ -34,6 +36,8 @@ struct Case {
     h: usize,
     terms: u32,
     search: Option<CssmSearch>,
+    /// MSM's quantized moments alone (`technique::add_msm_table`; `terms`, `search` unused).
+    msm: bool,
     variant: SatVariant,
     storage: Storage,
     bad: usize,
@@ -75,13 +79,21 @@ fn run(g: &Gpu, case: &Case, raw: &[f32], coding: SatCoding) -> (Vec<Vec<u32>>, 
     let mut graph = Graph::default();
     let (w, h) = (case.w as u32, case.h as u32);
     graph.import("in", wgpu::TextureFormat::R32Float, w, h, Some(0));
-    let basis = CsmBasis {
-        terms: case.terms,
-        search: case.search,
-        storage: case.storage,
-        depth: LinearizeParams::ORTHOGRAPHIC,
+    let tables = if case.msm {
+        let m = MsmTable {
+            storage: case.storage,
+            depth: LinearizeParams::ORTHOGRAPHIC,
+        };
+        vec![add_msm_table(&mut graph, 0, "in", &m, coding)]
+    } else {
+        let basis = CsmBasis {
+            terms: case.terms,
+            search: case.search,
+            storage: case.storage,
+            depth: LinearizeParams::ORTHOGRAPHIC,
+        };
+        add_csm_tables(&mut graph, 0, "in", &basis, coding)
     };
-    let tables = add_csm_tables(&mut graph, 0, "in", &basis, coding);
     let names: Vec<&str> = tables.iter().map(String::as_str).collect();
     let plan = plan(&graph, &names).expect("plan");
     let input = g.device.create_texture(&wgpu::TextureDescriptor {
@@ -178,10 +190,22 @@ fn moment_tolerance(storage: Storage, v: f64) -> f64 {
     3.0 * U * v.abs() + f16(storage, v)
 }
 
+/// MSM's quantized moments against f64: the power moments (≤ 1) through the quantization
+/// matrix in f32, four products with entries up to 82 and their sum (6·82·U), then the
+/// storage's rounding (f16 2⁻¹¹ relative, unorm16 half of 1/65535, 2⁻¹⁷).
+fn msm_tolerance(storage: Storage, v: f64) -> f64 {
+    let unorm16 = if storage == Storage::Unorm16 {
+        2f64.powi(-17)
+    } else {
+        0.0
+    };
+    6.0 * 82.0 * U + f16(storage, v) + unorm16
+}
+
 fn check(g: &Gpu, seed: u64, case: &Case) {
     let what = format!(
-        "{}×{} M = {} search {:?} {:?} {:?}",
-        case.w, case.h, case.terms, case.search, case.variant, case.storage
+        "{}×{} M = {} search {:?} msm {} {:?} {:?}",
+        case.w, case.h, case.terms, case.search, case.msm, case.variant, case.storage
     );
     let mut rng = common::rng(seed);
     let (raw, lin) = depth(&mut rng, case.w, case.h, case.bad);
@@ -191,7 +215,11 @@ fn check(g: &Gpu, seed: u64, case: &Case) {
     }
     .expect("coding");
     let (tables, steps, stats) = run(g, case, &raw, coding);
-    let want = basis(&lin, case.terms, case.search);
+    let want = if case.msm {
+        vec![cpu::msm::msm(&lin, true)]
+    } else {
+        basis(&lin, case.terms, case.search)
+    };
     let moments = case.search == Some(CssmSearch::Moments);
     assert_eq!(tables.len(), want.len(), "{what}: tables");
     // The edges of every layer, the carries, four tables a dispatch.
@@ -216,7 +244,9 @@ fn check(g: &Gpu, seed: u64, case: &Case) {
             .data
             .iter()
             .map(|&x| {
-                if power {
+                if case.msm {
+                    msm_tolerance(case.storage, x)
+                } else if power {
                     moment_tolerance(case.storage, x)
                 } else {
                     basis_tolerance(case.terms, case.storage, x)
@@ -276,6 +306,7 @@ fn layered_csm_tables_match_the_f64_basis() {
             h: 130,
             terms: 8,
             search: Some(CssmSearch::CsmZ),
+            msm: false,
             variant: SatVariant::Fixed,
             storage: Storage::F32,
             bad: 7,
@@ -286,6 +317,7 @@ fn layered_csm_tables_match_the_f64_basis() {
             h: 150,
             terms: 3,
             search: Some(CssmSearch::CsmZ),
+            msm: false,
             variant: SatVariant::Float,
             storage: Storage::F32,
             bad: 2,
@@ -296,6 +328,7 @@ fn layered_csm_tables_match_the_f64_basis() {
             h: 64,
             terms: 16,
             search: None,
+            msm: false,
             variant: SatVariant::Fixed,
             storage: Storage::F16,
             bad: 1,
@@ -306,6 +339,7 @@ fn layered_csm_tables_match_the_f64_basis() {
             h: 130,
             terms: 8,
             search: Some(CssmSearch::Moments),
+            msm: false,
             variant: SatVariant::Fixed,
             storage: Storage::F32,
             bad: 3,
@@ -316,12 +350,183 @@ fn layered_csm_tables_match_the_f64_basis() {
             h: 70,
             terms: 5,
             search: Some(CssmSearch::Moments),
+            msm: false,
             variant: SatVariant::Float,
             storage: Storage::F16,
+            bad: 2,
+        },
+        // MSM's quantized moments alone (msm_soft, msm with `filter = "sat"`): one layer, no
+        // terms; unorm16 and f16 rounding, both variants.
+        Case {
+            w: 150,
+            h: 100,
+            terms: 0,
+            search: None,
+            msm: true,
+            variant: SatVariant::Fixed,
+            storage: Storage::Unorm16,
+            bad: 3,
+        },
+        Case {
+            w: 64,
+            h: 97,
+            terms: 0,
+            search: None,
+            msm: true,
+            variant: SatVariant::Float,
+            storage: Storage::F16,
+            bad: 1,
+        },
+        Case {
+            w: 33,
+            h: 70,
+            terms: 0,
+            search: None,
+            msm: true,
+            variant: SatVariant::Fixed,
+            storage: Storage::F32,
             bad: 2,
         },
     ];
     for (k, case) in cases.iter().enumerate() {
         check(&g, 0xC55 + k as u64, case);
     }
+}
+
+/// `round_f16(x)` in f64: to nearest, ties to even, with 11 significant bits in f16's normal
+/// range and f16's subnormal step 2⁻²⁴ below it.
+fn f16_reference(x: f64) -> f64 {
+    let step = if x.abs() < 2f64.powi(-14) {
+        2f64.powi(-24)
+    } else {
+        2f64.powi(x.abs().log2().floor() as i32 - 10)
+    };
+    (x / step).round_ties_even() * step
+}
+
+/// `shared/storage_round`, which the depth-sourced tables use to hold what an f16 or unorm16
+/// map would, on the GPU by a kernel of the test's own: `round_f16` bit for bit against f64
+/// round-to-nearest-even at 11 significant bits (subnormal step below 2⁻¹⁴), `round_unorm16`'s
+/// code `round(65535·v)` the nearest to `65535·clamp(x)` up to the f32 product's rounding
+/// (2⁻⁹; its value is that code over 65535 within the division's 2.5 ULP). Inputs: random magnitudes over [2⁻³⁰, 2] of both signs,
+/// f16 values, the exact midpoints between neighbours (ties), the edges of the subnormal range,
+/// 0 and 1.
+#[test]
+fn storage_rounding_matches_f64() {
+    use wgpu::util::DeviceExt;
+    let g = common::gpu();
+    let mut rng = common::rng(0x516);
+    let mut xs: Vec<f32> = vec![
+        0.0,
+        1.0,
+        -1.0,
+        2f32.powi(-14),
+        -2f32.powi(-14),
+        2f32.powi(-24),
+    ];
+    for _ in 0..20000 {
+        let e: f64 = rng.random_range(-30.0..1.0);
+        let sign = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+        xs.push((sign * 2f64.powf(e)) as f32);
+        // An f16 value, and the midpoint above it (exact in f32): a tie.
+        let h = f16_reference(sign * 2f64.powf(e));
+        let step = if h.abs() < 2f64.powi(-14) {
+            2f64.powi(-24)
+        } else {
+            2f64.powi(h.abs().log2().floor() as i32 - 10)
+        };
+        xs.push(h as f32);
+        xs.push((h + 0.5 * step) as f32);
+        xs.push(rng.random_range(-0.2..1.2));
+    }
+    xs.resize(xs.len().div_ceil(4) * 4, 0.5);
+    let text = "// #import shared/storage_round\n\
+                @group(0) @binding(0) var<storage, read> xs: array<vec4<f32>>;\n\
+                @group(0) @binding(1) var<storage, read_write> out: array<vec4<f32>>;\n\
+                @compute @workgroup_size(64)\n\
+                fn main(@builtin(global_invocation_id) id: vec3<u32>) {\n\
+                    let i = id.x;\n\
+                    if i < arrayLength(&xs) {\n\
+                        out[2u * i] = round_f16(xs[i]);\n\
+                        out[2u * i + 1u] = round_unorm16(xs[i]);\n\
+                    }\n\
+                }\n";
+    let wgsl = shadowgraph::kernels::resolve_source("test.storage_round", text).expect("resolve");
+    let d = &g.device;
+    let kernel =
+        shadowgraph::exec::ComputeKernel::new(d, "storage_round", &wgsl).expect("harness compiles");
+    let input = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("test.storage_round.in"),
+        contents: bytemuck::cast_slice(&xs),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let size = (xs.len() * 2 * 4) as u64;
+    let out = d.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("test.storage_round.out"),
+        size,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let readback = d.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("test.storage_round.readback"),
+        size,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("test.storage_round"),
+        layout: &kernel.layouts[0],
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: input.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: out.as_entire_binding(),
+            },
+        ],
+    });
+    let mut enc = d.create_command_encoder(&Default::default());
+    {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&kernel.pipeline);
+        pass.set_bind_group(0, &bg, &[]);
+        pass.dispatch_workgroups(((xs.len() / 4) as u32).div_ceil(64), 1, 1);
+    }
+    enc.copy_buffer_to_buffer(&out, 0, &readback, 0, size);
+    shadowgraph::gpu::submit_and_wait(d, &g.queue, enc, "storage_round").expect("submit");
+    let raw = shadowgraph::gpu::read_buffer(d, &readback).expect("readback");
+    let got: &[f32] = bytemuck::cast_slice(&raw);
+    let (mut f16_bad, mut unorm_bad) = (Vec::new(), Vec::new());
+    for (i, &x) in xs.iter().enumerate() {
+        let (v, c) = (i / 4, i % 4);
+        let h = got[8 * v + c];
+        let u = got[8 * v + 4 + c];
+        let want = f16_reference(f64::from(x));
+        if f64::from(h) != want {
+            f16_bad.push((x, h, want));
+        }
+        // The code is the nearest to 65535·x, up to the f32 product's rounding (≤ 2⁻⁹ below
+        // 65536): within that of a tie it may go either way.
+        let exact = 65535.0 * f64::from(x).clamp(0.0, 1.0);
+        let code = (f64::from(u) * 65535.0).round();
+        if (code - exact).abs() > 0.5 + 2f64.powi(-9) {
+            unorm_bad.push((x, u, exact));
+        }
+    }
+    assert!(
+        f16_bad.is_empty(),
+        "round_f16: {} of {} differ, e.g. {:?}",
+        f16_bad.len(),
+        xs.len(),
+        &f16_bad[..f16_bad.len().min(5)]
+    );
+    assert!(
+        unorm_bad.is_empty(),
+        "round_unorm16: {} of {} differ, e.g. {:?}",
+        unorm_bad.len(),
+        xs.len(),
+        &unorm_bad[..unorm_bad.len().min(5)]
+    );
 }

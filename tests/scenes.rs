@@ -702,17 +702,21 @@ fn blocker_kernels_are_planned_only_for_soft_lights() {
                 v.extend(vec![tiles; (basis + z).div_ceil(per)]);
                 Some(v)
             }
-            Technique::Vssm { .. } | Technique::MsmSoft { .. } => {
-                let encode = if matches!(l.shadow.technique, Technique::Vssm { .. }) {
-                    "vsm"
-                } else {
-                    "msm"
-                };
+            Technique::Vssm { .. } => {
                 let sums = l.shadow.technique.soft().map(|s| s.sums);
-                let mut v = vec![encode];
+                let mut v = vec!["vsm"];
                 v.extend(sat(sums.unwrap_or(shadowgraph::sat::SatVariant::Fixed)));
                 Some(v)
             }
+            // The moments computed in the table's own tile passes (one layer, no map).
+            Technique::MsmSoft { soft, .. } => Some(match soft.sums {
+                shadowgraph::sat::SatVariant::Fixed => {
+                    vec!["msm_sat_tile_sums", "sat_carries", "msm_sat_tiles"]
+                }
+                shadowgraph::sat::SatVariant::Float => {
+                    vec!["msm_sat_tile_sums_f32", "sat_carries", "msm_sat_tiles_f32"]
+                }
+            }),
             _ => None,
         };
         match expected {

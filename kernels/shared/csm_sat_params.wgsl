@@ -1,4 +1,5 @@
-// Parameters of the layered CSM / CSM-Z summed-area tables (import-only module of
+// Parameters of the layered summed-area tables computed from the depth — CSM's basis, CSSM's
+// search maps, MSM's moments (`msm_sat_*`) — (import-only module of
 // `csm_sat_tile_sums`, `csm_sat_tiles` and their f32 variants; src/sat/layers.rs): the tile
 // passes read the depth buffer and compute their layer's basis map on the fly (`SatSource`,
 // shared/sat_tile), so the basis maps are never stored. Layer L (workgroup z = L − first_map)
@@ -16,9 +17,9 @@ struct CsmSatParams {
     terms: u32,           // M
     f16: u32,             // 1: round each basis value to f16, as an rgba16float map would hold it
     moments: u32,         // 1: the layer after CSM's is the power moments (CSSM's moment search)
+    unorm16: u32,         // 1: round each value to 16-bit unorm, as an rgba16unorm map would hold it
     _pad0: u32,
     _pad1: u32,
-    _pad2: u32,
 }
 
 // Tiles of a `size` map along x and y: the width of a band of row_part, the height of one of
@@ -27,7 +28,14 @@ fn csm_sat_tiles_of(size: vec2<u32>) -> vec2<u32> {
     return (size + vec2<u32>(TILE - 1u)) / TILE;
 }
 
-// Layer `layer`'s source, for a map of `tiles` tiles.
+// Layer `layer`'s source, for a map of `tiles` tiles: map `layer` of the CSM sequence.
 fn csm_sat_source(p: CsmSatParams, layer: u32, tiles: vec2<u32>) -> SatSource {
-    return SatSource(true, p.f16 != 0u, layer, p.terms, p.moments != 0u, p.depth, layer * tiles);
+    return SatSource(true, false, p.f16 != 0u, layer, p.terms, p.moments != 0u, false, p.depth,
+        layer * tiles);
+}
+
+// The source of MSM's one layer (`msm` kernels): its quantized moments, rounded as the map's
+// storage would (`p.f16`, `p.unorm16`).
+fn msm_sat_source(p: CsmSatParams) -> SatSource {
+    return SatSource(true, true, p.f16 != 0u, 0u, 0u, false, p.unorm16 != 0u, p.depth, vec2<u32>(0u));
 }

@@ -5,9 +5,11 @@
 // #completed-by-importer
 // #import shared/sat_tile
 // #import shared/csm_maps
+// #import shared/msm_quantize
+// #import shared/storage_round
 // #import shared/linear_depth
 
-// Non-finite depth texels this invocation's `sat_texel` replaced (CSM sources; the first
+// Non-finite depth texels this invocation's `sat_texel` replaced (depth sources; the first
 // tile pass counts layer 0's).
 var<private> sat_non_finite: u32;
 
@@ -26,15 +28,24 @@ fn sat_texel(
 ) -> vec4<u32> {
     let inside = all(q < size);
     var v = textureLoad(src, min(q, size - 1u), 0);
-    if s.csm {
+    if s.from_depth {
         let raw = v.r;
         if inside && !depth_is_finite(raw) {
             sat_non_finite += 1u;
         }
-        v = csm_basis_map(s.layer, s.terms, s.moments, linear_depth(raw, s.depth));
-        if s.f16 {
-            v = vec4<f32>(unpack2x16float(pack2x16float(v.xy)), unpack2x16float(pack2x16float(v.zw)));
+        let z = linear_depth(raw, s.depth);
+        if s.msm {
+            // MSM's moments as shared/msm_moments computes them, quantized (a table's always
+            // are).
+            let z2 = z * z;
+            v = msm_quantize(vec4<f32>(z, z2, z2 * z, z2 * z2));
+        } else {
+            v = csm_basis_map(s.layer, s.terms, s.moments, z);
         }
+        // The storage's rounding, selected rather than branched on: llvmpipe runs a branch's
+        // body for every lane, and both roundings are a few integer operations.
+        v = select(v, round_f16(v), s.f16);
+        v = select(v, round_unorm16(v), s.unorm16);
     }
     return select(vec4<u32>(0u), sat_encode_as(v, p, fs), inside);
 }

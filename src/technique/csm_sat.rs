@@ -1,10 +1,11 @@
-//! CSM and CSSM through summed-area tables, the basis never stored: the layered tables of
-//! [`crate::sat::layers`] whose tile kernels (`kernels/csm_sat_tile_sums.wgsl`,
-//! `kernels/csm_sat_tiles.wgsl` and their f32 variants) compute each basis map from the depth
-//! on the fly, one layer a map of the light's sequence (`kernels/shared/csm_basis.wgsl`).
+//! CSM, CSSM and MSM through summed-area tables, the representation never stored: the
+//! layered tables of [`crate::sat::layers`] whose tile kernels (`kernels/csm_sat_tile_sums.wgsl`,
+//! `kernels/csm_sat_tiles.wgsl` and their f32 variants) compute each map from the depth on the
+//! fly, one layer a map of the light's sequence (`kernels/shared/csm_maps.wgsl`; MSM's moments
+//! a sequence of no terms and its moment map).
 
 use super::csm::basis_sequence;
-use super::nodes::{LightNodes, float_moments_format};
+use super::nodes::{LightNodes, float_moments_format, moments_format};
 use crate::gpu_data::LinearizeParams;
 use crate::graph::{Graph, SizeRule};
 use crate::kernels::KernelId;
@@ -31,8 +32,10 @@ pub struct CsmSatParams {
     pub f16: u32,
     /// 1: the layer after CSM's is the power moments (CSSM's moment search).
     pub moments: u32,
+    /// 1: each value rounded to 16-bit unorm, as unorm16 storage of the map would hold it.
+    pub unorm16: u32,
     /// Padding to 16 bytes.
-    pub _pad: [u32; 3],
+    pub _pad: [u32; 2],
 }
 
 /// What the layered tables of one light's basis hold ([`add_csm_tables`]).
@@ -81,31 +84,109 @@ pub fn add_csm_tables(
     coding: SatCoding,
 ) -> Vec<String> {
     let tables = basis_maps(graph, light, depth, b);
-    let (lin, terms) = (b.depth, b.terms);
-    let f16 = u32::from(b.storage == Storage::F16);
-    let moments = u32::from(b.search == Some(CssmSearch::Moments));
-    let params = move |sat: SatParams, first_map: u32, maps: u32| {
-        let p = CsmSatParams {
-            sat,
-            depth: lin,
-            first_map,
-            maps,
-            terms,
-            f16,
-            moments,
-            _pad: [0; 3],
-        };
-        bytemuck::bytes_of(&p).to_vec()
+    let template = CsmSatParams {
+        sat: coding.params(4, 0),
+        depth: b.depth,
+        first_map: 0,
+        maps: 0,
+        terms: b.terms,
+        f16: u32::from(b.storage == Storage::F16),
+        moments: u32::from(b.search == Some(CssmSearch::Moments)),
+        unorm16: 0,
+        _pad: [0; 2],
     };
     let kernels = match coding.variant {
         SatVariant::Fixed => [KernelId::CsmSatTileSums, KernelId::CsmSatTiles],
         SatVariant::Float => [KernelId::CsmSatTileSumsF32, KernelId::CsmSatTilesF32],
     };
-    let prefix = format!("light{light}.csm");
+    depth_tables(
+        graph, light, depth, "csm", &tables, kernels, template, coding,
+    )
+}
+
+/// Adds the summed-area table of light `light`'s MSM moments (quantized, as a table's always
+/// are: `technique::msm_quantized`; rounded as `storage` would hold them) coded as `coding`, computed from the depth `depth` in
+/// the table's own tile passes: one layer of [`add_layered_sat`], 3 dispatches, the depth read twice and the moments never stored. The map
+/// `light{light}.msm` is declared in its storage's format but never planned. Returns
+/// `light{light}.msm.sat`.
+pub fn add_msm_table(
+    graph: &mut Graph,
+    light: usize,
+    depth: &str,
+    m: &MsmTable,
+    coding: SatCoding,
+) -> String {
+    let size = SizeRule::Reduced {
+        of: depth.to_string(),
+        shift: 0,
+    };
+    let format = moments_format(m.storage, 4);
+    let map = graph.resource(format!("light{light}.msm"), format, size, Some(light));
+    let template = CsmSatParams {
+        sat: coding.params(4, 0),
+        depth: m.depth,
+        first_map: 0,
+        maps: 0,
+        terms: 0,
+        f16: u32::from(m.storage == Storage::F16),
+        moments: 0,
+        unorm16: u32::from(m.storage == Storage::Unorm16),
+        _pad: [0; 2],
+    };
+    let kernels = match coding.variant {
+        SatVariant::Fixed => [KernelId::MsmSatTileSums, KernelId::MsmSatTiles],
+        SatVariant::Float => [KernelId::MsmSatTileSumsF32, KernelId::MsmSatTilesF32],
+    };
+    let tables = depth_tables(
+        graph,
+        light,
+        depth,
+        "msm",
+        &[(map, 4)],
+        kernels,
+        template,
+        coding,
+    );
+    tables.into_iter().next().unwrap_or_default()
+}
+
+/// What [`add_msm_table`] sums: MSM's quantized moments.
+#[derive(Clone, Copy, Debug)]
+pub struct MsmTable {
+    /// The moments' storage: f16 and unorm16 round every value as such a map would.
+    pub storage: Storage,
+    /// The depth buffer's linearization.
+    pub depth: LinearizeParams,
+}
+
+/// The layered tables of `tables` (`(map, channels)`, in layer order) computed from `depth`
+/// by the depth-sourced tile kernels `kernels` (pass 1, pass 3) with parameters `template`
+/// (its `first_map`, `maps` and `sat` set per dispatch), nodes named `light{light}.{stem}.sat.*`.
+#[allow(clippy::too_many_arguments)]
+fn depth_tables(
+    graph: &mut Graph,
+    light: usize,
+    depth: &str,
+    stem: &str,
+    tables: &[(String, u32)],
+    kernels: [KernelId; 2],
+    template: CsmSatParams,
+    coding: SatCoding,
+) -> Vec<String> {
+    let params = move |sat: SatParams, first_map: u32, maps: u32| {
+        let p = CsmSatParams {
+            sat,
+            first_map,
+            maps,
+            ..template
+        };
+        bytemuck::bytes_of(&p).to_vec()
+    };
+    let prefix = format!("light{light}.{stem}");
     let sat = LayeredSat {
         source: depth,
         prefix: &prefix,
-        tables: &tables,
+        tables,
         kernels,
         params: &params,
         coding,
