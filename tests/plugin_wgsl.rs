@@ -6,7 +6,9 @@ use std::path::Path;
 
 use shadowgraph::kernels;
 use shadowgraph::prefilter::{PrefilterConfig, StageError, wgsl};
-use shadowgraph::scene::{BlurKernel, Filter, PcfKernel, Prefilter, Scene, Storage, Technique};
+use shadowgraph::scene::{
+    BlurKernel, CssmSearch, Filter, PcfKernel, Prefilter, Scene, Storage, Technique,
+};
 use shadowgraph::technique::LightGpu;
 
 fn every_technique() -> Vec<Technique> {
@@ -344,6 +346,12 @@ fn configs_follow_the_scene_rules() {
         ("vssm", "", 0.5, PrefilterConfig::vssm(64, 0.5)),
         (
             "cssm",
+            "blocker_search = \"csm_z\"",
+            0.5,
+            PrefilterConfig::cssm(64, 8, 0.5).with_blocker_search(CssmSearch::CsmZ),
+        ),
+        (
+            "cssm",
             "terms = 4\nsharpen = 100.5",
             0.5,
             cssm_sharpen(PrefilterConfig::cssm(64, 4, 0.5), 100.5),
@@ -460,6 +468,11 @@ fn settings_that_do_not_apply_are_named() {
         .validated()
         .unwrap_err();
     assert!(e.to_string().contains("moment_bias"), "{e}");
+    let e = PrefilterConfig::vssm(64, 0.5)
+        .with_blocker_search(CssmSearch::CsmZ)
+        .validated()
+        .unwrap_err();
+    assert!(e.to_string().contains("blocker_search"), "{e}");
     let e = PrefilterConfig::vsm(0).validated().unwrap_err();
     assert!(e.to_string().contains("size"), "{e}");
     let e = PrefilterConfig::vsm(64)

@@ -7,7 +7,8 @@ use glam::{Mat4, Vec3, Vec4};
 use super::StageError;
 use crate::model::Cascades;
 use crate::model::{
-    BlurKernel, Filter, Light, LightKind, ParamValue, ParamValues, Shadow, Storage, Technique,
+    BlurKernel, CssmSearch, Filter, Light, LightKind, ParamValue, ParamValues, Shadow, Storage,
+    Technique,
 };
 use crate::sat::SatVariant;
 use crate::technique::params::{CASCADES, COMMON, Given, GivenError, filter_values, storage_name};
@@ -259,6 +260,15 @@ impl PrefilterConfig {
             self.moment_bias_set = true;
         }
         self
+    }
+
+    /// The same with CSSM's blocker search (the scene key `blocker_search`): the power moments
+    /// in one table (the default) or the paper's CSM-Z basis. Not applicable to other
+    /// techniques (validation names the key).
+    pub fn with_blocker_search(self, search: CssmSearch) -> Self {
+        self.with_values("blocker_search", |v| {
+            v.set("blocker_search", ParamValue::Choice(search.name()));
+        })
     }
 
     /// The same with the receiver-plane depth bias on, each tap's correction capped at `cap`
