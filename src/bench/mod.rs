@@ -199,6 +199,15 @@ pub const CASES: &[BenchCase] = &[
     },
     // CSSM's prefilter: the layered tables (basis computed in their tile passes) against the
     // chain before them, until the comparison is recorded.
+    // The soft techniques' whole prefilter at their defaults: issue 14's table build.
+    BenchCase {
+        name: "chain vssm (depth → table)",
+        build: |n| chain_graph(n, named("vssm", &[]), &["light0.vsm.sat"]),
+    },
+    BenchCase {
+        name: "chain msm_soft (depth → table)",
+        build: |n| chain_graph(n, named("msm_soft", &[]), &["light0.msm.sat"]),
+    },
     BenchCase {
         name: "chain cssm 8 terms (depth → 5 tables)",
         build: csm_chain::layered,
