@@ -1,8 +1,8 @@
 //! CSM, CSSM and MSM through summed-area tables, the representation never stored: the
 //! layered tables of [`crate::sat::layers`] whose tile kernels (`kernels/csm_sat_tile_sums.wgsl`,
 //! `kernels/csm_sat_tiles.wgsl` and their f32 variants) compute each map from the depth on the
-//! fly, one layer a map of the light's sequence (`kernels/shared/csm_maps.wgsl`; MSM's moments
-//! a sequence of no terms and its moment map).
+//! fly, one layer a map of the light's sequence (`kernels/shared/csm_maps.wgsl`); MSM's moments
+//! likewise, one layer by their own kernels (`kernels/msm_sat_*.wgsl`).
 
 use super::csm::basis_sequence;
 use super::nodes::{LightNodes, float_moments_format, moments_format};
@@ -105,9 +105,10 @@ pub fn add_csm_tables(
 }
 
 /// Adds the summed-area table of light `light`'s MSM moments (quantized, as a table's always
-/// are: `technique::msm_quantized`; rounded as `storage` would hold them) coded as `coding`, computed from the depth `depth` in
-/// the table's own tile passes: one layer of [`add_layered_sat`], 3 dispatches, the depth read twice and the moments never stored. The map
-/// `light{light}.msm` is declared in its storage's format but never planned. Returns
+/// are: `technique::msm_quantized`; rounded as `m.storage` would hold them) coded as `coding`,
+/// computed from the depth `depth` in the table's own tile passes: one layer of
+/// [`add_layered_sat`], 3 dispatches, the depth read twice and the moments never stored. The
+/// map `light{light}.msm` is declared in its storage's format but never planned. Returns
 /// `light{light}.msm.sat`.
 pub fn add_msm_table(
     graph: &mut Graph,
