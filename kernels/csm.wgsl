@@ -8,8 +8,8 @@
 //     map from channel 4·(m − ⌈M/2⌉) on, channels past the last zeros. Filtered next to the CSM
 //     basis they give E[f̄(d, z)·z] over any rectangle, f̄ = 1 − f, so the average blocker depth
 //     E[f̄·z] / E[f̄] (shared/blocker.wgsl) is a lookup.
-//   - or, CSSM with `blocker_search = "moments"` (`moments` = 1), one map of the power moments
-//     (z, z², z³, z⁴), whose means give MSM's blocker estimate.
+//   - or, CSSM with `blocker_search = "moments"` (`moments` = 1), one map of MSM's quantized
+//     moments (z, z², z³, z⁴), whose means give MSM's blocker estimate.
 // This dispatch writes maps first_map … first_map + maps − 1 to dst0 … dst<maps − 1> (the
 // executor binds the unused outputs to the last bound one; they are not stored to). Every value
 // lies in [−1, 1] (|z·sin| ≤ z ≤ 1), so f16 storage keeps them to 2⁻¹¹. The argument is reduced

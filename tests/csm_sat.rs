@@ -7,8 +7,8 @@
 //! exact sums of those codes (wrapping u32, as the integer reference `cpu::sat::sat_fixed`
 //! sums them), in f32 every table texel is within the scan's rounding bound of the f64 table.
 //! Random depth with NaN and ±Inf texels (counted once), ragged tiles, both variants, CSM
-//! alone, CSSM's CSM + CSM-Z and CSSM's CSM + power moments (`cpu::msm`), f32 and f16
-//! storage.
+//! alone, CSSM's CSM + CSM-Z and CSSM's CSM + MSM's quantized moments (`cpu::msm`), MSM's
+//! moments alone, f32, f16 and unorm16 storage.
 
 mod common;
 
@@ -137,7 +137,7 @@ fn run(g: &Gpu, case: &Case, raw: &[f32], coding: SatCoding) -> (Vec<Vec<u32>>, 
 }
 
 /// Per table, the f64 basis of `lin`: its channels of the CSM sequence (2M) then, with
-/// `search`, of the CSM-Z sequence (2M + 1), four a table, or the four power moments.
+/// `search`, of the CSM-Z sequence (2M + 1), four a table, or MSM's four quantized moments.
 fn basis(lin: &Texels, terms: u32, search: Option<CssmSearch>) -> Vec<Texels> {
     let chunks = |t: Texels, maps: u32| -> Vec<Texels> {
         (0..maps as usize)
@@ -161,7 +161,7 @@ fn basis(lin: &Texels, terms: u32, search: Option<CssmSearch>) -> Vec<Texels> {
         Some(CssmSearch::CsmZ) => {
             out.extend(chunks(cpu::csm_z::csm_z(lin, terms), csm_z_maps(terms)));
         }
-        Some(CssmSearch::Moments) => out.push(cpu::msm::msm(lin, false)),
+        Some(CssmSearch::Moments) => out.push(cpu::msm::msm(lin, true)),
         None => {}
     }
     out
@@ -182,12 +182,6 @@ fn f16(storage: Storage, v: f64) -> f64 {
     } else {
         0.0
     }
-}
-
-/// The GPU's power moments against f64: the depth texel is exact (orthographic), z², z³ = z²·z
-/// and z⁴ = z²·z² round at most three times (3U relative), then f16 storage.
-fn moment_tolerance(storage: Storage, v: f64) -> f64 {
-    3.0 * U * v.abs() + f16(storage, v)
 }
 
 /// MSM's quantized moments against f64: the power moments (≤ 1) through the quantization
@@ -247,7 +241,7 @@ fn check(g: &Gpu, seed: u64, case: &Case) {
                 if case.msm {
                     msm_tolerance(case.storage, x)
                 } else if power {
-                    moment_tolerance(case.storage, x)
+                    msm_tolerance(case.storage, x)
                 } else {
                     basis_tolerance(case.terms, case.storage, x)
                 }

@@ -549,8 +549,8 @@ fn csm_basis_matches_reference() {
             rtol,
         );
     }
-    // With `moments` (CSSM's moment search) the map after the basis is (z, z², z³, z⁴): three
-    // f32 roundings at most (z² then z³ = z²·z, z⁴ = z²·z²).
+    // With `moments` (CSSM's moment search) the map after the basis is MSM's quantized moments:
+    // the quantization matrix's f32 products (entries up to 82: 6·82·2⁻²⁴).
     let params = bytemuck::bytes_of(&CsmParams {
         depth: shadowgraph::technique::LinearizeParams::ORTHOGRAPHIC,
         first_map: shadowgraph::technique::csm_maps(terms),
@@ -567,13 +567,13 @@ fn csm_basis_matches_reference() {
         &out,
         upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin),
     );
-    let want = cpu::msm::msm(&input, false);
+    let want = cpu::msm::msm(&input, true);
     common::assert_close(
         "csm moments map",
         &channels(&gpu, 4),
         &want.data,
+        6.0 * 82.0 * 2f64.powi(-24),
         0.0,
-        3.0 * 2f64.powi(-24),
     );
 }
 

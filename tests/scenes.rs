@@ -417,7 +417,7 @@ fn check_prefilter_chain(scene: &Scene, frame: &shadowgraph::render::Frame, li: 
                 let f = move |t: &Texels| {
                     let a = cpu::csm::csm(t, terms);
                     let b = match search {
-                        shadowgraph::scene::CssmSearch::Moments => cpu::msm::msm(t, false),
+                        shadowgraph::scene::CssmSearch::Moments => cpu::msm::msm(t, true),
                         shadowgraph::scene::CssmSearch::CsmZ => cpu::csm_z::csm_z(t, terms),
                     };
                     let data = a

@@ -2,6 +2,7 @@
 // layered tables' `SatSource`, shared/sat_tile, which compute them on the fly), built from the
 // Fourier basis of shared/csm_basis.
 // #import shared/csm_basis
+// #import shared/msm_quantize
 
 // Map m of the light's sequence at depth z, M = `terms`: the ⌈M/2⌉ CSM basis maps (sin c_k z,
 // cos c_k z, sin c_{k+1} z, cos c_{k+1} z), k = 2m + 1, a pair past M zeros; then (CSSM) the
@@ -27,7 +28,7 @@ fn csm_basis_map(m: u32, terms: u32, moments: bool, z: f32) -> vec4<f32> {
     let channel = 4u * j + vec4<u32>(0u, 1u, 2u, 3u);
     let keep = select(channel <= vec4<u32>(2u * terms), term <= vec4<u32>(terms), csm);
     let z2 = z * z;
-    let power = vec4<f32>(z, z2, z2 * z, z2 * z2);
+    let power = msm_quantize(vec4<f32>(z, z2, z2 * z, z2 * z2));
     let rest = select(select(vec4<f32>(0.0), z_seq, keep), power, moments);
     return select(rest, select(vec4<f32>(0.0), basis, keep), csm);
 }

@@ -16,7 +16,7 @@ struct CsmSatParams {
     maps: u32,            // layers of this dispatch (workgroups along z)
     terms: u32,           // M
     f16: u32,             // 1: round each basis value to f16, as an rgba16float map would hold it
-    moments: u32,         // 1: the layer after CSM's is the power moments (CSSM's moment search)
+    moments: u32,         // 1: the layer after CSM's is MSM's moments (CSSM's moment search)
     unorm16: u32,         // 1: round each value to 16-bit unorm, as an rgba16unorm map would hold it
     _pad0: u32,
     _pad1: u32,

@@ -47,7 +47,7 @@ struct SatSource {
     f16: bool,           // round each basis value to f16
     layer: u32,          // the basis map (CSM's ⌈M/2⌉, then CSM-Z's)
     terms: u32,          // M
-    moments: bool,       // the map after CSM's is the power moments (CSSM's moment search)
+    moments: bool,       // the map after CSM's is MSM's moments (CSSM's moment search)
     unorm16: bool,       // round each value to 16-bit unorm
     depth: DepthParams,  // the depth buffer's linearization
     band: vec2<u32>,     // this table's carries start at this (tile column, tile row)

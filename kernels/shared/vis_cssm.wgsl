@@ -9,7 +9,7 @@
 // (share < BLOCKER_MIN_SHARE) is lit.
 // The shading block (technique::cssm's `visibility`) reads, at the search width snapped
 // outward to texel edges (`sat_search_*`, 4 loads a table), either (`blocker_search =
-// "moments"`, the default) the power moments' table, which gives `cssm_blocker_moments`, or
+// "moments"`, the default) MSM's quantized moments' table, which gives `cssm_blocker_moments`, or
 // (`"csm_z"`, the paper's) sums `csm_z_chunk_of` over the light's CSM-Z tables and
 // `csm_chunk_of` over its basis tables, which gives `cssm_blocker`; where that
 // finds blockers, a loop of `soft_filter_trips` trips sums the basis tables again at
@@ -24,11 +24,11 @@ fn cssm_blocker(below: f32, zsum: f32, l: Light, s: LightSample) -> vec2<f32> {
     return blocker_csm_z(below, zsum, s.depth - l.bias);
 }
 
-// `blocker_search = "moments"`: from the power moments (z, z², z³, z⁴) over the search square,
-// biased by `l.moment_bias` and projected onto valid moments as MSM's raw moments are,
-// msm_soft's three-point estimate (blocker_msm).
+// `blocker_search = "moments"`: from MSM's quantized moments over the search square,
+// dequantized and biased by `l.moment_bias` as `msm_soft`'s (msm_biased: the light's
+// `msm_flags` say quantized), msm_soft's three-point estimate (blocker_msm).
 fn cssm_blocker_moments(m: vec4<f32>, l: Light, s: LightSample) -> vec2<f32> {
-    return blocker_msm(msm_moments(m, l.moment_bias, true), s.depth - l.bias);
+    return blocker_msm(msm_biased(m, l), s.depth - l.bias);
 }
 
 // v^p for v in [0, 1], p ≥ 1 (0 at v = 0, where log2 is −∞).

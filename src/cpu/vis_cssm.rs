@@ -1,6 +1,6 @@
 //! Reference of `kernels/shared/vis_cssm.wgsl` (with the body `technique::visibility_body`
 //! generates around it), in the three steps of [`super::vis_vssm`]: the search's means over
-//! the search square (the power moments, or the CSM and CSM-Z series), the blocker estimate,
+//! the search square (MSM's quantized moments, or the CSM and CSM-Z series), the blocker estimate,
 //! the sharpened CSM visibility at the penumbra width.
 
 use super::blocker::{self, Blocker};
@@ -14,7 +14,7 @@ use crate::model::CssmSearch;
 pub struct Maps<'a> {
     /// The CSM basis, `2M` channels or more (sin, cos per term; padding zeros after).
     pub basis: &'a Integral,
-    /// The blocker search's representation: the power moments `(z, z², z³, z⁴)`
+    /// The blocker search's representation: MSM's quantized moments `(z, z², z³, z⁴)`
     /// ([`CssmSearch::Moments`]) or the CSM-Z basis, `2M + 1` channels or more
     /// (`kernels/shared/csm_maps.wgsl`'s order; [`CssmSearch::CsmZ`]).
     pub search: &'a Integral,

@@ -26,8 +26,9 @@ pub use sat_variant::SatVariant;
 /// the blocker share and average depth.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum CssmSearch {
-    /// The four power moments `(z, z², z³, z⁴)` in one table, MSM's three-point estimate
-    /// (`msm_soft`'s search): one table read at the search width.
+    /// MSM's four moments `(z, z², z³, z⁴)`, quantized as `msm_soft`'s table holds them, in one
+    /// table; MSM's three-point estimate (`msm_soft`'s search): one table read at the search
+    /// width.
     Moments,
     /// The paper's CSM-Z basis `[z, z·sin c_k z, z·cos c_k z]` with CSM's basis: `E[f̄·z] /
     /// E[f̄]`, ⌈M/2⌉ + ⌈(2M + 1)/4⌉ tables read at the search width.

@@ -62,7 +62,7 @@ pub fn csm_z_maps(terms: u32) -> u32 {
 
 /// The maps after the CSM basis for CSSM's blocker search, `(name, channels)`: the CSM-Z maps
 /// `csm_z<chunk>` (four channels of `[z, z·sin c₁z, z·cos c₁z, …]` each), or the power
-/// moments' map `csm_moments` (`(z, z², z³, z⁴)`).
+/// moments' map `csm_moments` (MSM's `(z, z², z³, z⁴)`, quantized).
 pub fn search_maps(terms: u32, search: CssmSearch) -> Vec<(String, u32)> {
     match search {
         CssmSearch::CsmZ => {

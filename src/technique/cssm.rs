@@ -6,7 +6,7 @@ use super::csm::series_values;
 use super::params::{CSM, FLOAT_FORMAT, SOFT, choice, float, soft, soft_values};
 use super::sweep_plan::{SweepPlan, SweepVariant};
 use super::{TechniqueDef, no_clamp};
-use crate::gpu_data::TECHNIQUE_CSSM;
+use crate::gpu_data::{MSM_QUANTIZED, TECHNIQUE_CSSM};
 use crate::model::{
     CssmSearch, DEFAULT_SHARPEN, DEFAULT_SHARPEN_FALLOFF, ParamSpec, ParamValue, ParamValues,
     Technique, default_soft_moment_bias,
@@ -37,8 +37,8 @@ const SHARPEN: &[ParamSpec] = &[
         "blocker_search",
         &["moments", "csm_z"],
         "moments",
-        "blocker search: the four power moments in one table (msm_soft's estimate) or the \
-         paper's CSM-Z basis",
+        "blocker search: MSM's four moments in one table (msm_soft's estimate) or the paper's \
+         CSM-Z basis",
     ),
 ];
 
@@ -172,8 +172,10 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
         {
             g.sharpen = sharpen;
             g.sharpen_falloff = sharpen_falloff;
-            // The moment search's bias: msm_soft's default for the storage.
+            // The moment search's moments: quantized, biased by msm_soft's default for the
+            // storage.
             g.moment_bias = default_soft_moment_bias(soft.storage);
+            g.msm_flags = MSM_QUANTIZED;
         }
     },
     nodes: |n| match n.light.shadow.technique {

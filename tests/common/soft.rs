@@ -378,7 +378,7 @@ pub fn cssm_tolerance(
 
 /// A CSSM light's shade map (its tables' values side by side, `technique::map_channels`
 /// each, as `Frame::shade_maps` holds them) split into the CSM basis (2M channels) and the
-/// search's representation (the four power moments, or the CSM-Z basis's 2M + 1), padding
+/// search's representation (MSM's four quantized moments, or the CSM-Z basis's 2M + 1), padding
 /// dropped.
 pub fn split_cssm(light: &shadowgraph::scene::Light, map: &Texels) -> (Texels, Texels) {
     let shadowgraph::scene::Technique::Cssm { terms, search, .. } = light.shadow.technique else {
