@@ -24,19 +24,9 @@ const FLOAT_SUMS: bool = true;
 @compute @workgroup_size(WG_SIZE)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     let layer = params.first_map + wg.z;
-    let size = textureDimensions(src);
-    let tiles = csm_sat_tiles_of(size);
-    let source = csm_sat_source(params, layer, tiles);
-    let e = sat_tile_edges(params.sat, FLOAT_SUMS, source, wg.xy, li);
+    let source = csm_sat_source(params, layer, csm_sat_tiles_of(textureDimensions(src)));
+    sat_tile_sums_pass(params.sat, FLOAT_SUMS, source, wg.xy, li);
     if layer == 0u && sat_non_finite > 0u {
         atomicAdd(&stats[0], sat_non_finite);
-    }
-    let q = wg.xy * TILE + li % TILE;
-    if li < TILE {
-        if q.y < size.y {
-            textureStore(row_part, vec2<u32>(source.band.x + wg.x, q.y), e);
-        }
-    } else if q.x < size.x {
-        textureStore(col_part, vec2<u32>(q.x, source.band.y + wg.y), e);
     }
 }

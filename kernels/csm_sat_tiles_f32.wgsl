@@ -29,9 +29,9 @@
 
 const FLOAT_SUMS: bool = true;
 
-// Texel q of table j of this dispatch.
-fn store(j: u32, q: vec2<u32>, v: vec4<u32>) {
-    switch j {
+// Texel q of table `slot` of this dispatch (shared/sat_tile_scan).
+fn sat_store(slot: u32, q: vec2<u32>, v: vec4<u32>) {
+    switch slot {
         case 0u: {
             textureStore(dst0, q, bitcast<vec4<f32>>(v));
         }
@@ -49,22 +49,7 @@ fn store(j: u32, q: vec2<u32>, v: vec4<u32>) {
 
 @compute @workgroup_size(WG_SIZE)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    let fs = FLOAT_SUMS;
     let size = textureDimensions(src);
     let source = csm_sat_source(params, params.first_map + wg.z, csm_sat_tiles_of(size));
-    var col_add: array<vec4<u32>, SUB>;
-    sat_tile_prepare(col_carry, row_carry, params.sat, fs, source, wg.xy, li, &col_add);
-    let origin = sat_sub_origin(wg.xy, li);
-    var col: array<vec4<u32>, SUB>;
-    for (var j = 0u; j < SUB; j++) {
-        sat_sweep_row(origin, j, params.sat, fs, source, &col);
-        let row_add = sat_row_add(fs, li, j);
-        for (var i = 0u; i < SUB; i++) {
-            let q = origin + vec2<u32>(i, j);
-            let sum = sat_sum(sat_sum(col[i], row_add, fs), col_add[i], fs);
-            if all(q < size) {
-                store(wg.z, q, sum);
-            }
-        }
-    }
+    sat_tile_table(params.sat, FLOAT_SUMS, source, wg.xy, li, wg.z);
 }

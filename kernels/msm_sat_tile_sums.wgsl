@@ -23,18 +23,8 @@ const FLOAT_SUMS: bool = false;
 
 @compute @workgroup_size(WG_SIZE)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    let size = textureDimensions(src);
-    let source = msm_sat_source(params);
-    let e = sat_tile_edges(params.sat, FLOAT_SUMS, source, wg.xy, li);
+    sat_tile_sums_pass(params.sat, FLOAT_SUMS, msm_sat_source(params), wg.xy, li);
     if sat_non_finite > 0u {
         atomicAdd(&stats[0], sat_non_finite);
-    }
-    let q = wg.xy * TILE + li % TILE;
-    if li < TILE {
-        if q.y < size.y {
-            textureStore(row_part, vec2<u32>(source.band.x + wg.x, q.y), e);
-        }
-    } else if q.x < size.x {
-        textureStore(col_part, vec2<u32>(q.x, source.band.y + wg.y), e);
     }
 }

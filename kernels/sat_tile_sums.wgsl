@@ -21,14 +21,5 @@ const FLOAT_SUMS: bool = false;
 
 @compute @workgroup_size(WG_SIZE)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    let e = sat_tile_edges(params, FLOAT_SUMS, SAT_STORED, wg.xy, li);
-    let size = textureDimensions(src);
-    let q = wg.xy * TILE + li % TILE;
-    if li < TILE {
-        if q.y < size.y {
-            textureStore(row_part, vec2<u32>(wg.x, q.y), e);
-        }
-    } else if q.x < size.x {
-        textureStore(col_part, vec2<u32>(q.x, wg.y), e);
-    }
+    sat_tile_sums_pass(params, FLOAT_SUMS, SAT_STORED, wg.xy, li);
 }

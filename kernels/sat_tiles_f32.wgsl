@@ -20,23 +20,12 @@
 
 const FLOAT_SUMS: bool = true;
 
+// Table texel q (shared/sat_tile_scan; one table, `slot` unused).
+fn sat_store(slot: u32, q: vec2<u32>, v: vec4<u32>) {
+    textureStore(dst, q, bitcast<vec4<f32>>(v));
+}
+
 @compute @workgroup_size(WG_SIZE)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    let fs = FLOAT_SUMS;
-    var col_add: array<vec4<u32>, SUB>;
-    sat_tile_prepare(col_carry, row_carry, params, fs, SAT_STORED, wg.xy, li, &col_add);
-    let origin = sat_sub_origin(wg.xy, li);
-    let size = textureDimensions(dst);
-    var col: array<vec4<u32>, SUB>;
-    for (var j = 0u; j < SUB; j++) {
-        sat_sweep_row(origin, j, params, fs, SAT_STORED, &col);
-        let row_add = sat_row_add(fs, li, j);
-        for (var i = 0u; i < SUB; i++) {
-            let q = origin + vec2<u32>(i, j);
-            let sum = sat_sum(sat_sum(col[i], row_add, fs), col_add[i], fs);
-            if all(q < size) {
-                textureStore(dst, q, bitcast<vec4<f32>>(sum));
-            }
-        }
-    }
+    sat_tile_table(params, FLOAT_SUMS, SAT_STORED, wg.xy, li, 0u);
 }

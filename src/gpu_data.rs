@@ -263,13 +263,13 @@ pub struct CsmParams {
     pub depth: LinearizeParams,
     /// Index of the map `dst0` receives in the light's sequence of maps: the ⌈M/2⌉ CSM basis
     /// maps (`technique::csm_maps`), then (CSSM) the CSM-Z maps (`technique::csm_z_maps`) or the
-    /// power moments' map.
+    /// moment map (MSM's quantized moments).
     pub first_map: u32,
     /// Maps this dispatch writes (`dst0` … `dst<maps − 1>`; 1 to [`CSM_OUTPUTS`]).
     pub maps: u32,
     /// Total terms M (a pair past M is written as zeros).
     pub terms: u32,
-    /// 1: the map after the CSM basis maps is the power moments `(z, z², z³, z⁴)` (CSSM's
+    /// 1: the map after the CSM basis maps is MSM's quantized moments `(z, z², z³, z⁴)` (CSSM's
     /// moment search), not the CSM-Z maps.
     pub moments: u32,
 }

@@ -1,5 +1,5 @@
 // The table of one tile with its carries (import-only module of `sat_tiles` and
-// `sat_tiles_f32`, and of the layered `csm_sat_tiles*`, pass 3 of 3); the carries of the
+// `sat_tiles_f32`, and of the depth-sourced `csm_sat_tiles*` and `msm_sat_tiles*`, pass 3 of 3); the carries of the
 // source's band (`SatSource.band`). A table texel (x, y) of tile (tx, ty) is the sum of three
 // disjoint parts of [0, x] × [0, y]:
 //   the tile's own inclusive table at (x, y)                       (registers + workgroup),
@@ -13,7 +13,9 @@
 // reads and one write per texel over the three passes.
 // #import shared/sat_tile
 // #import shared/sat_tile_texel
-// The importing kernel declares `src` (shared/sat_tile_texel):
+// The importing kernel declares `src` (shared/sat_tile_texel), the carries it reads,
+// `col_carry` and `row_carry` (`texture_2d<u32>`), and `fn sat_store(slot: u32, q: vec2<u32>,
+// v: vec4<u32>)`, which writes table texel q (`slot`: which of its tables, where it has several):
 // #completed-by-importer
 
 // Row y: at [y · (GRID − 1) + a − 1], the sum of row y over sub-blocks a' < a (a ≥ 1).
@@ -129,4 +131,25 @@ fn sat_row_add(fs: bool, li: u32, j: u32) -> vec4<u32> {
         add = sat_sum(add, sh_right[(b * SUB + j) * SIDE + a - 1u], fs);
     }
     return add;
+}
+
+// Pass 3 for tile `tile`: its table with the carries of band `s.band`, every texel inside the
+// map handed to the importer's `sat_store(slot, q, v)`. Every invocation calls it.
+fn sat_tile_table(p: SatParams, fs: bool, s: SatSource, tile: vec2<u32>, li: u32, slot: u32) {
+    var col_add: array<vec4<u32>, SUB>;
+    sat_tile_prepare(col_carry, row_carry, p, fs, s, tile, li, &col_add);
+    let origin = sat_sub_origin(tile, li);
+    let size = textureDimensions(src);
+    var col: array<vec4<u32>, SUB>;
+    for (var j = 0u; j < SUB; j++) {
+        sat_sweep_row(origin, j, p, fs, s, &col);
+        let row_add = sat_row_add(fs, li, j);
+        for (var i = 0u; i < SUB; i++) {
+            let q = origin + vec2<u32>(i, j);
+            let sum = sat_sum(sat_sum(col[i], row_add, fs), col_add[i], fs);
+            if all(q < size) {
+                sat_store(slot, q, sum);
+            }
+        }
+    }
 }

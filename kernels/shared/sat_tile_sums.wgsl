@@ -1,10 +1,12 @@
 // The edges of one tile's own table (import-only module of `sat_tile_sums` and
-// `sat_tile_sums_f32`, and of the layered `csm_sat_tile_sums*`, pass 1 of 3): the tile's last row and last column, from one read of
-// the tile. Each invocation sums its sub-block's rows and columns in registers; the edges
-// across the tile come from those partial sums in workgroup memory, two barriers in all.
+// `sat_tile_sums_f32`, and of the depth-sourced `csm_sat_tile_sums*` and `msm_sat_tile_sums*`,
+// pass 1 of 3): the tile's last row and last column, from one read of the tile. Each
+// invocation sums its sub-block's rows and columns in registers; the edges across the tile
+// come from those partial sums in workgroup memory, two barriers in all.
 // #import shared/sat_tile
 // #import shared/sat_tile_texel
-// The importing kernel declares `src` (shared/sat_tile_texel):
+// The importing kernel declares `src` (shared/sat_tile_texel) and the edges it writes,
+// `col_part` and `row_part` (storage textures of u32 words):
 // #completed-by-importer
 
 // Row y's partial sums, one per sub-block column a, at [y · GRID + a]; column x's, one per
@@ -60,4 +62,20 @@ fn sat_tile_edges(
         e = sat_sum(e, sh_lines[(first + k * SUB + SUB - 1u) * GRID], fs);
     }
     return e;
+}
+
+// Pass 1 for tile `tile`: its edges (`sat_tile_edges`) stored into band `s.band` of the
+// importer's `row_part` (invocations li < TILE, one row each) and `col_part` (the rest, one
+// column each), inside the map. Every invocation calls it.
+fn sat_tile_sums_pass(p: SatParams, fs: bool, s: SatSource, tile: vec2<u32>, li: u32) {
+    let e = sat_tile_edges(p, fs, s, tile, li);
+    let size = textureDimensions(src);
+    let q = tile * TILE + li % TILE;
+    if li < TILE {
+        if q.y < size.y {
+            textureStore(row_part, vec2<u32>(s.band.x + tile.x, q.y), e);
+        }
+    } else if q.x < size.x {
+        textureStore(col_part, vec2<u32>(q.x, s.band.y + tile.y), e);
+    }
 }

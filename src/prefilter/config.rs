@@ -262,8 +262,8 @@ impl PrefilterConfig {
         self
     }
 
-    /// The same with CSSM's blocker search (the scene key `blocker_search`): the power moments
-    /// in one table (the default) or the paper's CSM-Z basis. Not applicable to other
+    /// The same with CSSM's blocker search (the scene key `blocker_search`): MSM's quantized
+    /// moments in one table (the default) or the paper's CSM-Z basis. Not applicable to other
     /// techniques (validation names the key).
     pub fn with_blocker_search(self, search: CssmSearch) -> Self {
         self.with_values("blocker_search", |v| {

@@ -61,8 +61,8 @@ pub fn csm_z_maps(terms: u32) -> u32 {
 }
 
 /// The maps after the CSM basis for CSSM's blocker search, `(name, channels)`: the CSM-Z maps
-/// `csm_z<chunk>` (four channels of `[z, z·sin c₁z, z·cos c₁z, …]` each), or the power
-/// moments' map `csm_moments` (MSM's `(z, z², z³, z⁴)`, quantized).
+/// `csm_z<chunk>` (four channels of `[z, z·sin c₁z, z·cos c₁z, …]` each), or the moments'
+/// map `csm_moments` (MSM's `(z, z², z³, z⁴)`, quantized).
 pub fn search_maps(terms: u32, search: CssmSearch) -> Vec<(String, u32)> {
     match search {
         CssmSearch::CsmZ => {
@@ -147,7 +147,7 @@ fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
 
 /// The filtered maps of light `i`'s convolution basis: the CSM basis maps
 /// (`light{i}.csm<chunk>`, two terms each), then with `search` (CSSM) the maps its blocker
-/// search filters ([`search_maps`]: the CSM-Z maps `light{i}.csm_z<chunk>` or the power
+/// search filters ([`search_maps`]: the CSM-Z maps `light{i}.csm_z<chunk>` or MSM's quantized
 /// moments `light{i}.csm_moments`). `kernels/csm.wgsl` writes up
 /// to [`CSM_OUTPUTS`] of them from one read of the depth (nodes `light{i}.csm.<g>`).
 ///

@@ -30,7 +30,7 @@ pub struct CsmSatParams {
     pub terms: u32,
     /// 1: each basis value rounded to f16, as f16 storage of the map would hold it.
     pub f16: u32,
-    /// 1: the layer after CSM's is the power moments (CSSM's moment search).
+    /// 1: the layer after CSM's is MSM's quantized moments (CSSM's moment search).
     pub moments: u32,
     /// 1: each value rounded to 16-bit unorm, as unorm16 storage of the map would hold it.
     pub unorm16: u32,
@@ -43,7 +43,7 @@ pub struct CsmSatParams {
 pub struct CsmBasis {
     /// Terms M.
     pub terms: u32,
-    /// With the maps of CSSM's blocker search (the CSM-Z maps or the power moments), after
+    /// With the maps of CSSM's blocker search (the CSM-Z maps or MSM's moments), after
     /// the ⌈M/2⌉ CSM maps.
     pub search: Option<CssmSearch>,
     /// The representation's storage: f16 rounds every basis value as an f16 map would.

@@ -192,7 +192,7 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     },
     visibility,
     variant: terms,
-    // The CSM basis, the CSM-Z basis (z, z·sin, z·cos) and the power moments.
+    // The CSM basis, the CSM-Z basis (z, z·sin, z·cos) and MSM's quantized moments.
     value_range: |_| ([-1.0; 4], [1.0; 4]),
     clamp: no_clamp,
     area_light: true,
