@@ -38,6 +38,8 @@ struct Frame {
 @group(0) @binding(5) var out_color: texture_storage_2d<rgba8unorm, write>;
 @group(0) @binding(6) var<storage, read_write> out_visibility: array<f32>;
 @group(0) @binding(7) var cmp_sampler: sampler_comparison;
+// Linear filtering, clamped to the edge: f32 summed-area tables' corner fetches (`sat_mean_linear`).
+@group(0) @binding(8) var sat_sampler: sampler;
 
 // #generated
 

@@ -118,12 +118,21 @@ pub struct LightGpu {
     pub cascade_near: f32,
     /// Cascades: the blend band, a fraction of each cascade's view-distance range.
     pub cascade_blend: f32,
-    /// Padding.
     /// Map UV per unit of a face's UV: (1, 1) for a one-map light, (1/3, 1/2) for a point
     /// light's atlas of 3 × 2 faces (offsets in world or face units reach the atlas through it).
     pub face_uv: [f32; 2],
     /// Cascades: each cascade's far view distance, cascade `c` at `[c / 4][c % 4]`.
     pub cascade_far: [[f32; 4]; 2],
+    /// Tables: 1 where the light's summed-area table is f32 and read with filtered fetches,
+    /// its rectangles on the 2⁻⁸-texel grid (`sat_mean_linear`), else 0. The shading kernel's
+    /// lookups are chosen when it is generated; the CPU references read this.
+    pub sat_filtered: u32,
+    /// Tables: the largest `|v − sat_offset|` of any channel over the representation's value
+    /// range (half the widest channel's range): the error models' bound on the table's corner
+    /// sums (`tolerance::filtered_table_error`).
+    pub sat_amplitude: f32,
+    /// Padding to the struct's 16-byte alignment.
+    pub _pad_end: [u32; 2],
 }
 
 /// Technique id of `hard` (`LightGpu::technique`; `TECHNIQUE_HARD` in

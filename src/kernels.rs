@@ -180,17 +180,12 @@ pub fn validate(kernel: &str, wgsl: &str) -> Result<naga::Module> {
 /// Validates `wgsl` and reads its bindings and workgroup size.
 pub fn reflect(kernel: &str, wgsl: &str) -> Result<(naga::Module, Reflection)> {
     let module = validate(kernel, wgsl)?;
-    let has_filtering_sampler = module.global_variables.iter().any(|(_, g)| {
-        matches!(
-            module.types[g.ty].inner,
-            naga::TypeInner::Sampler { comparison: false }
-        )
-    });
+    let sampled = sampled_images(&module);
     let mut bindings = Vec::new();
-    for (_, g) in module.global_variables.iter() {
+    for (h, g) in module.global_variables.iter() {
         let Some(rb) = &g.binding else { continue };
         let name = g.name.clone().unwrap_or_default();
-        let ty = binding_type(&module, g, has_filtering_sampler).map_err(|m| Error::Kernel {
+        let ty = binding_type(&module, g, sampled.contains(&h)).map_err(|m| Error::Kernel {
             kernel: kernel.to_string(),
             message: format!("binding `{name}`: {m}"),
         })?;
@@ -225,6 +220,99 @@ pub fn reflect(kernel: &str, wgsl: &str) -> Result<(naga::Module, Reflection)> {
             stages,
         },
     ))
+}
+
+/// The texture globals that some `textureSample*` without a depth reference reads, directly or
+/// through function arguments (followed up the calls to a fixed point): those bind as
+/// filterable float, every other float texture as unfilterable, which also admits
+/// `depth32float` views and needs no `FLOAT32_FILTERABLE` for 32-bit formats.
+fn sampled_images(
+    module: &naga::Module,
+) -> std::collections::HashSet<naga::Handle<naga::GlobalVariable>> {
+    use naga::{Expression, Statement};
+    use std::collections::HashSet;
+    // Functions by index: the module's, then the entry points'.
+    let functions: Vec<&naga::Function> = module
+        .functions
+        .iter()
+        .map(|(_, f)| f)
+        .chain(module.entry_points.iter().map(|e| &e.function))
+        .collect();
+    let mut globals = HashSet::new();
+    // (function index, argument index) pairs that reach a sample.
+    let mut args: HashSet<(usize, u32)> = HashSet::new();
+    let mark = |f: &naga::Function,
+                fi: usize,
+                e: naga::Handle<Expression>,
+                globals: &mut HashSet<_>,
+                args: &mut HashSet<(usize, u32)>| {
+        match f.expressions[e] {
+            Expression::GlobalVariable(g) => globals.insert(g),
+            Expression::FunctionArgument(a) => args.insert((fi, a)),
+            _ => false,
+        }
+    };
+    for (fi, f) in functions.iter().enumerate() {
+        for (_, e) in f.expressions.iter() {
+            if let Expression::ImageSample {
+                image,
+                depth_ref: None,
+                ..
+            } = *e
+            {
+                mark(f, fi, image, &mut globals, &mut args);
+            }
+        }
+    }
+    fn calls<'a>(block: &'a naga::Block, out: &mut Vec<(usize, &'a [naga::Handle<Expression>])>) {
+        for st in block.iter() {
+            match st {
+                Statement::Call {
+                    function,
+                    arguments,
+                    ..
+                } => out.push((function.index(), arguments)),
+                Statement::Block(b) => calls(b, out),
+                Statement::If { accept, reject, .. } => {
+                    calls(accept, out);
+                    calls(reject, out);
+                }
+                Statement::Switch { cases, .. } => cases.iter().for_each(|c| calls(&c.body, out)),
+                Statement::Loop {
+                    body, continuing, ..
+                } => {
+                    calls(body, out);
+                    calls(continuing, out);
+                }
+                _ => {}
+            }
+        }
+    }
+    // Per function: (callee index, arguments) of every call it makes.
+    type Calls<'a> = Vec<(usize, &'a [naga::Handle<Expression>])>;
+    let call_lists: Vec<Calls> = functions
+        .iter()
+        .map(|f| {
+            let mut out = Vec::new();
+            calls(&f.body, &mut out);
+            out
+        })
+        .collect();
+    loop {
+        let before = (globals.len(), args.len());
+        for (fi, list) in call_lists.iter().enumerate() {
+            for &(callee, arguments) in list {
+                for (a, &e) in arguments.iter().enumerate() {
+                    if args.contains(&(callee, a as u32)) {
+                        mark(functions[fi], fi, e, &mut globals, &mut args);
+                    }
+                }
+            }
+        }
+        if (globals.len(), args.len()) == before {
+            return globals;
+        }
+    }
 }
 
 /// Size in bytes of the WGSL struct `name` as naga lays it out (for the Rust mirrors' tests).
@@ -290,8 +378,8 @@ fn image_type(
     Ok(match class {
         ImageClass::Sampled { kind, multi } => wgpu::BindingType::Texture {
             sample_type: match kind {
-                // Kernels read with textureLoad unless the module has a filtering
-                // sampler; unfilterable float also admits depth32float views.
+                // Filterable only where `textureSample*` reads it (`sampled_images`);
+                // unfilterable float also admits depth32float views.
                 ScalarKind::Float => wgpu::TextureSampleType::Float { filterable },
                 ScalarKind::Uint => wgpu::TextureSampleType::Uint,
                 ScalarKind::Sint => wgpu::TextureSampleType::Sint,

@@ -284,7 +284,8 @@ pub fn dispatch_groups(plan: &Plan, node: &Node, wg: [u32; 3]) -> [u32; 3] {
 }
 
 /// Checks that the device offers the features the lights' techniques need (unorm16 moment
-/// storage needs `TEXTURE_FORMAT_16BIT_NORM`).
+/// storage needs `TEXTURE_FORMAT_16BIT_NORM`; f32 summed-area tables, read with filtered
+/// fetches, `FLOAT32_FILTERABLE`).
 pub fn check_features(device: &wgpu::Device, lights: &[Light]) -> Result<()> {
     for (i, l) in lights.iter().enumerate() {
         // Only MSM's tables accept unorm16 (`technique::params::MSM_FORMAT`).
@@ -297,6 +298,16 @@ pub fn check_features(device: &wgpu::Device, lights: &[Light]) -> Result<()> {
             return Err(Error::MissingFeature {
                 what: format!("light[{i}].shadow.format = \"unorm16\""),
                 feature: "TEXTURE_FORMAT_16BIT_NORM",
+            });
+        }
+        if l.shadow.technique.sat_filtered()
+            && !device
+                .features()
+                .contains(wgpu::Features::FLOAT32_FILTERABLE)
+        {
+            return Err(Error::MissingFeature {
+                what: format!("light[{i}].shadow.sat_sums = \"float\""),
+                feature: "FLOAT32_FILTERABLE",
             });
         }
     }

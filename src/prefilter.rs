@@ -146,6 +146,25 @@ impl<'a> From<&'a wgpu::Texture> for DepthLayer<'a> {
     }
 }
 
+/// The sampler a host binds after the maps where [`Prefilter::needs_filtering_sampler`]: an
+/// f32 summed-area table's corners are read with bilinear-filtered fetches (linear filtering,
+/// clamped to the edge, level 0; `kernels/shared/sat.wgsl`, `sat_mean_linear`). The renderer
+/// binds the same one.
+pub const SAT_SAMPLER_DESCRIPTOR: wgpu::SamplerDescriptor<'static> = wgpu::SamplerDescriptor {
+    label: Some("shadowgraph.sat_sampler"),
+    address_mode_u: wgpu::AddressMode::ClampToEdge,
+    address_mode_v: wgpu::AddressMode::ClampToEdge,
+    address_mode_w: wgpu::AddressMode::ClampToEdge,
+    mag_filter: wgpu::FilterMode::Linear,
+    min_filter: wgpu::FilterMode::Linear,
+    mipmap_filter: wgpu::MipmapFilterMode::Nearest,
+    lod_min_clamp: 0.0,
+    lod_max_clamp: 32.0,
+    compare: None,
+    anisotropy_clamp: 1,
+    border_color: None,
+};
+
 /// Lights one stage serves at most ([`Prefilter::record_light`]'s `slot`).
 pub const MAX_LIGHTS: usize = 256;
 
@@ -343,7 +362,8 @@ impl Prefilter {
 
     /// The host's WGSL: the technique's visibility function, its maps bound at
     /// `@group(group) @binding(first_binding + k)` (then a comparison sampler where
-    /// [`Prefilter::needs_comparison_sampler`]) and
+    /// [`Prefilter::needs_comparison_sampler`], a filtering one where
+    /// [`Prefilter::needs_filtering_sampler`]) and
     /// `fn shadowgraph_visibility(l: Light, p: vec3<f32>, n: vec3<f32>) -> f32`.
     pub fn wgsl(&self, group: u32, first_binding: u32) -> Result<String> {
         wgsl::host_block(&self.config.technique, group, first_binding)
@@ -423,7 +443,7 @@ impl Prefilter {
     }
 
     /// The host's bind group layout entries for [`Prefilter::wgsl`]'s bindings (maps, then
-    /// the comparison sampler where needed), visible to `visibility`.
+    /// the comparison and filtering samplers where needed), visible to `visibility`.
     pub fn layout_entries(
         &self,
         first_binding: u32,
@@ -436,6 +456,14 @@ impl Prefilter {
     /// the host binds one (linear filtering, compare less-equal) after the maps.
     pub fn needs_comparison_sampler(&self) -> Result<bool> {
         wgsl::needs_comparison_sampler(&self.config.technique)
+    }
+
+    /// Whether the technique reads f32 summed-area tables (`sat_sums = "float"`) with
+    /// filtered fetches: the host binds a filtering sampler ([`SAT_SAMPLER_DESCRIPTOR`]) after
+    /// the maps (and after the comparison sampler, where there is one), and the tables bind
+    /// as filterable float, which needs the device feature `FLOAT32_FILTERABLE`.
+    pub fn needs_filtering_sampler(&self) -> Result<bool> {
+        wgsl::needs_filtering_sampler(&self.config.technique)
     }
 
     /// Times each kernel from now on with GPU timestamps written between the stage's passes

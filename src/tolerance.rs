@@ -34,12 +34,66 @@ pub fn chebyshev(mean: f64, mean_sq: f64, receiver: f64, floor: f64, e: f64) -> 
     (t * t * dvar + 2.0 * t.abs() * var * dt) / (var + t * t).powi(2)
 }
 
-/// VSM at `s`: the bilinear mix and the receiver's depth carry ~8 roundings; then the
+/// [`chebyshev`] with, besides the relative error `e`, an absolute error `abs` on both means
+/// (a table read with filtered fetches, [`filtered_table_error`]).
+pub fn chebyshev_abs(mean: f64, mean_sq: f64, receiver: f64, floor: f64, e: f64, abs: f64) -> f64 {
+    if receiver <= mean - abs {
+        return 0.0;
+    }
+    let var = (mean_sq - mean * mean).max(floor);
+    let t = (receiver - mean).max(0.0);
+    let dvar =
+        e * (mean_sq.abs() + 2.0 * mean * mean) + 2.0 * e * floor + abs * (1.0 + 2.0 * mean.abs());
+    let dt = e * (receiver.abs() + mean.abs()) + abs;
+    let first = (t * t * dvar + 2.0 * t.abs() * var * dt) / (var + t * t).powi(2);
+    // A receiver within `abs` of the mean may read either side of it: 1 against the bound at
+    // t + abs.
+    let near = if receiver <= mean + abs {
+        1.0 - var / (var + (t + abs).powi(2))
+    } else {
+        0.0
+    };
+    (first + near).min(1.0)
+}
+
+/// The absolute error of a mean read at `s` from a table of f32 sums with filtered fetches
+/// (`l.sat_filtered`; 0 for other maps), with the `sat` filter's square: each of the four
+/// corners is a bilinear mix of table texels, two lerps in x and one in y (three roundings
+/// each, relative to the sums there, bounded by `⌈x⌉·⌈y⌉·amplitude`), and the window three
+/// subtractions, over the clamped square's area (the table's own texels are the reference's).
+pub fn filtered_table_error(l: &LightGpu, s: &LightSample) -> f64 {
+    if l.sat_filtered == 0 {
+        return 0.0;
+    }
+    let (w, h) = (l.map_size[0] as usize, l.map_size[1] as usize);
+    let (cx, cy) = (
+        s.uv[0] as f32 * l.map_size[0],
+        s.uv[1] as f32 * l.map_size[1],
+    );
+    let half = 0.5 * l.filter_width;
+    let r = crate::cpu::sat::grid_rect([cx - half, cy - half, cx + half, cy + half], w, h)
+        .map(f64::from);
+    filtered_rect_error(l, r)
+}
+
+/// [`filtered_table_error`] for the rectangle `r` (texel units, on the grid).
+pub fn filtered_rect_error(l: &LightGpu, r: [f64; 4]) -> f64 {
+    let area = (r[2] - r[0]) * (r[3] - r[1]);
+    let corners: f64 = [(r[0], r[1]), (r[2], r[1]), (r[0], r[3]), (r[2], r[3])]
+        .iter()
+        .map(|&(x, y)| x.ceil() * y.ceil())
+        .sum();
+    12.0 * U * corners * f64::from(l.sat_amplitude) / area
+}
+
+/// VSM at `s`: the bilinear mix and the receiver's depth carry ~8 roundings, and a table read
+/// with filtered fetches its corners' roundings ([`filtered_table_error`]); then the
 /// light-bleeding reduction divides by `1 − bleed`. Plus 1e-5 for the final arithmetic.
 pub fn vsm(maps: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
     let m = crate::cpu::mips::sample(maps, l, s);
     let d = s.depth - f64::from(l.bias);
-    let dp = chebyshev(m[0], m[1], d, f64::from(l.min_variance), 8.0 * U);
+    let abs = filtered_table_error(l, s);
+    let dp = chebyshev_abs(m[0], m[1], d, f64::from(l.min_variance), 8.0 * U, abs);
     1e-5 + dp / (1.0 - f64::from(l.bleed))
 }
 
@@ -103,6 +157,7 @@ pub fn esm_sat(
     v: f64,
 ) -> f64 {
     let m = crate::cpu::mips::sample(moments, l, s)[0].max(1e-37);
+    let table = filtered_table_error(l, s) / m;
     let c = f64::from(l.exp_pos);
     let ulp = 2f64.powi(-23);
     let x = m.ln() + c - c * s.depth;
@@ -112,7 +167,8 @@ pub fn esm_sat(
         + 3.0 * ulp * m.ln().abs()
         + 4.0 * ulp * (c + c * s.depth)
         + (3.0 + 2.0 * x.abs()) * ulp
-        + depth;
+        + depth
+        + table;
     1e-6 + v * rel
 }
 
@@ -126,10 +182,13 @@ pub fn esm_sat(
 pub fn msm(maps: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
     let q = crate::cpu::mips::sample(maps, l, s);
     let b = dequantized(&q, l);
+    // A table read with filtered fetches adds its corners' roundings to every stored moment,
+    // carried through the dequantization (entries of its matrix below 1: four per moment).
+    let table = filtered_table_error(l, s);
     let dequantize_error = if l.msm_flags & MSM_QUANTIZED != 0 {
-        8.0 * U * q.iter().map(|v| v.abs()).sum::<f64>()
+        8.0 * U * q.iter().map(|v| v.abs()).sum::<f64>() + 4.0 * table
     } else {
-        0.0
+        table
     };
     let d = s.depth - f64::from(l.bias);
     let hausdorff = l.msm_flags & MSM_HAUSDORFF != 0;
@@ -170,5 +229,14 @@ pub fn csm_weights(l: &LightGpu) -> Vec<f64> {
 /// is scaled by `scale`. Plus 1e-5 for the f32 sum.
 pub fn csm(l: &LightGpu) -> f64 {
     let w: f64 = csm_weights(l).iter().sum();
-    1e-5 + f64::from(l.csm_scale) * w * 2.0 * 2f64.powi(-11)
+    // A table read with filtered fetches: each basis mean off by its corners' roundings, at
+    // the smallest square the clamp leaves (a quarter of the filter's, in a map corner).
+    let table = if l.sat_filtered != 0 {
+        let half = f64::from(0.5 * l.filter_width).max(1.0);
+        let n = f64::from(l.map_size[0].max(l.map_size[1]));
+        filtered_rect_error(l, [n - half, n - half, n, n])
+    } else {
+        0.0
+    };
+    1e-5 + f64::from(l.csm_scale) * w * 2.0 * (2f64.powi(-11) + table)
 }

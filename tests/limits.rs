@@ -328,6 +328,34 @@ fn lowered_limits_and_budgets_name_the_key() {
             && shown.contains("TEXTURE_FORMAT_16BIT_NORM"),
         "{shown}"
     );
+    // A soft technique's f32 tables are read with filtered fetches: without FLOAT32_FILTERABLE
+    // the scene is refused at its `sat_sums` line (with the feature, the same scene passes).
+    let (text, s) = scene(
+        64,
+        48,
+        &[light(256, "technique = \"vssm\"\nsat_sums = \"float\"")
+            .replace("extent = 4.0", "extent = 4.0\nsize = 0.5")],
+    );
+    let sp = plan_lights(&s.lights).unwrap();
+    let check_with = |features| {
+        shadowgraph::limits::check_scene(
+            &s,
+            &sp,
+            &full,
+            features,
+            &RenderOptions::default(),
+            1 << 30,
+        )
+    };
+    let shown = check_with(wgpu::Features::empty())
+        .expect_err("f32 tables without the feature")
+        .to_string();
+    let line = nth_line(&text, "sat_sums", 0);
+    assert!(
+        shown.starts_with(&format!("limits.toml:{line}:")) && shown.contains("FLOAT32_FILTERABLE"),
+        "{shown}"
+    );
+    check_with(wgpu::Features::FLOAT32_FILTERABLE).expect("f32 tables with the feature");
 }
 
 /// A wgpu error raised outside any error scope (here a zero-sized texture) used to be logged

@@ -203,6 +203,13 @@ fn host_visibility(
             resource: wgpu::BindingResource::Sampler(&sampler),
         });
     }
+    let sat_sampler = d.create_sampler(&shadowgraph::prefilter::SAT_SAMPLER_DESCRIPTOR);
+    if stage.needs_filtering_sampler().expect("block") {
+        entries.push(wgpu::BindGroupEntry {
+            binding: entries.len() as u32,
+            resource: wgpu::BindingResource::Sampler(&sat_sampler),
+        });
+    }
     let bg1 = d.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("host.probe.maps"),
         layout: &kernel.layouts[1],

@@ -503,3 +503,25 @@ fn unorm16_msm_without_the_16_bit_norm_feature_is_a_missing_feature() {
     let f16 = PrefilterConfig::msm(64).with_storage(shadowgraph::scene::Storage::F16);
     Prefilter::new(&plain, &f16).expect("f16 MSM on a plain device");
 }
+
+/// f32 tables are read with filtered fetches, so they need FLOAT32_FILTERABLE; fixed-point ones
+/// need nothing.
+#[test]
+fn float_tables_without_float32_filterable_are_a_missing_feature() {
+    let g = common::gpu();
+    let (plain, _) = device_with(&g, g.adapter.limits());
+    let config = PrefilterConfig::vssm(64, 0.5).with_soft(shadowgraph::sat::SatVariant::Float, 0.2);
+    match Prefilter::new(&plain, &config) {
+        Err(e @ Error::MissingFeature { .. }) => {
+            let m = e.to_string();
+            assert!(
+                m.contains("sat_sums") && m.contains("FLOAT32_FILTERABLE"),
+                "{m}"
+            );
+        }
+        Err(e) => panic!("expected a missing feature, got {e}"),
+        Ok(_) => panic!("f32 tables accepted without FLOAT32_FILTERABLE"),
+    }
+    let fixed = PrefilterConfig::vssm(64, 0.5).with_soft(shadowgraph::sat::SatVariant::Fixed, 0.2);
+    Prefilter::new(&plain, &fixed).expect("fixed-point tables on a plain device");
+}

@@ -182,6 +182,10 @@ fn fs_main(@location(0) p: vec3<f32>) -> @location(0) vec4<f32> {{
                 if wgsl::needs_comparison_sampler(&t).expect("block") {
                     expected.push((3 + maps as u32, "shadowgraph_cmp_sampler".into()));
                 }
+                if wgsl::needs_filtering_sampler(&t).expect("block") {
+                    let at = 3 + expected.len() as u32;
+                    expected.push((at, "shadowgraph_sat_sampler".into()));
+                }
                 if maps == 0 || group2 != expected {
                     failures.push(format!("{}: bindings {group2:?}", t.name()));
                 }

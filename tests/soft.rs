@@ -9,7 +9,7 @@ mod common;
 
 use common::soft::TableError;
 use common::soft_maps::{
-    DIR, MAP, SPOT, Tables, cssm, light, msm_soft, rounded, tables, trig_error, vssm,
+    DIR, MAP, SPOT, Tables, cssm, light, msm_soft, rounded, tables, trig_error, vssm, with_sums,
 };
 use glam::{DVec3, Vec3};
 use rand::Rng;
@@ -80,7 +80,12 @@ fn check_soft(
             .iter()
             .map(|t| TableError::new(&t.decoded, &coding))
             .collect();
-        let decoded: Vec<Integral> = tabs.iter().map(|t| Integral::new(&t.decoded)).collect();
+        // f32 tables are read with filtered fetches: the filter's square on the 2⁻⁸ grid.
+        let float = coding.variant == SatVariant::Float;
+        let decoded: Vec<Integral> = tabs
+            .iter()
+            .map(|t| Integral::new(&t.decoded).filtered(float))
+            .collect();
         let maps: Vec<ProbeMap> = tabs
             .iter()
             .flat_map(|t| {
@@ -200,22 +205,24 @@ fn msm_soft_matches_reference() {
     // The table always sums the quantized moments (`technique::msm_quantized`); the unorm16
     // case reads them rounded to f32 as well (only the bias differs).
     let g = common::gpu();
-    for (storage, hausdorff, seed) in [
-        (Storage::F32, false, 210),
-        (Storage::F32, true, 211),
-        (Storage::Unorm16, false, 212),
+    for (storage, hausdorff, sums, seed) in [
+        (Storage::F32, false, SatVariant::Fixed, 210),
+        (Storage::F32, true, SatVariant::Fixed, 211),
+        (Storage::Unorm16, false, SatVariant::Fixed, 212),
+        (Storage::F32, false, SatVariant::Float, 213),
     ] {
-        let quantized = shadowgraph::technique::msm_quantized(&msm_soft(storage, hausdorff));
+        let technique = with_sums(msm_soft(storage, hausdorff), sums);
+        let quantized = shadowgraph::technique::msm_quantized(&technique);
         assert!(quantized, "a soft MSM table sums quantized moments");
         let seen = check_soft(
             &g,
-            msm_soft(storage, hausdorff),
+            technique,
             seed,
             &|lin| vec![rounded(cpu::msm::msm(lin, quantized))],
             &|t, l, s| cpu::vis_msm_soft::vis_msm_soft(&t[0], l, s),
             &|t, e, l, s, v| common::soft::msm_soft_tolerance(&t[0], &e[0], l, s, v),
         );
-        eprintln!("msm_soft {storage:?} hausdorff {hausdorff}: {seen}");
+        eprintln!("msm_soft {storage:?} hausdorff {hausdorff} {sums:?}: {seen}");
     }
 }
 
@@ -229,15 +236,16 @@ fn cssm_matches_reference() {
     let g = common::gpu();
     let e_trig = trig_error(&g);
     eprintln!("device sin/cos error (×2 + 2⁻²⁴): {e_trig:.2e}");
-    for (terms, seed, kind) in [
-        (4, 220, CssmSearch::Moments),
-        (7, 221, CssmSearch::Moments),
-        (4, 222, CssmSearch::CsmZ),
-        (7, 223, CssmSearch::CsmZ),
+    for (terms, seed, kind, sums) in [
+        (4, 220, CssmSearch::Moments, SatVariant::Fixed),
+        (7, 221, CssmSearch::Moments, SatVariant::Fixed),
+        (4, 222, CssmSearch::CsmZ, SatVariant::Fixed),
+        (7, 223, CssmSearch::CsmZ, SatVariant::Fixed),
+        (4, 224, CssmSearch::Moments, SatVariant::Float),
     ] {
         let seen = check_soft(
             &g,
-            cssm(terms, 3.0, 10.0, kind),
+            with_sums(cssm(terms, 3.0, 10.0, kind), sums),
             seed,
             &|lin| {
                 let search = match kind {
@@ -263,7 +271,7 @@ fn cssm_matches_reference() {
                 common::soft::cssm_tolerance(maps, (&e[0], &e[1]), e_trig, l, s, v)
             },
         );
-        eprintln!("cssm M = {terms} {}: {seen}", kind.name());
+        eprintln!("cssm M = {terms} {} {sums:?}: {seen}", kind.name());
     }
 }
 

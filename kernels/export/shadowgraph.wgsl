@@ -26,8 +26,10 @@
 //   let pick = sg_cascade_pick(l0, p);          // pick.index, pick.blend
 // gives the renderer's choice: cascade pick.index's visibility, mixed toward the next
 // cascade's by pick.blend across the blend band.
-// Prefiltered maps are read with four loads, so no sampler or filterable format is needed;
-// only `sg_vis_pcf_hardware` takes a comparison sampler (linear filtering, compare less-equal).
+// Prefiltered maps are read with loads, so no sampler or filterable format is needed, except:
+// `sg_vis_pcf_hardware` takes a comparison sampler (linear filtering, compare less-equal), and
+// f32 summed-area tables (`sat_sums = float`: the `_float` lookups and soft functions) take a
+// filtering sampler (linear, clamp to edge) and a filterable binding (FLOAT32_FILTERABLE).
 // Two moments in f16 (VSM, EVSM2 with `Storage::F16`, not through a table) come as an r32uint
 // texture, 4 bytes a texel, each word pack2x16float(moments): bind it as texture_2d<u32> and
 // call `sg_vis_vsm_of(sg_sample_map_packed(map, l, s), l, s)` (EVSM2: `sg_vis_evsm_of`).
@@ -42,7 +44,7 @@
 //   fn sg_vis_evsm_of(m: vec4<f32>, l: sg_Light, s: sg_LightSample) -> f32
 //   fn sg_vis_hard(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32
 //   fn sg_vis_msm_soft_fixed(map: texture_2d<u32>, l: sg_Light, s: sg_LightSample) -> f32
-//   fn sg_vis_msm_soft_float(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32
+//   fn sg_vis_msm_soft_float(map: texture_2d<f32>, smp: sampler, l: sg_Light, s: sg_LightSample) -> f32
 //   fn sg_vis_pcf(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32
 //   fn sg_vis_pcf_hardware(map: texture_depth_2d, cmp: sampler_comparison, l: sg_Light, s: sg_LightSample) -> f32
 //   fn sg_vis_pcss(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32
@@ -50,14 +52,14 @@
 //   fn sg_vis_vsm(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32
 //   fn sg_vis_vsm_of(m: vec4<f32>, l: sg_Light, s: sg_LightSample) -> f32
 //   fn sg_vis_vssm_fixed(map: texture_2d<u32>, l: sg_Light, s: sg_LightSample) -> f32
-//   fn sg_vis_vssm_float(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32
+//   fn sg_vis_vssm_float(map: texture_2d<f32>, smp: sampler, l: sg_Light, s: sg_LightSample) -> f32
 //
 // Names defined here, each with the `sg_` prefix (a host's own names need only avoid
 // `sg_` and `shadowgraph_`):
 //   sg_BLOCKER_MIN_SHARE sg_CSM_PI sg_CascadePick sg_GOLDEN_ANGLE sg_Light sg_LightSample
-//   sg_MSM_B0 sg_MSM_B0_COV sg_MSM_B0_SCHUR sg_MipTaps sg_MsmMoments sg_SAT_MIN_EXTENT
-//   sg_SatNodes sg_SoftLookup sg_TECHNIQUE_CSM sg_TECHNIQUE_CSSM sg_TECHNIQUE_ESM
-//   sg_TECHNIQUE_EVSM sg_TECHNIQUE_HARD sg_TECHNIQUE_MIDPOINT sg_TECHNIQUE_MSM
+//   sg_MSM_B0 sg_MSM_B0_COV sg_MSM_B0_SCHUR sg_MipTaps sg_MsmMoments sg_SAT_GRID
+//   sg_SAT_MIN_EXTENT sg_SatNodes sg_SoftLookup sg_TECHNIQUE_CSM sg_TECHNIQUE_CSSM
+//   sg_TECHNIQUE_ESM sg_TECHNIQUE_EVSM sg_TECHNIQUE_HARD sg_TECHNIQUE_MIDPOINT sg_TECHNIQUE_MSM
 //   sg_TECHNIQUE_MSM_SOFT sg_TECHNIQUE_PCF sg_TECHNIQUE_PCSS sg_TECHNIQUE_SECOND_DEPTH
 //   sg_TECHNIQUE_SMRT sg_TECHNIQUE_VSM sg_TECHNIQUE_VSSM sg_bilinear_level
 //   sg_bilinear_level_packed sg_bilinear_log_level sg_blocker_csm_z sg_blocker_filter_width
@@ -73,15 +75,15 @@
 //   sg_msm_soft_blocker sg_pack_f16x2 sg_pcss_search_radius sg_point_coords sg_point_face
 //   sg_point_sample sg_sample_bilinear sg_sample_bilinear_log sg_sample_map sg_sample_map_log
 //   sg_sample_map_packed sg_sat_box sg_sat_box_fixed sg_sat_box_float sg_sat_clamp
-//   sg_sat_filter_fixed sg_sat_filter_float sg_sat_mean_fixed sg_sat_mean_float sg_sat_nearest
-//   sg_sat_node_f32 sg_sat_node_u32 sg_sat_nodes sg_sat_rect sg_sat_sample_fixed
-//   sg_sat_sample_float sg_sat_search_fixed sg_sat_search_float sg_sat_span_weights
-//   sg_smrt_emitter_point sg_smrt_ray sg_soft_blockers sg_soft_filter_trips sg_texel_of
-//   sg_trilinear sg_trilinear_log sg_trilinear_packed sg_unpack_f16x2 sg_vis_esm
-//   sg_vis_esm_of_log sg_vis_esm_of_sat sg_vis_evsm sg_vis_evsm_of sg_vis_hard sg_vis_msm
-//   sg_vis_msm_of sg_vis_msm_soft_fixed sg_vis_msm_soft_float sg_vis_pcf sg_vis_pcf_hardware
-//   sg_vis_pcss sg_vis_smrt sg_vis_vsm sg_vis_vsm_of sg_vis_vssm_fixed sg_vis_vssm_float
-//   sg_vogel_disc sg_vssm_blocker
+//   sg_sat_corner_linear sg_sat_filter_fixed sg_sat_filter_float sg_sat_grid sg_sat_mean_fixed
+//   sg_sat_mean_float sg_sat_mean_linear sg_sat_nearest sg_sat_node_f32 sg_sat_node_u32
+//   sg_sat_nodes sg_sat_rect sg_sat_sample_fixed sg_sat_sample_float sg_sat_search_fixed
+//   sg_sat_search_float sg_sat_span_weights sg_smrt_emitter_point sg_smrt_ray sg_soft_blockers
+//   sg_soft_filter_trips sg_texel_of sg_trilinear sg_trilinear_log sg_trilinear_packed
+//   sg_unpack_f16x2 sg_vis_esm sg_vis_esm_of_log sg_vis_esm_of_sat sg_vis_evsm sg_vis_evsm_of
+//   sg_vis_hard sg_vis_msm sg_vis_msm_of sg_vis_msm_soft_fixed sg_vis_msm_soft_float sg_vis_pcf
+//   sg_vis_pcf_hardware sg_vis_pcss sg_vis_smrt sg_vis_vsm sg_vis_vsm_of sg_vis_vssm_fixed
+//   sg_vis_vssm_float sg_vogel_disc sg_vssm_blocker
 
 // Shared light description and light-space helpers (import-only module).
 //
@@ -144,6 +146,10 @@ struct sg_Light {
     cascade_blend: f32,      // cascades: blend band, fraction of each cascade's range
     face_uv: vec2<f32>,      // map UV per unit of a face's UV: (1, 1); a point light's atlas (1/3, 1/2)
     cascade_far: array<vec4<f32>, 2>, // cascades: far view distance of cascade c at [c / 4][c % 4]
+    sat_filtered: u32,       // tables: 1 where f32 and read with filtered fetches (the CPU references read it)
+    sat_amplitude: f32,      // tables: the largest |v − sat_offset| over the value range (the CPU references read it)
+    _pad_end0: u32,
+    _pad_end1: u32,
 }
 
 // `Light::technique` (keep in sync with the `TECHNIQUE_*` constants of src/gpu_data.rs; a test
@@ -722,6 +728,17 @@ fn sg_csm_resolve(sum: f32, l: sg_Light) -> f32 {
 // A rectangle is ordered, clamped to the map and, where thinner than SAT_MIN_EXTENT, widened
 // to it inside the map (the mean then tends to the point value, never 0/0). Channels the
 // representation does not have hold 0 in the table and decode to `offset`.
+//
+// An f32 table can also be read with bilinear-filtered fetches (`sat_mean_linear`): the
+// hardware's bilinear mix of four SAT texels at a fractional corner is the same F as above,
+// so four filtered fetches give the exact integral that the sixteen loads give. Filtering
+// hardware keeps 8 fractional bits of the weights (the minimum Vulkan and D3D require, and
+// what NVIDIA and AMD keep), so the corners are put on the 2⁻⁸-texel grid first: a weight
+// there is exact on every device, and the mean is exact for a rectangle whose edges moved by
+// at most 2⁻⁹ texel (`sat_grid`). Off the grid, the truncated weights would move each edge
+// by up to 2⁻⁸ texel while the mean is divided by the unmoved area: a relative error of the
+// mean's distance to `offset` of 2⁻⁷ / width, which the variance of two moments turns into
+// light leaks (4·10⁻³ of variance at width 1).
 
 const sg_SAT_MIN_EXTENT: f32 = 0.00390625; // 2⁻⁸ texel
 
@@ -871,6 +888,48 @@ fn sg_sat_box_float(sat: texture_2d<f32>, rect: vec4<f32>, offset: vec4<f32>, sc
     return window / (scale * area) + offset;
 }
 
+// Fractional corners of `sat_mean_linear` are multiples of 1 / SAT_GRID texel.
+const sg_SAT_GRID: f32 = 256.0;
+
+// `sat_clamp`'s rectangle with its edges on the 2⁻⁸-texel grid (nearest, ties up) and at
+// least one grid step wide, within [0, size] (a clamped edge is on the grid already).
+fn sg_sat_grid(rect: vec4<f32>, size: vec2<u32>) -> vec4<f32> {
+    let c = sg_sat_clamp(rect, size);
+    let lo = floor(c.xy * sg_SAT_GRID + 0.5) / sg_SAT_GRID;
+    let hi = floor(c.zw * sg_SAT_GRID + 0.5) / sg_SAT_GRID;
+    return vec4<f32>(lo, max(hi, lo + 1.0 / sg_SAT_GRID));
+}
+
+// F(x, y), every channel, at a point of [0, width] × [0, height] from one bilinear fetch:
+// SAT texel (X − 1, Y − 1) holds F(X, Y) and is centred at (X − ½, Y − ½), so for x, y ≥ 1 F
+// is the filtered fetch at (x − ½, y − ½). Below 1 F falls linearly to 0 at the top and left
+// edges, where the table has no texels: F(x, y) = min(x, 1)·min(y, 1)·F(max(x, 1), max(y, 1))
+// (F is bilinear on [0, 1]² between 0 and the first nodes). `smp` filters linearly and clamps
+// to the edge; the level is explicit, so the fetch is defined in non-uniform control flow.
+// With `size` a power of two, (x − ½) / size is exact and so is the hardware's weight.
+// #fetches sg_sat_corner_linear: 1
+fn sg_sat_corner_linear(sat: texture_2d<f32>, smp: sampler, p: vec2<f32>, size: vec2<f32>) -> vec4<f32> {
+    let q = max(p, vec2<f32>(1.0));
+    let f = textureSampleLevel(sat, smp, (q - 0.5) / size, 0.0);
+    let edge = min(p, vec2<f32>(1.0));
+    return f * (edge.x * edge.y);
+}
+
+// The mean of `sat_mean_float` over `rect` on the 2⁻⁸-texel grid (`sat_grid`) in four
+// filtered fetches of an f32 table (rgba32float … r32float, bound filterable), where
+// `sat_mean_float` makes sixteen loads. The f32 rounding is the same: each corner is a sum
+// over [0, x] × [0, y], rounded relative to it.
+// #fetches sg_sat_mean_linear: 4
+fn sg_sat_mean_linear(sat: texture_2d<f32>, smp: sampler, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
+    let dims = textureDimensions(sat);
+    let size = vec2<f32>(dims);
+    let r = sg_sat_grid(rect, dims);
+    let window = (sg_sat_corner_linear(sat, smp, r.zw, size) - sg_sat_corner_linear(sat, smp, r.xw, size))
+        - (sg_sat_corner_linear(sat, smp, r.zy, size) - sg_sat_corner_linear(sat, smp, r.xy, size));
+    let area = (r.z - r.x) * (r.w - r.y);
+    return window / (scale * area) + offset;
+}
+
 // The integer nodes (X0, Y0, X1, Y1) of `sat_nodes`' rectangle snapped outward: X0 = ⌊x0⌋,
 // X1 = ⌈x1⌉ (> X0: the rectangle is at least SAT_MIN_EXTENT wide), within [0, size].
 fn sg_sat_box(rect: vec4<f32>, size: vec2<u32>) -> vec4<i32> {
@@ -891,7 +950,11 @@ fn sg_sat_sample_fixed(map: texture_2d<u32>, l: sg_Light, uv: vec2<f32>, width: 
     return sg_sat_mean_fixed(map, sg_sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
 }
 
-// The mean over `sat_rect(l, uv, width)` from an f32 table (rgba32float).
+// The mean over `sat_rect(l, uv, width)` from an f32 table (rgba32float). Sixteen loads, not
+// four filtered fetches: the loads' window sums are differences of neighbouring table texels,
+// exact to the table, where a filtered fetch rounds each corner relative to the whole corner
+// sum; at the `sat` filter's few-texel widths that rounding reached the moments (MSM at width
+// 3 on a 512² map read shadow in 6% of lit pixels).
 // #fetches sg_sat_sample_float: 16
 fn sg_sat_sample_float(map: texture_2d<f32>, l: sg_Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
     return sg_sat_mean_float(map, sg_sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
@@ -914,9 +977,14 @@ fn sg_sat_filter_fixed(map: texture_2d<u32>, l: sg_Light, uv: vec2<f32>, width: 
     return sg_sat_box_fixed(map, sg_sat_nearest(sg_sat_rect(l, uv, width)), l.sat_offset, l.sat_scale);
 }
 
-// #fetches sg_sat_filter_float: 4
-fn sg_sat_filter_float(map: texture_2d<f32>, l: sg_Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
-    return sg_sat_box_float(map, sg_sat_nearest(sg_sat_rect(l, uv, width)), l.sat_offset, l.sat_scale);
+// From an f32 table the soft filter needs no rounding: four filtered fetches give the mean
+// over the square itself, its edges on the 2⁻⁸-texel grid (`sat_mean_linear`; `smp` filters
+// linearly). Each corner is rounded relative to its sum, which the penumbra's wide squares
+// divide by their area (against the area-light truth at 1024² no change from the fixed-point
+// table's rounded squares).
+// #fetches sg_sat_filter_float: sg_sat_mean_linear
+fn sg_sat_filter_float(map: texture_2d<f32>, smp: sampler, l: sg_Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
+    return sg_sat_mean_linear(map, smp, sg_sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
 }
 
 // The mean over `sat_rect(l, uv, width)` snapped outward to texel edges (`sat_box_*`): the
@@ -1381,12 +1449,12 @@ fn sg_vis_msm_soft_fixed(map: texture_2d<u32>, l: sg_Light, s: sg_LightSample) -
 }
 
 // #fetches sg_vis_msm_soft_float: sg_sat_search_float + sg_sat_filter_float
-fn sg_vis_msm_soft_float(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
+fn sg_vis_msm_soft_float(map: texture_2d<f32>, smp: sampler, l: sg_Light, s: sg_LightSample) -> f32 {
     let search = sg_sat_search_float(map, l, s.uv, sg_blocker_search_width(l, s));
     let look = sg_soft_blockers(sg_msm_soft_blocker(search, l, s), l, s);
     var m = vec4<f32>(0.0);
     for (var k = 0u; k < sg_soft_filter_trips(look); k++) {
-        m = sg_sat_filter_float(map, l, s.uv, look.width);
+        m = sg_sat_filter_float(map, smp, l, s.uv, look.width);
     }
     if !look.blockers {
         return 1.0;
@@ -1616,12 +1684,12 @@ fn sg_vis_vssm_fixed(map: texture_2d<u32>, l: sg_Light, s: sg_LightSample) -> f3
 }
 
 // #fetches sg_vis_vssm_float: sg_sat_search_float + sg_sat_filter_float
-fn sg_vis_vssm_float(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
+fn sg_vis_vssm_float(map: texture_2d<f32>, smp: sampler, l: sg_Light, s: sg_LightSample) -> f32 {
     let search = sg_sat_search_float(map, l, s.uv, sg_blocker_search_width(l, s));
     let look = sg_soft_blockers(sg_vssm_blocker(search, l, s), l, s);
     var m = vec4<f32>(0.0);
     for (var k = 0u; k < sg_soft_filter_trips(look); k++) {
-        m = sg_sat_filter_float(map, l, s.uv, look.width);
+        m = sg_sat_filter_float(map, smp, l, s.uv, look.width);
     }
     if !look.blockers {
         return 1.0;

@@ -59,6 +59,10 @@ struct Light {
     cascade_blend: f32,      // cascades: blend band, fraction of each cascade's range
     face_uv: vec2<f32>,      // map UV per unit of a face's UV: (1, 1); a point light's atlas (1/3, 1/2)
     cascade_far: array<vec4<f32>, 2>, // cascades: far view distance of cascade c at [c / 4][c % 4]
+    sat_filtered: u32,       // tables: 1 where f32 and read with filtered fetches (the CPU references read it)
+    sat_amplitude: f32,      // tables: the largest |v − sat_offset| over the value range (the CPU references read it)
+    _pad_end0: u32,
+    _pad_end1: u32,
 }
 
 // `Light::technique` (keep in sync with the `TECHNIQUE_*` constants of src/gpu_data.rs; a test

@@ -31,12 +31,12 @@ fn vis_vssm_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32 {
 }
 
 // #fetches vis_vssm_float: sat_search_float + sat_filter_float
-fn vis_vssm_float(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
+fn vis_vssm_float(map: texture_2d<f32>, smp: sampler, l: Light, s: LightSample) -> f32 {
     let search = sat_search_float(map, l, s.uv, blocker_search_width(l, s));
     let look = soft_blockers(vssm_blocker(search, l, s), l, s);
     var m = vec4<f32>(0.0);
     for (var k = 0u; k < soft_filter_trips(look); k++) {
-        m = sat_filter_float(map, l, s.uv, look.width);
+        m = sat_filter_float(map, smp, l, s.uv, look.width);
     }
     if !look.blockers {
         return 1.0;

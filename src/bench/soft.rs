@@ -32,7 +32,12 @@ pub const SOFT_TECHNIQUES: &[(&str, &str)] = &[
         "technique = \"pcss\"\nblocker_samples = 64\nfilter_samples = 64",
     ),
     ("vssm", "technique = \"vssm\""),
+    ("vssm float", "technique = \"vssm\"\nsat_sums = \"float\""),
     ("msm_soft", "technique = \"msm_soft\""),
+    (
+        "msm_soft float",
+        "technique = \"msm_soft\"\nsat_sums = \"float\"",
+    ),
     ("cssm M=8", "technique = \"cssm\"\nterms = 8"),
     (
         "cssm M=8 csm_z",

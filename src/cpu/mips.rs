@@ -159,7 +159,8 @@ pub fn taps<'a>(levels: &'a [Texels], l: &LightGpu, s: &LightSample) -> Vec<(f64
 
 /// The `sat` filter's taps (`sat_sample_*` in `kernels/shared/sat_lookup.wgsl`): every texel
 /// the square of `l.filter_width` texels centred on `uv` overlaps, weighted by its overlap over
-/// the (clamped) square's area; the rectangle itself is formed in f32 as the shader forms it.
+/// the (clamped) square's area; the rectangle itself is formed in f32 as the shader forms it,
+/// and for a table read with filtered fetches (`l.sat_filtered`) put on the 2⁻⁸-texel grid.
 pub fn sat_taps<'a>(t: &'a Texels, l: &LightGpu, uv: [f64; 2]) -> Vec<(f64, &'a [f64])> {
     sat_taps_width(t, l, uv, l.filter_width)
 }
@@ -174,7 +175,13 @@ pub fn sat_taps_width<'a>(
     let (cx, cy) = (uv[0] as f32 * l.map_size[0], uv[1] as f32 * l.map_size[1]);
     let h = 0.5 * width;
     let rect = [cx - h, cy - h, cx + h, cy + h];
-    let [x0, y0, x1, y1] = super::sat::clamp_rect(rect, t.width, t.height).map(f64::from);
+    // An f32 table is read with filtered fetches, its rectangle on the 2⁻⁸-texel grid.
+    let clamped = if l.sat_filtered != 0 {
+        super::sat::grid_rect(rect, t.width, t.height)
+    } else {
+        super::sat::clamp_rect(rect, t.width, t.height)
+    };
+    let [x0, y0, x1, y1] = clamped.map(f64::from);
     let area = (x1 - x0) * (y1 - y0);
     let overlap = |lo: f64, hi: f64, i: usize| (hi.min(i as f64 + 1.0) - lo.max(i as f64)).max(0.0);
     let mut taps = Vec::new();

@@ -157,6 +157,19 @@ pub fn clamp_rect(rect: [f32; 4], width: usize, height: usize) -> [f32; 4] {
     out
 }
 
+/// The step of the grid filtered table lookups put their corners on: 2⁻⁸ texel, the weight
+/// precision of bilinear filtering hardware (`SAT_GRID` in `kernels/shared/sat.wgsl`).
+pub const GRID: f32 = 1.0 / 256.0;
+
+/// `rect` after [`clamp_rect`] with its edges on the [`GRID`] (nearest, ties up) and at least one
+/// step wide, in f32 as `sat_grid` in `kernels/shared/sat.wgsl` computes it.
+pub fn grid_rect(rect: [f32; 4], width: usize, height: usize) -> [f32; 4] {
+    let c = clamp_rect(rect, width, height);
+    let snap = |v: f32| (v * 256.0 + 0.5).floor() / 256.0;
+    let (x0, y0) = (snap(c[0]), snap(c[1]));
+    [x0, y0, snap(c[2]).max(x0 + GRID), snap(c[3]).max(y0 + GRID)]
+}
+
 /// The square of `width` texels centred on `uv` (formed in f32 as `sat_rect` forms it) with
 /// its edges rounded to the nearest texel edges, ties to even, at least one texel wide
 /// (`sat_nearest` in `kernels/shared/sat_lookup.wgsl`), before clamping: (x0, y0, x1, y1).
@@ -205,6 +218,9 @@ pub struct Integral {
     channels: usize,
     /// `(width + 1)·(height + 1)` nodes of `channels` values each, row-major.
     nodes: Vec<f64>,
+    /// The table is f32 and read with filtered fetches: [`Self::filter_square_mean`] is the
+    /// exact square on the 2⁻⁸-texel grid ([`grid_rect`]), not the rounded one.
+    filtered: bool,
 }
 
 impl Integral {
@@ -227,7 +243,44 @@ impl Integral {
             height: h,
             channels: n,
             nodes,
+            filtered: false,
         }
+    }
+
+    /// The same integral for a table read with filtered fetches (`filtered`: an f32 table,
+    /// `sat_sums = "float"`) or with loads.
+    pub fn filtered(self, filtered: bool) -> Self {
+        Self { filtered, ..self }
+    }
+
+    /// Whether [`Self::filter_square_mean`] reads the square on the 2⁻⁸ grid of filtered
+    /// fetches ([`Self::filtered`]).
+    pub fn is_filtered(&self) -> bool {
+        self.filtered
+    }
+
+    /// How far [`Self::grid_square_mean`] moves, per channel, when each edge of its grid
+    /// rectangle may land one grid step either way: the sum over the four edges of the larger
+    /// change of one step in or out. A device whose square differs from the f64 one by less
+    /// than half a step (its edges' f32 error) picks the same or the next grid point.
+    pub fn grid_flip_error(&self, map_size: [f32; 2], uv: [f64; 2], width: f64) -> Vec<f64> {
+        let r = grid_rect(square(map_size, uv, width), self.width, self.height);
+        let base = self.rect_mean(r);
+        let mut out = vec![0.0; self.channels];
+        for edge in 0..4 {
+            let mut worst = vec![0.0f64; self.channels];
+            for step in [-GRID, GRID] {
+                let mut moved = r;
+                moved[edge] += step;
+                for (c, m) in self.rect_mean(moved).iter().enumerate() {
+                    worst[c] = worst[c].max((m - base[c]).abs());
+                }
+            }
+            for c in 0..self.channels {
+                out[c] += worst[c];
+            }
+        }
+        out
     }
 
     /// Channels per texel.
@@ -270,6 +323,28 @@ impl Integral {
     pub fn nearest_square_mean(&self, map_size: [f32; 2], uv: [f64; 2], width: f64) -> Vec<f64> {
         let r = clamp_rect(nearest_square(map_size, uv, width), self.width, self.height);
         self.rect_mean([r[0].floor(), r[1].floor(), r[2].ceil(), r[3].ceil()])
+    }
+
+    /// The mean over the square of [`Self::square_mean`] as the soft techniques' filter reads
+    /// it: from a table read with loads, [`Self::nearest_square_mean`]; from one read with
+    /// filtered fetches ([`Self::filtered`]), the square itself on the 2⁻⁸-texel grid
+    /// ([`grid_rect`], `sat_filter_float`).
+    pub fn filter_square_mean(&self, map_size: [f32; 2], uv: [f64; 2], width: f64) -> Vec<f64> {
+        if self.filtered {
+            self.grid_square_mean(map_size, uv, width)
+        } else {
+            self.nearest_square_mean(map_size, uv, width)
+        }
+    }
+
+    /// The mean over the square of [`Self::square_mean`] after [`grid_rect`]: the rectangle
+    /// four filtered fetches of an f32 table integrate (`sat_mean_linear`).
+    pub fn grid_square_mean(&self, map_size: [f32; 2], uv: [f64; 2], width: f64) -> Vec<f64> {
+        self.rect_mean(grid_rect(
+            square(map_size, uv, width),
+            self.width,
+            self.height,
+        ))
     }
 
     /// The mean over the square of [`Self::square_mean`] snapped outward to texel edges after

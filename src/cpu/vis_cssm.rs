@@ -49,11 +49,12 @@ pub fn blocker_of(kind: CssmSearch, m: &[f64], l: &LightGpu, s: &LightSample) ->
     }
 }
 
-/// The CSM series over the penumbra width of `b`, the square's edges rounded to the nearest
-/// texel edges.
+/// The CSM series over the penumbra width of `b`, the square as the table is read
+/// ([`Integral::filter_square_mean`]: rounded to texel edges, or on the 2⁻⁸ grid of filtered
+/// fetches).
 pub fn filtered(maps: Maps, l: &LightGpu, s: &LightSample, b: Blocker) -> f64 {
     let w = blocker::filter_width(l, s, b.depth);
-    let basis = maps.basis.nearest_square_mean(l.map_size, s.uv, w);
+    let basis = maps.basis.filter_square_mean(l.map_size, s.uv, w);
     super::vis_csm::series(&basis, l, super::vis_csm::shifted_depth(l, s))
 }
 

@@ -18,10 +18,11 @@ pub fn blocker_of(m: &[f64], l: &LightGpu, s: &LightSample) -> Blocker {
     blocker::vsm(m, s.depth - f64::from(l.bias), f64::from(l.min_variance))
 }
 
-/// The mean moments over the penumbra width of `b`, the square's edges rounded to the nearest
-/// texel edges.
+/// The mean moments over the penumbra width of `b`, the square as the table is read
+/// ([`Integral::filter_square_mean`]: rounded to texel edges, or on the 2⁻⁸ grid of filtered
+/// fetches).
 pub fn filtered(moments: &Integral, l: &LightGpu, s: &LightSample, b: Blocker) -> Vec<f64> {
-    moments.nearest_square_mean(l.map_size, s.uv, blocker::filter_width(l, s, b.depth))
+    moments.filter_square_mean(l.map_size, s.uv, blocker::filter_width(l, s, b.depth))
 }
 
 /// The visibility for blocker estimate `b` (`vssm_resolve` after the second lookup).

@@ -170,6 +170,20 @@ impl Checker<'_> {
                     feature: "TEXTURE_FORMAT_16BIT_NORM",
                 });
             }
+            // A soft technique's f32 tables are read with filtered fetches (`sat_mean_linear`).
+            if l.shadow.technique.sat_filtered()
+                && !features.contains(wgpu::Features::FLOAT32_FILTERABLE)
+            {
+                let key = format!("light[{i}].shadow.sat_sums");
+                return Err(Error::MissingFeature {
+                    what: format!(
+                        "{}{}: `{key}` = \"float\" (the soft filter's filtered table lookups)",
+                        self.scene.path.display(),
+                        self.scene.locations.get(&key)
+                    ),
+                    feature: "FLOAT32_FILTERABLE",
+                });
+            }
         }
         Ok(())
     }

@@ -350,6 +350,23 @@ impl Technique {
         }
     }
 
+    /// The variant of the summed-area table it reads, if it reads one (the `sat` filter or a
+    /// soft technique's table).
+    pub fn sat_variant(&self) -> Option<SatVariant> {
+        match (self.filter(), self.soft()) {
+            (Some(Filter::Sat { variant, .. }), _) => Some(variant),
+            (_, Some(Soft { sums, .. })) => Some(sums),
+            _ => None,
+        }
+    }
+
+    /// Whether its table is f32 and its filter reads it with bilinear-filtered fetches: a soft
+    /// technique with `sat_sums = "float"` (`sat_filter_float`; the `sat` filter's f32 tables
+    /// keep their sixteen loads, whose window sums stay exact to the table at small widths).
+    pub fn sat_filtered(&self) -> bool {
+        self.soft().is_some_and(|s| s.sums == SatVariant::Float)
+    }
+
     /// The storage precision of a prefiltered or soft technique's representation (ESM's is
     /// always f32); `None` for techniques that shade from the depth.
     pub fn storage(&self) -> Option<Storage> {

@@ -27,6 +27,9 @@ const MAP_PREFIX: &str = "shadowgraph_map";
 /// The comparison sampler of hardware PCF (a global of `kernels/shade.wgsl`) and its host name.
 const CMP_SAMPLER: &str = "cmp_sampler";
 const HOST_CMP_SAMPLER: &str = "shadowgraph_cmp_sampler";
+/// The filtering sampler of f32 tables' lookups (a global of `kernels/shade.wgsl`).
+const SAT_SAMPLER: &str = crate::technique::SAT_SAMPLER;
+const HOST_SAT_SAMPLER: &str = "shadowgraph_sat_sampler";
 
 /// Every technique's visibility function with `struct Light` and the sampling helpers, resolved
 /// (no `// #import` left), headed by how to use them: the text of [`LIBRARY_PATH`].
@@ -90,8 +93,10 @@ const LIBRARY_HEADER: &str = "\
 //   let pick = sg_cascade_pick(l0, p);          // pick.index, pick.blend
 // gives the renderer's choice: cascade pick.index's visibility, mixed toward the next
 // cascade's by pick.blend across the blend band.
-// Prefiltered maps are read with four loads, so no sampler or filterable format is needed;
-// only `sg_vis_pcf_hardware` takes a comparison sampler (linear filtering, compare less-equal).
+// Prefiltered maps are read with loads, so no sampler or filterable format is needed, except:
+// `sg_vis_pcf_hardware` takes a comparison sampler (linear filtering, compare less-equal), and
+// f32 summed-area tables (`sat_sums = float`: the `_float` lookups and soft functions) take a
+// filtering sampler (linear, clamp to edge) and a filterable binding (FLOAT32_FILTERABLE).
 // Two moments in f16 (VSM, EVSM2 with `Storage::F16`, not through a table) come as an r32uint
 // texture, 4 bytes a texel, each word pack2x16float(moments): bind it as texture_2d<u32> and
 // call `sg_vis_vsm_of(sg_sample_map_packed(map, l, s), l, s)` (EVSM2: `sg_vis_evsm_of`).
@@ -252,9 +257,16 @@ pub fn needs_comparison_sampler(technique: &Technique) -> Result<bool> {
     Ok(split_tokens(&block_of(technique)?.body).contains(&CMP_SAMPLER))
 }
 
+/// Whether `technique` binds a filtering sampler after its maps (and comparison sampler): f32
+/// summed-area tables read with filtered fetches.
+pub fn needs_filtering_sampler(technique: &Technique) -> Result<bool> {
+    Ok(split_tokens(&block_of(technique)?.body).contains(&SAT_SAMPLER))
+}
+
 /// A host's WGSL for `technique`: [`technique_functions`], then its [`light_block`] with the
 /// default names: one binding per map at `@group(group) @binding(first_binding + k)` named
-/// `shadowgraph_map{k}` (then `shadowgraph_cmp_sampler` where [`needs_comparison_sampler`]),
+/// `shadowgraph_map{k}` (then `shadowgraph_cmp_sampler` where [`needs_comparison_sampler`]
+/// and `shadowgraph_sat_sampler` where [`needs_filtering_sampler`]),
 /// and `fn shadowgraph_visibility(l: sg_Light, p: vec3<f32>, n: vec3<f32>) -> f32`: 0 where
 /// the receiver faces away from the light, 1 outside the map, else the technique's
 /// visibility.
@@ -276,6 +288,7 @@ pub fn host_block(technique: &Technique, group: u32, first_binding: u32) -> Resu
 /// One light's bindings and functions, without the functions they call (include
 /// [`functions_for`] the techniques once per shader module). With `light` empty the names are
 /// [`host_block`]'s; else `shadowgraph_{light}_map{k}`, `shadowgraph_{light}_cmp_sampler`,
+/// `shadowgraph_{light}_sat_sampler`,
 /// `shadowgraph_visibility_{light}(l, p, n)` and `shadowgraph_visibility_footprint_{light}`,
 /// so that blocks of several lights (each at its own bindings) live in one module. `light`
 /// is an identifier's tail: ASCII letters, digits and `_`.
@@ -310,16 +323,21 @@ pub fn light_block(
                 let _ = write!(call, "{}{k}", names.map);
             }
             None if t == CMP_SAMPLER => call.push_str(&names.cmp_sampler),
+            None if t == SAT_SAMPLER => call.push_str(&names.sat_sampler),
             None => call.push_str(t),
         }
     }
-    if call.contains(&names.cmp_sampler) {
-        let binding = first_binding + block.maps.len() as u32;
-        let _ = writeln!(
-            s,
-            "@group({group}) @binding({binding}) var {}: sampler_comparison;",
-            names.cmp_sampler
-        );
+    // The samplers follow the maps, in this order, each where the call uses it.
+    let tokens = split_tokens(&call);
+    let mut binding = first_binding + block.maps.len() as u32;
+    for (name, ty) in [
+        (&names.cmp_sampler, "sampler_comparison"),
+        (&names.sat_sampler, "sampler"),
+    ] {
+        if tokens.contains(&name.as_str()) {
+            let _ = writeln!(s, "@group({group}) @binding({binding}) var {name}: {ty};");
+            binding += 1;
+        }
     }
     if let Some(fetches) = &block.fetches {
         let _ = writeln!(s, "// #fetches {}: {fetches}", names.light_visibility);
@@ -350,6 +368,7 @@ pub fn light_block(
 struct BlockNames {
     map: String,
     cmp_sampler: String,
+    sat_sampler: String,
     light_visibility: String,
     visibility: String,
     footprint: String,
@@ -361,6 +380,7 @@ impl BlockNames {
             return Self {
                 map: MAP_PREFIX.to_string(),
                 cmp_sampler: HOST_CMP_SAMPLER.to_string(),
+                sat_sampler: HOST_SAT_SAMPLER.to_string(),
                 light_visibility: "shadowgraph_light_visibility".into(),
                 visibility: "shadowgraph_visibility".into(),
                 footprint: "shadowgraph_visibility_footprint".into(),
@@ -369,6 +389,7 @@ impl BlockNames {
         Self {
             map: format!("shadowgraph_{light}_map"),
             cmp_sampler: format!("shadowgraph_{light}_cmp_sampler"),
+            sat_sampler: format!("shadowgraph_{light}_sat_sampler"),
             light_visibility: format!("shadowgraph_light_visibility_{light}"),
             visibility: format!("shadowgraph_visibility_{light}"),
             footprint: format!("shadowgraph_visibility_footprint_{light}"),
@@ -394,8 +415,9 @@ fn split_tokens(text: &str) -> Vec<&str> {
 }
 
 /// Bind group layout entries of the bindings [`host_block`] declares from `first_binding` on,
-/// reflected from that WGSL: unfilterable-float textures for maps (f32 maps need no filtering
-/// feature), a depth texture and comparison sampler for hardware PCF.
+/// reflected from that WGSL: unfilterable-float textures for maps read with loads (f32 maps
+/// need no filtering feature), filterable ones for f32 tables with a filtering sampler, a depth
+/// texture and comparison sampler for hardware PCF.
 pub fn layout_entries(
     technique: &Technique,
     first_binding: u32,

@@ -35,6 +35,8 @@ pub struct Renderer {
     peel: HashMap<u32, (wgpu::RenderPipeline, wgpu::BindGroupLayout)>,
     gbuffer: Option<(wgpu::RenderPipeline, wgpu::BindGroupLayout)>,
     cmp_sampler: wgpu::Sampler,
+    /// Linear, clamped to the edge: f32 tables' filtered corner fetches.
+    sat_sampler: wgpu::Sampler,
     /// The last scene shape's resources.
     targets: Option<Targets>,
     /// The shading pass's bind groups for the last kernel and maps.
@@ -82,6 +84,7 @@ impl Renderer {
                     ..Default::default()
                 },
             ),
+            sat_sampler: created::sampler(device, &crate::prefilter::SAT_SAMPLER_DESCRIPTOR),
         }
     }
 
@@ -424,6 +427,10 @@ impl Renderer {
             wgpu::BindGroupEntry {
                 binding: 7,
                 resource: wgpu::BindingResource::Sampler(&self.cmp_sampler),
+            },
+            wgpu::BindGroupEntry {
+                binding: 8,
+                resource: wgpu::BindingResource::Sampler(&self.sat_sampler),
             },
         ];
         let map_entries: Vec<wgpu::BindGroupEntry> = maps

@@ -67,6 +67,32 @@ impl Map {
         }
     }
 
+    /// Exact sum over `[0, x) × [0, y)` at a point of the 2⁻⁸-texel grid (`x`, `y` in
+    /// 256ths of a texel), times 256²: the bilinear mix of the four nodes around it, in i128.
+    fn corner_256(&self, x: i64, y: i64) -> i128 {
+        let (i, j) = ((x / 256) as usize, (y / 256) as usize);
+        let (a, b) = (i128::from(x % 256), i128::from(y % 256));
+        let c = |x: usize, y: usize| {
+            if x > self.n || y > self.n {
+                0
+            } else {
+                i128::from(self.corner(x, y))
+            }
+        };
+        (256 - a) * (256 - b) * c(i, j)
+            + a * (256 - b) * c(i + 1, j)
+            + (256 - a) * b * c(i, j + 1)
+            + a * b * c(i + 1, j + 1)
+    }
+
+    /// Exact sum over a rectangle on the 2⁻⁸-texel grid (texel units), as a value.
+    fn fractional_window(&self, r: [f32; 4]) -> f64 {
+        let [x0, y0, x1, y1] = r.map(|v| (v * 256.0) as i64);
+        let s = self.corner_256(x1, y1) - self.corner_256(x0, y1) - self.corner_256(x1, y0)
+            + self.corner_256(x0, y0);
+        s as f64 / 65536.0 * UNIT
+    }
+
     /// Exact window sum, as a value (f64 holds it exactly: < 2⁵³ units).
     fn window(&self, [x0, y0, x1, y1]: [usize; 4]) -> f64 {
         let s =
@@ -135,13 +161,22 @@ fn corner_texels(windows: &[[usize; 4]]) -> Vec<(u32, u32)> {
     v
 }
 
-/// Builds the table of `map` with `coding` on the GPU and reads the texels at `coords`.
+/// What [`gpu_table`] reads of a table: its texels at the windows' corners and, for an f32
+/// table, the means of `sat_mean_linear` (four filtered fetches) over the fractional rectangles.
+struct Read {
+    texels: HashMap<(u32, u32), [u32; 4]>,
+    filtered: Vec<f32>,
+}
+
+/// Builds the table of `map` with `coding` on the GPU and reads the texels at `coords` (and,
+/// for an f32 table, the filtered lookups' means over `rects`).
 fn gpu_table(
     gpu: &Gpu,
     map: &Map,
     coding: &SatCoding,
     coords: &[(u32, u32)],
-) -> Result<HashMap<(u32, u32), [u32; 4]>> {
+    rects: &[[f32; 4]],
+) -> Result<Read> {
     let n = map.n as u32;
     let mut graph = Graph::default();
     graph.import("in", wgpu::TextureFormat::R32Float, n, n, Some(0));
@@ -157,12 +192,135 @@ fn gpu_table(
     let mut exec = Executor::new();
     let poison = Poison::Texels(&out, coords);
     let ran = run_graph(gpu, &mut exec, &graph, &[&out], imports, false, poison)?;
-    let texels = read_texels(gpu, &ran.outputs.textures[&out], coords)?;
+    let table = &ran.outputs.textures[&out];
+    let texels = read_texels(gpu, table, coords)?;
+    let filtered = if coding.variant == SatVariant::Float {
+        filtered_means(gpu, table, coding.offset[0], rects)?
+    } else {
+        Vec::new()
+    };
     // Free the large textures now, not whenever wgpu next cleans up.
     for t in ran.outputs.textures.values() {
         t.destroy();
     }
-    Ok(coords.iter().copied().zip(texels).collect())
+    Ok(Read {
+        texels: coords.iter().copied().zip(texels).collect(),
+        filtered,
+    })
+}
+
+/// The probe of the filtered lookups: one invocation per rectangle, `sat_mean_linear` of the
+/// shading side (the soft techniques' and the `sat` filter's lookup of f32 tables).
+const FILTERED_PROBE: &str = "\
+// #import shared/sat
+@group(0) @binding(0) var table: texture_2d<f32>;
+@group(0) @binding(1) var smp: sampler;
+@group(0) @binding(2) var<storage, read> rects: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read_write> means: array<f32>;
+@group(0) @binding(4) var<uniform> offset: vec4<f32>;
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= arrayLength(&rects) {
+        return;
+    }
+    means[id.x] = sat_mean_linear(table, smp, rects[id.x], offset, vec4<f32>(1.0)).x;
+}
+";
+
+/// Means of `sat_mean_linear` over `rects` (texel units) from the f32 `table`.
+fn filtered_means(
+    gpu: &Gpu,
+    table: &wgpu::Texture,
+    offset: f32,
+    rects: &[[f32; 4]],
+) -> Result<Vec<f32>> {
+    use wgpu::util::DeviceExt;
+    let d = &gpu.device;
+    let wgsl = crate::kernels::resolve_source("stability_filtered", FILTERED_PROBE)?;
+    let kernel = crate::exec::ComputeKernel::new(d, "stability_filtered", &wgsl)?;
+    let rect_buf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("stability.rects"),
+        contents: bytemuck::cast_slice(rects),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let offset_buf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("stability.offset"),
+        contents: bytemuck::cast_slice(&[offset, 0.0, 0.0, 0.0]),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let size = (rects.len() * 4) as u64;
+    let means = d.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("stability.means"),
+        size,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let readback = d.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("stability.means.read"),
+        size,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let sampler = d.create_sampler(&crate::prefilter::SAT_SAMPLER_DESCRIPTOR);
+    let view = table.create_view(&Default::default());
+    let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("stability.filtered"),
+        layout: &kernel.layouts[0],
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::TextureView(&view),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::Sampler(&sampler),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: rect_buf.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 3,
+                resource: means.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 4,
+                resource: offset_buf.as_entire_binding(),
+            },
+        ],
+    });
+    let mut enc = d.create_command_encoder(&Default::default());
+    {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&kernel.pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        pass.dispatch_workgroups((rects.len() as u32).div_ceil(64), 1, 1);
+    }
+    enc.copy_buffer_to_buffer(&means, 0, &readback, 0, size);
+    crate::gpu::submit_and_wait(d, &gpu.queue, enc, "stability filtered lookups")?;
+    let raw = crate::gpu::read_buffer(d, &readback)?;
+    Ok(bytemuck::cast_slice(&raw).to_vec())
+}
+
+/// Fractional rectangles from `windows`: each edge moved by a whole number of 2⁻⁸-texel steps
+/// (up to 255 either way, inside the map, at least one step wide): where filtered fetches
+/// weigh their texels exactly on every device.
+fn fractional(rng: &mut Rng, windows: &[[usize; 4]], n: usize) -> Vec<[f32; 4]> {
+    let steps = (n * 256) as i64;
+    let mut jitter = |v: usize| -> i64 {
+        let k = rng.below(511) as i64 - 255;
+        (v as i64 * 256 + k).clamp(0, steps)
+    };
+    windows
+        .iter()
+        .map(|&[x0, y0, x1, y1]| {
+            let (a, b) = (jitter(x0), jitter(y0));
+            let (c, d) = (jitter(x1).max(a + 1), jitter(y1).max(b + 1));
+            let (a, b) = (a.min(steps - 1), b.min(steps - 1));
+            let (c, d) = (c.min(steps).max(a + 1), d.min(steps).max(b + 1));
+            [a, b, c, d].map(|v| v as f32 / 256.0)
+        })
+        .collect()
 }
 
 /// Depth of the GPU's summation tree for one f32 table texel of an `n`² map
@@ -241,13 +399,21 @@ fn check_fixed(
     ]
 }
 
-/// The f32 table's window means against the exact means, each within the scan's model.
+/// The f32 table's window means against the exact means, each within the scan's model; and
+/// the filtered lookups' means over the fractional rectangles `rects`, within the same model
+/// plus the bilinear mixes: each corner is two lerps in x and one in y of table texels, three
+/// roundings each relative to the sums there, so `(d + 12)·u` of the corner's sum bound
+/// (`(⌈x⌉·⌈y⌉)·max|x|`) counts the table texels' error, the mixes and the window's three
+/// subtractions.
 fn check_float(
     map: &Map,
     coding: &SatCoding,
     wins: &[[usize; 4]],
-    got: &HashMap<(u32, u32), [u32; 4]>,
-) -> Row {
+    got: &Read,
+    rects: &[[f32; 4]],
+) -> [Row; 2] {
+    let filtered = check_filtered(map, coding, rects, &got.filtered);
+    let got = &got.texels;
     let n = map.n;
     let offset = f64::from(coding.offset[0]);
     let max_x = map
@@ -279,9 +445,51 @@ fn check_float(
             window_name(w, n)
         });
     }
+    [
+        means.row(
+            1,
+            &format!("{} {}²: window means", map.name, n),
+            "sat (f32 model)",
+            "f32",
+        ),
+        filtered,
+    ]
+}
+
+/// The filtered lookups' means (`sat_mean_linear`, four filtered fetches) against the exact
+/// means of `rects` (see [`check_float`] for the bound).
+fn check_filtered(map: &Map, coding: &SatCoding, rects: &[[f32; 4]], got: &[f32]) -> Row {
+    let n = map.n;
+    let offset = f64::from(coding.offset[0]);
+    let max_x = map
+        .values
+        .iter()
+        .fold(0.0f64, |m, &v| m.max((f64::from(v) - offset).abs()));
+    let d = scan_depth(n);
+    let mut means = Check::new();
+    if got.len() != rects.len() {
+        means.compare(f64::NAN, 0.0, 0.0, || {
+            format!("{} means for {} rectangles", got.len(), rects.len())
+        });
+    }
+    for (r, &mean) in rects.iter().zip(got) {
+        let [x0, y0, x1, y1] = r.map(f64::from);
+        let area = (x1 - x0) * (y1 - y0);
+        let corners: f64 = [(x0, y0), (x1, y0), (x0, y1), (x1, y1)]
+            .iter()
+            .map(|&(x, y)| x.ceil() * y.ceil() * max_x)
+            .sum();
+        let exact = map.fractional_window(*r);
+        let bound = ((d + 12.0) * U * corners + U * (exact - area * offset).abs()) / area
+            + U * max_x
+            + 1e-12;
+        means.compare(f64::from(mean), exact / area, bound, || {
+            format!("[{x0}, {x1}) × [{y0}, {y1})")
+        });
+    }
     means.row(
         1,
-        &format!("{} {}²: window means", map.name, n),
+        &format!("{} {}²: filtered lookups (4 fetches)", map.name, n),
         "sat (f32 model)",
         "f32",
     )
@@ -331,6 +539,8 @@ pub(crate) fn sat_case(gpu: &Gpu, size: u32, tables: SatTables) -> Result<Vec<Ro
         let wins = windows(&mut rng, n, n, 400);
         // Drawn whatever runs, so every table sees the same windows in either mode.
         let small = windows(&mut rng, n, 65, 400);
+        // The f32 table's filtered lookups: the whole-map windows with fractional edges.
+        let rects = fractional(&mut rng, &wins, n);
         let mut codings = vec![
             (whole, wins.clone(), "sat (all windows exact)"),
             (fine, small, "sat (64² lookups)"),
@@ -346,10 +556,12 @@ pub(crate) fn sat_case(gpu: &Gpu, size: u32, tables: SatTables) -> Result<Vec<Ro
         }
         for (coding, wins, label) in codings {
             let coords = corner_texels(&wins);
-            let got = gpu_table(gpu, map, &coding, &coords)?;
+            let got = gpu_table(gpu, map, &coding, &coords, &rects)?;
             match coding.variant {
-                SatVariant::Fixed => rows.extend(check_fixed(map, &coding, &wins, &got, label)),
-                SatVariant::Float => rows.push(check_float(map, &coding, &wins, &got)),
+                SatVariant::Fixed => {
+                    rows.extend(check_fixed(map, &coding, &wins, &got.texels, label))
+                }
+                SatVariant::Float => rows.extend(check_float(map, &coding, &wins, &got, &rects)),
             }
         }
     }

@@ -15,7 +15,7 @@ use std::fmt::Write;
 
 use super::csm::{csm_gpu, csm_maps, csm_nodes, terms};
 use super::nodes::map_type;
-use super::shade::{ShadeInput, VisibilityBody, table_suffix};
+use super::shade::{ShadeInput, VisibilityBody, table_args, table_suffix};
 use crate::model::Light;
 
 const SHARPEN: &[ParamSpec] = &[
@@ -81,7 +81,12 @@ fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
     let suffix = table_suffix(soft.sums);
     let (basis, z) = maps.split_at((csm_maps(terms) as usize).min(maps.len()));
     let search = |m: &str| format!("sat_search_{suffix}({m}, l, s.uv, width)");
-    let sample = |m: &str| format!("sat_filter_{suffix}({m}, l, s.uv, look.width)");
+    let sample = |m: &str| {
+        format!(
+            "sat_filter_{suffix}({}, l, s.uv, look.width)",
+            table_args(soft.sums, m)
+        )
+    };
     // The search reads its tables over the square snapped outward to texel edges (4 loads
     // each); the filter reads the basis tables over the penumbra square with its edges
     // rounded to the nearest texel edges (4 loads each), in a loop of 0 or 1 trips

@@ -2,7 +2,7 @@
 //! technique, and the summed-area-table coding a technique's representation needs.
 
 use crate::gpu_data::LightGpu;
-use crate::model::{Filter, Light, LightKind, Soft, Technique, mip_levels};
+use crate::model::{Filter, Light, LightKind, Technique, mip_levels};
 use crate::sat::{SatCoding, SatVariant, lookup_area};
 
 impl LightGpu {
@@ -80,6 +80,9 @@ impl LightGpu {
             }
             self.sat_offset = c.offset;
             self.sat_scale = c.scale;
+            self.sat_filtered = u32::from(light.shadow.technique.sat_filtered());
+            let (lo, hi) = value_range(&light.shadow.technique);
+            self.sat_amplitude = (0..4).fold(0.0f32, |a, i| a.max(0.5 * (hi[i] - lo[i])));
         }
         self
     }
@@ -111,14 +114,7 @@ pub fn soft_lookup_area(max_search: f32, map: u32) -> u64 {
 /// The table variant of `light`'s summed-area table, if its technique reads one (the `sat`
 /// filter or a soft technique).
 pub fn sat_variant(light: &Light) -> Option<SatVariant> {
-    match (
-        light.shadow.technique.filter(),
-        light.shadow.technique.soft(),
-    ) {
-        (Some(Filter::Sat { variant, .. }), _) => Some(variant),
-        (_, Some(Soft { sums, .. })) => Some(sums),
-        _ => None,
-    }
+    light.shadow.technique.sat_variant()
 }
 
 /// The summed-area-table coding of light `light`'s representation when it is read through a

@@ -64,6 +64,11 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
                 values: &[],
                 storage: Some(crate::model::Storage::F16),
             },
+            SweepVariant {
+                label: "msm_soft f32 float",
+                values: &[("sat_sums", ParamValue::Choice("float"))],
+                storage: None,
+            },
         ],
         quick: 1,
     },

@@ -268,7 +268,7 @@ pub const SOFT: &[ParamSpec] = &[
         "sat_sums",
         &["fixed", "float"],
         "fixed",
-        "table sums: u32 fixed point or f32",
+        "table sums: u32 fixed point, or f32 whose filter lookups are four bilinear-filtered fetches (needs FLOAT32_FILTERABLE)",
     ),
     float(
         "max_search",

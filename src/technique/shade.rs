@@ -70,7 +70,22 @@ pub(super) fn table_suffix(variant: SatVariant) -> &'static str {
     }
 }
 
-/// The rectangle mean of `map` at `width` as a WGSL expression.
+/// The filtering sampler of f32 tables' lookups (a global of `kernels/shade.wgsl`: linear,
+/// clamped to the edge; a plug-in host binds its own after the maps).
+pub const SAT_SAMPLER: &str = "sat_sampler";
+
+/// The table arguments of a soft technique's filter lookup or visibility function of
+/// `variant`: the map, then for f32 tables, whose filter reads filtered fetches, the sampler
+/// ([`SAT_SAMPLER`]).
+pub(super) fn table_args(variant: SatVariant, map: &str) -> String {
+    match variant {
+        SatVariant::Fixed => map.to_string(),
+        SatVariant::Float => format!("{map}, {SAT_SAMPLER}"),
+    }
+}
+
+/// The rectangle mean of `map` at `width` as a WGSL expression (the `sat` filter: sixteen
+/// loads, in either variant).
 pub(super) fn sat_sample(variant: SatVariant, map: &str, width: &str) -> String {
     format!(
         "sat_sample_{}({map}, l, s.uv, {width})",
@@ -114,12 +129,19 @@ pub(super) fn soft_call(
     module: &'static str,
     f: &str,
 ) -> VisibilityBody {
-    let suffix = light
+    let sums = light
         .shadow
         .technique
         .soft()
-        .map_or("fixed", |s| table_suffix(s.sums));
-    call(module, &format!("{f}_{suffix}"), maps)
+        .map_or(SatVariant::Fixed, |s| s.sums);
+    VisibilityBody::simple(
+        vec![module],
+        format!(
+            "return {f}_{}({}, l, s);",
+            table_suffix(sums),
+            table_args(sums, first(maps))
+        ),
+    )
 }
 
 /// The key of the shading kernel for `lights`: what [`shading_block`] reads of each light (its

@@ -8,7 +8,7 @@ use super::vsm::{moments, variance_gpu};
 use super::{TechniqueDef, no_clamp};
 use super::{no_variant, unit_range};
 use crate::gpu_data::TECHNIQUE_VSSM;
-use crate::model::{ParamValues, Technique};
+use crate::model::{ParamValue, ParamValues, Technique};
 
 fn values(t: &Technique) -> ParamValues {
     let mut out = ParamValues::default();
@@ -58,11 +58,18 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     example: "scenes/techniques/vssm.toml",
     colour: [0x00, 0x5f, 0x3f],
     sweep: SweepPlan::Variants {
-        full: &[SweepVariant {
-            label: "vssm",
-            values: &[],
-            storage: None,
-        }],
+        full: &[
+            SweepVariant {
+                label: "vssm",
+                values: &[],
+                storage: None,
+            },
+            SweepVariant {
+                label: "vssm float",
+                values: &[("sat_sums", ParamValue::Choice("float"))],
+                storage: None,
+            },
+        ],
         quick: 1,
     },
 };

@@ -138,6 +138,27 @@ pub struct Chain<'a> {
     /// The filter square's edges before rounding for blockers at this depth
     /// (`cpu::sat::square`).
     pub filter_box: &'a dyn Fn(f64) -> [f32; 4],
+    /// The filter reads an f32 table with filtered fetches: its square's edges snap to the
+    /// 2⁻⁸ grid, where an edge landing one step off moves the means by no more than
+    /// [`grid_flips`] adds to `e_last` (no point is set aside for its edges).
+    pub grid: bool,
+}
+
+/// `e` (a mean's error per channel, of the filter's square at `width`) plus, for a table read
+/// with filtered fetches, the change of the means when the GPU's square lands its edges one
+/// grid step away from the f64 one ([`Integral::grid_flip_error`]).
+pub fn grid_flips(
+    t: &Integral,
+    l: &LightGpu,
+    s: &LightSample,
+    width: f64,
+    e: [f64; 4],
+) -> [f64; 4] {
+    if !t.is_filtered() {
+        return e;
+    }
+    let flips = t.grid_flip_error(l.map_size, s.uv, width);
+    std::array::from_fn(|c| e[c] + flips.get(c).copied().unwrap_or(0.0))
 }
 
 /// How close to a half texel a filter square's edge may lie before its point is set aside:
@@ -180,7 +201,7 @@ impl Chain<'_> {
             return Some(1e-5);
         }
         let near_half = |x: &f32| (x - x.floor() - 0.5).abs() < EDGE_MARGIN;
-        if (self.filter_box)(b0.depth).iter().any(near_half) {
+        if !self.grid && (self.filter_box)(b0.depth).iter().any(near_half) {
             return None;
         }
         let search = [b0.depth - dz, b0.depth + dz]
@@ -231,7 +252,8 @@ pub fn vssm_tolerance(
     use cpu::vis_vssm as v;
     let b0 = v::blocker_of(&v::search(t, l, s), l, s);
     let es = err.mean(l, s, cpu::blocker::search_width(l, s));
-    let el = err.mean(l, s, cpu::blocker::filter_width(l, s, b0.depth));
+    let width = cpu::blocker::filter_width(l, s, b0.depth);
+    let el = grid_flips(t, l, s, width, err.mean(l, s, width));
     Chain {
         search: &|du| v::search(t, l, &shifted(s, du))[..2].to_vec(),
         e_search: es[..2].to_vec(),
@@ -242,6 +264,7 @@ pub fn vssm_tolerance(
         visibility: &|m, dd| cpu::vis_vsm::vis_vsm_of(m, l, &moved(s, dd)),
         e_depth: depth_error(l, s),
         filter_box: &|z| filter_box(l, s, z),
+        grid: t.is_filtered(),
     }
     .tolerance(v0)
 }
@@ -293,7 +316,7 @@ pub fn msm_soft_tolerance(
     );
     let width = cpu::blocker::filter_width(l, s, b0.depth);
     let last0 = v::filtered(t, l, s, b0);
-    let el = msm_moment_error(l, &last0, err.mean(l, s, width));
+    let el = msm_moment_error(l, &last0, grid_flips(t, l, s, width, err.mean(l, s, width)));
     let d = s.depth - f64::from(l.bias);
     Chain {
         search: &|du| cpu::vis_msm::dequantized(&v::search(t, l, &shifted(s, du)), l).to_vec(),
@@ -305,6 +328,7 @@ pub fn msm_soft_tolerance(
         visibility: &|b, dd| cpu::vis_msm::visibility(&msm_bias(l, b), d + dd, l),
         e_depth: depth_error(l, s),
         filter_box: &|z| filter_box(l, s, z),
+        grid: t.is_filtered(),
     }
     .tolerance(v0)
 }
@@ -352,7 +376,7 @@ pub fn cssm_tolerance(
     };
     let width = cpu::blocker::filter_width(l, s, b0.depth);
     let sum = v::filtered(maps, l, s, b0);
-    let e_sum = series_error(err.0.mean(l, s, width));
+    let e_sum = series_error(grid_flips(maps.basis, l, s, width, err.0.mean(l, s, width)));
     let pow = if b0.found() {
         let p = v::exponent(l, s, b0);
         let base = cpu::vis_csm::resolve(sum, l);
@@ -371,6 +395,7 @@ pub fn cssm_tolerance(
         visibility: &|m, dd| v::resolve(m[0], l, &moved(s, dd), b0),
         e_depth: e_d,
         filter_box: &|z| filter_box(l, s, z),
+        grid: maps.basis.is_filtered(),
     }
     .tolerance(v0)
     .map(|t| t + 2.0 * pow)
@@ -446,7 +471,10 @@ impl SoftInputs {
         Some(Self {
             light: light.clone(),
             errors: parts.iter().map(|t| TableError::new(t, &coding)).collect(),
-            integrals: parts.iter().map(Integral::new).collect(),
+            integrals: parts
+                .iter()
+                .map(|t| Integral::new(t).filtered(coding.variant == SatVariant::Float))
+                .collect(),
             e_trig,
         })
     }
