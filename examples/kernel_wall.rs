@@ -15,13 +15,12 @@
 //! With `--passes`, each pass's share too: the plan cut after each of its steps is timed, and
 //! each pass is the difference to the cut before it.
 
-use std::collections::HashMap;
 use std::time::Instant;
 
-use shadowgraph::bench::{BenchCase, CASES};
+use shadowgraph::bench::{BenchCase, CASES, random_imports};
 use shadowgraph::exec::{ComputeKernel, Executor, wgsl_storage_format};
-use shadowgraph::gpu::{Gpu, submit_and_wait, write_texture};
-use shadowgraph::graph::{self, Plan, texel_bytes};
+use shadowgraph::gpu::{Gpu, submit_and_wait};
+use shadowgraph::graph;
 
 fn main() {
     if let Err(e) = run() {
@@ -156,7 +155,7 @@ fn time_case(
     let plan = graph::plan(&built.graph, &outputs).map_err(|e| e.to_string())?;
     exec.prepare(&gpu.device, &plan)
         .map_err(|e| e.to_string())?;
-    let imports = imports(gpu, &plan);
+    let imports = random_imports(&gpu.device, &gpu.queue, &plan).map_err(|e| e.to_string())?;
     let mut out = None;
     let ms = time_runs(gpu, repeat, |enc| {
         let o = exec
@@ -180,7 +179,7 @@ fn time_passes(
     let built = (case.build)(n);
     let outputs: Vec<&str> = built.outputs.iter().map(String::as_str).collect();
     let plan = graph::plan(&built.graph, &outputs).map_err(|e| e.to_string())?;
-    let imports = imports(gpu, &plan);
+    let imports = random_imports(&gpu.device, &gpu.queue, &plan).map_err(|e| e.to_string())?;
     let mut before = 0.0;
     let mut out = Vec::new();
     for k in 1..=plan.steps.len() {
@@ -194,40 +193,6 @@ fn time_passes(
         before = ms;
     }
     Ok(out)
-}
-
-/// Random values in (0, 1] for every imported texture of `plan` (32-bit float formats).
-fn imports(gpu: &Gpu, plan: &Plan) -> HashMap<String, wgpu::Texture> {
-    let mut map = HashMap::new();
-    let mut state = 0x5EEDu64;
-    for r in plan.resources.iter().filter(|r| r.slot.is_none()) {
-        let t = gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: None,
-            size: wgpu::Extent3d {
-                width: r.width,
-                height: r.height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: r.resource.format,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
-        let count = (texel_bytes(r.resource.format) / 4) as usize * (r.width * r.height) as usize;
-        let values: Vec<f32> = (0..count)
-            .map(|_| {
-                state = state
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                ((state >> 40) as f32 + 1.0) / (1u64 << 24) as f32
-            })
-            .collect();
-        write_texture(&gpu.queue, &t, bytemuck::cast_slice(&values));
-        map.insert(r.resource.name.clone(), t);
-    }
-    map
 }
 
 /// Wall time of a compute kernel copying `src` into a texture of the same format and size.

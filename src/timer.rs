@@ -3,7 +3,8 @@
 //! Each timed span (a pass, a graph node, a group of passes) begins at a *mark* and ends at the
 //! next one: consecutive spans share their boundary, so their sum is the time from the first
 //! mark to the last. A mark is two timestamp writes on the encoder, between passes: the first
-//! is the boundary, the second is written only to make it true on software drivers.
+//! is the boundary, the second is written only to make it true on software drivers, which also
+//! wait for the first's stamp (below).
 //!
 //! Why two: Mesa's lavapipe (llvmpipe) does not stamp a timestamp when the command buffer
 //! reaches it. `vkCmdWriteTimestamp` (at any stage but the top of the pipe) flushes the
@@ -14,9 +15,19 @@
 //! flush, *after* the dispatch, unless a barrier happened to flush in between; a pass's own
 //! begin/end pair read the gap between two flushes, near zero for every compute pass after the
 //! first (a blur of 40–270 ms per frame read 0.1 ms). The second write of a mark is such a
-//! flush: it stamps the first at the boundary, before any later work starts. On a GPU it is one
+//! flush: it hands the first to the rasterizer threads at the boundary. On a GPU it is one
 //! more query write between passes (nanoseconds), and it is the same code path that the
 //! lavapipe test checks (`tests/timing.rs`).
+//!
+//! Handing it over is not stamping it: the rasterizer threads run asynchronously and compete
+//! for the cores with the compute threads of the dispatch that follows, so on a CPU driver a
+//! boundary could still be stamped after most of the next pass (a 3.5 ms copy read 0.1 ms in
+//! 8 of its 12 runs, each run's wall clock 3.4–3.8 ms; `tests/timing.rs` checks the bench
+//! run by run against the wall clock). So on a CPU device (an adapter of
+//! [`wgpu::DeviceType::Cpu`]) each mark also resolves its boundary query into a scratch buffer:
+//! lavapipe copies a query result with Vulkan's wait flag, which waits for the scene holding
+//! the timestamp, so the next pass starts only after its boundary is stamped. A GPU writes its
+//! timestamps in order and skips that copy, which would add a small command to every span.
 //!
 //! Writing on the encoder needs `TIMESTAMP_QUERY_INSIDE_ENCODERS` (Vulkan, DX12 and Metal on
 //! Apple GPUs offer it); a device without it cannot time. Timestamps inside a pass's descriptor
@@ -81,6 +92,9 @@ pub struct GpuTimer {
     /// The span begun by the last mark, if any: label and its first mark.
     open: Option<(String, u32)>,
     period_ns: f64,
+    /// On a CPU device: where each mark resolves its boundary, to wait for its stamp (see the
+    /// module's documentation).
+    wait_marks: Option<wgpu::Buffer>,
 }
 
 impl GpuTimer {
@@ -134,6 +148,17 @@ impl GpuTimer {
             spans: Vec::new(),
             open: None,
             period_ns: f64::from(queue.get_timestamp_period()),
+            wait_marks: (device.adapter_info().device_type == wgpu::DeviceType::Cpu).then(|| {
+                created::buffer(
+                    device,
+                    &wgpu::BufferDescriptor {
+                        label: Some("shadowgraph.timer.wait"),
+                        size: 8,
+                        usage: wgpu::BufferUsages::QUERY_RESOLVE,
+                        mapped_at_creation: false,
+                    },
+                )
+            }),
         })
     }
     /// The number of spans this timer can hold per frame.
@@ -149,7 +174,8 @@ impl GpuTimer {
     }
 
     /// Writes a mark: two timestamps, the first the boundary, the second the write that makes
-    /// lavapipe stamp the first now (see the module's documentation). `None` when full.
+    /// lavapipe hand the first to its rasterizer now, and on a CPU device the resolve that
+    /// waits for the first's stamp (see the module's documentation). `None` when full.
     fn mark(&mut self, encoder: &mut wgpu::CommandEncoder) -> Option<u32> {
         if self.marks >= self.capacity {
             return None;
@@ -157,6 +183,9 @@ impl GpuTimer {
         let m = self.marks;
         encoder.write_timestamp(&self.query_set, 2 * m);
         encoder.write_timestamp(&self.query_set, 2 * m + 1);
+        if let Some(wait) = &self.wait_marks {
+            encoder.resolve_query_set(&self.query_set, 2 * m..2 * m + 1, wait, 0);
+        }
         self.marks += 1;
         Some(m)
     }

@@ -5,7 +5,7 @@
 use std::sync::Arc;
 
 use super::BenchGraph;
-use super::harness::{median_time, random_depths, timer};
+use super::harness::{Timed, median_time, random_depths, timer};
 use crate::error::{Error, Result};
 use crate::exec::{ComputeKernel, GpuTimer, KernelCache, wgsl_storage_format};
 use crate::gpu::scoped;
@@ -43,7 +43,7 @@ pub fn format_name(format: wgpu::TextureFormat) -> String {
 
 /// A graph of one node copying an imported `n`² texture of `format` into a texture of the same
 /// format (a depth texture into `r32float`): the texture roofline of that format.
-pub(super) fn copy_texture_graph(n: u32, format: wgpu::TextureFormat) -> BenchGraph {
+pub fn copy_texture_graph(n: u32, format: wgpu::TextureFormat) -> BenchGraph {
     let (kernel, out) = match format {
         wgpu::TextureFormat::R32Uint
         | wgpu::TextureFormat::Rg32Uint
@@ -73,15 +73,15 @@ pub(super) fn copy_texture_graph(n: u32, format: wgpu::TextureFormat) -> BenchGr
     }
 }
 
-/// The median time of copying a `buffer_bytes` buffer with `kernels/copy.wgsl` (moving twice
-/// that), ms.
+/// The median times of copying a `buffer_bytes` buffer with `kernels/copy.wgsl` (moving twice
+/// that).
 pub(super) fn time_buffer_copy(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     kernels: &mut KernelCache,
     buffer_bytes: u64,
     repeat: u32,
-) -> Result<f64> {
+) -> Result<Timed> {
     let max_x = device
         .limits()
         .max_compute_workgroups_per_dimension

@@ -2,6 +2,7 @@
 //! [`GpuTimer`] and keeps the median over timed runs.
 
 use std::collections::HashMap;
+use std::time::Instant;
 
 use super::WARMUP;
 use crate::error::{Error, Result};
@@ -25,15 +26,31 @@ pub(super) fn gb_per_s(bytes: f64, ms: f64) -> f64 {
     bytes / (ms * 1e6)
 }
 
-/// Median of the summed span times of `repeat` runs of `record` (after [`WARMUP`] runs), ms.
+/// A run's time by the GPU's timestamps and by the wall clock, ms (medians over runs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Timed {
+    /// The summed span times.
+    pub ms: f64,
+    /// Submission to completion: the cross-check of `ms` (on a CPU device the two agree within
+    /// the submission's fraction of a millisecond; on a GPU the submission can dominate).
+    pub wall_ms: f64,
+    /// The least share of its wall time a timed run's spans read: the timer's check run by run
+    /// (a median can hide a fault that hits some runs). On a CPU device a true timer reads
+    /// near 1; a boundary stamped late reads far below.
+    pub least_share: f64,
+}
+
+/// Medians of the summed span times and of the wall times of `repeat` runs of `record` (after
+/// [`WARMUP`] runs), ms.
 pub(super) fn median_time(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     timer: &mut GpuTimer,
     repeat: u32,
     mut record: impl FnMut(&mut wgpu::CommandEncoder, &mut GpuTimer) -> Result<()>,
-) -> Result<f64> {
+) -> Result<Timed> {
     let mut times = Vec::with_capacity(repeat as usize);
+    let mut walls = Vec::with_capacity(repeat as usize);
     for run in 0..WARMUP + repeat {
         timer.reset();
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -41,7 +58,9 @@ pub(super) fn median_time(
         });
         record(&mut enc, timer)?;
         timer.resolve(&mut enc);
+        let submitted = Instant::now();
         submit_and_wait(device, queue, enc, "bench")?;
+        let wall_ms = submitted.elapsed().as_secs_f64() * 1e3;
         let spans = timer.read(device)?;
         if spans.is_empty() {
             return Err(Error::Gpu {
@@ -51,9 +70,19 @@ pub(super) fn median_time(
         }
         if run >= WARMUP {
             times.push(spans.iter().map(|(_, ms)| ms).sum());
+            walls.push(wall_ms);
         }
     }
-    Ok(median(&mut times))
+    let least_share = times
+        .iter()
+        .zip(&walls)
+        .map(|(t, w)| t / w)
+        .fold(f64::INFINITY, f64::min);
+    Ok(Timed {
+        ms: median(&mut times),
+        wall_ms: median(&mut walls),
+        least_share,
+    })
 }
 
 /// Median (mean of the middle two for an even count); NaN for no values.
@@ -67,8 +96,8 @@ pub(super) fn median(values: &mut [f64]) -> f64 {
     }
 }
 
-/// Plans `graph` for `outputs`, fills its imports and returns the plan and the median time of
-/// recording it, ms.
+/// Plans `graph` for `outputs`, fills its imports and returns the plan and the median times of
+/// running it.
 pub(super) fn time_graph(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
@@ -76,7 +105,7 @@ pub(super) fn time_graph(
     graph: &Graph,
     outputs: &[String],
     repeat: u32,
-) -> Result<(Plan, f64)> {
+) -> Result<(Plan, Timed)> {
     let outputs: Vec<&str> = outputs.iter().map(String::as_str).collect();
     let plan = graph::plan(graph, &outputs)?;
     executor.prepare(device, &plan)?;
@@ -91,7 +120,7 @@ pub(super) fn time_graph(
 
 /// A texture for every import of `plan`, filled with random values: floats in (0, 1], halves
 /// in [⅛, 1), any u32; a depth texture (which the CPU cannot write) is cleared to ½.
-pub(super) fn random_imports(
+pub fn random_imports(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     plan: &Plan,

@@ -22,7 +22,8 @@ use std::fmt::Write;
 
 use glam::Vec3;
 
-pub use self::copy::{COPY, COPY_FORMATS, format_name};
+pub use self::copy::{COPY, COPY_FORMATS, copy_texture_graph, format_name};
+pub use self::harness::{Timed, random_imports};
 use self::harness::{gb_per_s, time_graph};
 pub use self::lookup::{LOOKUP_WIDTHS, LookupRow, format_lookup_table, lookup_cost};
 pub use self::soft::{SOFT_LIGHT_SIZES, SOFT_TECHNIQUES, SoftRow, format_soft_table, soft_cost};
@@ -53,6 +54,13 @@ pub struct BenchRow {
     pub bytes_moved: f64,
     /// Median GPU time per run over the timed runs, milliseconds (all nodes of the run).
     pub median_ms: f64,
+    /// Median wall time per run, submission to completion, milliseconds: the cross-check of
+    /// `median_ms` (on a CPU device the two agree within a fraction of a millisecond; on a GPU
+    /// the submission's tens of microseconds can dominate a short run).
+    pub wall_ms: f64,
+    /// The least share of its wall time one timed run read ([`Timed::least_share`]): the
+    /// timer's check run by run.
+    pub least_share: f64,
     /// Effective bandwidth: `bytes_moved / median time`, GB/s (10⁹ bytes per second).
     pub gbps: f64,
     /// `gbps` over the yardstick's GB/s at the same size.
@@ -461,15 +469,17 @@ pub fn plan_bytes(plan: &Plan) -> Result<f64> {
 }
 
 /// A kernel or texture-copy row from a timed plan.
-fn row(name: &str, format: String, n: u32, plan: &Plan, ms: f64) -> Result<BenchRow> {
+fn row(name: &str, format: String, n: u32, plan: &Plan, t: Timed) -> Result<BenchRow> {
     let bytes = plan_bytes(plan)?;
     Ok(BenchRow {
         kernel: name.to_string(),
         format,
         size: n,
         bytes_moved: bytes,
-        median_ms: ms,
-        gbps: gb_per_s(bytes, ms),
+        median_ms: t.ms,
+        wall_ms: t.wall_ms,
+        least_share: t.least_share,
+        gbps: gb_per_s(bytes, t.ms),
         ratio: f64::NAN,
         yardstick: String::new(),
     })
@@ -516,14 +526,16 @@ pub fn measure(
     let mut rows = Vec::new();
     for &n in sizes {
         let buffer = texels(n) * 16;
-        let ms = copy::time_buffer_copy(device, queue, &mut executor.kernels, buffer, repeat)?;
-        let buffer_gbps = gb_per_s(2.0 * buffer as f64, ms);
+        let t = copy::time_buffer_copy(device, queue, &mut executor.kernels, buffer, repeat)?;
+        let buffer_gbps = gb_per_s(2.0 * buffer as f64, t.ms);
         rows.push(BenchRow {
             kernel: "copy buffer".into(),
             format: "-".into(),
             size: n,
             bytes_moved: 2.0 * buffer as f64,
-            median_ms: ms,
+            median_ms: t.ms,
+            wall_ms: t.wall_ms,
+            least_share: t.least_share,
             gbps: buffer_gbps,
             ratio: 1.0,
             yardstick: String::new(),
@@ -532,7 +544,7 @@ pub fn measure(
             let mut copies = Vec::new();
             for &format in COPY_FORMATS {
                 let built = copy::copy_texture_graph(n, format);
-                let (plan, ms) = time_graph(
+                let (plan, t) = time_graph(
                     device,
                     queue,
                     executor,
@@ -540,7 +552,7 @@ pub fn measure(
                     &built.outputs,
                     repeat,
                 )?;
-                let mut r = row("copy texture", format_name(format), n, &plan, ms)?;
+                let mut r = row("copy texture", format_name(format), n, &plan, t)?;
                 r.ratio = r.gbps / buffer_gbps;
                 r.yardstick = "copy buffer".into();
                 copies.push(r);
@@ -555,7 +567,7 @@ pub fn measure(
         let mut cases_rows = Vec::new();
         for case in &cases {
             let built = (case.build)(n);
-            let (plan, ms) = time_graph(
+            let (plan, t) = time_graph(
                 device,
                 queue,
                 &mut executor,
@@ -570,7 +582,7 @@ pub fn measure(
                 .ok_or_else(|| {
                     Error::Invalid(format!("benchmark `{}` plans no output", case.name))
                 })?;
-            cases_rows.push((format, row(case.name, format_name(format), n, &plan, ms)?));
+            cases_rows.push((format, row(case.name, format_name(format), n, &plan, t)?));
             executor.release_textures();
         }
         // The copies again: each format's row keeps the faster of its two runs.
@@ -617,7 +629,8 @@ pub fn format_table(device: &str, cpu: bool, repeat: u32, rows: &[BenchRow]) -> 
          reads included, as `shadowgraph plan` prints them); GB/s = bytes / time; x = GB/s over\n\
          the yardstick's: for a kernel the texture copy of its output's format (16x16\n\
          workgroups, one load and one store per texel; timed before and after the kernels,\n\
-         the faster run kept), for a texture copy the buffer copy."
+         the faster run kept), for a texture copy the buffer copy. wall ms: the median run's\n\
+         submission to completion, the timestamps' cross-check."
     );
     if cpu {
         let _ = writeln!(
@@ -628,18 +641,19 @@ pub fn format_table(device: &str, cpu: bool, repeat: u32, rows: &[BenchRow]) -> 
     }
     let _ = writeln!(
         s,
-        "{:>6}  {:<18} {:<12} {:>10} {:>10} {:>9} {:>7}  yardstick",
-        "size", "kernel", "format", "MiB moved", "median ms", "GB/s", "x"
+        "{:>6}  {:<18} {:<12} {:>10} {:>10} {:>10} {:>9} {:>7}  yardstick",
+        "size", "kernel", "format", "MiB moved", "median ms", "wall ms", "GB/s", "x"
     );
     for r in rows {
         let _ = writeln!(
             s,
-            "{:>6}  {:<18} {:<12} {:>10.2} {:>10.3} {:>9.2} {:>7.2}  {}",
+            "{:>6}  {:<18} {:<12} {:>10.2} {:>10.3} {:>10.3} {:>9.2} {:>7.2}  {}",
             r.size,
             r.kernel,
             r.format,
             r.bytes_moved / (1024.0 * 1024.0),
             r.median_ms,
+            r.wall_ms,
             r.gbps,
             r.ratio,
             r.yardstick
