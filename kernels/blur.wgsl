@@ -19,18 +19,28 @@
 // `BLUR_COL_PER` in src/filter.rs.
 const COL_PER: u32 = 32u;
 
+// The invocation's outputs along the pass's axis (`vertical`: a constant at each call).
+fn blur_outputs(b: BlurLine, vertical: bool) {
+    for (var k = 0; k < b.count; k++) {
+        let o = out_offset(b, k);
+        var s = weight(0, b.r) * tap(b, o, vertical);
+        for (var i = 1; i <= b.r; i++) {
+            s += weight(i, b.r) * (tap(b, o - i, vertical) + tap(b, o + i, vertical));
+        }
+        put(b, o, s, vertical);
+    }
+}
+
 @compute @workgroup_size(WG_SIZE)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     let b = blur_line(wg.xy, li, true, COL_PER);
     if !blur_active(b) {
         return;
     }
-    for (var k = 0; k < b.count; k++) {
-        let o = out_offset(b, k);
-        var s = weight(0, b.r) * tap(b, o);
-        for (var i = 1; i <= b.r; i++) {
-            s += weight(i, b.r) * (tap(b, o - i) + tap(b, o + i));
-        }
-        put(b, o, s);
+    // The axis tested once, not at every tap (shared/blur_pass's `tap`).
+    if params.axis == 1u {
+        blur_outputs(b, true);
+    } else {
+        blur_outputs(b, false);
     }
 }

@@ -21,20 +21,20 @@ const SPAN: f32 = 80.0;
 const COL_PER: u32 = PER;
 
 // The log-sum-exp of output k's window around its own maximum.
-fn log_sum_at(b: BlurLine, k: i32) -> f32 {
+fn log_sum_at(b: BlurLine, k: i32, vertical: bool) -> f32 {
     var m = -3.0e38;
     for (var i = -b.r; i <= b.r; i++) {
-        m = max(m, tap(b, k + i).x);
+        m = max(m, tap(b, k + i, vertical).x);
     }
     var sum = 0.0;
     for (var i = -b.r; i <= b.r; i++) {
-        sum += weight(i, b.r) * exp(tap(b, k + i).x - m);
+        sum += weight(i, b.r) * exp(tap(b, k + i, vertical).x - m);
     }
     return m + log(sum);
 }
 
-fn put_x(b: BlurLine, k: i32, v: f32) {
-    put(b, k, vec4<f32>(v, 0.0, 0.0, 0.0));
+fn put_x(b: BlurLine, k: i32, v: f32, vertical: bool) {
+    put(b, k, vec4<f32>(v, 0.0, 0.0, 0.0), vertical);
 }
 
 @compute @workgroup_size(WG_SIZE)
@@ -43,22 +43,32 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l
     if !blur_active(b) {
         return;
     }
+    // The axis tested once, not at every tap (shared/blur_pass's `tap`).
+    if params.axis == 1u {
+        blur_log_outputs(b, true);
+    } else {
+        blur_log_outputs(b, false);
+    }
+}
+
+// The invocation's PER outputs along the pass's axis (`vertical`: a constant at each call).
+fn blur_log_outputs(b: BlurLine, vertical: bool) {
     var hi = -3.0e38;
     var lo = 3.0e38;
     for (var t = -b.r; t < i32(PER) + b.r; t++) {
-        let v = tap(b, t).x;
+        let v = tap(b, t, vertical).x;
         hi = max(hi, v);
         lo = min(lo, v);
     }
     if hi - lo > SPAN {
-        put_x(b, 0, log_sum_at(b, 0));
-        put_x(b, 1, log_sum_at(b, 1));
-        put_x(b, 2, log_sum_at(b, 2));
-        put_x(b, 3, log_sum_at(b, 3));
-        put_x(b, 4, log_sum_at(b, 4));
-        put_x(b, 5, log_sum_at(b, 5));
-        put_x(b, 6, log_sum_at(b, 6));
-        put_x(b, 7, log_sum_at(b, 7));
+        put_x(b, 0, log_sum_at(b, 0, vertical), vertical);
+        put_x(b, 1, log_sum_at(b, 1, vertical), vertical);
+        put_x(b, 2, log_sum_at(b, 2, vertical), vertical);
+        put_x(b, 3, log_sum_at(b, 3, vertical), vertical);
+        put_x(b, 4, log_sum_at(b, 4, vertical), vertical);
+        put_x(b, 5, log_sum_at(b, 5, vertical), vertical);
+        put_x(b, 6, log_sum_at(b, 6, vertical), vertical);
+        put_x(b, 7, log_sum_at(b, 7, vertical), vertical);
         return;
     }
     var s0 = 0.0;
@@ -70,7 +80,7 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l
     var s6 = 0.0;
     var s7 = 0.0;
     for (var t = -b.r; t < i32(PER) + b.r; t++) {
-        let v = exp(tap(b, t).x - hi);
+        let v = exp(tap(b, t, vertical).x - hi);
         s0 += weight(t - 0, b.r) * v;
         s1 += weight(t - 1, b.r) * v;
         s2 += weight(t - 2, b.r) * v;
@@ -80,12 +90,12 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l
         s6 += weight(t - 6, b.r) * v;
         s7 += weight(t - 7, b.r) * v;
     }
-    put_x(b, 0, hi + log(s0));
-    put_x(b, 1, hi + log(s1));
-    put_x(b, 2, hi + log(s2));
-    put_x(b, 3, hi + log(s3));
-    put_x(b, 4, hi + log(s4));
-    put_x(b, 5, hi + log(s5));
-    put_x(b, 6, hi + log(s6));
-    put_x(b, 7, hi + log(s7));
+    put_x(b, 0, hi + log(s0), vertical);
+    put_x(b, 1, hi + log(s1), vertical);
+    put_x(b, 2, hi + log(s2), vertical);
+    put_x(b, 3, hi + log(s3), vertical);
+    put_x(b, 4, hi + log(s4), vertical);
+    put_x(b, 5, hi + log(s5), vertical);
+    put_x(b, 6, hi + log(s6), vertical);
+    put_x(b, 7, hi + log(s7), vertical);
 }

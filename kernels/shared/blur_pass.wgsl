@@ -88,22 +88,26 @@ fn weight(d: i32, r: i32) -> f32 {
     return select(0.0, params.weights[i / 4u][i % 4u], abs(d) <= r);
 }
 
-// Texel `first + t` along the line, clamped to the map.
-fn tap(b: BlurLine, t: i32) -> vec4<f32> {
+// Texel `first + t` along the line, clamped to the map. `vertical` is the pass's axis
+// (params.axis == 1), which every kernel passes as a constant: it tests the axis once and
+// calls its loop twice, with `true` and with `false` (see `blur.wgsl`), so that no tap tests
+// the axis at run time. llvmpipe did not hoist that uniform test out of the tap loops: the
+// blur at r = 4 ran 1.6× faster by the wall clock with it gone (2.1× at r = 32).
+fn tap(b: BlurLine, t: i32, vertical: bool) -> vec4<f32> {
     let c = u32(clamp(b.first + t, 0, b.along - 1));
-    if params.axis == 1u {
+    if vertical {
         return textureLoad(src, vec2<u32>(b.line, c), 0);
     }
     return textureLoad(src, vec2<u32>(c, b.line), 0);
 }
 
-// Writes v as output k of the invocation (if inside the map).
-fn put(b: BlurLine, k: i32, v: vec4<f32>) {
+// Writes v as output k of the invocation (if inside the map); `vertical` as for `tap`.
+fn put(b: BlurLine, k: i32, v: vec4<f32>, vertical: bool) {
     let a = b.first + k;
     if a >= b.along {
         return;
     }
-    if params.axis == 1u {
+    if vertical {
         textureStore(dst, vec2<u32>(b.line, u32(a)), v);
     } else {
         textureStore(dst, vec2<u32>(u32(a), b.line), v);
