@@ -20,23 +20,12 @@ pub const U: f64 = 1.0 / (1u64 << 24) as f64;
 
 /// First-order bound on the f32 error of the one-tailed Chebyshev bound
 /// `p = σ² / (σ² + t²)`, `σ² = max(E[x²] − E[x]², floor)`, `t = r − E[x]`, when every input
-/// carries relative error `e`: the cancellation in σ² amplifies it by `E[x²] / σ²`. The floor
-/// carries 2e (EVSM forms it from the squared filtered mean).
-pub fn chebyshev(mean: f64, mean_sq: f64, receiver: f64, floor: f64, e: f64) -> f64 {
-    if receiver <= mean {
-        // p = 1 here; at the boundary p is continuous (σ² / σ²).
-        return 0.0;
-    }
-    let var = (mean_sq - mean * mean).max(floor);
-    let t = receiver - mean;
-    let dvar = e * (mean_sq.abs() + 2.0 * mean * mean) + 2.0 * e * floor;
-    let dt = e * (receiver.abs() + mean.abs());
-    (t * t * dvar + 2.0 * t.abs() * var * dt) / (var + t * t).powi(2)
-}
-
-/// [`chebyshev`] with, besides the relative error `e`, an absolute error `abs` on both means
-/// (a table read with filtered fetches, [`filtered_table_error`]).
-pub fn chebyshev_abs(mean: f64, mean_sq: f64, receiver: f64, floor: f64, e: f64, abs: f64) -> f64 {
+/// carries relative error `e` and both means an absolute error `abs` besides (a table read with
+/// filtered fetches, [`filtered_table_error`]; 0 otherwise): the cancellation in σ² amplifies
+/// the relative error by `E[x²] / σ²`. The floor carries 2e (EVSM forms it from the squared
+/// filtered mean). At most 1, which no visibility's error exceeds.
+pub fn chebyshev(mean: f64, mean_sq: f64, receiver: f64, floor: f64, e: f64, abs: f64) -> f64 {
+    // p = 1 at and below the mean (continuous at the boundary, σ² / σ²).
     if receiver <= mean - abs {
         return 0.0;
     }
@@ -93,7 +82,7 @@ pub fn vsm(maps: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
     let m = crate::cpu::mips::sample(maps, l, s);
     let d = s.depth - f64::from(l.bias);
     let abs = filtered_table_error(l, s);
-    let dp = chebyshev_abs(m[0], m[1], d, f64::from(l.min_variance), 8.0 * U, abs);
+    let dp = chebyshev(m[0], m[1], d, f64::from(l.min_variance), 8.0 * U, abs);
     1e-5 + dp / (1.0 - f64::from(l.bleed))
 }
 
@@ -108,9 +97,9 @@ pub fn evsm(maps: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
         let c = f64::from(c);
         (3.0 + 4.0 * c) * ulp + 8.0 * ulp + 4.0 * c * ulp
     };
-    let mut dp = chebyshev(m[0], m[1], pos, floor_pos, e(l.exp_pos));
+    let mut dp = chebyshev(m[0], m[1], pos, floor_pos, e(l.exp_pos), 0.0);
     if l.moments == 4 {
-        dp = dp.max(chebyshev(m[2], m[3], neg, floor_neg, e(l.exp_neg)));
+        dp = dp.max(chebyshev(m[2], m[3], neg, floor_neg, e(l.exp_neg), 0.0));
     }
     1e-5 + dp / (1.0 - f64::from(l.bleed))
 }

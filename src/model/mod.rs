@@ -350,6 +350,16 @@ impl Technique {
         }
     }
 
+    /// The storage and table of a soft technique, to change them (`None` for the others).
+    pub fn soft_mut(&mut self) -> Option<&mut Soft> {
+        match self {
+            Technique::Cssm { soft, .. }
+            | Technique::Vssm { soft, .. }
+            | Technique::MsmSoft { soft, .. } => Some(soft),
+            _ => None,
+        }
+    }
+
     /// The variant of the summed-area table it reads, if it reads one (the `sat` filter or a
     /// soft technique's table).
     pub fn sat_variant(&self) -> Option<SatVariant> {

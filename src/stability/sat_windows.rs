@@ -58,6 +58,14 @@ impl Map {
         })
     }
 
+    /// The largest `|v − offset|` over the map: the magnitude the table's centred sums grow
+    /// from, which every table model scales its rounding by.
+    fn spread(&self, offset: f64) -> f64 {
+        self.values
+            .iter()
+            .fold(0.0f64, |m, &v| m.max((f64::from(v) - offset).abs()))
+    }
+
     /// Exact sum over `[0, x) × [0, y)` in units.
     fn corner(&self, x: usize, y: usize) -> i64 {
         if x == 0 || y == 0 {
@@ -365,10 +373,7 @@ fn check_fixed(
         }
     };
     let (scale, offset) = (f64::from(coding.scale[0]), f64::from(coding.offset[0]));
-    let spread = map
-        .values
-        .iter()
-        .fold(0.0f64, |m, &v| m.max((f64::from(v) - offset).abs()));
+    let spread = map.spread(offset);
     let bound = 0.5 / scale + U * spread + 1e-12;
     let mut means = Check::new();
     for &w in wins {
@@ -416,10 +421,7 @@ fn check_float(
     let got = &got.texels;
     let n = map.n;
     let offset = f64::from(coding.offset[0]);
-    let max_x = map
-        .values
-        .iter()
-        .fold(0.0f64, |m, &v| m.max((f64::from(v) - offset).abs()));
+    let max_x = map.spread(offset);
     let d = scan_depth(n);
     let node = |x: usize, y: usize| -> f64 {
         if x == 0 || y == 0 {
@@ -461,10 +463,7 @@ fn check_float(
 fn check_filtered(map: &Map, coding: &SatCoding, rects: &[[f32; 4]], got: &[f32]) -> Row {
     let n = map.n;
     let offset = f64::from(coding.offset[0]);
-    let max_x = map
-        .values
-        .iter()
-        .fold(0.0f64, |m, &v| m.max((f64::from(v) - offset).abs()));
+    let max_x = map.spread(offset);
     let d = scan_depth(n);
     let mut means = Check::new();
     if got.len() != rects.len() {

@@ -63,9 +63,8 @@ pub fn assert_within(what: &str, gpu: &[f32], reference: &[f64], tolerance: &[f6
 /// The f32-vs-f64 error models, from the library's one tolerance module
 /// (`shadowgraph::tolerance`), which the numerical-stability suite uses too.
 pub use shadowgraph::tolerance::{
-    chebyshev as chebyshev_tolerance, csm as csm_tolerance, esm as esm_tolerance,
-    esm_sat as esm_sat_tolerance, evsm as evsm_tolerance, msm as msm_tolerance,
-    vsm as vsm_tolerance,
+    csm as csm_tolerance, esm as esm_tolerance, esm_sat as esm_sat_tolerance,
+    evsm as evsm_tolerance, msm as msm_tolerance, vsm as vsm_tolerance,
 };
 
 /// A linear depth map with structure: a background and overlapping random rectangles, so

@@ -251,58 +251,9 @@ pub fn msm_soft(storage: Storage, hausdorff: bool) -> Technique {
 
 /// `t` (a soft technique) with its tables' sums `sums` (f32 ones are read with filtered
 /// fetches).
-pub fn with_sums(t: Technique, sums: SatVariant) -> Technique {
-    match t {
-        Technique::Vssm {
-            mut soft,
-            bleed,
-            min_variance,
-        } => {
-            soft.sums = sums;
-            Technique::Vssm {
-                soft,
-                bleed,
-                min_variance,
-            }
-        }
-        Technique::MsmSoft {
-            mut soft,
-            hausdorff,
-            moment_bias,
-            bleed,
-        } => {
-            soft.sums = sums;
-            Technique::MsmSoft {
-                soft,
-                hausdorff,
-                moment_bias,
-                bleed,
-            }
-        }
-        Technique::Cssm {
-            mut soft,
-            terms,
-            attenuation,
-            offset,
-            scale,
-            sharpen,
-            sharpen_falloff,
-            search,
-        } => {
-            soft.sums = sums;
-            Technique::Cssm {
-                soft,
-                terms,
-                attenuation,
-                offset,
-                scale,
-                sharpen,
-                sharpen_falloff,
-                search,
-            }
-        }
-        other => panic!("not a soft technique: {}", other.name()),
-    }
+pub fn with_sums(mut t: Technique, sums: SatVariant) -> Technique {
+    t.soft_mut().expect("a soft technique").sums = sums;
+    t
 }
 
 /// CSSM with `terms` terms, offset ½/M, scale 2, the given sharpening and blocker search.
