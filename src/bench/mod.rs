@@ -659,8 +659,38 @@ pub fn format_table(device: &str, cpu: bool, repeat: u32, rows: &[BenchRow]) -> 
             r.yardstick
         );
     }
+    if cpu {
+        let suspect: Vec<String> = rows
+            .iter()
+            .filter(|r| r.least_share < CPU_LEAST_SHARE && r.wall_ms >= CPU_CHECKED_MS)
+            .map(|r| {
+                format!(
+                    "{} {} at {}² ({:.2})",
+                    r.kernel, r.format, r.size, r.least_share
+                )
+            })
+            .collect();
+        if !suspect.is_empty() {
+            let _ = writeln!(
+                s,
+                "WARNING: measure again, a run read under {CPU_LEAST_SHARE} of its wall time (a \
+                 CPU device's true timer never does: another load on the cores, or a timer \
+                 fault): {}",
+                suspect.join("; ")
+            );
+        }
+    }
     s
 }
+
+/// On a CPU device a run's spans read at least this share of its wall time (the submission
+/// adds 0.1–0.5 ms; runs of 3–15 ms read 0.85 and more on idle cores): a row with a run below
+/// it is flagged by [`format_table`] if its runs take [`CPU_CHECKED_MS`] or more.
+pub const CPU_LEAST_SHARE: f64 = 0.5;
+
+/// Runs shorter than this by the wall clock are mostly submission on a CPU device (a 256² copy:
+/// 0.3 ms of 0.43), so the wall clock cannot check them.
+pub const CPU_CHECKED_MS: f64 = 2.0;
 
 /// A `--map` size the device can make: past its largest texture side it is an error naming
 /// the flag (the scene's own `shadow_map` line would name a key the user did not write).
@@ -801,6 +831,42 @@ mod tests {
         }
         let text = format_table("test device", true, 2, &rows);
         assert!(text.contains("only the ratios") && text.contains("copy texture rg32float"));
+    }
+
+    /// On a CPU device a row with a run under [`CPU_LEAST_SHARE`] of its wall time is named
+    /// in a warning after the table, unless its runs are too short to check; on a GPU (wall
+    /// time mostly submission) it is not.
+    #[test]
+    fn rows_with_a_short_run_are_flagged_on_a_cpu_device() {
+        let row = |kernel: &str, least_share: f64| BenchRow {
+            kernel: kernel.into(),
+            format: "r32float".into(),
+            size: 1024,
+            bytes_moved: 8.0 * 1024.0 * 1024.0,
+            median_ms: 3.3,
+            wall_ms: 3.5,
+            least_share,
+            gbps: 2.5,
+            ratio: 1.0,
+            yardstick: "copy buffer".into(),
+        };
+        let rows = [row("copy texture", 0.03), row("esm", 0.93)];
+        let text = format_table("test device", true, 5, &rows);
+        let warning = text
+            .lines()
+            .find(|l| l.starts_with("WARNING"))
+            .expect("a warning");
+        assert!(
+            warning.contains("copy texture r32float at 1024² (0.03)"),
+            "{warning}"
+        );
+        assert!(!warning.contains("esm"), "{warning}");
+        let fine = format_table("test device", true, 5, &rows[1..]);
+        assert!(!fine.contains("WARNING"), "{fine}");
+        let mut short = row("copy texture", 0.3);
+        short.wall_ms = 0.4;
+        assert!(!format_table("test device", true, 5, &[short]).contains("WARNING"));
+        assert!(!format_table("test device", false, 5, &rows).contains("WARNING"));
     }
 
     /// The bytes of a SAT are its three passes' (two reads of the representation, one write
