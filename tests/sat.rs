@@ -13,16 +13,16 @@ use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 use rand::Rng;
 use shadowgraph::cpu::{Texels, sat as reference};
-use shadowgraph::exec::{ComputeKernel, Executor};
-use shadowgraph::gpu::{Gpu, read_buffer, read_texture, submit_and_wait, write_texture};
+use shadowgraph::exec::Executor;
+use shadowgraph::gpu::{Gpu, read_texture, submit_and_wait, write_texture};
 use shadowgraph::graph::{Graph, plan, texel_bytes};
 use shadowgraph::kernels;
 use shadowgraph::sat::five_pass::{SAT_BLOCK, SAT_CARRY_LINES, add_sat_five_pass};
+use shadowgraph::sat::probe::{Lookup, probe_means};
 use shadowgraph::sat::{
     SAT_LINES_PER_GROUP, SAT_TILE, SatCoding, SatParams, SatVariant, add_sat, float_sum_depth,
     format_channels, lookup_area,
 };
-use wgpu::util::DeviceExt;
 
 /// f32's unit roundoff (round to nearest; Vulkan's f32 add, sub and mul are correctly rounded).
 const U: f64 = 1.0 / (1u64 << 24) as f64;
@@ -481,98 +481,14 @@ fn constant_depth_0_999_map() {
     check_float("float constant", &mut rng, &map, &float, &table);
 }
 
-/// `shared/sat`'s lookups run by a test kernel: one rectangle per invocation.
-fn probe_wgsl(variant: SatVariant) -> String {
-    let (ty, f) = match variant {
-        SatVariant::Fixed => ("u32", "sat_mean_fixed"),
-        SatVariant::Float => ("f32", "sat_mean_float"),
-    };
-    let module = kernels::resolve("shared/sat", None).unwrap();
-    format!(
-        "{module}
-struct Coding {{ offset: vec4<f32>, scale: vec4<f32> }}
-@group(0) @binding(0) var table: texture_2d<{ty}>;
-@group(0) @binding(1) var<storage, read> rects: array<vec4<f32>>;
-@group(0) @binding(2) var<storage, read_write> means: array<vec4<f32>>;
-@group(0) @binding(3) var<uniform> coding: Coding;
-@compute @workgroup_size(64)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
-    if id.x < arrayLength(&rects) {{
-        means[id.x] = {f}(table, rects[id.x], coding.offset, coding.scale);
-    }}
-}}
-"
-    )
-}
-
-/// Means over `rects` looked up on the GPU from `table`.
+/// Means over `rects` looked up on the GPU from `table` (`shared/sat`'s exact lookup of the
+/// table's variant, by the library's probe kernel: one rectangle per invocation).
 fn probe(g: &Gpu, table: &wgpu::Texture, coding: &SatCoding, rects: &[[f32; 4]]) -> Vec<[f32; 4]> {
-    let d = &g.device;
-    let k = ComputeKernel::new(d, "sat_probe", &probe_wgsl(coding.variant)).expect("probe kernel");
-    let init = |label, contents: &[u8], usage| {
-        d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(label),
-            contents,
-            usage,
-        })
+    let lookup = match coding.variant {
+        SatVariant::Fixed => Lookup::Fixed,
+        SatVariant::Float => Lookup::Float,
     };
-    let rects_buf = init(
-        "rects",
-        bytemuck::cast_slice(rects),
-        wgpu::BufferUsages::STORAGE,
-    );
-    let bytes = (rects.len() * 16) as u64;
-    let means = d.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("means"),
-        size: bytes,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let readback = d.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("means.readback"),
-        size: bytes,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
-    let uniform: [[f32; 4]; 2] = [coding.offset, coding.scale];
-    let coding_buf = init(
-        "coding",
-        bytemuck::bytes_of(&uniform),
-        wgpu::BufferUsages::UNIFORM,
-    );
-    let view = table.create_view(&Default::default());
-    let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("sat_probe"),
-        layout: &k.layouts[0],
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(&view),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: rects_buf.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: means.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 3,
-                resource: coding_buf.as_entire_binding(),
-            },
-        ],
-    });
-    let mut enc = d.create_command_encoder(&Default::default());
-    {
-        let mut pass = enc.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&k.pipeline);
-        pass.set_bind_group(0, &bind, &[]);
-        pass.dispatch_workgroups((rects.len() as u32).div_ceil(64), 1, 1);
-    }
-    enc.copy_buffer_to_buffer(&means, 0, &readback, 0, bytes);
-    submit_and_wait(d, &g.queue, enc, "sat_probe").expect("probe");
-    bytemuck::cast_slice(&read_buffer(d, &readback).expect("readback")).to_vec()
+    probe_means(g, table, lookup, coding, rects).expect("probe")
 }
 
 /// Random rectangles up to `max` texels a side, some reversed, partly or wholly outside the

@@ -40,6 +40,7 @@
 
 pub mod five_pass;
 pub mod layers;
+pub mod probe;
 
 use crate::error::{Error, Result};
 use crate::graph::{Dispatch, Graph, Node, SizeRule};

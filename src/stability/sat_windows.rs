@@ -23,6 +23,7 @@ use crate::error::{Error, Result};
 use crate::exec::Executor;
 use crate::gpu::Gpu;
 use crate::graph::Graph;
+use crate::sat::probe::{Lookup, probe_means};
 use crate::sat::{SatCoding, SatVariant, add_sat, float_sum_depth, lookup_area};
 
 /// Units of the maps' values: every texel is an integer multiple of 2⁻²⁴.
@@ -203,7 +204,10 @@ fn gpu_table(
     let table = &ran.outputs.textures[&out];
     let texels = read_texels(gpu, table, coords)?;
     let filtered = if coding.variant == SatVariant::Float {
-        filtered_means(gpu, table, coding.offset[0], rects)?
+        probe_means(gpu, table, Lookup::Linear, coding, rects)?
+            .iter()
+            .map(|m| m[0])
+            .collect()
     } else {
         Vec::new()
     };
@@ -215,99 +219,6 @@ fn gpu_table(
         texels: coords.iter().copied().zip(texels).collect(),
         filtered,
     })
-}
-
-/// The probe of the filtered lookups: one invocation per rectangle, `sat_mean_linear` of the
-/// shading side (the soft techniques' and the `sat` filter's lookup of f32 tables).
-const FILTERED_PROBE: &str = "\
-// #import shared/sat
-@group(0) @binding(0) var table: texture_2d<f32>;
-@group(0) @binding(1) var smp: sampler;
-@group(0) @binding(2) var<storage, read> rects: array<vec4<f32>>;
-@group(0) @binding(3) var<storage, read_write> means: array<f32>;
-@group(0) @binding(4) var<uniform> offset: vec4<f32>;
-@compute @workgroup_size(64)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    if id.x >= arrayLength(&rects) {
-        return;
-    }
-    means[id.x] = sat_mean_linear(table, smp, rects[id.x], offset, vec4<f32>(1.0)).x;
-}
-";
-
-/// Means of `sat_mean_linear` over `rects` (texel units) from the f32 `table`.
-fn filtered_means(
-    gpu: &Gpu,
-    table: &wgpu::Texture,
-    offset: f32,
-    rects: &[[f32; 4]],
-) -> Result<Vec<f32>> {
-    use wgpu::util::DeviceExt;
-    let d = &gpu.device;
-    let wgsl = crate::kernels::resolve_source("stability_filtered", FILTERED_PROBE)?;
-    let kernel = crate::exec::ComputeKernel::new(d, "stability_filtered", &wgsl)?;
-    let rect_buf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("stability.rects"),
-        contents: bytemuck::cast_slice(rects),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
-    let offset_buf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("stability.offset"),
-        contents: bytemuck::cast_slice(&[offset, 0.0, 0.0, 0.0]),
-        usage: wgpu::BufferUsages::UNIFORM,
-    });
-    let size = (rects.len() * 4) as u64;
-    let means = d.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("stability.means"),
-        size,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let readback = d.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("stability.means.read"),
-        size,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
-    let sampler = d.create_sampler(&crate::prefilter::SAT_SAMPLER_DESCRIPTOR);
-    let view = table.create_view(&Default::default());
-    let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("stability.filtered"),
-        layout: &kernel.layouts[0],
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(&view),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: wgpu::BindingResource::Sampler(&sampler),
-            },
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: rect_buf.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 3,
-                resource: means.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 4,
-                resource: offset_buf.as_entire_binding(),
-            },
-        ],
-    });
-    let mut enc = d.create_command_encoder(&Default::default());
-    {
-        let mut pass = enc.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&kernel.pipeline);
-        pass.set_bind_group(0, &group, &[]);
-        pass.dispatch_workgroups((rects.len() as u32).div_ceil(64), 1, 1);
-    }
-    enc.copy_buffer_to_buffer(&means, 0, &readback, 0, size);
-    crate::gpu::submit_and_wait(d, &gpu.queue, enc, "stability filtered lookups")?;
-    let raw = crate::gpu::read_buffer(d, &readback)?;
-    Ok(bytemuck::cast_slice(&raw).to_vec())
 }
 
 /// Fractional rectangles from `windows`: each edge moved by a whole number of 2⁻⁸-texel steps
