@@ -79,16 +79,35 @@ fn blur_log_outputs(b: BlurLine, vertical: bool) {
     var s5 = 0.0;
     var s6 = 0.0;
     var s7 = 0.0;
-    for (var t = -b.r; t < i32(PER) + b.r; t++) {
+    // wk = weight(t − k): tap t + 1's weights are tap t's moved one output on, so each tap
+    // looks up one weight instead of eight.
+    let t0 = -b.r;
+    var w0 = weight(t0, b.r);
+    var w1 = weight(t0 - 1, b.r);
+    var w2 = weight(t0 - 2, b.r);
+    var w3 = weight(t0 - 3, b.r);
+    var w4 = weight(t0 - 4, b.r);
+    var w5 = weight(t0 - 5, b.r);
+    var w6 = weight(t0 - 6, b.r);
+    var w7 = weight(t0 - 7, b.r);
+    for (var t = t0; t < i32(PER) + b.r; t++) {
         let v = exp(tap(b, t, vertical).x - hi);
-        s0 += weight(t - 0, b.r) * v;
-        s1 += weight(t - 1, b.r) * v;
-        s2 += weight(t - 2, b.r) * v;
-        s3 += weight(t - 3, b.r) * v;
-        s4 += weight(t - 4, b.r) * v;
-        s5 += weight(t - 5, b.r) * v;
-        s6 += weight(t - 6, b.r) * v;
-        s7 += weight(t - 7, b.r) * v;
+        s0 += w0 * v;
+        s1 += w1 * v;
+        s2 += w2 * v;
+        s3 += w3 * v;
+        s4 += w4 * v;
+        s5 += w5 * v;
+        s6 += w6 * v;
+        s7 += w7 * v;
+        w7 = w6;
+        w6 = w5;
+        w5 = w4;
+        w4 = w3;
+        w3 = w2;
+        w2 = w1;
+        w1 = w0;
+        w0 = weight(t + 1, b.r);
     }
     put_x(b, 0, hi + log(s0), vertical);
     put_x(b, 1, hi + log(s1), vertical);
