@@ -146,24 +146,9 @@ impl<'a> From<&'a wgpu::Texture> for DepthLayer<'a> {
     }
 }
 
-/// The sampler a host binds after the maps where [`Prefilter::needs_filtering_sampler`]: an
-/// f32 summed-area table's corners are read with bilinear-filtered fetches (linear filtering,
-/// clamped to the edge, level 0; `kernels/shared/sat.wgsl`, `sat_mean_linear`). The renderer
-/// binds the same one.
-pub const SAT_SAMPLER_DESCRIPTOR: wgpu::SamplerDescriptor<'static> = wgpu::SamplerDescriptor {
-    label: Some("shadowgraph.sat_sampler"),
-    address_mode_u: wgpu::AddressMode::ClampToEdge,
-    address_mode_v: wgpu::AddressMode::ClampToEdge,
-    address_mode_w: wgpu::AddressMode::ClampToEdge,
-    mag_filter: wgpu::FilterMode::Linear,
-    min_filter: wgpu::FilterMode::Linear,
-    mipmap_filter: wgpu::MipmapFilterMode::Nearest,
-    lod_min_clamp: 0.0,
-    lod_max_clamp: 32.0,
-    compare: None,
-    anisotropy_clamp: 1,
-    border_color: None,
-};
+/// The sampler a host binds after the maps where [`Prefilter::needs_filtering_sampler`]
+/// (defined beside the tables it reads, [`crate::sat::SAT_SAMPLER_DESCRIPTOR`]).
+pub use crate::sat::SAT_SAMPLER_DESCRIPTOR;
 
 /// Lights one stage serves at most ([`Prefilter::record_light`]'s `slot`).
 pub const MAX_LIGHTS: usize = 256;

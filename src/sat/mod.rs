@@ -59,6 +59,26 @@ pub const MAX_FIXED_AREA: u64 = (1 << 31) - 1;
 
 pub use crate::model::SatVariant;
 
+/// The sampler of f32 summed-area tables read with bilinear-filtered fetches (linear
+/// filtering, clamped to the edge, level 0; `kernels/shared/sat.wgsl`, `sat_mean_linear`): a
+/// plug-in host binds it after the maps where `Prefilter::needs_filtering_sampler` says so (the
+/// plug-in re-exports it as `prefilter::SAT_SAMPLER_DESCRIPTOR`); the renderer and the probe
+/// ([`probe`]) bind the same one.
+pub const SAT_SAMPLER_DESCRIPTOR: wgpu::SamplerDescriptor<'static> = wgpu::SamplerDescriptor {
+    label: Some("shadowgraph.sat_sampler"),
+    address_mode_u: wgpu::AddressMode::ClampToEdge,
+    address_mode_v: wgpu::AddressMode::ClampToEdge,
+    address_mode_w: wgpu::AddressMode::ClampToEdge,
+    mag_filter: wgpu::FilterMode::Linear,
+    min_filter: wgpu::FilterMode::Linear,
+    mipmap_filter: wgpu::MipmapFilterMode::Nearest,
+    lod_min_clamp: 0.0,
+    lod_max_clamp: 32.0,
+    compare: None,
+    anisotropy_clamp: 1,
+    border_color: None,
+};
+
 /// The kernels of a table's first and last pass in `variant` (one per variant, so the
 /// variant's arithmetic is a constant in them).
 fn tile_kernels(variant: SatVariant) -> [KernelId; 2] {

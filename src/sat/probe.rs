@@ -17,7 +17,7 @@ pub enum Lookup {
     /// `sat_mean_float`: the same from an f32 table.
     Float,
     /// `sat_mean_linear`: four bilinear-filtered fetches of an f32 table (corners on the
-    /// 2⁻⁸-texel grid), through [`crate::prefilter::SAT_SAMPLER_DESCRIPTOR`].
+    /// 2⁻⁸-texel grid), through [`super::SAT_SAMPLER_DESCRIPTOR`].
     Linear,
 }
 
@@ -103,7 +103,7 @@ pub fn probe_means(
         mapped_at_creation: false,
     });
     let view = table.create_view(&Default::default());
-    let sampler = d.create_sampler(&crate::prefilter::SAT_SAMPLER_DESCRIPTOR);
+    let sampler = d.create_sampler(&super::SAT_SAMPLER_DESCRIPTOR);
     let mut entries = vec![
         wgpu::BindGroupEntry {
             binding: 0,
