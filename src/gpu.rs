@@ -284,6 +284,27 @@ pub fn submit_and_wait(
     take_uncaptured(device)
 }
 
+/// Records a copy of `buffer` (which needs `COPY_SRC`) into a staging buffer at the end of
+/// `encoder`, submits it as [`submit_and_wait`] does and returns the buffer's bytes: the
+/// one-off readback of a probe or test kernel's storage output.
+pub fn submit_and_read(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    mut encoder: wgpu::CommandEncoder,
+    buffer: &wgpu::Buffer,
+    stage: &str,
+) -> Result<Vec<u8>> {
+    let staging = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("shadowgraph.readback"),
+        size: buffer.size(),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
+    submit_and_wait(device, queue, encoder, stage)?;
+    read_buffer(device, &staging)
+}
+
 /// Reads a whole buffer back (it must have `MAP_READ`); waits for the device.
 pub fn read_buffer(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
     let (tx, rx) = std::sync::mpsc::channel();

@@ -460,12 +460,6 @@ fn storage_rounding_matches_f64() {
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         mapped_at_creation: false,
     });
-    let readback = d.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("test.storage_round.readback"),
-        size,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
     let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("test.storage_round"),
         layout: &kernel.layouts[0],
@@ -487,9 +481,8 @@ fn storage_rounding_matches_f64() {
         pass.set_bind_group(0, &bg, &[]);
         pass.dispatch_workgroups(((xs.len() / 4) as u32).div_ceil(64), 1, 1);
     }
-    enc.copy_buffer_to_buffer(&out, 0, &readback, 0, size);
-    shadowgraph::gpu::submit_and_wait(d, &g.queue, enc, "storage_round").expect("submit");
-    let raw = shadowgraph::gpu::read_buffer(d, &readback).expect("readback");
+    let raw = shadowgraph::gpu::submit_and_read(d, &g.queue, enc, &out, "storage_round")
+        .expect("readback");
     let got: &[f32] = bytemuck::cast_slice(&raw);
     let (mut f16_bad, mut unorm_bad) = (Vec::new(), Vec::new());
     for (i, &x) in xs.iter().enumerate() {

@@ -72,12 +72,6 @@ fn run(g: &shadowgraph::gpu::Gpu, body: &str, sampler: bool, queries: &[[u32; 4]
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         mapped_at_creation: false,
     });
-    let readback = d.create_buffer(&wgpu::BufferDescriptor {
-        label: None,
-        size: queries.len() as u64 * 4,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
     let smp = d.create_sampler(&Default::default());
     let mut entries = vec![
         wgpu::BindGroupEntry {
@@ -111,9 +105,9 @@ fn run(g: &shadowgraph::gpu::Gpu, body: &str, sampler: bool, queries: &[[u32; 4]
         pass.set_bind_group(0, &bg, &[]);
         pass.dispatch_workgroups(queries.len() as u32 / 64, 1, 1);
     }
-    enc.copy_buffer_to_buffer(&out, 0, &readback, 0, out.size());
-    shadowgraph::gpu::submit_and_wait(d, &g.queue, enc, "divergence").expect("submit");
-    bytemuck::cast_slice(&shadowgraph::gpu::read_buffer(d, &readback).expect("read")).to_vec()
+    let raw =
+        shadowgraph::gpu::submit_and_read(d, &g.queue, enc, &out, "divergence").expect("read");
+    bytemuck::cast_slice(&raw).to_vec()
 }
 
 fn queries(active: f64, level: Option<u32>, count: u32) -> Vec<[u32; 4]> {

@@ -7,7 +7,7 @@ use wgpu::util::DeviceExt;
 use super::SatCoding;
 use crate::error::Result;
 use crate::exec::ComputeKernel;
-use crate::gpu::{Gpu, read_buffer, submit_and_wait};
+use crate::gpu::{Gpu, submit_and_read};
 
 /// Which of `shared/sat`'s lookups the probe runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -96,12 +96,6 @@ pub fn probe_means(
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         mapped_at_creation: false,
     });
-    let readback = d.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("sat_probe.readback"),
-        size: bytes,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
     let view = table.create_view(&Default::default());
     let sampler = d.create_sampler(&super::SAT_SAMPLER_DESCRIPTOR);
     let mut entries = vec![
@@ -140,9 +134,7 @@ pub fn probe_means(
         pass.set_bind_group(0, &group, &[]);
         pass.dispatch_workgroups((rects.len() as u32).div_ceil(64), 1, 1);
     }
-    enc.copy_buffer_to_buffer(&means, 0, &readback, 0, bytes);
-    submit_and_wait(d, &gpu.queue, enc, name)?;
-    let raw = read_buffer(d, &readback)?;
+    let raw = submit_and_read(d, &gpu.queue, enc, &means, name)?;
     let all: &[[f32; 4]] = bytemuck::cast_slice(&raw);
     Ok(all[..rects.len()].to_vec())
 }
