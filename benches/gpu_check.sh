@@ -1,15 +1,15 @@
 #!/bin/bash
 # The device checks to run first when a GPU is lent: the figures issues 14 (soft shading,
 # table build) and 15 (kernels against a texture copy) are measured by, in one call of about
-# four minutes on an H100. From the repository root, after `cargo build --release`:
+# five minutes (H200: 67 + 6 + 2 × 93 s, seven files in OUT). From the repository root, after `cargo build --release`:
 #
 #   benches/gpu_check.sh [BINARY] [OUT]     # defaults: target/release/shadowgraph, gpu-out
 #
 # A second binary to compare against goes in as BASE=path/to/other/shadowgraph: its kernel
 # rows are then timed alternately with BINARY's on the same warm machine (compare timings
-# only within one call: the same card's figures moved up to 4× between calls at 4096²). The
-# pending comparison: a build of d728e7b, before the blur passes tested their axis once
-# (abbe986; 1.5–2.1× faster on lavapipe, not yet timed on a GPU).
+# only within one call: the same card's figures moved up to 4× between calls at 4096²). On an
+# H200 (2026-11-26) the soft table took 67 s, the 2048² kernels 6 s and each large round 93 s
+# per binary: with BASE, give the call 420 s or more.
 # Each step writes its own file in OUT and prints its wall time, so a call stopped by its time
 # box still returns what ran. Record the results in benches/RESULTS.md (device, date, commit,
 # command, table).
@@ -37,6 +37,8 @@ step info.txt "$B" info
 # Issue 14: the soft techniques' shading against PCSS 16 + 32 at 1920×1080 with a 2048² map,
 # each configuration's prefilter, and each frame's passes against its wall time.
 step soft.txt "$B" bench --lookup 3 --repeat 20 --image 1920x1080 --map 2048
+# The timer against the wall clock on a bundled scene.
+step wall.txt "$B" render scenes/bunny.toml --timings --repeat 20 -o "$OUT/bunny.png"
 # Issue 15: every kernel at 2048² (figures there repeat within 1%), then the chains the
 # targets name at 4096² and 8192², twice (their two-channel figures moved between runs).
 step kernels_2048.txt "$B" bench --sizes 2048 --repeat 20
@@ -48,8 +50,6 @@ for round in 1 2; do
     echo "## $B, round $round" >>"$OUT/kernels_large.txt"
     step kernels_large.txt "$B" bench --sizes 4096,8192 --repeat 20 --only chain,blur,mips,sat
 done
-# The timer against the wall clock on a bundled scene.
-step wall.txt "$B" render scenes/bunny.toml --timings --repeat 20 -o "$OUT/bunny.png"
 command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=clocks.sm --format=csv \
     >>"$OUT/clocks.txt" 2>&1
 exit 0
