@@ -22,6 +22,10 @@ struct Params {
 // #traffic stats: none
 
 const CHANNELS: u32 = 4u;
+// The tile its workgroup memory allows (shared/encode_blur). Keep in sync with
+// `encode_blur_tile` in src/filter/encode_blur.rs.
+const TILE: u32 = 16u;
+const SH_TEXELS: u32 = 1024u;
 alias Texel = vec4<f32>;
 
 fn texel_of(v: vec4<f32>) -> Texel {

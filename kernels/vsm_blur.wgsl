@@ -18,6 +18,10 @@ struct Params {
 // #traffic stats: none
 
 const CHANNELS: u32 = 2u;
+// The tile its workgroup memory allows (shared/encode_blur). Keep in sync with
+// `encode_blur_tile` in src/filter/encode_blur.rs.
+const TILE: u32 = 24u;
+const SH_TEXELS: u32 = 1600u;
 alias Texel = vec2<f32>;
 
 fn texel_of(v: vec4<f32>) -> Texel {

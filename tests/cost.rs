@@ -69,11 +69,17 @@ fn vsm_with_blur_moves_what_the_hand_count_says() {
     assert_traffic(
         "techniques/vsm.toml",
         &[
-            // `vsm_blur` reads the depth32float buffer itself: a 16 × 16 tile with a halo of
-            // r + 1 = 4 texels each side, (16 + 8)² / 256 × 4 B; rg32float out once.
-            ("vsm.blur", 1, 9.0, 8.0),
+            // `vsm_blur` reads the depth32float buffer itself: ⌈512 / 24⌉² = 22² tiles of 24 × 24
+            // outputs, each with a halo of r + 1 = 4 texels each side, (24 + 8)² × 4 B a tile
+            // (the last row and column of tiles cover 8 texels of the map); rg32float out once.
+            (
+                "vsm.blur",
+                1,
+                22.0 * 22.0 * 32.0 * 32.0 * 4.0 / (512.0 * 512.0),
+                8.0,
+            ),
         ],
-        17.0,
+        15.5625,
         // one read of the depth (4 B) + one write of the blurred moments (8 B)
         12.0,
     );
@@ -129,11 +135,11 @@ fn vsm_f16_writes_four_bytes_a_texel() {
     assert_traffic(
         "techniques/vsm_f16.toml",
         &[
-            // The depth tile with its halo of 4 (9 B, as in `vsm.toml`); 4 B out, not the 8 of
-            // rgba16float (before the packing) or rg32float.
-            ("vsm.blur", 1, 9.0, 4.0),
+            // The depth tiles with their halo of 4 (7.5625 B, as in `vsm.toml`); 4 B out, not
+            // the 8 of rgba16float (before the packing) or rg32float.
+            ("vsm.blur", 1, 7.5625, 4.0),
         ],
-        13.0,
+        11.5625,
         // one read of the depth (4 B) + one write of the packed moments (4 B)
         8.0,
     );
@@ -295,8 +301,8 @@ fn plan_prints_traffic_and_fetches() {
     let text = shadowgraph::cli::plan(&scene_path("techniques/vsm.toml"), false).expect("plan");
     for needle in [
         "traffic per texel of the 512² map:",
-        "reads    9.00 B, writes    8.00 B",
-        "total: 1 dispatch, 17.00 B/texel (one read + one write of the result: 12.00 B/texel)",
+        "reads    7.56 B, writes    8.00 B",
+        "total: 1 dispatch, 15.56 B/texel (one read + one write of the result: 12.00 B/texel)",
         "shade: vsm 4 fetches/pixel",
     ] {
         assert!(text.contains(needle), "`{needle}` missing:\n{text}");
@@ -304,8 +310,8 @@ fn plan_prints_traffic_and_fetches() {
     let text = shadowgraph::cli::plan(&scene_path("techniques/vsm_f16.toml"), false).expect("plan");
     for needle in [
         "light0.vsm.blur          R32Uint f16x2    512x512      1.0 MiB",
-        "reads    9.00 B, writes    4.00 B",
-        "total: 1 dispatch, 13.00 B/texel (one read + one write of the result: 8.00 B/texel)",
+        "reads    7.56 B, writes    4.00 B",
+        "total: 1 dispatch, 11.56 B/texel (one read + one write of the result: 8.00 B/texel)",
         "memory: 1.0 MiB in 1 pooled texture(s)",
     ] {
         assert!(text.contains(needle), "`{needle}` missing:\n{text}");
@@ -319,8 +325,14 @@ fn plan_prints_traffic_and_fetches() {
 fn a_point_lights_atlas_is_planned_like_one_map() {
     assert_traffic(
         "techniques/point_vsm.toml",
-        &[("vsm.blur", 1, 9.0, 8.0)],
-        17.0,
+        // 64 × 43 tiles of 24² outputs over the 1536 × 1024 atlas, (24 + 8)² depths each.
+        &[(
+            "vsm.blur",
+            1,
+            64.0 * 43.0 * 32.0 * 32.0 * 4.0 / (1536.0 * 1024.0),
+            8.0,
+        )],
+        64.0 * 43.0 * 32.0 * 32.0 * 4.0 / (1536.0 * 1024.0) + 8.0,
         12.0,
     );
     let plan = plan_lights(&scene("techniques/point_vsm.toml").lights)
@@ -333,7 +345,7 @@ fn a_point_lights_atlas_is_planned_like_one_map() {
         "light 0: point, vsm shadows, six 512² faces, guard band 5 texels (90° cores of 502²)",
         "light0.depth             Depth32Float    1536x1024",
         "traffic per texel of the 1536×1024 map:",
-        "total: 1 dispatch, 17.00 B/texel",
+        "total: 1 dispatch, 15.17 B/texel",
     ] {
         assert!(text.contains(needle), "`{needle}` missing:\n{text}");
     }

@@ -253,8 +253,10 @@ fn csm_writes_basis_maps_from_one_read() {
 /// The encodings fused into the blur (`vsm_blur`, `evsm_blur`, `msm_blur`) against the f64
 /// composition of the independent references, encoding then both blur passes
 /// (`cpu::vsm_blur` and its siblings), on the random perspective depth with non-finite texels:
-/// at radius 3 (one dispatch, a 16 × 16 tile in workgroup memory) and 12 (past the tile's 8:
-/// the encoding fused into the horizontal pass, then `blur`'s vertical pass).
+/// at radius 3 and 7 (one dispatch: a tile of 24² outputs for two channels, 16² for four, in
+/// workgroup memory; at 7, the largest the tile takes, two channels fill six blocks of encoded
+/// texels and four of horizontal sums, and the 67² map leaves ragged tiles) and 12 (past the
+/// tile's 7: the encoding fused into the horizontal pass, then `blur`'s vertical pass).
 #[test]
 fn fused_blurs_match_encode_then_blur() {
     use shadowgraph::scene::BlurKernel;
@@ -313,7 +315,7 @@ fn fused_blurs_match_encode_then_blur() {
             2.0 * (10.0 * LINEAR_RTOL + 13.0 * U),
         ),
     ];
-    for (radius, steps) in [(3u32, 1usize), (12, 1)] {
+    for (radius, steps) in [(3u32, 1usize), (7, 1), (12, 1)] {
         let sigma = f64::from(radius) / 2.0;
         let filter =
             format!("\nfilter = \"blur\"\nfilter_radius = {radius}\nfilter_sigma = {sigma}");

@@ -552,23 +552,43 @@ fn peel_epsilon_matches_the_wgsl() {
 
 #[test]
 fn encode_blur_dispatch_constants_match_the_wgsl() {
-    use shadowgraph::filter::{ENCODE_BLUR_ROW, ENCODE_BLUR_TILE, ENCODE_BLUR_TILE_RADIUS};
-    for kernel in ["vsm_blur", "evsm_blur", "msm_blur"] {
-        let wgsl = kernels::resolve(kernel, None).expect("resolve");
-        let (module, r) = kernels::reflect(kernel, &wgsl).expect("reflect");
-        for (name, rust) in [
-            ("TILE", ENCODE_BLUR_TILE),
+    use shadowgraph::filter::{ENCODE_BLUR_ROW, ENCODE_BLUR_TILE_RADIUS, encode_blur_tile};
+    use shadowgraph::kernels::KernelId;
+    for kernel in [KernelId::VsmBlur, KernelId::EvsmBlur, KernelId::MsmBlur] {
+        let name = kernel.name();
+        let wgsl = kernels::resolve(name, None).expect("resolve");
+        let (module, r) = kernels::reflect(name, &wgsl).expect("reflect");
+        let tile = encode_blur_tile(kernel);
+        for (constant, rust) in [
+            ("TILE", tile),
             ("ROW", ENCODE_BLUR_ROW),
             ("TILE_RADIUS", ENCODE_BLUR_TILE_RADIUS),
         ] {
-            assert_eq!(wgsl_const(&module, name), Some(rust), "{kernel}: {name}");
+            assert_eq!(
+                wgsl_const(&module, constant),
+                Some(rust),
+                "{name}: {constant}"
+            );
         }
-        // One invocation per output of a tile and of a row.
-        assert_eq!(
-            r.workgroup_size,
-            Some([ENCODE_BLUR_TILE * ENCODE_BLUR_TILE, 1, 1]),
-            "{kernel}: workgroup"
+        // One invocation per output of a row; a tile's outputs WG_SIZE at a time, its encoded
+        // texels in at most six and its horizontal sums in at most four blocks of WG_SIZE
+        // (`encode_tile`'s e0 … e5, `blur_tile`'s h0 … h3).
+        let wg = r.workgroup_size.expect("workgroup size")[0];
+        assert_eq!(wg, ENCODE_BLUR_ROW, "{name}: workgroup");
+        let enc = tile + 2 * ENCODE_BLUR_TILE_RADIUS;
+        assert!(enc * enc <= 6 * wg, "{name}: encoded tile");
+        assert!(tile * enc <= 4 * wg, "{name}: horizontal sums");
+        // Workgroup memory: the depth tile with its halo, and the fallback's three rows.
+        let sh = wgsl_const(&module, "SH_TEXELS").expect("SH_TEXELS");
+        let channels = wgsl_const(&module, "CHANNELS").expect("CHANNELS");
+        let dep = enc + 2;
+        assert!(
+            dep * dep <= sh && 3 * (ENCODE_BLUR_ROW + 2 * 32 + 2) <= sh,
+            "{name}: SH_TEXELS"
         );
-        assert_eq!(ENCODE_BLUR_ROW, ENCODE_BLUR_TILE * ENCODE_BLUR_TILE);
+        assert!(
+            sh * 4 * channels <= 16384,
+            "{name}: 16 KiB of workgroup memory"
+        );
     }
 }

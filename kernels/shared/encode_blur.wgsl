@@ -17,10 +17,14 @@
 // Each workgroup counts the non-finite depths of its own outputs, so each is counted once.
 //
 // The importing kernel declares `const CHANNELS` (2 or 4), `struct Params` (its encoding's
-// fields, then `blur: BlurSpec`), `fn encode(z, left, right, up, down) -> vec4<f32>`, and the
+// fields, then `blur: BlurSpec`), `fn encode(z, left, right, up, down) -> vec4<f32>`, the
 // texel its channels need in workgroup memory: `alias Texel` (vec2<f32> for two channels,
 // vec4<f32> for four), `fn texel_of(v: vec4<f32>) -> Texel` and `fn texel_out(t: Texel) ->
-// vec4<f32>` (two channels in vec2s halve the workgroup memory and its traffic):
+// vec4<f32>` (two channels in vec2s halve the workgroup memory and its traffic), and the tile
+// that memory allows, `const TILE` (outputs per side) and `const SH_TEXELS` (texels of
+// workgroup memory: at least the depth tile at TILE_RADIUS, (TILE + 2·TILE_RADIUS + 2)², and
+// three rows of the fallback, 3·(ROW + 2·MAX_RADIUS + 2) = 966; 16 KiB at most): 24 and 1600
+// with two channels (12.5 KiB), 16 and 1024 with four (16 KiB):
 // #completed-by-importer
 // Storage: rg32float by default; the executor re-declares `dst` for the bound format.
 
@@ -42,22 +46,29 @@ struct BlurSpec {
 
 // Keep in sync with `ENCODE_BLUR_*` in src/filter.rs.
 const WG_SIZE: u32 = 256u;
-const TILE: u32 = 16u;
 const ROW: u32 = 256u;
 const TILE_RADIUS: u32 = 7u;
 const MAX_RADIUS: u32 = 32u;
-// Encoded texels an invocation holds between barriers (`encode_tile`: e0 … e3): at least
-// ⌈(TILE + 2·TILE_RADIUS)² / WG_SIZE⌉ of a tile and ⌈(ROW + 2·MAX_RADIUS) / WG_SIZE⌉ of a row.
-// Horizontal sums (`blur_tile`: h0, h1): at least ⌈TILE · (TILE + 2·TILE_RADIUS) / WG_SIZE⌉.
-// Texels of workgroup memory, a `Texel` each (one access a tap): the depth
-// tile ((TILE + 2·TILE_RADIUS + 2)² = 1024, or three rows of ROW + 2·MAX_RADIUS + 2), the
-// encoded tile ((TILE + 2·TILE_RADIUS)² = 900, or ROW + 2·MAX_RADIUS) and the horizontal sums
-// each fit: 16 KiB with four channels, 8 KiB with two.
-const SH_TEXELS: u32 = 1024u;
+// Encoded texels an invocation holds between barriers (`encode_tile`: e0 … e5): at least
+// ⌈(TILE + 2·TILE_RADIUS)² / WG_SIZE⌉ of a tile (6 at TILE = 24) and ⌈(ROW + 2·MAX_RADIUS) /
+// WG_SIZE⌉ of a row. Horizontal sums (`blur_tile`: h0 … h3): at least ⌈TILE · (TILE +
+// 2·TILE_RADIUS) / WG_SIZE⌉ (4 at TILE = 24); outputs, WG_SIZE at a time. The blocks past the
+// first four (two) exist only in kernels whose tile can need them (`ENC_MAX`, `H_MAX`: constant
+// conditions, compiled away for a 16² tile: as a run-time test llvmpipe computed the blocks
+// anyway and EVSM4/MSM ran 12–20% slower), and are skipped where the radius leaves them empty
+// (`k·WG_SIZE < n`, the same for the whole workgroup). Workgroup memory (SH_TEXELS, a `Texel` each, one access a
+// tap) holds in turn the depth tile ((TILE + 2·TILE_RADIUS + 2)², or three rows of
+// ROW + 2·MAX_RADIUS + 2), the encoded tile ((TILE + 2·TILE_RADIUS)², or ROW + 2·MAX_RADIUS)
+// and the horizontal sums.
 
 // The depth tile (in x), then the encoded tile, then the horizontal sums, each over the one
 // before.
 var<workgroup> sh_tile: array<Texel, SH_TEXELS>;
+
+// The most encoded texels and horizontal sums a tile holds (at TILE_RADIUS): the blocks of
+// WG_SIZE past the first four and two are compiled only where a kernel's tile needs them.
+const ENC_MAX: u32 = (TILE + 2u * TILE_RADIUS) * (TILE + 2u * TILE_RADIUS);
+const H_MAX: u32 = TILE * (TILE + 2u * TILE_RADIUS);
 
 // A workgroup's outputs and the extents it works over.
 struct Tile {
@@ -148,11 +159,22 @@ fn encode_tile(t: Tile, li: u32) {
     let e1 = encode_at(t, i + s);
     let e2 = encode_at(t, i + 2 * s);
     let e3 = encode_at(t, i + 3 * s);
+    var e4 = e3;
+    var e5 = e3;
+    // Constant for each kernel: a 16² tile has no such block, and no code for it.
+    if ENC_MAX > 4u * WG_SIZE && 4 * s < n {
+        e4 = encode_at(t, i + 4 * s);
+        e5 = encode_at(t, i + 5 * s);
+    }
     workgroupBarrier();
     put_below(i, n, e0);
     put_below(i + s, n, e1);
     put_below(i + 2 * s, n, e2);
     put_below(i + 3 * s, n, e3);
+    if ENC_MAX > 4u * WG_SIZE && 4 * s < n {
+        put_below(i + 4 * s, n, e4);
+        put_below(i + 5 * s, n, e5);
+    }
     workgroupBarrier();
 }
 
@@ -174,24 +196,47 @@ fn store(t: Tile, o: vec2<i32>, v: Texel) {
 }
 
 // Phases 3 and 4: along x into workgroup memory (outs.x × enc.y sums, H_PER an invocation),
-// then along y into `dst`.
+// then along y into `dst` (outs.x × outs.y outputs, WG_SIZE at a time).
 fn blur_tile(t: Tile, li: u32) {
     let n = t.outs.x * t.enc.y;
     let i = i32(li);
-    let j = min(i + i32(WG_SIZE), n - 1);
+    let w = i32(WG_SIZE);
+    let j1 = min(i + w, n - 1);
     let h0 = sum_x(t, i % t.outs.x, i / t.outs.x);
-    let h1 = sum_x(t, j % t.outs.x, j / t.outs.x);
+    let h1 = sum_x(t, j1 % t.outs.x, j1 / t.outs.x);
+    var h2 = h1;
+    var h3 = h1;
+    if H_MAX > 2u * WG_SIZE && 2 * w < n {
+        let j2 = min(i + 2 * w, n - 1);
+        let j3 = min(i + 3 * w, n - 1);
+        h2 = sum_x(t, j2 % t.outs.x, j2 / t.outs.x);
+        h3 = sum_x(t, j3 % t.outs.x, j3 / t.outs.x);
+    }
     workgroupBarrier();
     put_below(i, n, h0);
-    put_below(i + i32(WG_SIZE), n, h1);
-    workgroupBarrier();
-    let o = vec2<i32>(i % t.outs.x, i / t.outs.x);
-    let c = (o.y + t.r.y) * t.outs.x + o.x;
-    var s = blur_weight(0) * sh_get(c);
-    for (var k = 1; k <= t.r.y; k++) {
-        s += blur_weight(k) * (sh_get(c - k * t.outs.x) + sh_get(c + k * t.outs.x));
+    put_below(i + w, n, h1);
+    if H_MAX > 2u * WG_SIZE && 2 * w < n {
+        put_below(i + 2 * w, n, h2);
+        put_below(i + 3 * w, n, h3);
     }
-    store(t, o, s);
+    workgroupBarrier();
+    sum_y(t, i);
+    if TILE * TILE > WG_SIZE {
+        for (var q = i + w; q < t.outs.x * t.outs.y; q += w) {
+            sum_y(t, q);
+        }
+    }
+}
+
+// The vertical sum of output q of the tile, stored.
+fn sum_y(t: Tile, q: i32) {
+    let o = vec2<i32>(q % t.outs.x, q / t.outs.x);
+    let c = (o.y + t.r.y) * t.outs.x + o.x;
+    var v = blur_weight(0) * sh_get(c);
+    for (var k = 1; k <= t.r.y; k++) {
+        v += blur_weight(k) * (sh_get(c - k * t.outs.x) + sh_get(c + k * t.outs.x));
+    }
+    store(t, o, v);
 }
 
 // The importing kernel's `main`: workgroup `wg`, invocation `li`.
