@@ -1,11 +1,15 @@
 // One pass of a separable blur of a one-channel logarithmic representation (ESM's c·z; only
 // the first channel is read and written, so no exp is spent on the others): per texel
 // log Σ wᵢ exp(vᵢ) over its 2r + 1 neighbours along the axis (shared/blur_pass: PER outputs an
-// invocation). Each texel is exponentiated once, relative to the largest value the
-// invocation reads (its PER + 2r texels): `hi + log Σ w·exp(v − hi)`. Where those texels
-// span more than SPAN (exp(−SPAN) is still a normal f32, every bit kept), the invocation takes
-// each output's own window maximum instead, at one exp per tap: every exp ≤ 1, so nothing
-// that matters underflows at any c (ESM at c > SPAN across a depth edge).
+// invocation). Each texel is exponentiated once, relative to the first texel the invocation
+// reads (of its PER + 2r): `v₀ + log Σ w·exp(v − v₀)`, while the same loop tracks the texels'
+// span. Within a span of SPAN every exp lies in [exp(−SPAN), exp(SPAN)], normal f32 both
+// ways, and a sum of 2r + 1 of them stays finite; SPIR-V's exp error, (3 + 2|x|) ULP, is bounded
+// by the span as it was relative to the maximum. Where the texels span more than SPAN, the
+// sums (whose arguments are clamped to ±SPAN, so finite) are dropped and the invocation takes
+// each output's own window maximum instead, at one exp per tap: every exp ≤ 1, so nothing that
+// matters underflows at any c (ESM at c > SPAN across a depth edge). One read of the texels
+// instead of a read for the span and another for the sums: 1.08–1.21× faster on llvmpipe.
 // The invocation reads its PER + 2r texels once into PER running sums, kept as named values (an
 // array indexed in a loop stays in memory on llvmpipe, three times slower).
 // #import shared/blur_pass
@@ -53,24 +57,11 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l
 
 // The invocation's PER outputs along the pass's axis (`vertical`: a constant at each call).
 fn blur_log_outputs(b: BlurLine, vertical: bool) {
-    var hi = -3.0e38;
-    var lo = 3.0e38;
-    for (var t = -b.r; t < i32(PER) + b.r; t++) {
-        let v = tap(b, t, vertical).x;
-        hi = max(hi, v);
-        lo = min(lo, v);
-    }
-    if hi - lo > SPAN {
-        put_x(b, 0, log_sum_at(b, 0, vertical), vertical);
-        put_x(b, 1, log_sum_at(b, 1, vertical), vertical);
-        put_x(b, 2, log_sum_at(b, 2, vertical), vertical);
-        put_x(b, 3, log_sum_at(b, 3, vertical), vertical);
-        put_x(b, 4, log_sum_at(b, 4, vertical), vertical);
-        put_x(b, 5, log_sum_at(b, 5, vertical), vertical);
-        put_x(b, 6, log_sum_at(b, 6, vertical), vertical);
-        put_x(b, 7, log_sum_at(b, 7, vertical), vertical);
-        return;
-    }
+    // One read of the PER + 2r texels: each exponentiated relative to the first, the span
+    // tracked alongside; where it exceeds SPAN the sums are dropped for the per-output path.
+    let first = tap(b, -b.r, vertical).x;
+    var hi = first;
+    var lo = first;
     var s0 = 0.0;
     var s1 = 0.0;
     var s2 = 0.0;
@@ -79,8 +70,6 @@ fn blur_log_outputs(b: BlurLine, vertical: bool) {
     var s5 = 0.0;
     var s6 = 0.0;
     var s7 = 0.0;
-    // wk = weight(t − k): tap t + 1's weights are tap t's moved one output on, so each tap
-    // looks up one weight instead of eight.
     let t0 = -b.r;
     var w0 = weight(t0, b.r);
     var w1 = weight(t0 - 1, b.r);
@@ -91,7 +80,10 @@ fn blur_log_outputs(b: BlurLine, vertical: bool) {
     var w6 = weight(t0 - 6, b.r);
     var w7 = weight(t0 - 7, b.r);
     for (var t = t0; t < i32(PER) + b.r; t++) {
-        let v = exp(tap(b, t, vertical).x - hi);
+        let x = tap(b, t, vertical).x;
+        hi = max(hi, x);
+        lo = min(lo, x);
+        let v = exp(clamp(x - first, -SPAN, SPAN));
         s0 += w0 * v;
         s1 += w1 * v;
         s2 += w2 * v;
@@ -109,12 +101,23 @@ fn blur_log_outputs(b: BlurLine, vertical: bool) {
         w1 = w0;
         w0 = weight(t + 1, b.r);
     }
-    put_x(b, 0, hi + log(s0), vertical);
-    put_x(b, 1, hi + log(s1), vertical);
-    put_x(b, 2, hi + log(s2), vertical);
-    put_x(b, 3, hi + log(s3), vertical);
-    put_x(b, 4, hi + log(s4), vertical);
-    put_x(b, 5, hi + log(s5), vertical);
-    put_x(b, 6, hi + log(s6), vertical);
-    put_x(b, 7, hi + log(s7), vertical);
+    if hi - lo > SPAN {
+        put_x(b, 0, log_sum_at(b, 0, vertical), vertical);
+        put_x(b, 1, log_sum_at(b, 1, vertical), vertical);
+        put_x(b, 2, log_sum_at(b, 2, vertical), vertical);
+        put_x(b, 3, log_sum_at(b, 3, vertical), vertical);
+        put_x(b, 4, log_sum_at(b, 4, vertical), vertical);
+        put_x(b, 5, log_sum_at(b, 5, vertical), vertical);
+        put_x(b, 6, log_sum_at(b, 6, vertical), vertical);
+        put_x(b, 7, log_sum_at(b, 7, vertical), vertical);
+        return;
+    }
+    put_x(b, 0, first + log(s0), vertical);
+    put_x(b, 1, first + log(s1), vertical);
+    put_x(b, 2, first + log(s2), vertical);
+    put_x(b, 3, first + log(s3), vertical);
+    put_x(b, 4, first + log(s4), vertical);
+    put_x(b, 5, first + log(s5), vertical);
+    put_x(b, 6, first + log(s6), vertical);
+    put_x(b, 7, first + log(s7), vertical);
 }

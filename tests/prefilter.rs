@@ -388,7 +388,8 @@ fn evsm_and_esm_encodings_match_reference() {
             BlurKernel::Gaussian,
             true,
         );
-        // Each log-sum-exp: exp of (v − max) ∈ [−c, 0] at (3 + 2|x|) ULP relative, then log:
+        // Each log-sum-exp: exp of (v − v₀) ∈ [−c, c] (v₀ the first texel an invocation
+        // reads; at c = 200, past the span, v − max ∈ [−c, 0]) at (3 + 2|x|) ULP relative, then log:
         // the absolute error in L is ≲ 2·(3 + 2c) ULP of 1 plus the rounding of |L| ≤ c.
         common::assert_close(
             &format!("esm c={c} log-space blur"),
