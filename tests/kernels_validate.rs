@@ -581,9 +581,10 @@ fn encode_blur_dispatch_constants_match_the_wgsl() {
         // Workgroup memory: the depth tile with its halo, and the fallback's three rows.
         let sh = wgsl_const(&module, "SH_TEXELS").expect("SH_TEXELS");
         let channels = wgsl_const(&module, "CHANNELS").expect("CHANNELS");
+        let max_radius = wgsl_const(&module, "MAX_RADIUS").expect("MAX_RADIUS");
         let dep = enc + 2;
         assert!(
-            dep * dep <= sh && 3 * (ENCODE_BLUR_ROW + 2 * 32 + 2) <= sh,
+            dep * dep <= sh && 3 * (ENCODE_BLUR_ROW + 2 * max_radius + 2) <= sh,
             "{name}: SH_TEXELS"
         );
         assert!(

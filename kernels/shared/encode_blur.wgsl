@@ -56,10 +56,10 @@ const MAX_RADIUS: u32 = 32u;
 // first four (two) exist only in kernels whose tile can need them (`ENC_MAX`, `H_MAX`: constant
 // conditions, compiled away for a 16² tile: as a run-time test llvmpipe computed the blocks
 // anyway and EVSM4/MSM ran 12–20% slower), and are skipped where the radius leaves them empty
-// (`k·WG_SIZE < n`, the same for the whole workgroup). Workgroup memory (SH_TEXELS, a `Texel` each, one access a
-// tap) holds in turn the depth tile ((TILE + 2·TILE_RADIUS + 2)², or three rows of
-// ROW + 2·MAX_RADIUS + 2), the encoded tile ((TILE + 2·TILE_RADIUS)², or ROW + 2·MAX_RADIUS)
-// and the horizontal sums.
+// (`k·WG_SIZE < n`, the same for the whole workgroup). Workgroup memory (SH_TEXELS, a `Texel`
+// each, one access a tap) holds in turn the depth tile ((TILE + 2·TILE_RADIUS + 2)², or three
+// rows of ROW + 2·MAX_RADIUS + 2), the encoded tile ((TILE + 2·TILE_RADIUS)², or
+// ROW + 2·MAX_RADIUS) and the horizontal sums.
 
 // The depth tile (in x), then the encoded tile, then the horizontal sums, each over the one
 // before.

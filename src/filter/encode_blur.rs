@@ -14,7 +14,8 @@ use crate::model::Filter;
 /// [`ENCODE_BLUR_TILE_RADIUS`] lets workgroup memory be, within WebGPU's 16 KiB. Two channels
 /// (`vsm_blur`, 8 B a texel) take 24² outputs, 40² depths: 12.5 KiB; four (`evsm_blur`,
 /// `msm_blur`) 16², 32² depths: 16 KiB. The 24² tile moves 13% fewer bytes than a 16² one (its
-/// halo) and ran 1.16–1.25× faster on llvmpipe (`bench --only vsm_blur`, 1024², r = 4).
+/// halo) and ran 1.12–1.29× faster on llvmpipe (`bench --sizes 1024,2048 --only vsm_blur`,
+/// r = 4, alternated with the 16² build; `benches/RESULTS.md`).
 pub fn encode_blur_tile(kernel: KernelId) -> u32 {
     match kernel {
         KernelId::VsmBlur => 24,
