@@ -34,9 +34,11 @@ pub struct Timed {
     /// Submission to completion: the cross-check of `ms` (on a CPU device the two agree within
     /// the submission's fraction of a millisecond; on a GPU the submission can dominate).
     pub wall_ms: f64,
-    /// The least share of its wall time a timed run's spans read: the timer's check run by run
-    /// (a median can hide a fault that hits some runs). On a CPU device a true timer reads
-    /// near 1; a boundary stamped late reads far below.
+    /// The shortest timed run's spans as a share of the median wall time: the timer's check
+    /// run by run (a median can hide a fault that hits some runs). On a CPU device a true timer
+    /// reads near 1; a boundary stamped late shortens a run's spans and reads far below. Over
+    /// the median wall time, not the run's own: a run whose wait alone was stretched (the
+    /// thread descheduled on busy cores) keeps true spans and must not read as a fault.
     pub least_share: f64,
 }
 
@@ -73,15 +75,12 @@ pub(super) fn median_time(
             walls.push(wall_ms);
         }
     }
-    let least_share = times
-        .iter()
-        .zip(&walls)
-        .map(|(t, w)| t / w)
-        .fold(f64::INFINITY, f64::min);
+    let shortest = times.iter().copied().fold(f64::INFINITY, f64::min);
+    let wall_ms = median(&mut walls);
     Ok(Timed {
         ms: median(&mut times),
-        wall_ms: median(&mut walls),
-        least_share,
+        wall_ms,
+        least_share: shortest / wall_ms,
     })
 }
 

@@ -58,7 +58,7 @@ pub struct BenchRow {
     /// `median_ms` (on a CPU device the two agree within a fraction of a millisecond; on a GPU
     /// the submission's tens of microseconds can dominate a short run).
     pub wall_ms: f64,
-    /// The least share of its wall time one timed run read ([`Timed::least_share`]): the
+    /// The shortest timed run's spans over the median wall time ([`Timed::least_share`]): the
     /// timer's check run by run.
     pub least_share: f64,
     /// Effective bandwidth: `bytes_moved / median time`, GB/s (10⁹ bytes per second).
@@ -673,7 +673,7 @@ pub fn format_table(device: &str, cpu: bool, repeat: u32, rows: &[BenchRow]) -> 
         if !suspect.is_empty() {
             let _ = writeln!(
                 s,
-                "WARNING: measure again, a run read under {CPU_LEAST_SHARE} of its wall time (a \
+                "WARNING: measure again, a run read under {CPU_LEAST_SHARE} of the median wall time (a \
                  CPU device's true timer never does: another load on the cores, or a timer \
                  fault): {}",
                 suspect.join("; ")
@@ -683,9 +683,9 @@ pub fn format_table(device: &str, cpu: bool, repeat: u32, rows: &[BenchRow]) -> 
     s
 }
 
-/// On a CPU device a run's spans read at least this share of its wall time (the submission
-/// adds 0.1–0.5 ms; runs of 3–15 ms read 0.85 and more on idle cores): a row with a run below
-/// it is flagged by [`format_table`] if its runs take [`CPU_CHECKED_MS`] or more.
+/// On a CPU device a run's spans read at least this share of the median wall time (the
+/// submission adds 0.1–0.5 ms; runs of 3–15 ms read 0.85 and more on idle cores): a row with a
+/// run below it is flagged by [`format_table`] if its runs take [`CPU_CHECKED_MS`] or more.
 pub const CPU_LEAST_SHARE: f64 = 0.5;
 
 /// Runs shorter than this by the wall clock are mostly submission on a CPU device (a 256² copy:
@@ -833,7 +833,7 @@ mod tests {
         assert!(text.contains("only the ratios") && text.contains("copy texture rg32float"));
     }
 
-    /// On a CPU device a row with a run under [`CPU_LEAST_SHARE`] of its wall time is named
+    /// On a CPU device a row with a run under [`CPU_LEAST_SHARE`] of its median wall time is named
     /// in a warning after the table, unless its runs are too short to check; on a GPU (wall
     /// time mostly submission) it is not.
     #[test]
