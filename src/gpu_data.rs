@@ -131,8 +131,12 @@ pub struct LightGpu {
     /// range (half the widest channel's range): the error models' bound on the table's corner
     /// sums (`tolerance::filtered_table_error`).
     pub sat_amplitude: f32,
+    /// CSSM: 1 where the filtered series is resolved by the two-depth inversion
+    /// (`resolve = "two_depth"`, which also has the receiver plane's slope computed), 0 for
+    /// the paper's clamp and sharpening alone (`"sharpen"`).
+    pub cssm_two_depth: u32,
     /// Padding to the struct's 16-byte alignment.
-    pub _pad_end: [u32; 2],
+    pub _pad_end: u32,
 }
 
 /// Technique id of `hard` (`LightGpu::technique`; `TECHNIQUE_HARD` in

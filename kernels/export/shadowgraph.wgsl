@@ -56,34 +56,36 @@
 //
 // Names defined here, each with the `sg_` prefix (a host's own names need only avoid
 // `sg_` and `shadowgraph_`):
-//   sg_BLOCKER_MIN_SHARE sg_CSM_PI sg_CascadePick sg_GOLDEN_ANGLE sg_Light sg_LightSample
-//   sg_MSM_B0 sg_MSM_B0_COV sg_MSM_B0_SCHUR sg_MipTaps sg_MsmMoments sg_SAT_GRID
-//   sg_SAT_MIN_EXTENT sg_SatNodes sg_SoftLookup sg_TECHNIQUE_CSM sg_TECHNIQUE_CSSM
-//   sg_TECHNIQUE_ESM sg_TECHNIQUE_EVSM sg_TECHNIQUE_HARD sg_TECHNIQUE_MIDPOINT sg_TECHNIQUE_MSM
-//   sg_TECHNIQUE_MSM_SOFT sg_TECHNIQUE_PCF sg_TECHNIQUE_PCSS sg_TECHNIQUE_SECOND_DEPTH
-//   sg_TECHNIQUE_SMRT sg_TECHNIQUE_VSM sg_TECHNIQUE_VSSM sg_bilinear_level
-//   sg_bilinear_level_packed sg_bilinear_log_level sg_blocker_csm_z sg_blocker_filter_width
-//   sg_blocker_msm sg_blocker_result sg_blocker_search_width sg_blocker_vsm sg_blocker_width
-//   sg_cascade_far_of sg_cascade_pick sg_chebyshev_upper sg_csm_chunk sg_csm_chunk_of
-//   sg_csm_resolve sg_csm_sin_cos sg_csm_weight sg_csm_z_chunk_of sg_cssm_blocker
-//   sg_cssm_blocker_moments sg_cssm_resolve sg_cssm_sharpen sg_level_size sg_level_size_of
-//   sg_light_depth_slope sg_light_depth_slope_view sg_light_faces sg_light_footprint
-//   sg_light_linear_to_ndc sg_light_linear_to_z sg_light_map_width sg_light_receiver_offset
-//   sg_light_sample sg_light_tap_offset sg_light_texel sg_light_to_light sg_linstep
-//   sg_load_depth sg_map_sample sg_mip_tap_uv sg_mip_taps sg_msm_biased sg_msm_dequantize
-//   sg_msm_expect sg_msm_intensity sg_msm_moments sg_msm_quantize sg_msm_roots
-//   sg_msm_soft_blocker sg_pack_f16x2 sg_pcss_search_radius sg_point_coords sg_point_face
-//   sg_point_sample sg_sample_bilinear sg_sample_bilinear_log sg_sample_map sg_sample_map_log
-//   sg_sample_map_packed sg_sat_box sg_sat_box_fixed sg_sat_box_float sg_sat_clamp
-//   sg_sat_corner_linear sg_sat_filter_fixed sg_sat_filter_float sg_sat_grid sg_sat_mean_fixed
-//   sg_sat_mean_float sg_sat_mean_linear sg_sat_nearest sg_sat_node_f32 sg_sat_node_u32
-//   sg_sat_nodes sg_sat_rect sg_sat_sample_fixed sg_sat_sample_float sg_sat_search_fixed
-//   sg_sat_search_float sg_sat_span_weights sg_smrt_emitter_point sg_smrt_ray sg_soft_blockers
-//   sg_soft_filter_trips sg_texel_of sg_trilinear sg_trilinear_log sg_trilinear_packed
-//   sg_unpack_f16x2 sg_vis_esm sg_vis_esm_of_log sg_vis_esm_of_sat sg_vis_evsm sg_vis_evsm_of
-//   sg_vis_hard sg_vis_msm sg_vis_msm_of sg_vis_msm_soft_fixed sg_vis_msm_soft_float sg_vis_pcf
-//   sg_vis_pcf_hardware sg_vis_pcss sg_vis_smrt sg_vis_vsm sg_vis_vsm_of sg_vis_vssm_fixed
-//   sg_vis_vssm_float sg_vogel_disc sg_vssm_blocker
+//   sg_BLOCKER_MIN_SHARE sg_CSM_PI sg_CSSM_FULL_CONTRAST sg_CSSM_MIN_CONTRAST sg_CascadePick
+//   sg_CsmTerms sg_GOLDEN_ANGLE sg_Light sg_LightSample sg_MSM_B0 sg_MSM_B0_COV sg_MSM_B0_SCHUR
+//   sg_MipTaps sg_MsmMoments sg_SAT_GRID sg_SAT_MIN_EXTENT sg_SatNodes sg_SoftLookup
+//   sg_TECHNIQUE_CSM sg_TECHNIQUE_CSSM sg_TECHNIQUE_ESM sg_TECHNIQUE_EVSM sg_TECHNIQUE_HARD
+//   sg_TECHNIQUE_MIDPOINT sg_TECHNIQUE_MSM sg_TECHNIQUE_MSM_SOFT sg_TECHNIQUE_PCF
+//   sg_TECHNIQUE_PCSS sg_TECHNIQUE_SECOND_DEPTH sg_TECHNIQUE_SMRT sg_TECHNIQUE_VSM
+//   sg_TECHNIQUE_VSSM sg_bilinear_level sg_bilinear_level_packed sg_bilinear_log_level
+//   sg_blocker_csm_z sg_blocker_filter_width sg_blocker_msm sg_blocker_result
+//   sg_blocker_search_width sg_blocker_vsm sg_blocker_width sg_cascade_far_of sg_cascade_pick
+//   sg_chebyshev_upper sg_csm_chunk sg_csm_chunk_of sg_csm_resolve sg_csm_sin_cos
+//   sg_csm_terms_advance sg_csm_terms_chunk sg_csm_terms_start sg_csm_weight sg_csm_z_chunk_of
+//   sg_cssm_blocker sg_cssm_blocker_moments sg_cssm_resolve sg_cssm_sharpen sg_cssm_two_series
+//   sg_level_size sg_level_size_of sg_light_depth_slope sg_light_depth_slope_view sg_light_faces
+//   sg_light_footprint sg_light_linear_to_ndc sg_light_linear_to_z sg_light_map_width
+//   sg_light_plane_slope sg_light_receiver_offset sg_light_sample sg_light_tap_offset
+//   sg_light_texel sg_light_to_light sg_linstep sg_load_depth sg_map_sample sg_mip_tap_uv
+//   sg_mip_taps sg_msm_biased sg_msm_dequantize sg_msm_expect sg_msm_intensity sg_msm_moments
+//   sg_msm_quantize sg_msm_roots sg_msm_soft_blocker sg_pack_f16x2 sg_pcss_search_radius
+//   sg_point_coords sg_point_face sg_point_sample sg_sample_bilinear sg_sample_bilinear_log
+//   sg_sample_map sg_sample_map_log sg_sample_map_packed sg_sat_box sg_sat_box_fixed
+//   sg_sat_box_float sg_sat_clamp sg_sat_corner_linear sg_sat_filter_fixed sg_sat_filter_float
+//   sg_sat_grid sg_sat_mean_fixed sg_sat_mean_float sg_sat_mean_linear sg_sat_nearest
+//   sg_sat_node_f32 sg_sat_node_u32 sg_sat_nodes sg_sat_rect sg_sat_sample_fixed
+//   sg_sat_sample_float sg_sat_search_fixed sg_sat_search_float sg_sat_span_weights
+//   sg_smrt_emitter_point sg_smrt_ray sg_soft_blockers sg_soft_filter_trips sg_texel_of
+//   sg_trilinear sg_trilinear_log sg_trilinear_packed sg_unpack_f16x2 sg_vis_esm
+//   sg_vis_esm_of_log sg_vis_esm_of_sat sg_vis_evsm sg_vis_evsm_of sg_vis_hard sg_vis_msm
+//   sg_vis_msm_of sg_vis_msm_soft_fixed sg_vis_msm_soft_float sg_vis_pcf sg_vis_pcf_hardware
+//   sg_vis_pcss sg_vis_smrt sg_vis_vsm sg_vis_vsm_of sg_vis_vssm_fixed sg_vis_vssm_float
+//   sg_vogel_disc sg_vssm_blocker
 
 // Shared light description and light-space helpers (import-only module).
 //
@@ -148,8 +150,8 @@ struct sg_Light {
     cascade_far: array<vec4<f32>, 2>, // cascades: far view distance of cascade c at [c / 4][c % 4]
     sat_filtered: u32,       // tables: 1 where f32 and read with filtered fetches (the CPU references read it)
     sat_amplitude: f32,      // tables: the largest |v − sat_offset| over the value range (the CPU references read it)
-    _pad_end0: u32,
-    _pad_end1: u32,
+    cssm_two_depth: u32,     // cssm: 1 two-depth resolve (needs the receiver plane's slope), 0 sharpening alone
+    _pad_end: u32,
 }
 
 // `Light::technique` (keep in sync with the `TECHNIQUE_*` constants of src/gpu_data.rs; a test
@@ -176,7 +178,7 @@ struct sg_LightSample {
     view_z: f32,     // receiver's distance Z along the light axis
     inside: bool,    // inside the map and the depth range
     footprint: vec4<f32>, // the pixel's footprint in the map, texels: axes (x, y) and (z, w); 0 unknown
-    depth_slope: vec2<f32>, // receiver plane: d(depth)/d(texel) along u and v (0 when off)
+    depth_slope: vec2<f32>, // receiver plane: d(depth)/d(texel) along u and v (0 unless light_plane_slope)
 }
 
 // World width of the whole map at view distance z.
@@ -235,7 +237,7 @@ fn sg_map_sample(l: sg_Light, p: vec3<f32>, n: vec3<f32>) -> sg_LightSample {
         && s.depth >= 0.0 && s.depth <= 1.0;
     s.footprint = vec4<f32>(0.0);
     s.depth_slope = vec2<f32>(0.0);
-    if l.receiver_plane > 0.0 {
+    if sg_light_plane_slope(l) {
         s.depth_slope = sg_light_depth_slope(l, q, n, s.view_z);
     }
     return s;
@@ -290,13 +292,19 @@ fn sg_point_sample(l: sg_Light, p: vec3<f32>, n: vec3<f32>) -> sg_LightSample {
     s.inside = c.z > 0.0 && s.depth >= 0.0 && s.depth <= 1.0;
     s.footprint = vec4<f32>(0.0);
     s.depth_slope = vec2<f32>(0.0);
-    if l.receiver_plane > 0.0 {
+    if sg_light_plane_slope(l) {
         // The face's view space: point_coords gives (x, y, distance) and looks down −z.
         let nf = sg_point_coords(n, f);
         let v = vec3<f32>(c.x, c.y, -c.z);
         s.depth_slope = sg_light_depth_slope_view(l, v, vec3<f32>(nf.x, nf.y, -nf.z), c.z, true);
     }
     return s;
+}
+
+// Whether a sample carries its receiver plane's slope: for the receiver-plane bias, and for
+// CSSM's two-depth resolve (the receivers' mean series over its filter square).
+fn sg_light_plane_slope(l: sg_Light) -> bool {
+    return l.receiver_plane > 0.0 || l.cssm_two_depth != 0u;
 }
 
 // Receiver-plane depth bias (Isidoro, GDC 2006): the depth of the plane through the receiver q
@@ -681,6 +689,58 @@ fn sg_csm_chunk_of(v: vec4<f32>, chunk: u32, l: sg_Light, s: sg_LightSample) -> 
     return sum;
 }
 
+// The receiver's factors of the series term by term, for a pass that sums every term (CSSM's
+// filter): (sin, cos) of c_k x advanced from term k to k + 1 by a rotation of 2πx, and the
+// weight's Gaussian exp(−α (k/M)²) by its ratio exp(−α (2k + 1)/M²), itself advanced by
+// exp(−2α/M²). Two sines and one exponential in all, where csm_chunk_of computes two sines and
+// an exponential per term; the rotation's rounding grows by a few ulps a term (M ≤ 16).
+struct sg_CsmTerms {
+    k: u32,
+    sc: vec2<f32>,    // (sin, cos) of c_k x
+    step: vec2<f32>,  // (sin, cos) of 2πx
+    gauss: f32,       // exp(−α (k/M)²)
+    ratio: f32,       // exp(−α (2k + 1)/M²)
+    q2: f32,          // exp(−2α/M²)
+}
+
+fn sg_csm_terms_start(x: f32, l: sg_Light) -> sg_CsmTerms {
+    var t: sg_CsmTerms;
+    t.k = 1u;
+    t.sc = sg_csm_sin_cos(1u, x);
+    t.step = vec2<f32>(2.0 * t.sc.x * t.sc.y, t.sc.y * t.sc.y - t.sc.x * t.sc.x);
+    let m = f32(l.csm_terms);
+    let q = exp(-l.csm_attenuation / (m * m));
+    t.gauss = q;
+    t.q2 = q * q;
+    t.ratio = q * t.q2;
+    return t;
+}
+
+// csm_chunk_of with the factors `t` at the shifted receiver depth (csm_terms_start), advanced
+// past the chunk's two terms: the chunks must come in order from 0.
+fn sg_csm_terms_chunk(v: vec4<f32>, t: ptr<function, sg_CsmTerms>, l: sg_Light) -> f32 {
+    var sum = 0.0;
+    for (var j = 0u; j < 2u; j++) {
+        if (*t).k > l.csm_terms {
+            break;
+        }
+        let w = 2.0 / (sg_CSM_PI * f32(2u * (*t).k - 1u)) * (*t).gauss;
+        let basis = select(v.xy, v.zw, j == 1u);
+        sum += w * ((*t).sc.y * basis.x - (*t).sc.x * basis.y);
+        sg_csm_terms_advance(t);
+    }
+    return sum;
+}
+
+fn sg_csm_terms_advance(t: ptr<function, sg_CsmTerms>) {
+    let sc = (*t).sc;
+    let st = (*t).step;
+    (*t).sc = vec2<f32>(sc.x * st.y + sc.y * st.x, sc.y * st.y - sc.x * st.x);
+    (*t).gauss *= (*t).ratio;
+    (*t).ratio *= (*t).q2;
+    (*t).k += 1u;
+}
+
 // w_k = (2 / c_k) · exp(−α (k / M)²): the attenuated weight of term k.
 fn sg_csm_weight(k: u32, l: sg_Light) -> f32 {
     let kf = f32(k) / f32(l.csm_terms);
@@ -697,8 +757,10 @@ fn sg_csm_resolve(sum: f32, l: sg_Light) -> f32 {
 // about ½ and clamped to [0, 1] as CSM's (csm_resolve: the clamp cuts the ringing), then
 // sharpened selectively, v^p with p = 1 + A·exp(−B (d − z_avg)): near contact (d ≈ z_avg),
 // where the smooth Fourier step leaks light and the penumbra is narrow, the darkening is
-// strongest; it fades as the receiver leaves its blockers. A square without blockers
-// (share < BLOCKER_MIN_SHARE) is lit.
+// strongest; it fades as the receiver leaves its blockers. By default (`resolve =
+// "two_depth"`, this project's) away from contact the series is instead inverted for the share
+// of blockers at z_avg (cssm_resolve). A square without blockers (share < BLOCKER_MIN_SHARE)
+// is lit.
 // The shading block (technique::cssm's `visibility`) reads, at the search width snapped
 // outward to texel edges (`sat_search_*`, 4 loads a table), either (`blocker_search =
 // "moments"`, the default) MSM's quantized moments' table, which gives `cssm_blocker_moments`, or
@@ -1350,14 +1412,68 @@ fn sg_cssm_sharpen(v: f32, p: f32) -> f32 {
     return select(0.0, exp2(p * log2(v)), v > 0.0);
 }
 
-// The visibility from the basis sum at the filter width and the blocker estimate `b` (which
-// found blockers: share ≥ BLOCKER_MIN_SHARE).
-fn sg_cssm_resolve(sum: f32, b: vec2<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
-    let v = sg_csm_resolve(sum, l);
-    let gap = max(s.depth - l.bias - b.x, 0.0);
-    let p = 1.0 + l.sharpen * exp(-l.sharpen_falloff * gap);
-    return sg_cssm_sharpen(v, p);
+// The two series of the two-depth resolve in one loop: (Σ_k w_k sin(c_k x_r)·sinc(c_k a.x)·
+// sinc(c_k a.y), Σ_k w_k sin(c_k x_b)), i.e. f − ½ at depth offset x_r as the mean over a
+// square on a plane whose depth changes by ±a (linear depth units) from the square's centre to
+// its edges along u and v (the mean of sin(c(x + a.x·u + a.y·v)) over u, v ∈ [−1, 1] is
+// sin(c x)·sinc(c a.x)·sinc(c a.y), sinc(t) = sin(t)/t), and f − ½ at x_b. The sines of
+// c_k = π(2k − 1) times the four arguments advance by a rotation of 2π·argument per term (four
+// multiply-adds instead of a sine: the loop runs at every shaded pixel with blockers), the
+// weights as csm_terms_chunk's.
+fn sg_cssm_two_series(x_r: f32, a: vec2<f32>, x_b: f32, l: sg_Light) -> vec2<f32> {
+    let v = vec4<f32>(x_r, x_b, a);
+    var sn = sin(sg_CSM_PI * v);
+    var cs = cos(sg_CSM_PI * v);
+    let step_sin = 2.0 * sn * cs;
+    let step_cos = cs * cs - sn * sn;
+    // The weights' Gaussian factors as csm_terms_start advances them.
+    var w = sg_csm_terms_start(0.0, l);
+    var sum = vec2<f32>(0.0);
+    for (var k = 1u; k <= l.csm_terms; k++) {
+        let c = sg_CSM_PI * f32(2u * k - 1u);
+        let t = c * a;
+        let sinc = select(vec2<f32>(1.0), sn.zw / t, abs(t) > vec2<f32>(1e-4));
+        sum += (2.0 / c * w.gauss) * vec2<f32>(sn.x * sinc.x * sinc.y, sn.y);
+        sg_csm_terms_advance(&w);
+        let next = sn * step_cos + cs * step_sin;
+        cs = cs * step_cos - sn * step_sin;
+        sn = next;
+    }
+    return sum;
 }
+
+// The visibility from the basis sum at the filter width and the search's lookup `look` (which
+// found blockers: share ≥ BLOCKER_MIN_SHARE).
+// The paper's resolve: CSM's clamp (csm_resolve, v₁), then v₁^p. The clamp has a dead zone: a
+// square whose share of blockers is small reads 1 (lit), as the series leaks light at blockers
+// near the receiver (at M = 4 a blocker 0.1 in front reads f = 0.63), and v^p cannot darken 1:
+// thin blockers lose their shadow (measured on `pole`).
+// `l.cssm_two_depth`: the square modelled as the receiver's plane and blockers at z_avg,
+// E[f] = (1 − σ)·f_r + σ·f_b with f_r the series' mean over the plane (cssm_two_series, the
+// slope from the G-buffer normal) and f_b the series at z_avg, gives the blockers' share
+// σ = (f_r − E[f]) / (f_r − f_b) and v₂ = 1 − σ, with no dead zone. min(v₁, v₂): where the
+// blockers spread in depth (an umbra of several surfaces), v₂ under-darkens and the clamp does
+// not. The contrast f_r − f_b is the inversion's divisor: below 0.3 (blockers within about
+// 1/(2M) of the receiver, contact) the paper's v₁^p, blended in up to 0.6.
+fn sg_cssm_resolve(sum: f32, look: sg_SoftLookup, l: sg_Light, s: sg_LightSample) -> f32 {
+    let v1 = sg_csm_resolve(sum, l);
+    let gap = max(s.depth - l.bias - look.blocker.x, 0.0);
+    let p = 1.0 + l.sharpen * exp(-l.sharpen_falloff * gap);
+    let sharpened = sg_cssm_sharpen(v1, p);
+    if l.cssm_two_depth == 0u {
+        return sharpened;
+    }
+    let d = s.depth - l.bias - l.csm_offset;
+    let f = sg_cssm_two_series(s.depth - d, s.depth_slope * (0.5 * look.width), look.blocker.x - d, l);
+    let f_r = f.x;
+    let contrast = f.x - f.y;
+    let v2 = clamp(1.0 - (f_r - sum) / max(contrast, sg_CSSM_MIN_CONTRAST), 0.0, 1.0);
+    return mix(sharpened, min(v1, v2), smoothstep(sg_CSSM_MIN_CONTRAST, sg_CSSM_FULL_CONTRAST, contrast));
+}
+
+// The two-depth resolve's blend over the series' contrast f_r − f_b (cssm_resolve).
+const sg_CSSM_MIN_CONTRAST: f32 = 0.3;
+const sg_CSSM_FULL_CONTRAST: f32 = 0.6;
 // Exponential shadow maps: visibility = clamp(E[exp(c z)] · exp(−c d), 0, 1), with the filtered
 // moment kept as its logarithm L, so the product is exp(L − c d) and never overflows.
 

@@ -61,8 +61,8 @@ struct Light {
     cascade_far: array<vec4<f32>, 2>, // cascades: far view distance of cascade c at [c / 4][c % 4]
     sat_filtered: u32,       // tables: 1 where f32 and read with filtered fetches (the CPU references read it)
     sat_amplitude: f32,      // tables: the largest |v − sat_offset| over the value range (the CPU references read it)
-    _pad_end0: u32,
-    _pad_end1: u32,
+    cssm_two_depth: u32,     // cssm: 1 two-depth resolve (needs the receiver plane's slope), 0 sharpening alone
+    _pad_end: u32,
 }
 
 // `Light::technique` (keep in sync with the `TECHNIQUE_*` constants of src/gpu_data.rs; a test
@@ -89,7 +89,7 @@ struct LightSample {
     view_z: f32,     // receiver's distance Z along the light axis
     inside: bool,    // inside the map and the depth range
     footprint: vec4<f32>, // the pixel's footprint in the map, texels: axes (x, y) and (z, w); 0 unknown
-    depth_slope: vec2<f32>, // receiver plane: d(depth)/d(texel) along u and v (0 when off)
+    depth_slope: vec2<f32>, // receiver plane: d(depth)/d(texel) along u and v (0 unless light_plane_slope)
 }
 
 // World width of the whole map at view distance z.
@@ -148,7 +148,7 @@ fn map_sample(l: Light, p: vec3<f32>, n: vec3<f32>) -> LightSample {
         && s.depth >= 0.0 && s.depth <= 1.0;
     s.footprint = vec4<f32>(0.0);
     s.depth_slope = vec2<f32>(0.0);
-    if l.receiver_plane > 0.0 {
+    if light_plane_slope(l) {
         s.depth_slope = light_depth_slope(l, q, n, s.view_z);
     }
     return s;
@@ -203,13 +203,19 @@ fn point_sample(l: Light, p: vec3<f32>, n: vec3<f32>) -> LightSample {
     s.inside = c.z > 0.0 && s.depth >= 0.0 && s.depth <= 1.0;
     s.footprint = vec4<f32>(0.0);
     s.depth_slope = vec2<f32>(0.0);
-    if l.receiver_plane > 0.0 {
+    if light_plane_slope(l) {
         // The face's view space: point_coords gives (x, y, distance) and looks down −z.
         let nf = point_coords(n, f);
         let v = vec3<f32>(c.x, c.y, -c.z);
         s.depth_slope = light_depth_slope_view(l, v, vec3<f32>(nf.x, nf.y, -nf.z), c.z, true);
     }
     return s;
+}
+
+// Whether a sample carries its receiver plane's slope: for the receiver-plane bias, and for
+// CSSM's two-depth resolve (the receivers' mean series over its filter square).
+fn light_plane_slope(l: Light) -> bool {
+    return l.receiver_plane > 0.0 || l.cssm_two_depth != 0u;
 }
 
 // Receiver-plane depth bias (Isidoro, GDC 2006): the depth of the plane through the receiver q

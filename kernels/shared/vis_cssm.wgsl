@@ -5,8 +5,10 @@
 // about ½ and clamped to [0, 1] as CSM's (csm_resolve: the clamp cuts the ringing), then
 // sharpened selectively, v^p with p = 1 + A·exp(−B (d − z_avg)): near contact (d ≈ z_avg),
 // where the smooth Fourier step leaks light and the penumbra is narrow, the darkening is
-// strongest; it fades as the receiver leaves its blockers. A square without blockers
-// (share < BLOCKER_MIN_SHARE) is lit.
+// strongest; it fades as the receiver leaves its blockers. By default (`resolve =
+// "two_depth"`, this project's) away from contact the series is instead inverted for the share
+// of blockers at z_avg (cssm_resolve). A square without blockers (share < BLOCKER_MIN_SHARE)
+// is lit.
 // The shading block (technique::cssm's `visibility`) reads, at the search width snapped
 // outward to texel edges (`sat_search_*`, 4 loads a table), either (`blocker_search =
 // "moments"`, the default) MSM's quantized moments' table, which gives `cssm_blocker_moments`, or
@@ -36,11 +38,65 @@ fn cssm_sharpen(v: f32, p: f32) -> f32 {
     return select(0.0, exp2(p * log2(v)), v > 0.0);
 }
 
-// The visibility from the basis sum at the filter width and the blocker estimate `b` (which
-// found blockers: share ≥ BLOCKER_MIN_SHARE).
-fn cssm_resolve(sum: f32, b: vec2<f32>, l: Light, s: LightSample) -> f32 {
-    let v = csm_resolve(sum, l);
-    let gap = max(s.depth - l.bias - b.x, 0.0);
-    let p = 1.0 + l.sharpen * exp(-l.sharpen_falloff * gap);
-    return cssm_sharpen(v, p);
+// The two series of the two-depth resolve in one loop: (Σ_k w_k sin(c_k x_r)·sinc(c_k a.x)·
+// sinc(c_k a.y), Σ_k w_k sin(c_k x_b)), i.e. f − ½ at depth offset x_r as the mean over a
+// square on a plane whose depth changes by ±a (linear depth units) from the square's centre to
+// its edges along u and v (the mean of sin(c(x + a.x·u + a.y·v)) over u, v ∈ [−1, 1] is
+// sin(c x)·sinc(c a.x)·sinc(c a.y), sinc(t) = sin(t)/t), and f − ½ at x_b. The sines of
+// c_k = π(2k − 1) times the four arguments advance by a rotation of 2π·argument per term (four
+// multiply-adds instead of a sine: the loop runs at every shaded pixel with blockers), the
+// weights as csm_terms_chunk's.
+fn cssm_two_series(x_r: f32, a: vec2<f32>, x_b: f32, l: Light) -> vec2<f32> {
+    let v = vec4<f32>(x_r, x_b, a);
+    var sn = sin(CSM_PI * v);
+    var cs = cos(CSM_PI * v);
+    let step_sin = 2.0 * sn * cs;
+    let step_cos = cs * cs - sn * sn;
+    // The weights' Gaussian factors as csm_terms_start advances them.
+    var w = csm_terms_start(0.0, l);
+    var sum = vec2<f32>(0.0);
+    for (var k = 1u; k <= l.csm_terms; k++) {
+        let c = CSM_PI * f32(2u * k - 1u);
+        let t = c * a;
+        let sinc = select(vec2<f32>(1.0), sn.zw / t, abs(t) > vec2<f32>(1e-4));
+        sum += (2.0 / c * w.gauss) * vec2<f32>(sn.x * sinc.x * sinc.y, sn.y);
+        csm_terms_advance(&w);
+        let next = sn * step_cos + cs * step_sin;
+        cs = cs * step_cos - sn * step_sin;
+        sn = next;
+    }
+    return sum;
 }
+
+// The visibility from the basis sum at the filter width and the search's lookup `look` (which
+// found blockers: share ≥ BLOCKER_MIN_SHARE).
+// The paper's resolve: CSM's clamp (csm_resolve, v₁), then v₁^p. The clamp has a dead zone: a
+// square whose share of blockers is small reads 1 (lit), as the series leaks light at blockers
+// near the receiver (at M = 4 a blocker 0.1 in front reads f = 0.63), and v^p cannot darken 1:
+// thin blockers lose their shadow (measured on `pole`).
+// `l.cssm_two_depth`: the square modelled as the receiver's plane and blockers at z_avg,
+// E[f] = (1 − σ)·f_r + σ·f_b with f_r the series' mean over the plane (cssm_two_series, the
+// slope from the G-buffer normal) and f_b the series at z_avg, gives the blockers' share
+// σ = (f_r − E[f]) / (f_r − f_b) and v₂ = 1 − σ, with no dead zone. min(v₁, v₂): where the
+// blockers spread in depth (an umbra of several surfaces), v₂ under-darkens and the clamp does
+// not. The contrast f_r − f_b is the inversion's divisor: below 0.3 (blockers within about
+// 1/(2M) of the receiver, contact) the paper's v₁^p, blended in up to 0.6.
+fn cssm_resolve(sum: f32, look: SoftLookup, l: Light, s: LightSample) -> f32 {
+    let v1 = csm_resolve(sum, l);
+    let gap = max(s.depth - l.bias - look.blocker.x, 0.0);
+    let p = 1.0 + l.sharpen * exp(-l.sharpen_falloff * gap);
+    let sharpened = cssm_sharpen(v1, p);
+    if l.cssm_two_depth == 0u {
+        return sharpened;
+    }
+    let d = s.depth - l.bias - l.csm_offset;
+    let f = cssm_two_series(s.depth - d, s.depth_slope * (0.5 * look.width), look.blocker.x - d, l);
+    let f_r = f.x;
+    let contrast = f.x - f.y;
+    let v2 = clamp(1.0 - (f_r - sum) / max(contrast, CSSM_MIN_CONTRAST), 0.0, 1.0);
+    return mix(sharpened, min(v1, v2), smoothstep(CSSM_MIN_CONTRAST, CSSM_FULL_CONTRAST, contrast));
+}
+
+// The two-depth resolve's blend over the series' contrast f_r − f_b (cssm_resolve).
+const CSSM_MIN_CONTRAST: f32 = 0.3;
+const CSSM_FULL_CONTRAST: f32 = 0.6;

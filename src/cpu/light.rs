@@ -18,7 +18,7 @@ pub struct LightSample {
     pub inside: bool,
     /// The pixel's footprint in the map, texels: axes `[0..2]` and `[2..4]` (0: unknown).
     pub footprint: [f64; 4],
-    /// Receiver plane: d(depth)/d(texel) along u and v (0 when the bias is off).
+    /// Receiver plane: d(depth)/d(texel) along u and v (0 unless [`plane_slope`]).
     pub depth_slope: [f64; 2],
 }
 
@@ -76,7 +76,7 @@ pub fn sample(l: &LightGpu, p: DVec3, n: DVec3) -> LightSample {
     let inside = clip.w > 0.0
         && uv.iter().all(|&c| (0.0..=1.0).contains(&c))
         && (0.0..=1.0).contains(&depth);
-    let depth_slope = if l.receiver_plane > 0.0 {
+    let depth_slope = if plane_slope(l) {
         depth_slope(l, q, n, view_z)
     } else {
         [0.0; 2]
@@ -108,7 +108,7 @@ pub fn point_sample(l: &LightGpu, p: DVec3, n: DVec3) -> LightSample {
     let tile = [0.5 + 0.5 * v.x / t, 0.5 - 0.5 * v.y / t];
     let (col, row) = (f64::from(f % point::COLUMNS), f64::from(f / point::COLUMNS));
     let depth = (view_z - near) / (far - near);
-    let depth_slope = if l.receiver_plane > 0.0 {
+    let depth_slope = if plane_slope(l) {
         let nv = (view * n.extend(0.0)).truncate();
         depth_slope_view(l, v, nv, view_z, true)
     } else {
@@ -134,6 +134,11 @@ pub fn point_moved(l: &LightGpu, p: DVec3, n: DVec3) -> DVec3 {
     let z0 = (p - v3(l.position)).abs().max_element();
     let ndl = n.dot(to_light(l, p)).clamp(0.0, 1.0);
     p + n * (f64::from(l.normal_bias) * texel(l, z0.max(f64::from(l.near))) * (1.0 - ndl))
+}
+
+/// `light_plane_slope`: whether a sample carries its receiver plane's slope.
+pub fn plane_slope(l: &LightGpu) -> bool {
+    l.receiver_plane > 0.0 || l.cssm_two_depth != 0
 }
 
 /// `light_depth_slope`: the depth of the plane through `q` with normal `n` per texel of offset

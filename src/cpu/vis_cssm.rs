@@ -1,7 +1,7 @@
 //! Reference of `kernels/shared/vis_cssm.wgsl` (with the body `technique::visibility_body`
 //! generates around it), in the three steps of [`super::vis_vssm`]: the search's means over
 //! the search square (MSM's quantized moments, or the CSM and CSM-Z series), the blocker estimate,
-//! the sharpened CSM visibility at the penumbra width.
+//! the CSM visibility at the penumbra width, sharpened or (`two_depth`) inverted.
 
 use super::blocker::{self, Blocker};
 use super::light::LightSample;
@@ -64,17 +64,60 @@ pub fn exponent(l: &LightGpu, s: &LightSample, b: Blocker) -> f64 {
     1.0 + f64::from(l.sharpen) * (-f64::from(l.sharpen_falloff) * gap).exp()
 }
 
-/// `cssm_resolve` for the series `sum` at the filter width.
-pub fn resolve(sum: f64, l: &LightGpu, s: &LightSample, b: Blocker) -> f64 {
+/// `CSSM_MIN_CONTRAST`, `CSSM_FULL_CONTRAST`: the two-depth resolve's blend over the series'
+/// contrast `f_r − f_b`.
+pub const MIN_CONTRAST: f64 = 0.3;
+/// See [`MIN_CONTRAST`].
+pub const FULL_CONTRAST: f64 = 0.6;
+
+/// `cssm_two_series` (its first; its second is this at `a = 0`): `Σ w_k sin(c_k x)·sinc(c_k a₀)·
+/// sinc(c_k a₁)`, the series `f − ½` at depth offset `x` averaged over a square on a plane whose
+/// depth changes by `±a` from the square's centre to its edges. Here each sine directly; the
+/// kernel advances them by rotations.
+pub fn plane_series(x: f64, a: [f64; 2], l: &LightGpu) -> f64 {
+    let sinc = |t: f64| if t.abs() > 1e-4 { t.sin() / t } else { 1.0 };
+    (1..=l.csm_terms)
+        .map(|k| {
+            let c = std::f64::consts::PI * f64::from(2 * k - 1);
+            super::vis_csm::weight(k, l) * (c * x).sin() * sinc(c * a[0]) * sinc(c * a[1])
+        })
+        .sum()
+}
+
+/// WGSL's `smoothstep(e0, e1, x)`.
+fn smoothstep(e0: f64, e1: f64, x: f64) -> f64 {
+    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+/// `cssm_resolve` for the series `sum` at the filter width `width` (texels) of `b`.
+pub fn resolve(sum: f64, l: &LightGpu, s: &LightSample, b: Blocker, width: f64) -> f64 {
     if !b.found() {
         return 1.0;
     }
-    super::vis_csm::resolve(sum, l).powf(exponent(l, s, b))
+    let v1 = super::vis_csm::resolve(sum, l);
+    let sharpened = v1.powf(exponent(l, s, b));
+    if l.cssm_two_depth == 0 {
+        return sharpened;
+    }
+    let d = super::vis_csm::shifted_depth(l, s);
+    let half = 0.5 * width;
+    let f_r = plane_series(
+        s.depth - d,
+        [s.depth_slope[0] * half, s.depth_slope[1] * half],
+        l,
+    );
+    let f_b = plane_series(b.depth - d, [0.0; 2], l);
+    let contrast = f_r - f_b;
+    let v2 = (1.0 - (f_r - sum) / contrast.max(MIN_CONTRAST)).clamp(0.0, 1.0);
+    let t = smoothstep(MIN_CONTRAST, FULL_CONTRAST, contrast);
+    sharpened + (v1.min(v2) - sharpened) * t
 }
 
 /// The visibility for blocker estimate `b`.
 pub fn finish(maps: Maps, l: &LightGpu, s: &LightSample, b: Blocker) -> f64 {
-    resolve(filtered(maps, l, s, b), l, s, b)
+    let width = blocker::filter_width(l, s, b.depth);
+    resolve(filtered(maps, l, s, b), l, s, b, width)
 }
 
 /// CSSM visibility.

@@ -253,7 +253,8 @@ pub enum Technique {
     /// Convolution soft shadow maps (Annen et al. 2008): the CSM basis and the CSM-Z basis
     /// (z, z·sin c_k z, z·cos c_k z) through summed-area tables; the average blocker depth over
     /// the light cone's search square, the PCSS penumbra width, the CSM lookup at that width,
-    /// then the selective sharpening `v^p`, `p = 1 + A·exp(−B (d − z_avg))`.
+    /// then the selective sharpening `v^p`, `p = 1 + A·exp(−B (d − z_avg))`, or (`two_depth`)
+    /// away from contact the series inverted for the share of blockers at z_avg.
     Cssm {
         /// Storage, table sums and search cap.
         soft: Soft,
@@ -271,6 +272,11 @@ pub enum Technique {
         sharpen_falloff: f32,
         /// Where the blocker search's means come from.
         search: CssmSearch,
+        /// `resolve = "two_depth"`: away from contact, the share of the filter square's texels
+        /// at the blockers' depth from inverting the series between the receiver plane's mean
+        /// and the blockers' (`kernels/shared/vis_cssm.wgsl`); else the paper's clamp and
+        /// sharpening alone.
+        two_depth: bool,
     },
     /// Variance soft shadow maps (Yang et al. 2010): from the VSM moments over the search
     /// square, the Chebyshev share p of lit texels and `z_avg = (μ − p·d)/(1 − p)`; then VSM

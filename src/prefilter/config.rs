@@ -271,6 +271,16 @@ impl PrefilterConfig {
         })
     }
 
+    /// The same with CSSM's resolve (the scene key `resolve`): `two_depth` (the default: away
+    /// from contact, the filtered series inverted for the share of blockers at their average
+    /// depth) or the paper's clamp and sharpening alone. Not applicable to other techniques.
+    pub fn with_cssm_resolve(self, two_depth: bool) -> Self {
+        self.with_values("resolve", |v| {
+            let name = if two_depth { "two_depth" } else { "sharpen" };
+            v.set("resolve", ParamValue::Choice(name));
+        })
+    }
+
     /// The same with the receiver-plane depth bias on, each tap's correction capped at `cap`
     /// linear depth units (0: off).
     pub fn with_receiver_plane(mut self, cap: f32) -> Self {

@@ -40,6 +40,14 @@ const SHARPEN: &[ParamSpec] = &[
         "blocker search: MSM's four moments in one table (msm_soft's estimate) or the paper's \
          CSM-Z basis",
     ),
+    choice(
+        "resolve",
+        &["two_depth", "sharpen"],
+        "two_depth",
+        "the filtered series' visibility: away from contact, inverted for the share of texels at \
+         the blockers' depth against the receiver plane's (two_depth), or the paper's clamp and \
+         sharpening alone",
+    ),
 ];
 
 fn values(t: &Technique) -> ParamValues {
@@ -53,6 +61,7 @@ fn values(t: &Technique) -> ParamValues {
         sharpen,
         sharpen_falloff,
         search,
+        two_depth,
     } = t
     {
         soft_values(soft, &mut out);
@@ -60,6 +69,10 @@ fn values(t: &Technique) -> ParamValues {
         out.set("sharpen", ParamValue::Float(*sharpen));
         out.set("sharpen_falloff", ParamValue::Float(*sharpen_falloff));
         out.set("blocker_search", ParamValue::Choice(search.name()));
+        out.set(
+            "resolve",
+            ParamValue::Choice(if *two_depth { "two_depth" } else { "sharpen" }),
+        );
     }
     out
 }
@@ -123,17 +136,22 @@ fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
             z.len() + basis.len()
         }
     };
-    body.push_str("\n    var sum = 0.0;\n    for (var k = 0u; k < soft_filter_trips(look); k++) {");
-    for (chunk, m) in basis.iter().enumerate() {
+    // The filter sums every term in order: the receiver's factors advance term by term
+    // (csm_terms_chunk).
+    body.push_str(
+        "\n    var sum = 0.0;\n    for (var k = 0u; k < soft_filter_trips(look); k++) {\n        \
+         var terms = csm_terms_start(s.depth - l.bias - l.csm_offset, l);",
+    );
+    for m in basis {
         let _ = write!(
             body,
-            "\n        sum += csm_chunk_of({}, {chunk}u, l, s);",
+            "\n        sum += csm_terms_chunk({}, &terms, l);",
             sample(m)
         );
     }
     body.push_str(
         "\n    }\n    if !look.blockers {\n        return 1.0;\n    }\n    \
-         return cssm_resolve(sum, look.blocker, l, s);",
+         return cssm_resolve(sum, look, l, s);",
     );
     let fetches = format!(
         "{searched} * sat_search_{suffix} + {} * sat_filter_{suffix}",
@@ -164,6 +182,7 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
             "csm_z" => CssmSearch::CsmZ,
             _ => CssmSearch::Moments,
         },
+        two_depth: v.choice("resolve") == "two_depth",
     },
     values,
     gpu: |t, g| {
@@ -172,11 +191,13 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
             sharpen,
             sharpen_falloff,
             soft,
+            two_depth,
             ..
         } = *t
         {
             g.sharpen = sharpen;
             g.sharpen_falloff = sharpen_falloff;
+            g.cssm_two_depth = u32::from(two_depth);
             // The moment search's moments: quantized, biased by msm_soft's default for the
             // storage.
             g.moment_bias = default_soft_moment_bias(soft.storage);
@@ -218,6 +239,14 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
             SweepVariant {
                 label: "cssm M16",
                 values: &[("terms", ParamValue::Int(16))],
+                storage: None,
+            },
+            SweepVariant {
+                label: "cssm M8 sharpen",
+                values: &[
+                    ("terms", ParamValue::Int(8)),
+                    ("resolve", ParamValue::Choice("sharpen")),
+                ],
                 storage: None,
             },
             SweepVariant {

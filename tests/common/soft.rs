@@ -385,6 +385,17 @@ pub fn cssm_tolerance(
     } else {
         0.0
     };
+    // The two-depth resolve's two series f_r, f_b carry the device's sin/cos error per term
+    // (series_error without basis error, sinc's sin/t included: its argument is exact to
+    // 2⁻²⁴ relative); v₂ = 1 − (f_r − sum)/c moves by at most 2e/c for each of f_r and f_b
+    // (|f_r − sum| ≤ c where v₂ is inside [0, 1]), c ≥ MIN_CONTRAST; the blend weight's slope
+    // is at most 1.5/(FULL − MIN) per unit of c, times |v₁^p − min(v₁, v₂)| ≤ 1.
+    let two_depth = if b0.found() && l.cssm_two_depth != 0 {
+        let e = 2.0 * series_error([0.0; 4]);
+        4.0 * e / v::MIN_CONTRAST + 1.5 / (v::FULL_CONTRAST - v::MIN_CONTRAST) * 2.0 * e
+    } else {
+        0.0
+    };
     Chain {
         search: &|du| v::search(maps, l, &shifted(s, du)),
         e_search,
@@ -392,13 +403,13 @@ pub fn cssm_tolerance(
         finish: &|z| v::finish(maps, l, s, Blocker { depth: z, ..b0 }),
         last: &|du| vec![v::filtered(maps, l, &shifted(s, du), b0)],
         e_last: vec![e_sum],
-        visibility: &|m, dd| v::resolve(m[0], l, &moved(s, dd), b0),
+        visibility: &|m, dd| v::resolve(m[0], l, &moved(s, dd), b0, width),
         e_depth: e_d,
         filter_box: &|z| filter_box(l, s, z),
         grid: maps.basis.is_filtered(),
     }
     .tolerance(v0)
-    .map(|t| t + 2.0 * pow)
+    .map(|t| t + 2.0 * pow + two_depth)
 }
 
 /// A CSSM light's shade map (its tables' values side by side, `technique::map_channels`

@@ -256,8 +256,29 @@ pub fn with_sums(mut t: Technique, sums: SatVariant) -> Technique {
     t
 }
 
-/// CSSM with `terms` terms, offset ½/M, scale 2, the given sharpening and blocker search.
+/// CSSM with `terms` terms, offset ½/M, scale 2, the given sharpening and blocker search, and
+/// the default two-depth resolve ([`cssm_sharpened`]: the paper's).
 pub fn cssm(terms: u32, sharpen: f32, sharpen_falloff: f32, search: CssmSearch) -> Technique {
+    cssm_resolved(terms, sharpen, sharpen_falloff, search, true)
+}
+
+/// [`cssm`] with the paper's resolve (clamp and sharpening alone).
+pub fn cssm_sharpened(
+    terms: u32,
+    sharpen: f32,
+    sharpen_falloff: f32,
+    search: CssmSearch,
+) -> Technique {
+    cssm_resolved(terms, sharpen, sharpen_falloff, search, false)
+}
+
+fn cssm_resolved(
+    terms: u32,
+    sharpen: f32,
+    sharpen_falloff: f32,
+    search: CssmSearch,
+    two_depth: bool,
+) -> Technique {
     Technique::Cssm {
         soft: soft(Storage::F32, SatVariant::Fixed),
         terms,
@@ -267,5 +288,6 @@ pub fn cssm(terms: u32, sharpen: f32, sharpen_falloff: f32, search: CssmSearch) 
         sharpen,
         sharpen_falloff,
         search,
+        two_depth,
     }
 }
