@@ -356,6 +356,12 @@ fn configs_follow_the_scene_rules() {
         ),
         (
             "cssm",
+            "resolve = \"sharpen\"",
+            0.5,
+            PrefilterConfig::cssm(64, 8, 0.5).with_cssm_resolve(false),
+        ),
+        (
+            "cssm",
             "terms = 4\nsharpen = 100.5",
             0.5,
             cssm_sharpen(PrefilterConfig::cssm(64, 4, 0.5), 100.5),

@@ -1,6 +1,8 @@
 //! `cssm`: convolution soft shadow maps (Annen et al. 2008): the CSM and CSM-Z bases through
 //! summed-area tables, the blocker depth over the search square, CSM at the penumbra width,
-//! then the selective sharpening `v^p`, `p = 1 + A·exp(−B (d − z_avg))`.
+//! then (`resolve = "two_depth"`, the default) away from contact the series inverted for the
+//! share of blockers at z_avg, or the paper's selective sharpening `v^p`,
+//! `p = 1 + A·exp(−B (d − z_avg))` alone.
 
 use super::csm::series_values;
 use super::params::{CSM, FLOAT_FORMAT, SOFT, choice, float, soft, soft_values};
@@ -168,7 +170,8 @@ fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
 pub(super) static DEF: TechniqueDef = TechniqueDef {
     name: "cssm",
     id: TECHNIQUE_CSSM,
-    doc: "convolution soft shadow maps: CSM at the penumbra width, sharpened",
+    doc: "convolution soft shadow maps: CSM at the penumbra width, resolved for two depths or \
+          sharpened",
     params: &[FLOAT_FORMAT, SOFT, CSM, SHARPEN],
     build: |v| Technique::Cssm {
         soft: soft(v),
