@@ -176,16 +176,6 @@ fn encode_tile(t: Tile, li: u32) {
     workgroupBarrier();
 }
 
-// The horizontal sum at output column x of encoded row y.
-fn sum_x(t: Tile, x: i32, y: i32) -> Texel {
-    let c = y * t.enc.x + x + t.r.x;
-    var s = blur_weight(0) * sh_get(c);
-    for (var i = 1; i <= t.r.x; i++) {
-        s += blur_weight(i) * (sh_get(c - i) + sh_get(c + i));
-    }
-    return s;
-}
-
 fn store(t: Tile, o: vec2<i32>, v: Texel) {
     let p = t.origin + o;
     if all(p < t.size) {
@@ -274,6 +264,18 @@ fn blur_tile(t: Tile, li: u32) {
     }
 }
 
+// The row's blur along x (outs.x = ROW outputs, runs of RUN: ROW / RUN invocations).
+fn blur_row(t: Tile, li: u32) {
+    let x0 = i32(li) * i32(RUN);
+    if x0 < t.outs.x {
+        let v = run_sums(x0 + t.r.x, 1, t.r.x);
+        store(t, vec2<i32>(x0, 0), v.s0);
+        store(t, vec2<i32>(x0 + 1, 0), v.s1);
+        store(t, vec2<i32>(x0 + 2, 0), v.s2);
+        store(t, vec2<i32>(x0 + 3, 0), v.s3);
+    }
+}
+
 // The importing kernel's `main`: workgroup `wg`, invocation `li`.
 fn encode_blur(wg: vec2<u32>, li: u32) {
     let t = tile_of(wg);
@@ -283,6 +285,6 @@ fn encode_blur(wg: vec2<u32>, li: u32) {
     if params.blur.axis == 2u {
         blur_tile(t, li);
     } else {
-        store(t, vec2<i32>(i32(li), 0), sum_x(t, i32(li), 0));
+        blur_row(t, li);
     }
 }
