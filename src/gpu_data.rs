@@ -131,9 +131,11 @@ pub struct LightGpu {
     /// range (half the widest channel's range): the error models' bound on the table's corner
     /// sums (`tolerance::filtered_table_error`).
     pub sat_amplitude: f32,
-    /// CSSM: 1 where the filtered series is resolved by the two-depth inversion
-    /// (`resolve = "two_depth"`, which also has the receiver plane's slope computed), 0 for
-    /// the paper's clamp and sharpening alone (`"sharpen"`).
+    /// CSSM: how the filtered series is resolved: 0 the paper's clamp and sharpening alone
+    /// (`resolve = "sharpen"`); 1 the two-depth inversion with the search's z_avg
+    /// (`"two_depth_search"`, or `"two_depth"` with the CSM-Z search); 2 with the blockers'
+    /// depth over the filter square (`"two_depth"` with the moment search). Non-zero also has
+    /// the receiver plane's slope computed.
     pub cssm_two_depth: u32,
     /// Padding to the struct's 16-byte alignment.
     pub _pad_end: u32,

@@ -263,9 +263,11 @@ fn cssm_moves_what_the_hand_count_says() {
 /// The hand counts of the shading fetches: one bilinear lookup (4 loads) for VSM with a blur,
 /// one table lookup (16 loads: the 4 × 4 texels around the rectangle's corners) for MSM with
 /// a table, and for CSSM with M = 8 the power moments' table over the search square snapped
-/// outward (4 loads) plus the ⌈M/2⌉ = 4 CSM tables over the filter square with its edges at
-/// the nearest texel edges (4 loads each): 5 × 4 = 20 (with the CSM-Z search, the 4 CSM and
-/// ⌈(2M + 1)/4⌉ = 5 CSM-Z tables over the search square too: 13 × 4 = 52); VSSM and soft
+/// outward (4 loads) plus the ⌈M/2⌉ = 4 CSM tables and the moments' table again (the two-depth
+/// resolve's blockers over the filter square) over the filter square with its edges at the
+/// nearest texel edges (4 loads each): 6 × 4 = 24 (20 with `resolve = "two_depth_search"`;
+/// with the CSM-Z search, the 4 CSM and ⌈(2M + 1)/4⌉ = 5 CSM-Z tables over the search square
+/// too and no second read: 13 × 4 = 52); VSSM and soft
 /// MSM one table, 4 + 4; PCSS 16 blocker + 32 filter taps; anisotropic mips 8 taps of 8 loads
 /// (trilinear).
 #[test]
@@ -275,7 +277,7 @@ fn shading_fetches_match_the_hand_counts() {
         // Packed f16 moments: the same four loads, each one word unpacked.
         ("techniques/vsm_f16.toml", 4.0),
         ("techniques/msm_sat.toml", 16.0),
-        ("techniques/cssm.toml", 20.0),
+        ("techniques/cssm.toml", 24.0),
         ("techniques/vssm.toml", 8.0),
         ("techniques/msm_soft.toml", 8.0),
         ("sphere_on_plane.toml", 48.0),
@@ -293,6 +295,13 @@ fn shading_fetches_match_the_hand_counts() {
     let s = Scene::parse(&path, &text).expect("parse");
     let got = shadowgraph::cli::shading_fetches(&s.lights).expect("fetches");
     assert_eq!(got, [52.0], "cssm.toml, csm_z");
+    let text = std::fs::read_to_string(&path).expect("cssm.toml").replace(
+        "technique = \"cssm\"",
+        "technique = \"cssm\"\nresolve = \"two_depth_search\"",
+    );
+    let s = Scene::parse(&path, &text).expect("parse");
+    let got = shadowgraph::cli::shading_fetches(&s.lights).expect("fetches");
+    assert_eq!(got, [20.0], "cssm.toml, two_depth_search");
 }
 
 /// `plan` prints each node's traffic, the closing total and the shading fetches.

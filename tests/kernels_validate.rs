@@ -112,7 +112,7 @@ fn all_techniques() -> Vec<Technique> {
             sharpen: 2.0,
             sharpen_falloff: 50.0,
             search: shadowgraph::scene::CssmSearch::Moments,
-            two_depth: true,
+            resolve: shadowgraph::scene::CssmResolve::TwoDepthSearch,
         },
         Technique::Cssm {
             soft: soft(Storage::F16, SatVariant::Float),
@@ -123,7 +123,7 @@ fn all_techniques() -> Vec<Technique> {
             sharpen: 0.0,
             sharpen_falloff: 0.0,
             search: shadowgraph::scene::CssmSearch::CsmZ,
-            two_depth: false,
+            resolve: shadowgraph::scene::CssmResolve::Sharpen,
         },
         Technique::Vssm {
             soft: soft(Storage::F32, SatVariant::Fixed),

@@ -7,7 +7,7 @@ use std::path::Path;
 use shadowgraph::kernels;
 use shadowgraph::prefilter::{PrefilterConfig, StageError, wgsl};
 use shadowgraph::scene::{
-    BlurKernel, CssmSearch, Filter, PcfKernel, Prefilter, Scene, Storage, Technique,
+    BlurKernel, CssmResolve, CssmSearch, Filter, PcfKernel, Prefilter, Scene, Storage, Technique,
 };
 use shadowgraph::technique::LightGpu;
 
@@ -358,7 +358,13 @@ fn configs_follow_the_scene_rules() {
             "cssm",
             "resolve = \"sharpen\"",
             0.5,
-            PrefilterConfig::cssm(64, 8, 0.5).with_cssm_resolve(false),
+            PrefilterConfig::cssm(64, 8, 0.5).with_cssm_resolve(CssmResolve::Sharpen),
+        ),
+        (
+            "cssm",
+            "resolve = \"two_depth_search\"",
+            0.5,
+            PrefilterConfig::cssm(64, 8, 0.5).with_cssm_resolve(CssmResolve::TwoDepthSearch),
         ),
         (
             "cssm",

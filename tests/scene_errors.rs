@@ -1126,7 +1126,7 @@ fn soft_techniques_keys_defaults_and_errors() {
             sharpen: shadowgraph::scene::DEFAULT_SHARPEN,
             sharpen_falloff: shadowgraph::scene::DEFAULT_SHARPEN_FALLOFF,
             search: shadowgraph::scene::CssmSearch::Moments,
-            two_depth: true,
+            resolve: shadowgraph::scene::CssmResolve::TwoDepth,
         }
     );
     let s = parse(&soft("technique = \"vssm\"", "size = 0.5")).expect("vssm parses");

@@ -877,7 +877,7 @@ fn every_technique_renders_every_bundled_scene() {
             sharpen: shadowgraph::scene::DEFAULT_SHARPEN,
             sharpen_falloff: shadowgraph::scene::DEFAULT_SHARPEN_FALLOFF,
             search: shadowgraph::scene::CssmSearch::CsmZ,
-            two_depth: true,
+            resolve: shadowgraph::scene::CssmResolve::TwoDepth,
         },
         Technique::Vssm {
             soft: soft(Storage::F16, shadowgraph::sat::SatVariant::Float),

@@ -9,8 +9,8 @@ mod common;
 
 use common::soft::TableError;
 use common::soft_maps::{
-    DIR, MAP, SPOT, Tables, cssm, cssm_sharpened, light, msm_soft, rounded, tables, trig_error,
-    vssm, with_sums,
+    DIR, MAP, SPOT, Tables, cssm_resolved, light, msm_soft, rounded, tables, trig_error, vssm,
+    with_sums,
 };
 use glam::{DVec3, Vec3};
 use rand::Rng;
@@ -233,25 +233,30 @@ fn cssm_matches_reference() {
     // Vulkan's 2⁻¹¹ first) and the means' errors per term; the moment search's means their
     // tables' error as msm_soft's do; then as VSSM's, plus the f32 exp2/log2 of the sharpening
     // v^p. Sharpening A = 3, B = 10 per depth unit, so that most penumbra points are sharpened
-    // noticeably. Both blocker searches: the moments (the default) and the paper's CSM-Z; both
-    // resolves: the two-depth inversion (the default; its two series carry the sin/cos error)
-    // and the paper's sharpening alone.
+    // noticeably. Both blocker searches: the moments (the default) and the paper's CSM-Z; the
+    // three resolves: the two-depth inversion (the default; its two series carry the sin/cos
+    // error) with the blockers' depth over the filter square (its moments' means carry their
+    // table's error) or the search's, and the paper's sharpening alone.
     let g = common::gpu();
     let e_trig = trig_error(&g);
     eprintln!("device sin/cos error (×2 + 2⁻²⁴): {e_trig:.2e}");
-    for (terms, seed, kind, sums, two_depth) in [
-        (4, 220, CssmSearch::Moments, SatVariant::Fixed, true),
-        (7, 221, CssmSearch::Moments, SatVariant::Fixed, true),
-        (4, 222, CssmSearch::CsmZ, SatVariant::Fixed, true),
-        (7, 223, CssmSearch::CsmZ, SatVariant::Fixed, false),
-        (4, 224, CssmSearch::Moments, SatVariant::Float, true),
-        (7, 225, CssmSearch::Moments, SatVariant::Fixed, false),
+    use shadowgraph::scene::CssmResolve::{Sharpen, TwoDepth, TwoDepthSearch};
+    for (terms, seed, kind, sums, resolve) in [
+        (4, 220, CssmSearch::Moments, SatVariant::Fixed, TwoDepth),
+        (7, 221, CssmSearch::Moments, SatVariant::Fixed, TwoDepth),
+        (4, 222, CssmSearch::CsmZ, SatVariant::Fixed, TwoDepth),
+        (7, 223, CssmSearch::CsmZ, SatVariant::Fixed, Sharpen),
+        (4, 224, CssmSearch::Moments, SatVariant::Float, TwoDepth),
+        (7, 225, CssmSearch::Moments, SatVariant::Fixed, Sharpen),
+        (
+            5,
+            226,
+            CssmSearch::Moments,
+            SatVariant::Fixed,
+            TwoDepthSearch,
+        ),
     ] {
-        let technique = if two_depth {
-            cssm(terms, 3.0, 10.0, kind)
-        } else {
-            cssm_sharpened(terms, 3.0, 10.0, kind)
-        };
+        let technique = cssm_resolved(terms, 3.0, 10.0, kind, resolve);
         let seen = check_soft(
             &g,
             with_sums(technique, sums),
@@ -281,8 +286,9 @@ fn cssm_matches_reference() {
             },
         );
         eprintln!(
-            "cssm M = {terms} {} {sums:?} two_depth {two_depth}: {seen}",
-            kind.name()
+            "cssm M = {terms} {} {sums:?} {}: {seen}",
+            kind.name(),
+            resolve.name()
         );
     }
 }

@@ -56,19 +56,20 @@
 //
 // Names defined here, each with the `sg_` prefix (a host's own names need only avoid
 // `sg_` and `shadowgraph_`):
-//   sg_BLOCKER_MIN_SHARE sg_CSM_PI sg_CSSM_FULL_CONTRAST sg_CSSM_MIN_CONTRAST sg_CascadePick
-//   sg_CsmTerms sg_GOLDEN_ANGLE sg_Light sg_LightSample sg_MSM_B0 sg_MSM_B0_COV sg_MSM_B0_SCHUR
-//   sg_MipTaps sg_MsmMoments sg_SAT_GRID sg_SAT_MIN_EXTENT sg_SatNodes sg_SoftLookup
-//   sg_TECHNIQUE_CSM sg_TECHNIQUE_CSSM sg_TECHNIQUE_ESM sg_TECHNIQUE_EVSM sg_TECHNIQUE_HARD
-//   sg_TECHNIQUE_MIDPOINT sg_TECHNIQUE_MSM sg_TECHNIQUE_MSM_SOFT sg_TECHNIQUE_PCF
-//   sg_TECHNIQUE_PCSS sg_TECHNIQUE_SECOND_DEPTH sg_TECHNIQUE_SMRT sg_TECHNIQUE_VSM
-//   sg_TECHNIQUE_VSSM sg_bilinear_level sg_bilinear_level_packed sg_bilinear_log_level
-//   sg_blocker_csm_z sg_blocker_filter_width sg_blocker_msm sg_blocker_result
-//   sg_blocker_search_width sg_blocker_vsm sg_blocker_width sg_cascade_far_of sg_cascade_pick
-//   sg_chebyshev_upper sg_csm_chunk sg_csm_chunk_of sg_csm_resolve sg_csm_sin_cos
-//   sg_csm_terms_advance sg_csm_terms_chunk sg_csm_terms_start sg_csm_weight sg_csm_z_chunk_of
-//   sg_cssm_blocker sg_cssm_blocker_moments sg_cssm_resolve sg_cssm_sharpen sg_cssm_two_series
-//   sg_level_size sg_level_size_of sg_light_depth_slope sg_light_depth_slope_view sg_light_faces
+//   sg_BLOCKER_MIN_SHARE sg_CSM_PI sg_CSSM_BLOCKER_FLOOR sg_CSSM_FULL_CONTRAST
+//   sg_CSSM_MIN_CONTRAST sg_CascadePick sg_CsmTerms sg_GOLDEN_ANGLE sg_Light sg_LightSample
+//   sg_MSM_B0 sg_MSM_B0_COV sg_MSM_B0_SCHUR sg_MipTaps sg_MsmMoments sg_SAT_GRID
+//   sg_SAT_MIN_EXTENT sg_SatNodes sg_SoftLookup sg_TECHNIQUE_CSM sg_TECHNIQUE_CSSM
+//   sg_TECHNIQUE_ESM sg_TECHNIQUE_EVSM sg_TECHNIQUE_HARD sg_TECHNIQUE_MIDPOINT sg_TECHNIQUE_MSM
+//   sg_TECHNIQUE_MSM_SOFT sg_TECHNIQUE_PCF sg_TECHNIQUE_PCSS sg_TECHNIQUE_SECOND_DEPTH
+//   sg_TECHNIQUE_SMRT sg_TECHNIQUE_VSM sg_TECHNIQUE_VSSM sg_bilinear_level
+//   sg_bilinear_level_packed sg_bilinear_log_level sg_blocker_csm_z sg_blocker_filter_width
+//   sg_blocker_msm sg_blocker_result sg_blocker_search_width sg_blocker_vsm sg_blocker_width
+//   sg_cascade_far_of sg_cascade_pick sg_chebyshev_upper sg_csm_chunk sg_csm_chunk_of
+//   sg_csm_resolve sg_csm_sin_cos sg_csm_terms_advance sg_csm_terms_chunk sg_csm_terms_start
+//   sg_csm_weight sg_csm_z_chunk_of sg_cssm_blocker sg_cssm_blocker_moments
+//   sg_cssm_filter_blockers sg_cssm_resolve sg_cssm_sharpen sg_cssm_two_series sg_level_size
+//   sg_level_size_of sg_light_depth_slope sg_light_depth_slope_view sg_light_faces
 //   sg_light_footprint sg_light_linear_to_ndc sg_light_linear_to_z sg_light_map_width
 //   sg_light_plane_slope sg_light_receiver_offset sg_light_sample sg_light_tap_offset
 //   sg_light_texel sg_light_to_light sg_linstep sg_load_depth sg_map_sample sg_mip_tap_uv
@@ -150,7 +151,7 @@ struct sg_Light {
     cascade_far: array<vec4<f32>, 2>, // cascades: far view distance of cascade c at [c / 4][c % 4]
     sat_filtered: u32,       // tables: 1 where f32 and read with filtered fetches (the CPU references read it)
     sat_amplitude: f32,      // tables: the largest |v − sat_offset| over the value range (the CPU references read it)
-    cssm_two_depth: u32,     // cssm: 1 two-depth resolve (needs the receiver plane's slope), 0 sharpening alone
+    cssm_two_depth: u32,     // cssm: 0 sharpening alone; two-depth resolve (needs the receiver plane's slope) with the search's z_avg 1, the filter square's 2
     _pad_end: u32,
 }
 
@@ -1407,6 +1408,22 @@ fn sg_cssm_blocker_moments(m: vec4<f32>, l: sg_Light, s: sg_LightSample) -> vec2
     return sg_blocker_msm(sg_msm_biased(m, l), s.depth - l.bias);
 }
 
+// The blockers' depth over the filter square for the two-depth resolve (`resolve =
+// "two_depth"` with the moment search): from the moments' table's mean there `m`, dequantized,
+// VSSM's estimate (blocker_vsm: Chebyshev's share behind d, the rest's mean) from its first two
+// moments, variance floored at CSSM_BLOCKER_FLOOR; where it finds no blockers, the search's
+// z_avg. The search square is wider than the filter's where the blockers are near the receiver
+// and holds other blockers: its z_avg, in front of the filter square's blockers, under-darkens
+// their umbra (measured on `point`: umbra error 0.161 against 0.085).
+fn sg_cssm_filter_blockers(m: vec4<f32>, look: sg_SoftLookup, l: sg_Light, s: sg_LightSample) -> f32 {
+    let b = select(m, sg_msm_dequantize(m), (l.msm_flags & 2u) != 0u);
+    let f = sg_blocker_vsm(b, s.depth - l.bias, sg_CSSM_BLOCKER_FLOOR);
+    return select(look.blocker.x, f.x, f.y >= sg_BLOCKER_MIN_SHARE);
+}
+
+// The variance floor of cssm_filter_blockers (linear depth units²).
+const sg_CSSM_BLOCKER_FLOOR: f32 = 1e-6;
+
 // v^p for v in [0, 1], p ≥ 1 (0 at v = 0, where log2 is −∞).
 fn sg_cssm_sharpen(v: f32, p: f32) -> f32 {
     return select(0.0, exp2(p * log2(v)), v > 0.0);
@@ -1442,20 +1459,21 @@ fn sg_cssm_two_series(x_r: f32, a: vec2<f32>, x_b: f32, l: sg_Light) -> vec2<f32
     return sum;
 }
 
-// The visibility from the basis sum at the filter width and the search's lookup `look` (which
-// found blockers: share ≥ BLOCKER_MIN_SHARE).
+// The visibility from the basis sum at the filter width, the search's lookup `look` (which
+// found blockers: share ≥ BLOCKER_MIN_SHARE) and the blockers' depth z_b (look's z_avg, or
+// cssm_filter_blockers').
 // The paper's resolve: CSM's clamp (csm_resolve, v₁), then v₁^p. The clamp has a dead zone: a
 // square whose share of blockers is small reads 1 (lit), as the series leaks light at blockers
 // near the receiver (at M = 4 a blocker 0.1 in front reads f = 0.63), and v^p cannot darken 1:
 // thin blockers lose their shadow (measured on `pole`).
-// `l.cssm_two_depth`: the square modelled as the receiver's plane and blockers at z_avg,
+// `l.cssm_two_depth`: the square modelled as the receiver's plane and blockers at z_b,
 // E[f] = (1 − σ)·f_r + σ·f_b with f_r the series' mean over the plane (cssm_two_series, the
-// slope from the G-buffer normal) and f_b the series at z_avg, gives the blockers' share
+// slope from the G-buffer normal) and f_b the series at z_b, gives the blockers' share
 // σ = (f_r − E[f]) / (f_r − f_b) and v₂ = 1 − σ, with no dead zone. min(v₁, v₂): where the
 // blockers spread in depth (an umbra of several surfaces), v₂ under-darkens and the clamp does
 // not. The contrast f_r − f_b is the inversion's divisor: below 0.3 (blockers within about
 // 1/(2M) of the receiver, contact) the paper's v₁^p, blended in up to 0.6.
-fn sg_cssm_resolve(sum: f32, look: sg_SoftLookup, l: sg_Light, s: sg_LightSample) -> f32 {
+fn sg_cssm_resolve(sum: f32, look: sg_SoftLookup, z_b: f32, l: sg_Light, s: sg_LightSample) -> f32 {
     let v1 = sg_csm_resolve(sum, l);
     let gap = max(s.depth - l.bias - look.blocker.x, 0.0);
     let p = 1.0 + l.sharpen * exp(-l.sharpen_falloff * gap);
@@ -1464,7 +1482,7 @@ fn sg_cssm_resolve(sum: f32, look: sg_SoftLookup, l: sg_Light, s: sg_LightSample
         return sharpened;
     }
     let d = s.depth - l.bias - l.csm_offset;
-    let f = sg_cssm_two_series(s.depth - d, s.depth_slope * (0.5 * look.width), look.blocker.x - d, l);
+    let f = sg_cssm_two_series(s.depth - d, s.depth_slope * (0.5 * look.width), z_b - d, l);
     let f_r = f.x;
     let contrast = f.x - f.y;
     let v2 = clamp(1.0 - (f_r - sum) / max(contrast, sg_CSSM_MIN_CONTRAST), 0.0, 1.0);

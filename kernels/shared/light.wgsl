@@ -61,7 +61,7 @@ struct Light {
     cascade_far: array<vec4<f32>, 2>, // cascades: far view distance of cascade c at [c / 4][c % 4]
     sat_filtered: u32,       // tables: 1 where f32 and read with filtered fetches (the CPU references read it)
     sat_amplitude: f32,      // tables: the largest |v − sat_offset| over the value range (the CPU references read it)
-    cssm_two_depth: u32,     // cssm: 1 two-depth resolve (needs the receiver plane's slope), 0 sharpening alone
+    cssm_two_depth: u32,     // cssm: 0 sharpening alone; two-depth resolve (needs the receiver plane's slope) with the search's z_avg 1, the filter square's 2
     _pad_end: u32,
 }
 

@@ -90,8 +90,31 @@ fn smoothstep(e0: f64, e1: f64, x: f64) -> f64 {
     t * t * (3.0 - 2.0 * t)
 }
 
-/// `cssm_resolve` for the series `sum` at the filter width `width` (texels) of `b`.
-pub fn resolve(sum: f64, l: &LightGpu, s: &LightSample, b: Blocker, width: f64) -> f64 {
+/// `CSSM_BLOCKER_FLOOR`: the variance floor of [`filter_blockers`].
+pub const BLOCKER_FLOOR: f64 = 1e-6;
+
+/// `cssm_filter_blockers`: the blockers' depth over the filter square from the moments' table's
+/// mean there `m` (VSSM's estimate from the first two dequantized moments), else `b`'s.
+pub fn filter_blockers(m: &[f64], l: &LightGpu, s: &LightSample, b: Blocker) -> f64 {
+    let d = s.depth - f64::from(l.bias);
+    let f = blocker::vsm(&super::vis_msm::dequantized(m, l), d, BLOCKER_FLOOR);
+    if f.found() { f.depth } else { b.depth }
+}
+
+/// The blockers' depth the two-depth resolve uses: over the filter square
+/// (`l.cssm_two_depth == 2`: the moments' table's mean there) or the search's.
+pub fn resolve_depth(maps: Maps, l: &LightGpu, s: &LightSample, b: Blocker) -> f64 {
+    if l.cssm_two_depth != 2 {
+        return b.depth;
+    }
+    let w = blocker::filter_width(l, s, b.depth);
+    let m = maps.search.filter_square_mean(l.map_size, s.uv, w);
+    filter_blockers(&m, l, s, b)
+}
+
+/// `cssm_resolve` for the series `sum` at the filter width `width` (texels) of `b`, blockers at
+/// depth `z_b` for the two-depth resolve.
+pub fn resolve(sum: f64, l: &LightGpu, s: &LightSample, b: Blocker, width: f64, z_b: f64) -> f64 {
     if !b.found() {
         return 1.0;
     }
@@ -107,7 +130,7 @@ pub fn resolve(sum: f64, l: &LightGpu, s: &LightSample, b: Blocker, width: f64) 
         [s.depth_slope[0] * half, s.depth_slope[1] * half],
         l,
     );
-    let f_b = plane_series(b.depth - d, [0.0; 2], l);
+    let f_b = plane_series(z_b - d, [0.0; 2], l);
     let contrast = f_r - f_b;
     let v2 = (1.0 - (f_r - sum) / contrast.max(MIN_CONTRAST)).clamp(0.0, 1.0);
     let t = smoothstep(MIN_CONTRAST, FULL_CONTRAST, contrast);
@@ -117,7 +140,8 @@ pub fn resolve(sum: f64, l: &LightGpu, s: &LightSample, b: Blocker, width: f64) 
 /// The visibility for blocker estimate `b`.
 pub fn finish(maps: Maps, l: &LightGpu, s: &LightSample, b: Blocker) -> f64 {
     let width = blocker::filter_width(l, s, b.depth);
-    resolve(filtered(maps, l, s, b), l, s, b, width)
+    let z_b = resolve_depth(maps, l, s, b);
+    resolve(filtered(maps, l, s, b), l, s, b, width, z_b)
 }
 
 /// CSSM visibility.

@@ -45,6 +45,30 @@ impl CssmSearch {
     }
 }
 
+/// CSSM's resolve (`resolve`): how the filtered CSM series becomes visibility.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum CssmResolve {
+    /// Away from contact, the series inverted for the share of blockers between the receiver
+    /// plane and the blockers' depth, that depth estimated over the filter square from the
+    /// moments' table (with the moment search; 4 more loads), else the search's z_avg.
+    TwoDepth,
+    /// The same with the search's z_avg as the blockers' depth.
+    TwoDepthSearch,
+    /// The paper's clamp and sharpening alone.
+    Sharpen,
+}
+
+impl CssmResolve {
+    /// The scene key's value.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::TwoDepth => "two_depth",
+            Self::TwoDepthSearch => "two_depth_search",
+            Self::Sharpen => "sharpen",
+        }
+    }
+}
+
 /// A perspective camera.
 #[derive(Clone, Debug)]
 pub struct Camera {
@@ -254,7 +278,7 @@ pub enum Technique {
     /// (z, z·sin c_k z, z·cos c_k z) through summed-area tables; the average blocker depth over
     /// the light cone's search square, the PCSS penumbra width, the CSM lookup at that width,
     /// then the selective sharpening `v^p`, `p = 1 + A·exp(−B (d − z_avg))`, or (`two_depth`)
-    /// away from contact the series inverted for the share of blockers at z_avg.
+    /// away from contact the series inverted for the share of blockers at their depth.
     Cssm {
         /// Storage, table sums and search cap.
         soft: Soft,
@@ -272,11 +296,8 @@ pub enum Technique {
         sharpen_falloff: f32,
         /// Where the blocker search's means come from.
         search: CssmSearch,
-        /// `resolve = "two_depth"`: away from contact, the share of the filter square's texels
-        /// at the blockers' depth from inverting the series between the receiver plane's mean
-        /// and the blockers' (`kernels/shared/vis_cssm.wgsl`); else the paper's clamp and
-        /// sharpening alone.
-        two_depth: bool,
+        /// How the filtered series becomes visibility (`kernels/shared/vis_cssm.wgsl`).
+        resolve: CssmResolve,
     },
     /// Variance soft shadow maps (Yang et al. 2010): from the VSM moments over the search
     /// square, the Chebyshev share p of lit texels and `z_avg = (μ − p·d)/(1 − p)`; then VSM

@@ -7,8 +7,8 @@ use glam::{Mat4, Vec3, Vec4};
 use super::StageError;
 use crate::model::Cascades;
 use crate::model::{
-    BlurKernel, CssmSearch, Filter, Light, LightKind, ParamValue, ParamValues, Shadow, Storage,
-    Technique,
+    BlurKernel, CssmResolve, CssmSearch, Filter, Light, LightKind, ParamValue, ParamValues, Shadow,
+    Storage, Technique,
 };
 use crate::sat::SatVariant;
 use crate::technique::params::{CASCADES, COMMON, Given, GivenError, filter_values, storage_name};
@@ -271,13 +271,14 @@ impl PrefilterConfig {
         })
     }
 
-    /// The same with CSSM's resolve (the scene key `resolve`): `two_depth` (the default: away
-    /// from contact, the filtered series inverted for the share of blockers at their average
-    /// depth) or the paper's clamp and sharpening alone. Not applicable to other techniques.
-    pub fn with_cssm_resolve(self, two_depth: bool) -> Self {
+    /// The same with CSSM's resolve (the scene key `resolve`): `CssmResolve::TwoDepth` (the
+    /// default: away from contact, the filtered series inverted for the share of blockers at
+    /// their depth over the filter square), `TwoDepthSearch` (at the search's z_avg: 4 fewer
+    /// loads) or `Sharpen` (the paper's clamp and sharpening alone). Not applicable to other
+    /// techniques.
+    pub fn with_cssm_resolve(self, resolve: CssmResolve) -> Self {
         self.with_values("resolve", |v| {
-            let name = if two_depth { "two_depth" } else { "sharpen" };
-            v.set("resolve", ParamValue::Choice(name));
+            v.set("resolve", ParamValue::Choice(resolve.name()));
         })
     }
 

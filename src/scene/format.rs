@@ -166,7 +166,7 @@ pub struct ShadowFile {
     pub sharpen_falloff: Option<Spanned<f64>>,
     /// CSSM blocker search: `moments` or `csm_z`.
     pub blocker_search: Option<Spanned<String>>,
-    /// CSSM resolve: `two_depth` or `sharpen`.
+    /// CSSM resolve: `two_depth`, `two_depth_search` or `sharpen`.
     pub resolve: Option<Spanned<String>>,
     /// SMRT: rays per receiver.
     pub rays: Option<Spanned<i64>>,

@@ -26,9 +26,9 @@ mod parse;
 mod validate;
 
 pub use crate::model::{
-    BlurKernel, Camera, CssmSearch, DEFAULT_MAX_SEARCH, DEFAULT_SHARPEN, DEFAULT_SHARPEN_FALLOFF,
-    Filter, Light, LightKind, PcfKernel, Prefilter, Shadow, Soft, Storage, Technique,
-    default_moment_bias, default_soft_moment_bias, exponent_limit,
+    BlurKernel, Camera, CssmResolve, CssmSearch, DEFAULT_MAX_SEARCH, DEFAULT_SHARPEN,
+    DEFAULT_SHARPEN_FALLOFF, Filter, Light, LightKind, PcfKernel, Prefilter, Shadow, Soft, Storage,
+    Technique, default_moment_bias, default_soft_moment_bias, exponent_limit,
 };
 pub use crate::technique::sat_exponent_limit;
 #[cfg(feature = "cli")]

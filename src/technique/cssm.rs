@@ -10,8 +10,8 @@ use super::sweep_plan::{SweepPlan, SweepVariant};
 use super::{TechniqueDef, no_clamp};
 use crate::gpu_data::{MSM_QUANTIZED, TECHNIQUE_CSSM};
 use crate::model::{
-    CssmSearch, DEFAULT_SHARPEN, DEFAULT_SHARPEN_FALLOFF, ParamSpec, ParamValue, ParamValues,
-    Technique, default_soft_moment_bias,
+    CssmResolve, CssmSearch, DEFAULT_SHARPEN, DEFAULT_SHARPEN_FALLOFF, ParamSpec, ParamValue,
+    ParamValues, Technique, default_soft_moment_bias,
 };
 use std::fmt::Write;
 
@@ -44,11 +44,12 @@ const SHARPEN: &[ParamSpec] = &[
     ),
     choice(
         "resolve",
-        &["two_depth", "sharpen"],
+        &["two_depth", "two_depth_search", "sharpen"],
         "two_depth",
         "the filtered series' visibility: away from contact, inverted for the share of texels at \
-         the blockers' depth against the receiver plane's (two_depth), or the paper's clamp and \
-         sharpening alone",
+         the blockers' depth against the receiver plane's, that depth over the filter square \
+         from the moments' table (two_depth; the search's z_avg with blocker_search = \"csm_z\") \
+         or the search's z_avg (two_depth_search), or the paper's clamp and sharpening alone",
     ),
 ];
 
@@ -63,7 +64,7 @@ fn values(t: &Technique) -> ParamValues {
         sharpen,
         sharpen_falloff,
         search,
-        two_depth,
+        resolve,
     } = t
     {
         soft_values(soft, &mut out);
@@ -71,10 +72,7 @@ fn values(t: &Technique) -> ParamValues {
         out.set("sharpen", ParamValue::Float(*sharpen));
         out.set("sharpen_falloff", ParamValue::Float(*sharpen_falloff));
         out.set("blocker_search", ParamValue::Choice(search.name()));
-        out.set(
-            "resolve",
-            ParamValue::Choice(if *two_depth { "two_depth" } else { "sharpen" }),
-        );
+        out.set("resolve", ParamValue::Choice(resolve.name()));
     }
     out
 }
@@ -88,6 +86,7 @@ fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
         terms,
         soft,
         search: kind,
+        resolve,
         ..
     } = light.shadow.technique
     else {
@@ -140,8 +139,14 @@ fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
     };
     // The filter sums every term in order: the receiver's factors advance term by term
     // (csm_terms_chunk).
+    // With `resolve_flag` 2 the same loop reads the moments' table over the filter square
+    // for the blockers' depth there (4 loads).
+    let refine = (resolve_flag(resolve, kind) == 2)
+        .then(|| z.first())
+        .flatten();
     body.push_str(
-        "\n    var sum = 0.0;\n    for (var k = 0u; k < soft_filter_trips(look); k++) {\n        \
+        "\n    var sum = 0.0;\n    var z_b = look.blocker.x;\n    \
+         for (var k = 0u; k < soft_filter_trips(look); k++) {\n        \
          var terms = csm_terms_start(s.depth - l.bias - l.csm_offset, l);",
     );
     for m in basis {
@@ -151,18 +156,35 @@ fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
             sample(m)
         );
     }
+    if let Some(m) = refine {
+        let _ = write!(
+            body,
+            "\n        z_b = cssm_filter_blockers({}, look, l, s);",
+            sample(m)
+        );
+    }
     body.push_str(
         "\n    }\n    if !look.blockers {\n        return 1.0;\n    }\n    \
-         return cssm_resolve(sum, look, l, s);",
+         return cssm_resolve(sum, look, z_b, l, s);",
     );
     let fetches = format!(
         "{searched} * sat_search_{suffix} + {} * sat_filter_{suffix}",
-        basis.len()
+        basis.len() + usize::from(refine.is_some())
     );
     VisibilityBody {
         modules: vec!["shared/vis_cssm"],
         body,
         fetches: Some(fetches),
+    }
+}
+
+/// `LightGpu::cssm_two_depth` for a resolve and search: the filter square's blocker depth
+/// needs the moments' table.
+fn resolve_flag(resolve: CssmResolve, search: CssmSearch) -> u32 {
+    match (resolve, search) {
+        (CssmResolve::Sharpen, _) => 0,
+        (CssmResolve::TwoDepth, CssmSearch::Moments) => 2,
+        _ => 1,
     }
 }
 
@@ -185,7 +207,11 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
             "csm_z" => CssmSearch::CsmZ,
             _ => CssmSearch::Moments,
         },
-        two_depth: v.choice("resolve") == "two_depth",
+        resolve: match v.choice("resolve") {
+            "sharpen" => CssmResolve::Sharpen,
+            "two_depth_search" => CssmResolve::TwoDepthSearch,
+            _ => CssmResolve::TwoDepth,
+        },
     },
     values,
     gpu: |t, g| {
@@ -194,13 +220,14 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
             sharpen,
             sharpen_falloff,
             soft,
-            two_depth,
+            resolve,
+            search,
             ..
         } = *t
         {
             g.sharpen = sharpen;
             g.sharpen_falloff = sharpen_falloff;
-            g.cssm_two_depth = u32::from(two_depth);
+            g.cssm_two_depth = resolve_flag(resolve, search);
             // The moment search's moments: quantized, biased by msm_soft's default for the
             // storage.
             g.moment_bias = default_soft_moment_bias(soft.storage);
@@ -242,6 +269,14 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
             SweepVariant {
                 label: "cssm M16",
                 values: &[("terms", ParamValue::Int(16))],
+                storage: None,
+            },
+            SweepVariant {
+                label: "cssm M8 two_depth_search",
+                values: &[
+                    ("terms", ParamValue::Int(8)),
+                    ("resolve", ParamValue::Choice("two_depth_search")),
+                ],
                 storage: None,
             },
             SweepVariant {

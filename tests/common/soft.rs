@@ -396,14 +396,40 @@ pub fn cssm_tolerance(
     } else {
         0.0
     };
+    // With the blockers' depth over the filter square (`cssm_two_depth == 2`) the final step
+    // also reads the moments' table there: its four means carry their table's error as the
+    // search's do, and the depth comes from them again under each perturbation.
+    let refine = l.cssm_two_depth == 2;
+    let last = |du: [f64; 2]| {
+        let t = shifted(s, du);
+        let mut inputs = vec![v::filtered(maps, l, &t, b0)];
+        if refine {
+            inputs.extend(maps.search.filter_square_mean(l.map_size, t.uv, width));
+        }
+        inputs
+    };
+    let mut e_last = vec![e_sum];
+    if refine {
+        let means = maps.search.filter_square_mean(l.map_size, s.uv, width);
+        let e = grid_flips(maps.search, l, s, width, err.1.mean(l, s, width));
+        e_last.extend(msm_moment_error(l, &means, e));
+    }
     Chain {
         search: &|du| v::search(maps, l, &shifted(s, du)),
         e_search,
         blocker: &|m, dd| v::blocker_of(kind, m, l, &moved(s, dd)),
         finish: &|z| v::finish(maps, l, s, Blocker { depth: z, ..b0 }),
-        last: &|du| vec![v::filtered(maps, l, &shifted(s, du), b0)],
-        e_last: vec![e_sum],
-        visibility: &|m, dd| v::resolve(m[0], l, &moved(s, dd), b0, width),
+        last: &last,
+        e_last,
+        visibility: &|m, dd| {
+            let t = moved(s, dd);
+            let z_b = if refine {
+                v::filter_blockers(&m[1..], l, &t, b0)
+            } else {
+                b0.depth
+            };
+            v::resolve(m[0], l, &t, b0, width, z_b)
+        },
         e_depth: e_d,
         filter_box: &|z| filter_box(l, s, z),
         grid: maps.basis.is_filtered(),

@@ -7,7 +7,9 @@ use glam::Vec3;
 use shadowgraph::cpu::{self, Texels};
 use shadowgraph::gpu::Gpu;
 use shadowgraph::sat::{SatCoding, SatVariant};
-use shadowgraph::scene::{CssmSearch, Light, LightKind, Shadow, Soft, Storage, Technique};
+use shadowgraph::scene::{
+    CssmResolve, CssmSearch, Light, LightKind, Shadow, Soft, Storage, Technique,
+};
 
 const ULP: f64 = 1.0 / 16_777_216.0; // 2⁻²⁴
 
@@ -257,27 +259,24 @@ pub fn with_sums(mut t: Technique, sums: SatVariant) -> Technique {
 }
 
 /// CSSM with `terms` terms, offset ½/M, scale 2, the given sharpening and blocker search, and
-/// the default two-depth resolve ([`cssm_sharpened`]: the paper's).
+/// the default two-depth resolve ([`cssm_resolved`]: another).
 pub fn cssm(terms: u32, sharpen: f32, sharpen_falloff: f32, search: CssmSearch) -> Technique {
-    cssm_resolved(terms, sharpen, sharpen_falloff, search, true)
+    cssm_resolved(
+        terms,
+        sharpen,
+        sharpen_falloff,
+        search,
+        CssmResolve::TwoDepth,
+    )
 }
 
-/// [`cssm`] with the paper's resolve (clamp and sharpening alone).
-pub fn cssm_sharpened(
+/// [`cssm`] with the resolve `resolve`.
+pub fn cssm_resolved(
     terms: u32,
     sharpen: f32,
     sharpen_falloff: f32,
     search: CssmSearch,
-) -> Technique {
-    cssm_resolved(terms, sharpen, sharpen_falloff, search, false)
-}
-
-fn cssm_resolved(
-    terms: u32,
-    sharpen: f32,
-    sharpen_falloff: f32,
-    search: CssmSearch,
-    two_depth: bool,
+    resolve: CssmResolve,
 ) -> Technique {
     Technique::Cssm {
         soft: soft(Storage::F32, SatVariant::Fixed),
@@ -288,6 +287,6 @@ fn cssm_resolved(
         sharpen,
         sharpen_falloff,
         search,
-        two_depth,
+        resolve,
     }
 }
