@@ -176,6 +176,28 @@ fn equal_shade_keys_mean_equal_blocks() {
         }
     }
     lights.extend(variants);
+    // Each light's technique with every option of each of its choice keys (a choice may change
+    // the generated code without changing the maps: CSSM's `resolve`).
+    let mut choices = Vec::new();
+    for l in &lights {
+        let def = technique::of(&l.shadow.technique);
+        for spec in def.params.iter().flat_map(|p| p.iter()) {
+            let shadowgraph::model::ParamKind::Choice(options) = spec.kind else {
+                continue;
+            };
+            for &option in options {
+                let mut values = (def.values)(&l.shadow.technique);
+                if values.get(spec.key).is_none() {
+                    continue;
+                }
+                values.set(spec.key, shadowgraph::model::ParamValue::Choice(option));
+                let mut v = l.clone();
+                v.shadow.technique = (def.build)(&values);
+                choices.push(v);
+            }
+        }
+    }
+    lights.extend(choices);
     let mut seen: Vec<(String, String)> = Vec::new();
     for l in &lights {
         let one = std::slice::from_ref(l);

@@ -15,7 +15,7 @@ use crate::model::{
 };
 use std::fmt::Write;
 
-use super::csm::{csm_gpu, csm_maps, csm_nodes, terms};
+use super::csm::{csm_gpu, csm_maps, csm_nodes};
 use super::nodes::map_type;
 use super::shade::{ShadeInput, VisibilityBody, table_args, table_suffix};
 use crate::model::Light;
@@ -188,6 +188,20 @@ fn resolve_flag(resolve: CssmResolve, search: CssmSearch) -> u32 {
     }
 }
 
+/// What the visibility code depends on besides the maps (the shading kernel's key): M, and
+/// whether the filter loop reads the moments' table again (`resolve_flag` 2).
+fn variant(t: &Technique) -> String {
+    match *t {
+        Technique::Cssm {
+            terms,
+            resolve,
+            search,
+            ..
+        } => format!("{terms} {}", resolve_flag(resolve, search)),
+        _ => String::new(),
+    }
+}
+
 /// `cssm`.
 pub(super) static DEF: TechniqueDef = TechniqueDef {
     name: "cssm",
@@ -247,7 +261,7 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
         _ => n.one(n.depth.clone()),
     },
     visibility,
-    variant: terms,
+    variant,
     // The CSM basis, the CSM-Z basis (z, z·sin, z·cos) and MSM's quantized moments.
     value_range: |_| ([-1.0; 4], [1.0; 4]),
     clamp: no_clamp,
