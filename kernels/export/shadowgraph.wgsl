@@ -760,7 +760,7 @@ fn sg_csm_resolve(sum: f32, l: sg_Light) -> f32 {
 // where the smooth Fourier step leaks light and the penumbra is narrow, the darkening is
 // strongest; it fades as the receiver leaves its blockers. By default (`resolve =
 // "two_depth"`, this project's) away from contact the series is instead inverted for the share
-// of blockers at z_avg (cssm_resolve). A square without blockers (share < BLOCKER_MIN_SHARE)
+// of blockers at their depth z_b (cssm_resolve; cssm_filter_blockers). A square without blockers (share < BLOCKER_MIN_SHARE)
 // is lit.
 // The shading block (technique::cssm's `visibility`) reads, at the search width snapped
 // outward to texel edges (`sat_search_*`, 4 loads a table), either (`blocker_search =

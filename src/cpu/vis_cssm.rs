@@ -101,14 +101,13 @@ pub fn filter_blockers(m: &[f64], l: &LightGpu, s: &LightSample, b: Blocker) -> 
     if f.found() { f.depth } else { b.depth }
 }
 
-/// The blockers' depth the two-depth resolve uses: over the filter square
+/// The blockers' depth the two-depth resolve uses: over the filter square of `width` texels
 /// (`l.cssm_two_depth == 2`: the moments' table's mean there) or the search's.
-pub fn resolve_depth(maps: Maps, l: &LightGpu, s: &LightSample, b: Blocker) -> f64 {
+pub fn resolve_depth(maps: Maps, l: &LightGpu, s: &LightSample, b: Blocker, width: f64) -> f64 {
     if l.cssm_two_depth != 2 {
         return b.depth;
     }
-    let w = blocker::filter_width(l, s, b.depth);
-    let m = maps.search.filter_square_mean(l.map_size, s.uv, w);
+    let m = maps.search.filter_square_mean(l.map_size, s.uv, width);
     filter_blockers(&m, l, s, b)
 }
 
@@ -140,7 +139,7 @@ pub fn resolve(sum: f64, l: &LightGpu, s: &LightSample, b: Blocker, width: f64, 
 /// The visibility for blocker estimate `b`.
 pub fn finish(maps: Maps, l: &LightGpu, s: &LightSample, b: Blocker) -> f64 {
     let width = blocker::filter_width(l, s, b.depth);
-    let z_b = resolve_depth(maps, l, s, b);
+    let z_b = resolve_depth(maps, l, s, b, width);
     resolve(filtered(maps, l, s, b), l, s, b, width, z_b)
 }
 

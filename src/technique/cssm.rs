@@ -1,7 +1,8 @@
 //! `cssm`: convolution soft shadow maps (Annen et al. 2008): the CSM and CSM-Z bases through
 //! summed-area tables, the blocker depth over the search square, CSM at the penumbra width,
 //! then (`resolve = "two_depth"`, the default) away from contact the series inverted for the
-//! share of blockers at z_avg, or the paper's selective sharpening `v^p`,
+//! share of blockers at their depth (over the filter square with the moment search), or the
+//! paper's selective sharpening `v^p`,
 //! `p = 1 + A·exp(−B (d − z_avg))` alone.
 
 use super::csm::series_values;
