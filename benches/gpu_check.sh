@@ -7,9 +7,10 @@
 #
 # A second binary to compare against goes in as BASE=path/to/other/shadowgraph: its kernel
 # rows are then timed alternately with BINARY's on the same warm machine (compare timings
-# only within one call: the same card's figures moved up to 4× between calls at 4096²). On an
-# H200 (2026-11-26) the soft table took 67 s, the 2048² kernels 6 s and each large round 93 s
-# per binary: with BASE, give the call 420 s or more.
+# only within one call: before the GPU warm-up by time of 2026-11-27, the same card's
+# figures moved up to 4× between calls at 4096²). On an H200 (2026-11-26) the soft table
+# took 67 s, the 2048² kernels 6 s and each large round 93 s per binary: with BASE, give
+# the call 420 s or more.
 # Each step writes its own file in OUT and prints its wall time, so a call stopped by its time
 # box still returns what ran. Record the results in benches/RESULTS.md (device, date, commit,
 # command, table).
@@ -40,7 +41,8 @@ step soft.txt "$B" bench --lookup 3 --repeat 20 --image 1920x1080 --map 2048
 # The timer against the wall clock on a bundled scene.
 step wall.txt "$B" render scenes/bunny.toml --timings --repeat 20 -o "$OUT/bunny.png"
 # Issue 15: every kernel at 2048² (figures there repeat within 1%), then the chains the
-# targets name at 4096² and 8192², twice (their two-channel figures moved between runs).
+# targets name at 4096² and 8192², twice (a check that the warm-up holds: before it,
+# figures there moved up to 4× between runs).
 step kernels_2048.txt "$B" bench --sizes 2048 --repeat 20
 for round in 1 2; do
     if [ -n "$BASE" ]; then

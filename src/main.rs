@@ -94,6 +94,11 @@ enum Command {
         /// configurations (e.g. `cssm`), and PCSS 16+32, their yardstick.
         #[arg(long, value_delimiter = ',')]
         only: Vec<String>,
+        /// What the kernels' imported textures hold: `random` values, a `smooth` field or a
+        /// `constant` (a GPU that stores textures compressed moves smooth and constant data
+        /// faster; the texture copies read the same kind).
+        #[arg(long, default_value = "random", value_parser = clap::builder::PossibleValuesParser::new(shadowgraph::bench::Inputs::NAMES), conflicts_with = "lookup")]
+        inputs: String,
     },
     /// Sweep techniques and their accuracy knobs, time each on the GPU and measure its error
     /// against ground truth: report.html/.md/.csv/.json, pareto{,_penumbra,_flip}.svg, grid.png
@@ -244,6 +249,7 @@ fn run(args: Args) -> Result<()> {
             image,
             map,
             only,
+            inputs,
         } => {
             let gpu = Gpu::new()?;
             match lookup {
@@ -278,7 +284,13 @@ fn run(args: Args) -> Result<()> {
                         )
                     );
                 }
-                None => print!("{}", shadowgraph::bench::run(&gpu, &sizes, repeat, &only)?),
+                None => {
+                    let inputs = shadowgraph::bench::Inputs::parse(&inputs)?;
+                    print!(
+                        "{}",
+                        shadowgraph::bench::run(&gpu, &sizes, repeat, &only, inputs)?
+                    )
+                }
             }
         }
         Command::Stability { large } => {

@@ -41,6 +41,24 @@ use std::sync::atomic::{AtomicU8, Ordering};
 use crate::created;
 use crate::error::{Error, Result};
 
+/// Least wall time of untimed work before a GPU is timed, ms. A GPU left idle (while the
+/// host fills the next case's textures, or measures the last frame's error) drops its clocks,
+/// and runs of a few milliseconds right after read up to 4× slow: without it, two thirds of an
+/// H200's busy samples during the kernel benchmark ran below 1000 MHz of its 1980, and the
+/// kernels at 4096² and 8192² read 1.4-4.6× their warm times (`benches/RESULTS.md`,
+/// 2026-11-27). A CPU device has no such governor.
+pub const GPU_WARMUP_MS: f64 = 300.0;
+
+/// Most untimed runs on a GPU (a kernel of microseconds would otherwise make thousands).
+pub const MAX_WARMUP_RUNS: u32 = 2000;
+
+/// Whether another untimed run is due after `runs` of them over `elapsed_ms`: `least` runs
+/// on any device, and on a GPU (`gpu`) until [`GPU_WARMUP_MS`] have passed (at most
+/// [`MAX_WARMUP_RUNS`] runs). The benchmarks and the evaluation warm up with it.
+pub fn keep_warming(runs: u32, least: u32, elapsed_ms: f64, gpu: bool) -> bool {
+    runs < least || (gpu && runs < MAX_WARMUP_RUNS && elapsed_ms < GPU_WARMUP_MS)
+}
+
 /// The features [`GpuTimer`] needs.
 pub const TIMER_FEATURES: wgpu::Features =
     wgpu::Features::TIMESTAMP_QUERY.union(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);

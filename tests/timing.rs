@@ -341,8 +341,15 @@ fn bench_times_agree_with_the_wall_clock() {
     let floor = if cpu(&g) { BENCH_FLOOR } else { 0.0 };
     let mut bad = Vec::new();
     for m in 0..BENCH_MEASUREMENTS {
-        let rows = shadowgraph::bench::measure(&g.device, &g.queue, &[1024], 5, &["esm".into()])
-            .expect("bench");
+        let rows = shadowgraph::bench::measure(
+            &g.device,
+            &g.queue,
+            &[1024],
+            5,
+            &["esm".into()],
+            shadowgraph::bench::Inputs::Random,
+        )
+        .expect("bench");
         assert!(
             rows.len() > shadowgraph::bench::COPY_FORMATS.len() + 1,
             "copies and esm"

@@ -328,4 +328,69 @@ mod tests {
             assert!(got.iter().any(|&b| b != 0), "{}", format_name(format));
         }
     }
+
+    /// The smooth inputs reach the GPU as the formula gives them, in each format's coding:
+    /// f32 as is, u32 as 24-bit fixed point, halves ordered in [⅛, 1) (checked in f64 on the
+    /// texture read back; tolerances: f32 sines, fixed point's truncation of an f32).
+    #[test]
+    fn smooth_imports_hold_the_field_in_each_format() {
+        use super::super::harness::{Inputs, fill_imports};
+        let gpu = gpu();
+        let (device, queue) = (&gpu.device, &gpu.queue);
+        let n = 45u32;
+        let want = |x: u32, y: u32, c: u32| {
+            let tau = std::f64::consts::TAU;
+            0.5 + 0.2 * (tau * (x as f64 / 97.0 + c as f64 / 7.0)).sin()
+                + 0.2 * (tau * (y as f64 / 61.0 + c as f64 / 5.0)).cos()
+        };
+        for format in [
+            wgpu::TextureFormat::Rg32Float,
+            wgpu::TextureFormat::Rgba32Uint,
+            wgpu::TextureFormat::Rgba16Float,
+        ] {
+            let built = copy_texture_graph(n, format);
+            let outputs: Vec<&str> = built.outputs.iter().map(String::as_str).collect();
+            let plan = crate::graph::plan(&built.graph, &outputs).unwrap();
+            let imports = fill_imports(device, queue, &plan, Inputs::Smooth).unwrap();
+            let bytes = crate::gpu::read_texture(device, queue, &imports["copy.src"], 0).unwrap();
+            let channels = match format {
+                wgpu::TextureFormat::Rg32Float => 2,
+                _ => 4,
+            };
+            let mut previous = None;
+            for y in 0..n {
+                for x in 0..n {
+                    for c in 0..channels {
+                        let i = ((y * n + x) * channels + c) as usize;
+                        let v = want(x, y, c);
+                        match format {
+                            wgpu::TextureFormat::Rg32Float => {
+                                let got: f32 = bytemuck::pod_read_unaligned(&bytes[4 * i..][..4]);
+                                assert!((got as f64 - v).abs() < 1e-5, "{x} {y} {c}: {got} {v}");
+                            }
+                            wgpu::TextureFormat::Rgba32Uint => {
+                                let got: u32 = bytemuck::pod_read_unaligned(&bytes[4 * i..][..4]);
+                                let fixed = v * (1u64 << 24) as f64;
+                                assert!((got as f64 - fixed).abs() < 200.0, "{got} {fixed}");
+                            }
+                            _ => {
+                                let got: u16 = bytemuck::pod_read_unaligned(&bytes[2 * i..][..2]);
+                                assert!((0x3000..0x3C00).contains(&got), "{got:#x}");
+                                // Ordered as the field along a row of channel 0.
+                                if c == 0 && x > 0 {
+                                    let (pv, pg): (f64, u16) = previous.unwrap();
+                                    if v > pv + 1e-3 {
+                                        assert!(got >= pg, "{x} {y}");
+                                    }
+                                }
+                                if c == 0 {
+                                    previous = Some((v, got));
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
 }

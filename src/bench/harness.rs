@@ -42,8 +42,14 @@ pub struct Timed {
     pub least_share: f64,
 }
 
+/// Whether another untimed run is due after `runs` of them over `elapsed_ms` ([`WARMUP`] at
+/// least; on a GPU see [`crate::timer::keep_warming`]).
+pub(super) fn keep_warming(runs: u32, elapsed_ms: f64, gpu: bool) -> bool {
+    crate::timer::keep_warming(runs, WARMUP, elapsed_ms, gpu)
+}
+
 /// Medians of the summed span times and of the wall times of `repeat` runs of `record` (after
-/// [`WARMUP`] runs), ms.
+/// [`WARMUP`] runs, and on a GPU at least [`crate::timer::GPU_WARMUP_MS`] of them), ms.
 pub(super) fn median_time(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
@@ -53,7 +59,21 @@ pub(super) fn median_time(
 ) -> Result<Timed> {
     let mut times = Vec::with_capacity(repeat as usize);
     let mut walls = Vec::with_capacity(repeat as usize);
-    for run in 0..WARMUP + repeat {
+    let gpu = device.adapter_info().device_type != wgpu::DeviceType::Cpu;
+    let warming = Instant::now();
+    let mut warm = 0u32;
+    while keep_warming(warm, warming.elapsed().as_secs_f64() * 1e3, gpu) {
+        timer.reset();
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("shadowgraph.bench.warmup"),
+        });
+        record(&mut enc, timer)?;
+        timer.resolve(&mut enc);
+        submit_and_wait(device, queue, enc, "bench")?;
+        timer.read(device)?;
+        warm += 1;
+    }
+    for _ in 0..repeat {
         timer.reset();
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("shadowgraph.bench"),
@@ -70,10 +90,8 @@ pub(super) fn median_time(
                 message: "no pass was timed".into(),
             });
         }
-        if run >= WARMUP {
-            times.push(spans.iter().map(|(_, ms)| ms).sum());
-            walls.push(wall_ms);
-        }
+        times.push(spans.iter().map(|(_, ms)| ms).sum());
+        walls.push(wall_ms);
     }
     let shortest = times.iter().copied().fold(f64::INFINITY, f64::min);
     let wall_ms = median(&mut walls);
@@ -95,7 +113,7 @@ pub(super) fn median(values: &mut [f64]) -> f64 {
     }
 }
 
-/// Plans `graph` for `outputs`, fills its imports and returns the plan and the median times of
+/// Plans `graph` for `outputs`, fills its imports as `inputs` says and returns the plan and the median times of
 /// running it.
 pub(super) fn time_graph(
     device: &wgpu::Device,
@@ -104,11 +122,12 @@ pub(super) fn time_graph(
     graph: &Graph,
     outputs: &[String],
     repeat: u32,
+    inputs: Inputs,
 ) -> Result<(Plan, Timed)> {
     let outputs: Vec<&str> = outputs.iter().map(String::as_str).collect();
     let plan = graph::plan(graph, &outputs)?;
     executor.prepare(device, &plan)?;
-    let imports = random_imports(device, queue, &plan)?;
+    let imports = fill_imports(device, queue, &plan, inputs)?;
     let mut timer = timer(device, queue, plan.steps.len() as u32)?;
     let ms = median_time(device, queue, &mut timer, repeat, |enc, t| {
         executor.record(device, enc, &plan, &imports, Some(t))?;
@@ -117,12 +136,101 @@ pub(super) fn time_graph(
     Ok((plan, ms))
 }
 
+/// What the benchmark's imported textures hold (`shadowgraph bench --inputs`).
+///
+/// A GPU may store a texture compressed, so that a kernel's time depends on the values it
+/// moves and not only on their bytes: the same two blur dispatches took 2-4× longer over a
+/// random import than over encoded moments on an H100 and an H200 (`benches/RESULTS.md`).
+/// Timing a kernel and its texture copy on each kind of input shows how much.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Inputs {
+    /// Independent pseudo-random values (incompressible): floats in (0, 1], halves in
+    /// [⅛, 1), any u32.
+    #[default]
+    Random,
+    /// A smooth field: every channel a sum of slow sines over the texel's position, as a
+    /// shadow map's depths are between edges (floats in (0.1, 0.9), halves and u32 fixed
+    /// point of the same).
+    Smooth,
+    /// Every texel the same (½, or its half or fixed-point form).
+    Constant,
+}
+
+impl Inputs {
+    /// The names `--inputs` takes.
+    pub const NAMES: [&'static str; 3] = ["random", "smooth", "constant"];
+
+    /// The mode named `name` (one of [`Inputs::NAMES`]).
+    pub fn parse(name: &str) -> Result<Inputs> {
+        match name {
+            "random" => Ok(Inputs::Random),
+            "smooth" => Ok(Inputs::Smooth),
+            "constant" => Ok(Inputs::Constant),
+            _ => Err(Error::Invalid(format!(
+                "bench --inputs `{name}`: expected one of {}",
+                Inputs::NAMES.join(", ")
+            ))),
+        }
+    }
+
+    /// The name [`Inputs::parse`] takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Inputs::Random => "random",
+            Inputs::Smooth => "smooth",
+            Inputs::Constant => "constant",
+        }
+    }
+
+    /// `width × height × channels` values in [0, 1), channels interleaved, for the smooth and
+    /// constant fields (`None` for random inputs, which each format draws in its own range).
+    fn field(self, width: u32, height: u32, channels: usize) -> Option<Vec<f32>> {
+        let tau = std::f32::consts::TAU;
+        match self {
+            Inputs::Random => None,
+            Inputs::Constant => Some(vec![0.5; (width * height) as usize * channels]),
+            Inputs::Smooth => {
+                // Separable: a sine over x plus a cosine over y, tabled once per channel.
+                let wave = |len: u32, period: f32, phase: f32, f: fn(f32) -> f32| -> Vec<f32> {
+                    (0..len)
+                        .map(|i| 0.2 * f(tau * (i as f32 / period + phase)))
+                        .collect()
+                };
+                let xs: Vec<Vec<f32>> = (0..channels)
+                    .map(|c| wave(width, 97.0, c as f32 / 7.0, f32::sin))
+                    .collect();
+                let ys: Vec<Vec<f32>> = (0..channels)
+                    .map(|c| wave(height, 61.0, c as f32 / 5.0, f32::cos))
+                    .collect();
+                let mut values = Vec::with_capacity((width * height) as usize * channels);
+                for y in 0..height as usize {
+                    for x in 0..width as usize {
+                        values.extend(xs.iter().zip(&ys).map(|(xs, ys)| 0.5 + xs[x] + ys[y]));
+                    }
+                }
+                Some(values)
+            }
+        }
+    }
+}
+
 /// A texture for every import of `plan`, filled with random values: floats in (0, 1], halves
 /// in [⅛, 1), any u32; a depth texture (which the CPU cannot write) is cleared to ½.
 pub fn random_imports(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     plan: &Plan,
+) -> Result<HashMap<String, wgpu::Texture>> {
+    fill_imports(device, queue, plan, Inputs::Random)
+}
+
+/// A texture for every import of `plan`, filled as `inputs` says; a depth texture (which the
+/// CPU cannot write) is cleared to ½ whatever `inputs` is.
+pub fn fill_imports(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    plan: &Plan,
+    inputs: Inputs,
 ) -> Result<HashMap<String, wgpu::Texture>> {
     let mut imports = HashMap::new();
     for (i, r) in plan
@@ -135,28 +243,44 @@ pub fn random_imports(
         let format = r.resource.format;
         let texels = r.width as usize * r.height as usize;
         let seed = 0x5EED + i as u64;
+        let channels = (graph::texel_bytes(format) as usize / 4).max(1);
+        let field = |channels: usize| inputs.field(r.width, r.height, channels);
         let data: Option<Vec<u8>> = match format {
             wgpu::TextureFormat::R32Float
             | wgpu::TextureFormat::Rg32Float
             | wgpu::TextureFormat::Rgba32Float => {
-                let channels = graph::texel_bytes(format) as usize / 4;
-                Some(bytemuck::cast_slice(&random_depths(texels * channels, seed)).to_vec())
+                let values =
+                    field(channels).unwrap_or_else(|| random_depths(texels * channels, seed));
+                Some(bytemuck::cast_slice(&values).to_vec())
             }
             wgpu::TextureFormat::Rgba16Float => {
-                let halves: Vec<u16> = random_bits(texels * 4, seed)
-                    .into_iter()
-                    .map(|b| 0x3000 + (b as u16 % 0x0C00))
-                    .collect();
+                let halves: Vec<u16> = match field(4) {
+                    // Halves in [⅛, 1) ordered as the values are.
+                    Some(values) => values
+                        .iter()
+                        .map(|&v| 0x3000 + (v * 0x0C00 as f32) as u16)
+                        .collect(),
+                    None => random_bits(texels * 4, seed)
+                        .into_iter()
+                        .map(|b| 0x3000 + (b as u16 % 0x0C00))
+                        .collect(),
+                };
                 Some(bytemuck::cast_slice(&halves).to_vec())
             }
             wgpu::TextureFormat::R32Uint
             | wgpu::TextureFormat::Rg32Uint
             | wgpu::TextureFormat::Rgba32Uint => {
-                let channels = graph::texel_bytes(format) as usize / 4;
-                let words: Vec<u32> = random_bits(texels * channels, seed)
-                    .into_iter()
-                    .map(|b| b as u32)
-                    .collect();
+                let words: Vec<u32> = match field(channels) {
+                    // 24-bit fixed point, as the summed-area tables' inputs are.
+                    Some(values) => values
+                        .iter()
+                        .map(|&v| (v * (1u32 << 24) as f32) as u32)
+                        .collect(),
+                    None => random_bits(texels * channels, seed)
+                        .into_iter()
+                        .map(|b| b as u32)
+                        .collect(),
+                };
                 Some(bytemuck::cast_slice(&words).to_vec())
             }
             wgpu::TextureFormat::Depth32Float => None,
@@ -251,12 +375,82 @@ pub(super) fn random_depths(count: usize, seed: u64) -> Vec<f32> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::timer::GPU_WARMUP_MS;
 
     #[test]
     fn median_of_odd_even_and_unsorted() {
         assert_eq!(median(&mut [3.0, 1.0, 2.0]), 2.0);
         assert_eq!(median(&mut [4.0, 1.0, 3.0, 2.0]), 2.5);
         assert!(median(&mut []).is_nan());
+    }
+
+    #[test]
+    fn warm_up_is_warmup_runs_and_on_a_gpu_a_least_time() {
+        // A CPU device: WARMUP runs, however short.
+        assert!(keep_warming(WARMUP - 1, 1e9, false));
+        assert!(!keep_warming(WARMUP, 0.0, false));
+        // A GPU: WARMUP runs and GPU_WARMUP_MS, whichever is more, capped at MAX_WARMUP.
+        assert!(keep_warming(WARMUP - 1, 1e9, true));
+        assert!(keep_warming(WARMUP, GPU_WARMUP_MS - 1.0, true));
+        assert!(keep_warming(50, 0.0, true));
+        assert!(!keep_warming(WARMUP, GPU_WARMUP_MS, true));
+        assert!(!keep_warming(crate::timer::MAX_WARMUP_RUNS, 0.0, true));
+    }
+
+    /// The smooth field is the sum of two slow waves (checked in f64 from its formula), moves
+    /// little from texel to texel and spans most of (0.1, 0.9); the constant field is ½.
+    #[test]
+    fn smooth_and_constant_fields_are_what_they_say() {
+        let (w, h, channels) = (300u32, 200u32, 3usize);
+        let field = Inputs::Smooth.field(w, h, channels).unwrap();
+        assert_eq!(field.len(), (w * h) as usize * channels);
+        let tau = std::f64::consts::TAU;
+        let mut worst = 0.0f64;
+        for y in 0..h as usize {
+            for x in 0..w as usize {
+                for c in 0..channels {
+                    let want = 0.5
+                        + 0.2 * (tau * (x as f64 / 97.0 + c as f64 / 7.0)).sin()
+                        + 0.2 * (tau * (y as f64 / 61.0 + c as f64 / 5.0)).cos();
+                    let got = field[(y * w as usize + x) * channels + c] as f64;
+                    // f32 sines of arguments up to 2π·3.1: a few ulps of 1.
+                    worst = worst.max((got - want).abs());
+                    assert!(got > 0.1 - 1e-6 && got < 0.9 + 1e-6, "{got}");
+                }
+            }
+        }
+        assert!(worst < 1e-5, "{worst}");
+        // Neighbours along x differ by at most 0.2 · 2π / 97 (the wave's steepest slope).
+        let step = field
+            .chunks(channels)
+            .zip(field.chunks(channels).skip(1))
+            .enumerate()
+            .filter(|(i, _)| (i + 1) % w as usize != 0)
+            .flat_map(|(_, (a, b))| a.iter().zip(b).map(|(a, b)| (a - b).abs()))
+            .fold(0.0f32, f32::max);
+        assert!(
+            step > 0.005 && step < 0.2 * std::f32::consts::TAU / 97.0 + 1e-4,
+            "{step}"
+        );
+        let (lo, hi) = field
+            .iter()
+            .fold((1.0f32, 0.0f32), |(l, h), &v| (l.min(v), h.max(v)));
+        assert!(lo < 0.2 && hi > 0.8, "{lo} {hi}");
+        let constant = Inputs::Constant.field(7, 5, 2).unwrap();
+        assert!(constant.len() == 70 && constant.iter().all(|&v| v == 0.5));
+        assert!(Inputs::Random.field(7, 5, 2).is_none());
+    }
+
+    #[test]
+    fn inputs_parse_their_names_and_name_the_choices_otherwise() {
+        for name in Inputs::NAMES {
+            assert_eq!(Inputs::parse(name).unwrap().name(), name);
+        }
+        let e = Inputs::parse("noise").unwrap_err().to_string();
+        assert!(
+            e.contains("`noise`") && e.contains("random, smooth, constant"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -2,8 +2,8 @@
 
 use std::fmt::Write;
 
-use super::WARMUP;
-use super::harness::median;
+use super::harness::{keep_warming, median};
+use super::{GPU_WARMUP_MS, WARMUP};
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
 use crate::sat::SatVariant;
@@ -37,7 +37,7 @@ pub struct LookupRow {
 }
 
 /// The shading pass's cost as the filter widens: for each width in `widths`, the median over
-/// `repeat` frames (after [`WARMUP`]) of the `shade` pass of the VSM technique scene rendered
+/// `repeat` frames (after [`WARMUP`], on a GPU at least [`super::GPU_WARMUP_MS`] of them) of the `shade` pass of the VSM technique scene rendered
 /// with a PCF box of that width and with VSM read through summed-area tables of that box.
 /// PCF's taps grow with the square of the width; the table's lookups stay at four per channel
 /// (sixteen with sub-texel edges) whatever the width.
@@ -78,9 +78,23 @@ pub fn lookup_cost(
         base.lights[0].shadow_map = n;
     }
     let mut renderer = crate::render::Renderer::new(&gpu.device);
+    let gpu_device = gpu.adapter.get_info().device_type != wgpu::DeviceType::Cpu;
     let mut shade = |technique: Technique| -> Result<(f64, f64)> {
         let mut scene = base.clone();
         scene.lights[0].shadow.technique = technique;
+        // On a GPU, untimed frames until its clocks have risen (`keep_warming`); then the
+        // WARMUP frames below as on any device.
+        let warming = std::time::Instant::now();
+        let mut warm = WARMUP;
+        while gpu_device && keep_warming(warm, warming.elapsed().as_secs_f64() * 1e3, true) {
+            let opts = crate::render::RenderOptions {
+                aux: false,
+                repeat: 1,
+                dump: false,
+            };
+            renderer.render(&gpu.device, &gpu.queue, &scene, opts)?;
+            warm += 1;
+        }
         let frame = renderer.render(
             &gpu.device,
             &gpu.queue,
@@ -147,7 +161,7 @@ pub fn format_lookup_table(device: &str, cpu: bool, repeat: u32, rows: &[LookupR
     let _ = writeln!(
         s,
         "scenes/techniques/vsm.toml ({w}×{h}, {map}² map); GPU timestamps of the shade pass, median \
-         of {repeat} frame(s) after {WARMUP} warm-up frame(s); (×) = over the first width's time."
+         of {repeat} frame(s) after {WARMUP} warm-up frame(s) (on a GPU, at least {GPU_WARMUP_MS} ms); (×) = over the first width's time."
     );
     if cpu {
         let _ = writeln!(

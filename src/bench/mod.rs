@@ -23,7 +23,7 @@ use std::fmt::Write;
 use glam::Vec3;
 
 pub use self::copy::{COPY, COPY_FORMATS, copy_texture_graph, format_name};
-pub use self::harness::{Timed, random_imports};
+pub use self::harness::{Inputs, Timed, fill_imports, random_imports};
 use self::harness::{gb_per_s, time_graph};
 pub use self::lookup::{LOOKUP_WIDTHS, LookupRow, format_lookup_table, lookup_cost};
 pub use self::soft::{SOFT_LIGHT_SIZES, SOFT_TECHNIQUES, SoftRow, format_soft_table, soft_cost};
@@ -37,6 +37,7 @@ use crate::sat::{self, SatCoding, SatVariant};
 use crate::scene::{Light, LightKind, Shadow, Storage, Technique};
 use crate::technique;
 use crate::technique::params::storage_name;
+pub use crate::timer::GPU_WARMUP_MS;
 
 /// Untimed runs before the timed ones (pipeline warm-up, lazy clears, caches).
 pub const WARMUP: u32 = 2;
@@ -518,6 +519,7 @@ pub fn measure(
     sizes: &[u32],
     repeat: u32,
     only: &[String],
+    inputs: Inputs,
 ) -> Result<Vec<BenchRow>> {
     check_args(device, sizes, repeat)?;
     let cases = select_cases(only)?;
@@ -551,6 +553,7 @@ pub fn measure(
                     &built.graph,
                     &built.outputs,
                     repeat,
+                    inputs,
                 )?;
                 let mut r = row("copy texture", format_name(format), n, &plan, t)?;
                 r.ratio = r.gbps / buffer_gbps;
@@ -574,6 +577,7 @@ pub fn measure(
                 &built.graph,
                 &built.outputs,
                 repeat,
+                inputs,
             )?;
             let output = built.outputs.first().and_then(|o| plan.resource(o));
             // The texture's own format (a packed f16 pair is an r32uint texture).
@@ -612,25 +616,39 @@ pub fn measure(
 }
 
 /// Runs [`measure`] on `gpu` and formats the report.
-pub fn run(gpu: &Gpu, sizes: &[u32], repeat: u32, only: &[String]) -> Result<String> {
-    let rows = measure(&gpu.device, &gpu.queue, sizes, repeat, only)?;
+pub fn run(
+    gpu: &Gpu,
+    sizes: &[u32],
+    repeat: u32,
+    only: &[String],
+    inputs: Inputs,
+) -> Result<String> {
+    let rows = measure(&gpu.device, &gpu.queue, sizes, repeat, only, inputs)?;
     let cpu = gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu;
-    Ok(format_table(&gpu.describe(), cpu, repeat, &rows))
+    Ok(format_table(&gpu.describe(), cpu, repeat, inputs, &rows))
 }
 
 /// The report: a header naming the device and the method, then one line per row.
-pub fn format_table(device: &str, cpu: bool, repeat: u32, rows: &[BenchRow]) -> String {
+pub fn format_table(
+    device: &str,
+    cpu: bool,
+    repeat: u32,
+    inputs: Inputs,
+    rows: &[BenchRow],
+) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "kernel benchmark on {device}");
     let _ = writeln!(
         s,
-        "GPU timestamps between passes, median of {repeat} run(s) after {WARMUP} warm-up run(s).\n\
-         MiB moved: the cost model's bytes (every dispatch's reads and writes, halos and second\n\
-         reads included, as `shadowgraph plan` prints them); GB/s = bytes / time; x = GB/s over\n\
-         the yardstick's: for a kernel the texture copy of its output's format (16x16\n\
-         workgroups, one load and one store per texel; timed before and after the kernels,\n\
-         the faster run kept), for a texture copy the buffer copy. wall ms: the median run's\n\
-         submission to completion, the timestamps' cross-check."
+        "GPU timestamps between passes, median of {repeat} run(s) after {WARMUP} warm-up run(s)\n\
+         (on a GPU, at least {GPU_WARMUP_MS} ms of them: its clocks rise). Imported textures:\n\
+         {} values. MiB moved: the cost model's bytes (every dispatch's reads and writes,\n\
+         halos and second reads included, as `shadowgraph plan` prints them); GB/s = bytes /\n\
+         time; x = GB/s over the yardstick's: for a kernel the texture copy of its output's\n\
+         format (16x16 workgroups, one load and one store per texel; timed before and after\n\
+         the kernels, the faster run kept), for a texture copy the buffer copy. wall ms: the\n\
+         median run's submission to completion, the timestamps' cross-check.",
+        inputs.name()
     );
     if cpu {
         let _ = writeln!(
@@ -749,7 +767,16 @@ mod tests {
         let (sat, msm) = (built("sat fixed"), built("msm"));
         let mut executor = Executor::new();
         let time = |executor: &mut Executor, b: &BenchGraph| {
-            time_graph(&gpu.device, &gpu.queue, executor, &b.graph, &b.outputs, 1).unwrap();
+            time_graph(
+                &gpu.device,
+                &gpu.queue,
+                executor,
+                &b.graph,
+                &b.outputs,
+                1,
+                Inputs::Random,
+            )
+            .unwrap();
             executor.texture_count()
         };
         let own = time(&mut executor, &msm);
@@ -777,7 +804,7 @@ mod tests {
     fn only_keeps_the_named_cases() {
         let gpu = gpu();
         let only = vec!["sat fixed".to_string(), "linearize".to_string()];
-        let rows = measure(&gpu.device, &gpu.queue, &[32], 1, &only).unwrap();
+        let rows = measure(&gpu.device, &gpu.queue, &[32], 1, &only, Inputs::Random).unwrap();
         let kernels: Vec<&str> = rows
             .iter()
             .filter(|r| !r.kernel.starts_with("copy"))
@@ -792,7 +819,15 @@ mod tests {
         assert!(want.len() >= 2, "{want:?}");
         let copies = rows.iter().filter(|r| r.kernel == "copy texture").count();
         assert_eq!(copies, COPY_FORMATS.len());
-        let e = measure(&gpu.device, &gpu.queue, &[32], 1, &["no such".to_string()]).unwrap_err();
+        let e = measure(
+            &gpu.device,
+            &gpu.queue,
+            &[32],
+            1,
+            &["no such".to_string()],
+            Inputs::Random,
+        )
+        .unwrap_err();
         assert!(
             e.to_string().contains("--only no such: matches no kernel"),
             "{e}"
@@ -804,7 +839,7 @@ mod tests {
     #[test]
     fn measure_reports_copies_then_each_case_per_size() {
         let gpu = gpu();
-        let rows = measure(&gpu.device, &gpu.queue, &[32, 48], 2, &[]).unwrap();
+        let rows = measure(&gpu.device, &gpu.queue, &[32, 48], 2, &[], Inputs::Random).unwrap();
         let names: Vec<(&str, u32)> = rows.iter().map(|r| (r.kernel.as_str(), r.size)).collect();
         let mut want = Vec::new();
         for n in [32, 48] {
@@ -829,7 +864,7 @@ mod tests {
             assert_eq!(r.yardstick, format!("copy texture {}", r.format));
             assert!((r.ratio - r.gbps / copy.gbps).abs() < 1e-12, "{r:?}");
         }
-        let text = format_table("test device", true, 2, &rows);
+        let text = format_table("test device", true, 2, Inputs::Random, &rows);
         assert!(text.contains("only the ratios") && text.contains("copy texture rg32float"));
     }
 
@@ -851,7 +886,7 @@ mod tests {
             yardstick: "copy buffer".into(),
         };
         let rows = [row("copy texture", 0.03), row("esm", 0.93)];
-        let text = format_table("test device", true, 5, &rows);
+        let text = format_table("test device", true, 5, Inputs::Random, &rows);
         let warning = text
             .lines()
             .find(|l| l.starts_with("WARNING"))
@@ -861,12 +896,14 @@ mod tests {
             "{warning}"
         );
         assert!(!warning.contains("esm"), "{warning}");
-        let fine = format_table("test device", true, 5, &rows[1..]);
+        let fine = format_table("test device", true, 5, Inputs::Random, &rows[1..]);
         assert!(!fine.contains("WARNING"), "{fine}");
         let mut short = row("copy texture", 0.3);
         short.wall_ms = 0.4;
-        assert!(!format_table("test device", true, 5, &[short]).contains("WARNING"));
-        assert!(!format_table("test device", false, 5, &rows).contains("WARNING"));
+        assert!(
+            !format_table("test device", true, 5, Inputs::Random, &[short]).contains("WARNING")
+        );
+        assert!(!format_table("test device", false, 5, Inputs::Random, &rows).contains("WARNING"));
     }
 
     /// The bytes of a SAT are its three passes' (two reads of the representation, one write
@@ -911,17 +948,20 @@ mod tests {
     fn bad_arguments_are_errors() {
         let gpu = gpu();
         let (d, q) = (&gpu.device, &gpu.queue);
-        assert!(matches!(measure(d, q, &[], 1, &[]), Err(Error::Invalid(_))));
         assert!(matches!(
-            measure(d, q, &[64], 0, &[]),
+            measure(d, q, &[], 1, &[], Inputs::Random),
             Err(Error::Invalid(_))
         ));
         assert!(matches!(
-            measure(d, q, &[0], 1, &[]),
+            measure(d, q, &[64], 0, &[], Inputs::Random),
             Err(Error::Invalid(_))
         ));
         assert!(matches!(
-            measure(d, q, &[u32::MAX], 1, &[]),
+            measure(d, q, &[0], 1, &[], Inputs::Random),
+            Err(Error::Invalid(_))
+        ));
+        assert!(matches!(
+            measure(d, q, &[u32::MAX], 1, &[], Inputs::Random),
             Err(Error::Limit { .. })
         ));
     }

@@ -3,8 +3,8 @@
 
 use std::fmt::Write;
 
-use super::WARMUP;
-use super::harness::median;
+use super::harness::{keep_warming, median};
+use super::{GPU_WARMUP_MS, WARMUP};
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
 use crate::render::{RenderOptions, Renderer};
@@ -113,7 +113,7 @@ fn shading_fetches(scene: &Scene) -> Result<f64> {
 }
 
 /// The shading pass's cost of every configuration of [`SOFT_TECHNIQUES`] at each light size in
-/// `sizes`: the median over `repeat` rounds (after [`WARMUP`] untimed ones) of the `shade`
+/// `sizes`: the median over `repeat` rounds (after [`WARMUP`] untimed ones, on a GPU at least [`super::GPU_WARMUP_MS`] of them) of the `shade`
 /// pass. Rounds interleave the configurations (each renders [`STEADY_FRAMES`] consecutive
 /// frames in turn, the last timed), so that a change of load on a shared machine reaches every
 /// configuration alike while each timed frame follows frames of its own configuration.
@@ -185,7 +185,17 @@ pub fn soft_cost(
         repeat: STEADY_FRAMES,
         ..Default::default()
     };
-    for round in 0..WARMUP + repeat {
+    // Untimed rounds: WARMUP, and on a GPU until its clocks have risen (`keep_warming`).
+    let gpu_device = gpu.adapter.get_info().device_type != wgpu::DeviceType::Cpu;
+    let warming = std::time::Instant::now();
+    let mut warm = 0;
+    while keep_warming(warm, warming.elapsed().as_secs_f64() * 1e3, gpu_device) {
+        for scene in &scenes {
+            renderer.render(&gpu.device, &gpu.queue, scene, opts)?;
+        }
+        warm += 1;
+    }
+    for _ in 0..repeat {
         for (k, scene) in scenes.iter().enumerate() {
             let f = renderer.render(&gpu.device, &gpu.queue, scene, opts)?;
             let (passes, wall) = f
@@ -198,7 +208,7 @@ pub fn soft_cost(
                 .find(|(name, _)| name == "shade")
                 .map(|(_, ms)| *ms)
                 .ok_or_else(|| Error::Invalid("the frame has no timed `shade` pass".into()))?;
-            if round >= WARMUP {
+            {
                 times[k].push(shade);
                 let sum = |keep: &dyn Fn(&str) -> bool| -> f64 {
                     passes
@@ -251,7 +261,7 @@ pub fn format_soft_table(
         s,
         "scenes/techniques/cssm.toml ({w}×{h}, {map}² spot map), the light's size swept (wider \
          penumbrae); GPU timestamps of the shade pass, median of {repeat} round(s) after \
-         {WARMUP} warm-up round(s), configurations interleaved, each round's frame the last of \
+         {WARMUP} warm-up round(s) (on a GPU, at least {GPU_WARMUP_MS} ms), configurations interleaved, each round's frame the last of \
          {STEADY_FRAMES} consecutive ones; (×) = over PCSS 16+32 at the same size; prefilter = every \
          pass of the light after its raster; frame = all passes, wall = submission to completion \
          (first size)."
