@@ -26,6 +26,8 @@ const CHANNELS: u32 = 4u;
 // `encode_blur_tile` in src/filter/encode_blur.rs.
 const TILE: u32 = 16u;
 const SH_TEXELS: u32 = 1024u;
+// Outputs an invocation sums in the tile's blur passes, four channels: one output an invocation (shared/encode_blur, `run_sums`).
+const RUN: u32 = 1u;
 alias Texel = vec4<f32>;
 
 fn texel_of(v: vec4<f32>) -> Texel {

@@ -22,6 +22,8 @@ const CHANNELS: u32 = 2u;
 // `encode_blur_tile` in src/filter/encode_blur.rs.
 const TILE: u32 = 24u;
 const SH_TEXELS: u32 = 1600u;
+// Outputs an invocation sums in the tile's blur passes, two channels: runs of 4 (shared/encode_blur, `run_sums`).
+const RUN: u32 = 4u;
 alias Texel = vec2<f32>;
 
 fn texel_of(v: vec4<f32>) -> Texel {

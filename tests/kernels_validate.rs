@@ -573,20 +573,30 @@ fn encode_blur_dispatch_constants_match_the_wgsl() {
             );
         }
         // One invocation per output of a row; a tile's encoded texels in at most six blocks of
-        // WG_SIZE (`encode_tile`'s e0 … e5), its blur in runs of RUN (four named sums), one
-        // run an invocation along x (TILE / RUN a row of the encoded tile) and along y.
+        // WG_SIZE (`encode_tile`'s e0 … e5). Its blur: with two channels in runs of RUN = 4
+        // (four named sums), one run an invocation along x (TILE / RUN a row of the encoded
+        // tile) and along y; with four, one output an invocation, the horizontal sums in at
+        // most four blocks of WG_SIZE (`blur_tile_single`'s h0 … h3).
         let wg = r.workgroup_size.expect("workgroup size")[0];
         assert_eq!(wg, ENCODE_BLUR_ROW, "{name}: workgroup");
         let enc = tile + 2 * ENCODE_BLUR_TILE_RADIUS;
         assert!(enc * enc <= 6 * wg, "{name}: encoded tile");
         let run = wgsl_const(&module, "RUN").expect("RUN");
-        assert_eq!(run, 4, "{name}: RUN (the sums s0 … s3)");
-        assert_eq!(tile % run, 0, "{name}: runs per line");
-        assert!(tile / run * enc <= wg, "{name}: runs along x");
-        assert!(tile / run * tile <= wg, "{name}: runs along y");
+        let channels = wgsl_const(&module, "CHANNELS").expect("CHANNELS");
+        match channels {
+            2 => {
+                assert_eq!(run, 4, "{name}: RUN (the sums s0 … s3)");
+                assert_eq!(tile % run, 0, "{name}: runs per line");
+                assert!(tile / run * enc <= wg, "{name}: runs along x");
+                assert!(tile / run * tile <= wg, "{name}: runs along y");
+            }
+            _ => {
+                assert_eq!(run, 1, "{name}: RUN (one output an invocation)");
+                assert!(tile * enc <= 4 * wg, "{name}: horizontal sums");
+            }
+        }
         // Workgroup memory: the depth tile with its halo, and the fallback's three rows.
         let sh = wgsl_const(&module, "SH_TEXELS").expect("SH_TEXELS");
-        let channels = wgsl_const(&module, "CHANNELS").expect("CHANNELS");
         let max_radius = wgsl_const(&module, "MAX_RADIUS").expect("MAX_RADIUS");
         let dep = enc + 2;
         assert!(

@@ -24,7 +24,8 @@
 // that memory allows, `const TILE` (outputs per side) and `const SH_TEXELS` (texels of
 // workgroup memory: at least the depth tile at TILE_RADIUS, (TILE + 2·TILE_RADIUS + 2)², and
 // three rows of the fallback, 3·(ROW + 2·MAX_RADIUS + 2) = 966; 16 KiB at most): 24 and 1600
-// with two channels (12.5 KiB), 16 and 1024 with four (16 KiB):
+// with two channels (12.5 KiB), 16 and 1024 with four (16 KiB); and `const RUN`, the outputs an
+// invocation sums in a tile's blur passes: 4 with two channels, 1 with four (see `run_sums`):
 // #completed-by-importer
 // Storage: rg32float by default; the executor re-declares `dst` for the bound format.
 
@@ -51,8 +52,9 @@ const TILE_RADIUS: u32 = 7u;
 const MAX_RADIUS: u32 = 32u;
 // Encoded texels an invocation holds between barriers (`encode_tile`: e0 … e5): at least
 // ⌈(TILE + 2·TILE_RADIUS)² / WG_SIZE⌉ of a tile (6 at TILE = 24) and ⌈(ROW + 2·MAX_RADIUS) /
-// WG_SIZE⌉ of a row; the blur's sums, one run of RUN an invocation (`blur_tile`). The blocks
-// past the first four exist only in kernels whose tile can need them (`ENC_MAX`: a constant
+// WG_SIZE⌉ of a row; the blur's sums, a run of RUN (`blur_tile_runs`) or up to four blocks of
+// WG_SIZE (`blur_tile_single`, h0 … h3). The blocks past the first four (two) exist only in
+// kernels whose tile can need them (`ENC_MAX`, `H_MAX`: a constant
 // condition, compiled away for a 16² tile: as a run-time test llvmpipe computed the blocks
 // anyway and EVSM4/MSM ran 12–20% slower), and are skipped where the radius leaves them empty
 // (`k·WG_SIZE < n`, the same for the whole workgroup). Workgroup memory (SH_TEXELS, a `Texel`
@@ -67,6 +69,10 @@ var<workgroup> sh_tile: array<Texel, SH_TEXELS>;
 // The most encoded texels a tile holds (at TILE_RADIUS): the blocks of WG_SIZE past the first
 // four are compiled only where a kernel's tile needs them.
 const ENC_MAX: u32 = (TILE + 2u * TILE_RADIUS) * (TILE + 2u * TILE_RADIUS);
+
+// The most horizontal sums of a tile (at TILE_RADIUS) with one output an invocation: the blocks
+// of WG_SIZE past the first two likewise.
+const H_MAX: u32 = TILE * (TILE + 2u * TILE_RADIUS);
 
 // A workgroup's outputs and the extents it works over.
 struct Tile {
@@ -183,13 +189,18 @@ fn store(t: Tile, o: vec2<i32>, v: Texel) {
     }
 }
 
-// Outputs an invocation sums in one run along a line of the tile (RUN consecutive texels of a
-// row, then of a column): each of the RUN + 2r texels the run covers is read once from
-// workgroup memory into RUN running sums, RUN + 2r reads for RUN outputs where one output at a
-// time reads 2r + 1 (3 against 9 an output at r = 4, 4.5 against 15 at r = 7). The tile's side
-// (24, 16) is a multiple of RUN, and its runs fit one an invocation: (TILE / RUN) · (TILE +
-// 2·TILE_RADIUS) ≤ WG_SIZE (228 at TILE = 24).
-const RUN: u32 = 4u;
+// Runs (RUN = 4): an invocation sums RUN consecutive outputs along a line of the tile (a row,
+// then a column): each of the RUN + 2r texels the run covers is read once from workgroup memory
+// into RUN running sums, RUN + 2r reads for RUN outputs where one output at a time reads 2r + 1
+// (3 against 9 an output at r = 4). The tile's side is a multiple of RUN and its runs fit one
+// an invocation: (TILE / RUN) · (TILE + 2·TILE_RADIUS) ≤ WG_SIZE (228 at TILE = 24).
+// Which kernels run them, measured (benches/RESULTS.md, 2026-11-27): the two-channel tile (24²)
+// keeps 144 of 256 invocations busy in its vertical pass and ran 6% faster on an H200 (1.29–
+// 1.33× on llvmpipe); a four-channel tile (16²) keeps 64 busy and ran 17–20% slower on the H200
+// (1.07–1.12× faster on llvmpipe), and so does the row path (ROW / RUN = 64 of 256: 12% slower
+// there, 1.13–1.19× faster on llvmpipe). The GPU decides: four channels and the row path sum one
+// output an invocation (`blur_tile_single`, `sum_x`). RUN is a constant, so each kernel
+// compiles one of the two.
 
 // The weight of offset d, 0 past the radius r.
 fn run_weight(d: i32, r: i32) -> f32 {
@@ -230,10 +241,10 @@ fn run_sums(first: i32, step: i32, r: i32) -> Run {
     return o;
 }
 
-// Phases 3 and 4: along x into workgroup memory (outs.x × enc.y sums, a run of RUN an
-// invocation), then along y into `dst` (outs.x × outs.y outputs, a run of RUN down a column an
+// Phases 3 and 4 in runs (RUN = 4): along x into workgroup memory (outs.x × enc.y sums, a run an
+// invocation), then along y into `dst` (outs.x × outs.y outputs, a run down a column an
 // invocation). Invocations past the last run idle through the barriers.
-fn blur_tile(t: Tile, li: u32) {
+fn blur_tile_runs(t: Tile, li: u32) {
     let i = i32(li);
     let runs_x = t.outs.x / i32(RUN);
     let row = i / runs_x;
@@ -264,15 +275,57 @@ fn blur_tile(t: Tile, li: u32) {
     }
 }
 
-// The row's blur along x (outs.x = ROW outputs, runs of RUN: ROW / RUN invocations).
-fn blur_row(t: Tile, li: u32) {
-    let x0 = i32(li) * i32(RUN);
-    if x0 < t.outs.x {
-        let v = run_sums(x0 + t.r.x, 1, t.r.x);
-        store(t, vec2<i32>(x0, 0), v.s0);
-        store(t, vec2<i32>(x0 + 1, 0), v.s1);
-        store(t, vec2<i32>(x0 + 2, 0), v.s2);
-        store(t, vec2<i32>(x0 + 3, 0), v.s3);
+// The horizontal sum at output column x of encoded row y, alone.
+fn sum_x(t: Tile, x: i32, y: i32) -> Texel {
+    let c = y * t.enc.x + x + t.r.x;
+    var s = blur_weight(0) * sh_get(c);
+    for (var i = 1; i <= t.r.x; i++) {
+        s += blur_weight(i) * (sh_get(c - i) + sh_get(c + i));
+    }
+    return s;
+}
+
+// The vertical sum of output q of the tile, alone, stored.
+fn sum_y(t: Tile, q: i32) {
+    let o = vec2<i32>(q % t.outs.x, q / t.outs.x);
+    let c = (o.y + t.r.y) * t.outs.x + o.x;
+    var v = blur_weight(0) * sh_get(c);
+    for (var k = 1; k <= t.r.y; k++) {
+        v += blur_weight(k) * (sh_get(c - k * t.outs.x) + sh_get(c + k * t.outs.x));
+    }
+    store(t, o, v);
+}
+
+// Phases 3 and 4 one output an invocation (RUN = 1): along x into workgroup memory (outs.x ×
+// enc.y sums, in up to four blocks of WG_SIZE), then along y into `dst` (WG_SIZE at a time).
+fn blur_tile_single(t: Tile, li: u32) {
+    let n = t.outs.x * t.enc.y;
+    let i = i32(li);
+    let w = i32(WG_SIZE);
+    let j1 = min(i + w, n - 1);
+    let h0 = sum_x(t, i % t.outs.x, i / t.outs.x);
+    let h1 = sum_x(t, j1 % t.outs.x, j1 / t.outs.x);
+    var h2 = h1;
+    var h3 = h1;
+    if H_MAX > 2u * WG_SIZE && 2 * w < n {
+        let j2 = min(i + 2 * w, n - 1);
+        let j3 = min(i + 3 * w, n - 1);
+        h2 = sum_x(t, j2 % t.outs.x, j2 / t.outs.x);
+        h3 = sum_x(t, j3 % t.outs.x, j3 / t.outs.x);
+    }
+    workgroupBarrier();
+    put_below(i, n, h0);
+    put_below(i + w, n, h1);
+    if H_MAX > 2u * WG_SIZE && 2 * w < n {
+        put_below(i + 2 * w, n, h2);
+        put_below(i + 3 * w, n, h3);
+    }
+    workgroupBarrier();
+    sum_y(t, i);
+    if TILE * TILE > WG_SIZE {
+        for (var q = i + w; q < t.outs.x * t.outs.y; q += w) {
+            sum_y(t, q);
+        }
     }
 }
 
@@ -283,8 +336,14 @@ fn encode_blur(wg: vec2<u32>, li: u32) {
     workgroupBarrier();
     encode_tile(t, li);
     if params.blur.axis == 2u {
-        blur_tile(t, li);
+        // A constant condition: each kernel compiles one of the two.
+        if RUN == 4u {
+            blur_tile_runs(t, li);
+        } else {
+            blur_tile_single(t, li);
+        }
     } else {
-        blur_row(t, li);
+        // The row's blur along x: one output an invocation (ROW = WG_SIZE).
+        store(t, vec2<i32>(i32(li), 0), sum_x(t, i32(li), 0));
     }
 }
