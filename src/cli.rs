@@ -116,6 +116,20 @@ pub fn render(
 ) -> Result<String> {
     let scene = Scene::load(scene_path)?;
     let mut renderer = Renderer::new(&gpu.device);
+    // Timings on a GPU: untimed frames first until its clocks have risen (timer::keep_warming).
+    if timings && gpu.adapter.get_info().device_type != wgpu::DeviceType::Cpu {
+        let warming = std::time::Instant::now();
+        let mut warm = 0;
+        while crate::timer::keep_warming(warm, 0, warming.elapsed().as_secs_f64() * 1e3, true) {
+            let opts = RenderOptions {
+                aux: false,
+                repeat: 1,
+                dump: false,
+            };
+            renderer.render(&gpu.device, &gpu.queue, &scene, opts)?;
+            warm += 1;
+        }
+    }
     let frame = renderer.render(
         &gpu.device,
         &gpu.queue,
@@ -211,8 +225,13 @@ pub fn timing_table(gpu: &Gpu, frame: &Frame) -> String {
     };
     let _ = writeln!(
         s,
-        "GPU time per pass (timestamps between passes), median of {} frame(s), on {}:",
+        "GPU time per pass (timestamps between passes), median of {} frame(s){}, on {}:",
         frame.timings.len(),
+        if gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu {
+            String::new()
+        } else {
+            format!(" after {} ms of untimed ones", crate::timer::GPU_WARMUP_MS)
+        },
         gpu.describe()
     );
     let mut total = 0.0;
