@@ -99,6 +99,9 @@ enum Command {
         /// faster; the texture copies read the same kind).
         #[arg(long, default_value = "random", value_parser = clap::builder::PossibleValuesParser::new(shadowgraph::bench::Inputs::NAMES), conflicts_with = "lookup")]
         inputs: String,
+        /// Also print each dispatch's median time under a kernel of several.
+        #[arg(long, conflicts_with = "lookup")]
+        passes: bool,
     },
     /// Sweep techniques and their accuracy knobs, time each on the GPU and measure its error
     /// against ground truth: report.html/.md/.csv/.json, pareto{,_penumbra,_flip}.svg, grid.png
@@ -250,6 +253,7 @@ fn run(args: Args) -> Result<()> {
             map,
             only,
             inputs,
+            passes,
         } => {
             let gpu = Gpu::new()?;
             match lookup {
@@ -288,7 +292,7 @@ fn run(args: Args) -> Result<()> {
                     let inputs = shadowgraph::bench::Inputs::parse(&inputs)?;
                     print!(
                         "{}",
-                        shadowgraph::bench::run(&gpu, &sizes, repeat, &only, inputs)?
+                        shadowgraph::bench::run(&gpu, &sizes, repeat, &only, inputs, passes)?
                     )
                 }
             }

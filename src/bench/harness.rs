@@ -27,7 +27,7 @@ pub(super) fn gb_per_s(bytes: f64, ms: f64) -> f64 {
 }
 
 /// A run's time by the GPU's timestamps and by the wall clock, ms (medians over runs).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Timed {
     /// The summed span times.
     pub ms: f64,
@@ -40,6 +40,9 @@ pub struct Timed {
     /// the median wall time, not the run's own: a run whose wait alone was stretched (the
     /// thread descheduled on busy cores) keeps true spans and must not read as a fault.
     pub least_share: f64,
+    /// Each span's median on its own (a graph's dispatches by node name, in order): where
+    /// the summed time goes (`bench --passes`).
+    pub passes: Vec<(String, f64)>,
 }
 
 /// Whether another untimed run is due after `runs` of them over `elapsed_ms` ([`WARMUP`] at
@@ -59,6 +62,7 @@ pub(super) fn median_time(
 ) -> Result<Timed> {
     let mut times = Vec::with_capacity(repeat as usize);
     let mut walls = Vec::with_capacity(repeat as usize);
+    let mut passes: Vec<(String, Vec<f64>)> = Vec::new();
     let gpu = device.adapter_info().device_type != wgpu::DeviceType::Cpu;
     let warming = Instant::now();
     let mut warm = 0u32;
@@ -92,6 +96,12 @@ pub(super) fn median_time(
         }
         times.push(spans.iter().map(|(_, ms)| ms).sum());
         walls.push(wall_ms);
+        if passes.is_empty() {
+            passes = spans.iter().map(|(l, _)| (l.clone(), Vec::new())).collect();
+        }
+        for ((_, v), (_, ms)) in passes.iter_mut().zip(&spans) {
+            v.push(*ms);
+        }
     }
     let shortest = times.iter().copied().fold(f64::INFINITY, f64::min);
     let wall_ms = median(&mut walls);
@@ -99,6 +109,10 @@ pub(super) fn median_time(
         ms: median(&mut times),
         wall_ms,
         least_share: shortest / wall_ms,
+        passes: passes
+            .into_iter()
+            .map(|(l, mut v)| (l, median(&mut v)))
+            .collect(),
     })
 }
 

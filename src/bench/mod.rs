@@ -66,6 +66,9 @@ pub struct BenchRow {
     pub gbps: f64,
     /// `gbps` over the yardstick's GB/s at the same size.
     pub ratio: f64,
+    /// Each dispatch's median time, ms, by node name in order ([`Timed::passes`]; empty for
+    /// the buffer copy).
+    pub passes: Vec<(String, f64)>,
     /// The yardstick: `copy texture <format>` for a kernel, `copy buffer` for a texture copy
     /// (empty for the buffer copy itself).
     pub yardstick: String,
@@ -483,6 +486,7 @@ fn row(name: &str, format: String, n: u32, plan: &Plan, t: Timed) -> Result<Benc
         gbps: gb_per_s(bytes, t.ms),
         ratio: f64::NAN,
         yardstick: String::new(),
+        passes: t.passes,
     })
 }
 
@@ -541,6 +545,7 @@ pub fn measure(
             gbps: buffer_gbps,
             ratio: 1.0,
             yardstick: String::new(),
+            passes: Vec::new(),
         });
         let time_copies = |executor: &mut Executor| -> Result<Vec<BenchRow>> {
             let mut copies = Vec::new();
@@ -622,18 +627,28 @@ pub fn run(
     repeat: u32,
     only: &[String],
     inputs: Inputs,
+    passes: bool,
 ) -> Result<String> {
     let rows = measure(&gpu.device, &gpu.queue, sizes, repeat, only, inputs)?;
     let cpu = gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu;
-    Ok(format_table(&gpu.describe(), cpu, repeat, inputs, &rows))
+    Ok(format_table(
+        &gpu.describe(),
+        cpu,
+        repeat,
+        inputs,
+        passes,
+        &rows,
+    ))
 }
 
-/// The report: a header naming the device and the method, then one line per row.
+/// The report: a header naming the device and the method, then one line per row (with
+/// `passes`, a kernel of several dispatches followed by one line for each).
 pub fn format_table(
     device: &str,
     cpu: bool,
     repeat: u32,
     inputs: Inputs,
+    passes: bool,
     rows: &[BenchRow],
 ) -> String {
     let mut s = String::new();
@@ -676,6 +691,11 @@ pub fn format_table(
             r.ratio,
             r.yardstick
         );
+        if passes && r.passes.len() > 1 {
+            for (label, ms) in &r.passes {
+                let _ = writeln!(s, "{:>6}    - {:<40} {:>10.3}", "", label, ms);
+            }
+        }
     }
     if cpu {
         let suspect: Vec<String> = rows
@@ -798,6 +818,40 @@ mod tests {
         assert_eq!(again, own);
     }
 
+    /// Each row carries its dispatches' medians by node name, in the plan's order (the SAT's
+    /// three), each within the run's total; `--passes` prints them under the row, and only
+    /// then.
+    #[test]
+    fn rows_carry_their_passes_and_print_them_on_request() {
+        let gpu = gpu();
+        let only = vec!["sat fixed".to_string()];
+        let rows = measure(&gpu.device, &gpu.queue, &[64], 2, &only, Inputs::Random).unwrap();
+        let sat = rows.iter().find(|r| r.kernel == "sat fixed").unwrap();
+        let built = (CASES.iter().find(|c| c.name == "sat fixed").unwrap().build)(64);
+        let outputs: Vec<&str> = built.outputs.iter().map(String::as_str).collect();
+        let plan = crate::graph::plan(&built.graph, &outputs).unwrap();
+        let names: Vec<&str> = sat.passes.iter().map(|(l, _)| l.as_str()).collect();
+        let want: Vec<&str> = plan.steps.iter().map(|s| s.node.name.as_str()).collect();
+        assert_eq!(names, want);
+        assert_eq!(names.len(), 3, "{names:?}");
+        let total: f64 = sat.passes.iter().map(|p| p.1).sum();
+        assert!(
+            sat.passes.iter().all(|p| p.1 >= 0.0 && p.1 <= total),
+            "{:?}",
+            sat.passes
+        );
+        let device = "test device";
+        let with = format_table(device, true, 2, Inputs::Random, true, &rows);
+        let without = format_table(device, true, 2, Inputs::Random, false, &rows);
+        for name in &names {
+            assert!(
+                with.lines()
+                    .any(|l| l.trim_start().starts_with(&format!("- {name} ")))
+            );
+            assert!(!without.contains(&format!("- {name}")), "{without}");
+        }
+    }
+
     /// `only` keeps the cases whose name contains one of its strings (the copies stay: they
     /// are the yardsticks); a filter that keeps none is an error naming the kernels.
     #[test]
@@ -864,7 +918,7 @@ mod tests {
             assert_eq!(r.yardstick, format!("copy texture {}", r.format));
             assert!((r.ratio - r.gbps / copy.gbps).abs() < 1e-12, "{r:?}");
         }
-        let text = format_table("test device", true, 2, Inputs::Random, &rows);
+        let text = format_table("test device", true, 2, Inputs::Random, false, &rows);
         assert!(text.contains("only the ratios") && text.contains("copy texture rg32float"));
     }
 
@@ -884,9 +938,10 @@ mod tests {
             gbps: 2.5,
             ratio: 1.0,
             yardstick: "copy buffer".into(),
+            passes: Vec::new(),
         };
         let rows = [row("copy texture", 0.03), row("esm", 0.93)];
-        let text = format_table("test device", true, 5, Inputs::Random, &rows);
+        let text = format_table("test device", true, 5, Inputs::Random, false, &rows);
         let warning = text
             .lines()
             .find(|l| l.starts_with("WARNING"))
@@ -896,14 +951,18 @@ mod tests {
             "{warning}"
         );
         assert!(!warning.contains("esm"), "{warning}");
-        let fine = format_table("test device", true, 5, Inputs::Random, &rows[1..]);
+        let fine = format_table("test device", true, 5, Inputs::Random, false, &rows[1..]);
         assert!(!fine.contains("WARNING"), "{fine}");
         let mut short = row("copy texture", 0.3);
         short.wall_ms = 0.4;
         assert!(
-            !format_table("test device", true, 5, Inputs::Random, &[short]).contains("WARNING")
+            !format_table("test device", true, 5, Inputs::Random, false, &[short])
+                .contains("WARNING")
         );
-        assert!(!format_table("test device", false, 5, Inputs::Random, &rows).contains("WARNING"));
+        assert!(
+            !format_table("test device", false, 5, Inputs::Random, false, &rows)
+                .contains("WARNING")
+        );
     }
 
     /// The bytes of a SAT are its three passes' (two reads of the representation, one write
