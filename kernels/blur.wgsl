@@ -1,12 +1,15 @@
 // One pass of a separable blur (Gaussian, or box with fractional edge weights) over every
 // channel of any float representation: the weighted sum of each texel's 2r + 1 neighbours
-// along the pass's axis, PER outputs an invocation (shared/blur_pass; a row's interleaved
-// WG_SIZE apart so that neighbouring invocations touch neighbouring texels), each summed as the
-// centre and then the symmetric pairs, w₀·v₀ + Σ wᵢ·(v₋ᵢ + vᵢ), straight from the texture.
-// (Reading each texel once into PER running sums instead was 2.2 times faster on llvmpipe at
-// r = 4, but its different f32 rounding of the sums moved MSM moments onto points where the
-// per-pixel MSM tolerances of tests/scenes.rs and the stability suite's case 3 fail; this
-// order keeps the sums the earlier kernel computed.)
+// along the pass's axis, each summed as the centre and then the symmetric pairs,
+// w₀·v₀ + Σ wᵢ·(v₋ᵢ + vᵢ), straight from the texture (shared/blur_pass), in runs of RUN = 2
+// consecutive outputs: the run's taps are read once each (RUN + 2r loads for RUN outputs, where
+// one output at a time reads 2r + 1: 5 against 9 an output at r = 4), two sliding windows of
+// RUN taps holding v_{k−i} and v_{k+i} of the run's outputs k as i grows. Every output's sum
+// keeps the order above, so the results are those of one output at a time, bit for bit (a
+// running sum in tap order, 2.2× faster on llvmpipe, had moved MSM moments onto points where
+// the per-pixel MSM tolerances of tests/scenes.rs and the stability suite's case 3 fail).
+// Rows: an invocation writes PER / RUN runs, WG_SIZE · RUN apart, neighbouring invocations'
+// runs side by side; columns: COL_PER / RUN runs down its column.
 // #import shared/blur_pass
 // Traffic (the cost model, src/graph/cost): a row workgroup loads its WG_SIZE · PER texels and
 // a halo of r each side; a column workgroup WG_SIZE columns of COL_PER + 2r texels each.
@@ -19,28 +22,64 @@
 // `BLUR_COL_PER` in src/filter.rs.
 const COL_PER: u32 = 32u;
 
-// The invocation's outputs along the pass's axis (`vertical`: a constant at each call).
-fn blur_outputs(b: BlurLine, vertical: bool) {
-    for (var k = 0; k < b.count; k++) {
-        let o = out_offset(b, k);
-        var s = weight(0, b.r) * tap(b, o, vertical);
-        for (var i = 1; i <= b.r; i++) {
-            s += weight(i, b.r) * (tap(b, o - i, vertical) + tap(b, o + i, vertical));
+// Outputs an invocation sums together (the sliding windows' length). 2, not 4: on llvmpipe
+// runs of 4 made the two-channel passes 1.2–2.0× faster but four-channel ones 5–13% slower
+// (sixteen vec4 live across the tap loop: spilled), where runs of 2 made both faster; on a GPU
+// the 48 floats of a run of 4's windows and sums would cut occupancy.
+const RUN: i32 = 2;
+
+// The run of outputs `o`, `o + 1` along the line (`vertical`: a constant at each call).
+fn blur_run(b: BlurLine, o: i32, vertical: bool) {
+    let c0 = tap(b, o, vertical);
+    let c1 = tap(b, o + 1, vertical);
+    let w0 = weight(0, b.r);
+    var s0 = w0 * c0;
+    var s1 = w0 * c1;
+    // At offset i: l_k = v_{k−i}, r_k = v_{k+i} of output k (from i = 1).
+    var l0 = tap(b, o - 1, vertical);
+    var l1 = c0;
+    var r0 = c1;
+    var r1 = tap(b, o + RUN, vertical);
+    for (var i = 1; i <= b.r; i++) {
+        let w = weight(i, b.r);
+        s0 += w * (l0 + r0);
+        s1 += w * (l1 + r1);
+        if i < b.r {
+            l1 = l0;
+            l0 = tap(b, o - i - 1, vertical);
+            r0 = r1;
+            r1 = tap(b, o + RUN + i, vertical);
         }
-        put(b, o, s, vertical);
+    }
+    put(b, o, s0, vertical);
+    put(b, o + 1, s1, vertical);
+}
+
+// The invocation's runs along the pass's axis (`vertical`: a constant at each call): `count`
+// outputs in runs `step` apart from `first`.
+fn blur_outputs(b: BlurLine, step: i32, vertical: bool) {
+    for (var k = 0; k < b.count; k += RUN) {
+        let o = (k / RUN) * step;
+        if b.first + o < b.along {
+            blur_run(b, o, vertical);
+        }
     }
 }
 
 @compute @workgroup_size(WG_SIZE)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    let b = blur_line(wg.xy, li, true, COL_PER);
-    if !blur_active(b) {
-        return;
-    }
+    var b = blur_line(wg.xy, li, false, COL_PER);
     // The axis tested once, not at every tap (shared/blur_pass's `tap`).
     if params.axis == 1u {
-        blur_outputs(b, true);
+        if blur_active(b) {
+            blur_outputs(b, RUN, true);
+        }
     } else {
-        blur_outputs(b, false);
+        // Runs of the workgroup's WG_SIZE · PER texels: invocation li's at li · RUN and every
+        // WG_SIZE · RUN after it, so that neighbouring invocations' runs lie side by side.
+        b.first = i32(wg.x * WG_SIZE * PER) + i32(li) * RUN;
+        if blur_active(b) {
+            blur_outputs(b, i32(WG_SIZE) * RUN, false);
+        }
     }
 }
