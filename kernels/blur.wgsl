@@ -56,10 +56,10 @@ fn blur_run(b: BlurLine, o: i32, vertical: bool) {
 }
 
 // The invocation's runs along the pass's axis (`vertical`: a constant at each call): `count`
-// outputs in runs `step` apart from `first`.
-fn blur_outputs(b: BlurLine, step: i32, vertical: bool) {
+// outputs in runs `step` apart from `first` (shared/blur_pass).
+fn blur_outputs(b: BlurLine, vertical: bool) {
     for (var k = 0; k < b.count; k += RUN) {
-        let o = (k / RUN) * step;
+        let o = (k / RUN) * b.step;
         if b.first + o < b.along {
             blur_run(b, o, vertical);
         }
@@ -68,18 +68,14 @@ fn blur_outputs(b: BlurLine, step: i32, vertical: bool) {
 
 @compute @workgroup_size(WG_SIZE)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    var b = blur_line(wg.xy, li, false, COL_PER);
+    let b = blur_line(wg.xy, li, u32(RUN), COL_PER);
+    if !blur_active(b) {
+        return;
+    }
     // The axis tested once, not at every tap (shared/blur_pass's `tap`).
     if params.axis == 1u {
-        if blur_active(b) {
-            blur_outputs(b, RUN, true);
-        }
+        blur_outputs(b, true);
     } else {
-        // Runs of the workgroup's WG_SIZE · PER texels: invocation li's at li · RUN and every
-        // WG_SIZE · RUN after it, so that neighbouring invocations' runs lie side by side.
-        b.first = i32(wg.x * WG_SIZE * PER) + i32(li) * RUN;
-        if blur_active(b) {
-            blur_outputs(b, i32(WG_SIZE) * RUN, false);
-        }
+        blur_outputs(b, false);
     }
 }

@@ -43,7 +43,7 @@ fn put_x(b: BlurLine, k: i32, v: f32, vertical: bool) {
 
 @compute @workgroup_size(WG_SIZE)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    let b = blur_line(wg.xy, li, false, COL_PER);
+    let b = blur_line(wg.xy, li, PER, COL_PER);
     if !blur_active(b) {
         return;
     }

@@ -1,8 +1,9 @@
 // One pass of a separable blur (import-only module of `blur` and `blur_log`): parameters,
-// bindings, and the line an invocation filters. Each invocation writes PER consecutive texels
-// of a line, reading its taps straight from the texture: no workgroup memory, so any radius up
-// to MAX_RADIUS fits (and llvmpipe, where a workgroup-memory access costs several texture
-// loads, runs it fast). Rows: a workgroup covers WG_SIZE · PER texels of one row; columns:
+// bindings, and the line an invocation filters. Each invocation writes PER texels of a row or
+// `col_per` of a column, in runs of consecutive texels (`blur_line`), reading its taps straight
+// from the texture: no workgroup memory, so any radius up to MAX_RADIUS fits (and llvmpipe,
+// where a workgroup-memory access costs several texture loads, runs it fast). Rows: a workgroup
+// covers WG_SIZE · PER texels of one row; columns:
 // WG_SIZE neighbouring columns, `col_per` rows each (the importing kernel's choice), so a
 // workgroup's loads lie side by side and its halo of 2r rows is shared by `col_per` outputs. Edges
 // clamp (replicate the border texel), so the map edge keeps its shadow instead of fading
@@ -27,12 +28,13 @@ const PER: u32 = 8u;
 const WG_SIZE: u32 = 64u;
 const MAX_RADIUS: u32 = 32u;
 
-// The texels an invocation writes: `first + k · stride` for k = 0 … PER − 1 along line `line`
-// of a map `along` texels long and `across` lines wide; `r` taps each side. Offsets passed to
-// `tap` and `put` are relative to `first`.
+// The texels an invocation writes along line `line` of a map `along` texels long and `across`
+// lines wide: `count` of them from `first`, in runs of consecutive texels `step` apart (the
+// importing kernel's run length); `r` taps each side. Offsets passed to `tap` and `put` are
+// relative to `first`.
 struct BlurLine {
     first: i32,
-    stride: i32,
+    step: i32,
     line: u32,
     along: i32,
     across: u32,
@@ -41,40 +43,31 @@ struct BlurLine {
     count: i32,
 }
 
-// Rows: workgroup (x, y) covers texels [x·WG_SIZE·PER, (x + 1)·WG_SIZE·PER) of row y; with
-// `interleave` invocation li writes texels li, li + WG_SIZE, …, so at each step neighbouring
-// invocations load and store neighbouring texels (coalesced on a GPU), else the PER
-// consecutive texels from li·PER (for kernels that slide one window along them). Columns:
-// workgroup (x, y) covers columns x·WG_SIZE + li, rows [y·col_per, (y + 1)·col_per):
+// Rows: workgroup (x, y) covers texels [x·WG_SIZE·PER, (x + 1)·WG_SIZE·PER) of row y in runs of
+// `run` consecutive texels: invocation li's start at li·run and follow every WG_SIZE·run, so
+// that neighbouring invocations' runs lie side by side (run = PER: the PER consecutive texels
+// from li·PER, for a kernel that slides one window along them). Columns: workgroup (x, y)
+// covers columns x·WG_SIZE + li, rows [y·col_per, (y + 1)·col_per), runs one after another:
 // neighbouring invocations are neighbouring columns either way.
-fn blur_line(wg: vec2<u32>, li: u32, interleave: bool, col_per: u32) -> BlurLine {
+fn blur_line(wg: vec2<u32>, li: u32, run: u32, col_per: u32) -> BlurLine {
     let size = textureDimensions(src);
     var b: BlurLine;
     b.r = i32(min(params.radius, MAX_RADIUS));
-    b.stride = 1;
     b.count = i32(select(PER, col_per, params.axis == 1u));
     if params.axis == 1u {
         b.first = i32(wg.y * col_per);
+        b.step = i32(run);
         b.line = wg.x * WG_SIZE + li;
         b.along = i32(size.y);
         b.across = size.x;
     } else {
-        if interleave {
-            b.first = i32(wg.x * WG_SIZE * PER + li);
-            b.stride = i32(WG_SIZE);
-        } else {
-            b.first = i32((wg.x * WG_SIZE + li) * PER);
-        }
+        b.first = i32(wg.x * WG_SIZE * PER + li * run);
+        b.step = i32(WG_SIZE * run);
         b.line = wg.y;
         b.along = i32(size.x);
         b.across = size.y;
     }
     return b;
-}
-
-// The offset (from `first`) of output k.
-fn out_offset(b: BlurLine, k: i32) -> i32 {
-    return k * b.stride;
 }
 
 // Whether the invocation has any texel to write.
