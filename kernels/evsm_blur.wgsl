@@ -29,6 +29,10 @@ const TILE: u32 = 16u;
 const SH_TEXELS: u32 = 1024u;
 // Outputs an invocation sums in the tile's blur passes, four channels: one output an invocation (shared/encode_blur, `run_sums`).
 const RUN: u32 = 1u;
+// Outputs of a one-row workgroup (the fallback past TILE_RADIUS) and the run an invocation sums
+// there (shared/encode_blur). Keep in sync with `encode_blur_row` in src/filter/encode_blur.rs.
+const ROW: u32 = 256u;
+const ROW_RUN: u32 = 1u;
 alias Texel = vec4<f32>;
 
 fn texel_of(v: vec4<f32>) -> Texel {

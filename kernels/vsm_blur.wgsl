@@ -21,9 +21,13 @@ const CHANNELS: u32 = 2u;
 // The tile its workgroup memory allows (shared/encode_blur). Keep in sync with
 // `encode_blur_tile` in src/filter/encode_blur.rs.
 const TILE: u32 = 24u;
-const SH_TEXELS: u32 = 1600u;
+const SH_TEXELS: u32 = 1734u;
 // Outputs an invocation sums in the tile's blur passes, two channels: runs of 4 (shared/encode_blur, `run_sums`).
 const RUN: u32 = 4u;
+// Outputs of a one-row workgroup (the fallback past TILE_RADIUS) and the run an invocation sums
+// there (shared/encode_blur). Keep in sync with `encode_blur_row` in src/filter/encode_blur.rs.
+const ROW: u32 = 512u;
+const ROW_RUN: u32 = 2u;
 alias Texel = vec2<f32>;
 
 fn texel_of(v: vec4<f32>) -> Texel {

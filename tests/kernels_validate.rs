@@ -554,7 +554,7 @@ fn peel_epsilon_matches_the_wgsl() {
 
 #[test]
 fn encode_blur_dispatch_constants_match_the_wgsl() {
-    use shadowgraph::filter::{ENCODE_BLUR_ROW, ENCODE_BLUR_TILE_RADIUS, encode_blur_tile};
+    use shadowgraph::filter::{ENCODE_BLUR_TILE_RADIUS, encode_blur_row, encode_blur_tile};
     use shadowgraph::kernels::KernelId;
     for kernel in [KernelId::VsmBlur, KernelId::EvsmBlur, KernelId::MsmBlur] {
         let name = kernel.name();
@@ -563,7 +563,7 @@ fn encode_blur_dispatch_constants_match_the_wgsl() {
         let tile = encode_blur_tile(kernel);
         for (constant, rust) in [
             ("TILE", tile),
-            ("ROW", ENCODE_BLUR_ROW),
+            ("ROW", encode_blur_row(kernel)),
             ("TILE_RADIUS", ENCODE_BLUR_TILE_RADIUS),
         ] {
             assert_eq!(
@@ -578,19 +578,26 @@ fn encode_blur_dispatch_constants_match_the_wgsl() {
         // tile) and along y; with four, one output an invocation, the horizontal sums in at
         // most four blocks of WG_SIZE (`blur_tile_single`'s h0 … h3).
         let wg = r.workgroup_size.expect("workgroup size")[0];
-        assert_eq!(wg, ENCODE_BLUR_ROW, "{name}: workgroup");
+        assert_eq!(wg, 256, "{name}: workgroup");
+        // The row: ROW_RUN outputs an invocation, every invocation busy (2 with two channels,
+        // `blur_row_pairs`; 1 with four).
+        let row = encode_blur_row(kernel);
+        let row_run = wgsl_const(&module, "ROW_RUN").expect("ROW_RUN");
+        assert_eq!(row, row_run * wg, "{name}: ROW = ROW_RUN · WG_SIZE");
         let enc = tile + 2 * ENCODE_BLUR_TILE_RADIUS;
         assert!(enc * enc <= 6 * wg, "{name}: encoded tile");
         let run = wgsl_const(&module, "RUN").expect("RUN");
         let channels = wgsl_const(&module, "CHANNELS").expect("CHANNELS");
         match channels {
             2 => {
+                assert_eq!(row_run, 2, "{name}: ROW_RUN (blur_row_pairs)");
                 assert_eq!(run, 4, "{name}: RUN (the sums s0 … s3)");
                 assert_eq!(tile % run, 0, "{name}: runs per line");
                 assert!(tile / run * enc <= wg, "{name}: runs along x");
                 assert!(tile / run * tile <= wg, "{name}: runs along y");
             }
             _ => {
+                assert_eq!(row_run, 1, "{name}: ROW_RUN (one output an invocation)");
                 assert_eq!(run, 1, "{name}: RUN (one output an invocation)");
                 assert!(tile * enc <= 4 * wg, "{name}: horizontal sums");
             }
@@ -600,7 +607,7 @@ fn encode_blur_dispatch_constants_match_the_wgsl() {
         let max_radius = wgsl_const(&module, "MAX_RADIUS").expect("MAX_RADIUS");
         let dep = enc + 2;
         assert!(
-            dep * dep <= sh && 3 * (ENCODE_BLUR_ROW + 2 * max_radius + 2) <= sh,
+            dep * dep <= sh && 3 * (row + 2 * max_radius + 2) <= sh,
             "{name}: SH_TEXELS"
         );
         assert!(

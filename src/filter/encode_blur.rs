@@ -23,8 +23,18 @@ pub fn encode_blur_tile(kernel: KernelId) -> u32 {
     }
 }
 
-/// Outputs of a one-row workgroup, the two-pass fallback (`ROW`).
-pub const ENCODE_BLUR_ROW: u32 = 256;
+/// Outputs of a one-row workgroup, the two-pass fallback (`ROW`, which each fused kernel
+/// declares for `kernels/shared/encode_blur.wgsl`): one an invocation of its 256 with four
+/// channels; 512 in runs of 2 with two (`vsm_blur`), whose three rows of depths with their halo,
+/// 3·(512 + 2·32 + 2) texels of 8 B, fit its 16 KiB of workgroup memory: every invocation stays
+/// busy, each row texel is read 2 + 2r times for 2 outputs instead of 2r + 1 for one, and the
+/// halo is loaded once for twice the outputs.
+pub fn encode_blur_row(kernel: KernelId) -> u32 {
+    match kernel {
+        KernelId::VsmBlur => 512,
+        _ => 256,
+    }
+}
 
 /// The largest radius the one-dispatch tile takes (`TILE_RADIUS`): the tile's depths with
 /// their halo, (TILE + 2·8)² texels of workgroup memory, fit 16 KiB ([`encode_blur_tile`]).
@@ -85,7 +95,7 @@ pub fn add_encode_blur(
 }
 
 /// The node `name` of `e`'s fused kernel with `blur`: a workgroup per `tile`² outputs, or per
-/// [`ENCODE_BLUR_ROW`] texels of a row when `tile` is 0.
+/// [`encode_blur_row`] texels of a row when `tile` is 0.
 fn fused_node(
     graph: &mut Graph,
     light: usize,
@@ -104,7 +114,7 @@ fn fused_node(
         Some(light),
     );
     let (x, y) = match tile {
-        0 => (ENCODE_BLUR_ROW, 1),
+        0 => (encode_blur_row(e.kernel), 1),
         t => (t, t),
     };
     graph.node(Node {
