@@ -116,19 +116,9 @@ pub fn render(
 ) -> Result<String> {
     let scene = Scene::load(scene_path)?;
     let mut renderer = Renderer::new(&gpu.device);
-    // Timings on a GPU: untimed frames first until its clocks have risen (timer::keep_warming).
-    if timings && gpu.adapter.get_info().device_type != wgpu::DeviceType::Cpu {
-        let warming = std::time::Instant::now();
-        let mut warm = 0;
-        while crate::timer::keep_warming(warm, 0, warming.elapsed().as_secs_f64() * 1e3, true) {
-            let opts = RenderOptions {
-                aux: false,
-                repeat: 1,
-                dump: false,
-            };
-            renderer.render(&gpu.device, &gpu.queue, &scene, opts)?;
-            warm += 1;
-        }
+    // Timings on a GPU: untimed frames first until its clocks have risen.
+    if timings {
+        renderer.warm_up(&gpu.device, &gpu.queue, &scene)?;
     }
     let frame = renderer.render(
         &gpu.device,
@@ -227,10 +217,10 @@ pub fn timing_table(gpu: &Gpu, frame: &Frame) -> String {
         s,
         "GPU time per pass (timestamps between passes), median of {} frame(s){}, on {}:",
         frame.timings.len(),
-        if gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu {
-            String::new()
-        } else {
+        if crate::timer::is_gpu(&gpu.device) {
             format!(" after {} ms of untimed ones", crate::timer::GPU_WARMUP_MS)
+        } else {
+            String::new()
         },
         gpu.describe()
     );

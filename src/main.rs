@@ -97,8 +97,8 @@ enum Command {
         /// What the kernels' imported textures hold: `random` values, a `smooth` field or a
         /// `constant` (a GPU that stores textures compressed moves smooth and constant data
         /// faster; the texture copies read the same kind).
-        #[arg(long, default_value = "random", value_parser = clap::builder::PossibleValuesParser::new(shadowgraph::bench::Inputs::NAMES), conflicts_with = "lookup")]
-        inputs: String,
+        #[arg(long, default_value = "random", value_parser = parse_inputs, conflicts_with = "lookup")]
+        inputs: shadowgraph::bench::Inputs,
         /// Also print each dispatch's median time under a kernel of several.
         #[arg(long, conflicts_with = "lookup")]
         passes: bool,
@@ -144,6 +144,11 @@ enum Command {
         #[arg(long)]
         large: bool,
     },
+}
+
+/// `bench --inputs`: one of `Inputs::NAMES`.
+fn parse_inputs(name: &str) -> Result<shadowgraph::bench::Inputs, String> {
+    shadowgraph::bench::Inputs::parse(name).map_err(|e| e.to_string())
 }
 
 /// `--repeat` of every command: 1 to `render::MAX_REPEAT` frames (each keeps a row of timings).
@@ -289,7 +294,6 @@ fn run(args: Args) -> Result<()> {
                     );
                 }
                 None => {
-                    let inputs = shadowgraph::bench::Inputs::parse(&inputs)?;
                     print!(
                         "{}",
                         shadowgraph::bench::run(&gpu, &sizes, repeat, &only, inputs, passes)?

@@ -59,6 +59,28 @@ pub fn keep_warming(runs: u32, least: u32, elapsed_ms: f64, gpu: bool) -> bool {
     runs < least || (gpu && runs < MAX_WARMUP_RUNS && elapsed_ms < GPU_WARMUP_MS)
 }
 
+/// Whether `device` is a GPU (not a CPU driver), whose clocks [`warm_up`] must raise.
+pub fn is_gpu(device: &wgpu::Device) -> bool {
+    device.adapter_info().device_type != wgpu::DeviceType::Cpu
+}
+
+/// Calls `run` (one untimed run) while [`keep_warming`] says so: `least` times on any device,
+/// and on `device` if it is a GPU until [`GPU_WARMUP_MS`] have passed. Returns the runs made.
+pub fn warm_up(
+    device: &wgpu::Device,
+    least: u32,
+    mut run: impl FnMut() -> Result<()>,
+) -> Result<u32> {
+    let gpu = is_gpu(device);
+    let start = std::time::Instant::now();
+    let mut runs = 0;
+    while keep_warming(runs, least, start.elapsed().as_secs_f64() * 1e3, gpu) {
+        run()?;
+        runs += 1;
+    }
+    Ok(runs)
+}
+
 /// The features [`GpuTimer`] needs.
 pub const TIMER_FEATURES: wgpu::Features =
     wgpu::Features::TIMESTAMP_QUERY.union(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);

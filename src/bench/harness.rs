@@ -45,12 +45,6 @@ pub struct Timed {
     pub passes: Vec<(String, f64)>,
 }
 
-/// Whether another untimed run is due after `runs` of them over `elapsed_ms` ([`WARMUP`] at
-/// least; on a GPU see [`crate::timer::keep_warming`]).
-pub(super) fn keep_warming(runs: u32, elapsed_ms: f64, gpu: bool) -> bool {
-    crate::timer::keep_warming(runs, WARMUP, elapsed_ms, gpu)
-}
-
 /// Medians of the summed span times and of the wall times of `repeat` runs of `record` (after
 /// [`WARMUP`] runs, and on a GPU at least [`crate::timer::GPU_WARMUP_MS`] of them), ms.
 pub(super) fn median_time(
@@ -60,24 +54,8 @@ pub(super) fn median_time(
     repeat: u32,
     mut record: impl FnMut(&mut wgpu::CommandEncoder, &mut GpuTimer) -> Result<()>,
 ) -> Result<Timed> {
-    let mut times = Vec::with_capacity(repeat as usize);
-    let mut walls = Vec::with_capacity(repeat as usize);
-    let mut passes: Vec<(String, Vec<f64>)> = Vec::new();
-    let gpu = device.adapter_info().device_type != wgpu::DeviceType::Cpu;
-    let warming = Instant::now();
-    let mut warm = 0u32;
-    while keep_warming(warm, warming.elapsed().as_secs_f64() * 1e3, gpu) {
-        timer.reset();
-        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("shadowgraph.bench.warmup"),
-        });
-        record(&mut enc, timer)?;
-        timer.resolve(&mut enc);
-        submit_and_wait(device, queue, enc, "bench")?;
-        timer.read(device)?;
-        warm += 1;
-    }
-    for _ in 0..repeat {
+    // One run: its spans and its wall time, submission to completion.
+    let mut run = || -> Result<(Vec<(String, f64)>, f64)> {
         timer.reset();
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("shadowgraph.bench"),
@@ -87,7 +65,14 @@ pub(super) fn median_time(
         let submitted = Instant::now();
         submit_and_wait(device, queue, enc, "bench")?;
         let wall_ms = submitted.elapsed().as_secs_f64() * 1e3;
-        let spans = timer.read(device)?;
+        Ok((timer.read(device)?, wall_ms))
+    };
+    crate::timer::warm_up(device, WARMUP, || run().map(|_| ()))?;
+    let mut times = Vec::with_capacity(repeat as usize);
+    let mut walls = Vec::with_capacity(repeat as usize);
+    let mut passes: Vec<(String, Vec<f64>)> = Vec::new();
+    for _ in 0..repeat {
+        let (spans, wall_ms) = run()?;
         if spans.is_empty() {
             return Err(Error::Gpu {
                 stage: "bench".into(),
@@ -401,6 +386,8 @@ mod tests {
 
     #[test]
     fn warm_up_is_warmup_runs_and_on_a_gpu_a_least_time() {
+        let keep_warming =
+            |runs, elapsed, gpu| crate::timer::keep_warming(runs, WARMUP, elapsed, gpu);
         // A CPU device: WARMUP runs, however short.
         assert!(keep_warming(WARMUP - 1, 1e9, false));
         assert!(!keep_warming(WARMUP, 0.0, false));

@@ -2,7 +2,7 @@
 
 use std::fmt::Write;
 
-use super::harness::{keep_warming, median};
+use super::harness::median;
 use super::{GPU_WARMUP_MS, WARMUP};
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
@@ -78,23 +78,12 @@ pub fn lookup_cost(
         base.lights[0].shadow_map = n;
     }
     let mut renderer = crate::render::Renderer::new(&gpu.device);
-    let gpu_device = gpu.adapter.get_info().device_type != wgpu::DeviceType::Cpu;
     let mut shade = |technique: Technique| -> Result<(f64, f64)> {
         let mut scene = base.clone();
         scene.lights[0].shadow.technique = technique;
-        // On a GPU, untimed frames until its clocks have risen (`keep_warming`); then the
-        // WARMUP frames below as on any device.
-        let warming = std::time::Instant::now();
-        let mut warm = WARMUP;
-        while gpu_device && keep_warming(warm, warming.elapsed().as_secs_f64() * 1e3, true) {
-            let opts = crate::render::RenderOptions {
-                aux: false,
-                repeat: 1,
-                dump: false,
-            };
-            renderer.render(&gpu.device, &gpu.queue, &scene, opts)?;
-            warm += 1;
-        }
+        // On a GPU, untimed frames until its clocks have risen; then the WARMUP frames below
+        // as on any device.
+        renderer.warm_up(&gpu.device, &gpu.queue, &scene)?;
         let frame = renderer.render(
             &gpu.device,
             &gpu.queue,

@@ -818,6 +818,34 @@ mod tests {
         assert_eq!(again, own);
     }
 
+    /// `timer::warm_up` runs `least` times on a CPU device (lavapipe: no clock to raise), at
+    /// least that on a GPU, and stops at the first error.
+    #[test]
+    fn warm_up_runs_least_times_on_a_cpu_device_and_stops_at_an_error() {
+        let gpu = gpu();
+        let mut calls = 0;
+        let runs = crate::timer::warm_up(&gpu.device, 3, || {
+            calls += 1;
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(runs, calls);
+        if crate::timer::is_gpu(&gpu.device) {
+            assert!(runs >= 3, "{runs}");
+        } else {
+            assert_eq!(runs, 3);
+        }
+        let mut calls = 0;
+        let e = crate::timer::warm_up(&gpu.device, 5, || {
+            calls += 1;
+            match calls {
+                2 => Err(Error::Invalid("second run".into())),
+                _ => Ok(()),
+            }
+        });
+        assert!(e.is_err() && calls == 2, "{calls}");
+    }
+
     /// Each row carries its dispatches' medians by node name, in the plan's order (the SAT's
     /// three), each within the run's total; `--passes` prints them under the row, and only
     /// then.

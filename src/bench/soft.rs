@@ -3,7 +3,7 @@
 
 use std::fmt::Write;
 
-use super::harness::{keep_warming, median};
+use super::harness::median;
 use super::{GPU_WARMUP_MS, WARMUP};
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
@@ -185,16 +185,13 @@ pub fn soft_cost(
         repeat: STEADY_FRAMES,
         ..Default::default()
     };
-    // Untimed rounds: WARMUP, and on a GPU until its clocks have risen (`keep_warming`).
-    let gpu_device = gpu.adapter.get_info().device_type != wgpu::DeviceType::Cpu;
-    let warming = std::time::Instant::now();
-    let mut warm = 0;
-    while keep_warming(warm, warming.elapsed().as_secs_f64() * 1e3, gpu_device) {
+    // Untimed rounds: WARMUP, and on a GPU until its clocks have risen (`timer::warm_up`).
+    crate::timer::warm_up(&gpu.device, WARMUP, || {
         for scene in &scenes {
             renderer.render(&gpu.device, &gpu.queue, scene, opts)?;
         }
-        warm += 1;
-    }
+        Ok(())
+    })?;
     for _ in 0..repeat {
         for (k, scene) in scenes.iter().enumerate() {
             let f = renderer.render(&gpu.device, &gpu.queue, scene, opts)?;

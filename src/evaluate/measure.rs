@@ -82,18 +82,7 @@ pub fn measure(
     let truth = &reference.truth;
     // On a GPU, untimed frames until its clocks have risen (the error measurement of the last
     // configuration left it idle); on a CPU device none beyond the dropped frame below.
-    let gpu_device = gpu.adapter.get_info().device_type != wgpu::DeviceType::Cpu;
-    let warming = std::time::Instant::now();
-    let mut warm = 0;
-    while crate::timer::keep_warming(warm, 0, warming.elapsed().as_secs_f64() * 1e3, gpu_device) {
-        let opts = RenderOptions {
-            aux: false,
-            repeat: 1,
-            dump: false,
-        };
-        renderer.render(&gpu.device, &gpu.queue, scene, opts)?;
-        warm += 1;
-    }
+    renderer.warm_up(&gpu.device, &gpu.queue, scene)?;
     let frame = renderer.render(
         &gpu.device,
         &gpu.queue,

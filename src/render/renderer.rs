@@ -159,6 +159,25 @@ impl Renderer {
             .insert_keyed(device, &technique::shade_key(lights), "shade", wgsl)
     }
 
+    /// On a GPU, renders `scene` untimed (no aux outputs) until its clocks have risen
+    /// ([`crate::timer::warm_up`]), before frames whose times matter; on a CPU device nothing.
+    pub fn warm_up(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+    ) -> Result<()> {
+        let opts = RenderOptions {
+            aux: false,
+            repeat: 1,
+            dump: false,
+        };
+        crate::timer::warm_up(device, 0, || {
+            self.render(device, queue, scene, opts).map(|_| ())
+        })?;
+        Ok(())
+    }
+
     /// Renders `scene` on `device`/`queue` and reads the frame back.
     pub fn render(
         &mut self,
