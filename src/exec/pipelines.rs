@@ -243,6 +243,9 @@ fn changes(
             if let Some(change) = change_for(name, binding, b.ty, *format)? {
                 changes.push(change);
             }
+            if let Some(change) = channels_for(binding, b.ty, *format) {
+                changes.push(change);
+            }
         }
     }
     Ok(changes)
@@ -276,6 +279,10 @@ enum Change {
     PackStores { binding: String, from: &'static str },
     /// A float texture bound to a packed texture.
     UnpackLoads { binding: String },
+    /// The channel count of a storage texture bound with another count than declared, where
+    /// the kernel reads it: `const NAME: u32 = N; // #channels <binding>` (e.g. `blur`'s run
+    /// length along columns).
+    Channels { binding: String, count: u32 },
 }
 
 impl Change {
@@ -283,7 +290,8 @@ impl Change {
         match self {
             Change::Retype { binding, .. }
             | Change::PackStores { binding, .. }
-            | Change::UnpackLoads { binding } => binding,
+            | Change::UnpackLoads { binding }
+            | Change::Channels { binding, .. } => binding,
         }
     }
 
@@ -292,6 +300,7 @@ impl Change {
             Change::Retype { binding, from, to } => retype_storage(wgsl, binding, from, to),
             Change::PackStores { binding, from } => super::packed::pack_stores(wgsl, binding, from),
             Change::UnpackLoads { binding } => super::packed::unpack_loads(wgsl, binding),
+            Change::Channels { binding, count } => set_channels(wgsl, binding, *count),
         }
     }
 }
@@ -349,6 +358,58 @@ fn change_for(
     }
 }
 
+/// The channels of a storage texel format as a kernel sees them: a packed
+/// [`crate::graph::PACKED_F16X2`] word holds two.
+fn channels_of(format: wgpu::TextureFormat) -> u32 {
+    if format == crate::graph::texture_format(crate::graph::PACKED_F16X2) {
+        2
+    } else {
+        u32::from(format.components())
+    }
+}
+
+/// The [`Change::Channels`] binding a `bound` texture to storage texture `binding` (of type
+/// `ty`) needs: where the channel counts differ (applied only where the kernel marks a
+/// constant for it).
+fn channels_for(
+    binding: &str,
+    ty: wgpu::BindingType,
+    bound: wgpu::TextureFormat,
+) -> Option<Change> {
+    let wgpu::BindingType::StorageTexture {
+        format: declared, ..
+    } = ty
+    else {
+        return None;
+    };
+    let count = channels_of(bound);
+    (count != channels_of(declared)).then(|| Change::Channels {
+        binding: binding.to_string(),
+        count,
+    })
+}
+
+/// `wgsl` with the constant marked `// #channels <binding>` (`const NAME: u32 = N;`, the
+/// declared format's count) set to `count`; unchanged where no constant is marked. None for
+/// a marked line of another shape.
+fn set_channels(wgsl: &str, binding: &str, count: u32) -> Option<String> {
+    let marker = format!("// #channels {binding}");
+    let mut out = String::with_capacity(wgsl.len());
+    for line in wgsl.split_inclusive('\n') {
+        let Some(code) = line.trim_end().strip_suffix(&marker) else {
+            out.push_str(line);
+            continue;
+        };
+        let (decl, value) = code.trim_end().split_once(" = ")?;
+        if !decl.trim_start().starts_with("const ") || !decl.ends_with(": u32") {
+            return None;
+        }
+        value.strip_suffix("u;")?.parse::<u32>().ok()?;
+        out.push_str(&format!("{decl} = {count}u; {marker}\n"));
+    }
+    Some(out)
+}
+
 /// The WGSL name of a storage texel format.
 pub fn wgsl_storage_format(f: wgpu::TextureFormat) -> Result<&'static str> {
     use wgpu::TextureFormat as T;
@@ -376,4 +437,44 @@ fn retype_storage(wgsl: &str, binding: &str, from: &str, to: &str) -> Option<Str
     let at = wgsl.find(&decl)?;
     let new = format!("var {binding}: texture_storage_2d<{to},");
     Some(format!("{}{new}{}", &wgsl[..at], &wgsl[at + decl.len()..]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const MARKED: &str =
+        "const A: u32 = 1u;\nconst DST_CHANNELS: u32 = 2u; // #channels dst\nfn f() {}\n";
+
+    #[test]
+    fn set_channels_rewrites_only_the_marked_constant() {
+        let out = set_channels(MARKED, "dst", 4).unwrap();
+        assert_eq!(
+            out,
+            "const A: u32 = 1u;\nconst DST_CHANNELS: u32 = 4u; // #channels dst\nfn f() {}\n"
+        );
+        // Another binding's marker, or none: unchanged.
+        assert_eq!(set_channels(MARKED, "src", 4).unwrap(), MARKED);
+        // A marked line that is not a u32 constant is refused, not guessed at.
+        assert!(set_channels("let c = 2u; // #channels dst\n", "dst", 4).is_none());
+        assert!(set_channels("const C: i32 = 2; // #channels dst\n", "dst", 4).is_none());
+    }
+
+    #[test]
+    fn blur_sees_the_bound_formats_channels() {
+        use wgpu::TextureFormat as T;
+        let channels = |f: T| {
+            let wgsl = specialized_source("blur", &[("dst".to_string(), f)]).unwrap();
+            wgsl.lines()
+                .find(|l| l.ends_with("// #channels dst"))
+                .expect("blur marks DST_CHANNELS")
+                .to_string()
+        };
+        assert!(channels(T::Rg32Float).contains("= 2u;"));
+        assert!(channels(T::R32Float).contains("= 1u;"));
+        assert!(channels(T::Rgba32Float).contains("= 4u;"));
+        assert!(channels(T::Rgba16Float).contains("= 4u;"));
+        let packed = crate::graph::texture_format(crate::graph::PACKED_F16X2);
+        assert!(channels(packed).contains("= 2u;"));
+    }
 }
