@@ -45,6 +45,15 @@ step wall.txt "$B" render scenes/bunny.toml --timings --repeat 20 -o "$OUT/bunny
 # targets name at 4096² and 8192², twice (a check that the warm-up holds: before it,
 # figures there moved up to 4× between runs). `--passes` splits each chain by dispatch (the
 # soft tables' build, issue 14's ≤ 0.2 ms at 2048²: `chain vssm`, `chain msm_soft`).
+if [ -n "$BASE" ]; then
+    # The blur passes and fused blurs of both builds at 2048², alternated.
+    for round in 1 2; do
+        echo "## base, round $round" >>"$OUT/blur_2048.txt"
+        step blur_2048.txt "$BASE" bench --sizes 2048 --repeat 20 --only blur --passes
+        echo "## $B, round $round" >>"$OUT/blur_2048.txt"
+        step blur_2048.txt "$B" bench --sizes 2048 --repeat 20 --only blur --passes
+    done
+fi
 step kernels_2048.txt "$B" bench --sizes 2048 --repeat 20 --passes
 for round in 1 2; do
     if [ -n "$BASE" ]; then
