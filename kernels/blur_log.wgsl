@@ -1,123 +1,14 @@
-// One pass of a separable blur of a one-channel logarithmic representation (ESM's c·z; only
-// the first channel is read and written, so no exp is spent on the others): per texel
-// log Σ wᵢ exp(vᵢ) over its 2r + 1 neighbours along the axis (shared/blur_pass: PER outputs an
-// invocation). Each texel is exponentiated once, relative to the first texel the invocation
-// reads (of its PER + 2r): `v₀ + log Σ w·exp(v − v₀)`, while the same loop tracks the texels'
-// span. Within a span of SPAN every exp lies in [exp(−SPAN), exp(SPAN)], normal f32 both
-// ways, and a sum of 2r + 1 of them stays finite; SPIR-V's exp error, (3 + 2|x|) ULP, is bounded
-// by the span as it was relative to the maximum. Where the texels span more than SPAN, the
-// sums (whose arguments are clamped to ±SPAN, so finite) are dropped and the invocation takes
-// each output's own window maximum instead, at one exp per tap: every exp ≤ 1, so nothing that
-// matters underflows at any c (ESM at c > SPAN across a depth edge). One read of the texels
-// instead of a read for the span and another for the sums: 1.08–1.21× faster on llvmpipe.
-// The invocation reads its PER + 2r texels once into PER running sums, kept as named values (an
-// array indexed in a loop stays in memory on llvmpipe, three times slower).
-// #import shared/blur_pass
+// One pass of ESM's log-space blur (shared/blur_log_pass) for texels that lie within SPAN =
+// 80 of each other: c·z with c ≤ 80. No per-output fallback (see `blur_log_wide`).
+// #import shared/blur_log_pass
 // Traffic (the cost model, src/graph/cost): a row workgroup loads its WG_SIZE · PER texels and
 // a halo of r each side; a column workgroup WG_SIZE columns of PER + 2r texels each.
 // #traffic src: select(WG_SIZE * PER + 2 * min(params.radius, MAX_RADIUS), WG_SIZE * (PER + 2 * min(params.radius, MAX_RADIUS)), params.axis == 1) per group
 // #traffic dst: all
 
-const SPAN: f32 = 80.0;
-
-// Rows down a column one invocation writes: PER, the named running sums s0 … s7 below. Keep in
-// sync with `BLUR_PER_INVOCATION` in src/filter.rs.
-const COL_PER: u32 = PER;
-
-// The log-sum-exp of output k's window around its own maximum.
-fn log_sum_at(b: BlurLine, k: i32, vertical: bool) -> f32 {
-    var m = -3.0e38;
-    for (var i = -b.r; i <= b.r; i++) {
-        m = max(m, tap(b, k + i, vertical).x);
-    }
-    var sum = 0.0;
-    for (var i = -b.r; i <= b.r; i++) {
-        sum += weight(i, b.r) * exp(tap(b, k + i, vertical).x - m);
-    }
-    return m + log(sum);
-}
-
-fn put_x(b: BlurLine, k: i32, v: f32, vertical: bool) {
-    put(b, k, vec4<f32>(v, 0.0, 0.0, 0.0), vertical);
-}
+const WIDE: bool = false;
 
 @compute @workgroup_size(WG_SIZE)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    let b = blur_line(wg.xy, li, PER, COL_PER);
-    if !blur_active(b) {
-        return;
-    }
-    // The axis tested once, not at every tap (shared/blur_pass's `tap`).
-    if params.axis == 1u {
-        blur_log_outputs(b, true);
-    } else {
-        blur_log_outputs(b, false);
-    }
-}
-
-// The invocation's PER outputs along the pass's axis (`vertical`: a constant at each call).
-fn blur_log_outputs(b: BlurLine, vertical: bool) {
-    // One read of the PER + 2r texels: each exponentiated relative to the first, the span
-    // tracked alongside; where it exceeds SPAN the sums are dropped for the per-output path.
-    let first = tap(b, -b.r, vertical).x;
-    var hi = first;
-    var lo = first;
-    var s0 = 0.0;
-    var s1 = 0.0;
-    var s2 = 0.0;
-    var s3 = 0.0;
-    var s4 = 0.0;
-    var s5 = 0.0;
-    var s6 = 0.0;
-    var s7 = 0.0;
-    let t0 = -b.r;
-    var w0 = weight(t0, b.r);
-    var w1 = weight(t0 - 1, b.r);
-    var w2 = weight(t0 - 2, b.r);
-    var w3 = weight(t0 - 3, b.r);
-    var w4 = weight(t0 - 4, b.r);
-    var w5 = weight(t0 - 5, b.r);
-    var w6 = weight(t0 - 6, b.r);
-    var w7 = weight(t0 - 7, b.r);
-    for (var t = t0; t < i32(PER) + b.r; t++) {
-        let x = tap(b, t, vertical).x;
-        hi = max(hi, x);
-        lo = min(lo, x);
-        let v = exp(clamp(x - first, -SPAN, SPAN));
-        s0 += w0 * v;
-        s1 += w1 * v;
-        s2 += w2 * v;
-        s3 += w3 * v;
-        s4 += w4 * v;
-        s5 += w5 * v;
-        s6 += w6 * v;
-        s7 += w7 * v;
-        w7 = w6;
-        w6 = w5;
-        w5 = w4;
-        w4 = w3;
-        w3 = w2;
-        w2 = w1;
-        w1 = w0;
-        w0 = weight(t + 1, b.r);
-    }
-    if hi - lo > SPAN {
-        put_x(b, 0, log_sum_at(b, 0, vertical), vertical);
-        put_x(b, 1, log_sum_at(b, 1, vertical), vertical);
-        put_x(b, 2, log_sum_at(b, 2, vertical), vertical);
-        put_x(b, 3, log_sum_at(b, 3, vertical), vertical);
-        put_x(b, 4, log_sum_at(b, 4, vertical), vertical);
-        put_x(b, 5, log_sum_at(b, 5, vertical), vertical);
-        put_x(b, 6, log_sum_at(b, 6, vertical), vertical);
-        put_x(b, 7, log_sum_at(b, 7, vertical), vertical);
-        return;
-    }
-    put_x(b, 0, first + log(s0), vertical);
-    put_x(b, 1, first + log(s1), vertical);
-    put_x(b, 2, first + log(s2), vertical);
-    put_x(b, 3, first + log(s3), vertical);
-    put_x(b, 4, first + log(s4), vertical);
-    put_x(b, 5, first + log(s5), vertical);
-    put_x(b, 6, first + log(s6), vertical);
-    put_x(b, 7, first + log(s7), vertical);
+    blur_log(wg.xy, li);
 }

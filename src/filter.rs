@@ -31,8 +31,42 @@ pub const BLUR_GROUP: u32 = 64;
 pub enum BlurMode {
     /// Weighted sum (moments, basis images).
     Linear,
-    /// `log Σ wᵢ exp(vᵢ)`, stably (the texels hold logarithms, e.g. ESM's `c·z`).
+    /// `log Σ wᵢ exp(vᵢ)`, stably, of texels (logarithms, e.g. ESM's `c·z`) that lie within
+    /// [`LOG_BLUR_SPAN`] of each other: `blur_log`.
     LogSumExp,
+    /// The same of texels of any spread: `blur_log_wide`, which takes each output's own
+    /// maximum where an invocation's texels spread wider (`kernels/shared/blur_log_pass.wgsl`).
+    LogSumExpWide,
+}
+
+/// The spread of texel values `blur_log` serves without a per-output fallback (its `SPAN`):
+/// every exp of a difference within it is a normal f32.
+pub const LOG_BLUR_SPAN: f32 = 80.0;
+
+impl BlurMode {
+    /// Log-sum-exp of texels that lie in an interval `spread` wide (ESM's `c·z`, z ∈ [0, 1]:
+    /// `spread` = c): [`BlurMode::LogSumExp`] within [`LOG_BLUR_SPAN`], else the wide kernel.
+    pub fn log_sum_exp(spread: f32) -> Self {
+        if spread <= LOG_BLUR_SPAN {
+            BlurMode::LogSumExp
+        } else {
+            BlurMode::LogSumExpWide
+        }
+    }
+
+    /// Whether the texels are logarithms (either log-sum-exp mode).
+    pub fn is_log(self) -> bool {
+        self != BlurMode::Linear
+    }
+
+    /// `BlurParams::mode`: 0 linear, 1 log-sum-exp, 2 log-sum-exp of any spread.
+    fn code(self) -> u32 {
+        match self {
+            BlurMode::Linear => 0,
+            BlurMode::LogSumExp => 1,
+            BlurMode::LogSumExpWide => 2,
+        }
+    }
 }
 
 /// Parameters of `kernels/blur.wgsl` (mirrors its `Params`).
@@ -43,7 +77,7 @@ pub struct BlurParams {
     pub axis: u32,
     /// Taps each side.
     pub radius: u32,
-    /// 0 linear, 1 log-sum-exp.
+    /// 0 linear, 1 log-sum-exp (`blur_log`), 2 log-sum-exp of any spread (`blur_log_wide`).
     pub mode: u32,
     /// Padding.
     pub _pad: u32,
@@ -78,7 +112,7 @@ impl BlurParams {
         Self {
             axis,
             radius: w.len() as u32 - 1,
-            mode: u32::from(mode == BlurMode::LogSumExp),
+            mode: mode.code(),
             _pad: 0,
             weights,
         }
@@ -128,7 +162,8 @@ fn add_blur_pass(
 ) -> String {
     let (kernel_id, col_per) = match params.mode {
         0 => (KernelId::Blur, BLUR_COL_PER),
-        _ => (KernelId::BlurLog, BLUR_PER_INVOCATION),
+        1 => (KernelId::BlurLog, BLUR_PER_INVOCATION),
+        _ => (KernelId::BlurLogWide, BLUR_PER_INVOCATION),
     };
     let out = graph.resource(
         name.to_string(),
@@ -254,9 +289,10 @@ fn add_mips(
         .unwrap_or_default();
     graph.node(Node {
         name: format!("{input}.mips"),
-        kernel: match mode {
-            BlurMode::Linear => KernelId::Mips,
-            BlurMode::LogSumExp => KernelId::MipsLog,
+        kernel: if mode.is_log() {
+            KernelId::MipsLog
+        } else {
+            KernelId::Mips
         },
         inputs: vec![("src".into(), input.to_string())],
         outputs: vec![("dst".into(), out.clone())],
@@ -286,7 +322,7 @@ pub fn mip_chain(width: u32, height: u32, mode: BlurMode) -> (Vec<u8>, Vec<SubDi
             base: [width, height],
             first,
             count,
-            mode: u32::from(mode == BlurMode::LogSumExp),
+            mode: u32::from(mode.is_log()),
             copy: u32::from(first == 0),
             general: u32::from(odd((width >> first).max(1)) || odd((height >> first).max(1))),
             _pad: 0,

@@ -363,6 +363,7 @@ fn storage_format_variants_validate() {
         ("vsm", "rg32float", &["rg32float", "rgba16float"][..]),
         ("blur", "rg32float", all),
         ("blur_log", "rg32float", &["r32float"][..]),
+        ("blur_log_wide", "rg32float", &["r32float"][..]),
         ("msm", "rgba32float", &["rgba16float", "rgba16unorm"][..]),
         (
             "csm",
@@ -513,7 +514,11 @@ fn wgsl_const(module: &naga::Module, name: &str) -> Option<u32> {
 #[test]
 fn blur_dispatch_constants_match_the_wgsl() {
     use shadowgraph::filter::{BLUR_COL_PER, BLUR_GROUP, BLUR_PER_INVOCATION};
-    for (kernel, col_per) in [("blur", BLUR_COL_PER), ("blur_log", BLUR_PER_INVOCATION)] {
+    for (kernel, col_per) in [
+        ("blur", BLUR_COL_PER),
+        ("blur_log", BLUR_PER_INVOCATION),
+        ("blur_log_wide", BLUR_PER_INVOCATION),
+    ] {
         let wgsl = kernels::resolve(kernel, None).expect("resolve");
         let (module, r) = kernels::reflect(kernel, &wgsl).expect("reflect");
         assert_eq!(
@@ -550,6 +555,37 @@ fn peel_epsilon_matches_the_wgsl() {
         ref e => panic!("PEEL_EPSILON is {e:?}, not an f32 literal"),
     };
     assert_eq!(value, shadowgraph::technique::PEEL_EPSILON);
+}
+
+/// `blur_log`'s span, past which only `blur_log_wide` is exact, is the planner's
+/// `LOG_BLUR_SPAN` (`BlurMode::log_sum_exp` picks the kernel by it), and `blur_log` has no
+/// per-output path (`WIDE` false) where `blur_log_wide` has one.
+#[test]
+fn log_blur_span_matches_the_wgsl() {
+    for (kernel, wide) in [("blur_log", false), ("blur_log_wide", true)] {
+        let wgsl = kernels::resolve(kernel, None).expect("resolve");
+        let (module, _) = kernels::reflect(kernel, &wgsl).expect("reflect");
+        let literal = |name: &str| {
+            let (_, c) = module
+                .constants
+                .iter()
+                .find(|(_, c)| c.name.as_deref() == Some(name))
+                .unwrap_or_else(|| panic!("{name} in {kernel}"));
+            module.global_expressions[c.init].clone()
+        };
+        assert!(
+            matches!(literal("SPAN"), naga::Expression::Literal(naga::Literal::F32(v))
+                if v == shadowgraph::filter::LOG_BLUR_SPAN),
+            "{kernel}: SPAN"
+        );
+        assert!(
+            matches!(literal("WIDE"), naga::Expression::Literal(naga::Literal::Bool(w)) if w == wide),
+            "{kernel}: WIDE"
+        );
+    }
+    use shadowgraph::filter::BlurMode;
+    assert_eq!(BlurMode::log_sum_exp(80.0), BlurMode::LogSumExp);
+    assert_eq!(BlurMode::log_sum_exp(80.5), BlurMode::LogSumExpWide);
 }
 
 #[test]

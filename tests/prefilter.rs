@@ -361,9 +361,23 @@ fn evsm_and_esm_encodings_match_reference() {
             "evsm at the f32 limit overflowed"
         );
     }
-    // ESM at c = 40 (every window within `blur_log`'s span of 80: one exp per texel) and at
-    // c = 200 (exp(200) overflows f32; most windows span more than 80: one exp per tap around
-    // each output's maximum): log-space blur keeps everything finite.
+    // ESM at c = 40 (`blur_log`: every window within its span of 80, one exp per texel) and at
+    // c = 200 (`blur_log_wide`: exp(200) overflows f32, and one texel in five is a blocker at
+    // 0.1 before a receiver at 0.8 or more, so most invocations' texels span more than 80 and
+    // take one exp per tap around each output's maximum): log-space blur keeps everything
+    // finite. (The ramps of `random_linear` alone span at most 0.32: 64 at c = 200, which left
+    // the per-output path untested.)
+    let edges: Vec<f32> = lin
+        .iter()
+        .map(|&z| {
+            if rng.random_bool(0.2) {
+                0.1
+            } else {
+                z.max(0.8)
+            }
+        })
+        .collect();
+    let input = Texels::from_f32(w as usize, h as usize, 1, &edges);
     for c in [40.0f32, 200.0] {
         let params = bytemuck::bytes_of(&ExpParams::new(c, 0.0)).to_vec();
         let (graph, out) = encode_graph(
@@ -373,13 +387,13 @@ fn evsm_and_esm_encodings_match_reference() {
             h,
             wgpu::TextureFormat::R32Float,
             Some(blur),
-            BlurMode::LogSumExp,
+            BlurMode::log_sum_exp(c),
         );
         let gpu = run(
             &g,
             &graph,
             &out,
-            upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin),
+            upload(&g, w, h, wgpu::TextureFormat::R32Float, &edges),
         );
         let expected = cpu::blur::blur_mode(
             &cpu::esm::esm(&input, f64::from(c)),
@@ -596,7 +610,7 @@ fn mip_chain_matches_reference_and_ends_at_the_mean() {
         (384, 160, BlurMode::Linear),
     ] {
         let lin = random_linear(&mut rng, w as usize, h as usize);
-        let log = mode == BlurMode::LogSumExp;
+        let log = mode.is_log();
         // Log mode holds logarithms (ESM's c·z with c = 80); linear mode the VSM moments.
         let data: Vec<f32> = if log {
             lin.iter().map(|z| 80.0 * z).collect()

@@ -129,6 +129,17 @@ pub const CASES: &[BenchCase] = &[
         name: "blur log r4",
         build: |n| stage_graph(light_graph(n, esm()), "light0.esm", "light0.esm.blur_v"),
     },
+    // ESM past c = 80: `blur_log_wide`, with the per-output path for texels spread wider.
+    BenchCase {
+        name: "blur log r4 wide (c = 200)",
+        build: |n| {
+            stage_graph(
+                light_graph(n, esm_wide()),
+                "light0.esm",
+                "light0.esm.blur_v",
+            )
+        },
+    },
     // Depth → blurred moments: the encoding fused into the blur (issue 15), and the chain it
     // replaced (encode, blur_h, blur_v: the `(old)` rows) timed beside it.
     BenchCase {
@@ -319,6 +330,13 @@ fn csm() -> Technique {
 
 fn esm() -> Technique {
     named("esm", &BLUR4)
+}
+
+fn esm_wide() -> Technique {
+    named(
+        "esm",
+        &[BLUR4[0], BLUR4[1], ("exponent", ParamValue::Float(200.0))],
+    )
 }
 
 /// CSM with `terms` terms (offset 0.25 whatever M: the bench times the series, not its fit).

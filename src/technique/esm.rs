@@ -47,7 +47,8 @@ fn nodes(n: &mut super::LightNodes) -> ShadeInput {
         KernelId::Esm,
         format,
         bytemuck::bytes_of(&params),
-        BlurMode::LogSumExp,
+        // c·z lies in [0, c].
+        BlurMode::log_sum_exp(exponent),
     )
 }
 
