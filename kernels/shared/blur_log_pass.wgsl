@@ -12,10 +12,11 @@
 // than SPAN the sums (whose arguments are clamped to ±SPAN, so finite) are dropped and the
 // invocation takes each output's own window maximum instead, at one exp per tap: every exp ≤ 1,
 // so nothing that matters underflows at any c (ESM at c > SPAN across a depth edge). Two
-// kernels, not a run-time test: llvmpipe (Mesa 22.3) runs an `if`'s body under a lane mask
-// even where no lane takes it, and the per-output path's loops cost `blur_log` 1.8× there
-// though no input reached them (benches/RESULTS.md, 2026-11-27); on a GPU a branch no lane
-// takes is skipped, so the split costs nothing.
+// kernels, not a run-time test: llvmpipe (Mesa 22.3) runs an `if`'s straight-line body (here
+// eight logs and eight stores around the loops) under a lane mask even where no lane takes it,
+// and the per-output path cost `blur_log` 1.8× there though no input reached it
+// (benches/RESULTS.md, 2026-11-27); on a GPU a branch no lane takes is skipped, so the split
+// costs nothing.
 // The invocation reads its PER + 2r texels once into PER running sums, kept as named values (an
 // array indexed in a loop stays in memory on llvmpipe, three times slower).
 // The importing kernel declares `const WIDE: bool` and calls `blur_log` from its `main`:
