@@ -10,8 +10,8 @@
 # only within one call: before the GPU warm-up by time of 2026-11-27, the same card's
 # figures moved up to 4× between calls at 4096²). On an H200 (2026-11-26) the soft table
 # took 67 s, the 2048² kernels 6 s and each large round 93 s per binary, before the GPU
-# warm-up added 0.3 s a kernel case (about 15 s a kernel step): with BASE, give the call
-# 480 s or more.
+# warm-up added 0.3 s a kernel case (about 15 s a kernel step): with BASE (which adds four
+# 2048² blur steps and a large round), give the call 540 s or more.
 # Each step writes its own file in OUT and prints its wall time, so a call stopped by its time
 # box still returns what ran. Record the results in benches/RESULTS.md (device, date, commit,
 # command, table).
