@@ -56,11 +56,11 @@ impl Need {
 /// A plan step that needs more than the device allows.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct StepOver {
-    /// The node's name (`light0.blur_x`).
+    /// The node's name (`light0.vsm.blur_h`).
     pub node: String,
     /// The light the node works for.
     pub light: Option<usize>,
-    /// `kernel `blur`: workgroup memory in bytes (max_compute_workgroup_storage_size)` or
+    /// `kernel `vsm_blur`: workgroup memory in bytes (max_compute_workgroup_storage_size)` or
     /// `node `…`: workgroups per dimension (…)`.
     pub what: String,
     /// Whether the size of the map (not the technique's kernel) is what is too large.
