@@ -14,7 +14,13 @@ use crate::gpu_data::TECHNIQUE_ESM;
 use crate::kernels::KernelId;
 use crate::model::{ParamSpec, ParamValue, ParamValues, Technique};
 
-const PARAMS: &[ParamSpec] = &[float("exponent", 0.01, 1e4, 80.0, "exponent c")];
+const PARAMS: &[ParamSpec] = &[float(
+    "exponent",
+    0.01,
+    1e4,
+    80.0,
+    "exponent c (past 80 the log-space blur takes `blur_log_wide`, which also handles texels spread wider than 80)",
+)];
 
 fn values(t: &Technique) -> ParamValues {
     let mut out = ParamValues::default();
