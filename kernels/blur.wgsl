@@ -29,10 +29,11 @@ const DST_CHANNELS: u32 = 2u; // #channels dst
 
 // Outputs an invocation sums together (the sliding windows' length): 8 along rows, and along
 // columns of one or two channels; 2 along columns of four. On llvmpipe, against runs of 2
-// everywhere (benches/RESULTS.md, 2026-11-27), the two-channel passes ran 1.3–1.4× faster at
-// r = 4 and 1.7× at r = 32, and the four-channel rows 1.3×, but the four-channel columns 1.7×
-// slower (runs of 4 as slow: 24 or 12 live vec4 an invocation); on a GPU the taps a run reads
-// fall 4.5× at r = 4 (2 an output against 9), for 24 live values an invocation.
+// everywhere (benches/RESULTS.md, 2026-11-27), the two-channel passes ran 1.2–1.4× faster at
+// r = 4 and 1.6–1.8× at r = 32, and the four-channel rows 1.3–1.6×, but the four-channel
+// columns 1.7× slower at 1024² and 2048² with runs of 4 or 8 (as fast at 2000²: a cache effect
+// of power-of-two rows as much as the 24 live vec4); on a GPU the taps a run reads fall 4.5× at
+// r = 4 (2 an output against 9), for 24 live values an invocation.
 const RUN: i32 = 8;
 const COL_RUN: i32 = select(RUN, 2, DST_CHANNELS > 2u);
 
