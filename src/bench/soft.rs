@@ -205,19 +205,17 @@ pub fn soft_cost(
                 .find(|(name, _)| name == "shade")
                 .map(|(_, ms)| *ms)
                 .ok_or_else(|| Error::Invalid("the frame has no timed `shade` pass".into()))?;
-            {
-                times[k].push(shade);
-                let sum = |keep: &dyn Fn(&str) -> bool| -> f64 {
-                    passes
-                        .iter()
-                        .filter(|(name, _)| keep(name))
-                        .map(|(_, ms)| ms)
-                        .sum()
-                };
-                prefilter[k].push(sum(&is_prefilter));
-                frame_wall[k].0.push(sum(&|_| true));
-                frame_wall[k].1.push(*wall);
-            }
+            times[k].push(shade);
+            let sum = |keep: &dyn Fn(&str) -> bool| -> f64 {
+                passes
+                    .iter()
+                    .filter(|(name, _)| keep(name))
+                    .map(|(_, ms)| ms)
+                    .sum()
+            };
+            prefilter[k].push(sum(&is_prefilter));
+            frame_wall[k].0.push(sum(&|_| true));
+            frame_wall[k].1.push(*wall);
         }
     }
     let mut rows = Vec::new();
