@@ -75,7 +75,12 @@ fn blur_run(b: BlurLine, o: i32, vertical: bool) {
     var r5 = c6;
     var r6 = c7;
     var r7 = tap(b, o + RUN, vertical);
-    for (var i = 1; i <= b.r; i++) {
+    // Offsets 1 .. r − 1 slide the windows after their sums; offset r, which needs no next
+    // taps, is summed after the loop. With the slide behind `if i < r` inside the loop,
+    // llvmpipe ran it as masked selects of all 16 windows at every offset: peeled, 1.2–1.3×
+    // faster at r = 32 (benches/RESULTS.md, 2026-11-27, tenth session); a GPU branches on the
+    // uniform test either way.
+    for (var i = 1; i < b.r; i++) {
         let w = weight(i, b.r);
         s0 += w * (l0 + r0);
         s1 += w * (l1 + r1);
@@ -85,24 +90,33 @@ fn blur_run(b: BlurLine, o: i32, vertical: bool) {
         s5 += w * (l5 + r5);
         s6 += w * (l6 + r6);
         s7 += w * (l7 + r7);
-        if i < b.r {
-            l7 = l6;
-            l6 = l5;
-            l5 = l4;
-            l4 = l3;
-            l3 = l2;
-            l2 = l1;
-            l1 = l0;
-            l0 = tap(b, o - i - 1, vertical);
-            r0 = r1;
-            r1 = r2;
-            r2 = r3;
-            r3 = r4;
-            r4 = r5;
-            r5 = r6;
-            r6 = r7;
-            r7 = tap(b, o + RUN + i, vertical);
-        }
+        l7 = l6;
+        l6 = l5;
+        l5 = l4;
+        l4 = l3;
+        l3 = l2;
+        l2 = l1;
+        l1 = l0;
+        l0 = tap(b, o - i - 1, vertical);
+        r0 = r1;
+        r1 = r2;
+        r2 = r3;
+        r3 = r4;
+        r4 = r5;
+        r5 = r6;
+        r6 = r7;
+        r7 = tap(b, o + RUN + i, vertical);
+    }
+    if b.r > 0 {
+        let w = weight(b.r, b.r);
+        s0 += w * (l0 + r0);
+        s1 += w * (l1 + r1);
+        s2 += w * (l2 + r2);
+        s3 += w * (l3 + r3);
+        s4 += w * (l4 + r4);
+        s5 += w * (l5 + r5);
+        s6 += w * (l6 + r6);
+        s7 += w * (l7 + r7);
     }
     put(b, o, s0, vertical);
     put(b, o + 1, s1, vertical);
@@ -125,16 +139,19 @@ fn blur_run2(b: BlurLine, o: i32, vertical: bool) {
     var l1 = c0;
     var r0 = c1;
     var r1 = tap(b, o + 2, vertical);
-    for (var i = 1; i <= b.r; i++) {
+    for (var i = 1; i < b.r; i++) {
         let w = weight(i, b.r);
         s0 += w * (l0 + r0);
         s1 += w * (l1 + r1);
-        if i < b.r {
-            l1 = l0;
-            l0 = tap(b, o - i - 1, vertical);
-            r0 = r1;
-            r1 = tap(b, o + 2 + i, vertical);
-        }
+        l1 = l0;
+        l0 = tap(b, o - i - 1, vertical);
+        r0 = r1;
+        r1 = tap(b, o + 2 + i, vertical);
+    }
+    if b.r > 0 {
+        let w = weight(b.r, b.r);
+        s0 += w * (l0 + r0);
+        s1 += w * (l1 + r1);
     }
     put(b, o, s0, vertical);
     put(b, o + 1, s1, vertical);
