@@ -1,5 +1,5 @@
 // MSM's moments summed into a table computed from the depth, pass 1 of 3, f32 variant
-// (src/sat/layers.rs, technique::add_msm_table: one layer): each workgroup computes its tile
+// (src/sat/layers.rs, technique::add_moment_table: one layer): each workgroup computes its tile
 // of MSM's quantized moments from the depth on the fly (`msm_sat_source`, shared/sat_tile),
 // rounded as the map's storage would hold them, and writes the edges of its tile's own table,
 // as `sat_tile_sums` does for a stored map. Counts the non-finite depth texels. The depth is

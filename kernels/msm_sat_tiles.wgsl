@@ -1,5 +1,5 @@
 // MSM's moments summed into a table computed from the depth, pass 3 of 3, fixed-point variant
-// (src/sat/layers.rs, technique::add_msm_table: one layer): each workgroup computes its tile
+// (src/sat/layers.rs, technique::add_moment_table: one layer): each workgroup computes its tile
 // of MSM's quantized moments from the depth again (`msm_sat_source`, shared/sat_tile), scans
 // it as `sat_tiles` does, adds the carries (pass 2, `sat_carries`) and stores the table.
 // #import shared/sat_tile_scan

@@ -8,7 +8,8 @@
 //! sums them), in f32 every table texel is within the scan's rounding bound of the f64 table.
 //! Random depth with NaN and ±Inf texels (counted once), ragged tiles, both variants, CSM
 //! alone, CSSM's CSM + CSM-Z and CSSM's CSM + MSM's quantized moments (`cpu::msm`), MSM's
-//! moments alone, f32, f16 and unorm16 storage.
+//! moments alone, VSM's moments alone (`cpu::vsm`, the derivatives from the neighbours' depth),
+//! f32, f16 and unorm16 storage.
 
 mod common;
 
@@ -23,7 +24,8 @@ use shadowgraph::sat::layers::LAYERED_SAT_OUTPUTS;
 use shadowgraph::sat::{SatCoding, SatVariant, decode_table, float_sum_depth, lookup_area};
 use shadowgraph::scene::{CssmSearch, Storage};
 use shadowgraph::technique::{
-    CsmBasis, LinearizeParams, MsmTable, add_csm_tables, add_msm_table, csm_maps, csm_z_maps,
+    CsmBasis, LinearizeParams, MomentTable, Moments, add_csm_tables, add_moment_table, csm_maps,
+    csm_z_maps,
 };
 
 /// f32's unit roundoff.
@@ -36,8 +38,9 @@ struct Case {
     h: usize,
     terms: u32,
     search: Option<CssmSearch>,
-    /// MSM's quantized moments alone (`technique::add_msm_table`; `terms`, `search` unused).
-    msm: bool,
+    /// MSM's quantized or VSM's moments alone (`technique::add_moment_table`; `terms`,
+    /// `search` unused).
+    moments: Option<Moments>,
     variant: SatVariant,
     storage: Storage,
     bad: usize,
@@ -79,12 +82,13 @@ fn run(g: &Gpu, case: &Case, raw: &[f32], coding: SatCoding) -> (Vec<Vec<u32>>, 
     let mut graph = Graph::default();
     let (w, h) = (case.w as u32, case.h as u32);
     graph.import("in", wgpu::TextureFormat::R32Float, w, h, Some(0));
-    let tables = if case.msm {
-        let m = MsmTable {
+    let tables = if let Some(moments) = case.moments {
+        let m = MomentTable {
+            moments,
             storage: case.storage,
             depth: LinearizeParams::ORTHOGRAPHIC,
         };
-        vec![add_msm_table(&mut graph, 0, "in", &m, coding)]
+        vec![add_moment_table(&mut graph, 0, "in", &m, coding)]
     } else {
         let basis = CsmBasis {
             terms: case.terms,
@@ -196,23 +200,38 @@ fn msm_tolerance(storage: Storage, v: f64) -> f64 {
     6.0 * 82.0 * U + f16(storage, v) + unorm16
 }
 
+/// VSM's moments against f64 (`cpu::vsm`): z exact; z² + ¼(∂x² + ∂y²), a sum of non-negative
+/// terms, rounded by at most six f32 operations (each difference, square, the products and the
+/// sums: 6·U relative), and where the two one-sided differences are equal within their
+/// rounding f32 may take the other, whose square differs by 4·U of it: 8·U·|v|; then the
+/// storage's rounding (f16 2⁻¹¹ relative).
+fn vsm_tolerance(storage: Storage, v: f64) -> f64 {
+    8.0 * U * v.abs() + f16(storage, v)
+}
+
 fn check(g: &Gpu, seed: u64, case: &Case) {
     let what = format!(
-        "{}×{} M = {} search {:?} msm {} {:?} {:?}",
-        case.w, case.h, case.terms, case.search, case.msm, case.variant, case.storage
+        "{}×{} M = {} search {:?} moments {:?} {:?} {:?}",
+        case.w, case.h, case.terms, case.search, case.moments, case.variant, case.storage
     );
     let mut rng = common::rng(seed);
     let (raw, lin) = depth(&mut rng, case.w, case.h, case.bad);
+    // VSM's second moment passes 1 at depth steps near z = 1 (the derivative term).
+    let hi = if case.moments == Some(Moments::Vsm) {
+        2.0
+    } else {
+        1.0
+    };
     let coding = match case.variant {
-        SatVariant::Fixed => SatCoding::fixed(lookup_area(24.0, 24.0), [-1.0; 4], [1.0; 4]),
-        SatVariant::Float => SatCoding::float([-1.0; 4], [1.0; 4]),
+        SatVariant::Fixed => SatCoding::fixed(lookup_area(24.0, 24.0), [-1.0; 4], [hi; 4]),
+        SatVariant::Float => SatCoding::float([-1.0; 4], [hi; 4]),
     }
     .expect("coding");
     let (tables, steps, stats) = run(g, case, &raw, coding);
-    let want = if case.msm {
-        vec![cpu::msm::msm(&lin, true)]
-    } else {
-        basis(&lin, case.terms, case.search)
+    let want = match case.moments {
+        Some(Moments::Msm) => vec![cpu::msm::msm(&lin, true)],
+        Some(Moments::Vsm) => vec![cpu::vsm::vsm(&lin)],
+        None => basis(&lin, case.terms, case.search),
     };
     let moments = case.search == Some(CssmSearch::Moments);
     assert_eq!(tables.len(), want.len(), "{what}: tables");
@@ -234,12 +253,14 @@ fn check(g: &Gpu, seed: u64, case: &Case) {
         );
         let decoded = decode_table(words, case.w, case.h, &coding, n);
         // MSM's quantized moments: MSM's table, or CSSM's moment map (its last table).
-        let quantized = case.msm || (moments && m == want.len() - 1);
+        let quantized = case.moments == Some(Moments::Msm) || (moments && m == want.len() - 1);
         let mut tol: Vec<f64> = v
             .data
             .iter()
             .map(|&x| {
-                if quantized {
+                if case.moments == Some(Moments::Vsm) {
+                    vsm_tolerance(case.storage, x)
+                } else if quantized {
                     msm_tolerance(case.storage, x)
                 } else {
                     basis_tolerance(case.terms, case.storage, x)
@@ -299,7 +320,7 @@ fn layered_csm_tables_match_the_f64_basis() {
             h: 130,
             terms: 8,
             search: Some(CssmSearch::CsmZ),
-            msm: false,
+            moments: None,
             variant: SatVariant::Fixed,
             storage: Storage::F32,
             bad: 7,
@@ -310,7 +331,7 @@ fn layered_csm_tables_match_the_f64_basis() {
             h: 150,
             terms: 3,
             search: Some(CssmSearch::CsmZ),
-            msm: false,
+            moments: None,
             variant: SatVariant::Float,
             storage: Storage::F32,
             bad: 2,
@@ -321,7 +342,7 @@ fn layered_csm_tables_match_the_f64_basis() {
             h: 64,
             terms: 16,
             search: None,
-            msm: false,
+            moments: None,
             variant: SatVariant::Fixed,
             storage: Storage::F16,
             bad: 1,
@@ -332,7 +353,7 @@ fn layered_csm_tables_match_the_f64_basis() {
             h: 130,
             terms: 8,
             search: Some(CssmSearch::Moments),
-            msm: false,
+            moments: None,
             variant: SatVariant::Fixed,
             storage: Storage::F32,
             bad: 3,
@@ -343,7 +364,7 @@ fn layered_csm_tables_match_the_f64_basis() {
             h: 70,
             terms: 5,
             search: Some(CssmSearch::Moments),
-            msm: false,
+            moments: None,
             variant: SatVariant::Float,
             storage: Storage::F16,
             bad: 2,
@@ -355,7 +376,7 @@ fn layered_csm_tables_match_the_f64_basis() {
             h: 100,
             terms: 0,
             search: None,
-            msm: true,
+            moments: Some(Moments::Msm),
             variant: SatVariant::Fixed,
             storage: Storage::Unorm16,
             bad: 3,
@@ -365,7 +386,7 @@ fn layered_csm_tables_match_the_f64_basis() {
             h: 97,
             terms: 0,
             search: None,
-            msm: true,
+            moments: Some(Moments::Msm),
             variant: SatVariant::Float,
             storage: Storage::F16,
             bad: 1,
@@ -375,9 +396,43 @@ fn layered_csm_tables_match_the_f64_basis() {
             h: 70,
             terms: 0,
             search: None,
-            msm: true,
+            moments: Some(Moments::Msm),
             variant: SatVariant::Fixed,
             storage: Storage::F32,
+            bad: 2,
+        },
+        // CSM at M = 1: one two-channel table, so two-channel edges and carries.
+        Case {
+            w: 40,
+            h: 33,
+            terms: 1,
+            search: None,
+            moments: None,
+            variant: SatVariant::Fixed,
+            storage: Storage::F32,
+            bad: 1,
+        },
+        // VSM's moments alone (vssm, vsm with `filter = "sat"`): one two-channel layer, the
+        // derivatives from the neighbours' depth at ragged tile and map edges; both variants,
+        // f32 and f16.
+        Case {
+            w: 150,
+            h: 77,
+            terms: 0,
+            search: None,
+            moments: Some(Moments::Vsm),
+            variant: SatVariant::Fixed,
+            storage: Storage::F32,
+            bad: 3,
+        },
+        Case {
+            w: 64,
+            h: 97,
+            terms: 0,
+            search: None,
+            moments: Some(Moments::Vsm),
+            variant: SatVariant::Float,
+            storage: Storage::F16,
             bad: 2,
         },
     ];

@@ -311,6 +311,10 @@ fn rust_mirrors_match_naga_layouts() {
         ("msm_sat_tile_sums_f32", size_of::<CsmSatParams>()),
         ("msm_sat_tiles", size_of::<CsmSatParams>()),
         ("msm_sat_tiles_f32", size_of::<CsmSatParams>()),
+        ("vsm_sat_tile_sums", size_of::<CsmSatParams>()),
+        ("vsm_sat_tile_sums_f32", size_of::<CsmSatParams>()),
+        ("vsm_sat_tiles", size_of::<CsmSatParams>()),
+        ("vsm_sat_tiles_f32", size_of::<CsmSatParams>()),
         ("vsm", size_of::<VsmParams>()),
         ("evsm", size_of::<ExpParams>()),
         ("esm", size_of::<ExpParams>()),
@@ -385,6 +389,15 @@ fn storage_format_variants_validate() {
             "rgba32float",
             &["r32float", "rg32float"][..],
         ),
+        // The depth-sourced tables: edges of the widest table's channels (`sat::layers`),
+        // VSM's two-channel table, CSM's at M = 1.
+        ("csm_sat_tile_sums", "rgba32uint", &["rg32uint"][..]),
+        ("csm_sat_tiles", "rgba32uint", &["rg32uint"][..]),
+        ("csm_sat_tiles_f32", "rgba32float", &["rg32float"][..]),
+        ("vsm_sat_tile_sums", "rgba32uint", &["rg32uint"][..]),
+        ("vsm_sat_tile_sums_f32", "rgba32uint", &["rg32uint"][..]),
+        ("vsm_sat_tiles", "rgba32uint", &["rg32uint"][..]),
+        ("vsm_sat_tiles_f32", "rgba32float", &["rg32float"][..]),
     ] {
         let base = kernels::resolve(kernel, None).unwrap();
         for f in formats {

@@ -418,7 +418,7 @@ fn sizes_and_kernels_past_the_device_limits_are_named() {
     });
     let e = limit_error(&little_memory, &table);
     assert!(
-        e.contains("`sat_tile_sums`") && e.contains("max_compute_workgroup_storage_size"),
+        e.contains("`vsm_sat_tile_sums`") && e.contains("max_compute_workgroup_storage_size"),
         "{e}"
     );
     // The encoding fused into the blur keeps its tile in WebGPU's default 16 KiB of workgroup

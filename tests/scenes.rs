@@ -644,13 +644,6 @@ fn blocker_kernels_are_planned_only_for_soft_lights() {
         soft_scene("msm_soft.toml"),
     ]);
     let sp = shadowgraph::render::plan_lights(&lights).expect("plan");
-    // A table's three passes, in the variant's kernels.
-    let sat = |sums| match sums {
-        shadowgraph::sat::SatVariant::Fixed => ["sat_tile_sums", "sat_carries", "sat_tiles"],
-        shadowgraph::sat::SatVariant::Float => {
-            ["sat_tile_sums_f32", "sat_carries", "sat_tiles_f32"]
-        }
-    };
     for (i, l) in lights.iter().enumerate() {
         let mut kernels: Vec<&str> = sp
             .plan
@@ -702,13 +695,15 @@ fn blocker_kernels_are_planned_only_for_soft_lights() {
                 v.extend(vec![tiles; (basis + z).div_ceil(per)]);
                 Some(v)
             }
-            Technique::Vssm { .. } => {
-                let sums = l.shadow.technique.soft().map(|s| s.sums);
-                let mut v = vec!["vsm"];
-                v.extend(sat(sums.unwrap_or(shadowgraph::sat::SatVariant::Fixed)));
-                Some(v)
-            }
             // The moments computed in the table's own tile passes (one layer, no map).
+            Technique::Vssm { soft, .. } => Some(match soft.sums {
+                shadowgraph::sat::SatVariant::Fixed => {
+                    vec!["vsm_sat_tile_sums", "sat_carries", "vsm_sat_tiles"]
+                }
+                shadowgraph::sat::SatVariant::Float => {
+                    vec!["vsm_sat_tile_sums_f32", "sat_carries", "vsm_sat_tiles_f32"]
+                }
+            }),
             Technique::MsmSoft { soft, .. } => Some(match soft.sums {
                 shadowgraph::sat::SatVariant::Fixed => {
                     vec!["msm_sat_tile_sums", "sat_carries", "msm_sat_tiles"]

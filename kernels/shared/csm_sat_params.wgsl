@@ -1,5 +1,5 @@
 // Parameters of the layered summed-area tables computed from the depth — CSM's basis, CSSM's
-// search maps, MSM's moments (`msm_sat_*`) — (import-only module of
+// search maps, MSM's moments (`msm_sat_*`), VSM's (`vsm_sat_*`) — (import-only module of
 // `csm_sat_tile_sums`, `csm_sat_tiles` and their f32 variants; src/sat/layers.rs): the tile
 // passes read the depth buffer and compute their layer's basis map on the fly (`SatSource`,
 // shared/sat_tile), so the basis maps are never stored. Layer L (workgroup z = L − first_map)
@@ -30,12 +30,20 @@ fn csm_sat_tiles_of(size: vec2<u32>) -> vec2<u32> {
 
 // Layer `layer`'s source, for a map of `tiles` tiles: map `layer` of the CSM sequence.
 fn csm_sat_source(p: CsmSatParams, layer: u32, tiles: vec2<u32>) -> SatSource {
-    return SatSource(true, false, p.f16 != 0u, layer, p.terms, p.moments != 0u, false, p.depth,
+    return SatSource(true, false, false, p.f16 != 0u, layer, p.terms, p.moments != 0u, false, p.depth,
         layer * tiles);
 }
 
 // The source of MSM's one layer (`msm` kernels): its quantized moments, rounded as the map's
 // storage would (`p.f16`, `p.unorm16`).
 fn msm_sat_source(p: CsmSatParams) -> SatSource {
-    return SatSource(true, true, p.f16 != 0u, 0u, 0u, false, p.unorm16 != 0u, p.depth, vec2<u32>(0u));
+    return SatSource(true, true, false, p.f16 != 0u, 0u, 0u, false, p.unorm16 != 0u, p.depth,
+        vec2<u32>(0u));
+}
+
+// The source of VSM's one layer (`vsm_sat` kernels): its two moments, each texel's from its own
+// depth and its four neighbours' (clamped to the map) as `vsm` computes them, rounded as the
+// map's storage would (`p.f16`).
+fn vsm_sat_source(p: CsmSatParams) -> SatSource {
+    return SatSource(true, false, true, p.f16 != 0u, 0u, 0u, false, false, p.depth, vec2<u32>(0u));
 }

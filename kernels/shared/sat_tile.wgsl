@@ -36,14 +36,16 @@ fn sat_sub_origin(tile: vec2<u32>, li: u32) -> vec2<u32> {
 
 // Where a tile pass's texels come from: the representation `src` holds (`SAT_STORED`), or the
 // layered tables' (src/sat/layers.rs): `src` is the depth buffer and the texel is basis map
-// `layer` of the light's sequence at its linear depth (shared/csm_maps) or MSM's quantized
-// moments of it, rounded to f16 or 16-bit unorm where the map would be stored so, computed on
-// the fly and never stored. `from_depth` and `msm` are literals where each kernel builds its
+// `layer` of the light's sequence at its linear depth (shared/csm_maps), MSM's quantized
+// moments of it or VSM's moments (with its four neighbours' depths, shared/vsm_moments),
+// rounded to f16 or 16-bit unorm where the map would be stored so, computed on the fly and
+// never stored. `from_depth`, `msm` and `vsm` are literals where each kernel builds its
 // source, so every kernel compiles only its own branch. The tile
 // kernels of the representation pass the constant `SAT_STORED`, so the branch folds away.
 struct SatSource {
     from_depth: bool,    // computed from the depth; false: the texel as stored
-    msm: bool,           // MSM's quantized moments (else the CSM sequence's map `layer`)
+    msm: bool,           // MSM's quantized moments
+    vsm: bool,           // VSM's moments (neither: the CSM sequence's map `layer`)
     f16: bool,           // round each basis value to f16
     layer: u32,          // the basis map (CSM's ⌈M/2⌉, then CSM-Z's)
     terms: u32,          // M
@@ -54,4 +56,4 @@ struct SatSource {
 }
 
 const SAT_STORED: SatSource =
-    SatSource(false, false, false, 0u, 0u, false, false, DepthParams(0u, 0.0, 1.0, 0u), vec2<u32>(0u));
+    SatSource(false, false, false, false, 0u, 0u, false, false, DepthParams(0u, 0.0, 1.0, 0u), vec2<u32>(0u));

@@ -1,7 +1,7 @@
 // The table of one tile with its carries (import-only module of `sat_tiles` and
-// `sat_tiles_f32`, and of the depth-sourced `csm_sat_tiles*` and `msm_sat_tiles*`, pass 3 of 3); the carries of the
-// source's band (`SatSource.band`). A table texel (x, y) of tile (tx, ty) is the sum of three
-// disjoint parts of [0, x] × [0, y]:
+// `sat_tiles_f32`, and of the depth-sourced `csm_sat_tiles*`, `msm_sat_tiles*` and
+// `vsm_sat_tiles*`, pass 3 of 3); the carries of the source's band (`SatSource.band`). A table
+// texel (x, y) of tile (tx, ty) is the sum of three disjoint parts of [0, x] × [0, y]:
 //   the tile's own inclusive table at (x, y)                       (registers + workgroup),
 //   col_carry(x, ty): columns tx·TILE ..= x, every row above the tile      (pass 2),
 //   row_carry(tx, y): every column left of the tile, every row up to y     (pass 2).
@@ -72,6 +72,11 @@ fn sat_tile_prepare(
         sh_carry[li] = textureLoad(row_carry, vec2<u32>(s.band.x + tile.x, q.y), 0);
     } else {
         sh_carry[li] = textureLoad(col_carry, vec2<u32>(q.x, s.band.y + tile.y), 0);
+    }
+    // A literal condition: only the VSM source's kernels compile it. Both sweeps of the pass
+    // read the block.
+    if s.from_depth && s.vsm {
+        sat_vsm_fill(origin, size, s);
     }
     var col: array<vec4<u32>, SUB>;
     for (var j = 0u; j < SUB; j++) {

@@ -1,5 +1,6 @@
 // The edges of one tile's own table (import-only module of `sat_tile_sums` and
-// `sat_tile_sums_f32`, and of the depth-sourced `csm_sat_tile_sums*` and `msm_sat_tile_sums*`,
+// `sat_tile_sums_f32`, and of the depth-sourced `csm_sat_tile_sums*`, `msm_sat_tile_sums*` and
+// `vsm_sat_tile_sums*`,
 // pass 1 of 3): the tile's last row and last column, from one read of the tile. Each
 // invocation sums its sub-block's rows and columns in registers; the edges across the tile
 // come from those partial sums in workgroup memory, two barriers in all.
@@ -28,6 +29,10 @@ fn sat_tile_edges(
     let b = li / GRID;
     let size = textureDimensions(src);
     let origin = sat_sub_origin(tile, li);
+    // A literal condition: only the VSM source's kernels compile it.
+    if s.from_depth && s.vsm {
+        sat_vsm_fill(origin, size, s);
+    }
     // Row sums prefixed down the sub-block (its table's last column), and column sums, then
     // prefixed along it (its last row).
     var down = vec4<u32>(0u);

@@ -8,10 +8,40 @@
 // #import shared/msm_quantize
 // #import shared/storage_round
 // #import shared/linear_depth
+// #import shared/vsm_moments
 
 // Non-finite depth texels this invocation's `sat_texel` replaced (depth sources; the first
 // tile pass counts layer 0's).
 var<private> sat_non_finite: u32;
+
+// VSM's moments of the sub-block a pass sweeps (SUB × SUB, row-major), filled by
+// `sat_vsm_fill` before its sweeps and read by `sat_texel`.
+var<private> sat_vsm_block: array<vec2<f32>, 16>; // SUB · SUB
+
+// VSM's moments of the sub-block at `origin` as `vsm` computes them (shared/vsm_moments):
+// each texel's derivatives take its four neighbours' depths, clamped to the map. The linear
+// depth of the sub-block and its one-texel border is read once, (SUB + 2)² loads, where each
+// texel's own five would be 5·SUB² (80 against 36 at SUB = 4; on llvmpipe the table built with
+// them per texel ran 1.1× slower than the stored map's, `benches/RESULTS.md`, 2026-11-27).
+// Texels past the map's edge (ragged tiles) get values that `sat_texel` discards.
+fn sat_vsm_fill(origin: vec2<u32>, size: vec2<u32>, s: SatSource) {
+    const BORDERED: u32 = SUB + 2u;
+    var z: array<f32, 36>; // BORDERED²
+    for (var k = 0u; k < BORDERED * BORDERED; k++) {
+        let at = vec2<i32>(origin) + vec2<i32>(i32(k % BORDERED), i32(k / BORDERED)) - 1;
+        z[k] = sat_depth_at(at, size, s.depth);
+    }
+    for (var k = 0u; k < SUB * SUB; k++) {
+        let c = (k / SUB + 1u) * BORDERED + k % SUB + 1u;
+        sat_vsm_block[k] = vsm_moments(z[c], z[c - 1u], z[c + 1u], z[c - BORDERED], z[c + BORDERED]);
+    }
+}
+
+// The linear depth of `src` (the depth buffer) at p clamped to the map of `size`.
+fn sat_depth_at(p: vec2<i32>, size: vec2<u32>, depth: DepthParams) -> f32 {
+    let q = clamp(p, vec2<i32>(0), vec2<i32>(size) - 1);
+    return linear_depth(textureLoad(src, q, 0).r, depth);
+}
 
 // The encoded texel `q` of `src` (`size` its size) read as `s` says, 0 outside the map (the
 // load is clamped to the map and its value discarded, so no invocation branches).
@@ -39,6 +69,10 @@ fn sat_texel(
             // are).
             let z2 = z * z;
             v = msm_quantize(vec4<f32>(z, z2, z2 * z, z2 * z2));
+        } else if s.vsm {
+            // VSM's moments of the invocation's sub-block, computed once a pass
+            // (`sat_vsm_fill`; sub-blocks start at multiples of SUB).
+            v = vec4<f32>(sat_vsm_block[q.y % SUB * SUB + q.x % SUB], 0.0, 0.0);
         } else {
             v = csm_basis_map(s.layer, s.terms, s.moments, z);
         }

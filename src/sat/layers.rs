@@ -15,8 +15,8 @@
 //!
 //! That is `2 + ⌈L / 4⌉` dispatches. Per texel: the source read `2L` times (once a layer per
 //! tile pass; both sweeps of pass 3 share a tile), each table written once, and the stacked
-//! edges and carries (`8·L / TILE` texels of 16 B). Each table is exactly the one
-//! [`super::add_sat`] builds of the representation the kernel computes: the tile passes share
+//! edges and carries (`8·L / TILE` texels of 4 B a channel of the widest table). Each table is
+//! exactly the one [`super::add_sat`] builds of the representation the kernel computes: the tile passes share
 //! their scans with `sat_tile_sums` / `sat_tiles` (`kernels/shared/sat_tile_*.wgsl`), so in
 //! fixed point a table is bit-identical to the integer reference of the codes the kernel
 //! computes.
@@ -55,9 +55,11 @@ pub fn add_layered_sat(graph: &mut Graph, light: usize, sat: &LayeredSat<'_>) ->
         return Vec::new();
     }
     let source = sat.source.to_string();
-    let mut sat_params = sat.coding.params(4, 0);
+    // The edges and carries hold as many channels as the widest table (two for VSM's moments).
+    let channels = sat.tables.iter().map(|(_, c)| *c).max().unwrap_or(4);
+    let mut sat_params = sat.coding.params(channels, 0);
     sat_params.layers = layers;
-    let words = SatVariant::Fixed.format(4);
+    let words = SatVariant::Fixed.format(channels);
     let stem = format!("{}.sat", sat.prefix);
     let mut edges = |suffix: &str, x: u32, y: u32, across: u32, down: u32| {
         let size = SizeRule::Stacked {

@@ -1,8 +1,9 @@
-//! CSM, CSSM and MSM through summed-area tables, the representation never stored: the
+//! CSM, CSSM, MSM and VSM through summed-area tables, the representation never stored: the
 //! layered tables of [`crate::sat::layers`] whose tile kernels (`kernels/csm_sat_tile_sums.wgsl`,
 //! `kernels/csm_sat_tiles.wgsl` and their f32 variants) compute each map from the depth on the
-//! fly, one layer a map of the light's sequence (`kernels/shared/csm_maps.wgsl`); MSM's moments
-//! likewise, one layer by their own kernels (`kernels/msm_sat_*.wgsl`).
+//! fly, one layer a map of the light's sequence (`kernels/shared/csm_maps.wgsl`); MSM's and
+//! VSM's moments likewise, one layer by their own kernels (`kernels/msm_sat_*.wgsl`,
+//! `kernels/vsm_sat_*.wgsl`).
 
 use super::csm::basis_sequence;
 use super::nodes::{LightNodes, float_moments_format, moments_format};
@@ -104,27 +105,32 @@ pub fn add_csm_tables(
     )
 }
 
-/// Adds the summed-area table of light `light`'s MSM moments (quantized, as a table's always
-/// are: `technique::msm_quantized`; rounded as `m.storage` would hold them) coded as `coding`,
-/// computed from the depth `depth` in the table's own tile passes: one layer of
+/// Adds the summed-area table of light `light`'s moments `m.moments` (MSM's quantized, as a
+/// table's always are: `technique::msm_quantized`; or VSM's, each from its depth and its four
+/// neighbours' as `vsm` computes them), rounded as `m.storage` would hold them, coded as
+/// `coding`, computed from the depth `depth` in the table's own tile passes: one layer of
 /// [`add_layered_sat`], 3 dispatches, the depth read twice and the moments never stored. The
-/// map `light{light}.msm` is declared in its storage's format but never planned. Returns
-/// `light{light}.msm.sat`.
-pub fn add_msm_table(
+/// map `light{light}.msm` (`.vsm`) is declared in its storage's format but never planned.
+/// Returns `light{light}.msm.sat` (`.vsm.sat`).
+pub fn add_moment_table(
     graph: &mut Graph,
     light: usize,
     depth: &str,
-    m: &MsmTable,
+    m: &MomentTable,
     coding: SatCoding,
 ) -> String {
     let size = SizeRule::Reduced {
         of: depth.to_string(),
         shift: 0,
     };
-    let format = moments_format(m.storage, 4);
-    let map = graph.resource(format!("light{light}.msm"), format, size, Some(light));
+    let (stem, channels) = match m.moments {
+        Moments::Msm => ("msm", 4),
+        Moments::Vsm => ("vsm", 2),
+    };
+    let format = moments_format(m.storage, channels);
+    let map = graph.resource(format!("light{light}.{stem}"), format, size, Some(light));
     let template = CsmSatParams {
-        sat: coding.params(4, 0),
+        sat: coding.params(channels, 0),
         depth: m.depth,
         first_map: 0,
         maps: 0,
@@ -134,16 +140,22 @@ pub fn add_msm_table(
         unorm16: u32::from(m.storage == Storage::Unorm16),
         _pad: [0; 2],
     };
-    let kernels = match coding.variant {
-        SatVariant::Fixed => [KernelId::MsmSatTileSums, KernelId::MsmSatTiles],
-        SatVariant::Float => [KernelId::MsmSatTileSumsF32, KernelId::MsmSatTilesF32],
+    let kernels = match (m.moments, coding.variant) {
+        (Moments::Msm, SatVariant::Fixed) => [KernelId::MsmSatTileSums, KernelId::MsmSatTiles],
+        (Moments::Msm, SatVariant::Float) => {
+            [KernelId::MsmSatTileSumsF32, KernelId::MsmSatTilesF32]
+        }
+        (Moments::Vsm, SatVariant::Fixed) => [KernelId::VsmSatTileSums, KernelId::VsmSatTiles],
+        (Moments::Vsm, SatVariant::Float) => {
+            [KernelId::VsmSatTileSumsF32, KernelId::VsmSatTilesF32]
+        }
     };
     let tables = depth_tables(
         graph,
         light,
         depth,
-        "msm",
-        &[(map, 4)],
+        stem,
+        &[(map, channels)],
         kernels,
         template,
         coding,
@@ -151,9 +163,20 @@ pub fn add_msm_table(
     tables.into_iter().next().unwrap_or_default()
 }
 
-/// What [`add_msm_table`] sums: MSM's quantized moments.
+/// Which moments [`add_moment_table`] sums.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Moments {
+    /// MSM's four, quantized.
+    Msm,
+    /// VSM's two, (z, z² + ¼ (∂z/∂x² + ∂z/∂y²)).
+    Vsm,
+}
+
+/// What [`add_moment_table`] sums.
 #[derive(Clone, Copy, Debug)]
-pub struct MsmTable {
+pub struct MomentTable {
+    /// MSM's or VSM's moments.
+    pub moments: Moments,
     /// The moments' storage: f16 and unorm16 round every value as such a map would.
     pub storage: Storage,
     /// The depth buffer's linearization.

@@ -36,7 +36,7 @@ pub use crate::model::mip_levels;
 use crate::model::{Light, ParamSource, ParamSpec, ParamValues, Technique};
 pub use cascade_shade::{CascadeGroup, shade_key_cascaded};
 pub use csm::{basis_sequence, csm_maps, csm_z_channels, csm_z_maps, search_maps};
-pub use csm_sat::{CsmBasis, CsmSatParams, MsmTable, add_csm_tables, add_msm_table};
+pub use csm_sat::{CsmBasis, CsmSatParams, MomentTable, Moments, add_csm_tables, add_moment_table};
 use light_gpu::unit_range;
 pub use light_gpu::{sat_coding, sat_variant, soft_lookup_area, soft_max_width, soft_width_cap};
 pub use msm::msm_quantized;

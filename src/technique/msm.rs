@@ -1,7 +1,7 @@
 //! `msm`: moment shadow maps (Peters & Klein 2015), (z, z², z³, z⁴) raw in f32 or through the
 //! optimized 16-bit quantization; Hamburger or Hausdorff reconstruction.
 
-use super::csm_sat::{MsmTable, add_msm_table};
+use super::csm_sat::{MomentTable, Moments, add_moment_table};
 use super::light_gpu::quantized_msm_range;
 use super::nodes::{LightNodes, moments_format};
 use super::params::{FILTER, MSM, MSM_FORMAT, prefilter, prefilter_values, storage};
@@ -59,7 +59,7 @@ pub(super) fn msm_gpu(t: &Technique, g: &mut LightGpu) {
 }
 
 /// The four moments (raw or quantized), filtered as the light asks (`msm`, `msm_soft`):
-/// through a summed-area table, the table computed from the depth ([`add_msm_table`]); else the
+/// through a summed-area table, the table computed from the depth ([`add_moment_table`]); else the
 /// `msm` encoding, then its blur or mips.
 pub(super) fn moments(n: &mut LightNodes) -> ShadeInput {
     let t = &n.light.shadow.technique;
@@ -71,12 +71,13 @@ pub(super) fn moments(n: &mut LightNodes) -> ShadeInput {
     // Through a summed-area table (`filter = "sat"`, `msm_soft`) the moments are computed in
     // the table's own tile passes, never stored.
     if let Ok(Some(coding)) = super::light_gpu::sat_coding(n.light) {
-        let m = MsmTable {
+        let m = MomentTable {
+            moments: Moments::Msm,
             storage,
             depth: n.lin,
         };
         let depth = n.depth.clone();
-        let table = add_msm_table(n.graph, n.i, &depth, &m, coding);
+        let table = add_moment_table(n.graph, n.i, &depth, &m, coding);
         return n.one(table);
     }
     let params = MsmParams {
