@@ -1,6 +1,6 @@
 // MSM's moments summed into a table computed from the depth, pass 3 of 3, fixed-point variant
 // (src/sat/layers.rs, technique::add_moment_table: one layer): each workgroup computes its tile
-// of MSM's quantized moments from the depth again (`msm_sat_source`, shared/sat_tile), scans
+// of MSM's quantized moments from the depth again (`moment_sat_source`, shared/sat_tile), scans
 // it as `sat_tiles` does, adds the carries (pass 2, `sat_carries`) and stores the table.
 // #import shared/sat_tile_scan
 // #import shared/csm_sat_params
@@ -27,5 +27,5 @@ fn sat_store(slot: u32, q: vec2<u32>, v: vec4<u32>) {
 
 @compute @workgroup_size(WG_SIZE)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    sat_tile_table(params.sat, FLOAT_SUMS, msm_sat_source(params), wg.xy, li, 0u);
+    sat_tile_table(params.sat, FLOAT_SUMS, moment_sat_source(params, SAT_MSM), wg.xy, li, 0u);
 }

@@ -1,7 +1,7 @@
 // VSM's moments summed into a table computed from the depth, pass 1 of 3, f32 variant
 // (src/sat/layers.rs, technique::add_moment_table: one layer, two channels): each workgroup
 // computes its tile of VSM's moments from the depth and its four neighbours on the fly
-// (`vsm_sat_source`, shared/sat_tile), rounded as the map's storage would hold them, and
+// (`moment_sat_source`, shared/sat_tile), rounded as the map's storage would hold them, and
 // writes the edges of its tile's own table, as `sat_tile_sums` does for a stored map: the
 // `vsm` dispatch and its map's write and two reads are gone. Counts the non-finite depth
 // texels.
@@ -24,7 +24,7 @@ const FLOAT_SUMS: bool = true;
 
 @compute @workgroup_size(WG_SIZE)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    sat_tile_sums_pass(params.sat, FLOAT_SUMS, vsm_sat_source(params), wg.xy, li);
+    sat_tile_sums_pass(params.sat, FLOAT_SUMS, moment_sat_source(params, SAT_VSM), wg.xy, li);
     if sat_non_finite > 0u {
         atomicAdd(&stats[0], sat_non_finite);
     }

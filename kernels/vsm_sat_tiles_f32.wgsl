@@ -1,6 +1,6 @@
 // VSM's moments summed into a table computed from the depth, pass 3 of 3, f32 variant
 // (src/sat/layers.rs, technique::add_moment_table: one layer, two channels): each workgroup
-// computes its tile of VSM's moments from the depth again (`vsm_sat_source`, shared/sat_tile),
+// computes its tile of VSM's moments from the depth again (`moment_sat_source`, shared/sat_tile),
 // scans it as `sat_tiles` does, adds the carries (pass 2, `sat_carries`) and stores the table.
 // The executor re-declares `dst0` for the table's two channels.
 // #import shared/sat_tile_scan
@@ -28,5 +28,5 @@ fn sat_store(slot: u32, q: vec2<u32>, v: vec4<u32>) {
 
 @compute @workgroup_size(WG_SIZE)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    sat_tile_table(params.sat, FLOAT_SUMS, vsm_sat_source(params), wg.xy, li, 0u);
+    sat_tile_table(params.sat, FLOAT_SUMS, moment_sat_source(params, SAT_VSM), wg.xy, li, 0u);
 }

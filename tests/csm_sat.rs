@@ -9,7 +9,8 @@
 //! Random depth with NaN and ±Inf texels (counted once), ragged tiles, both variants, CSM
 //! alone, CSSM's CSM + CSM-Z and CSSM's CSM + MSM's quantized moments (`cpu::msm`), MSM's
 //! moments alone, VSM's moments alone (`cpu::vsm`, the derivatives from the neighbours' depth),
-//! f32, f16 and unorm16 storage.
+//! EVSM's (`cpu::evsm`, four and two channels) and ESM's (`cpu::esm_linear`), f32, f16 and
+//! unorm16 storage.
 
 mod common;
 
@@ -41,6 +42,8 @@ struct Case {
     /// MSM's quantized or VSM's moments alone (`technique::add_moment_table`; `terms`,
     /// `search` unused).
     moments: Option<Moments>,
+    /// EVSM's (c⁺, c⁻), ESM's (c, unused).
+    exp: [f32; 2],
     variant: SatVariant,
     storage: Storage,
     bad: usize,
@@ -85,6 +88,7 @@ fn run(g: &Gpu, case: &Case, raw: &[f32], coding: SatCoding) -> (Vec<Vec<u32>>, 
     let tables = if let Some(moments) = case.moments {
         let m = MomentTable {
             moments,
+            exp: case.exp,
             storage: case.storage,
             depth: LinearizeParams::ORTHOGRAPHIC,
         };
@@ -209,6 +213,15 @@ fn vsm_tolerance(storage: Storage, v: f64) -> f64 {
     8.0 * U * v.abs() + f16(storage, v)
 }
 
+/// SPIR-V's exp: (3 + 2|x|) ULP (2⁻²³ relative each) at |x| ≤ c; the argument c·(2z − 1)
+/// (EVSM) or c·(z − 1) (ESM) rounded twice, 2·c·U absolute, which moves exp by that relative;
+/// EVSM's squares double both and add a rounding; then f16 storage's 2⁻¹¹ relative.
+fn exp_tolerance(c: f64, squared: bool, storage: Storage, v: f64) -> f64 {
+    let once = (3.0 + 2.0 * c) * 2f64.powi(-23) + 2.0 * c * U;
+    let rel = if squared { 2.0 * once + U } else { once };
+    rel * v.abs() + f16(storage, v)
+}
+
 fn check(g: &Gpu, seed: u64, case: &Case) {
     let what = format!(
         "{}×{} M = {} search {:?} moments {:?} {:?} {:?}",
@@ -216,21 +229,36 @@ fn check(g: &Gpu, seed: u64, case: &Case) {
     );
     let mut rng = common::rng(seed);
     let (raw, lin) = depth(&mut rng, case.w, case.h, case.bad);
-    // VSM's second moment passes 1 at depth steps near z = 1 (the derivative term).
-    let hi = if case.moments == Some(Moments::Vsm) {
-        2.0
-    } else {
-        1.0
+    // VSM's second moment passes 1 at depth steps near z = 1 (the derivative term); EVSM's
+    // moments span ±exp(2c).
+    let (lo, hi) = match case.moments {
+        Some(Moments::Vsm) => (-1.0, 2.0),
+        Some(Moments::Evsm { .. }) => {
+            let e = (2.0 * case.exp[0].max(case.exp[1])).exp();
+            (-e, e)
+        }
+        _ => (-1.0, 1.0),
     };
     let coding = match case.variant {
-        SatVariant::Fixed => SatCoding::fixed(lookup_area(24.0, 24.0), [-1.0; 4], [hi; 4]),
-        SatVariant::Float => SatCoding::float([-1.0; 4], [hi; 4]),
+        SatVariant::Fixed => SatCoding::fixed(lookup_area(24.0, 24.0), [lo; 4], [hi; 4]),
+        SatVariant::Float => SatCoding::float([lo; 4], [hi; 4]),
     }
     .expect("coding");
     let (tables, steps, stats) = run(g, case, &raw, coding);
+    let [c_pos, c_neg] = case.exp.map(f64::from);
     let want = match case.moments {
         Some(Moments::Msm) => vec![cpu::msm::msm(&lin, true)],
         Some(Moments::Vsm) => vec![cpu::vsm::vsm(&lin)],
+        Some(Moments::Evsm { four }) => {
+            let m = cpu::evsm::evsm(&lin, c_pos, c_neg);
+            let n = if four { 4 } else { 2 };
+            vec![Texels {
+                channels: n,
+                data: m.data.chunks(4).flat_map(|t| t[..n].to_vec()).collect(),
+                ..m
+            }]
+        }
+        Some(Moments::Esm) => vec![cpu::esm::esm_linear(&lin, c_pos)],
         None => basis(&lin, case.terms, case.search),
     };
     let moments = case.search == Some(CssmSearch::Moments);
@@ -257,9 +285,17 @@ fn check(g: &Gpu, seed: u64, case: &Case) {
         let mut tol: Vec<f64> = v
             .data
             .iter()
-            .map(|&x| {
+            .enumerate()
+            .map(|(i, &x)| {
+                // EVSM's channels: pos, pos², neg, neg².
+                let channel = i % v.channels;
                 if case.moments == Some(Moments::Vsm) {
                     vsm_tolerance(case.storage, x)
+                } else if let Some(Moments::Evsm { .. }) = case.moments {
+                    let c = if channel < 2 { c_pos } else { c_neg };
+                    exp_tolerance(c, channel % 2 == 1, case.storage, x)
+                } else if case.moments == Some(Moments::Esm) {
+                    exp_tolerance(c_pos, false, case.storage, x)
                 } else if quantized {
                     msm_tolerance(case.storage, x)
                 } else {
@@ -321,6 +357,7 @@ fn layered_csm_tables_match_the_f64_basis() {
             terms: 8,
             search: Some(CssmSearch::CsmZ),
             moments: None,
+            exp: [0.0; 2],
             variant: SatVariant::Fixed,
             storage: Storage::F32,
             bad: 7,
@@ -332,6 +369,7 @@ fn layered_csm_tables_match_the_f64_basis() {
             terms: 3,
             search: Some(CssmSearch::CsmZ),
             moments: None,
+            exp: [0.0; 2],
             variant: SatVariant::Float,
             storage: Storage::F32,
             bad: 2,
@@ -343,6 +381,7 @@ fn layered_csm_tables_match_the_f64_basis() {
             terms: 16,
             search: None,
             moments: None,
+            exp: [0.0; 2],
             variant: SatVariant::Fixed,
             storage: Storage::F16,
             bad: 1,
@@ -354,6 +393,7 @@ fn layered_csm_tables_match_the_f64_basis() {
             terms: 8,
             search: Some(CssmSearch::Moments),
             moments: None,
+            exp: [0.0; 2],
             variant: SatVariant::Fixed,
             storage: Storage::F32,
             bad: 3,
@@ -365,6 +405,7 @@ fn layered_csm_tables_match_the_f64_basis() {
             terms: 5,
             search: Some(CssmSearch::Moments),
             moments: None,
+            exp: [0.0; 2],
             variant: SatVariant::Float,
             storage: Storage::F16,
             bad: 2,
@@ -377,6 +418,7 @@ fn layered_csm_tables_match_the_f64_basis() {
             terms: 0,
             search: None,
             moments: Some(Moments::Msm),
+            exp: [0.0; 2],
             variant: SatVariant::Fixed,
             storage: Storage::Unorm16,
             bad: 3,
@@ -387,6 +429,7 @@ fn layered_csm_tables_match_the_f64_basis() {
             terms: 0,
             search: None,
             moments: Some(Moments::Msm),
+            exp: [0.0; 2],
             variant: SatVariant::Float,
             storage: Storage::F16,
             bad: 1,
@@ -397,6 +440,7 @@ fn layered_csm_tables_match_the_f64_basis() {
             terms: 0,
             search: None,
             moments: Some(Moments::Msm),
+            exp: [0.0; 2],
             variant: SatVariant::Fixed,
             storage: Storage::F32,
             bad: 2,
@@ -408,6 +452,7 @@ fn layered_csm_tables_match_the_f64_basis() {
             terms: 1,
             search: None,
             moments: None,
+            exp: [0.0; 2],
             variant: SatVariant::Fixed,
             storage: Storage::F32,
             bad: 1,
@@ -421,6 +466,7 @@ fn layered_csm_tables_match_the_f64_basis() {
             terms: 0,
             search: None,
             moments: Some(Moments::Vsm),
+            exp: [0.0; 2],
             variant: SatVariant::Fixed,
             storage: Storage::F32,
             bad: 3,
@@ -431,8 +477,44 @@ fn layered_csm_tables_match_the_f64_basis() {
             terms: 0,
             search: None,
             moments: Some(Moments::Vsm),
+            exp: [0.0; 2],
             variant: SatVariant::Float,
             storage: Storage::F16,
+            bad: 2,
+        },
+        // EVSM's moments (evsm4 and evsm2 with `filter = "sat"`) and ESM's exp(c (z − 1))
+        // (esm with `filter = "sat"`): one layer of four, two and one channel.
+        Case {
+            w: 130,
+            h: 70,
+            terms: 0,
+            search: None,
+            moments: Some(Moments::Evsm { four: true }),
+            exp: [5.0, 4.0],
+            variant: SatVariant::Fixed,
+            storage: Storage::F32,
+            bad: 2,
+        },
+        Case {
+            w: 70,
+            h: 45,
+            terms: 0,
+            search: None,
+            moments: Some(Moments::Evsm { four: false }),
+            exp: [5.5, 0.0],
+            variant: SatVariant::Float,
+            storage: Storage::F16,
+            bad: 1,
+        },
+        Case {
+            w: 100,
+            h: 67,
+            terms: 0,
+            search: None,
+            moments: Some(Moments::Esm),
+            exp: [20.0, 0.0],
+            variant: SatVariant::Fixed,
+            storage: Storage::F32,
             bad: 2,
         },
     ];

@@ -315,6 +315,14 @@ fn rust_mirrors_match_naga_layouts() {
         ("vsm_sat_tile_sums_f32", size_of::<CsmSatParams>()),
         ("vsm_sat_tiles", size_of::<CsmSatParams>()),
         ("vsm_sat_tiles_f32", size_of::<CsmSatParams>()),
+        ("evsm_sat_tile_sums", size_of::<CsmSatParams>()),
+        ("evsm_sat_tile_sums_f32", size_of::<CsmSatParams>()),
+        ("evsm_sat_tiles", size_of::<CsmSatParams>()),
+        ("evsm_sat_tiles_f32", size_of::<CsmSatParams>()),
+        ("esm_sat_tile_sums", size_of::<CsmSatParams>()),
+        ("esm_sat_tile_sums_f32", size_of::<CsmSatParams>()),
+        ("esm_sat_tiles", size_of::<CsmSatParams>()),
+        ("esm_sat_tiles_f32", size_of::<CsmSatParams>()),
         ("vsm", size_of::<VsmParams>()),
         ("evsm", size_of::<ExpParams>()),
         ("esm", size_of::<ExpParams>()),
@@ -390,7 +398,7 @@ fn storage_format_variants_validate() {
             &["r32float", "rg32float"][..],
         ),
         // The depth-sourced tables: edges of the widest table's channels (`sat::layers`),
-        // VSM's two-channel table, CSM's at M = 1.
+        // VSM's and EVSM2's two-channel tables, ESM's one-channel table, CSM's at M = 1.
         ("csm_sat_tile_sums", "rgba32uint", &["rg32uint"][..]),
         ("csm_sat_tiles", "rgba32uint", &["rg32uint"][..]),
         ("csm_sat_tiles_f32", "rgba32float", &["rg32float"][..]),
@@ -398,6 +406,13 @@ fn storage_format_variants_validate() {
         ("vsm_sat_tile_sums_f32", "rgba32uint", &["rg32uint"][..]),
         ("vsm_sat_tiles", "rgba32uint", &["rg32uint"][..]),
         ("vsm_sat_tiles_f32", "rgba32float", &["rg32float"][..]),
+        ("evsm_sat_tile_sums", "rgba32uint", &["rg32uint"][..]),
+        ("evsm_sat_tiles", "rgba32uint", &["rg32uint"][..]),
+        ("evsm_sat_tiles_f32", "rgba32float", &["rg32float"][..]),
+        ("esm_sat_tile_sums", "rgba32uint", &["r32uint"][..]),
+        ("esm_sat_tile_sums_f32", "rgba32uint", &["r32uint"][..]),
+        ("esm_sat_tiles", "rgba32uint", &["r32uint"][..]),
+        ("esm_sat_tiles_f32", "rgba32float", &["r32float"][..]),
     ] {
         let base = kernels::resolve(kernel, None).unwrap();
         for f in formats {

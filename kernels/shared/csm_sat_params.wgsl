@@ -1,5 +1,5 @@
 // Parameters of the layered summed-area tables computed from the depth — CSM's basis, CSSM's
-// search maps, MSM's moments (`msm_sat_*`), VSM's (`vsm_sat_*`) — (import-only module of
+// search maps, the moments of MSM, VSM, EVSM and ESM (`msm_sat_*`, …) — (import-only module of
 // `csm_sat_tile_sums`, `csm_sat_tiles` and their f32 variants; src/sat/layers.rs): the tile
 // passes read the depth buffer and compute their layer's basis map on the fly (`SatSource`,
 // shared/sat_tile), so the basis maps are never stored. Layer L (workgroup z = L − first_map)
@@ -18,8 +18,8 @@ struct CsmSatParams {
     f16: u32,             // 1: round each basis value to f16, as an rgba16float map would hold it
     moments: u32,         // 1: the layer after CSM's is MSM's moments (CSSM's moment search)
     unorm16: u32,         // 1: round each value to 16-bit unorm, as an rgba16unorm map would hold it
-    _pad0: u32,
-    _pad1: u32,
+    exp_pos: f32,         // EVSM's c⁺, ESM's c (the moment layers)
+    exp_neg: f32,         // EVSM's c⁻
 }
 
 // Tiles of a `size` map along x and y: the width of a band of row_part, the height of one of
@@ -30,20 +30,16 @@ fn csm_sat_tiles_of(size: vec2<u32>) -> vec2<u32> {
 
 // Layer `layer`'s source, for a map of `tiles` tiles: map `layer` of the CSM sequence.
 fn csm_sat_source(p: CsmSatParams, layer: u32, tiles: vec2<u32>) -> SatSource {
-    return SatSource(true, false, false, p.f16 != 0u, layer, p.terms, p.moments != 0u, false, p.depth,
-        layer * tiles);
+    return SatSource(true, SAT_CSM, p.f16 != 0u, layer, p.terms, p.moments != 0u, false, 0.0, 0.0,
+        p.depth, layer * tiles);
 }
 
-// The source of MSM's one layer (`msm` kernels): its quantized moments, rounded as the map's
-// storage would (`p.f16`, `p.unorm16`).
-fn msm_sat_source(p: CsmSatParams) -> SatSource {
-    return SatSource(true, true, false, p.f16 != 0u, 0u, 0u, false, p.unorm16 != 0u, p.depth,
-        vec2<u32>(0u));
-}
-
-// The source of VSM's one layer (`vsm_sat` kernels): its two moments, each texel's from its own
-// depth and its four neighbours' (clamped to the map) as `vsm` computes them, rounded as the
-// map's storage would (`p.f16`).
-fn vsm_sat_source(p: CsmSatParams) -> SatSource {
-    return SatSource(true, false, true, p.f16 != 0u, 0u, 0u, false, false, p.depth, vec2<u32>(0u));
+// The source of one layer of moments (`msm_sat`, `vsm_sat`, `evsm_sat`, `esm_sat` kernels), by
+// `kind` (a literal in each kernel): MSM's quantized moments, VSM's (each texel's derivatives
+// from its neighbours' depth, as `vsm`), EVSM's (c⁺ = p.exp_pos, c⁻ = p.exp_neg) or ESM's
+// exp(c (z − 1)) (c = p.exp_pos), as their encoding kernels compute them, rounded as the
+// map's storage would (`p.f16`, `p.unorm16`).
+fn moment_sat_source(p: CsmSatParams, kind: u32) -> SatSource {
+    return SatSource(true, kind, p.f16 != 0u, 0u, 0u, false, p.unorm16 != 0u, p.exp_pos, p.exp_neg,
+        p.depth, vec2<u32>(0u));
 }

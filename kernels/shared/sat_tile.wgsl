@@ -35,25 +35,33 @@ fn sat_sub_origin(tile: vec2<u32>, li: u32) -> vec2<u32> {
 }
 
 // Where a tile pass's texels come from: the representation `src` holds (`SAT_STORED`), or the
-// layered tables' (src/sat/layers.rs): `src` is the depth buffer and the texel is basis map
-// `layer` of the light's sequence at its linear depth (shared/csm_maps), MSM's quantized
-// moments of it or VSM's moments (with its four neighbours' depths, shared/vsm_moments),
-// rounded to f16 or 16-bit unorm where the map would be stored so, computed on the fly and
-// never stored. `from_depth`, `msm` and `vsm` are literals where each kernel builds its
-// source, so every kernel compiles only its own branch. The tile
+// layered tables' (src/sat/layers.rs): `src` is the depth buffer and the texel, by `kind`,
+// basis map `layer` of the light's sequence at its linear depth (shared/csm_maps), MSM's
+// quantized moments of it, VSM's moments (with its four neighbours' depths,
+// shared/vsm_moments), EVSM's (shared/evsm_moments) or ESM's exp(c (z − 1)), rounded to f16 or
+// 16-bit unorm where the map would be stored so, computed on the fly and never stored.
+// `from_depth` and `kind` are literals where each kernel builds its source, so every kernel
+// compiles only its own branch. The tile
 // kernels of the representation pass the constant `SAT_STORED`, so the branch folds away.
 struct SatSource {
     from_depth: bool,    // computed from the depth; false: the texel as stored
-    msm: bool,           // MSM's quantized moments
-    vsm: bool,           // VSM's moments (neither: the CSM sequence's map `layer`)
+    kind: u32,           // SAT_CSM (the sequence's map `layer`), SAT_MSM, SAT_VSM, SAT_EVSM, SAT_ESM
     f16: bool,           // round each basis value to f16
     layer: u32,          // the basis map (CSM's ⌈M/2⌉, then CSM-Z's)
     terms: u32,          // M
     moments: bool,       // the map after CSM's is MSM's moments (CSSM's moment search)
     unorm16: bool,       // round each value to 16-bit unorm
+    exp_pos: f32,        // EVSM's c⁺, ESM's c
+    exp_neg: f32,        // EVSM's c⁻
     depth: DepthParams,  // the depth buffer's linearization
     band: vec2<u32>,     // this table's carries start at this (tile column, tile row)
 }
 
-const SAT_STORED: SatSource =
-    SatSource(false, false, false, false, 0u, 0u, false, false, DepthParams(0u, 0.0, 1.0, 0u), vec2<u32>(0u));
+const SAT_CSM: u32 = 0u;
+const SAT_MSM: u32 = 1u;
+const SAT_VSM: u32 = 2u;
+const SAT_EVSM: u32 = 3u;
+const SAT_ESM: u32 = 4u;
+
+const SAT_STORED: SatSource = SatSource(false, SAT_CSM, false, 0u, 0u, false, false, 0.0, 0.0,
+    DepthParams(0u, 0.0, 1.0, 0u), vec2<u32>(0u));

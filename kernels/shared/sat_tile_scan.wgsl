@@ -75,7 +75,7 @@ fn sat_tile_prepare(
     }
     // A literal condition: only the VSM source's kernels compile it. Both sweeps of the pass
     // read the block.
-    if s.from_depth && s.vsm {
+    if s.from_depth && s.kind == SAT_VSM {
         sat_vsm_fill(origin, size, s);
     }
     var col: array<vec4<u32>, SUB>;

@@ -9,6 +9,7 @@
 // #import shared/storage_round
 // #import shared/linear_depth
 // #import shared/vsm_moments
+// #import shared/evsm_moments
 
 // Non-finite depth texels this invocation's `sat_texel` replaced (depth sources; the first
 // tile pass counts layer 0's).
@@ -64,15 +65,20 @@ fn sat_texel(
             sat_non_finite += 1u;
         }
         let z = linear_depth(raw, s.depth);
-        if s.msm {
+        if s.kind == SAT_MSM {
             // MSM's moments as shared/msm_moments computes them, quantized (a table's always
             // are).
             let z2 = z * z;
             v = msm_quantize(vec4<f32>(z, z2, z2 * z, z2 * z2));
-        } else if s.vsm {
+        } else if s.kind == SAT_VSM {
             // VSM's moments of the invocation's sub-block, computed once a pass
             // (`sat_vsm_fill`; sub-blocks start at multiples of SUB).
             v = vec4<f32>(sat_vsm_block[q.y % SUB * SUB + q.x % SUB], 0.0, 0.0);
+        } else if s.kind == SAT_EVSM {
+            v = evsm_moments(z, s.exp_pos, s.exp_neg);
+        } else if s.kind == SAT_ESM {
+            // `esm`'s moment for a summed-area table (`params.linear`).
+            v = vec4<f32>(exp(s.exp_pos * (z - 1.0)), 0.0, 0.0, 0.0);
         } else {
             v = csm_basis_map(s.layer, s.terms, s.moments, z);
         }

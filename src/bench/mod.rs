@@ -231,6 +231,16 @@ pub const CASES: &[BenchCase] = &[
         name: "chain msm_soft (depth → table)",
         build: |n| chain_graph(n, named("msm_soft", &[]), &["light0.msm.sat"]),
     },
+    // The exponential encodings through a table at the scenes' exponents
+    // (`scenes/techniques/evsm4_sat.toml`, `esm_sat.toml`): computed in the table's passes.
+    BenchCase {
+        name: "chain evsm4 sat (depth → table)",
+        build: |n| chain_graph(n, exp_sat("evsm4"), &["light0.evsm.sat"]),
+    },
+    BenchCase {
+        name: "chain esm sat (depth → table)",
+        build: |n| chain_graph(n, exp_sat("esm"), &["light0.esm.sat"]),
+    },
     BenchCase {
         name: "chain cssm 8 terms (depth → 5 tables)",
         build: csm_chain::layered,
@@ -306,6 +316,27 @@ fn vsm_f16() -> Technique {
 
 fn evsm4() -> Technique {
     named("evsm4", &BLUR4)
+}
+
+/// `evsm4` (c⁺ = c⁻ = 6, what its table keeps accurate for a 4-texel box) or `esm` (c = 20)
+/// through a fixed-point summed-area table, as the scenes `evsm4_sat` and `esm_sat`.
+fn exp_sat(name: &str) -> Technique {
+    let sat = [
+        ("filter", ParamValue::Choice("sat")),
+        ("filter_width", ParamValue::Float(4.0)),
+    ];
+    if name == "esm" {
+        named(
+            name,
+            &[sat[0], sat[1], ("exponent", ParamValue::Float(20.0))],
+        )
+    } else {
+        let c = ParamValue::Float(6.0);
+        named(
+            name,
+            &[sat[0], sat[1], ("exponent_pos", c), ("exponent_neg", c)],
+        )
+    }
 }
 
 fn msm(storage: Storage) -> Technique {

@@ -1,12 +1,13 @@
-//! CSM, CSSM, MSM and VSM through summed-area tables, the representation never stored: the
+//! CSM, CSSM and the moment techniques through summed-area tables, the representation never stored: the
 //! layered tables of [`crate::sat::layers`] whose tile kernels (`kernels/csm_sat_tile_sums.wgsl`,
 //! `kernels/csm_sat_tiles.wgsl` and their f32 variants) compute each map from the depth on the
-//! fly, one layer a map of the light's sequence (`kernels/shared/csm_maps.wgsl`); MSM's and
-//! VSM's moments likewise, one layer by their own kernels (`kernels/msm_sat_*.wgsl`,
-//! `kernels/vsm_sat_*.wgsl`).
+//! fly, one layer a map of the light's sequence (`kernels/shared/csm_maps.wgsl`); the moments
+//! of MSM, VSM, EVSM and ESM likewise, one layer by their own kernels (`kernels/msm_sat_*.wgsl`,
+//! `vsm_sat_*`, `evsm_sat_*`, `esm_sat_*`).
 
 use super::csm::basis_sequence;
 use super::nodes::{LightNodes, float_moments_format, moments_format};
+use super::shade::ShadeInput;
 use crate::gpu_data::LinearizeParams;
 use crate::graph::{Graph, SizeRule};
 use crate::kernels::KernelId;
@@ -35,8 +36,10 @@ pub struct CsmSatParams {
     pub moments: u32,
     /// 1: each value rounded to 16-bit unorm, as unorm16 storage of the map would hold it.
     pub unorm16: u32,
-    /// Padding to 16 bytes.
-    pub _pad: [u32; 2],
+    /// EVSM's c⁺, ESM's c (a layer of moments, [`add_moment_table`]).
+    pub exp_pos: f32,
+    /// EVSM's c⁻.
+    pub exp_neg: f32,
 }
 
 /// What the layered tables of one light's basis hold ([`add_csm_tables`]).
@@ -94,7 +97,8 @@ pub fn add_csm_tables(
         f16: u32::from(b.storage == Storage::F16),
         moments: u32::from(b.search == Some(CssmSearch::Moments)),
         unorm16: 0,
-        _pad: [0; 2],
+        exp_pos: 0.0,
+        exp_neg: 0.0,
     };
     let kernels = match coding.variant {
         SatVariant::Fixed => [KernelId::CsmSatTileSums, KernelId::CsmSatTiles],
@@ -105,13 +109,12 @@ pub fn add_csm_tables(
     )
 }
 
-/// Adds the summed-area table of light `light`'s moments `m.moments` (MSM's quantized, as a
-/// table's always are: `technique::msm_quantized`; or VSM's, each from its depth and its four
-/// neighbours' as `vsm` computes them), rounded as `m.storage` would hold them, coded as
-/// `coding`, computed from the depth `depth` in the table's own tile passes: one layer of
-/// [`add_layered_sat`], 3 dispatches, the depth read twice and the moments never stored. The
-/// map `light{light}.msm` (`.vsm`) is declared in its storage's format but never planned.
-/// Returns `light{light}.msm.sat` (`.vsm.sat`).
+/// Adds the summed-area table of light `light`'s moments `m.moments` ([`Moments`]: what the
+/// encoding kernel of the technique would store), rounded as `m.storage` would hold them,
+/// coded as `coding`, computed from the depth `depth` in the table's own tile passes: one layer
+/// of [`add_layered_sat`], 3 dispatches, the depth read twice and the moments never stored.
+/// The map `light{light}.<stem>` (`msm`, `vsm`, `evsm`, `esm`) is declared in its storage's
+/// format but never planned. Returns `light{light}.<stem>.sat`.
 pub fn add_moment_table(
     graph: &mut Graph,
     light: usize,
@@ -126,6 +129,8 @@ pub fn add_moment_table(
     let (stem, channels) = match m.moments {
         Moments::Msm => ("msm", 4),
         Moments::Vsm => ("vsm", 2),
+        Moments::Evsm { four } => ("evsm", if four { 4 } else { 2 }),
+        Moments::Esm => ("esm", 1),
     };
     let format = moments_format(m.storage, channels);
     let map = graph.resource(format!("light{light}.{stem}"), format, size, Some(light));
@@ -138,7 +143,8 @@ pub fn add_moment_table(
         f16: u32::from(m.storage == Storage::F16),
         moments: 0,
         unorm16: u32::from(m.storage == Storage::Unorm16),
-        _pad: [0; 2],
+        exp_pos: m.exp[0],
+        exp_neg: m.exp[1],
     };
     let kernels = match (m.moments, coding.variant) {
         (Moments::Msm, SatVariant::Fixed) => [KernelId::MsmSatTileSums, KernelId::MsmSatTiles],
@@ -148,6 +154,16 @@ pub fn add_moment_table(
         (Moments::Vsm, SatVariant::Fixed) => [KernelId::VsmSatTileSums, KernelId::VsmSatTiles],
         (Moments::Vsm, SatVariant::Float) => {
             [KernelId::VsmSatTileSumsF32, KernelId::VsmSatTilesF32]
+        }
+        (Moments::Evsm { .. }, SatVariant::Fixed) => {
+            [KernelId::EvsmSatTileSums, KernelId::EvsmSatTiles]
+        }
+        (Moments::Evsm { .. }, SatVariant::Float) => {
+            [KernelId::EvsmSatTileSumsF32, KernelId::EvsmSatTilesF32]
+        }
+        (Moments::Esm, SatVariant::Fixed) => [KernelId::EsmSatTileSums, KernelId::EsmSatTiles],
+        (Moments::Esm, SatVariant::Float) => {
+            [KernelId::EsmSatTileSumsF32, KernelId::EsmSatTilesF32]
         }
     };
     let tables = depth_tables(
@@ -170,13 +186,23 @@ pub enum Moments {
     Msm,
     /// VSM's two, (z, z² + ¼ (∂z/∂x² + ∂z/∂y²)).
     Vsm,
+    /// EVSM's four, (exp(c⁺z'), its square, −exp(−c⁻z'), its square) with z' = 2z − 1, or the
+    /// first two.
+    Evsm {
+        /// All four (`evsm4`), else the first two.
+        four: bool,
+    },
+    /// ESM's one, exp(c (z − 1)) (the linear moment a table sums).
+    Esm,
 }
 
 /// What [`add_moment_table`] sums.
 #[derive(Clone, Copy, Debug)]
 pub struct MomentTable {
-    /// MSM's or VSM's moments.
+    /// Which moments.
     pub moments: Moments,
+    /// EVSM's (c⁺, c⁻), ESM's (c, unused); unused otherwise.
+    pub exp: [f32; 2],
     /// The moments' storage: f16 and unorm16 round every value as such a map would.
     pub storage: Storage,
     /// The depth buffer's linearization.
@@ -234,4 +260,27 @@ pub(super) fn csm_sat_nodes(
     };
     let depth = n.depth.clone();
     add_csm_tables(n.graph, n.i, &depth, &b, coding)
+}
+
+/// The light of `n` through a summed-area table (`filter = "sat"` or a soft technique; its
+/// coding errors `render::plan_lights` reports first): its table of `moments` (exponents `exp`,
+/// storage `storage`) computed from its depth ([`add_moment_table`]); `None` without a table.
+pub(super) fn moment_table_nodes(
+    n: &mut LightNodes,
+    moments: Moments,
+    exp: [f32; 2],
+    storage: Storage,
+) -> Option<ShadeInput> {
+    let Ok(Some(coding)) = super::light_gpu::sat_coding(n.light) else {
+        return None;
+    };
+    let m = MomentTable {
+        moments,
+        exp,
+        storage,
+        depth: n.lin,
+    };
+    let depth = n.depth.clone();
+    let table = add_moment_table(n.graph, n.i, &depth, &m, coding);
+    Some(n.one(table))
 }

@@ -2,6 +2,7 @@
 //! (f16 `c·z` would cost percent-level visibility error).
 
 use super::TechniqueDef;
+use super::csm_sat::{Moments, moment_table_nodes};
 use super::no_variant;
 use super::params::{
     Clamp, ClampReason, FILTER, clamp, filter, filter_values, float, sat_exponent_limit,
@@ -12,7 +13,7 @@ use crate::filter::BlurMode;
 use crate::gpu_data::ExpParams;
 use crate::gpu_data::TECHNIQUE_ESM;
 use crate::kernels::KernelId;
-use crate::model::{ParamSpec, ParamValue, ParamValues, Technique};
+use crate::model::{ParamSpec, ParamValue, ParamValues, Storage, Technique};
 
 const PARAMS: &[ParamSpec] = &[float(
     "exponent",
@@ -45,6 +46,11 @@ fn nodes(n: &mut super::LightNodes) -> ShadeInput {
     let Technique::Esm { filter, exponent } = n.light.shadow.technique else {
         return n.one(n.depth.clone());
     };
+    // Through a summed-area table the moment exp(c (z − 1)) is computed in the table's own
+    // tile passes, never stored.
+    if let Some(table) = moment_table_nodes(n, Moments::Esm, [exponent, 0.0], Storage::F32) {
+        return table;
+    }
     let mut params = ExpParams::new(exponent, 0.0);
     params.depth = n.lin;
     params.linear = u32::from(matches!(filter, crate::model::Filter::Sat { .. }));

@@ -2,6 +2,7 @@
 //! then `exp(c⁺ z')` and its square, plus (EVSM4) `−exp(−c⁻ z')` and its square.
 
 use super::TechniqueDef;
+use super::csm_sat::{Moments, moment_table_nodes};
 use super::no_variant;
 use super::nodes::moments_format;
 use super::params::{
@@ -135,6 +136,12 @@ fn nodes(n: &mut super::LightNodes) -> ShadeInput {
     else {
         return n.one(n.depth.clone());
     };
+    // Through a summed-area table the moments are computed in the table's own tile passes,
+    // never stored.
+    let moments = Moments::Evsm { four };
+    if let Some(table) = moment_table_nodes(n, moments, [exp_pos, exp_neg], prefilter.storage) {
+        return table;
+    }
     let format = moments_format(prefilter.storage, if four { 4 } else { 2 });
     let params = ExpParams {
         depth: n.lin,

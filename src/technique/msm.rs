@@ -1,7 +1,7 @@
 //! `msm`: moment shadow maps (Peters & Klein 2015), (z, z², z³, z⁴) raw in f32 or through the
 //! optimized 16-bit quantization; Hamburger or Hausdorff reconstruction.
 
-use super::csm_sat::{MomentTable, Moments, add_moment_table};
+use super::csm_sat::{Moments, moment_table_nodes};
 use super::light_gpu::quantized_msm_range;
 use super::nodes::{LightNodes, moments_format};
 use super::params::{FILTER, MSM, MSM_FORMAT, prefilter, prefilter_values, storage};
@@ -70,15 +70,8 @@ pub(super) fn moments(n: &mut LightNodes) -> ShadeInput {
     };
     // Through a summed-area table (`filter = "sat"`, `msm_soft`) the moments are computed in
     // the table's own tile passes, never stored.
-    if let Ok(Some(coding)) = super::light_gpu::sat_coding(n.light) {
-        let m = MomentTable {
-            moments: Moments::Msm,
-            storage,
-            depth: n.lin,
-        };
-        let depth = n.depth.clone();
-        let table = add_moment_table(n.graph, n.i, &depth, &m, coding);
-        return n.one(table);
+    if let Some(table) = moment_table_nodes(n, Moments::Msm, [0.0; 2], storage) {
+        return table;
     }
     let params = MsmParams {
         depth: n.lin,

@@ -1,6 +1,6 @@
 //! `vsm`: variance shadow maps (Donnelly & Lauritzen 2006), moments (z, z²), filtered.
 
-use super::csm_sat::{MomentTable, Moments, add_moment_table};
+use super::csm_sat::{Moments, moment_table_nodes};
 use super::nodes::{LightNodes, moments_format};
 use super::params::{FILTER, FLOAT_FORMAT, float, prefilter, prefilter_values};
 use super::shade::{ShadeInput, prefiltered};
@@ -61,17 +61,10 @@ pub(super) fn variance_gpu(bleed: f32, min_variance: f32, g: &mut LightGpu) {
 
 /// The moments (z, z²) at `storage` precision, filtered (`vsm`, `vssm`); through a summed-area
 /// table (`filter = "sat"`, `vssm`) computed in the table's own tile passes from the depth,
-/// never stored ([`add_moment_table`]).
+/// never stored ([`super::add_moment_table`]).
 pub(super) fn moments(n: &mut LightNodes, storage: Storage) -> ShadeInput {
-    if let Ok(Some(coding)) = super::light_gpu::sat_coding(n.light) {
-        let m = MomentTable {
-            moments: Moments::Vsm,
-            storage,
-            depth: n.lin,
-        };
-        let depth = n.depth.clone();
-        let table = add_moment_table(n.graph, n.i, &depth, &m, coding);
-        return n.one(table);
+    if let Some(table) = moment_table_nodes(n, Moments::Vsm, [0.0; 2], storage) {
+        return table;
     }
     let params = VsmParams { depth: n.lin };
     let format = moments_format(storage, 2);
