@@ -73,10 +73,10 @@ fn sat_tile_prepare(
     } else {
         sh_carry[li] = textureLoad(col_carry, vec2<u32>(q.x, s.band.y + tile.y), 0);
     }
-    // A literal condition: only the VSM source's kernels compile it. Both sweeps of the pass
-    // read the block.
-    if s.from_depth && s.kind == SAT_VSM {
-        sat_vsm_fill(origin, size, s);
+    // A literal condition: only the VSM and ESM sources' kernels compile it. Both sweeps of
+    // the pass read the block.
+    if sat_blocked(s) {
+        sat_block_fill(origin, size, s);
     }
     var col: array<vec4<u32>, SUB>;
     for (var j = 0u; j < SUB; j++) {

@@ -29,9 +29,9 @@ fn sat_tile_edges(
     let b = li / GRID;
     let size = textureDimensions(src);
     let origin = sat_sub_origin(tile, li);
-    // A literal condition: only the VSM source's kernels compile it.
-    if s.from_depth && s.kind == SAT_VSM {
-        sat_vsm_fill(origin, size, s);
+    // A literal condition: only the VSM and ESM sources' kernels compile it.
+    if sat_blocked(s) {
+        sat_block_fill(origin, size, s);
     }
     // Row sums prefixed down the sub-block (its table's last column), and column sums, then
     // prefixed along it (its last row).

@@ -15,17 +15,33 @@
 // tile pass counts layer 0's).
 var<private> sat_non_finite: u32;
 
-// VSM's moments of the sub-block a pass sweeps (SUB × SUB, row-major), filled by
-// `sat_vsm_fill` before its sweeps and read by `sat_texel`.
-var<private> sat_vsm_block: array<vec2<f32>, 16>; // SUB · SUB
+// The moments of the sub-block a pass sweeps (SUB × SUB, row-major) for the sources that
+// `sat_blocked` names, filled by `sat_block_fill` before its sweeps and read by `sat_texel`.
+var<private> sat_block: array<vec2<f32>, 16>; // SUB · SUB
 
-// VSM's moments of the sub-block at `origin` as `vsm` computes them (shared/vsm_moments):
-// each texel's derivatives take its four neighbours' depths, clamped to the map. The linear
+// Whether `s` (literal fields) is computed a sub-block at a time: VSM, whose texels share
+// their neighbours' depth, and ESM, whose exp pass 3's two sweeps then share. One- and
+// two-channel sources only (a four-channel block would hold 64 values an invocation).
+fn sat_blocked(s: SatSource) -> bool {
+    return s.from_depth && (s.kind == SAT_VSM || s.kind == SAT_ESM);
+}
+
+// The sub-block at `origin`'s moments. VSM's as `vsm` computes them (shared/vsm_moments):
+// each texel's derivatives take its four neighbours' depths, clamped to the map; the linear
 // depth of the sub-block and its one-texel border is read once, (SUB + 2)² loads, where each
 // texel's own five would be 5·SUB² (80 against 36 at SUB = 4; on llvmpipe the table built with
 // them per texel ran 1.1× slower than the stored map's, `benches/RESULTS.md`, 2026-11-27).
-// Texels past the map's edge (ragged tiles) get values that `sat_texel` discards.
-fn sat_vsm_fill(origin: vec2<u32>, size: vec2<u32>, s: SatSource) {
+// ESM's exp(c (z − 1)), one exp a texel a pass instead of one a sweep. Texels past the map's
+// edge (ragged tiles) get values that `sat_texel` discards.
+fn sat_block_fill(origin: vec2<u32>, size: vec2<u32>, s: SatSource) {
+    if s.kind == SAT_ESM {
+        for (var k = 0u; k < SUB * SUB; k++) {
+            let at = vec2<i32>(origin) + vec2<i32>(i32(k % SUB), i32(k / SUB));
+            let z = sat_depth_at(at, size, s.depth);
+            sat_block[k] = vec2<f32>(exp(s.exp_pos * (z - 1.0)), 0.0);
+        }
+        return;
+    }
     const BORDERED: u32 = SUB + 2u;
     var z: array<f32, 36>; // BORDERED²
     for (var k = 0u; k < BORDERED * BORDERED; k++) {
@@ -34,7 +50,7 @@ fn sat_vsm_fill(origin: vec2<u32>, size: vec2<u32>, s: SatSource) {
     }
     for (var k = 0u; k < SUB * SUB; k++) {
         let c = (k / SUB + 1u) * BORDERED + k % SUB + 1u;
-        sat_vsm_block[k] = vsm_moments(z[c], z[c - 1u], z[c + 1u], z[c - BORDERED], z[c + BORDERED]);
+        sat_block[k] = vsm_moments(z[c], z[c - 1u], z[c + 1u], z[c - BORDERED], z[c + BORDERED]);
     }
 }
 
@@ -70,15 +86,13 @@ fn sat_texel(
             // are).
             let z2 = z * z;
             v = msm_quantize(vec4<f32>(z, z2, z2 * z, z2 * z2));
-        } else if s.kind == SAT_VSM {
-            // VSM's moments of the invocation's sub-block, computed once a pass
-            // (`sat_vsm_fill`; sub-blocks start at multiples of SUB).
-            v = vec4<f32>(sat_vsm_block[q.y % SUB * SUB + q.x % SUB], 0.0, 0.0);
+        } else if sat_blocked(s) {
+            // VSM's moments or ESM's exp(c (z − 1)) (`esm`'s moment for a summed-area table)
+            // of the invocation's sub-block, computed once a pass (`sat_block_fill`;
+            // sub-blocks start at multiples of SUB).
+            v = vec4<f32>(sat_block[q.y % SUB * SUB + q.x % SUB], 0.0, 0.0);
         } else if s.kind == SAT_EVSM {
             v = evsm_moments(z, s.exp_pos, s.exp_neg);
-        } else if s.kind == SAT_ESM {
-            // `esm`'s moment for a summed-area table (`params.linear`).
-            v = vec4<f32>(exp(s.exp_pos * (z - 1.0)), 0.0, 0.0, 0.0);
         } else {
             v = csm_basis_map(s.layer, s.terms, s.moments, z);
         }
