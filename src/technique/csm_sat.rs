@@ -1,9 +1,9 @@
-//! CSM, CSSM and the moment techniques through summed-area tables, the representation never stored: the
-//! layered tables of [`crate::sat::layers`] whose tile kernels (`kernels/csm_sat_tile_sums.wgsl`,
-//! `kernels/csm_sat_tiles.wgsl` and their f32 variants) compute each map from the depth on the
-//! fly, one layer a map of the light's sequence (`kernels/shared/csm_maps.wgsl`); the moments
-//! of MSM, VSM, EVSM and ESM likewise, one layer by their own kernels (`kernels/msm_sat_*.wgsl`,
-//! `vsm_sat_*`, `evsm_sat_*`, `esm_sat_*`).
+//! CSM, CSSM and the moment techniques through summed-area tables, the representation never
+//! stored: the layered tables of [`crate::sat::layers`] whose tile kernels
+//! (`kernels/csm_sat_tile_sums.wgsl`, `kernels/csm_sat_tiles.wgsl` and their f32 variants)
+//! compute each map from the depth on the fly, one layer a map of the light's sequence
+//! (`kernels/shared/csm_maps.wgsl`); the moments of MSM, VSM, EVSM and ESM likewise, one layer
+//! by their own kernels (`kernels/msm_sat_*.wgsl`, `vsm_sat_*`, `evsm_sat_*`, `esm_sat_*`).
 
 use super::csm::basis_sequence;
 use super::nodes::{LightNodes, float_moments_format, moments_format};
