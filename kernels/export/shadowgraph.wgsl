@@ -78,11 +78,11 @@
 //   sg_point_coords sg_point_face sg_point_sample sg_sample_bilinear sg_sample_bilinear_log
 //   sg_sample_map sg_sample_map_log sg_sample_map_packed sg_sat_box sg_sat_box_fixed
 //   sg_sat_box_float sg_sat_clamp sg_sat_corner_linear sg_sat_filter_fixed sg_sat_filter_float
-//   sg_sat_grid sg_sat_mean_fixed sg_sat_mean_float sg_sat_mean_linear sg_sat_nearest
-//   sg_sat_node_f32 sg_sat_node_u32 sg_sat_nodes sg_sat_rect sg_sat_sample_fixed
+//   sg_sat_filter_window sg_sat_grid sg_sat_mean_fixed sg_sat_mean_float sg_sat_mean_linear
+//   sg_sat_nearest sg_sat_node_f32 sg_sat_node_u32 sg_sat_nodes sg_sat_rect sg_sat_sample_fixed
 //   sg_sat_sample_float sg_sat_search_fixed sg_sat_search_float sg_sat_span_weights
-//   sg_smrt_emitter_point sg_smrt_ray sg_soft_blockers sg_soft_filter_trips sg_texel_of
-//   sg_trilinear sg_trilinear_log sg_trilinear_packed sg_unpack_f16x2 sg_vis_esm
+//   sg_sat_window_fixed sg_smrt_emitter_point sg_smrt_ray sg_soft_blockers sg_soft_filter_trips
+//   sg_texel_of sg_trilinear sg_trilinear_log sg_trilinear_packed sg_unpack_f16x2 sg_vis_esm
 //   sg_vis_esm_of_log sg_vis_esm_of_sat sg_vis_evsm sg_vis_evsm_of sg_vis_hard sg_vis_msm
 //   sg_vis_msm_of sg_vis_msm_soft_fixed sg_vis_msm_soft_float sg_vis_pcf sg_vis_pcf_hardware
 //   sg_vis_pcss sg_vis_smrt sg_vis_vsm sg_vis_vsm_of sg_vis_vssm_fixed sg_vis_vssm_float
@@ -935,7 +935,14 @@ fn sg_sat_mean_float(sat: texture_2d<f32>, rect: vec4<f32>, offset: vec4<f32>, s
 // where a square up to one texel wider per side reads as well as the exact one.
 // #fetches sg_sat_box_fixed: 4
 fn sg_sat_box_fixed(sat: texture_2d<u32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
-    let b = sg_sat_box(rect, textureDimensions(sat));
+    return sg_sat_window_fixed(sat, sg_sat_box(rect, textureDimensions(sat)), offset, scale);
+}
+
+// The mean over the integer window b (x0, y0, x1, y1; `sat_box`'s) of a fixed-point table, four
+// loads. Several tables of one size read over one square share the window's computation
+// (CSSM's filter lookups).
+// #fetches sg_sat_window_fixed: 4
+fn sg_sat_window_fixed(sat: texture_2d<u32>, b: vec4<i32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
     let window = sg_sat_node_u32(sat, b.z, b.w) - sg_sat_node_u32(sat, b.x, b.w)
         - sg_sat_node_u32(sat, b.z, b.y) + sg_sat_node_u32(sat, b.x, b.y);
     let area = f32((b.z - b.x) * (b.w - b.y));
@@ -1038,6 +1045,12 @@ fn sg_sat_nearest(r: vec4<f32>) -> vec4<f32> {
 // #fetches sg_sat_filter_fixed: 4
 fn sg_sat_filter_fixed(map: texture_2d<u32>, l: sg_Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
     return sg_sat_box_fixed(map, sg_sat_nearest(sg_sat_rect(l, uv, width)), l.sat_offset, l.sat_scale);
+}
+
+// `sat_filter_fixed`'s integer window over tables of `size`, for several tables of one size
+// read over one square (`sat_window_fixed` each): CSSM's five.
+fn sg_sat_filter_window(l: sg_Light, uv: vec2<f32>, width: f32, size: vec2<u32>) -> vec4<i32> {
+    return sg_sat_box(sg_sat_nearest(sg_sat_rect(l, uv, width)), size);
 }
 
 // From an f32 table the soft filter needs no rounding: four filtered fetches give the mean

@@ -158,7 +158,14 @@ fn sat_mean_float(sat: texture_2d<f32>, rect: vec4<f32>, offset: vec4<f32>, scal
 // where a square up to one texel wider per side reads as well as the exact one.
 // #fetches sat_box_fixed: 4
 fn sat_box_fixed(sat: texture_2d<u32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
-    let b = sat_box(rect, textureDimensions(sat));
+    return sat_window_fixed(sat, sat_box(rect, textureDimensions(sat)), offset, scale);
+}
+
+// The mean over the integer window b (x0, y0, x1, y1; `sat_box`'s) of a fixed-point table, four
+// loads. Several tables of one size read over one square share the window's computation
+// (CSSM's filter lookups).
+// #fetches sat_window_fixed: 4
+fn sat_window_fixed(sat: texture_2d<u32>, b: vec4<i32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
     let window = sat_node_u32(sat, b.z, b.w) - sat_node_u32(sat, b.x, b.w)
         - sat_node_u32(sat, b.z, b.y) + sat_node_u32(sat, b.x, b.y);
     let area = f32((b.z - b.x) * (b.w - b.y));

@@ -46,6 +46,12 @@ fn sat_filter_fixed(map: texture_2d<u32>, l: Light, uv: vec2<f32>, width: f32) -
     return sat_box_fixed(map, sat_nearest(sat_rect(l, uv, width)), l.sat_offset, l.sat_scale);
 }
 
+// `sat_filter_fixed`'s integer window over tables of `size`, for several tables of one size
+// read over one square (`sat_window_fixed` each): CSSM's five.
+fn sat_filter_window(l: Light, uv: vec2<f32>, width: f32, size: vec2<u32>) -> vec4<i32> {
+    return sat_box(sat_nearest(sat_rect(l, uv, width)), size);
+}
+
 // From an f32 table the soft filter needs no rounding: four filtered fetches give the mean
 // over the square itself, its edges on the 2⁻⁸-texel grid (`sat_mean_linear`; `smp` filters
 // linearly). Each corner is rounded relative to its sum, which the penumbra's wide squares

@@ -19,7 +19,7 @@ use std::fmt::Write;
 use super::csm::{csm_gpu, csm_maps, csm_nodes};
 use super::nodes::map_type;
 use super::shade::{ShadeInput, VisibilityBody, table_args, table_suffix};
-use crate::model::Light;
+use crate::model::{Light, SatVariant};
 
 const SHARPEN: &[ParamSpec] = &[
     float(
@@ -96,11 +96,23 @@ fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
     let suffix = table_suffix(soft.sums);
     let (basis, z) = maps.split_at((csm_maps(terms) as usize).min(maps.len()));
     let search = |m: &str| format!("sat_search_{suffix}({m}, l, s.uv, width)");
+    // Fixed-point tables, all of the map's size, share the filter square's integer window
+    // (`fwin`, computed once in the loop); f32 tables take their fractional corners each.
+    let fixed = soft.sums == SatVariant::Fixed;
+    let filter_fn = if fixed {
+        "sat_window_fixed".to_string()
+    } else {
+        format!("sat_filter_{suffix}")
+    };
     let sample = |m: &str| {
-        format!(
-            "sat_filter_{suffix}({}, l, s.uv, look.width)",
-            table_args(soft.sums, m)
-        )
+        if fixed {
+            format!("sat_window_fixed({m}, fwin, l.sat_offset, l.sat_scale)")
+        } else {
+            format!(
+                "sat_filter_{suffix}({}, l, s.uv, look.width)",
+                table_args(soft.sums, m)
+            )
+        }
     };
     // The search reads its tables over the square snapped outward to texel edges (4 loads
     // each); the filter reads the basis tables over the penumbra square with its edges
@@ -150,6 +162,12 @@ fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
          for (var k = 0u; k < soft_filter_trips(look); k++) {\n        \
          var terms = csm_terms_start(s.depth - l.bias - l.csm_offset, l);",
     );
+    if let (true, Some(first)) = (fixed, basis.first()) {
+        let _ = write!(
+            body,
+            "\n        let fwin = sat_filter_window(l, s.uv, look.width, textureDimensions({first}));"
+        );
+    }
     for m in basis {
         let _ = write!(
             body,
@@ -169,7 +187,7 @@ fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
          return cssm_resolve(sum, look, z_b, l, s);",
     );
     let fetches = format!(
-        "{searched} * sat_search_{suffix} + {} * sat_filter_{suffix}",
+        "{searched} * sat_search_{suffix} + {} * {filter_fn}",
         basis.len() + usize::from(refine.is_some())
     );
     VisibilityBody {
