@@ -1,31 +1,14 @@
-// VSM's moments summed into a table computed from the depth, pass 1 of 3, fixed-point variant
-// (src/sat/layers.rs, technique::add_moment_table: one layer, two channels): each workgroup
-// computes its tile of VSM's moments from the depth and its four neighbours on the fly
-// (`moment_sat_source`, shared/sat_tile), rounded as the map's storage would hold them, and
-// writes the edges of its tile's own table, as `sat_tile_sums` does for a stored map: the
-// `vsm` dispatch and its map's write and two reads are gone. Counts the non-finite depth
-// texels.
-// #import shared/sat_tile_sums
-// #import shared/csm_sat_params
+// VSM's moments (each texel's derivatives from its four neighbours' depth, a 4 × 4 sub-block at a
+// time: `sat_block_fill`) summed into a table computed from the depth, pass 1 of 3, fixed-point
+// variant (shared/moment_sat_sums).
+// #import shared/moment_sat_sums
 // Traffic (the cost model, src/graph/cost): each workgroup loads its tile of the depth and a
-// one-texel cross-shaped halo for the derivatives, as `vsm` (clamped at the map's edge) and writes its edges.
+// one-texel cross-shaped halo for the derivatives, as `vsm` (clamped at the map's edge) and
+// writes its edges.
 // #traffic src: TILE * TILE + 4 * TILE per group
 // #traffic col_part: all
 // #traffic row_part: all
 // #traffic stats: none
 
-@group(0) @binding(0) var src: texture_2d<f32>;
-@group(0) @binding(1) var col_part: texture_storage_2d<rgba32uint, write>;
-@group(0) @binding(2) var row_part: texture_storage_2d<rgba32uint, write>;
-@group(0) @binding(3) var<uniform> params: CsmSatParams;
-@group(0) @binding(4) var<storage, read_write> stats: array<atomic<u32>>;
-
+const SAT_KIND: u32 = SAT_VSM;
 const FLOAT_SUMS: bool = false;
-
-@compute @workgroup_size(WG_SIZE)
-fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    sat_tile_sums_pass(params.sat, FLOAT_SUMS, moment_sat_source(params, SAT_VSM), wg.xy, li);
-    if sat_non_finite > 0u {
-        atomicAdd(&stats[0], sat_non_finite);
-    }
-}
