@@ -75,14 +75,16 @@ impl Plan {
             return bad(format!("uses `{r}`, which is not in the plan"));
         }
         let mut dispatch = &n.dispatch;
-        while let Dispatch::Layers { base, layers } = dispatch {
+        while let Dispatch::Layers { base, layers } | Dispatch::Interleaved { base, layers } =
+            dispatch
+        {
             if *layers == 0 || matches!(**base, Dispatch::Several(_)) {
                 return bad("dispatches 0 layers, or several dispatches a layer".into());
             }
             dispatch = base;
         }
         let of = match dispatch {
-            Dispatch::Layers { .. } => None,
+            Dispatch::Layers { .. } | Dispatch::Interleaved { .. } => None,
             Dispatch::Texels(r) => Some(r),
             Dispatch::Blocks { of, .. } => Some(of),
             Dispatch::Lines { per_group: 0, .. } => {

@@ -69,6 +69,10 @@ pub struct Resource {
     pub imported: bool,
     /// The light this resource belongs to, if any.
     pub light: Option<usize>,
+    /// The tables interleaved along x in this texture ([`Graph::interleaved`]): texel
+    /// `(x·n + k, y)` is texel `(x, y)` of `layers[k]` (n = `layers.len()`). Empty for a
+    /// plain resource.
+    pub layers: Vec<String>,
 }
 
 /// How many workgroups a node dispatches.
@@ -105,6 +109,17 @@ pub enum Dispatch {
         /// The dispatch of one layer (not [`Dispatch::Several`]).
         base: Box<Dispatch>,
         /// Workgroups along z.
+        layers: u32,
+    },
+    /// `base`'s workgroups with `layers` of them side by side along x for each:
+    /// `[x·layers, y, 1]`, workgroup `X·layers + k` on layer k of `base`'s workgroup X. The
+    /// layers of one block run one after another, so that tables interleaved in one texture
+    /// ([`Graph::interleaved`]) have each cache line written within a short time
+    /// ([`crate::sat::layers`]).
+    Interleaved {
+        /// The dispatch of one layer (not [`Dispatch::Several`]).
+        base: Box<Dispatch>,
+        /// Workgroups side by side along x.
         layers: u32,
     },
     /// Several dispatches in the node's one compute pass, each with its own parameters, its
@@ -176,6 +191,10 @@ impl Dispatch {
                 let [x, y, _] = base.groups(size, workgroup)?;
                 [x, y, *layers]
             }
+            Self::Interleaved { base, layers } => {
+                let [x, y, _] = base.groups(size, workgroup)?;
+                [x.checked_mul(*layers)?, y, 1]
+            }
             Self::Several(_) => return None,
         })
     }
@@ -227,7 +246,35 @@ impl Graph {
             mips: 1,
             imported: false,
             light,
+            layers: Vec::new(),
         });
+        name
+    }
+
+    /// Declares a texture holding the maps `layers` (each the size of `of`) interleaved along
+    /// x: texel `(x, y)` of `layers[k]` at `(x·n + k, y)`, n = `layers.len()`, so that one
+    /// texel of every layer sits in one run of memory (a lookup reading the same texel of
+    /// several tables touches one cache line, not one a table). The layers are names, not
+    /// resources: readbacks split the texture into them ([`Resource::layers`]).
+    pub fn interleaved(
+        &mut self,
+        name: impl Into<String>,
+        format: wgpu::TextureFormat,
+        of: &str,
+        layers: Vec<String>,
+        light: Option<usize>,
+    ) -> String {
+        let size = SizeRule::Stacked {
+            of: of.to_string(),
+            x: 1,
+            y: 1,
+            across: layers.len() as u32,
+            down: 1,
+        };
+        let name = self.resource(name, format, size, light);
+        if let Some(r) = self.resources.last_mut() {
+            r.layers = layers;
+        }
         name
     }
 
@@ -263,6 +310,7 @@ impl Graph {
             mips: 1,
             imported: true,
             light,
+            layers: Vec::new(),
         });
         name
     }
@@ -276,6 +324,14 @@ impl Graph {
     pub fn find(&self, name: &str) -> Option<&Resource> {
         self.resources.iter().find(|r| r.name == name)
     }
+}
+
+/// Layer `k` of `layers` interleaved along x ([`Graph::interleaved`]) from a texture's values
+/// read back row-major, `per_texel` values a texel: that layer's values, row-major.
+pub fn layer_of<T: Copy>(data: &[T], per_texel: usize, layers: usize, k: usize) -> Vec<T> {
+    data.chunks_exact(per_texel * layers)
+        .flat_map(|group| group[k * per_texel..(k + 1) * per_texel].iter().copied())
+        .collect()
 }
 
 pub use crate::error::GraphError;
