@@ -290,32 +290,41 @@ impl FloatMap {
     }
 }
 
-/// Reads summed-area table `name` back as the per-texel representation it sums
-/// ([`crate::sat::decode_table`]), `channels` of them (the table's input's).
+/// Reads the summed-area tables of texture `name` back as the per-texel representations they
+/// sum ([`crate::sat::decode_table`]), side by side: `tables` lists the channels of each (the
+/// table's input's), one entry for a table of its own, several for tables interleaved along x
+/// ([`crate::graph::Graph::interleaved`], in slot order).
 pub fn read_sat_map(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     name: &str,
     texture: &wgpu::Texture,
     coding: &crate::sat::SatCoding,
-    channels: usize,
+    tables: &[usize],
 ) -> Result<FloatMap> {
     let raw = crate::gpu::read_texture(device, queue, texture, 0)?;
-    let (width, height) = (texture.width(), texture.height());
-    let data = crate::sat::decode_table(
-        bytemuck::cast_slice(&raw),
-        width as usize,
-        height as usize,
-        coding,
-        channels,
-    );
-    Ok(FloatMap {
-        resource: name.to_string(),
-        width,
-        height,
-        channels,
-        data,
-    })
+    let words: &[u32] = bytemuck::cast_slice(&raw);
+    let n = tables.len().max(1);
+    let (width, height) = (texture.width() / n as u32, texture.height());
+    let per_texel = words.len() / (texture.width() as usize * height as usize).max(1);
+    let maps = tables
+        .iter()
+        .enumerate()
+        .map(|(k, &channels)| FloatMap {
+            resource: name.to_string(),
+            width,
+            height,
+            channels,
+            data: crate::sat::decode_table(
+                &crate::graph::layer_of(words, per_texel, n, k),
+                width as usize,
+                height as usize,
+                coding,
+                channels,
+            ),
+        })
+        .collect();
+    FloatMap::concat(maps)
 }
 
 /// Adds to `frame` what `opts` asks for besides the image: every resource of the plan
@@ -346,13 +355,13 @@ fn read_extras(
     };
     for (i, input) in sp.shade_inputs.iter().enumerate() {
         let coding = technique::sat_coding(&drawn.lights[i])?;
-        let channels = technique::map_channels(&drawn.lights[i]);
+        let tables = technique::map_tables(&drawn.lights[i]);
         let maps = input
             .maps
             .iter()
-            .zip(channels)
+            .zip(tables)
             .map(|(m, n)| match &coding {
-                Some(c) => read_sat_map(device, queue, m, &outputs.textures[m], c, n),
+                Some(c) => read_sat_map(device, queue, m, &outputs.textures[m], c, &n),
                 None => FloatMap::read(device, queue, m, &outputs.textures[m], format_of(m)),
             })
             .collect::<Result<Vec<_>>>()?;
@@ -419,12 +428,45 @@ fn dump_resources(
                     })
                 })
                 .collect::<Result<Vec<_>>>()?;
-            Ok(DumpedResource {
-                levels,
-                light: r.resource.light,
-                producer: r.producer.map(|s| plan.steps[s].node.kernel.to_string()),
-                format: r.resource.format,
-            })
+            let producer = r.producer.map(|s| plan.steps[s].node.kernel.to_string());
+            // Interleaved tables are read back as the tables they hold.
+            Ok(split_layers(&r.resource.layers, levels)
+                .into_iter()
+                .map(|levels| DumpedResource {
+                    levels,
+                    light: r.resource.light,
+                    producer: producer.clone(),
+                    format: r.resource.format,
+                })
+                .collect::<Vec<_>>())
+        })
+        .collect::<Result<Vec<_>>>()
+        .map(|v| v.into_iter().flatten().collect())
+}
+
+/// The levels of a texture holding `layers` interleaved along x ([`Graph::interleaved`]) as
+/// each layer's levels, named after it; the levels as they are for a plain texture.
+///
+/// [`Graph::interleaved`]: crate::graph::Graph::interleaved
+fn split_layers(layers: &[String], levels: Vec<FloatMap>) -> Vec<Vec<FloatMap>> {
+    if layers.is_empty() {
+        return vec![levels];
+    }
+    let n = layers.len();
+    layers
+        .iter()
+        .enumerate()
+        .map(|(k, name)| {
+            levels
+                .iter()
+                .map(|m| FloatMap {
+                    resource: name.clone(),
+                    width: m.width / n as u32,
+                    height: m.height,
+                    channels: m.channels,
+                    data: crate::graph::layer_of(&m.data, m.channels, n, k),
+                })
+                .collect()
         })
         .collect()
 }

@@ -20,13 +20,13 @@ use rand::Rng;
 use shadowgraph::cpu::{self, Texels, sat as reference};
 use shadowgraph::exec::Executor;
 use shadowgraph::gpu::{Gpu, read_texture, submit_and_wait, write_texture};
-use shadowgraph::graph::{Graph, plan, texel_bytes};
+use shadowgraph::graph::{Graph, layer_of, plan, texel_bytes};
 use shadowgraph::sat::layers::LAYERED_SAT_OUTPUTS;
 use shadowgraph::sat::{SatCoding, SatVariant, decode_table, float_sum_depth, lookup_area};
 use shadowgraph::scene::{CssmSearch, Storage};
 use shadowgraph::technique::{
-    CsmBasis, LinearizeParams, MomentTable, Moments, add_csm_tables, add_moment_table, csm_maps,
-    csm_z_maps,
+    CsmBasis, LinearizeParams, MomentTable, Moments, add_csm_tables, add_moment_table,
+    basis_interleave, basis_sequence, csm_maps, csm_z_maps,
 };
 
 /// f32's unit roundoff.
@@ -81,7 +81,13 @@ fn depth(rng: &mut impl Rng, w: usize, h: usize, bad: usize) -> (Vec<f32>, Texel
 
 /// The tables of `case` on the GPU (every planned texture poisoned first, all bits set), as
 /// raw words, with the plan's step count and each step's non-finite count.
-fn run(g: &Gpu, case: &Case, raw: &[f32], coding: SatCoding) -> (Vec<Vec<u32>>, usize, Vec<u32>) {
+fn run(
+    g: &Gpu,
+    case: &Case,
+    raw: &[f32],
+    coding: SatCoding,
+    interleave: u32,
+) -> (Vec<Vec<u32>>, usize, Vec<u32>) {
     let mut graph = Graph::default();
     let (w, h) = (case.w as u32, case.h as u32);
     graph.import("in", wgpu::TextureFormat::R32Float, w, h, Some(0));
@@ -99,6 +105,7 @@ fn run(g: &Gpu, case: &Case, raw: &[f32], coding: SatCoding) -> (Vec<Vec<u32>>, 
             search: case.search,
             storage: case.storage,
             depth: LinearizeParams::ORTHOGRAPHIC,
+            interleave,
         };
         add_csm_tables(&mut graph, 0, "in", &basis, coding)
     };
@@ -133,11 +140,20 @@ fn run(g: &Gpu, case: &Case, raw: &[f32], coding: SatCoding) -> (Vec<Vec<u32>>, 
     }
     out.copy_stats(&mut enc);
     submit_and_wait(&g.device, &g.queue, enc, "csm_sat").expect("run");
+    // Each table, split out of the texture that holds it (interleaved along x with others).
     let words = tables
         .iter()
-        .map(|t| {
+        .flat_map(|t| {
             let bytes = read_texture(&g.device, &g.queue, &out.textures[t], 0).expect("read");
-            bytemuck::cast_slice(&bytes).to_vec()
+            let words: Vec<u32> = bytemuck::cast_slice(&bytes).to_vec();
+            let n = plan
+                .resource(t)
+                .map_or(0, |r| r.resource.layers.len())
+                .max(1);
+            let per_texel = words.len() / (n * case.w * case.h);
+            (0..n)
+                .map(|k| layer_of(&words, per_texel, n, k))
+                .collect::<Vec<_>>()
         })
         .collect();
     let stats = out.read_stats(&g.device).expect("stats");
@@ -244,7 +260,35 @@ fn check(g: &Gpu, seed: u64, case: &Case) {
         SatVariant::Float => SatCoding::float([lo; 4], [hi; 4]),
     }
     .expect("coding");
-    let (tables, steps, stats) = run(g, case, &raw, coding);
+    // The shipped layout: fixed-point basis tables interleaved as many a texture as fit.
+    let layers = if case.moments.is_some() {
+        1
+    } else {
+        basis_sequence(case.terms, case.search).len() as u32
+    };
+    let interleave = basis_interleave(case.w as u32, layers, case.variant);
+    let (tables, steps, stats) = run(g, case, &raw, coding, interleave);
+    if interleave > 1 {
+        // A texture a table holds the same words (its own channels; an interleaved table
+        // has its texture's, the widest table's, the rest 0).
+        let (alone, steps_alone, _) = run(g, case, &raw, coding, 1);
+        let texels = case.w * case.h;
+        for (m, (a, t)) in alone.iter().zip(&tables).enumerate() {
+            let (na, nt) = (a.len() / texels, t.len() / texels);
+            let same = a
+                .chunks(na)
+                .zip(t.chunks(nt))
+                .all(|(x, y)| y[..na] == *x && y[na..].iter().all(|&w| w == 0));
+            assert!(
+                same,
+                "{what} table {m}: interleaved {interleave} a texture, it differs"
+            );
+        }
+        assert_eq!(
+            steps_alone,
+            2 + tables.len().div_ceil(LAYERED_SAT_OUTPUTS as usize)
+        );
+    }
     let [c_pos, c_neg] = case.exp.map(f64::from);
     let want = match case.moments {
         Some(Moments::Msm) => vec![cpu::msm::msm(&lin, true)],
@@ -263,18 +307,25 @@ fn check(g: &Gpu, seed: u64, case: &Case) {
     };
     let moments = case.search == Some(CssmSearch::Moments);
     assert_eq!(tables.len(), want.len(), "{what}: tables");
-    // The edges of every layer, the carries, four tables a dispatch.
+    // The edges of every layer, the carries, four textures a dispatch.
     let per = LAYERED_SAT_OUTPUTS as usize;
-    assert_eq!(steps, 2 + want.len().div_ceil(per), "{what}: dispatches");
+    let textures = want.len().div_ceil(interleave as usize);
+    assert_eq!(steps, 2 + textures.div_ceil(per), "{what}: dispatches");
     // Pass 1's layer 0 counts each non-finite texel once; nothing else counts.
     assert_eq!(stats, vec![case.bad as u32], "{what}: non-finite count");
     let texels = case.w * case.h;
     for (m, (words, v)) in tables.iter().zip(&want).enumerate() {
         let n = v.channels;
         // The format has the channels, or four for three (no three-channel format); the
-        // fourth is 0 (the kernel's basis is 0 past the sequence).
-        let stride = if n == 3 { 4 } else { n };
-        assert_eq!(words.len(), texels * stride, "{what} table {m}: channels");
+        // fourth is 0 (the kernel's basis is 0 past the sequence). Interleaved tables have
+        // their texture's format, the widest of its tables'.
+        let stride = words.len() / texels;
+        assert!(
+            words.len() == texels * stride
+                && stride >= n
+                && (stride == n || interleave > 1 || n == 3),
+            "{what} table {m}: {stride} channels for {n}"
+        );
         assert!(
             words.chunks(stride).all(|t| t[n..].iter().all(|&w| w == 0)),
             "{what} table {m}: unused channel"

@@ -71,10 +71,10 @@ fn stage_maps_as_frame(
     submit_and_wait(&g.device, &g.queue, enc, "stage").expect("submit");
     out.maps
         .iter()
-        .zip(shadowgraph::technique::map_channels(light))
+        .zip(shadowgraph::technique::map_tables(light))
         .map(|(m, n)| {
             let map = shadowgraph::render::read_sat_map(
-                &g.device, &g.queue, "stage", &m.texture, &coding, n,
+                &g.device, &g.queue, "stage", &m.texture, &coding, &n,
             )
             .expect("readback");
             (map.channels, map.data)

@@ -653,14 +653,22 @@ fn blocker_kernels_are_planned_only_for_soft_lights() {
             .map(|s| s.node.kernel.as_str())
             .collect();
         let what = format!("light {i} ({})", l.shadow.technique.name());
-        // CSM-Z maps or their tables written (`light{i}.csm_z<k>` or `light{i}.csm_z<k>.sat`).
-        let blocker = sp
+        // CSM-Z maps or their tables written (`light{i}.csm_z<k>` or `light{i}.csm_z<k>.sat`,
+        // tables interleaved in one texture by the names of the tables it holds).
+        let written: Vec<String> = sp
             .plan
             .steps
             .iter()
             .filter(|s| s.node.light == Some(i))
             .flat_map(|s| &s.node.outputs)
-            .filter(|(_, r)| {
+            .flat_map(|(_, r)| match sp.plan.resource(r) {
+                Some(p) if !p.resource.layers.is_empty() => p.resource.layers.clone(),
+                _ => vec![r.clone()],
+            })
+            .collect();
+        let blocker = written
+            .iter()
+            .filter(|r| {
                 let r = r.strip_suffix(".sat").unwrap_or(r);
                 r.rsplit('.')
                     .next()
@@ -683,8 +691,13 @@ fn blocker_kernels_are_planned_only_for_soft_lights() {
                 };
                 assert_eq!(blocker, z, "{what}: the blocker search's tables");
                 // One layered table (`sat::layers`): the edges of every layer from the depth,
-                // the carries, and four tables a dispatch; no basis map stored.
+                // the carries, and four textures a dispatch, fixed-point tables as many a
+                // texture as fit; no basis map stored.
                 let per = shadowgraph::sat::layers::LAYERED_SAT_OUTPUTS as usize;
+                let tables = (basis + z) as u32;
+                let interleave =
+                    shadowgraph::technique::basis_interleave(l.map_dims().0, tables, soft.sums);
+                let textures = (basis + z).div_ceil(interleave as usize);
                 let (sums, tiles) = match soft.sums {
                     shadowgraph::sat::SatVariant::Fixed => ("csm_sat_tile_sums", "csm_sat_tiles"),
                     shadowgraph::sat::SatVariant::Float => {
@@ -692,7 +705,7 @@ fn blocker_kernels_are_planned_only_for_soft_lights() {
                     }
                 };
                 let mut v = vec![sums, "sat_carries"];
-                v.extend(vec![tiles; (basis + z).div_ceil(per)]);
+                v.extend(vec![tiles; textures.div_ceil(per)]);
                 Some(v)
             }
             // The moments computed in the table's own tile passes (one layer, no map).

@@ -59,7 +59,7 @@
 //   sg_BLOCKER_MIN_SHARE sg_CSM_PI sg_CSSM_BLOCKER_FLOOR sg_CSSM_FULL_CONTRAST
 //   sg_CSSM_MIN_CONTRAST sg_CascadePick sg_CsmTerms sg_GOLDEN_ANGLE sg_Light sg_LightSample
 //   sg_MSM_B0 sg_MSM_B0_COV sg_MSM_B0_SCHUR sg_MipTaps sg_MsmMoments sg_SAT_GRID
-//   sg_SAT_MIN_EXTENT sg_SatNodes sg_SoftLookup sg_TECHNIQUE_CSM sg_TECHNIQUE_CSSM
+//   sg_SAT_MIN_EXTENT sg_SatLayer sg_SatNodes sg_SoftLookup sg_TECHNIQUE_CSM sg_TECHNIQUE_CSSM
 //   sg_TECHNIQUE_ESM sg_TECHNIQUE_EVSM sg_TECHNIQUE_HARD sg_TECHNIQUE_MIDPOINT sg_TECHNIQUE_MSM
 //   sg_TECHNIQUE_MSM_SOFT sg_TECHNIQUE_PCF sg_TECHNIQUE_PCSS sg_TECHNIQUE_SECOND_DEPTH
 //   sg_TECHNIQUE_SMRT sg_TECHNIQUE_VSM sg_TECHNIQUE_VSSM sg_bilinear_level
@@ -76,13 +76,15 @@
 //   sg_mip_taps sg_msm_biased sg_msm_dequantize sg_msm_expect sg_msm_intensity sg_msm_moments
 //   sg_msm_quantize sg_msm_roots sg_msm_soft_blocker sg_pack_f16x2 sg_pcss_search_radius
 //   sg_point_coords sg_point_face sg_point_sample sg_sample_bilinear sg_sample_bilinear_log
-//   sg_sample_map sg_sample_map_log sg_sample_map_packed sg_sat_box sg_sat_box_fixed
-//   sg_sat_box_float sg_sat_clamp sg_sat_corner_linear sg_sat_filter_fixed sg_sat_filter_float
-//   sg_sat_filter_window sg_sat_grid sg_sat_mean_fixed sg_sat_mean_float sg_sat_mean_linear
-//   sg_sat_nearest sg_sat_node_f32 sg_sat_node_u32 sg_sat_nodes sg_sat_rect sg_sat_sample_fixed
-//   sg_sat_sample_float sg_sat_search_fixed sg_sat_search_float sg_sat_span_weights
-//   sg_sat_window_fixed sg_smrt_emitter_point sg_smrt_ray sg_soft_blockers sg_soft_filter_trips
-//   sg_texel_of sg_trilinear sg_trilinear_log sg_trilinear_packed sg_unpack_f16x2 sg_vis_esm
+//   sg_sample_map sg_sample_map_log sg_sample_map_packed sg_sat_alone sg_sat_box
+//   sg_sat_box_fixed sg_sat_box_float sg_sat_clamp sg_sat_corner_linear sg_sat_filter_fixed
+//   sg_sat_filter_float sg_sat_filter_window sg_sat_grid sg_sat_layer_box sg_sat_layer_mean
+//   sg_sat_layer_node sg_sat_layer_size sg_sat_layer_window sg_sat_mean_fixed sg_sat_mean_float
+//   sg_sat_mean_linear sg_sat_nearest sg_sat_node_f32 sg_sat_node_u32 sg_sat_nodes sg_sat_rect
+//   sg_sat_sample_fixed sg_sat_sample_float sg_sat_sample_layer sg_sat_search_fixed
+//   sg_sat_search_float sg_sat_search_layer sg_sat_span_weights sg_sat_window_fixed
+//   sg_smrt_emitter_point sg_smrt_ray sg_soft_blockers sg_soft_filter_trips sg_texel_of
+//   sg_trilinear sg_trilinear_log sg_trilinear_packed sg_unpack_f16x2 sg_vis_esm
 //   sg_vis_esm_of_log sg_vis_esm_of_sat sg_vis_evsm sg_vis_evsm_of sg_vis_hard sg_vis_msm
 //   sg_vis_msm_of sg_vis_msm_soft_fixed sg_vis_msm_soft_float sg_vis_pcf sg_vis_pcf_hardware
 //   sg_vis_pcss sg_vis_smrt sg_vis_vsm sg_vis_vsm_of sg_vis_vssm_fixed sg_vis_vssm_float
@@ -843,13 +845,39 @@ fn sg_sat_nodes(rect: vec4<f32>, size: vec2<u32>) -> sg_SatNodes {
     return n;
 }
 
-// F(X, Y) at integer nodes: 0 on the top and left edges, else SAT texel (X − 1, Y − 1). The
-// load is made unconditionally (at a clamped texel) and the edge selected after: a branch per
-// load costs a CPU driver a divergent branch per node and a GPU nothing either way.
+// Where a fixed-point table lies in its texture: `n` tables interleaved along x
+// (src/sat/layers.rs), this one at slot `k`, its texel (x, y) at (x·n + k, y). Reading the
+// same corner of several interleaved tables reads one run of memory, not a cache line a
+// table (CSSM's filter lookups). A table of its own is `sat_alone()`.
+struct sg_SatLayer {
+    n: i32,
+    k: i32,
+}
+
+fn sg_sat_alone() -> sg_SatLayer {
+    return sg_SatLayer(1, 0);
+}
+
+// The size of the table `layer` of `sat`.
+fn sg_sat_layer_size(sat: texture_2d<u32>, layer: sg_SatLayer) -> vec2<u32> {
+    let d = textureDimensions(sat);
+    return vec2<u32>(d.x / u32(layer.n), d.y);
+}
+
+// F(X, Y) at integer nodes: 0 on the top and left edges, else SAT texel (X − 1, Y − 1) of the
+// table `layer`. The load is made unconditionally (at a clamped texel) and the edge selected
+// after: a branch per load costs a CPU driver a divergent branch per node and a GPU nothing
+// either way.
+// #fetches sg_sat_layer_node: 1
+fn sg_sat_layer_node(sat: texture_2d<u32>, layer: sg_SatLayer, x: i32, y: i32) -> vec4<u32> {
+    let t = max(vec2<i32>(x - 1, y - 1), vec2<i32>(0));
+    let v = textureLoad(sat, vec2<i32>(t.x * layer.n + layer.k, t.y), 0);
+    return select(v, vec4<u32>(0u), x == 0 || y == 0);
+}
+
 // #fetches sg_sat_node_u32: 1
 fn sg_sat_node_u32(sat: texture_2d<u32>, x: i32, y: i32) -> vec4<u32> {
-    let v = textureLoad(sat, max(vec2<i32>(x - 1, y - 1), vec2<i32>(0)), 0);
-    return select(v, vec4<u32>(0u), x == 0 || y == 0);
+    return sg_sat_layer_node(sat, sg_sat_alone(), x, y);
 }
 
 // #fetches sg_sat_node_f32: 1
@@ -874,16 +902,22 @@ fn sg_sat_span_weights(w: vec4<f32>) -> vec3<f32> {
 // SAT (rgba32uint) encoded with `offset` and `scale` (SatCoding in src/sat.rs).
 // #fetches sg_sat_mean_fixed: 16
 fn sg_sat_mean_fixed(sat: texture_2d<u32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
-    let n = sg_sat_nodes(rect, textureDimensions(sat));
+    return sg_sat_layer_mean(sat, sg_sat_alone(), rect, offset, scale);
+}
+
+// `sat_mean_fixed` of the table `layer` of `sat`.
+// #fetches sg_sat_layer_mean: 16
+fn sg_sat_layer_mean(sat: texture_2d<u32>, layer: sg_SatLayer, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
+    let n = sg_sat_nodes(rect, sg_sat_layer_size(sat, layer));
     let wx = sg_sat_span_weights(n.wx);
     let wy = sg_sat_span_weights(n.wy);
     // Row differences first: d[j][k] = F(X_k+1, Y_j) − F(X_k, Y_j), wrapping.
     var d: array<vec4<u32>, 12>;
     for (var j = 0; j < 4; j++) {
-        let f0 = sg_sat_node_u32(sat, n.x[0], n.y[j]);
-        let f1 = sg_sat_node_u32(sat, n.x[1], n.y[j]);
-        let f2 = sg_sat_node_u32(sat, n.x[2], n.y[j]);
-        let f3 = sg_sat_node_u32(sat, n.x[3], n.y[j]);
+        let f0 = sg_sat_layer_node(sat, layer, n.x[0], n.y[j]);
+        let f1 = sg_sat_layer_node(sat, layer, n.x[1], n.y[j]);
+        let f2 = sg_sat_layer_node(sat, layer, n.x[2], n.y[j]);
+        let f3 = sg_sat_layer_node(sat, layer, n.x[3], n.y[j]);
         d[j * 3] = f1 - f0;
         d[j * 3 + 1] = f2 - f1;
         d[j * 3 + 2] = f3 - f2;
@@ -935,7 +969,13 @@ fn sg_sat_mean_float(sat: texture_2d<f32>, rect: vec4<f32>, offset: vec4<f32>, s
 // where a square up to one texel wider per side reads as well as the exact one.
 // #fetches sg_sat_box_fixed: 4
 fn sg_sat_box_fixed(sat: texture_2d<u32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
-    return sg_sat_window_fixed(sat, sg_sat_box(rect, textureDimensions(sat)), offset, scale);
+    return sg_sat_layer_box(sat, sg_sat_alone(), rect, offset, scale);
+}
+
+// `sat_box_fixed` of the table `layer` of `sat`.
+// #fetches sg_sat_layer_box: 4
+fn sg_sat_layer_box(sat: texture_2d<u32>, layer: sg_SatLayer, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
+    return sg_sat_layer_window(sat, layer, sg_sat_box(rect, sg_sat_layer_size(sat, layer)), offset, scale);
 }
 
 // The mean over the integer window b (x0, y0, x1, y1; `sat_box`'s) of a fixed-point table, four
@@ -943,8 +983,14 @@ fn sg_sat_box_fixed(sat: texture_2d<u32>, rect: vec4<f32>, offset: vec4<f32>, sc
 // (CSSM's filter lookups).
 // #fetches sg_sat_window_fixed: 4
 fn sg_sat_window_fixed(sat: texture_2d<u32>, b: vec4<i32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
-    let window = sg_sat_node_u32(sat, b.z, b.w) - sg_sat_node_u32(sat, b.x, b.w)
-        - sg_sat_node_u32(sat, b.z, b.y) + sg_sat_node_u32(sat, b.x, b.y);
+    return sg_sat_layer_window(sat, sg_sat_alone(), b, offset, scale);
+}
+
+// `sat_window_fixed` of the table `layer` of `sat`.
+// #fetches sg_sat_layer_window: 4
+fn sg_sat_layer_window(sat: texture_2d<u32>, layer: sg_SatLayer, b: vec4<i32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
+    let window = sg_sat_layer_node(sat, layer, b.z, b.w) - sg_sat_layer_node(sat, layer, b.x, b.w)
+        - sg_sat_layer_node(sat, layer, b.z, b.y) + sg_sat_layer_node(sat, layer, b.x, b.y);
     let area = f32((b.z - b.x) * (b.w - b.y));
     return vec4<f32>(bitcast<vec4<i32>>(window)) / (scale * area) + offset;
 }
@@ -1020,6 +1066,12 @@ fn sg_sat_sample_fixed(map: texture_2d<u32>, l: sg_Light, uv: vec2<f32>, width: 
     return sg_sat_mean_fixed(map, sg_sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
 }
 
+// `sat_sample_fixed` of the table `layer` of `map` (shared/sat's SatLayer).
+// #fetches sg_sat_sample_layer: 16
+fn sg_sat_sample_layer(map: texture_2d<u32>, layer: sg_SatLayer, l: sg_Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
+    return sg_sat_layer_mean(map, layer, sg_sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
+}
+
 // The mean over `sat_rect(l, uv, width)` from an f32 table (rgba32float). Sixteen loads, not
 // four filtered fetches: the loads' window sums are differences of neighbouring table texels,
 // exact to the table, where a filtered fetch rounds each corner relative to the whole corner
@@ -1068,6 +1120,12 @@ fn sg_sat_filter_float(map: texture_2d<f32>, smp: sampler, l: sg_Light, uv: vec2
 // #fetches sg_sat_search_fixed: 4
 fn sg_sat_search_fixed(map: texture_2d<u32>, l: sg_Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
     return sg_sat_box_fixed(map, sg_sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
+}
+
+// `sat_search_fixed` of the table `layer` of `map`.
+// #fetches sg_sat_search_layer: 4
+fn sg_sat_search_layer(map: texture_2d<u32>, layer: sg_SatLayer, l: sg_Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
+    return sg_sat_layer_box(map, layer, sg_sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
 }
 
 // #fetches sg_sat_search_float: 4

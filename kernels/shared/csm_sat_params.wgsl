@@ -20,6 +20,21 @@ struct CsmSatParams {
     unorm16: u32,         // 1: round each value to 16-bit unorm, as an rgba16unorm map would hold it
     exp_pos: f32,         // EVSM's c⁺, ESM's c (the moment layers)
     exp_neg: f32,         // EVSM's c⁻
+    interleave: u32,      // n: tables a texture, interleaved along x (src/sat/layers.rs)
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
+}
+
+// Where pass 3 stores texel q of layer `z` of its dispatch: (x, y) of output texture dst<w>,
+// w the result's z. With n = p.interleave tables a texture, texel (x, y) of table k is texel
+// (x·m + k mod n, y) of texture ⌊k / n⌋, which holds m = n tables (the last the rest); a
+// dispatch starts at a multiple of 4n tables, so its texture ⌊z / n⌋ is dst<⌊z / n⌋>.
+fn csm_sat_texel(p: CsmSatParams, z: u32, q: vec2<u32>) -> vec3<u32> {
+    let n = max(p.interleave, 1u);
+    let k = p.first_map + z;
+    let m = min(n, p.sat.layers - k / n * n);
+    return vec3<u32>(q.x * m + k % n, q.y, z / n);
 }
 
 // Tiles of a `size` map along x and y: the width of a band of row_part, the height of one of

@@ -66,13 +66,39 @@ fn sat_nodes(rect: vec4<f32>, size: vec2<u32>) -> SatNodes {
     return n;
 }
 
-// F(X, Y) at integer nodes: 0 on the top and left edges, else SAT texel (X − 1, Y − 1). The
-// load is made unconditionally (at a clamped texel) and the edge selected after: a branch per
-// load costs a CPU driver a divergent branch per node and a GPU nothing either way.
+// Where a fixed-point table lies in its texture: `n` tables interleaved along x
+// (src/sat/layers.rs), this one at slot `k`, its texel (x, y) at (x·n + k, y). Reading the
+// same corner of several interleaved tables reads one run of memory, not a cache line a
+// table (CSSM's filter lookups). A table of its own is `sat_alone()`.
+struct SatLayer {
+    n: i32,
+    k: i32,
+}
+
+fn sat_alone() -> SatLayer {
+    return SatLayer(1, 0);
+}
+
+// The size of the table `layer` of `sat`.
+fn sat_layer_size(sat: texture_2d<u32>, layer: SatLayer) -> vec2<u32> {
+    let d = textureDimensions(sat);
+    return vec2<u32>(d.x / u32(layer.n), d.y);
+}
+
+// F(X, Y) at integer nodes: 0 on the top and left edges, else SAT texel (X − 1, Y − 1) of the
+// table `layer`. The load is made unconditionally (at a clamped texel) and the edge selected
+// after: a branch per load costs a CPU driver a divergent branch per node and a GPU nothing
+// either way.
+// #fetches sat_layer_node: 1
+fn sat_layer_node(sat: texture_2d<u32>, layer: SatLayer, x: i32, y: i32) -> vec4<u32> {
+    let t = max(vec2<i32>(x - 1, y - 1), vec2<i32>(0));
+    let v = textureLoad(sat, vec2<i32>(t.x * layer.n + layer.k, t.y), 0);
+    return select(v, vec4<u32>(0u), x == 0 || y == 0);
+}
+
 // #fetches sat_node_u32: 1
 fn sat_node_u32(sat: texture_2d<u32>, x: i32, y: i32) -> vec4<u32> {
-    let v = textureLoad(sat, max(vec2<i32>(x - 1, y - 1), vec2<i32>(0)), 0);
-    return select(v, vec4<u32>(0u), x == 0 || y == 0);
+    return sat_layer_node(sat, sat_alone(), x, y);
 }
 
 // #fetches sat_node_f32: 1
@@ -97,16 +123,22 @@ fn sat_span_weights(w: vec4<f32>) -> vec3<f32> {
 // SAT (rgba32uint) encoded with `offset` and `scale` (SatCoding in src/sat.rs).
 // #fetches sat_mean_fixed: 16
 fn sat_mean_fixed(sat: texture_2d<u32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
-    let n = sat_nodes(rect, textureDimensions(sat));
+    return sat_layer_mean(sat, sat_alone(), rect, offset, scale);
+}
+
+// `sat_mean_fixed` of the table `layer` of `sat`.
+// #fetches sat_layer_mean: 16
+fn sat_layer_mean(sat: texture_2d<u32>, layer: SatLayer, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
+    let n = sat_nodes(rect, sat_layer_size(sat, layer));
     let wx = sat_span_weights(n.wx);
     let wy = sat_span_weights(n.wy);
     // Row differences first: d[j][k] = F(X_k+1, Y_j) − F(X_k, Y_j), wrapping.
     var d: array<vec4<u32>, 12>;
     for (var j = 0; j < 4; j++) {
-        let f0 = sat_node_u32(sat, n.x[0], n.y[j]);
-        let f1 = sat_node_u32(sat, n.x[1], n.y[j]);
-        let f2 = sat_node_u32(sat, n.x[2], n.y[j]);
-        let f3 = sat_node_u32(sat, n.x[3], n.y[j]);
+        let f0 = sat_layer_node(sat, layer, n.x[0], n.y[j]);
+        let f1 = sat_layer_node(sat, layer, n.x[1], n.y[j]);
+        let f2 = sat_layer_node(sat, layer, n.x[2], n.y[j]);
+        let f3 = sat_layer_node(sat, layer, n.x[3], n.y[j]);
         d[j * 3] = f1 - f0;
         d[j * 3 + 1] = f2 - f1;
         d[j * 3 + 2] = f3 - f2;
@@ -158,7 +190,13 @@ fn sat_mean_float(sat: texture_2d<f32>, rect: vec4<f32>, offset: vec4<f32>, scal
 // where a square up to one texel wider per side reads as well as the exact one.
 // #fetches sat_box_fixed: 4
 fn sat_box_fixed(sat: texture_2d<u32>, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
-    return sat_window_fixed(sat, sat_box(rect, textureDimensions(sat)), offset, scale);
+    return sat_layer_box(sat, sat_alone(), rect, offset, scale);
+}
+
+// `sat_box_fixed` of the table `layer` of `sat`.
+// #fetches sat_layer_box: 4
+fn sat_layer_box(sat: texture_2d<u32>, layer: SatLayer, rect: vec4<f32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
+    return sat_layer_window(sat, layer, sat_box(rect, sat_layer_size(sat, layer)), offset, scale);
 }
 
 // The mean over the integer window b (x0, y0, x1, y1; `sat_box`'s) of a fixed-point table, four
@@ -166,8 +204,14 @@ fn sat_box_fixed(sat: texture_2d<u32>, rect: vec4<f32>, offset: vec4<f32>, scale
 // (CSSM's filter lookups).
 // #fetches sat_window_fixed: 4
 fn sat_window_fixed(sat: texture_2d<u32>, b: vec4<i32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
-    let window = sat_node_u32(sat, b.z, b.w) - sat_node_u32(sat, b.x, b.w)
-        - sat_node_u32(sat, b.z, b.y) + sat_node_u32(sat, b.x, b.y);
+    return sat_layer_window(sat, sat_alone(), b, offset, scale);
+}
+
+// `sat_window_fixed` of the table `layer` of `sat`.
+// #fetches sat_layer_window: 4
+fn sat_layer_window(sat: texture_2d<u32>, layer: SatLayer, b: vec4<i32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
+    let window = sat_layer_node(sat, layer, b.z, b.w) - sat_layer_node(sat, layer, b.x, b.w)
+        - sat_layer_node(sat, layer, b.z, b.y) + sat_layer_node(sat, layer, b.x, b.y);
     let area = f32((b.z - b.x) * (b.w - b.y));
     return vec4<f32>(bitcast<vec4<i32>>(window)) / (scale * area) + offset;
 }

@@ -19,6 +19,12 @@ fn sat_sample_fixed(map: texture_2d<u32>, l: Light, uv: vec2<f32>, width: f32) -
     return sat_mean_fixed(map, sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
 }
 
+// `sat_sample_fixed` of the table `layer` of `map` (shared/sat's SatLayer).
+// #fetches sat_sample_layer: 16
+fn sat_sample_layer(map: texture_2d<u32>, layer: SatLayer, l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
+    return sat_layer_mean(map, layer, sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
+}
+
 // The mean over `sat_rect(l, uv, width)` from an f32 table (rgba32float). Sixteen loads, not
 // four filtered fetches: the loads' window sums are differences of neighbouring table texels,
 // exact to the table, where a filtered fetch rounds each corner relative to the whole corner
@@ -67,6 +73,12 @@ fn sat_filter_float(map: texture_2d<f32>, smp: sampler, l: Light, uv: vec2<f32>,
 // #fetches sat_search_fixed: 4
 fn sat_search_fixed(map: texture_2d<u32>, l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
     return sat_box_fixed(map, sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
+}
+
+// `sat_search_fixed` of the table `layer` of `map`.
+// #fetches sat_search_layer: 4
+fn sat_search_layer(map: texture_2d<u32>, layer: SatLayer, l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
+    return sat_layer_box(map, layer, sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
 }
 
 // #fetches sat_search_float: 4

@@ -4,7 +4,7 @@
 //! `csm` storing the nine basis maps four a dispatch, then three table passes per map. The old
 //! chain stays a bench case until the comparison is recorded.
 
-use super::{BenchGraph, bench_light, chain_graph, named};
+use super::{BenchGraph, bench_light, named, shading_chain};
 use crate::gpu_data::{CSM_OUTPUTS, CsmParams, LinearizeParams};
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
 use crate::kernels::KernelId;
@@ -25,26 +25,18 @@ fn cssm(search: CssmSearch) -> Technique {
     )
 }
 
-/// The tables the shading of CSSM M = 8 reads: 4 CSM then the search's (1 or 5).
-fn tables(search: CssmSearch) -> Vec<String> {
-    technique::basis_sequence(TERMS, Some(search))
-        .into_iter()
-        .map(|(name, _)| format!("light0.{name}.sat"))
-        .collect()
-}
-
 fn layered_of(n: u32, search: CssmSearch) -> BenchGraph {
-    let names = tables(search);
-    let names: Vec<&str> = names.iter().map(String::as_str).collect();
-    chain_graph(n, cssm(search), &names)
+    shading_chain(n, cssm(search))
 }
 
-/// The shipped chain with the moment search: 2 + ⌈5 / 4⌉ = 4 dispatches.
+/// The shipped chain with the moment search: its five tables interleaved in one texture up
+/// to 1638², four and one at 2048² (`technique::basis_interleave`): 3 dispatches up to 4096².
 pub(super) fn layered(n: u32) -> BenchGraph {
     layered_of(n, CssmSearch::Moments)
 }
 
-/// The shipped chain with the CSM-Z search: 2 + ⌈9 / 4⌉ = 5 dispatches.
+/// The shipped chain with the CSM-Z search: nine tables, interleaved as many as fit in 8192
+/// texels a texture (all nine up to 910²): 3 dispatches up to 2048².
 pub(super) fn layered_csm_z(n: u32) -> BenchGraph {
     layered_of(n, CssmSearch::CsmZ)
 }

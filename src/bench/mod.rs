@@ -394,6 +394,20 @@ fn chain_graph(n: u32, technique: Technique, outputs: &[&str]) -> BenchGraph {
     }
 }
 
+/// [`chain_graph`] up to the textures the shading reads (every table of CSSM's layered
+/// tables, however many a texture holds).
+fn shading_chain(n: u32, technique: Technique) -> BenchGraph {
+    let mut graph = Graph::default();
+    let input = technique::add_light_nodes(&mut graph, 0, &bench_light(n, technique));
+    for r in graph.resources.iter_mut().filter(|r| r.imported) {
+        r.format = wgpu::TextureFormat::R32Float;
+    }
+    BenchGraph {
+        graph,
+        outputs: input.maps,
+    }
+}
+
 /// A light's shipped graph at size `n`.
 fn light_graph(n: u32, technique: Technique) -> Graph {
     let mut graph = Graph::default();

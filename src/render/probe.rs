@@ -47,7 +47,9 @@ impl<'a> ProbeMap<'a> {
 
 /// Evaluates each light's visibility at `points` (position, unit normal) on the given maps
 /// with the real shading kernel. `maps` lists every light's maps in binding order (one per
-/// light; CSM: one per two terms). Returns `vis[point * lights + light]`.
+/// light; CSM: one per two terms), summed-area tables that the light's shading reads
+/// interleaved in one texture (`technique::map_tables`) one by one: the probe interleaves
+/// them. Returns `vis[point * lights + light]`.
 pub fn probe(
     renderer: &mut Renderer,
     device: &wgpu::Device,
@@ -56,15 +58,12 @@ pub fn probe(
     maps: &[ProbeMap],
     points: &[(Vec3, Vec3)],
 ) -> Result<Vec<f32>> {
-    let needed: usize = lights
+    // Per binding, the tables it holds (1 for a map).
+    let held: Vec<usize> = lights
         .iter()
-        .enumerate()
-        .map(|(i, l)| {
-            technique::add_light_nodes(&mut Graph::default(), i, l)
-                .maps
-                .len()
-        })
-        .sum();
+        .flat_map(|l| technique::map_tables(l).into_iter().map(|t| t.len()))
+        .collect();
+    let needed: usize = held.iter().sum();
     if maps.len() != needed || points.is_empty() {
         return Err(Error::Invalid(format!(
             "probe needs {needed} map(s) for these lights and at least one point"
@@ -105,13 +104,22 @@ pub fn probe(
         })
         .collect();
     let mut views = Vec::new();
-    for (m, packed) in maps.iter().zip(packed) {
+    let mut rest = maps;
+    for (&n, packed) in held.iter().zip(packed) {
+        let (tables, after) = rest.split_at(n);
+        rest = after;
+        // Several tables of one binding: one texture n times as wide.
+        let interleaved = interleave(tables)?;
+        let m = match &interleaved {
+            Some(i) => ProbeMap::new(i.size, i.format, &i.data),
+            None => ProbeMap { ..tables[0] },
+        };
         let channels = crate::gpu::float_channels(m.format).unwrap_or(0);
         let packed = packed && channels == 2;
         let side = |l: u32| (m.size >> l).max(1) as usize;
         let texels: usize = (0..m.mips).map(|l| side(l) * side(l)).sum();
         let is_f32 = crate::graph::texel_bytes(m.format) == 4 * channels as u64;
-        if !is_f32 || channels == 0 || m.mips == 0 || m.data.len() != texels * channels {
+        if !is_f32 || channels == 0 || m.mips == 0 || m.data.len() != texels * channels * n {
             return Err(Error::Invalid(format!(
                 "a {0}x{0} {1:?} probe map of {3} level(s) needs {2} f32 values",
                 m.size,
@@ -125,7 +133,7 @@ pub fn probe(
             &wgpu::TextureDescriptor {
                 label: Some("shadowgraph.probe.map"),
                 size: wgpu::Extent3d {
-                    width: m.size,
+                    width: m.size * n as u32,
                     height: m.size,
                     depth_or_array_layers: 1,
                 },
@@ -143,15 +151,15 @@ pub fn probe(
         );
         let mut at = 0;
         for level in 0..m.mips {
-            let n = side(level) * side(level) * channels;
-            let values = &m.data[at..at + n];
+            let count = side(level) * side(level) * channels * n;
+            let values = &m.data[at..at + count];
             let bytes: Vec<u8> = if packed {
                 bytemuck::cast_slice(&crate::gpu::pack_f16x2(values)).to_vec()
             } else {
                 bytemuck::cast_slice(values).to_vec()
             };
             crate::gpu::write_texture_level(queue, &t, level, &bytes);
-            at += n;
+            at += count;
         }
         views.push(created::view(&t, &Default::default()));
     }
@@ -182,6 +190,53 @@ pub fn probe(
     let mut vis: Vec<f32> = bytemuck::cast_slice(&read_buffer(device, &readback)?).to_vec();
     vis.truncate(points.len() * lights.len());
     Ok(vis)
+}
+
+/// Several fixed-point tables of one binding, interleaved along x as the graph stores them
+/// (`crate::graph::Graph::interleaved`).
+struct Interleaved {
+    /// One table's side (the texture is as many times as wide as there are tables).
+    size: u32,
+    /// The widest table's format.
+    format: wgpu::TextureFormat,
+    /// Row-major, every table's texel in turn, padded with zeros to the widest's channels.
+    data: Vec<f32>,
+}
+
+/// `tables` interleaved; `None` for a binding of one table or map.
+fn interleave(tables: &[ProbeMap<'_>]) -> Result<Option<Interleaved>> {
+    let [first, _, ..] = tables else {
+        return Ok(None);
+    };
+    let channels = |m: &ProbeMap| crate::gpu::float_channels(m.format).unwrap_or(0);
+    let texels = (first.size * first.size) as usize;
+    if tables.iter().any(|m| {
+        m.size != first.size
+            || m.mips != 1
+            || channels(m) == 0
+            || m.data.len() != texels * channels(m)
+    }) {
+        return Err(Error::Invalid(format!(
+            "{} probe tables of one binding need one level each of {1}x{1} texels",
+            tables.len(),
+            first.size
+        )));
+    }
+    let widest = tables.iter().max_by_key(|m| channels(m)).unwrap_or(first);
+    let c = channels(widest);
+    let mut data = Vec::with_capacity(texels * c * tables.len());
+    for t in 0..texels {
+        for m in tables {
+            let k = channels(m);
+            data.extend_from_slice(&m.data[t * k..(t + 1) * k]);
+            data.extend(std::iter::repeat_n(0.0, c - k));
+        }
+    }
+    Ok(Some(Interleaved {
+        size: first.size,
+        format: widest.format,
+        data,
+    }))
 }
 
 /// What [`Renderer::shade_points`] evaluates at.

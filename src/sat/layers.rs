@@ -9,11 +9,20 @@
 //!    and `.row_part` (`L·⌈width / TILE⌉ × height`), [`SizeRule::Stacked`].
 //! 2. `<prefix>.sat.carries`: `sat_carries` over every band at once (`SatParams::layers = L`,
 //!    workgroup z on band z), into `.col_carry` and `.row_carry`, shaped as the edges.
-//! 3. `<prefix>.sat.<g>`: the source kernel's pass 3, [`LAYERED_SAT_OUTPUTS`] tables a
-//!    dispatch (`dst0` … `dst3`, workgroup z on table `first + z`): what WebGPU's default
-//!    limit of storage textures a stage allows every device.
+//! 3. `<prefix>.sat.<g>`: the source kernel's pass 3, [`LAYERED_SAT_OUTPUTS`] textures a
+//!    dispatch (`dst0` … `dst3`, workgroup z on texture z, its tables one after another):
+//!    what WebGPU's default limit of storage textures a stage allows every device.
 //!
-//! That is `2 + ⌈L / 4⌉` dispatches. Per texel: the source read `2L` times (once a layer per
+//! With [`LayeredSat::interleave`] `n` > 1 the tables are stored `n` to a texture,
+//! interleaved along x ([`Graph::interleaved`], `<prefix>.sat.layers<s>`): texel (x, y) of
+//! table k at (x·n + k mod n, y) of texture ⌊k / n⌋. A lookup that reads the same corner of
+//! several tables (CSSM's filter reads five) then reads one run of memory instead of one
+//! cache line a table; pass 3 writes `4·n` tables a dispatch, a workgroup all of a texture's
+//! tables of its tile (one workgroup a table wrote every cache line `n` times, each time after
+//! the others had left it: 1.7× slower pass 3 on llvmpipe). Only tables read with loads can
+//! be interleaved (a filtered fetch would blend neighbouring tables).
+//!
+//! That is `2 + ⌈L / 4n⌉` dispatches. Per texel: the source read `2L` times (once a layer per
 //! tile pass; both sweeps of pass 3 share a tile), each table written once, and the stacked
 //! edges and carries (`8·L / TILE` texels of 4 B a channel of the widest table). Each table is
 //! exactly the one [`super::add_sat`] builds of the representation the kernel computes: the tile passes share
@@ -45,10 +54,15 @@ pub struct LayeredSat<'a> {
     pub params: &'a dyn Fn(SatParams, u32, u32) -> Vec<u8>,
     /// The tables' coding (the same for every layer).
     pub coding: SatCoding,
+    /// Tables a texture, interleaved along x (1: a texture each). The kernels' parameters
+    /// carry it to pass 3's stores.
+    pub interleave: u32,
 }
 
-/// Adds the passes of `sat`'s tables to `graph` for `light`; returns the tables, in layer
-/// order (empty for no layers).
+/// Adds the passes of `sat`'s tables to `graph` for `light`; returns the textures that hold
+/// them, in layer order (empty for no layers): a table each, or with `sat.interleave` n > 1
+/// ⌈L / n⌉ textures of n tables (the last of the rest), table k in texture ⌊k / n⌋ at slot
+/// k mod n.
 pub fn add_layered_sat(graph: &mut Graph, light: usize, sat: &LayeredSat<'_>) -> Vec<String> {
     let layers = sat.tables.len() as u32;
     if layers == 0 {
@@ -75,18 +89,38 @@ pub fn add_layered_sat(graph: &mut Graph, light: usize, sat: &LayeredSat<'_>) ->
     let row_part = edges("row_part", SAT_TILE, 1, layers, 1);
     let col_carry = edges("col_carry", 1, SAT_TILE, 1, layers);
     let row_carry = edges("row_carry", SAT_TILE, 1, layers, 1);
-    let tables: Vec<String> = sat
-        .tables
-        .iter()
-        .map(|(name, channels)| {
-            let same = SizeRule::Reduced {
-                of: source.clone(),
-                shift: 0,
-            };
-            let format = sat.coding.variant.format(*channels);
-            graph.resource(sat_name(name), format, same, Some(light))
-        })
-        .collect();
+    let per = sat.interleave.max(1) as usize;
+    let tables: Vec<String> = if per == 1 {
+        sat.tables
+            .iter()
+            .map(|(name, channels)| {
+                let same = SizeRule::Reduced {
+                    of: source.clone(),
+                    shift: 0,
+                };
+                let format = sat.coding.variant.format(*channels);
+                graph.resource(sat_name(name), format, same, Some(light))
+            })
+            .collect()
+    } else {
+        // A texture's format holds its widest table; narrower ones leave channels unused.
+        sat.tables
+            .chunks(per)
+            .enumerate()
+            .map(|(s, group)| {
+                let widest = group.iter().map(|(_, c)| *c).max().unwrap_or(4);
+                let format = sat.coding.variant.format(widest);
+                let names = group.iter().map(|(name, _)| sat_name(name)).collect();
+                graph.interleaved(
+                    format!("{stem}.layers{s}"),
+                    format,
+                    &source,
+                    names,
+                    Some(light),
+                )
+            })
+            .collect()
+    };
     let tiles = |count: u32| Dispatch::Layers {
         base: Box::new(Dispatch::Blocks {
             of: source.clone(),
@@ -129,8 +163,8 @@ pub fn add_layered_sat(graph: &mut Graph, light: usize, sat: &LayeredSat<'_>) ->
         },
     );
     for (g, group) in tables.chunks(LAYERED_SAT_OUTPUTS as usize).enumerate() {
-        let first = g as u32 * LAYERED_SAT_OUTPUTS;
-        let count = group.len() as u32;
+        let first = g as u32 * LAYERED_SAT_OUTPUTS * per as u32;
+        let count = (layers - first).min(LAYERED_SAT_OUTPUTS * per as u32);
         let dst = group
             .iter()
             .enumerate()
@@ -146,7 +180,18 @@ pub fn add_layered_sat(graph: &mut Graph, light: usize, sat: &LayeredSat<'_>) ->
             ]),
             dst,
             (sat.params)(sat_params, first, count),
-            tiles(count),
+            if per == 1 {
+                tiles(count)
+            } else {
+                Dispatch::Interleaved {
+                    base: Box::new(Dispatch::Blocks {
+                        of: source.clone(),
+                        x: SAT_TILE,
+                        y: SAT_TILE,
+                    }),
+                    layers: count,
+                }
+            },
         );
     }
     tables
@@ -179,6 +224,7 @@ mod tests {
             kernels: [KernelId::CsmSatTileSums, KernelId::CsmSatTiles],
             params: &params,
             coding,
+            interleave: 1,
         };
         let out = add_layered_sat(&mut g, 0, &sat);
         assert_eq!(out, ["t0.sat", "t1.sat", "t2.sat", "t3.sat", "t4.sat"]);
@@ -231,6 +277,66 @@ mod tests {
         assert_eq!(outputs, ["t4.sat"]);
     }
 
+    /// Five layers two a texture: three textures (two, two, one table) as wide as their
+    /// tables side by side, each naming its tables, one pass-3 dispatch with the five layers
+    /// of a tile side by side along x.
+    #[test]
+    fn interleaved_layers_share_textures_and_one_dispatch() {
+        let mut g = Graph::default();
+        g.import("d", wgpu::TextureFormat::R32Float, 200, 130, Some(0));
+        let tables: Vec<(String, u32)> = (0..5)
+            .map(|k| (format!("t{k}"), if k == 4 { 1 } else { 4 }))
+            .collect();
+        let params = |s: SatParams, first: u32, count: u32| {
+            let mut b = bytemuck::bytes_of(&s).to_vec();
+            b.extend([first, count].iter().flat_map(|v| v.to_le_bytes()));
+            b
+        };
+        let sat = LayeredSat {
+            source: "d",
+            prefix: "l",
+            tables: &tables,
+            kernels: [KernelId::CsmSatTileSums, KernelId::CsmSatTiles],
+            params: &params,
+            coding: SatCoding::fixed(64, [-1.0; 4], [1.0; 4]).unwrap(),
+            interleave: 2,
+        };
+        let out = add_layered_sat(&mut g, 0, &sat);
+        assert_eq!(out, ["l.sat.layers0", "l.sat.layers1", "l.sat.layers2"]);
+        let names: Vec<&str> = out.iter().map(String::as_str).collect();
+        let p = plan(&g, &names).unwrap();
+        let kernels: Vec<&str> = p.steps.iter().map(|s| s.node.kernel.as_str()).collect();
+        assert_eq!(
+            kernels,
+            ["csm_sat_tile_sums", "sat_carries", "csm_sat_tiles"]
+        );
+        let size = |n: &str| p.resource(n).map(|r| (r.width, r.height));
+        assert_eq!(size("l.sat.layers0"), Some((400, 130)));
+        assert_eq!(size("l.sat.layers2"), Some((200, 130)));
+        let layers = |n: &str| p.resource(n).map(|r| r.resource.layers.clone());
+        assert_eq!(
+            layers("l.sat.layers1"),
+            Some(vec!["t2.sat".into(), "t3.sat".into()])
+        );
+        assert_eq!(layers("l.sat.layers2"), Some(vec!["t4.sat".into()]));
+        // The widest table's format; the last texture holds only the one-channel table.
+        let format = |n: &str| p.resource(n).map(|r| r.resource.format);
+        assert_eq!(
+            format("l.sat.layers0"),
+            Some(wgpu::TextureFormat::Rgba32Uint)
+        );
+        assert_eq!(format("l.sat.layers2"), Some(wgpu::TextureFormat::R32Uint));
+        let groups = p.steps[2].node.dispatch.groups(size, [64, 1, 1]);
+        assert_eq!(groups, Some([35, 5, 1]));
+        let outputs: Vec<&str> = p.steps[2]
+            .node
+            .outputs
+            .iter()
+            .map(|o| o.1.as_str())
+            .collect();
+        assert_eq!(outputs, names);
+    }
+
     #[test]
     fn zero_layers_is_a_plan_error_and_no_layers_no_nodes() {
         let mut g = Graph::default();
@@ -243,6 +349,7 @@ mod tests {
             kernels: [KernelId::CsmSatTileSums, KernelId::CsmSatTiles],
             params: &params,
             coding: SatCoding::float([0.0; 4], [1.0; 4]).unwrap(),
+            interleave: 1,
         };
         assert!(add_layered_sat(&mut g, 0, &sat).is_empty());
         assert!(g.nodes.is_empty());

@@ -127,13 +127,29 @@ fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
         _ => None,
     };
     let mut body = String::from("var sum = 0.0;");
-    for (chunk, m) in maps.iter().enumerate() {
-        let call = match table {
-            Some(v) => format!(
+    let chunks = if table.is_some() {
+        let terms = match light.shadow.technique {
+            Technique::Csm { terms, .. } => terms,
+            _ => 0,
+        };
+        super::csm_sat::basis_refs(light, maps, csm_maps(terms) as usize)
+            .into_iter()
+            .map(|t| (t.map, t.layer))
+            .collect()
+    } else {
+        maps.iter().map(|m| (m.clone(), None)).collect::<Vec<_>>()
+    };
+    for (chunk, (m, layer)) in chunks.iter().enumerate() {
+        let call = match (table, layer) {
+            (Some(_), Some(layer)) => format!(
+                "csm_chunk_of(sat_sample_layer({m}, {layer}, l, s.uv, l.filter_width), {chunk}u, \
+                 l, s)"
+            ),
+            (Some(v), None) => format!(
                 "csm_chunk_of({}, {chunk}u, l, s)",
                 sat_sample(v, m, "l.filter_width")
             ),
-            None => format!("csm_chunk({m}, {chunk}u, l, s)"),
+            (None, _) => format!("csm_chunk({m}, {chunk}u, l, s)"),
         };
         let _ = write!(body, "\n            sum += {call};");
     }

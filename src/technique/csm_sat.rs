@@ -11,7 +11,7 @@ use super::shade::ShadeInput;
 use crate::gpu_data::LinearizeParams;
 use crate::graph::{Graph, SizeRule};
 use crate::kernels::KernelId;
-use crate::model::{CssmSearch, Storage};
+use crate::model::{CssmSearch, Light, Storage, Technique};
 use crate::sat::layers::{LayeredSat, add_layered_sat};
 use crate::sat::{SatCoding, SatParams, SatVariant};
 
@@ -40,6 +40,11 @@ pub struct CsmSatParams {
     pub exp_pos: f32,
     /// EVSM's c⁻.
     pub exp_neg: f32,
+    /// Tables a texture, interleaved along x (`LayeredSat::interleave`; pass 3 stores table
+    /// `first_map + z` at slot `(first_map + z) mod interleave` of `dst⌊z / interleave⌋`).
+    pub interleave: u32,
+    /// Padding to a 16-byte multiple.
+    pub pad: [u32; 3],
 }
 
 /// What the layered tables of one light's basis hold ([`add_csm_tables`]).
@@ -54,6 +59,74 @@ pub struct CsmBasis {
     pub storage: Storage,
     /// The depth buffer's linearization.
     pub depth: LinearizeParams,
+    /// Tables a texture, interleaved along x ([`basis_interleave`]; 1: a texture each).
+    pub interleave: u32,
+}
+
+/// The widest texture the interleaved tables may make: WebGPU's default
+/// `max_texture_dimension_2d`, which every adapter allows (so the layout, and the shading
+/// code that reads it, do not depend on the device).
+pub const INTERLEAVED_MAX_WIDTH: u32 = 8192;
+
+/// Tables a texture for `layers` tables of a map `width` texels wide coded as `variant`:
+/// fixed-point tables (read with loads) as many as fit in [`INTERLEAVED_MAX_WIDTH`], f32
+/// tables (read with filtered fetches, which would blend interleaved neighbours) one.
+pub fn basis_interleave(width: u32, layers: u32, variant: SatVariant) -> u32 {
+    match variant {
+        SatVariant::Fixed => (INTERLEAVED_MAX_WIDTH / width.max(1)).clamp(1, layers.max(1)),
+        SatVariant::Float => 1,
+    }
+}
+
+/// Where table `k` of a light's `count` basis tables lies: the texture `maps[k / n]`, the
+/// tables it holds (`n`, the last texture the rest) and its slot there, `k mod n` (`n` =
+/// `interleave`, the textures as [`add_csm_tables`] returned them).
+pub fn basis_table(maps: &[String], interleave: u32, count: usize, k: usize) -> (&str, u32, u32) {
+    let n = interleave.max(1) as usize;
+    let held = n.min(count.saturating_sub(k / n * n));
+    let map = maps.get(k / n).map_or("", String::as_str);
+    (map, held as u32, (k % n) as u32)
+}
+
+/// Tables a texture of light `light`'s basis tables ([`basis_interleave`] for `csm` through
+/// tables and `cssm`; 1 for every other light or without tables): what [`csm_sat_nodes`]
+/// builds and the shading code reads ([`basis_refs`]).
+pub(super) fn light_interleave(light: &Light) -> u32 {
+    let (terms, search) = match light.shadow.technique {
+        Technique::Csm { terms, .. } => (terms, None),
+        Technique::Cssm { terms, search, .. } => (terms, Some(search)),
+        _ => return 1,
+    };
+    let Ok(Some(coding)) = super::light_gpu::sat_coding(light) else {
+        return 1;
+    };
+    let layers = basis_sequence(terms, search).len() as u32;
+    basis_interleave(light.map_dims().0, layers, coding.variant)
+}
+
+/// One basis table as the shading code reads it.
+pub(super) struct TableRef {
+    /// The binding of the texture that holds it.
+    pub map: String,
+    /// For a fixed-point table, its `SatLayer` in that texture (`kernels/shared/sat.wgsl`,
+    /// read by the `sat_layer_*` lookups); `None` for an f32 table (a texture each).
+    pub layer: Option<String>,
+}
+
+/// Light `light`'s `count` basis tables (CSM's, then the search's) with their textures bound
+/// as `maps` ([`csm_sat_nodes`]' textures, in order).
+pub(super) fn basis_refs(light: &Light, maps: &[String], count: usize) -> Vec<TableRef> {
+    let fixed = super::light_gpu::sat_variant(light) == Some(SatVariant::Fixed);
+    let n = light_interleave(light);
+    (0..count)
+        .map(|k| {
+            let (map, held, slot) = basis_table(maps, n, count, k);
+            TableRef {
+                map: map.to_string(),
+                layer: fixed.then(|| format!("SatLayer({held}, {slot})")),
+            }
+        })
+        .collect()
 }
 
 /// Light `light`'s basis maps as `(resource, channels)`: `light{light}.csm<chunk>` (two terms
@@ -78,8 +151,9 @@ fn basis_maps(graph: &mut Graph, light: usize, depth: &str, b: &CsmBasis) -> Vec
 /// Adds the summed-area tables of light `light`'s basis maps (`b`; the maps as in
 /// `basis_maps`, each table `<map>.sat`) coded as `coding` to `graph`, computed from the
 /// imported depth `depth` (read as `texture_2d<f32>`: a depth or an r32float texture) by one
-/// layered table ([`add_layered_sat`]): `2 + ⌈maps / 4⌉` dispatches, the depth read once a
-/// layer in each tile pass. Returns the tables, CSM's then the search's.
+/// layered table ([`add_layered_sat`]): `2 + ⌈maps / 4n⌉` dispatches (n = `b.interleave`),
+/// the depth read once a layer in each tile pass. Returns the textures that hold the tables,
+/// CSM's then the search's, `b.interleave` a texture ([`basis_table`] finds one).
 pub fn add_csm_tables(
     graph: &mut Graph,
     light: usize,
@@ -99,6 +173,8 @@ pub fn add_csm_tables(
         unorm16: 0,
         exp_pos: 0.0,
         exp_neg: 0.0,
+        interleave: b.interleave.max(1),
+        pad: [0; 3],
     };
     let kernels = match coding.variant {
         SatVariant::Fixed => [KernelId::CsmSatTileSums, KernelId::CsmSatTiles],
@@ -145,6 +221,8 @@ pub fn add_moment_table(
         unorm16: u32::from(m.storage == Storage::Unorm16),
         exp_pos: m.exp[0],
         exp_neg: m.exp[1],
+        interleave: 1,
+        pad: [0; 3],
     };
     let kernels = match (m.moments, coding.variant) {
         (Moments::Msm, SatVariant::Fixed) => [KernelId::MsmSatTileSums, KernelId::MsmSatTiles],
@@ -240,6 +318,7 @@ fn depth_tables(
         kernels,
         params: &params,
         coding,
+        interleave: template.interleave,
     };
     add_layered_sat(graph, light, &sat)
 }
@@ -257,6 +336,7 @@ pub(super) fn csm_sat_nodes(
         search,
         storage,
         depth: n.lin,
+        interleave: light_interleave(n.light),
     };
     let depth = n.depth.clone();
     add_csm_tables(n.graph, n.i, &depth, &b, coding)

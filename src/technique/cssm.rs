@@ -5,7 +5,8 @@
 //! paper's selective sharpening `v^p`,
 //! `p = 1 + A·exp(−B (d − z_avg))` alone.
 
-use super::csm::series_values;
+use super::csm::{basis_sequence, series_values};
+use super::csm_sat::TableRef;
 use super::params::{CSM, FLOAT_FORMAT, SOFT, choice, float, soft, soft_values};
 use super::sweep_plan::{SweepPlan, SweepVariant};
 use super::{TechniqueDef, no_clamp};
@@ -94,25 +95,36 @@ fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
         return VisibilityBody::simple(vec!["shared/vis_cssm"], String::new());
     };
     let suffix = table_suffix(soft.sums);
-    let (basis, z) = maps.split_at((csm_maps(terms) as usize).min(maps.len()));
-    let search = |m: &str| format!("sat_search_{suffix}({m}, l, s.uv, width)");
+    let tables = super::csm_sat::basis_refs(light, maps, basis_sequence(terms, Some(kind)).len());
+    let (basis, z) = tables.split_at((csm_maps(terms) as usize).min(tables.len()));
+    // Fixed-point tables lie interleaved in their textures (`SatLayer`s, read by the
+    // `sat_layer_*` lookups); f32 tables have a texture each.
+    let search = |t: &TableRef| match &t.layer {
+        Some(layer) => format!("sat_search_layer({}, {layer}, l, s.uv, width)", t.map),
+        None => format!("sat_search_float({}, l, s.uv, width)", t.map),
+    };
+    let search_fn = if soft.sums == SatVariant::Fixed {
+        "sat_search_layer".to_string()
+    } else {
+        format!("sat_search_{suffix}")
+    };
     // Fixed-point tables, all of the map's size, share the filter square's integer window
     // (`fwin`, computed once in the loop); f32 tables take their fractional corners each.
     let fixed = soft.sums == SatVariant::Fixed;
     let filter_fn = if fixed {
-        "sat_window_fixed".to_string()
+        "sat_layer_window".to_string()
     } else {
         format!("sat_filter_{suffix}")
     };
-    let sample = |m: &str| {
-        if fixed {
-            format!("sat_window_fixed({m}, fwin, l.sat_offset, l.sat_scale)")
-        } else {
-            format!(
-                "sat_filter_{suffix}({}, l, s.uv, look.width)",
-                table_args(soft.sums, m)
-            )
-        }
+    let sample = |t: &TableRef| match &t.layer {
+        Some(layer) => format!(
+            "sat_layer_window({}, {layer}, fwin, l.sat_offset, l.sat_scale)",
+            t.map
+        ),
+        None => format!(
+            "sat_filter_{suffix}({}, l, s.uv, look.width)",
+            table_args(soft.sums, &t.map)
+        ),
     };
     // The search reads its tables over the square snapped outward to texel edges (4 loads
     // each); the filter reads the basis tables over the penumbra square with its edges
@@ -121,12 +133,13 @@ fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
     let mut body = String::from("let width = blocker_search_width(l, s);");
     let searched = match kind {
         CssmSearch::Moments => {
-            let m = z.first().map_or("", String::as_str);
-            let _ = write!(
-                body,
-                "\n    let look = soft_blockers(cssm_blocker_moments({}, l, s), l, s);",
-                search(m)
-            );
+            if let Some(m) = z.first() {
+                let _ = write!(
+                    body,
+                    "\n    let look = soft_blockers(cssm_blocker_moments({}, l, s), l, s);",
+                    search(m)
+                );
+            }
             z.len()
         }
         CssmSearch::CsmZ => {
@@ -162,10 +175,14 @@ fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
          for (var k = 0u; k < soft_filter_trips(look); k++) {\n        \
          var terms = csm_terms_start(s.depth - l.bias - l.csm_offset, l);",
     );
-    if let (true, Some(first)) = (fixed, basis.first()) {
+    if let Some(TableRef {
+        map,
+        layer: Some(layer),
+    }) = basis.first()
+    {
         let _ = write!(
             body,
-            "\n        let fwin = sat_filter_window(l, s.uv, look.width, textureDimensions({first}));"
+            "\n        let fwin = sat_filter_window(l, s.uv, look.width, sat_layer_size({map}, {layer}));"
         );
     }
     for m in basis {
@@ -187,7 +204,7 @@ fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
          return cssm_resolve(sum, look, z_b, l, s);",
     );
     let fetches = format!(
-        "{searched} * sat_search_{suffix} + {} * {filter_fn}",
+        "{searched} * {search_fn} + {} * {filter_fn}",
         basis.len() + usize::from(refine.is_some())
     );
     VisibilityBody {
@@ -207,8 +224,9 @@ fn resolve_flag(resolve: CssmResolve, search: CssmSearch) -> u32 {
     }
 }
 
-/// What the visibility code depends on besides the maps (the shading kernel's key): M, and
-/// whether the filter loop reads the moments' table again (`resolve_flag` 2).
+/// What the visibility code depends on besides the maps (the shading kernel's key): M, the
+/// blocker search (the tables' order: with interleaved tables the bindings' count no longer
+/// tells), and whether the filter loop reads the moments' table again (`resolve_flag` 2).
 fn variant(t: &Technique) -> String {
     match *t {
         Technique::Cssm {
@@ -216,7 +234,11 @@ fn variant(t: &Technique) -> String {
             resolve,
             search,
             ..
-        } => format!("{terms} {}", resolve_flag(resolve, search)),
+        } => format!(
+            "{terms} {} {}",
+            search.name(),
+            resolve_flag(resolve, search)
+        ),
         _ => String::new(),
     }
 }

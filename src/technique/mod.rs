@@ -36,14 +36,17 @@ pub use crate::model::mip_levels;
 use crate::model::{Light, ParamSource, ParamSpec, ParamValues, Technique};
 pub use cascade_shade::{CascadeGroup, shade_key_cascaded};
 pub use csm::{basis_sequence, csm_maps, csm_z_channels, csm_z_maps, search_maps};
-pub use csm_sat::{CsmBasis, CsmSatParams, MomentTable, Moments, add_csm_tables, add_moment_table};
+pub use csm_sat::{
+    CsmBasis, CsmSatParams, INTERLEAVED_MAX_WIDTH, MomentTable, Moments, add_csm_tables,
+    add_moment_table, basis_interleave, basis_table,
+};
 use light_gpu::unit_range;
 pub use light_gpu::{sat_coding, sat_variant, soft_lookup_area, soft_max_width, soft_width_cap};
 pub use msm::msm_quantized;
 pub use nodes::LightNodes;
 pub use nodes::{
     PACKED_MAP_TYPE, add_light_nodes, depth_name, float_moments_format, linear_name, map_channels,
-    map_type, maps_packed, moments_format,
+    map_tables, map_type, maps_packed, moments_format,
 };
 pub use params::{Clamp, ClampReason, sat_exponent_limit};
 pub use reference::parameters_markdown;

@@ -194,21 +194,32 @@ pub fn add_light_nodes(graph: &mut Graph, i: usize, light: &Light) -> ShadeInput
     (super::of(&light.shadow.technique).nodes)(&mut nodes)
 }
 
-/// Channels of the representation behind each map the shading binds for `light` (for a
-/// summed-area table, those of the table's input: the table itself always has four).
+/// Channels of the representation behind each table or map the shading reads for `light`
+/// (for a summed-area table, those of the table's input: the table itself always has four),
+/// in binding order, the tables a texture holds interleaved ([`map_tables`]) one after another.
 pub fn map_channels(light: &Light) -> Vec<usize> {
+    map_tables(light).into_iter().flatten().collect()
+}
+
+/// Per map the shading binds for `light`, the channels of the representation behind each
+/// table it holds: one entry for a map or a table of its own, one a table for tables
+/// interleaved in one texture ([`Graph::interleaved`]), in slot order.
+pub fn map_tables(light: &Light) -> Vec<Vec<usize>> {
     let mut graph = Graph::default();
     let input = add_light_nodes(&mut graph, 0, light);
+    let table = sat_coding(light).ok().flatten().is_some();
+    let channels = |m: &str| {
+        let source = m.strip_suffix(".sat").filter(|_| table);
+        graph
+            .find(source.unwrap_or(m))
+            .map_or(4, |r| crate::sat::format_channels(r.format) as usize)
+    };
     input
         .maps
         .iter()
-        .map(|m| {
-            let source = m
-                .strip_suffix(".sat")
-                .filter(|_| sat_coding(light).ok().flatten().is_some());
-            graph
-                .find(source.unwrap_or(m))
-                .map_or(4, |r| crate::sat::format_channels(r.format) as usize)
+        .map(|m| match graph.find(m).map(|r| r.layers.as_slice()) {
+            Some(layers) if !layers.is_empty() => layers.iter().map(|l| channels(l)).collect(),
+            _ => vec![channels(m)],
         })
         .collect()
 }

@@ -161,7 +161,25 @@ pub fn shade_key(lights: &[Light]) -> String {
         let footprint =
             matches!(t.filter(), Some(Filter::Mips { max_anisotropy, .. }) if max_anisotropy > 0);
         let def = super::of(t);
-        let input = add_light_nodes(&mut Graph::default(), i, light);
+        let mut graph = Graph::default();
+        let input = add_light_nodes(&mut graph, i, light);
+        // Tables interleaved in a texture are read at their slots (`SatLayer(n, k)`): the
+        // tables each binding holds, where any holds several.
+        let held: Vec<String> = input
+            .maps
+            .iter()
+            .map(|m| {
+                graph
+                    .find(m)
+                    .map_or(1, |r| r.layers.len().max(1))
+                    .to_string()
+            })
+            .collect();
+        let layout = if held.iter().any(|h| h != "1") {
+            format!(" [{}]", held.join(","))
+        } else {
+            String::new()
+        };
         let point = if light.kind == LightKind::Point {
             " point"
         } else {
@@ -169,7 +187,7 @@ pub fn shade_key(lights: &[Light]) -> String {
         };
         let _ = write!(
             key,
-            "|{}{point} {table} {} {} {}x{}",
+            "|{}{point} {table} {} {} {}x{}{layout}",
             def.name,
             u8::from(footprint),
             (def.variant)(t),
