@@ -104,6 +104,15 @@ fn tile_of(wg: vec2<u32>) -> Tile {
     return t;
 }
 
+// (i / d, i % d) for 0 ≤ i < 2²³ and d ≥ 1, in f32: llvmpipe has no vector integer division
+// (a SIMD group's division is eight scalar ones; the tile's shape is not a compile-time
+// constant). (i + ½)/d lies at least ½/d from an integer and its f32 quotient is within
+// 2⁻²⁴·(i + ½)/d < ½/d of it, so the truncation is ⌊i / d⌋ exactly.
+fn div_mod(i: i32, d: i32) -> vec2<i32> {
+    let q = i32((f32(i) + 0.5) / f32(d));
+    return vec2<i32>(q, i - q * d);
+}
+
 // The weight of offset i ≤ radius.
 fn blur_weight(i: i32) -> f32 {
     return params.blur.weights[u32(i) / 4u][u32(i) % 4u];
@@ -122,7 +131,8 @@ fn sh_depth(i: i32) -> f32 {
 fn load_depth(t: Tile, li: u32) {
     let n = t.dep.x * t.dep.y;
     for (var i = i32(li); i < n; i += i32(WG_SIZE)) {
-        let p = t.origin - t.r - 1 + vec2<i32>(i % t.dep.x, i / t.dep.x);
+        let yx = div_mod(i, t.dep.x);
+        let p = t.origin - t.r - 1 + vec2<i32>(yx.y, yx.x);
         let q = clamp(p, vec2<i32>(0), t.size - 1);
         let raw = textureLoad(src, q, 0).r;
         sh_tile[i] = texel_of(vec4<f32>(linear_depth(raw, params.depth), 0.0, 0.0, 0.0));
@@ -137,7 +147,8 @@ fn load_depth(t: Tile, li: u32) {
 // a texel it does not store, so none branches).
 fn encode_at(t: Tile, i: i32) -> Texel {
     let e = min(i, t.enc.x * t.enc.y - 1);
-    let d = (e / t.enc.x + 1) * t.dep.x + e % t.enc.x + 1;
+    let yx = div_mod(e, t.enc.x);
+    let d = (yx.x + 1) * t.dep.x + yx.y + 1;
     return texel_of(encode(
         sh_depth(d),
         sh_depth(d - 1),
@@ -249,8 +260,9 @@ fn run_sums(first: i32, step: i32, r: i32) -> Run {
 fn blur_tile_runs(t: Tile, li: u32) {
     let i = i32(li);
     let runs_x = t.outs.x / i32(RUN);
-    let row = i / runs_x;
-    let x0 = (i % runs_x) * i32(RUN);
+    let rx = div_mod(i, runs_x);
+    let row = rx.x;
+    let x0 = rx.y * i32(RUN);
     let along_x = row < t.enc.y;
     var h: Run;
     if along_x {
@@ -266,8 +278,9 @@ fn blur_tile_runs(t: Tile, li: u32) {
     }
     workgroupBarrier();
     let runs_y = t.outs.y / i32(RUN);
-    let col = i % t.outs.x;
-    let y0 = (i / t.outs.x) * i32(RUN);
+    let yc = div_mod(i, t.outs.x);
+    let col = yc.y;
+    let y0 = yc.x * i32(RUN);
     if i < t.outs.x * runs_y {
         let v = run_sums((y0 + t.r.y) * t.outs.x + col, t.outs.x, t.r.y);
         store(t, vec2<i32>(col, y0), v.s0);
@@ -289,7 +302,7 @@ fn sum_x(t: Tile, x: i32, y: i32) -> Texel {
 
 // The vertical sum of output q of the tile, alone, stored.
 fn sum_y(t: Tile, q: i32) {
-    let o = vec2<i32>(q % t.outs.x, q / t.outs.x);
+    let o = div_mod(q, t.outs.x).yx;
     let c = (o.y + t.r.y) * t.outs.x + o.x;
     var v = blur_weight(0) * sh_get(c);
     for (var k = 1; k <= t.r.y; k++) {
@@ -305,15 +318,19 @@ fn blur_tile_single(t: Tile, li: u32) {
     let i = i32(li);
     let w = i32(WG_SIZE);
     let j1 = min(i + w, n - 1);
-    let h0 = sum_x(t, i % t.outs.x, i / t.outs.x);
-    let h1 = sum_x(t, j1 % t.outs.x, j1 / t.outs.x);
+    let a0 = div_mod(i, t.outs.x);
+    let a1 = div_mod(j1, t.outs.x);
+    let h0 = sum_x(t, a0.y, a0.x);
+    let h1 = sum_x(t, a1.y, a1.x);
     var h2 = h1;
     var h3 = h1;
     if H_MAX > 2u * WG_SIZE && 2 * w < n {
         let j2 = min(i + 2 * w, n - 1);
         let j3 = min(i + 3 * w, n - 1);
-        h2 = sum_x(t, j2 % t.outs.x, j2 / t.outs.x);
-        h3 = sum_x(t, j3 % t.outs.x, j3 / t.outs.x);
+        let a2 = div_mod(j2, t.outs.x);
+        let a3 = div_mod(j3, t.outs.x);
+        h2 = sum_x(t, a2.y, a2.x);
+        h3 = sum_x(t, a3.y, a3.x);
     }
     workgroupBarrier();
     put_below(i, n, h0);
