@@ -15,8 +15,9 @@ use super::nodes::add_light_nodes;
 /// How the shading kernel reads a light's maps.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ShadeInput {
-    /// Graph resources bound, in binding order (one for every technique but CSM, which binds
-    /// one map per two terms).
+    /// Graph resources bound, in binding order (one for every technique but CSM and CSSM,
+    /// which bind one map per two terms and the search's maps, or through fixed-point tables
+    /// the textures their tables are interleaved in, `Graph::interleaved`).
     pub maps: Vec<String>,
     /// WGSL type of each binding.
     pub wgsl_type: &'static str,
