@@ -224,8 +224,35 @@ pub fn kernel_over(name: &str, wgsl: &str, l: &wgpu::Limits) -> Result<Option<Ne
         .find(Need::over))
 }
 
-/// The first step of `plan` whose kernel or dispatch exceeds `l`, if any.
+/// The first step of `plan` whose kernel or dispatch exceeds `l`, if any, or else the first
+/// texture wider or taller than the device allows (tables interleaved along x are several
+/// times as wide as the map: `Graph::interleaved`).
 pub fn plan_over(plan: &Plan, l: &wgpu::Limits) -> Result<Option<StepOver>> {
+    if let Some(over) = steps_over(plan, l)? {
+        return Ok(Some(over));
+    }
+    let max = l.max_texture_dimension_2d;
+    Ok(plan
+        .resources
+        .iter()
+        .find(|r| r.width.max(r.height) > max)
+        .map(|r| StepOver {
+            node: r
+                .producer
+                .map_or_else(String::new, |s| plan.steps[s].node.name.clone()),
+            light: r.resource.light,
+            what: format!(
+                "texture `{}` ({}×{}): its side (max_texture_dimension_2d)",
+                r.resource.name, r.width, r.height
+            ),
+            dispatch: true,
+            requested: r.width.max(r.height).into(),
+            limit: max.into(),
+        }))
+}
+
+/// The first step of `plan` whose kernel or dispatch exceeds `l`, if any.
+fn steps_over(plan: &Plan, l: &wgpu::Limits) -> Result<Option<StepOver>> {
     let mut workgroups: HashMap<&str, [u32; 3]> = HashMap::new();
     for step in &plan.steps {
         let node = &step.node;

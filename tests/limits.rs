@@ -242,6 +242,44 @@ fn a_point_lights_atlas_is_checked_whole() {
     assert_eq!(m.lights, vec![2 * 3072 * 2048 * 4]);
 }
 
+/// CSSM's fixed-point tables interleaved in one texture five times as wide as the map
+/// (`technique::basis_interleave`, as many as fit in 8192 texels): a device whose largest
+/// side is under that is told which texture and the map size's key and line, not wgpu's
+/// validation text; the map alone fits it.
+#[test]
+fn interleaved_tables_past_the_largest_side_name_the_map_size() {
+    let cssm = light(1024, "technique = \"cssm\"\nterms = 8")
+        .replace("shadow_map", "size = 0.5\nshadow_map");
+    let (text, s) = scene(64, 48, &[cssm]);
+    let sp = plan_lights(&s.lights).unwrap();
+    let check = |max: u32| {
+        let limits = wgpu::Limits {
+            max_texture_dimension_2d: max,
+            ..wgpu::Limits::default()
+        };
+        shadowgraph::limits::check_scene(
+            &s,
+            &sp,
+            &limits,
+            wgpu::Features::empty(),
+            &RenderOptions::default(),
+            1 << 30,
+        )
+        .map_err(|e| e.to_string())
+    };
+    check(8192).expect("5120 texels wide fit 8192");
+    let shown = check(4096).expect_err("5120 texels wide on a 4096 device");
+    let line = nth_line(&text, "shadow_map", 0);
+    assert!(
+        shown.starts_with(&format!("limits.toml:{line}:"))
+            && shown.contains("light0.csm.sat.layers0")
+            && shown.contains("5120")
+            && shown.contains("max_texture_dimension_2d")
+            && shown.contains("light[0].shadow_map"),
+        "{shown}"
+    );
+}
+
 /// A second-depth light counts its peeled second depth map too: two depth maps and the
 /// comparison map, by hand.
 #[test]
