@@ -79,6 +79,13 @@ impl Plan {
                     r.height,
                     human_bytes(r.bytes)
                 );
+                if !r.resource.layers.is_empty() {
+                    let _ = writeln!(
+                        s,
+                        "        interleaved along x: {}",
+                        r.resource.layers.join(", ")
+                    );
+                }
             }
             if let Some(extra) = per_light.get(li) {
                 s.push_str(extra);
