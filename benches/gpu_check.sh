@@ -11,7 +11,7 @@
 # figures moved up to 4× between calls at 4096²). On an H200 (2026-11-26) the soft table
 # took 67 s, the 2048² kernels 6 s and each large round 93 s per binary, before the GPU
 # warm-up added 0.3 s a kernel case (about 15 s a kernel step): with BASE (which adds four
-# 2048² blur steps and a large round), give the call 540 s or more.
+# 2048² blur steps, four CSSM shading steps and a large round), give the call 540 s or more.
 # Each step writes its own file in OUT and prints its wall time, so a call stopped by its time
 # box still returns what ran. Record the results in benches/RESULTS.md (device, date, commit,
 # command, table).
@@ -46,6 +46,14 @@ step wall.txt "$B" render scenes/bunny.toml --timings --repeat 20 -o "$OUT/bunny
 # figures there moved up to 4× between runs). `--passes` splits each chain by dispatch (the
 # soft tables' build, issue 14's ≤ 0.2 ms at 2048²: `chain vssm`, `chain msm_soft`).
 if [ -n "$BASE" ]; then
+    # CSSM's shading of both builds, alternated (b80d7f3 as BASE: a texture a table against
+    # the tables interleaved in one, 2026-11-27).
+    for round in 1 2; do
+        echo "## base, round $round" >>"$OUT/cssm_soft.txt"
+        step cssm_soft.txt "$BASE" bench --lookup 3 --repeat 20 --image 1920x1080 --map 2048 --only cssm
+        echo "## $B, round $round" >>"$OUT/cssm_soft.txt"
+        step cssm_soft.txt "$B" bench --lookup 3 --repeat 20 --image 1920x1080 --map 2048 --only cssm
+    done
     # The blur passes and fused blurs of both builds at 2048², alternated.
     for round in 1 2; do
         echo "## base, round $round" >>"$OUT/blur_2048.txt"
