@@ -269,25 +269,30 @@ fn check(g: &Gpu, seed: u64, case: &Case) {
     let interleave = basis_interleave(case.w as u32, layers, case.variant);
     let (tables, steps, stats) = run(g, case, &raw, coding, interleave);
     if interleave > 1 {
-        // A texture a table holds the same words (its own channels; an interleaved table
-        // has its texture's, the widest table's, the rest 0).
-        let (alone, steps_alone, _) = run(g, case, &raw, coding, 1);
+        // A texture a table, and two a texture (the last holding the rest: with nine tables
+        // five textures, two pass-3 dispatches), hold the same words (each its own channels;
+        // an interleaved table has its texture's, the widest table's, the rest 0).
         let texels = case.w * case.h;
-        for (m, (a, t)) in alone.iter().zip(&tables).enumerate() {
-            let (na, nt) = (a.len() / texels, t.len() / texels);
-            let same = a
-                .chunks(na)
-                .zip(t.chunks(nt))
-                .all(|(x, y)| y[..na] == *x && y[na..].iter().all(|&w| w == 0));
-            assert!(
-                same,
-                "{what} table {m}: interleaved {interleave} a texture, it differs"
+        for other in [1, 2] {
+            let (words, steps_other, _) = run(g, case, &raw, coding, other);
+            for (m, (a, t)) in words.iter().zip(&tables).enumerate() {
+                let (na, nt) = (a.len() / texels, t.len() / texels);
+                let n = na.min(nt);
+                let same = a.chunks(na).zip(t.chunks(nt)).all(|(x, y)| {
+                    x[..n] == y[..n] && x[n..].iter().chain(&y[n..]).all(|&w| w == 0)
+                });
+                assert!(
+                    same,
+                    "{what} table {m}: {other} a texture against {interleave}, it differs"
+                );
+            }
+            let textures = tables.len().div_ceil(other as usize);
+            assert_eq!(
+                steps_other,
+                2 + textures.div_ceil(LAYERED_SAT_OUTPUTS as usize),
+                "{what}: dispatches, {other} tables a texture"
             );
         }
-        assert_eq!(
-            steps_alone,
-            2 + tables.len().div_ceil(LAYERED_SAT_OUTPUTS as usize)
-        );
     }
     let [c_pos, c_neg] = case.exp.map(f64::from);
     let want = match case.moments {

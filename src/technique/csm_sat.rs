@@ -364,3 +364,34 @@ pub(super) fn moment_table_nodes(
     let table = add_moment_table(n.graph, n.i, &depth, &m, coding);
     Some(n.one(table))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Five tables two a texture: the last texture holds one, at slot 0; fixed-point tables
+    /// interleave as many as fit in 8192 texels, f32 tables never.
+    #[test]
+    fn tables_find_their_texture_width_and_slot() {
+        let maps: Vec<String> = ["a", "b", "c"].map(String::from).to_vec();
+        let at: Vec<(&str, u32, u32)> = (0..5).map(|k| basis_table(&maps, 2, 5, k)).collect();
+        assert_eq!(
+            at,
+            [
+                ("a", 2, 0),
+                ("a", 2, 1),
+                ("b", 2, 0),
+                ("b", 2, 1),
+                ("c", 1, 0)
+            ]
+        );
+        assert_eq!(basis_table(&maps[..1], 1, 1, 0), ("a", 1, 0));
+        let fixed = |w| basis_interleave(w, 5, SatVariant::Fixed);
+        assert_eq!(
+            [512, 1638, 1639, 2048, 4096, 8192, 16384].map(fixed),
+            [5, 5, 4, 4, 2, 1, 1]
+        );
+        assert_eq!(basis_interleave(512, 5, SatVariant::Float), 1);
+        assert_eq!(basis_interleave(512, 9, SatVariant::Fixed), 9);
+    }
+}
