@@ -30,11 +30,16 @@ const LINEAR_RTOL: f64 = 5.0 * U;
 /// A spot light (perspective depth) from `scenes/techniques/cssm.toml` with `shadow` as its
 /// technique keys, on a `MAP`² map.
 fn spot(shadow: &str) -> Light {
+    spot_sized(shadow, MAP)
+}
+
+/// [`spot`] on an `n`² map.
+fn spot_sized(shadow: &str, n: u32) -> Light {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/techniques/cssm.toml");
     let text = std::fs::read_to_string(&path)
         .expect("cssm.toml")
         .replace("technique = \"cssm\"\nterms = 8", shadow)
-        .replace("shadow_map = 512", &format!("shadow_map = {MAP}"));
+        .replace("shadow_map = 512", &format!("shadow_map = {n}"));
     let scene = Scene::parse(&path, &text).unwrap_or_else(|e| panic!("{shadow}: {e}"));
     scene.lights[0].clone()
 }
@@ -42,8 +47,13 @@ fn spot(shadow: &str) -> Light {
 /// A raw depth buffer: values spread over [0, 1] (perspective depth crowds near 1), with
 /// `bad` NaN and ±Inf texels.
 fn raw_depth(bad: usize) -> Vec<f32> {
+    raw_depth_sized(bad, MAP)
+}
+
+/// [`raw_depth`] of an `n`² map.
+fn raw_depth_sized(bad: usize, n: u32) -> Vec<f32> {
     let mut rng = common::rng(0xF05E);
-    let mut raw: Vec<f32> = (0..MAP * MAP)
+    let mut raw: Vec<f32> = (0..n * n)
         .map(|_| 1.0 - rng.random_range(0.0f32..1.0).powi(3))
         .collect();
     for k in 0..bad {
@@ -56,6 +66,7 @@ fn raw_depth(bad: usize) -> Vec<f32> {
 /// Runs `light`'s graph on `raw` for `outputs` (each in its own texture, poisoned with NaN
 /// first so unwritten texels show); returns them and each step's non-finite count.
 fn run(light: &Light, raw: &[f32], outputs: &[String]) -> (Vec<Texels>, Vec<(String, u32)>) {
+    let n = side(raw);
     let g = common::gpu();
     let mut graph = Graph::default();
     technique::add_light_nodes(&mut graph, 0, light);
@@ -64,8 +75,8 @@ fn run(light: &Light, raw: &[f32], outputs: &[String]) -> (Vec<Texels>, Vec<(Str
     let depth = g.device.create_texture(&wgpu::TextureDescriptor {
         label: Some("test.depth"),
         size: wgpu::Extent3d {
-            width: MAP,
-            height: MAP,
+            width: n,
+            height: n,
             depth_or_array_layers: 1,
         },
         mip_level_count: 1,
@@ -84,7 +95,7 @@ fn run(light: &Light, raw: &[f32], outputs: &[String]) -> (Vec<Texels>, Vec<(Str
         .expect("record");
     for name in outputs {
         let t = &out.textures[name];
-        let bytes = texel_bytes(t.format()) as usize * (MAP * MAP) as usize;
+        let bytes = texel_bytes(t.format()) as usize * (n * n) as usize;
         // 0xFF bytes: NaN in every float format.
         write_texture(&g.queue, t, &vec![0xFF; bytes]);
     }
@@ -97,18 +108,24 @@ fn run(light: &Light, raw: &[f32], outputs: &[String]) -> (Vec<Texels>, Vec<(Str
             let format = plan.resource(name).expect("planned").resource.format;
             let (c, v) = read_resource_texture(&g.device, &g.queue, &out.textures[name], 0, format)
                 .expect("read back");
-            Texels::from_f32(MAP as usize, MAP as usize, c, &v)
+            Texels::from_f32(n as usize, n as usize, c, &v)
         })
         .collect();
     (maps, out.read_stats(&g.device).expect("stats"))
 }
 
+/// The side of the square map `raw`.
+fn side(raw: &[f32]) -> u32 {
+    (raw.len() as f64).sqrt().round() as u32
+}
+
 /// The f64 linear depth of `raw` for `light`, and the texels it replaces.
 fn linear(light: &Light, raw: &[f32]) -> (Texels, u32) {
+    let n = side(raw) as usize;
     let (z, replaced) = cpu::linearize::linearize(raw, true, light.near.into(), light.far.into());
     let t = Texels {
-        width: MAP as usize,
-        height: MAP as usize,
+        width: n,
+        height: n,
         channels: 1,
         data: z,
     };
@@ -353,6 +370,42 @@ fn fused_blurs_match_encode_then_blur() {
             let blur_rtol = 2.0 * (f64::from(radius) + 3.0) * U;
             common::assert_close(&what, &got, &channels(&want, 0, n), atol, rtol + blur_rtol);
             assert_counted(&what, &stats, steps, replaced);
+        }
+    }
+}
+
+/// `vsm_blur`'s row path (radius past the tile's 7: the encoding fused into the horizontal
+/// pass, 512 outputs a workgroup in runs of 2, then `blur`'s vertical pass) on a 1100² map,
+/// three row workgroups a row (the last ragged), at radius 12 and 32, f32 and f16 (packed),
+/// against the f64 encoding then both blur passes; tolerances as
+/// `fused_blurs_match_encode_then_blur`'s.
+#[test]
+fn vsm_row_path_spans_row_workgroups() {
+    use shadowgraph::scene::BlurKernel;
+    const WIDE: u32 = 1100;
+    let raw = raw_depth_sized(5, WIDE);
+    for radius in [12u32, 32] {
+        let sigma = f64::from(radius) / 2.0;
+        for (format, store_rtol, atol) in [
+            ("f32", 0.0, 10.0 * U),
+            ("f16", 2.0 * 2f64.powi(-10), 10.0 * U + 2f64.powi(-14)),
+        ] {
+            let light = spot_sized(
+                &format!(
+                    "technique = \"vsm\"\nformat = \"{format}\"\nfilter = \"blur\"\n\
+                     filter_radius = {radius}\nfilter_sigma = {sigma}"
+                ),
+                WIDE,
+            );
+            let what = format!("vsm {format} r = {radius} on {WIDE}²");
+            let (maps, stats) = run(&light, &raw, &["light0.vsm.blur".to_string()]);
+            let (lin, replaced) = linear(&light, &raw);
+            let want = cpu::vsm_blur::vsm_blur(&lin, radius.into(), sigma, BlurKernel::Gaussian);
+            let got: Vec<f32> = channels(&maps[0], 0, 2).iter().map(|&v| v as f32).collect();
+            let rtol =
+                2.0 * LINEAR_RTOL + 3.0 * U + store_rtol + 2.0 * (f64::from(radius) + 3.0) * U;
+            common::assert_close(&what, &got, &channels(&want, 0, 2), atol, rtol);
+            assert_counted(&what, &stats, 1, replaced);
         }
     }
 }
