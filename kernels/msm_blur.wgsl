@@ -16,8 +16,8 @@ struct Params {
 }
 
 // Traffic (the cost model, src/graph/cost): a tile workgroup loads its TILE² depths with a halo
-// of r + 1 each side, a row workgroup three rows of ROW + 2r + 2; each output is stored once.
-// #traffic src: select(3 * (ROW + 2 * min(params.blur.radius, MAX_RADIUS) + 2), (TILE + 2 * min(params.blur.radius, TILE_RADIUS) + 2) * (TILE + 2 * min(params.blur.radius, TILE_RADIUS) + 2), params.blur.axis == 2) per group
+// of r + 1 each side, a row workgroup three rows of its outputs (ROW, the last of a row the rest) + 2r + 2; each output is stored once.
+// #traffic src: select(3 * (dst.width / ceil(dst.width / ROW) + 2 * min(params.blur.radius, MAX_RADIUS) + 2), (TILE + 2 * min(params.blur.radius, TILE_RADIUS) + 2) * (TILE + 2 * min(params.blur.radius, TILE_RADIUS) + 2), params.blur.axis == 2) per group
 // #traffic dst: all
 // #traffic stats: none
 

@@ -1,48 +1,19 @@
 // Rasterized depth → variance-shadow-map moments (shared/vsm_moments), blurred, in one pass:
-// the encoding fused into the separable blur (shared/encode_blur). With a radius past
-// TILE_RADIUS it is the first of two passes (encode and blur along x; `blur` along y).
+// the encoding fused into the separable blur (shared/encode_blur, shared/vsm_blur_kernel). With
+// a radius past TILE_RADIUS it is the first of two passes (encode and blur along x; `blur`
+// along y) on maps narrower than 1024 texels, `vsm_blur_row` on wider ones.
 
-// #import shared/encode_blur
-// #import shared/vsm_moments
-
-// Keep in sync with `VsmParams` in src/gpu_data.rs, then `BlurParams` in src/filter.rs.
-struct Params {
-    depth: DepthParams,
-    blur: BlurSpec,
-}
+// #import shared/vsm_blur_kernel
 
 // Traffic (the cost model, src/graph/cost): a tile workgroup loads its TILE² depths with a halo
-// of r + 1 each side, a row workgroup three rows of ROW + 2r + 2; each output is stored once.
-// #traffic src: select(3 * (ROW + 2 * min(params.blur.radius, MAX_RADIUS) + 2), (TILE + 2 * min(params.blur.radius, TILE_RADIUS) + 2) * (TILE + 2 * min(params.blur.radius, TILE_RADIUS) + 2), params.blur.axis == 2) per group
+// of r + 1 each side, a row workgroup three rows of its outputs (ROW, the last of a row the rest) + 2r + 2; each output is stored once.
+// #traffic src: select(3 * (dst.width / ceil(dst.width / ROW) + 2 * min(params.blur.radius, MAX_RADIUS) + 2), (TILE + 2 * min(params.blur.radius, TILE_RADIUS) + 2) * (TILE + 2 * min(params.blur.radius, TILE_RADIUS) + 2), params.blur.axis == 2) per group
 // #traffic dst: all
 // #traffic stats: none
 
-const CHANNELS: u32 = 2u;
-// The tile its workgroup memory allows (shared/encode_blur). Keep in sync with
-// `encode_blur_tile` in src/filter/encode_blur.rs.
-const TILE: u32 = 24u;
-const SH_TEXELS: u32 = 1734u;
-// Outputs an invocation sums in the tile's blur passes, two channels: runs of 4 (shared/encode_blur, `run_sums`).
-const RUN: u32 = 4u;
-// Outputs of a one-row workgroup (the fallback past TILE_RADIUS) and the run an invocation sums
-// there (shared/encode_blur). Keep in sync with `encode_blur_row` in src/filter/encode_blur.rs.
+// Outputs of a one-row workgroup and the run an invocation sums there (shared/encode_blur):
+// the row pass of maps narrower than `vsm_blur_row`'s 1024-texel rows (which would leave half
+// its invocations idle). Its three depth rows fit one a texel (`ROW_PACKED` false). Keep in
+// sync with `encode_blur_row` in src/filter/encode_blur.rs.
 const ROW: u32 = 512u;
 const ROW_RUN: u32 = 2u;
-alias Texel = vec2<f32>;
-
-fn texel_of(v: vec4<f32>) -> Texel {
-    return v.xy;
-}
-
-fn texel_out(t: Texel) -> vec4<f32> {
-    return vec4<f32>(t, 0.0, 0.0);
-}
-
-fn encode(z: f32, left: f32, right: f32, up: f32, down: f32) -> vec4<f32> {
-    return vec4<f32>(vsm_moments(z, left, right, up, down), 0.0, 0.0);
-}
-
-@compute @workgroup_size(WG_SIZE)
-fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    encode_blur(wg.xy, li);
-}

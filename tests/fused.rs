@@ -374,11 +374,12 @@ fn fused_blurs_match_encode_then_blur() {
     }
 }
 
-/// `vsm_blur`'s row path (radius past the tile's 7: the encoding fused into the horizontal
-/// pass, 512 outputs a workgroup in runs of 2, then `blur`'s vertical pass) on a 1100² map,
-/// three row workgroups a row (the last ragged), at radius 12 and 32, f32 and f16 (packed),
-/// against the f64 encoding then both blur passes; tolerances as
-/// `fused_blurs_match_encode_then_blur`'s.
+/// VSM's row pass on a map at least 1024 texels wide (radius past the tile's 7: the encoding
+/// fused into the horizontal pass by `vsm_blur_row`, 1024 outputs a workgroup in runs of 4, its
+/// depth rows packed two to a texel, then `blur`'s vertical pass) on a 1100² map, two row
+/// workgroups a row (the second ragged, clipped to the map), at radius 12 and 32, f32 and f16
+/// (packed), against the f64 encoding then both blur passes; tolerances as
+/// `fused_blurs_match_encode_then_blur`'s (whose 300² map keeps `vsm_blur`'s 512-texel rows).
 #[test]
 fn vsm_row_path_spans_row_workgroups() {
     use shadowgraph::scene::BlurKernel;
@@ -398,6 +399,15 @@ fn vsm_row_path_spans_row_workgroups() {
                 WIDE,
             );
             let what = format!("vsm {format} r = {radius} on {WIDE}²");
+            let mut graph = Graph::default();
+            technique::add_light_nodes(&mut graph, 0, &light);
+            let kernels: Vec<&str> = plan(&graph, &["light0.vsm.blur"])
+                .expect("plan")
+                .steps
+                .iter()
+                .map(|s| s.node.kernel.as_str())
+                .collect();
+            assert_eq!(kernels, ["vsm_blur_row", "blur"], "{what}");
             let (maps, stats) = run(&light, &raw, &["light0.vsm.blur".to_string()]);
             let (lin, replaced) = linear(&light, &raw);
             let want = cpu::vsm_blur::vsm_blur(&lin, radius.into(), sigma, BlurKernel::Gaussian);

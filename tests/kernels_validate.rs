@@ -330,6 +330,10 @@ fn rust_mirrors_match_naga_layouts() {
         // The encodings fused into the blur: the encoding's parameters, then the blur's.
         ("vsm_blur", size_of::<VsmParams>() + size_of::<BlurParams>()),
         (
+            "vsm_blur_row",
+            size_of::<VsmParams>() + size_of::<BlurParams>(),
+        ),
+        (
             "evsm_blur",
             size_of::<ExpParams>() + size_of::<BlurParams>(),
         ),
@@ -446,6 +450,7 @@ fn packed_f16_variants_validate() {
         "vsm",
         "evsm",
         "vsm_blur",
+        "vsm_blur_row",
         "evsm_blur",
         "blur",
         "mips",
@@ -476,7 +481,7 @@ fn packed_f16_variants_validate() {
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
-    assert_eq!(rewritten, 10, "every variant packs or unpacks");
+    assert_eq!(rewritten, 11, "every variant packs or unpacks");
 }
 
 /// Every compute kernel fits WebGPU's default limits (what `wgpu::Limits::default()` asks
@@ -618,9 +623,29 @@ fn log_blur_span_matches_the_wgsl() {
 
 #[test]
 fn encode_blur_dispatch_constants_match_the_wgsl() {
-    use shadowgraph::filter::{ENCODE_BLUR_TILE_RADIUS, encode_blur_row, encode_blur_tile};
+    use shadowgraph::filter::{
+        ENCODE_BLUR_TILE_RADIUS, encode_blur_row, encode_blur_row_kernel, encode_blur_tile,
+    };
     use shadowgraph::kernels::KernelId;
-    for kernel in [KernelId::VsmBlur, KernelId::EvsmBlur, KernelId::MsmBlur] {
+    // VSM's row pass: 1024-texel rows where they are full, else `vsm_blur`'s 512.
+    assert_eq!(
+        encode_blur_row_kernel(KernelId::VsmBlur, 1023),
+        KernelId::VsmBlur
+    );
+    assert_eq!(
+        encode_blur_row_kernel(KernelId::VsmBlur, 1024),
+        KernelId::VsmBlurRow
+    );
+    assert_eq!(
+        encode_blur_row_kernel(KernelId::EvsmBlur, 4096),
+        KernelId::EvsmBlur
+    );
+    for kernel in [
+        KernelId::VsmBlur,
+        KernelId::VsmBlurRow,
+        KernelId::EvsmBlur,
+        KernelId::MsmBlur,
+    ] {
         let name = kernel.name();
         let wgsl = kernels::resolve(name, None).expect("resolve");
         let (module, r) = kernels::reflect(name, &wgsl).expect("reflect");
@@ -654,7 +679,10 @@ fn encode_blur_dispatch_constants_match_the_wgsl() {
         let channels = wgsl_const(&module, "CHANNELS").expect("CHANNELS");
         match channels {
             2 => {
-                assert_eq!(row_run, 2, "{name}: ROW_RUN (blur_row_pairs)");
+                // `vsm_blur_row`'s runs of 4 (`blur_row_quads`), `vsm_blur`'s of 2
+                // (`blur_row_pairs`).
+                let want = if kernel == KernelId::VsmBlurRow { 4 } else { 2 };
+                assert_eq!(row_run, want, "{name}: ROW_RUN");
                 assert_eq!(run, 4, "{name}: RUN (the sums s0 … s3)");
                 assert_eq!(tile % run, 0, "{name}: runs per line");
                 assert!(tile / run * enc <= wg, "{name}: runs along x");
@@ -666,12 +694,23 @@ fn encode_blur_dispatch_constants_match_the_wgsl() {
                 assert!(tile * enc <= 4 * wg, "{name}: horizontal sums");
             }
         }
-        // Workgroup memory: the depth tile with its halo, and the fallback's three rows.
+        // Workgroup memory: the depth tile with its halo, the fallback's three rows (packed
+        // `channels` depths a texel where one a texel would not fit: `ROW_PACKED`), and the
+        // encoded row.
         let sh = wgsl_const(&module, "SH_TEXELS").expect("SH_TEXELS");
         let max_radius = wgsl_const(&module, "MAX_RADIUS").expect("MAX_RADIUS");
         let dep = enc + 2;
+        let rows = 3 * (row + 2 * max_radius + 2);
+        let packed = rows > sh;
+        assert_eq!(
+            packed,
+            kernel == KernelId::VsmBlurRow,
+            "{name}: packed rows"
+        );
         assert!(
-            dep * dep <= sh && 3 * (row + 2 * max_radius + 2) <= sh,
+            dep * dep <= sh
+                && rows.div_ceil(if packed { channels } else { 1 }) <= sh
+                && row + 2 * max_radius <= sh,
             "{name}: SH_TEXELS"
         );
         assert!(

@@ -23,12 +23,14 @@
 // vec4<f32>` (two channels in vec2s halve the workgroup memory and its traffic), and the tile
 // that memory allows, `const TILE` (outputs per side) and `const SH_TEXELS` (texels of
 // workgroup memory: at least the depth tile at TILE_RADIUS, (TILE + 2·TILE_RADIUS + 2)², and
-// three rows of the fallback, 3·(ROW + 2·MAX_RADIUS + 2): 966 at ROW = 256; 16 KiB at most): 24 and 1600
-// with two channels (12.5 KiB), 16 and 1024 with four (16 KiB), then 1734 with two channels
-// for its longer row; `const RUN`, the outputs an invocation sums in a tile's blur passes: 4 with
-// two channels, 1 with four (see `run_sums`); and the fallback's row, `const ROW` outputs a
-// workgroup in runs of `const ROW_RUN` an invocation (ROW = ROW_RUN · WG_SIZE): 512 in runs of
-// 2 with two channels, 256 one an invocation with four (see `blur_row_pairs`):
+// three rows of the fallback, 3·(ROW + 2·MAX_RADIUS + 2): 966 at ROW = 256, or half that
+// packed two depths a texel (`ROW_PACKED`); 16 KiB at most): 24 and 1734 with two channels
+// (13.5 KiB), 16 and 1024 with four (16 KiB); `const RUN`, the outputs an invocation sums in a
+// tile's blur passes: 4 with two channels, 1 with four (see `run_sums`); and the fallback's row,
+// `const ROW` outputs a workgroup in runs of `const ROW_RUN` an invocation (ROW = ROW_RUN ·
+// WG_SIZE): 1024 in runs of 4 for `vsm_blur_row` (its depth rows packed; see `blur_row_quads`),
+// 512 in runs of 2 for `vsm_blur` (see `blur_row_pairs`), 256 one an invocation with four
+// channels:
 // #completed-by-importer
 // Storage: rg32float by default; the executor re-declares `dst` for the bound format.
 
@@ -96,7 +98,8 @@ fn tile_of(wg: vec2<u32>) -> Tile {
         t.r = vec2<i32>(r);
     } else {
         t.origin = vec2<i32>(i32(wg.x * ROW), i32(wg.y));
-        t.outs = vec2<i32>(i32(ROW), 1);
+        // Clipped to the map: a row narrower than ROW loads and encodes only its own texels.
+        t.outs = vec2<i32>(min(i32(ROW), t.size.x - t.origin.x), 1);
         t.r = vec2<i32>(i32(min(params.blur.radius, MAX_RADIUS)), 0);
     }
     t.enc = t.outs + 2 * t.r;
@@ -122,20 +125,38 @@ fn sh_get(i: i32) -> Texel {
     return sh_tile[i];
 }
 
-// The linear depth at depth-tile index i.
-fn sh_depth(i: i32) -> f32 {
+// Depths a texel of workgroup memory holds in a packed row: one a channel.
+const DEPTHS: i32 = i32(CHANNELS);
+
+// Whether a row workgroup packs its depths (`vsm_blur_row`): only where its three depth rows
+// at MAX_RADIUS would not fit a depth a texel. A constant false for the other kernels, whose
+// code then has no packing: on llvmpipe, which gathers workgroup memory a lane at a time, any
+// (even behind a uniform test) slowed `vsm_blur`'s tile 12–40% (benches/RESULTS.md).
+const ROW_PACKED: bool = 3u * (ROW + 2u * MAX_RADIUS + 2u) > SH_TEXELS;
+
+// The linear depth at depth-tile index i (`packed`: uniform, a packed row's layout).
+fn sh_depth(i: i32, packed: bool) -> f32 {
+    if packed {
+        return sh_tile[i / DEPTHS][i % DEPTHS];
+    }
     return sh_tile[i].x;
 }
 
-// Phase 1: the linear depth of the tile, its halo and one texel more, at clamped coordinates.
-fn load_depth(t: Tile, li: u32) {
+// Phase 1: the linear depth of the tile, its halo and one texel more, at clamped coordinates
+// (`packed` as `sh_depth`'s).
+fn load_depth(t: Tile, li: u32, packed: bool) {
     let n = t.dep.x * t.dep.y;
     for (var i = i32(li); i < n; i += i32(WG_SIZE)) {
         let yx = div_mod(i, t.dep.x);
         let p = t.origin - t.r - 1 + vec2<i32>(yx.y, yx.x);
         let q = clamp(p, vec2<i32>(0), t.size - 1);
         let raw = textureLoad(src, q, 0).r;
-        sh_tile[i] = texel_of(vec4<f32>(linear_depth(raw, params.depth), 0.0, 0.0, 0.0));
+        let z = linear_depth(raw, params.depth);
+        if packed {
+            sh_tile[i / DEPTHS][i % DEPTHS] = z;
+        } else {
+            sh_tile[i] = texel_of(vec4<f32>(z, 0.0, 0.0, 0.0));
+        }
         let own = all(p == q) && all(p >= t.origin) && all(p < t.origin + t.outs);
         if own && !depth_is_finite(raw) {
             atomicAdd(&stats[0], 1u);
@@ -145,16 +166,16 @@ fn load_depth(t: Tile, li: u32) {
 
 // The encoding of encoded-tile texel i (clamped to the tile: an invocation past its end computes
 // a texel it does not store, so none branches).
-fn encode_at(t: Tile, i: i32) -> Texel {
+fn encode_at(t: Tile, i: i32, packed: bool) -> Texel {
     let e = min(i, t.enc.x * t.enc.y - 1);
     let yx = div_mod(e, t.enc.x);
     let d = (yx.x + 1) * t.dep.x + yx.y + 1;
     return texel_of(encode(
-        sh_depth(d),
-        sh_depth(d - 1),
-        sh_depth(d + 1),
-        sh_depth(d - t.dep.x),
-        sh_depth(d + t.dep.x)
+        sh_depth(d, packed),
+        sh_depth(d - 1, packed),
+        sh_depth(d + 1, packed),
+        sh_depth(d - t.dep.x, packed),
+        sh_depth(d + t.dep.x, packed)
     ));
 }
 
@@ -168,20 +189,20 @@ fn put_below(i: i32, n: i32, v: Texel) {
 // Phase 2: every texel of the tile and its blur halo encoded once, over the depth. The
 // ENC_PER values an invocation holds are named, not an array: llvmpipe keeps an array indexed
 // in a loop in memory.
-fn encode_tile(t: Tile, li: u32) {
+fn encode_tile(t: Tile, li: u32, packed: bool) {
     let n = t.enc.x * t.enc.y;
     let i = i32(li);
     let s = i32(WG_SIZE);
-    let e0 = encode_at(t, i);
-    let e1 = encode_at(t, i + s);
-    let e2 = encode_at(t, i + 2 * s);
-    let e3 = encode_at(t, i + 3 * s);
+    let e0 = encode_at(t, i, packed);
+    let e1 = encode_at(t, i + s, packed);
+    let e2 = encode_at(t, i + 2 * s, packed);
+    let e3 = encode_at(t, i + 3 * s, packed);
     var e4 = e3;
     var e5 = e3;
     // Constant for each kernel: a 16² tile has no such block, and no code for it.
     if ENC_MAX > 4u * WG_SIZE && 4 * s < n {
-        e4 = encode_at(t, i + 4 * s);
-        e5 = encode_at(t, i + 5 * s);
+        e4 = encode_at(t, i + 4 * s, packed);
+        e5 = encode_at(t, i + 5 * s, packed);
     }
     workgroupBarrier();
     put_below(i, n, e0);
@@ -389,12 +410,74 @@ fn blur_row_pairs(t: Tile, li: u32) {
     store(t, vec2<i32>(x + 1, 0), s1);
 }
 
+// The row's blur along x in runs of 4 (ROW = 4·WG_SIZE, `vsm_blur_row`): invocation li's
+// outputs x = 4li … 4li + 3, from 2 + 2r texels of the encoded row read once into two sets of
+// four sliding windows (output k's taps at c + k ∓ i; from offset i to i + 1 each window takes
+// its neighbour's value and one texel is read each side), each output summed in `sum_x`'s
+// order, so the results are those of one output at a time. Every invocation stays busy (runs
+// over a row of WG_SIZE outputs left three quarters idle: 12% slower on an H200).
+fn blur_row_quads(t: Tile, li: u32) {
+    let x = 4 * i32(li);
+    let c = x + t.r.x;
+    let w0 = blur_weight(0);
+    let c0 = sh_get(c);
+    let c1 = sh_get(c + 1);
+    let c2 = sh_get(c + 2);
+    let c3 = sh_get(c + 3);
+    var s0 = w0 * c0;
+    var s1 = w0 * c1;
+    var s2 = w0 * c2;
+    var s3 = w0 * c3;
+    var l0 = c0;
+    var l1 = c0;
+    var l2 = c1;
+    var l3 = c2;
+    var r0 = c1;
+    var r1 = c2;
+    var r2 = c3;
+    var r3 = c3;
+    if t.r.x > 0 {
+        l0 = sh_get(c - 1);
+        r3 = sh_get(c + 4);
+    }
+    // Offset r, which needs no next taps, after the loop (a test inside the loop ran on
+    // llvmpipe as masked selects of the windows at every offset).
+    for (var i = 1; i < t.r.x; i++) {
+        let w = blur_weight(i);
+        s0 += w * (l0 + r0);
+        s1 += w * (l1 + r1);
+        s2 += w * (l2 + r2);
+        s3 += w * (l3 + r3);
+        l3 = l2;
+        l2 = l1;
+        l1 = l0;
+        l0 = sh_get(c - i - 1);
+        r0 = r1;
+        r1 = r2;
+        r2 = r3;
+        r3 = sh_get(c + 3 + i + 1);
+    }
+    if t.r.x > 0 {
+        let w = blur_weight(t.r.x);
+        s0 += w * (l0 + r0);
+        s1 += w * (l1 + r1);
+        s2 += w * (l2 + r2);
+        s3 += w * (l3 + r3);
+    }
+    store(t, vec2<i32>(x, 0), s0);
+    store(t, vec2<i32>(x + 1, 0), s1);
+    store(t, vec2<i32>(x + 2, 0), s2);
+    store(t, vec2<i32>(x + 3, 0), s3);
+}
+
 // The importing kernel's `main`: workgroup `wg`, invocation `li`.
 fn encode_blur(wg: vec2<u32>, li: u32) {
     let t = tile_of(wg);
-    load_depth(t, li);
+    // Uniform; a constant false but in `vsm_blur_row`.
+    let packed = ROW_PACKED && params.blur.axis != 2u;
+    load_depth(t, li, packed);
     workgroupBarrier();
-    encode_tile(t, li);
+    encode_tile(t, li, packed);
     if params.blur.axis == 2u {
         // A constant condition: each kernel compiles one of the two.
         if RUN == 4u {
@@ -402,8 +485,10 @@ fn encode_blur(wg: vec2<u32>, li: u32) {
         } else {
             blur_tile_single(t, li);
         }
-    } else if ROW_RUN == 2u {
+    } else if ROW_RUN == 4u {
         // A constant condition, as RUN's.
+        blur_row_quads(t, li);
+    } else if ROW_RUN == 2u {
         blur_row_pairs(t, li);
     } else {
         // The row's blur along x: one output an invocation (ROW = WG_SIZE).

@@ -18,21 +18,35 @@ use crate::model::Filter;
 /// r = 4, alternated with the 16² build; `benches/RESULTS.md`).
 pub fn encode_blur_tile(kernel: KernelId) -> u32 {
     match kernel {
-        KernelId::VsmBlur => 24,
+        KernelId::VsmBlur | KernelId::VsmBlurRow => 24,
         _ => 16,
     }
 }
 
 /// Outputs of a one-row workgroup, the two-pass fallback (`ROW`, which each fused kernel
 /// declares for `kernels/shared/encode_blur.wgsl`): one an invocation of its 256 with four
-/// channels; 512 in runs of 2 with two (`vsm_blur`), whose three rows of depths with their halo,
-/// 3·(512 + 2·32 + 2) texels of 8 B, fit its 16 KiB of workgroup memory: every invocation stays
-/// busy, each row texel is read 2 + 2r times for 2 outputs instead of 2r + 1 for one, and the
-/// halo is loaded once for twice the outputs.
+/// channels; with two (VSM), 512 in runs of 2 (`vsm_blur`), whose three rows of depths with
+/// their halo, 3·(512 + 2·32 + 2) texels, fit its workgroup memory one a texel, or 1024 in runs
+/// of 4 (`vsm_blur_row`, maps at least that wide: [`encode_blur_row_kernel`]), its rows packed
+/// two depths a texel: every invocation stays busy, each row texel is read 2 + 2r times for 4
+/// outputs (2 for 2) instead of 2r + 1 for one, and the halo is loaded once for more outputs.
 pub fn encode_blur_row(kernel: KernelId) -> u32 {
     match kernel {
+        KernelId::VsmBlurRow => 1024,
         KernelId::VsmBlur => 512,
         _ => 256,
+    }
+}
+
+/// The kernel of `kernel`'s row pass over a map `width` texels wide: VSM's 1024-texel rows
+/// (`vsm_blur_row`, a kernel of its own: its packed rows in `vsm_blur` slowed the tile on
+/// llvmpipe) where they are full, 1.2–1.3× faster at r = 32 on llvmpipe than `vsm_blur`'s
+/// 512-texel rows, which narrower maps keep (on a 512² map the longer rows left half the
+/// invocations idle: 1.2× slower; `benches/RESULTS.md`, 2026-11-27).
+pub fn encode_blur_row_kernel(kernel: KernelId, width: u32) -> KernelId {
+    match kernel {
+        KernelId::VsmBlur if width >= encode_blur_row(KernelId::VsmBlurRow) => KernelId::VsmBlurRow,
+        k => k,
     }
 }
 
@@ -56,6 +70,8 @@ pub struct EncodeBlur<'a> {
     pub format: wgpu::TextureFormat,
     /// The encoding's parameters (the kernel's `Params` before its `blur` member).
     pub params: &'a [u8],
+    /// The depth's width in texels (which row kernel: [`encode_blur_row_kernel`]).
+    pub width: u32,
 }
 
 /// Adds the nodes of `e` fused into `filter`'s blur, writing `<encoded>.blur` (the depth's
@@ -83,7 +99,11 @@ pub fn add_encode_blur(
         return Some(out);
     }
     let h = format!("{}.blur_h", e.encoded);
-    fused_node(graph, light, e, &h, BlurParams { axis: 0, ..both }, 0);
+    let row = EncodeBlur {
+        kernel: encode_blur_row_kernel(e.kernel, e.width),
+        ..*e
+    };
+    fused_node(graph, light, &row, &h, BlurParams { axis: 0, ..both }, 0);
     let v = BlurParams { axis: 1, ..both };
     Some(add_blur_pass(
         graph,

@@ -90,6 +90,7 @@ impl LightNodes<'_> {
                 encoded: &out,
                 format,
                 params,
+                width: self.light.map_dims().0,
             };
             if let Some(filtered) = add_encode_blur(self.graph, self.i, &e, &filter) {
                 return self.one(filtered);

@@ -13,7 +13,9 @@
 //! load counts twice, a texel one workgroup loads twice once); `E per texel of b` is `E` texels
 //! for every texel of the texture bound to binding `b` (a small table read once per texel of
 //! the map); `none` moves nothing worth counting (a counter). `E` is an [`Expr`] over the
-//! kernel's WGSL constants and its uniform's fields, `params.<field>`.
+//! kernel's WGSL constants, its uniform's fields, `params.<field>`, and the sizes of the
+//! textures bound to its bindings, `<binding>.width` and `<binding>.height` (a row workgroup
+//! clipped to the map's width).
 //!
 //! A function of the shading side that reads a map declares its fetches per call:
 //!

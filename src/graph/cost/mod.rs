@@ -146,6 +146,18 @@ pub fn node_traffic(plan: &Plan, node: &Node) -> Result<Traffic> {
             if let Some(v) = consts.get(n) {
                 return Ok(*v);
             }
+            // `<binding>.width` / `.height`: the bound texture's (level's) size.
+            if let Some((b, side)) = n.split_once('.').filter(|(b, _)| *b != "params") {
+                let bound = d
+                    .bound
+                    .get(b)
+                    .ok_or_else(|| format!("`{n}`: no texture bound to `{b}`"))?;
+                return match side {
+                    "width" => Ok(f64::from(bound.width)),
+                    "height" => Ok(f64::from(bound.height)),
+                    _ => Err(format!("`{n}`: a binding has `.width` and `.height`")),
+                };
+            }
             match (n.strip_prefix("params."), params) {
                 (Some(field), Some(ty)) => declare::struct_field(&module, ty, d.params, field),
                 _ => Err(format!("`{n}` is neither a constant nor `params.<field>`")),

@@ -1,0 +1,40 @@
+// The VSM encoding fused into the blur (import-only module of `vsm_blur` and `vsm_blur_row`):
+// variance-shadow-map moments (shared/vsm_moments) of the rasterized depth, blurred in
+// workgroup memory (shared/encode_blur), with its parameters, texel and entry point. The
+// importing kernel declares the row path's shape, `const ROW` and `const ROW_RUN`
+// (shared/encode_blur), and its `// #traffic` lines:
+// #completed-by-importer
+// #import shared/encode_blur
+// #import shared/vsm_moments
+
+// Keep in sync with `VsmParams` in src/gpu_data.rs, then `BlurParams` in src/filter.rs.
+struct Params {
+    depth: DepthParams,
+    blur: BlurSpec,
+}
+
+const CHANNELS: u32 = 2u;
+// The tile its workgroup memory allows (shared/encode_blur). Keep in sync with
+// `encode_blur_tile` in src/filter/encode_blur.rs.
+const TILE: u32 = 24u;
+const SH_TEXELS: u32 = 1734u;
+// Outputs an invocation sums in the tile's blur passes, two channels: runs of 4 (shared/encode_blur, `run_sums`).
+const RUN: u32 = 4u;
+alias Texel = vec2<f32>;
+
+fn texel_of(v: vec4<f32>) -> Texel {
+    return v.xy;
+}
+
+fn texel_out(t: Texel) -> vec4<f32> {
+    return vec4<f32>(t, 0.0, 0.0);
+}
+
+fn encode(z: f32, left: f32, right: f32, up: f32, down: f32) -> vec4<f32> {
+    return vec4<f32>(vsm_moments(z, left, right, up, down), 0.0, 0.0);
+}
+
+@compute @workgroup_size(WG_SIZE)
+fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    encode_blur(wg.xy, li);
+}
