@@ -374,47 +374,112 @@ fn fused_blurs_match_encode_then_blur() {
     }
 }
 
-/// VSM's row pass on a map at least 1024 texels wide (radius past the tile's 7: the encoding
-/// fused into the horizontal pass by `vsm_blur_row`, 1024 outputs a workgroup in runs of 4, its
-/// depth rows packed two to a texel, then `blur`'s vertical pass) on a 1100² map, two row
-/// workgroups a row (the second ragged, clipped to the map), at radius 12 and 32, f32 and f16
-/// (packed), against the f64 encoding then both blur passes; tolerances as
-/// `fused_blurs_match_encode_then_blur`'s (whose 300² map keeps `vsm_blur`'s 512-texel rows).
+/// The row kernels past the tile's radius 7 on a map wide enough for them (1100²:
+/// `vsm_blur_row`, 1024 outputs a workgroup in runs of 4, its depth rows packed two to a texel;
+/// `evsm_blur_row` and `msm_blur_row`, 512 in runs of 2, packed four to a texel; the last row
+/// workgroup of each row ragged, clipped to the map), then `blur`'s vertical pass, at radius 12
+/// and 32, VSM and EVSM2 in f32 and f16 (packed), EVSM4 and MSM in f32, against the f64 encoding
+/// then both blur passes; tolerances as `fused_blurs_match_encode_then_blur`'s (whose 300² map
+/// keeps the tile kernels' own rows). The plan's kernels are checked.
 #[test]
-fn vsm_row_path_spans_row_workgroups() {
+fn row_kernels_span_row_workgroups() {
     use shadowgraph::scene::BlurKernel;
     const WIDE: u32 = 1100;
+    type Reference = fn(&Texels, f64, f64) -> Texels;
+    let f16 = 2f64.powi(-10);
+    // (technique keys, encoded map, row kernel, reference, atol, rtol, f16 stores)
+    let cases: [(&str, &str, &str, Reference, f64, f64, bool); 6] = [
+        (
+            "technique = \"vsm\"\nformat = \"f32\"",
+            "light0.vsm",
+            "vsm_blur_row",
+            |t, r, s| cpu::vsm_blur::vsm_blur(t, r, s, BlurKernel::Gaussian),
+            10.0 * U,
+            2.0 * LINEAR_RTOL + 3.0 * U,
+            false,
+        ),
+        (
+            "technique = \"vsm\"\nformat = \"f16\"",
+            "light0.vsm",
+            "vsm_blur_row",
+            |t, r, s| cpu::vsm_blur::vsm_blur(t, r, s, BlurKernel::Gaussian),
+            10.0 * U,
+            2.0 * LINEAR_RTOL + 3.0 * U,
+            true,
+        ),
+        (
+            "technique = \"evsm2\"\nformat = \"f32\"\nexponent_pos = 5.0",
+            "light0.evsm",
+            "evsm_blur_row",
+            |t, r, s| cpu::evsm_blur::evsm_blur(t, [5.0, 5.0], r, s, BlurKernel::Gaussian),
+            0.0,
+            2.0 * (10.0 * LINEAR_RTOL + 13.0 * U),
+            false,
+        ),
+        (
+            "technique = \"evsm2\"\nformat = \"f16\"\nexponent_pos = 5.0",
+            "light0.evsm",
+            "evsm_blur_row",
+            |t, r, s| cpu::evsm_blur::evsm_blur(t, [5.0, 5.0], r, s, BlurKernel::Gaussian),
+            0.0,
+            2.0 * (10.0 * LINEAR_RTOL + 13.0 * U),
+            true,
+        ),
+        (
+            "technique = \"evsm4\"\nformat = \"f32\"\nexponent_pos = 5.0\nexponent_neg = 5.0",
+            "light0.evsm",
+            "evsm_blur_row",
+            |t, r, s| cpu::evsm_blur::evsm_blur(t, [5.0, 5.0], r, s, BlurKernel::Gaussian),
+            0.0,
+            2.0 * (10.0 * LINEAR_RTOL + 13.0 * U),
+            false,
+        ),
+        (
+            "technique = \"msm\"\nformat = \"f32\"",
+            "light0.msm",
+            "msm_blur_row",
+            |t, r, s| cpu::msm_blur::msm_blur(t, false, r, s, BlurKernel::Gaussian),
+            0.0,
+            4.0 * LINEAR_RTOL + 4.0 * U,
+            false,
+        ),
+    ];
     let raw = raw_depth_sized(5, WIDE);
     for radius in [12u32, 32] {
         let sigma = f64::from(radius) / 2.0;
-        for (format, store_rtol, atol) in [
-            ("f32", 0.0, 10.0 * U),
-            ("f16", 2.0 * 2f64.powi(-10), 10.0 * U + 2f64.powi(-14)),
-        ] {
+        for (shadow, encoded, kernel, reference, atol, rtol, half) in cases {
             let light = spot_sized(
                 &format!(
-                    "technique = \"vsm\"\nformat = \"{format}\"\nfilter = \"blur\"\n\
-                     filter_radius = {radius}\nfilter_sigma = {sigma}"
+                    "{shadow}\nfilter = \"blur\"\nfilter_radius = {radius}\nfilter_sigma = {sigma}"
                 ),
                 WIDE,
             );
-            let what = format!("vsm {format} r = {radius} on {WIDE}²");
+            let what = format!("{shadow} r = {radius} on {WIDE}²");
+            let map = format!("{encoded}.blur");
             let mut graph = Graph::default();
             technique::add_light_nodes(&mut graph, 0, &light);
-            let kernels: Vec<&str> = plan(&graph, &["light0.vsm.blur"])
+            let kernels: Vec<&str> = plan(&graph, &[map.as_str()])
                 .expect("plan")
                 .steps
                 .iter()
                 .map(|s| s.node.kernel.as_str())
                 .collect();
-            assert_eq!(kernels, ["vsm_blur_row", "blur"], "{what}");
-            let (maps, stats) = run(&light, &raw, &["light0.vsm.blur".to_string()]);
+            assert_eq!(kernels, [kernel, "blur"], "{what}");
+            let (maps, stats) = run(&light, &raw, std::slice::from_ref(&map));
             let (lin, replaced) = linear(&light, &raw);
-            let want = cpu::vsm_blur::vsm_blur(&lin, radius.into(), sigma, BlurKernel::Gaussian);
-            let got: Vec<f32> = channels(&maps[0], 0, 2).iter().map(|&v| v as f32).collect();
-            let rtol =
-                2.0 * LINEAR_RTOL + 3.0 * U + store_rtol + 2.0 * (f64::from(radius) + 3.0) * U;
-            common::assert_close(&what, &got, &channels(&want, 0, 2), atol, rtol);
+            let want = reference(&lin, radius.into(), sigma);
+            let got = &maps[0];
+            let n = want.channels.min(got.channels);
+            let got: Vec<f32> = channels(got, 0, n).iter().map(|&v| v as f32).collect();
+            // Two f16 stores (each a whole ulp, denormals flushed), and the blur passes'
+            // roundings, as `fused_blurs_match_encode_then_blur`.
+            let (atol, rtol) = if half {
+                (atol + 2f64.powi(-14), rtol + 2.0 * f16)
+            } else {
+                (atol, rtol)
+            };
+            let blur_rtol = 2.0 * (f64::from(radius) + 3.0) * U;
+            common::assert_close(&what, &got, &channels(&want, 0, n), atol, rtol + blur_rtol);
             assert_counted(&what, &stats, 1, replaced);
         }
     }

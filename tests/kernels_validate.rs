@@ -338,6 +338,14 @@ fn rust_mirrors_match_naga_layouts() {
             size_of::<ExpParams>() + size_of::<BlurParams>(),
         ),
         ("msm_blur", size_of::<MsmParams>() + size_of::<BlurParams>()),
+        (
+            "msm_blur_row",
+            size_of::<MsmParams>() + size_of::<BlurParams>(),
+        ),
+        (
+            "evsm_blur_row",
+            size_of::<ExpParams>() + size_of::<BlurParams>(),
+        ),
     ] {
         let wgsl = kernels::resolve(kernel, None).unwrap();
         let (m, _) = kernels::reflect(kernel, &wgsl).unwrap();
@@ -452,6 +460,7 @@ fn packed_f16_variants_validate() {
         "vsm_blur",
         "vsm_blur_row",
         "evsm_blur",
+        "evsm_blur_row",
         "blur",
         "mips",
         "sat_tile_sums",
@@ -481,7 +490,7 @@ fn packed_f16_variants_validate() {
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
-    assert_eq!(rewritten, 11, "every variant packs or unpacks");
+    assert_eq!(rewritten, 12, "every variant packs or unpacks");
 }
 
 /// Every compute kernel fits WebGPU's default limits (what `wgpu::Limits::default()` asks
@@ -627,7 +636,7 @@ fn encode_blur_dispatch_constants_match_the_wgsl() {
         ENCODE_BLUR_TILE_RADIUS, encode_blur_row, encode_blur_row_kernel, encode_blur_tile,
     };
     use shadowgraph::kernels::KernelId;
-    // VSM's row pass: 1024-texel rows where they are full, else `vsm_blur`'s 512.
+    // The row kernels where their rows are full, else the tile kernels' shorter rows.
     assert_eq!(
         encode_blur_row_kernel(KernelId::VsmBlur, 1023),
         KernelId::VsmBlur
@@ -637,14 +646,25 @@ fn encode_blur_dispatch_constants_match_the_wgsl() {
         KernelId::VsmBlurRow
     );
     assert_eq!(
-        encode_blur_row_kernel(KernelId::EvsmBlur, 4096),
+        encode_blur_row_kernel(KernelId::EvsmBlur, 511),
         KernelId::EvsmBlur
     );
+    assert_eq!(
+        encode_blur_row_kernel(KernelId::MsmBlur, 512),
+        KernelId::MsmBlurRow
+    );
+    assert_eq!(
+        encode_blur_row_kernel(KernelId::EvsmBlur, 4096),
+        KernelId::EvsmBlurRow
+    );
+    assert_eq!(encode_blur_row_kernel(KernelId::Blur, 4096), KernelId::Blur);
     for kernel in [
         KernelId::VsmBlur,
         KernelId::VsmBlurRow,
         KernelId::EvsmBlur,
+        KernelId::EvsmBlurRow,
         KernelId::MsmBlur,
+        KernelId::MsmBlurRow,
     ] {
         let name = kernel.name();
         let wgsl = kernels::resolve(name, None).expect("resolve");
@@ -689,7 +709,9 @@ fn encode_blur_dispatch_constants_match_the_wgsl() {
                 assert!(tile / run * tile <= wg, "{name}: runs along y");
             }
             _ => {
-                assert_eq!(row_run, 1, "{name}: ROW_RUN (one output an invocation)");
+                // The row kernels' runs of 2 (`blur_row_pairs`), else one output an invocation.
+                let row_kernel = matches!(kernel, KernelId::EvsmBlurRow | KernelId::MsmBlurRow);
+                assert_eq!(row_run, if row_kernel { 2 } else { 1 }, "{name}: ROW_RUN");
                 assert_eq!(run, 1, "{name}: RUN (one output an invocation)");
                 assert!(tile * enc <= 4 * wg, "{name}: horizontal sums");
             }
@@ -704,7 +726,10 @@ fn encode_blur_dispatch_constants_match_the_wgsl() {
         let packed = rows > sh;
         assert_eq!(
             packed,
-            kernel == KernelId::VsmBlurRow,
+            matches!(
+                kernel,
+                KernelId::VsmBlurRow | KernelId::EvsmBlurRow | KernelId::MsmBlurRow
+            ),
             "{name}: packed rows"
         );
         assert!(

@@ -175,6 +175,11 @@ pub const CASES: &[BenchCase] = &[
         name: "msm_blur r4",
         build: |n| chain_graph(n, msm(Storage::F32), &["light0.msm.blur"]),
     },
+    // Past the tile's radius: the row kernels (`msm_blur_row` from 512² on) and `blur` along y.
+    BenchCase {
+        name: "msm_blur r32 (2 passes)",
+        build: |n| chain_graph(n, msm_blur(32.0), &["light0.msm.blur"]),
+    },
     BenchCase {
         name: "msm+blur r4 (old)",
         build: |n| old_chain(n, msm(Storage::F32), "light0.msm"),
@@ -342,6 +347,17 @@ fn exp_sat(name: &str) -> Technique {
 fn msm(storage: Storage) -> Technique {
     let format = ("format", ParamValue::Choice(storage_name(storage)));
     named("msm", &[format, BLUR4[0], BLUR4[1]])
+}
+
+/// MSM (f32) with a Gaussian blur of `radius` taps each side (σ = radius / 2).
+fn msm_blur(radius: f32) -> Technique {
+    named(
+        "msm",
+        &[
+            ("filter_radius", ParamValue::Float(radius)),
+            ("filter_sigma", ParamValue::Float(radius / 2.0)),
+        ],
+    )
 }
 
 fn msm_mips() -> Technique {
