@@ -49,20 +49,11 @@ fn sat_store(slot: u32, q: vec2<u32>, v: vec4<u32>) {
     }
 }
 
-// Workgroup (x, y, z) computes layer first_map + z of tile (x, y); with n > 1 tables a texture
-// the layers lie side by side along x instead (`Dispatch::Interleaved`: workgroup x = X·maps +
-// k on layer k of tile X), so that the interleaved texels of one tile are written within a
-// short time (a layer a workgroup z wrote each cache line n times, each after the others had
-// left it: pass 3 1.7× slower on llvmpipe).
+// Workgroup `wg` computes layer first_map + z of tile (x, y), (x, y, z) = csm_sat_pass3_at(wg).
 @compute @workgroup_size(WG_SIZE)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    let size = textureDimensions(src);
-    var tile = wg.xy;
-    var z = wg.z;
-    if params.interleave > 1u {
-        tile.x = wg.x / params.maps;
-        z = wg.x % params.maps;
-    }
-    let source = csm_sat_source(params, params.first_map + z, csm_sat_tiles_of(size));
-    sat_tile_table(params.sat, FLOAT_SUMS, source, tile, li, z);
+    let at = csm_sat_pass3_at(params, wg);
+    let tiles = csm_sat_tiles_of(textureDimensions(src));
+    let source = csm_sat_source(params, params.first_map + at.z, tiles);
+    sat_tile_table(params.sat, FLOAT_SUMS, source, at.xy, li, at.z);
 }

@@ -267,6 +267,86 @@ fn csm_writes_basis_maps_from_one_read() {
     assert_counted("csm", &stats, 1, replaced);
 }
 
+/// One encoding through a fused blur: its technique keys, its encoded map, the row kernel of its
+/// wide maps, the f64 reference at (radius, σ), the encoding's atol and rtol as in
+/// `fused_encodings_match_linearize_then_encode`, and whether its two moments are stored in f16.
+#[derive(Clone, Copy)]
+struct BlurCase {
+    shadow: &'static str,
+    encoded: &'static str,
+    row_kernel: &'static str,
+    reference: fn(&Texels, f64, f64) -> Texels,
+    atol: f64,
+    rtol: f64,
+    f16: bool,
+}
+
+impl BlurCase {
+    /// Its tolerance after `stores` stores: f16 adds, at each, a whole ulp (Vulkan lets the
+    /// conversion round toward zero), 2⁻¹⁰ relative, and a value below f16's smallest normal may
+    /// be flushed, 2⁻¹⁴ absolute (EVSM's squared moments reach e⁻¹⁰ ≈ 4.5·10⁻⁵).
+    fn tolerance(&self, stores: f64) -> (f64, f64) {
+        if self.f16 {
+            (
+                self.atol + 2f64.powi(-14),
+                self.rtol + stores * 2f64.powi(-10),
+            )
+        } else {
+            (self.atol, self.rtol)
+        }
+    }
+}
+
+/// VSM and EVSM2 in f32 and f16 (packed two to an r32uint word), EVSM4 and MSM in f32.
+fn blur_cases() -> [BlurCase; 6] {
+    use shadowgraph::scene::BlurKernel;
+    let vsm = BlurCase {
+        shadow: "technique = \"vsm\"\nformat = \"f32\"",
+        encoded: "light0.vsm",
+        row_kernel: "vsm_blur_row",
+        reference: |t, r, s| cpu::vsm_blur::vsm_blur(t, r, s, BlurKernel::Gaussian),
+        atol: 10.0 * U,
+        rtol: 2.0 * LINEAR_RTOL + 3.0 * U,
+        f16: false,
+    };
+    let evsm2 = BlurCase {
+        shadow: "technique = \"evsm2\"\nformat = \"f32\"\nexponent_pos = 5.0",
+        encoded: "light0.evsm",
+        row_kernel: "evsm_blur_row",
+        reference: |t, r, s| cpu::evsm_blur::evsm_blur(t, [5.0, 5.0], r, s, BlurKernel::Gaussian),
+        atol: 0.0,
+        rtol: 2.0 * (10.0 * LINEAR_RTOL + 13.0 * U),
+        f16: false,
+    };
+    [
+        vsm,
+        evsm2,
+        BlurCase {
+            shadow: "technique = \"evsm4\"\nformat = \"f32\"\nexponent_pos = 5.0\nexponent_neg = 5.0",
+            ..evsm2
+        },
+        BlurCase {
+            shadow: "technique = \"msm\"\nformat = \"f32\"",
+            encoded: "light0.msm",
+            row_kernel: "msm_blur_row",
+            reference: |t, r, s| cpu::msm_blur::msm_blur(t, false, r, s, BlurKernel::Gaussian),
+            atol: 0.0,
+            rtol: 4.0 * LINEAR_RTOL + 4.0 * U,
+            f16: false,
+        },
+        BlurCase {
+            shadow: "technique = \"vsm\"\nformat = \"f16\"",
+            f16: true,
+            ..vsm
+        },
+        BlurCase {
+            shadow: "technique = \"evsm2\"\nformat = \"f16\"\nexponent_pos = 5.0",
+            f16: true,
+            ..evsm2
+        },
+    ]
+}
+
 /// The encodings fused into the blur (`vsm_blur`, `evsm_blur`, `msm_blur`) against the f64
 /// composition of the independent references, encoding then both blur passes
 /// (`cpu::vsm_blur` and its siblings), on the random perspective depth with non-finite texels:
@@ -276,82 +356,20 @@ fn csm_writes_basis_maps_from_one_read() {
 /// tile's 7: the encoding fused into the horizontal pass, then `blur`'s vertical pass).
 #[test]
 fn fused_blurs_match_encode_then_blur() {
-    use shadowgraph::scene::BlurKernel;
     let raw = raw_depth(12);
-    type Reference = fn(&Texels, f64, f64) -> Texels;
-    // (technique keys, encoding, f64 reference at (radius, σ), the encoding's atol and rtol as
-    // in `fused_encodings_match_linearize_then_encode`).
-    let cases: [(&str, &str, Reference, f64, f64); 4] = [
-        (
-            "technique = \"vsm\"\nformat = \"f32\"",
-            "light0.vsm",
-            |t, r, s| cpu::vsm_blur::vsm_blur(t, r, s, BlurKernel::Gaussian),
-            10.0 * U,
-            2.0 * LINEAR_RTOL + 3.0 * U,
-        ),
-        (
-            "technique = \"evsm2\"\nformat = \"f32\"\nexponent_pos = 5.0",
-            "light0.evsm",
-            |t, r, s| cpu::evsm_blur::evsm_blur(t, [5.0, 5.0], r, s, BlurKernel::Gaussian),
-            0.0,
-            2.0 * (10.0 * LINEAR_RTOL + 13.0 * U),
-        ),
-        (
-            "technique = \"evsm4\"\nformat = \"f32\"\nexponent_pos = 5.0\nexponent_neg = 5.0",
-            "light0.evsm",
-            |t, r, s| cpu::evsm_blur::evsm_blur(t, [5.0, 5.0], r, s, BlurKernel::Gaussian),
-            0.0,
-            2.0 * (10.0 * LINEAR_RTOL + 13.0 * U),
-        ),
-        (
-            "technique = \"msm\"\nformat = \"f32\"",
-            "light0.msm",
-            |t, r, s| cpu::msm_blur::msm_blur(t, false, r, s, BlurKernel::Gaussian),
-            0.0,
-            4.0 * LINEAR_RTOL + 4.0 * U,
-        ),
-    ];
-    // The two-moment encodings in f16, packed two to an r32uint word: the same references,
-    // plus f16 rounding at each store (one for the fused kernel at r = 3, two at r = 12, the
-    // horizontal pass's and the vertical pass's); each may lose a whole ulp (Vulkan lets the
-    // conversion round toward zero), 2⁻¹⁰ relative, and a value below f16's smallest normal
-    // may be flushed, 2⁻¹⁴ absolute (EVSM's squared moments reach e⁻¹⁰ ≈ 4.5·10⁻⁵).
-    let f16_cases: [(&str, &str, Reference, f64, f64); 2] = [
-        (
-            "technique = \"vsm\"\nformat = \"f16\"",
-            "light0.vsm",
-            cases[0].2,
-            10.0 * U,
-            2.0 * LINEAR_RTOL + 3.0 * U,
-        ),
-        (
-            "technique = \"evsm2\"\nformat = \"f16\"\nexponent_pos = 5.0",
-            "light0.evsm",
-            cases[1].2,
-            0.0,
-            2.0 * (10.0 * LINEAR_RTOL + 13.0 * U),
-        ),
-    ];
     for (radius, steps) in [(3u32, 1usize), (7, 1), (12, 1)] {
         let sigma = f64::from(radius) / 2.0;
         let filter =
             format!("\nfilter = \"blur\"\nfilter_radius = {radius}\nfilter_sigma = {sigma}");
         let stores = if radius > 8 { 2.0 } else { 1.0 };
-        let f16 = f16_cases.iter().map(|&(s, e, r, atol, rtol)| {
-            (
-                s,
-                e,
-                r,
-                atol + 2f64.powi(-14),
-                rtol + stores * 2f64.powi(-10),
-            )
-        });
-        for (shadow, encoded, reference, atol, rtol) in cases.into_iter().chain(f16) {
+        for c in blur_cases() {
+            let (shadow, encoded, reference) = (c.shadow, c.encoded, c.reference);
+            let (atol, rtol) = c.tolerance(stores);
             let light = spot(&format!("{shadow}{filter}"));
             // f16 two moments are stored packed, 4 bytes a texel, not in rgba16float.
             assert_eq!(
                 technique::maps_packed(&light),
-                shadow.contains("f16"),
+                c.f16,
                 "{shadow}: packed maps"
             );
             let map = format!("{encoded}.blur");
@@ -383,71 +401,13 @@ fn fused_blurs_match_encode_then_blur() {
 /// keeps the tile kernels' own rows). The plan's kernels are checked.
 #[test]
 fn row_kernels_span_row_workgroups() {
-    use shadowgraph::scene::BlurKernel;
     const WIDE: u32 = 1100;
-    type Reference = fn(&Texels, f64, f64) -> Texels;
-    let f16 = 2f64.powi(-10);
-    // (technique keys, encoded map, row kernel, reference, atol, rtol, f16 stores)
-    let cases: [(&str, &str, &str, Reference, f64, f64, bool); 6] = [
-        (
-            "technique = \"vsm\"\nformat = \"f32\"",
-            "light0.vsm",
-            "vsm_blur_row",
-            |t, r, s| cpu::vsm_blur::vsm_blur(t, r, s, BlurKernel::Gaussian),
-            10.0 * U,
-            2.0 * LINEAR_RTOL + 3.0 * U,
-            false,
-        ),
-        (
-            "technique = \"vsm\"\nformat = \"f16\"",
-            "light0.vsm",
-            "vsm_blur_row",
-            |t, r, s| cpu::vsm_blur::vsm_blur(t, r, s, BlurKernel::Gaussian),
-            10.0 * U,
-            2.0 * LINEAR_RTOL + 3.0 * U,
-            true,
-        ),
-        (
-            "technique = \"evsm2\"\nformat = \"f32\"\nexponent_pos = 5.0",
-            "light0.evsm",
-            "evsm_blur_row",
-            |t, r, s| cpu::evsm_blur::evsm_blur(t, [5.0, 5.0], r, s, BlurKernel::Gaussian),
-            0.0,
-            2.0 * (10.0 * LINEAR_RTOL + 13.0 * U),
-            false,
-        ),
-        (
-            "technique = \"evsm2\"\nformat = \"f16\"\nexponent_pos = 5.0",
-            "light0.evsm",
-            "evsm_blur_row",
-            |t, r, s| cpu::evsm_blur::evsm_blur(t, [5.0, 5.0], r, s, BlurKernel::Gaussian),
-            0.0,
-            2.0 * (10.0 * LINEAR_RTOL + 13.0 * U),
-            true,
-        ),
-        (
-            "technique = \"evsm4\"\nformat = \"f32\"\nexponent_pos = 5.0\nexponent_neg = 5.0",
-            "light0.evsm",
-            "evsm_blur_row",
-            |t, r, s| cpu::evsm_blur::evsm_blur(t, [5.0, 5.0], r, s, BlurKernel::Gaussian),
-            0.0,
-            2.0 * (10.0 * LINEAR_RTOL + 13.0 * U),
-            false,
-        ),
-        (
-            "technique = \"msm\"\nformat = \"f32\"",
-            "light0.msm",
-            "msm_blur_row",
-            |t, r, s| cpu::msm_blur::msm_blur(t, false, r, s, BlurKernel::Gaussian),
-            0.0,
-            4.0 * LINEAR_RTOL + 4.0 * U,
-            false,
-        ),
-    ];
     let raw = raw_depth_sized(5, WIDE);
     for radius in [12u32, 32] {
         let sigma = f64::from(radius) / 2.0;
-        for (shadow, encoded, kernel, reference, atol, rtol, half) in cases {
+        for c in blur_cases() {
+            let (shadow, encoded, kernel, reference) =
+                (c.shadow, c.encoded, c.row_kernel, c.reference);
             let light = spot_sized(
                 &format!(
                     "{shadow}\nfilter = \"blur\"\nfilter_radius = {radius}\nfilter_sigma = {sigma}"
@@ -471,13 +431,8 @@ fn row_kernels_span_row_workgroups() {
             let got = &maps[0];
             let n = want.channels.min(got.channels);
             let got: Vec<f32> = channels(got, 0, n).iter().map(|&v| v as f32).collect();
-            // Two f16 stores (each a whole ulp, denormals flushed), and the blur passes'
-            // roundings, as `fused_blurs_match_encode_then_blur`.
-            let (atol, rtol) = if half {
-                (atol + 2f64.powi(-14), rtol + 2.0 * f16)
-            } else {
-                (atol, rtol)
-            };
+            // Two stores, f16 in the packed cases.
+            let (atol, rtol) = c.tolerance(2.0);
             let blur_rtol = 2.0 * (f64::from(radius) + 3.0) * U;
             common::assert_close(&what, &got, &channels(&want, 0, n), atol, rtol + blur_rtol);
             assert_counted(&what, &stats, 1, replaced);

@@ -637,27 +637,20 @@ fn encode_blur_dispatch_constants_match_the_wgsl() {
     };
     use shadowgraph::kernels::KernelId;
     // The row kernels where their rows are full, else the tile kernels' shorter rows.
-    assert_eq!(
-        encode_blur_row_kernel(KernelId::VsmBlur, 1023),
-        KernelId::VsmBlur
-    );
-    assert_eq!(
-        encode_blur_row_kernel(KernelId::VsmBlur, 1024),
-        KernelId::VsmBlurRow
-    );
-    assert_eq!(
-        encode_blur_row_kernel(KernelId::EvsmBlur, 511),
-        KernelId::EvsmBlur
-    );
-    assert_eq!(
-        encode_blur_row_kernel(KernelId::MsmBlur, 512),
-        KernelId::MsmBlurRow
-    );
-    assert_eq!(
-        encode_blur_row_kernel(KernelId::EvsmBlur, 4096),
-        KernelId::EvsmBlurRow
-    );
-    assert_eq!(encode_blur_row_kernel(KernelId::Blur, 4096), KernelId::Blur);
+    for (kernel, width, row) in [
+        (KernelId::VsmBlur, 1023, KernelId::VsmBlur),
+        (KernelId::VsmBlur, 1024, KernelId::VsmBlurRow),
+        (KernelId::EvsmBlur, 511, KernelId::EvsmBlur),
+        (KernelId::MsmBlur, 512, KernelId::MsmBlurRow),
+        (KernelId::EvsmBlur, 4096, KernelId::EvsmBlurRow),
+        (KernelId::Blur, 4096, KernelId::Blur),
+    ] {
+        assert_eq!(
+            encode_blur_row_kernel(kernel, width),
+            row,
+            "{kernel:?} at {width}"
+        );
+    }
     for kernel in [
         KernelId::VsmBlur,
         KernelId::VsmBlurRow,

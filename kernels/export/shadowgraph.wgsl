@@ -80,15 +80,14 @@
 //   sg_sat_box_fixed sg_sat_box_float sg_sat_clamp sg_sat_corner_linear sg_sat_filter_fixed
 //   sg_sat_filter_float sg_sat_filter_window sg_sat_grid sg_sat_layer_box sg_sat_layer_mean
 //   sg_sat_layer_node sg_sat_layer_size sg_sat_layer_window sg_sat_mean_fixed sg_sat_mean_float
-//   sg_sat_mean_linear sg_sat_nearest sg_sat_node_f32 sg_sat_node_u32 sg_sat_nodes sg_sat_rect
+//   sg_sat_mean_linear sg_sat_nearest sg_sat_node_f32 sg_sat_nodes sg_sat_rect
 //   sg_sat_sample_fixed sg_sat_sample_float sg_sat_sample_layer sg_sat_search_fixed
-//   sg_sat_search_float sg_sat_search_layer sg_sat_span_weights sg_sat_window_fixed
-//   sg_smrt_emitter_point sg_smrt_ray sg_soft_blockers sg_soft_filter_trips sg_texel_of
-//   sg_trilinear sg_trilinear_log sg_trilinear_packed sg_unpack_f16x2 sg_vis_esm
-//   sg_vis_esm_of_log sg_vis_esm_of_sat sg_vis_evsm sg_vis_evsm_of sg_vis_hard sg_vis_msm
-//   sg_vis_msm_of sg_vis_msm_soft_fixed sg_vis_msm_soft_float sg_vis_pcf sg_vis_pcf_hardware
-//   sg_vis_pcss sg_vis_smrt sg_vis_vsm sg_vis_vsm_of sg_vis_vssm_fixed sg_vis_vssm_float
-//   sg_vogel_disc sg_vssm_blocker
+//   sg_sat_search_float sg_sat_search_layer sg_sat_span_weights sg_smrt_emitter_point
+//   sg_smrt_ray sg_soft_blockers sg_soft_filter_trips sg_texel_of sg_trilinear sg_trilinear_log
+//   sg_trilinear_packed sg_unpack_f16x2 sg_vis_esm sg_vis_esm_of_log sg_vis_esm_of_sat
+//   sg_vis_evsm sg_vis_evsm_of sg_vis_hard sg_vis_msm sg_vis_msm_of sg_vis_msm_soft_fixed
+//   sg_vis_msm_soft_float sg_vis_pcf sg_vis_pcf_hardware sg_vis_pcss sg_vis_smrt sg_vis_vsm
+//   sg_vis_vsm_of sg_vis_vssm_fixed sg_vis_vssm_float sg_vogel_disc sg_vssm_blocker
 
 // Shared light description and light-space helpers (import-only module).
 //
@@ -875,11 +874,6 @@ fn sg_sat_layer_node(sat: texture_2d<u32>, layer: sg_SatLayer, x: i32, y: i32) -
     return select(v, vec4<u32>(0u), x == 0 || y == 0);
 }
 
-// #fetches sg_sat_node_u32: 1
-fn sg_sat_node_u32(sat: texture_2d<u32>, x: i32, y: i32) -> vec4<u32> {
-    return sg_sat_layer_node(sat, sg_sat_alone(), x, y);
-}
-
 // #fetches sg_sat_node_f32: 1
 fn sg_sat_node_f32(sat: texture_2d<f32>, x: i32, y: i32) -> vec4<f32> {
     let v = textureLoad(sat, max(vec2<i32>(x - 1, y - 1), vec2<i32>(0)), 0);
@@ -978,15 +972,9 @@ fn sg_sat_layer_box(sat: texture_2d<u32>, layer: sg_SatLayer, rect: vec4<f32>, o
     return sg_sat_layer_window(sat, layer, sg_sat_box(rect, sg_sat_layer_size(sat, layer)), offset, scale);
 }
 
-// The mean over the integer window b (x0, y0, x1, y1; `sat_box`'s) of a fixed-point table, four
-// loads. Several tables of one size read over one square share the window's computation
-// (CSSM's filter lookups).
-// #fetches sg_sat_window_fixed: 4
-fn sg_sat_window_fixed(sat: texture_2d<u32>, b: vec4<i32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
-    return sg_sat_layer_window(sat, sg_sat_alone(), b, offset, scale);
-}
-
-// `sat_window_fixed` of the table `layer` of `sat`.
+// The mean over the integer window b (x0, y0, x1, y1; `sat_box`'s) of the fixed-point table
+// `layer` of `sat`, four loads. Several tables of one size read over one square share the
+// window's computation (CSSM's filter lookups).
 // #fetches sg_sat_layer_window: 4
 fn sg_sat_layer_window(sat: texture_2d<u32>, layer: sg_SatLayer, b: vec4<i32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
     let window = sg_sat_layer_node(sat, layer, b.z, b.w) - sg_sat_layer_node(sat, layer, b.x, b.w)
@@ -1100,7 +1088,7 @@ fn sg_sat_filter_fixed(map: texture_2d<u32>, l: sg_Light, uv: vec2<f32>, width: 
 }
 
 // `sat_filter_fixed`'s integer window over tables of `size`, for several tables of one size
-// read over one square (`sat_window_fixed` each): CSSM's five.
+// read over one square (`sat_layer_window` each): CSSM's five.
 fn sg_sat_filter_window(l: sg_Light, uv: vec2<f32>, width: f32, size: vec2<u32>) -> vec4<i32> {
     return sg_sat_box(sg_sat_nearest(sg_sat_rect(l, uv, width)), size);
 }

@@ -16,8 +16,8 @@
 // a clamped texel's outward difference is 0, as the border texel's is.
 // Each workgroup counts the non-finite depths of its own outputs, so each is counted once.
 //
-// The importing kernel declares `const CHANNELS` (2 or 4), `struct Params` (its encoding's
-// fields, then `blur: BlurSpec`), `fn encode(z, left, right, up, down) -> vec4<f32>`, the
+// It holds the kernels' entry point, `main`. The importing kernel declares `const CHANNELS`
+// (2 or 4), `struct Params` (its encoding's fields, then `blur: BlurSpec`), `fn encode(z, left, right, up, down) -> vec4<f32>`, the
 // texel its channels need in workgroup memory: `alias Texel` (vec2<f32> for two channels,
 // vec4<f32> for four), `fn texel_of(v: vec4<f32>) -> Texel` and `fn texel_out(t: Texel) ->
 // vec4<f32>` (two channels in vec2s halve the workgroup memory and its traffic), and the tile
@@ -494,4 +494,10 @@ fn encode_blur(wg: vec2<u32>, li: u32) {
         // The row's blur along x: one output an invocation (ROW = WG_SIZE).
         store(t, vec2<i32>(i32(li), 0), sum_x(t, i32(li), 0));
     }
+}
+
+// The entry point of every kernel that imports this module.
+@compute @workgroup_size(WG_SIZE)
+fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    encode_blur(wg.xy, li);
 }

@@ -96,11 +96,6 @@ fn sat_layer_node(sat: texture_2d<u32>, layer: SatLayer, x: i32, y: i32) -> vec4
     return select(v, vec4<u32>(0u), x == 0 || y == 0);
 }
 
-// #fetches sat_node_u32: 1
-fn sat_node_u32(sat: texture_2d<u32>, x: i32, y: i32) -> vec4<u32> {
-    return sat_layer_node(sat, sat_alone(), x, y);
-}
-
 // #fetches sat_node_f32: 1
 fn sat_node_f32(sat: texture_2d<f32>, x: i32, y: i32) -> vec4<f32> {
     let v = textureLoad(sat, max(vec2<i32>(x - 1, y - 1), vec2<i32>(0)), 0);
@@ -199,15 +194,9 @@ fn sat_layer_box(sat: texture_2d<u32>, layer: SatLayer, rect: vec4<f32>, offset:
     return sat_layer_window(sat, layer, sat_box(rect, sat_layer_size(sat, layer)), offset, scale);
 }
 
-// The mean over the integer window b (x0, y0, x1, y1; `sat_box`'s) of a fixed-point table, four
-// loads. Several tables of one size read over one square share the window's computation
-// (CSSM's filter lookups).
-// #fetches sat_window_fixed: 4
-fn sat_window_fixed(sat: texture_2d<u32>, b: vec4<i32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
-    return sat_layer_window(sat, sat_alone(), b, offset, scale);
-}
-
-// `sat_window_fixed` of the table `layer` of `sat`.
+// The mean over the integer window b (x0, y0, x1, y1; `sat_box`'s) of the fixed-point table
+// `layer` of `sat`, four loads. Several tables of one size read over one square share the
+// window's computation (CSSM's filter lookups).
 // #fetches sat_layer_window: 4
 fn sat_layer_window(sat: texture_2d<u32>, layer: SatLayer, b: vec4<i32>, offset: vec4<f32>, scale: vec4<f32>) -> vec4<f32> {
     let window = sat_layer_node(sat, layer, b.z, b.w) - sat_layer_node(sat, layer, b.x, b.w)

@@ -53,7 +53,7 @@ fn sat_filter_fixed(map: texture_2d<u32>, l: Light, uv: vec2<f32>, width: f32) -
 }
 
 // `sat_filter_fixed`'s integer window over tables of `size`, for several tables of one size
-// read over one square (`sat_window_fixed` each): CSSM's five.
+// read over one square (`sat_layer_window` each): CSSM's five.
 fn sat_filter_window(l: Light, uv: vec2<f32>, width: f32, size: vec2<u32>) -> vec4<i32> {
     return sat_box(sat_nearest(sat_rect(l, uv, width)), size);
 }

@@ -1,8 +1,8 @@
 // The VSM encoding fused into the blur (import-only module of `vsm_blur` and `vsm_blur_row`):
 // variance-shadow-map moments (shared/vsm_moments) of the rasterized depth, blurred in
-// workgroup memory (shared/encode_blur), with its parameters, texel and entry point. The
-// importing kernel declares the row path's shape, `const ROW` and `const ROW_RUN`
-// (shared/encode_blur), and its `// #traffic` lines:
+// workgroup memory (shared/encode_blur), with its parameters and texel. The importing kernel
+// declares the row path's shape, `const ROW` and `const ROW_RUN` (shared/encode_blur), and its
+// `// #traffic` lines:
 // #completed-by-importer
 // #import shared/encode_blur
 // #import shared/vsm_moments
@@ -32,9 +32,4 @@ fn texel_out(t: Texel) -> vec4<f32> {
 
 fn encode(z: f32, left: f32, right: f32, up: f32, down: f32) -> vec4<f32> {
     return vec4<f32>(vsm_moments(z, left, right, up, down), 0.0, 0.0);
-}
-
-@compute @workgroup_size(WG_SIZE)
-fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    encode_blur(wg.xy, li);
 }

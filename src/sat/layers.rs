@@ -202,16 +202,15 @@ mod tests {
     use super::*;
     use crate::graph::plan;
 
-    /// Five layers of a ragged 200 × 130 source: the stacked edges' sizes, the passes, their
-    /// workgroups along z and each pass-3 dispatch's tables.
-    #[test]
-    fn layered_sat_plans_stacked_edges_and_four_tables_a_dispatch() {
+    /// Five layers (four of four channels, the last of one) of a ragged 200 × 130 source, fixed
+    /// point, `interleave` tables a texture, the first and count of each dispatch's tables
+    /// after its `SatParams`: the graph and the textures.
+    fn five_layers(interleave: u32) -> (Graph, Vec<String>) {
         let mut g = Graph::default();
         g.import("d", wgpu::TextureFormat::R32Float, 200, 130, Some(0));
         let tables: Vec<(String, u32)> = (0..5)
             .map(|k| (format!("t{k}"), if k == 4 { 1 } else { 4 }))
             .collect();
-        let coding = SatCoding::fixed(64, [-1.0; 4], [1.0; 4]).unwrap();
         let params = |s: SatParams, first: u32, count: u32| {
             let mut b = bytemuck::bytes_of(&s).to_vec();
             b.extend([first, count].iter().flat_map(|v| v.to_le_bytes()));
@@ -223,10 +222,18 @@ mod tests {
             tables: &tables,
             kernels: [KernelId::CsmSatTileSums, KernelId::CsmSatTiles],
             params: &params,
-            coding,
-            interleave: 1,
+            coding: SatCoding::fixed(64, [-1.0; 4], [1.0; 4]).unwrap(),
+            interleave,
         };
         let out = add_layered_sat(&mut g, 0, &sat);
+        (g, out)
+    }
+
+    /// Five layers of a ragged 200 × 130 source: the stacked edges' sizes, the passes, their
+    /// workgroups along z and each pass-3 dispatch's tables.
+    #[test]
+    fn layered_sat_plans_stacked_edges_and_four_tables_a_dispatch() {
+        let (g, out) = five_layers(1);
         assert_eq!(out, ["t0.sat", "t1.sat", "t2.sat", "t3.sat", "t4.sat"]);
         let names: Vec<&str> = out.iter().map(String::as_str).collect();
         let p = plan(&g, &names).unwrap();
@@ -282,26 +289,7 @@ mod tests {
     /// of a tile side by side along x.
     #[test]
     fn interleaved_layers_share_textures_and_one_dispatch() {
-        let mut g = Graph::default();
-        g.import("d", wgpu::TextureFormat::R32Float, 200, 130, Some(0));
-        let tables: Vec<(String, u32)> = (0..5)
-            .map(|k| (format!("t{k}"), if k == 4 { 1 } else { 4 }))
-            .collect();
-        let params = |s: SatParams, first: u32, count: u32| {
-            let mut b = bytemuck::bytes_of(&s).to_vec();
-            b.extend([first, count].iter().flat_map(|v| v.to_le_bytes()));
-            b
-        };
-        let sat = LayeredSat {
-            source: "d",
-            prefix: "l",
-            tables: &tables,
-            kernels: [KernelId::CsmSatTileSums, KernelId::CsmSatTiles],
-            params: &params,
-            coding: SatCoding::fixed(64, [-1.0; 4], [1.0; 4]).unwrap(),
-            interleave: 2,
-        };
-        let out = add_layered_sat(&mut g, 0, &sat);
+        let (g, out) = five_layers(2);
         assert_eq!(out, ["l.sat.layers0", "l.sat.layers1", "l.sat.layers2"]);
         let names: Vec<&str> = out.iter().map(String::as_str).collect();
         let p = plan(&g, &names).unwrap();

@@ -1,0 +1,21 @@
+// The four-channel texel of the encodings fused into the blur (import-only module of
+// shared/evsm_blur_kernel and shared/msm_blur_kernel): what shared/encode_blur asks of its
+// importer for four channels — a vec4<f32> texel, the 16² tile that 16 KiB of workgroup memory
+// allows at TILE_RADIUS (SH_TEXELS of 16 B), one output an invocation in the tile's blur.
+
+const CHANNELS: u32 = 4u;
+// The tile its workgroup memory allows (shared/encode_blur). Keep in sync with
+// `encode_blur_tile` in src/filter/encode_blur.rs.
+const TILE: u32 = 16u;
+const SH_TEXELS: u32 = 1024u;
+// Outputs an invocation sums in the tile's blur passes, four channels: one output an invocation (shared/encode_blur, `run_sums`).
+const RUN: u32 = 1u;
+alias Texel = vec4<f32>;
+
+fn texel_of(v: vec4<f32>) -> Texel {
+    return v;
+}
+
+fn texel_out(t: Texel) -> vec4<f32> {
+    return t;
+}
