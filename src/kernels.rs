@@ -5,8 +5,14 @@
 //! kernel, recursively). A line `// #generated` marks where a generated block (the per-scene
 //! visibility dispatch of the shading kernel) is spliced in. Bindings and workgroup sizes are
 //! read back from naga's IR, so Rust never restates them by hand.
+//!
+//! [`KERNEL_DIR_ENV`] names a folder whose `<name>.wgsl` files replace the embedded kernels and
+//! modules of the same name, so one build runs variants of its kernels (kernel work without a
+//! rebuild; ablations on a lent GPU, where a second binary costs device time to carry).
 
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
 use crate::error::{Error, Result};
 
@@ -47,8 +53,89 @@ impl PartialEq<&str> for KernelId {
     }
 }
 
-/// The embedded text of `kernels/<name>.wgsl`.
+/// The environment variable naming a folder of replacement kernels: its `<name>.wgsl` (and
+/// `shared/<name>.wgsl`) files take the place of the embedded files of the same name for the
+/// whole process. Every file must name an embedded kernel or module; the replaced names are
+/// said once on stderr.
+pub const KERNEL_DIR_ENV: &str = "SHADOWGRAPH_KERNEL_DIR";
+
+/// The replacement kernels of [`KERNEL_DIR_ENV`], read at the first kernel looked up: name →
+/// text, or the one-line error that every kernel lookup then reports.
+fn replacements() -> std::result::Result<&'static HashMap<String, &'static str>, &'static str> {
+    static REPLACED: OnceLock<std::result::Result<HashMap<String, &'static str>, String>> =
+        OnceLock::new();
+    let loaded = REPLACED.get_or_init(|| {
+        let Some(dir) = std::env::var_os(KERNEL_DIR_ENV) else {
+            return Ok(HashMap::new());
+        };
+        let dir = PathBuf::from(dir);
+        let replaced = read_replacements(&dir)?;
+        let mut names: Vec<&str> = replaced.keys().map(String::as_str).collect();
+        names.sort_unstable();
+        eprintln!(
+            "note: {KERNEL_DIR_ENV}={}: kernels replaced: {}",
+            dir.display(),
+            if names.is_empty() {
+                "none".to_string()
+            } else {
+                names.join(", ")
+            }
+        );
+        Ok(replaced
+            .into_iter()
+            .map(|(k, v)| (k, &*Box::leak(v.into_boxed_str())))
+            .collect())
+    });
+    loaded.as_ref().map_err(String::as_str)
+}
+
+/// The `.wgsl` files below `dir` (one level of folders: `shared/`), each by its path below
+/// `dir` without the extension; an error names a file that is no embedded kernel or module, or
+/// a folder that cannot be read.
+pub fn read_replacements(dir: &Path) -> std::result::Result<HashMap<String, String>, String> {
+    let mut out = HashMap::new();
+    let mut folders = vec![(dir.to_path_buf(), String::new())];
+    while let Some((folder, prefix)) = folders.pop() {
+        let entries = std::fs::read_dir(&folder)
+            .map_err(|e| format!("{KERNEL_DIR_ENV}: {}: {e}", folder.display()))?;
+        for entry in entries {
+            let entry =
+                entry.map_err(|e| format!("{KERNEL_DIR_ENV}: {}: {e}", folder.display()))?;
+            let path = entry.path();
+            let file_name = entry.file_name().to_string_lossy().into_owned();
+            if path.is_dir() {
+                if prefix.is_empty() {
+                    folders.push((path, format!("{file_name}/")));
+                }
+                continue;
+            }
+            let Some(stem) = file_name.strip_suffix(".wgsl") else {
+                continue;
+            };
+            let name = format!("{prefix}{stem}");
+            if !SOURCES.iter().any(|s| s.name == name) {
+                return Err(format!(
+                    "{KERNEL_DIR_ENV}: {}: names no kernel or module in kernels/",
+                    path.display()
+                ));
+            }
+            let text = std::fs::read_to_string(&path)
+                .map_err(|e| format!("{KERNEL_DIR_ENV}: {}: {e}", path.display()))?;
+            out.insert(name, text);
+        }
+    }
+    Ok(out)
+}
+
+/// The text of `kernels/<name>.wgsl`: embedded, or its replacement from [`KERNEL_DIR_ENV`].
 pub fn source(name: &str) -> Result<&'static str> {
+    let replaced = replacements().map_err(|message| Error::Kernel {
+        kernel: name.to_string(),
+        message: message.to_string(),
+    })?;
+    if let Some(text) = replaced.get(name) {
+        return Ok(text);
+    }
     SOURCES
         .iter()
         .find(|s| s.name == name)
@@ -159,20 +246,48 @@ impl Reflection {
     }
 }
 
-/// Parses and validates WGSL text, returning the module.
+/// Parses and validates WGSL text, returning the module. While [`KERNEL_DIR_ENV`] replaces
+/// kernels, an error is one line (naga's message and its line in the kernel with its imports
+/// spliced in), as for any other input; the embedded kernels keep naga's annotated source.
 pub fn validate(kernel: &str, wgsl: &str) -> Result<naga::Module> {
-    let module = naga::front::wgsl::parse_str(wgsl).map_err(|e| Error::Kernel {
+    let one_line = replacements().is_ok_and(|r| !r.is_empty());
+    let error = |message: String, line: Option<u32>| Error::Kernel {
         kernel: kernel.to_string(),
-        message: e.emit_to_string(wgsl),
+        message: if one_line {
+            let at = line.map(|l| format!(" (line {l} of the kernel with its imports)"));
+            format!(
+                "{}{} [kernels replaced by {KERNEL_DIR_ENV}]",
+                message.lines().next().unwrap_or_default(),
+                at.unwrap_or_default()
+            )
+        } else {
+            message
+        },
+    };
+    let module = naga::front::wgsl::parse_str(wgsl).map_err(|e| {
+        let line = e.location(wgsl).map(|l| l.line_number);
+        error(
+            if one_line {
+                e.message().to_string()
+            } else {
+                e.emit_to_string(wgsl)
+            },
+            line,
+        )
     })?;
     naga::valid::Validator::new(
         naga::valid::ValidationFlags::all(),
         naga::valid::Capabilities::all(),
     )
     .validate(&module)
-    .map_err(|e| Error::Kernel {
-        kernel: kernel.to_string(),
-        message: e.emit_to_string(wgsl),
+    .map_err(|e| {
+        let line = e.location(wgsl).map(|l| l.line_number);
+        let message = if one_line {
+            e.as_inner().to_string()
+        } else {
+            e.emit_to_string(wgsl)
+        };
+        error(message, line)
     })?;
     Ok(module)
 }

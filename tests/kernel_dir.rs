@@ -1,0 +1,135 @@
+//! `SHADOWGRAPH_KERNEL_DIR`: a folder of `.wgsl` files replaces the embedded kernels of the same
+//! names for one process (one build runs kernel variants). The replacement is what runs; a
+//! stray file, a missing folder or broken WGSL is one line and status 1.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use shadowgraph::kernels::{self, KERNEL_DIR_ENV};
+
+fn temp_dir(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("shadowgraph-kdir-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("temp dir");
+    d
+}
+
+/// `shadowgraph render sphere_on_plane.toml -o png`, with the kernels of `dir` (if any).
+fn render(dir: Option<&Path>, png: &Path) -> Output {
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/sphere_on_plane.toml");
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_shadowgraph"));
+    cmd.arg("render")
+        .arg(&scene)
+        .arg("-o")
+        .arg(png)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .env_remove(KERNEL_DIR_ENV);
+    if let Some(dir) = dir {
+        cmd.env(KERNEL_DIR_ENV, dir);
+    }
+    cmd.output().expect("run shadowgraph")
+}
+
+/// Status 1 and one line on stderr after the note, containing every needle.
+#[track_caller]
+fn refused(o: &Output, needles: &[&str]) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    let errors: Vec<&str> = err.lines().filter(|l| !l.starts_with("note: ")).collect();
+    assert_eq!(errors.len(), 1, "{err}");
+    for n in needles {
+        assert!(errors[0].contains(n), "`{n}` missing from {err}");
+    }
+}
+
+/// The shading kernel with its sRGB encoding replaced by black: every pixel's colour is then 0
+/// exactly, where the embedded kernel's render of the same scene has lit pixels.
+#[test]
+fn a_replaced_kernel_is_the_one_that_runs() {
+    let dir = temp_dir("shade");
+    let shade = kernels::source("shade").expect("embedded shade");
+    let head = "fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {\n";
+    assert!(shade.contains(head), "shade.wgsl's sRGB function moved");
+    let black = shade.replace(head, &format!("{head}    return vec3<f32>(0.0);\n"));
+    std::fs::write(dir.join("shade.wgsl"), black).unwrap();
+
+    let lit = |o: &Output, png: &Path| {
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let img = image::open(png).expect("png").to_rgba8();
+        img.pixels().filter(|p| p.0[..3] != [0, 0, 0]).count()
+    };
+    let png = dir.join("embedded.png");
+    let embedded = lit(&render(None, &png), &png);
+    assert!(
+        embedded > 1000,
+        "the embedded render is black: {embedded} lit pixels"
+    );
+
+    let png = dir.join("replaced.png");
+    let o = render(Some(&dir), &png);
+    assert_eq!(lit(&o, &png), 0, "the replaced kernel did not run");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("kernels replaced: shade"),
+        "no note naming the replaced kernel: {err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Files are named by their path below the folder (`shared/` for modules); anything else is
+/// refused by name.
+#[test]
+fn replacements_are_read_by_name() {
+    let dir = temp_dir("names");
+    std::fs::create_dir_all(dir.join("shared")).unwrap();
+    std::fs::write(dir.join("linearize.wgsl"), "// a").unwrap();
+    std::fs::write(dir.join("shared/light.wgsl"), "// b").unwrap();
+    std::fs::write(dir.join("notes.txt"), "not a kernel").unwrap();
+    let read = kernels::read_replacements(&dir).expect("read");
+    let mut names: Vec<&str> = read.keys().map(String::as_str).collect();
+    names.sort_unstable();
+    assert_eq!(names, ["linearize", "shared/light"]);
+    assert_eq!(read["shared/light"], "// b");
+
+    std::fs::write(dir.join("shared/nonesuch.wgsl"), "").unwrap();
+    let e = kernels::read_replacements(&dir).expect_err("a stray kernel");
+    assert!(
+        e.contains("nonesuch.wgsl") && e.contains("names no kernel"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_replacements_are_one_line_errors() {
+    let dir = temp_dir("bad");
+    let png = dir.join("out.png");
+    std::fs::write(dir.join("nonesuch.wgsl"), "").unwrap();
+    refused(
+        &render(Some(&dir), &png),
+        &["nonesuch.wgsl", "names no kernel"],
+    );
+    std::fs::remove_file(dir.join("nonesuch.wgsl")).unwrap();
+
+    refused(
+        &render(Some(&dir.join("missing")), &png),
+        &[KERNEL_DIR_ENV, "missing"],
+    );
+
+    // A parse error on the third line, and a type error (naga places it at the function).
+    std::fs::write(dir.join("linearize.wgsl"), "// a\n\nfn f( {}\n").unwrap();
+    refused(
+        &render(Some(&dir), &png),
+        &["kernel `linearize`", "(line 3 of", KERNEL_DIR_ENV],
+    );
+    std::fs::write(
+        dir.join("linearize.wgsl"),
+        "fn f() -> u32 {\n    return 1.5;\n}\n",
+    )
+    .unwrap();
+    refused(
+        &render(Some(&dir), &png),
+        &["kernel `linearize`", "cannot convert", KERNEL_DIR_ENV],
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
