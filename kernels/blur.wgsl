@@ -177,14 +177,23 @@ fn blur_outputs(b: BlurLine, vertical: bool) {
 
 @compute @workgroup_size(WG_SIZE)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    let b = blur_line(wg.xy, li, u32(select(RUN, COL_RUN, params.axis == 1u)), COL_PER);
-    if !blur_active(b) {
-        return;
-    }
     // The axis tested once, not at every tap (shared/blur_pass's `tap`).
     if params.axis == 1u {
-        blur_outputs(b, true);
+        let b = blur_line(wg.xy, li, u32(COL_RUN), COL_PER);
+        if blur_active(b) {
+            blur_outputs(b, true);
+        }
+    } else if GPU_LAYOUT {
+        // A row: every invocation stages, sums its one run (PER = RUN; past the map's edge
+        // too, from clamped texels, unwritten) and unstages (shared/blur_pass).
+        let b = blur_line(wg.xy, li, u32(RUN), COL_PER);
+        row_stage(wg.xy, li);
+        blur_run(b, 0, false);
+        row_unstage(wg.xy, li);
     } else {
-        blur_outputs(b, false);
+        let b = blur_line(wg.xy, li, u32(RUN), COL_PER);
+        if blur_active(b) {
+            blur_outputs(b, false);
+        }
     }
 }

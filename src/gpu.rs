@@ -151,6 +151,12 @@ impl Gpu {
             "timestamp period (ns/tick)",
             format!("{}", self.queue.get_timestamp_period()),
         );
+        let layout = match crate::exec::KernelLayout::for_device(&self.device) {
+            Ok(crate::exec::KernelLayout::Gpu) => "gpu".to_string(),
+            Ok(crate::exec::KernelLayout::Cpu) => "cpu".to_string(),
+            Err(e) => e.to_string(),
+        };
+        line("kernel layout", layout);
         s
     }
 }

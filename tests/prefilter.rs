@@ -7,7 +7,7 @@ use std::collections::HashMap;
 
 use rand::Rng;
 use shadowgraph::cpu::{self, Texels};
-use shadowgraph::exec::Executor;
+use shadowgraph::exec::{Executor, KernelLayout};
 use shadowgraph::gpu::{Gpu, read_resource_texture, submit_and_wait, write_texture};
 use shadowgraph::graph::{Graph, SizeRule, plan};
 use shadowgraph::scene::{BlurKernel, Filter};
@@ -37,11 +37,44 @@ fn run(g: &Gpu, graph: &Graph, output: &str, input: wgpu::Texture) -> Texels {
     run_levels(g, graph, output, input).swap_remove(0)
 }
 
+/// [`run`] in each of the kernels' two memory layouts (`exec::KernelLayout`: the blur's row
+/// pass staged through workgroup memory, as on a GPU, or straight from the texture, as on a
+/// CPU driver), which must agree bit for bit; returns the output.
+fn run_both(g: &Gpu, graph: &Graph, output: &str, input: wgpu::Texture, what: &str) -> Texels {
+    let staged = run_layout(g, graph, output, &input, Some(KernelLayout::Gpu)).swap_remove(0);
+    let direct = run_layout(g, graph, output, &input, Some(KernelLayout::Cpu)).swap_remove(0);
+    let bits = |t: &Texels| -> Vec<u32> { t.data.iter().map(|&v| (v as f32).to_bits()).collect() };
+    let (a, b) = (bits(&staged), bits(&direct));
+    if let Some(i) = (0..a.len()).find(|&i| a[i] != b[i]) {
+        panic!(
+            "{what}: the layouts differ at value {i} (texel {}): GPU layout {}, CPU layout {}",
+            i / staged.channels,
+            staged.data[i],
+            direct.data[i]
+        );
+    }
+    staged
+}
+
 /// [`run`], reading back every mip level of the output.
 fn run_levels(g: &Gpu, graph: &Graph, output: &str, input: wgpu::Texture) -> Vec<Texels> {
+    run_layout(g, graph, output, &input, None)
+}
+
+/// [`run_levels`] with the kernels compiled in `layout` (`None`: the device's).
+fn run_layout(
+    g: &Gpu,
+    graph: &Graph,
+    output: &str,
+    input: &wgpu::Texture,
+    layout: Option<KernelLayout>,
+) -> Vec<Texels> {
     let plan = plan(graph, &[output]).expect("plan");
     let mut exec = Executor::new();
-    let imports = HashMap::from([("in".to_string(), input)]);
+    if let Some(layout) = layout {
+        exec.kernels.set_layout(layout);
+    }
+    let imports = HashMap::from([("in".to_string(), input.clone())]);
     let mut enc = g.device.create_command_encoder(&Default::default());
     let first = exec
         .record(&g.device, &mut enc, &plan, &imports, None)
@@ -240,19 +273,10 @@ fn blur_matches_reference_for_each_kernel_and_storage() {
             ),
         ] {
             let (graph, out) = vsm_graph(w, h, format, Some(filter));
-            let gpu = run(
-                &g,
-                &graph,
-                &out,
-                upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin),
-            );
-            common::assert_close(
-                &format!("blur {w}x{h} r{radius} {kernel:?} {format:?}"),
-                &channels(&gpu, 2),
-                &expected.data,
-                atol,
-                rtol,
-            );
+            let what = format!("blur {w}x{h} r{radius} {kernel:?} {format:?}");
+            let input = upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin);
+            let gpu = run_both(&g, &graph, &out, input, &what);
+            common::assert_close(&what, &channels(&gpu, 2), &expected.data, atol, rtol);
         }
     }
 }
@@ -333,12 +357,8 @@ fn evsm_and_esm_encodings_match_reference() {
             filter,
             BlurMode::Linear,
         );
-        let gpu = run(
-            &g,
-            &graph,
-            &out,
-            upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin),
-        );
+        let depth = upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin);
+        let gpu = run_both(&g, &graph, &out, depth, &format!("evsm {format:?}"));
         let mut expected = cpu::evsm::evsm(&input, 42.0, 5.0);
         if filter.is_some() {
             expected = cpu::blur::blur(&expected, 3.0, 1.5, BlurKernel::Gaussian);
@@ -389,12 +409,8 @@ fn evsm_and_esm_encodings_match_reference() {
             Some(blur),
             BlurMode::log_sum_exp(c),
         );
-        let gpu = run(
-            &g,
-            &graph,
-            &out,
-            upload(&g, w, h, wgpu::TextureFormat::R32Float, &edges),
-        );
+        let depth = upload(&g, w, h, wgpu::TextureFormat::R32Float, &edges);
+        let gpu = run_both(&g, &graph, &out, depth, &format!("esm c={c}"));
         let expected = cpu::blur::blur_mode(
             &cpu::esm::esm(&input, f64::from(c)),
             3.0,
@@ -474,12 +490,8 @@ fn msm_encoding_matches_reference_for_each_storage() {
         })
         .to_vec();
         let (graph, out) = encode_graph("msm", params, w, h, format, filter, BlurMode::Linear);
-        let gpu = run(
-            &g,
-            &graph,
-            &out,
-            upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin),
-        );
+        let depth = upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin);
+        let gpu = run_both(&g, &graph, &out, depth, &format!("msm {format:?}"));
         let mut expected = cpu::msm::msm(&input, quantized);
         if filter.is_some() {
             expected = cpu::blur::blur(&expected, 2.0, 1.0, BlurKernel::Gaussian);

@@ -22,7 +22,10 @@ pub use crate::error::ExecError;
 use crate::error::Result;
 use crate::graph::{Plan, Slot};
 pub use crate::timer::GpuTimer;
-pub use pipelines::{ComputeKernel, KernelCache, specialized_source, wgsl_storage_format};
+pub use pipelines::{
+    ComputeKernel, GPU_LAYOUT_CONSTANT, KERNEL_LAYOUT_ENV, KernelCache, KernelLayout,
+    specialized_source, wgsl_storage_format,
+};
 pub use pool::{Outputs, TexturePool};
 
 /// Runs plans: owns pipelines, pooled textures and what the last plan's run needs; borrows

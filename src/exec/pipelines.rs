@@ -21,10 +21,67 @@ pub struct ComputeKernel {
     pub pipeline: wgpu::ComputePipeline,
 }
 
+/// The environment variable that picks [`KernelLayout`] for every device: `gpu` or `cpu`
+/// (unset: by the device's type). A/B of the two layouts on one machine.
+pub const KERNEL_LAYOUT_ENV: &str = "SHADOWGRAPH_KERNEL_LAYOUT";
+
+/// The pipeline constant a kernel declares (`override GPU_LAYOUT: bool`) where it has two
+/// memory layouts.
+pub const GPU_LAYOUT_CONSTANT: &str = "GPU_LAYOUT";
+
+/// Which of its two memory layouts a kernel that has two compiles (`override GPU_LAYOUT:
+/// bool`; the blur's row pass, `kernels/shared/blur_pass.wgsl`). A GPU coalesces a SIMD group's
+/// loads and stores only where its lanes touch neighbouring texels, which the row pass gets by
+/// staging its texels through workgroup memory; llvmpipe's lanes gather texel by texel anyway,
+/// and its workgroup memory is slow, so there the row pass reads and writes the texture in
+/// runs. Both layouts give the same results bit for bit (`tests/fused.rs`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum KernelLayout {
+    /// Neighbouring lanes on neighbouring texels (`GPU_LAYOUT = true`).
+    Gpu,
+    /// Each invocation's run straight from the texture (`GPU_LAYOUT = false`).
+    Cpu,
+}
+
+impl KernelLayout {
+    /// [`KERNEL_LAYOUT_ENV`] if set, else [`KernelLayout::Cpu`] on a CPU driver
+    /// ([`wgpu::DeviceType::Cpu`]) and [`KernelLayout::Gpu`] on anything else.
+    pub fn for_device(device: &wgpu::Device) -> Result<Self> {
+        match std::env::var(KERNEL_LAYOUT_ENV) {
+            Ok(v) if v == "gpu" => Ok(Self::Gpu),
+            Ok(v) if v == "cpu" => Ok(Self::Cpu),
+            Ok(v) => Err(Error::Kernel {
+                kernel: GPU_LAYOUT_CONSTANT.to_string(),
+                message: format!("{KERNEL_LAYOUT_ENV}={v}: expected `gpu` or `cpu`"),
+            }),
+            Err(_) if crate::timer::is_gpu(device) => Ok(Self::Gpu),
+            Err(_) => Ok(Self::Cpu),
+        }
+    }
+}
+
 impl ComputeKernel {
-    /// Validates, reflects and compiles `wgsl`; errors name the kernel.
+    /// Validates, reflects and compiles `wgsl` in the device's [`KernelLayout`]; errors name
+    /// the kernel.
     pub fn new(device: &wgpu::Device, name: &str, wgsl: &str) -> Result<Self> {
-        let (_, reflection) = kernels::reflect(name, wgsl)?;
+        Self::with_layout(device, name, wgsl, KernelLayout::for_device(device)?)
+    }
+
+    /// [`ComputeKernel::new`] in `layout` (where the kernel has two).
+    pub fn with_layout(
+        device: &wgpu::Device,
+        name: &str,
+        wgsl: &str,
+        layout: KernelLayout,
+    ) -> Result<Self> {
+        let (module, reflection) = kernels::reflect(name, wgsl)?;
+        let two_layouts = module
+            .overrides
+            .iter()
+            .any(|(_, o)| o.name.as_deref() == Some(GPU_LAYOUT_CONSTANT));
+        let gpu = f64::from(u8::from(layout == KernelLayout::Gpu));
+        let constants = [(GPU_LAYOUT_CONSTANT, gpu)];
+        let constants: &[(&str, f64)] = if two_layouts { &constants } else { &[] };
         let label = format!("shadowgraph.{name}");
         let (layouts, pipeline) = scoped(
             device,
@@ -63,7 +120,10 @@ impl ComputeKernel {
                         layout: Some(&layout),
                         module: &module,
                         entry_point: Some("main"),
-                        compilation_options: Default::default(),
+                        compilation_options: wgpu::PipelineCompilationOptions {
+                            constants,
+                            ..Default::default()
+                        },
                         cache: None,
                     },
                 );
@@ -93,9 +153,26 @@ impl ComputeKernel {
 #[derive(Default)]
 pub struct KernelCache {
     kernels: HashMap<String, Arc<ComputeKernel>>,
+    /// The layout kernels compile in; `None`: [`KernelLayout::for_device`].
+    layout: Option<KernelLayout>,
 }
 
 impl KernelCache {
+    /// Compiles every kernel from now on in `layout` whatever the device (the pipelines made
+    /// so far are dropped): both layouts tested on one device.
+    pub fn set_layout(&mut self, layout: KernelLayout) {
+        self.layout = Some(layout);
+        self.kernels.clear();
+    }
+
+    fn compile(&self, device: &wgpu::Device, name: &str, wgsl: &str) -> Result<ComputeKernel> {
+        let layout = match self.layout {
+            Some(layout) => layout,
+            None => KernelLayout::for_device(device)?,
+        };
+        ComputeKernel::with_layout(device, name, wgsl, layout)
+    }
+
     /// The pipeline of `kernels/<name>.wgsl`, compiled on first use.
     pub fn get(&mut self, device: &wgpu::Device, name: &str) -> Result<Arc<ComputeKernel>> {
         self.get_generated(device, name, None)
@@ -123,7 +200,7 @@ impl KernelCache {
             return Ok(k.clone());
         }
         let wgsl = apply(name, &changes)?;
-        let k = Arc::new(ComputeKernel::new(device, name, &wgsl)?);
+        let k = Arc::new(self.compile(device, name, &wgsl)?);
         self.kernels.insert(key, k.clone());
         Ok(k)
     }
@@ -140,7 +217,7 @@ impl KernelCache {
             return Ok(k.clone());
         }
         let wgsl = kernels::resolve(name, generated)?;
-        let k = Arc::new(ComputeKernel::new(device, name, &wgsl)?);
+        let k = Arc::new(self.compile(device, name, &wgsl)?);
         self.kernels.insert(key, k.clone());
         Ok(k)
     }
@@ -160,7 +237,7 @@ impl KernelCache {
             return Ok(k.clone());
         }
         let wgsl = kernels::resolve(name, Some(&generated()))?;
-        let k = Arc::new(ComputeKernel::new(device, name, &wgsl)?);
+        let k = Arc::new(self.compile(device, name, &wgsl)?);
         self.kernels.insert(key.to_string(), k.clone());
         Ok(k)
     }
@@ -175,7 +252,7 @@ impl KernelCache {
         name: &str,
         wgsl: &str,
     ) -> Result<()> {
-        let k = Arc::new(ComputeKernel::new(device, name, wgsl)?);
+        let k = Arc::new(self.compile(device, name, wgsl)?);
         self.kernels.insert(key.to_string(), k);
         Ok(())
     }
@@ -191,7 +268,7 @@ impl KernelCache {
         wgsl: &str,
     ) -> Result<()> {
         let key = generated_key(name, generated);
-        let k = Arc::new(ComputeKernel::new(device, name, wgsl)?);
+        let k = Arc::new(self.compile(device, name, wgsl)?);
         self.kernels.insert(key, k);
         Ok(())
     }
