@@ -1,76 +1,116 @@
 #!/bin/bash
-# The device checks to run first when a GPU is lent: the figures issues 14 (soft shading,
-# table build) and 15 (kernels against a texture copy) are measured by, in one call of about
-# five minutes (H200: 67 + 6 + 2 × 93 s, seven files in OUT). From the repository root, after `cargo build --release`:
+# The device checks to run first when a GPU is lent: the figures issues 14 (soft shading, the
+# shading pass's floor, table build) and 15 (kernels against a texture copy, the blur's two
+# row layouts) are measured by, in one call. From the repository root, after
+# `cargo build --release`:
 #
 #   benches/gpu_check.sh [BINARY] [OUT]     # defaults: target/release/shadowgraph, gpu-out
 #
-# A second binary to compare against goes in as BASE=path/to/other/shadowgraph: its kernel
-# rows are then timed alternately with BINARY's on the same warm machine (compare timings
-# only within one call: before the GPU warm-up by time of 2026-11-27, the same card's
-# figures moved up to 4× between calls at 4096²). On an H200 (2026-11-26) the soft table
-# took 67 s, the 2048² kernels 6 s and each large round 93 s per binary, before the GPU
-# warm-up added 0.3 s a kernel case (about 15 s a kernel step): with BASE (which adds four
-# 2048² blur steps, four CSSM shading steps and a large round), give the call 540 s or more.
-# Each step writes its own file in OUT and prints its wall time, so a call stopped by its time
-# box still returns what ran. Record the results in benches/RESULTS.md (device, date, commit,
-# command, table).
+# On an H200 (2026-11-27) the steps took: soft table 76 s, shade floor 6 × 13 s, each 2048²
+# kernel round 13 s, the 2048² table 23 s, each 4096²/8192² round 127 s; give the call 560 s.
+# The steps run most wanted first, each under its own time box, and append to at most seven
+# files in OUT (the device tool brings back eight), so a call stopped by its time box still
+# returns what ran. A second binary to compare against goes in as BASE=path/to/other/shadowgraph:
+# its 2048² blur rows are then timed alternately with BINARY's (compare timings only within
+# one call). Record the results in benches/RESULTS.md (device, date, commit, command, table).
 set -u
 B=${1:-target/release/shadowgraph}
 OUT=${2:-gpu-out}
 BASE=${BASE:-}
 mkdir -p "$OUT"
 export SHADOWGRAPH_MEMORY_BUDGET=${SHADOWGRAPH_MEMORY_BUDGET:-48GiB}
+unset SHADOWGRAPH_KERNEL_DIR SHADOWGRAPH_KERNEL_LAYOUT
+T0=$(date +%s)
 
-# Runs a command with its output in $OUT/$1, then says how long it took.
+# Runs a command (at most $2 seconds) with its output appended to $OUT/$1, then says how long
+# it took in $OUT/steps.txt.
 step() {
-    local file=$1
-    shift
+    local file=$1 limit=$2
+    shift 2
     local start
     start=$(date +%s%N)
-    "$@" >>"$OUT/$file" 2>&1
+    echo "## $*" >>"$OUT/$file"
+    timeout "$limit" "$@" >>"$OUT/$file" 2>&1
     local status=$?
-    echo "[$(( ($(date +%s%N) - start) / 1000000 )) ms, status $status] $*"
+    echo "[t=$(($(date +%s) - T0)) s, $((($(date +%s%N) - start) / 1000000)) ms, status $status] $*" |
+        tee -a "$OUT/steps.txt"
 }
 
 command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version,clocks.sm \
-    --format=csv >"$OUT/clocks.txt" 2>&1
-step info.txt "$B" info
+    --format=csv >>"$OUT/env.txt" 2>&1
+step env.txt 30 "$B" info
 # Issue 14: the soft techniques' shading against PCSS 16 + 32 at 1920×1080 with a 2048² map,
 # each configuration's prefilter, and each frame's passes against its wall time.
-step soft.txt "$B" bench --lookup 3 --repeat 20 --image 1920x1080 --map 2048
-# The timer against the wall clock on a bundled scene.
-step wall.txt "$B" render scenes/bunny.toml --timings --repeat 20 -o "$OUT/bunny.png"
-# Issue 15: every kernel at 2048² (figures there repeat within 1%), then the chains the
-# targets name at 4096² and 8192², twice (a check that the warm-up holds: before it,
-# figures there moved up to 4× between runs). `--passes` splits each chain by dispatch (the
-# soft tables' build, issue 14's ≤ 0.2 ms at 2048²: `chain vssm`, `chain msm_soft`).
-if [ -n "$BASE" ]; then
-    # CSSM's shading of both builds, alternated (b80d7f3 as BASE: a texture a table against
-    # the tables interleaved in one, 2026-11-27).
-    for round in 1 2; do
-        echo "## base, round $round" >>"$OUT/cssm_soft.txt"
-        step cssm_soft.txt "$BASE" bench --lookup 3 --repeat 20 --image 1920x1080 --map 2048 --only cssm
-        echo "## $B, round $round" >>"$OUT/cssm_soft.txt"
-        step cssm_soft.txt "$B" bench --lookup 3 --repeat 20 --image 1920x1080 --map 2048 --only cssm
+step soft.txt 150 "$B" bench --lookup 3 --repeat 20 --image 1920x1080 --map 2048
+# The shading pass's floor: `hard` with parts of kernels/shade.wgsl taken out
+# (SHADOWGRAPH_KERNEL_DIR), from the constant store alone up to the shipped kernel.
+V=$(mktemp -d)
+S=kernels/shade.wgsl
+KEEP='    if frame.light_count > 100000u {
+        // never at run time: keeps every binding of the shipped kernel referenced
+        let q = textureLoad(g_position, xy, 0);
+        let m = textureLoad(g_normal, xy, 0);
+        let vv = light_visibility(0u, q.xyz, m.xyz, q.xyz, m.xyz) + materials[0].x + lights[0].radiance.x;
+        out_visibility[0] = vv;
+        textureStore(out_color, xy, vec4<f32>(vv));
+        return;
+    }'
+MAIN='@compute @workgroup_size(WG_SIZE, WG_SIZE)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if any(id.xy >= frame.size) {
+        return;
+    }
+    let xy = id.xy;'
+mkdir -p "$V/shipped" "$V/no_srgb" "$V/no_lookup" "$V/gbuffer_only" "$V/store_only"
+cp "$S" "$V/shipped/shade.wgsl"
+sed 's/textureStore(out_color, xy, vec4<f32>(linear_to_srgb(radiance), 1.0));/textureStore(out_color, xy, vec4<f32>(radiance, 1.0));/' \
+    "$S" >"$V/no_srgb/shade.wgsl"
+sed 's/let v = light_visibility(i, gp.xyz, n, dp.dpdx, dp.dpdy);/var v = 1.0; if frame.light_count > 100000u { v = light_visibility(i, gp.xyz, n, dp.dpdx, dp.dpdy); }/' \
+    "$S" >"$V/no_lookup/shade.wgsl"
+{
+    sed '/^@compute/,$d' "$S"
+    printf '%s\n%s\n' "$MAIN" "$KEEP"
+    printf '    let gp = textureLoad(g_position, xy, 0);\n    let gn = textureLoad(g_normal, xy, 0);\n'
+    printf '    out_visibility[xy.y * frame.size.x + xy.x] = gp.w;\n'
+    printf '    textureStore(out_color, xy, vec4<f32>(gp.xyz + gn.xyz, 1.0));\n}\n'
+} >"$V/gbuffer_only/shade.wgsl"
+{
+    sed '/^@compute/,$d' "$S"
+    printf '%s\n%s\n' "$MAIN" "$KEEP"
+    printf '    textureStore(out_color, xy, vec4<f32>(0.5, 0.5, 0.5, 1.0));\n}\n'
+} >"$V/store_only/shade.wgsl"
+for v in no_srgb no_lookup; do
+    cmp -s "$S" "$V/$v/shade.wgsl" && echo "variant $v: its edit no longer applies to $S" |
+        tee -a "$OUT/steps.txt"
+done
+for v in shipped no_srgb no_lookup gbuffer_only store_only; do
+    echo "## variant $v" >>"$OUT/shade.txt"
+    SHADOWGRAPH_KERNEL_DIR="$V/$v" step shade.txt 40 "$B" bench --lookup 3 --repeat 20 \
+        --image 1920x1080 --map 2048 --only hard
+done
+# Issue 15: the blur's two row layouts (exec::KernelLayout) on the same machine, alternated,
+# at 2048² and 4096²: `gpu` stages each row through workgroup memory (the default on a GPU),
+# `cpu` reads it in runs straight from the texture (the layout timed on 2026-11-27).
+for round in 1 2; do
+    for layout in cpu gpu; do
+        echo "## layout $layout, round $round" >>"$OUT/layouts.txt"
+        SHADOWGRAPH_KERNEL_LAYOUT=$layout step layouts.txt 60 "$B" bench --sizes 2048,4096 \
+            --repeat 20 --only 'blur rg32f,blur log,+blur r4 (old)' --passes
     done
-    # The blur passes and fused blurs of both builds at 2048², alternated.
+done
+if [ -n "$BASE" ]; then
     for round in 1 2; do
-        echo "## base, round $round" >>"$OUT/blur_2048.txt"
-        step blur_2048.txt "$BASE" bench --sizes 2048 --repeat 20 --only blur --passes
-        echo "## $B, round $round" >>"$OUT/blur_2048.txt"
-        step blur_2048.txt "$B" bench --sizes 2048 --repeat 20 --only blur --passes
+        step layouts.txt 40 "$BASE" bench --sizes 2048 --repeat 20 --only blur --passes
+        step layouts.txt 40 "$B" bench --sizes 2048 --repeat 20 --only blur --passes
     done
 fi
-step kernels_2048.txt "$B" bench --sizes 2048 --repeat 20 --passes
-for round in 1 2; do
-    if [ -n "$BASE" ]; then
-        echo "## base, round $round" >>"$OUT/kernels_large.txt"
-        step kernels_large.txt "$BASE" bench --sizes 4096,8192 --repeat 20 --only chain,blur,mips,sat
-    fi
-    echo "## $B, round $round" >>"$OUT/kernels_large.txt"
-    step kernels_large.txt "$B" bench --sizes 4096,8192 --repeat 20 --only chain,blur,mips,sat --passes
-done
+# Every kernel at 2048² by dispatch (the soft tables' build: issue 14's ≤ 0.2 ms at 2048²,
+# `chain vssm`, `chain msm_soft`), then the chains the targets name at 4096² and 8192².
+step kernels_2048.txt 60 "$B" bench --sizes 2048 --repeat 20 --passes
+step kernels_large.txt 150 "$B" bench --sizes 4096,8192 --repeat 20 --only chain,blur,mips,sat --passes
+# The timer against the wall clock on a bundled scene.
+step env.txt 30 "$B" render scenes/bunny.toml --timings --repeat 20 -o "$V/bunny.png"
 command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=clocks.sm --format=csv \
-    >>"$OUT/clocks.txt" 2>&1
+    >>"$OUT/env.txt" 2>&1
+rm -rf "$V"
 exit 0
