@@ -41,7 +41,17 @@ command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version,c
 step env.txt 30 "$B" info
 # Issue 14: the soft techniques' shading against PCSS 16 + 32 at 1920×1080 with a 2048² map,
 # each configuration's prefilter, and each frame's passes against its wall time.
+# The SM clock sampled through it (the twelfth session's soft table read its prefilter
+# 2.4× the kernel bench's time for the same chain, and its frames 7 ms: is the clock low?).
+SAMPLER=
+if command -v nvidia-smi >/dev/null; then
+    echo "## clocks during the soft table" >>"$OUT/env.txt"
+    nvidia-smi --query-gpu=timestamp,clocks.sm,utilization.gpu --format=csv,noheader -lms 200 \
+        >>"$OUT/env.txt" 2>&1 &
+    SAMPLER=$!
+fi
 step soft.txt 150 "$B" bench --lookup 3 --repeat 20 --image 1920x1080 --map 2048
+[ -n "$SAMPLER" ] && kill "$SAMPLER" 2>/dev/null
 # The shading pass's floor: `hard` with parts of kernels/shade.wgsl taken out
 # (SHADOWGRAPH_KERNEL_DIR), from the constant store alone up to the shipped kernel.
 V=$(mktemp -d)
