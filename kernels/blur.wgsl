@@ -35,6 +35,8 @@ const DST_CHANNELS: u32 = 2u; // #channels dst
 // of power-of-two rows as much as the 24 live vec4); on a GPU the taps a run reads fall 4.5× at
 // r = 4 (2 an output against 9), for 24 live values an invocation.
 const RUN: i32 = 8;
+// The GPU layout's row pass sums one run an invocation (shared/blur_pass, `row_stage`).
+const_assert RUN == i32(PER);
 const COL_RUN: i32 = select(RUN, 2, DST_CHANNELS > 2u);
 
 // The run of outputs `o` .. `o + 7` along the line (`vertical`: a constant at each call). The

@@ -1,10 +1,13 @@
 //! `SHADOWGRAPH_KERNEL_DIR`: a folder of `.wgsl` files replaces the embedded kernels of the same
 //! names for one process (one build runs kernel variants). The replacement is what runs; a
-//! stray file, a missing folder or broken WGSL is one line and status 1.
+//! stray file, a missing folder or broken WGSL is one line and status 1. And
+//! `SHADOWGRAPH_KERNEL_LAYOUT`, which picks the kernels' memory layout: `info` prints it, a bad
+//! value is one line.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use shadowgraph::exec::KERNEL_LAYOUT_ENV;
 use shadowgraph::kernels::{self, KERNEL_DIR_ENV};
 
 fn temp_dir(tag: &str) -> PathBuf {
@@ -131,5 +134,50 @@ fn bad_replacements_are_one_line_errors() {
         &render(Some(&dir), &png),
         &["kernel `linearize`", "cannot convert", KERNEL_DIR_ENV],
     );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `shadowgraph info` with `SHADOWGRAPH_KERNEL_LAYOUT` set to `value` (unset: `None`).
+fn info(layout: Option<&str>) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_shadowgraph"));
+    cmd.arg("info")
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .env_remove(KERNEL_LAYOUT_ENV);
+    if let Some(layout) = layout {
+        cmd.env(KERNEL_LAYOUT_ENV, layout);
+    }
+    cmd.output().expect("run shadowgraph")
+}
+
+/// The layout line of `info`: lavapipe is a CPU driver, so `cpu` unless forced.
+#[test]
+fn kernel_layout_is_the_devices_unless_forced() {
+    let line = |o: &Output| -> String {
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let out = String::from_utf8_lossy(&o.stdout).into_owned();
+        let line = out.lines().find(|l| l.starts_with("kernel layout"));
+        line.unwrap_or_else(|| panic!("no layout line: {out}"))
+            .to_string()
+    };
+    assert!(
+        line(&info(None)).ends_with(" cpu"),
+        "lavapipe is a CPU driver"
+    );
+    assert!(line(&info(Some("gpu"))).ends_with(" gpu"));
+    assert!(line(&info(Some("cpu"))).ends_with(" cpu"));
+
+    let dir = temp_dir("layout");
+    let png = dir.join("out.png");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/sphere_on_plane.toml");
+    let o = Command::new(env!("CARGO_BIN_EXE_shadowgraph"))
+        .arg("render")
+        .arg(&scene)
+        .arg("-o")
+        .arg(&png)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .env(KERNEL_LAYOUT_ENV, "fast")
+        .output()
+        .expect("run shadowgraph");
+    refused(&o, &[KERNEL_LAYOUT_ENV, "fast", "`gpu` or `cpu`"]);
     let _ = std::fs::remove_dir_all(&dir);
 }

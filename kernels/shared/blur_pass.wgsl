@@ -136,10 +136,11 @@ override GPU_LAYOUT: bool = false;
 // H200 the horizontal pass took 3–5× the vertical one, whose neighbouring invocations are
 // neighbouring columns (benches/RESULTS.md, 2026-11-27, twelfth session). The sums, their
 // order and the edge clamping are unchanged: results bit for bit as before.
-// One slot of padding every 8 texels: invocation li's run starts at slot 9·li + …, so the 32
-// lanes of a SIMD group reading their runs' texels hit distinct banks.
+// One slot of padding every 8 texels: invocation li's run starts at slot 9·li + …, so the
+// eight lanes that a 16-byte access serves at a time (a quarter of a 32-lane SIMD group)
+// reading their runs' texels hit distinct banks.
 const ROW_STAGE: u32 = WG_SIZE * PER + 2u * MAX_RADIUS;
-var<workgroup> sh_row: array<vec4<f32>, 648>; // ROW_STAGE + ROW_STAGE / 8
+var<workgroup> sh_row: array<vec4<f32>, ROW_STAGE + ROW_STAGE / 8u>;
 var<private> row_out: array<vec4<f32>, PER>;
 
 fn row_slot(j: u32) -> u32 {
