@@ -6,7 +6,7 @@
 #
 #   benches/gpu_check.sh [BINARY] [OUT]     # defaults: target/release/shadowgraph, gpu-out
 #
-# On an H200 (2026-11-27) the steps took: soft table 76 s, shade floor 6 × 13 s, each 2048²
+# On an H200 (2026-11-27) the steps took: soft table 76 s, shade floor 7 × 13 s, each 2048²
 # kernel round 13 s, the 2048² table 23 s, each 4096²/8192² round 127 s; give the call 560 s.
 # The steps run most wanted first, each under its own time box, and append to at most seven
 # files in OUT (the device tool brings back eight), so a call stopped by its time box still
@@ -71,7 +71,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let xy = id.xy;'
-mkdir -p "$V/shipped" "$V/no_srgb" "$V/no_lookup" "$V/gbuffer_only" "$V/store_only"
+mkdir -p "$V/shipped" "$V/no_srgb" "$V/no_lookup" "$V/gbuffer_only" "$V/store_only" \
+    "$V/wg16" "$V/store_only_wg16"
 cp "$S" "$V/shipped/shade.wgsl"
 sed 's/textureStore(out_color, xy, vec4<f32>(linear_to_srgb(radiance), 1.0));/textureStore(out_color, xy, vec4<f32>(radiance, 1.0));/' \
     "$S" >"$V/no_srgb/shade.wgsl"
@@ -89,11 +90,16 @@ sed 's/let v = light_visibility(i, gp.xyz, n, dp.dpdx, dp.dpdy);/var v = 1.0; if
     printf '%s\n%s\n' "$MAIN" "$KEEP"
     printf '    textureStore(out_color, xy, vec4<f32>(0.5, 0.5, 0.5, 1.0));\n}\n'
 } >"$V/store_only/shade.wgsl"
-for v in no_srgb no_lookup; do
+# 16 × 16 workgroups instead of 8 × 8 (the dispatch follows the reflected size): is the floor
+# the launch of 32 400 workgroups of 64 invocations at 1080p, each with little to do?
+sed 's/^const WG_SIZE: u32 = 8u;/const WG_SIZE: u32 = 16u;/' "$S" >"$V/wg16/shade.wgsl"
+sed 's/^const WG_SIZE: u32 = 8u;/const WG_SIZE: u32 = 16u;/' "$V/store_only/shade.wgsl" \
+    >"$V/store_only_wg16/shade.wgsl"
+for v in no_srgb no_lookup wg16; do
     cmp -s "$S" "$V/$v/shade.wgsl" && echo "variant $v: its edit no longer applies to $S" |
         tee -a "$OUT/steps.txt"
 done
-for v in shipped no_srgb no_lookup gbuffer_only store_only; do
+for v in shipped no_srgb no_lookup gbuffer_only store_only wg16 store_only_wg16; do
     echo "## variant $v" >>"$OUT/shade.txt"
     SHADOWGRAPH_KERNEL_DIR="$V/$v" step shade.txt 40 "$B" bench --lookup 3 --repeat 20 \
         --image 1920x1080 --map 2048 --only hard
