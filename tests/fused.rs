@@ -13,7 +13,7 @@ use std::collections::HashMap;
 
 use rand::Rng;
 use shadowgraph::cpu::{self, Texels};
-use shadowgraph::exec::Executor;
+use shadowgraph::exec::{Executor, KernelLayout};
 use shadowgraph::gpu::{read_resource_texture, submit_and_wait, write_texture};
 use shadowgraph::graph::{Graph, plan, texel_bytes};
 use shadowgraph::scene::{Light, Scene};
@@ -66,6 +66,46 @@ fn raw_depth_sized(bad: usize, n: u32) -> Vec<f32> {
 /// Runs `light`'s graph on `raw` for `outputs` (each in its own texture, poisoned with NaN
 /// first so unwritten texels show); returns them and each step's non-finite count.
 fn run(light: &Light, raw: &[f32], outputs: &[String]) -> (Vec<Texels>, Vec<(String, u32)>) {
+    run_in(light, raw, outputs, None)
+}
+
+/// [`run`] in each of the kernels' two memory layouts (`exec::KernelLayout`: a row workgroup's
+/// outputs staged through workgroup memory before they are stored, as on a GPU, or stored
+/// straight, as on a CPU driver), which must agree bit for bit, counts included; returns the
+/// first.
+fn run_both(
+    light: &Light,
+    raw: &[f32],
+    outputs: &[String],
+    what: &str,
+) -> (Vec<Texels>, Vec<(String, u32)>) {
+    let staged = run_in(light, raw, outputs, Some(KernelLayout::Gpu));
+    let direct = run_in(light, raw, outputs, Some(KernelLayout::Cpu));
+    for (k, (a, b)) in staged.0.iter().zip(&direct.0).enumerate() {
+        let bits =
+            |t: &Texels| -> Vec<u32> { t.data.iter().map(|&v| (v as f32).to_bits()).collect() };
+        let (x, y) = (bits(a), bits(b));
+        if let Some(i) = (0..x.len()).find(|&i| x[i] != y[i]) {
+            panic!(
+                "{what}, {}: the layouts differ at value {i} (texel {}): GPU layout {}, CPU layout {}",
+                outputs[k],
+                i / a.channels,
+                a.data[i],
+                b.data[i]
+            );
+        }
+    }
+    assert_eq!(staged.1, direct.1, "{what}: the layouts' counts");
+    staged
+}
+
+/// [`run`] with the kernels compiled in `layout` (`None`: the device's).
+fn run_in(
+    light: &Light,
+    raw: &[f32],
+    outputs: &[String],
+    layout: Option<KernelLayout>,
+) -> (Vec<Texels>, Vec<(String, u32)>) {
     let n = side(raw);
     let g = common::gpu();
     let mut graph = Graph::default();
@@ -89,6 +129,9 @@ fn run(light: &Light, raw: &[f32], outputs: &[String]) -> (Vec<Texels>, Vec<(Str
     write_texture(&g.queue, &depth, bytemuck::cast_slice(raw));
     let imports = HashMap::from([(technique::depth_name(0), depth)]);
     let mut exec = Executor::new();
+    if let Some(layout) = layout {
+        exec.kernels.set_layout(layout);
+    }
     let mut enc = g.device.create_command_encoder(&Default::default());
     let out = exec
         .record(&g.device, &mut enc, &plan, &imports, None)
@@ -374,7 +417,7 @@ fn fused_blurs_match_encode_then_blur() {
             );
             let map = format!("{encoded}.blur");
             let what = format!("{map} (r = {radius}, {shadow})");
-            let (maps, stats) = run(&light, &raw, std::slice::from_ref(&map));
+            let (maps, stats) = run_both(&light, &raw, std::slice::from_ref(&map), &what);
             let (lin, replaced) = linear(&light, &raw);
             let want = reference(&lin, radius.into(), sigma);
             let got = &maps[0];
@@ -425,7 +468,7 @@ fn row_kernels_span_row_workgroups() {
                 .map(|s| s.node.kernel.as_str())
                 .collect();
             assert_eq!(kernels, [kernel, "blur"], "{what}");
-            let (maps, stats) = run(&light, &raw, std::slice::from_ref(&map));
+            let (maps, stats) = run_both(&light, &raw, std::slice::from_ref(&map), &what);
             let (lin, replaced) = linear(&light, &raw);
             let want = reference(&lin, radius.into(), sigma);
             let got = &maps[0];

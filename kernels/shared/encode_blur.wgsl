@@ -369,6 +369,27 @@ fn blur_tile_single(t: Tile, li: u32) {
     }
 }
 
+// The memory layout of a row workgroup's stores, a pipeline constant the executor sets by
+// device (`exec::KernelLayout`: true on a GPU). An invocation's run of outputs lies side by
+// side with its neighbours' runs, so storing them straight from its sums puts one store
+// instruction's texels a run apart, a cache sector each (the separable blur's row pass, stored
+// that way, took 3–5× its column pass on an H200: benches/RESULTS.md, 2026-11-27, twelfth
+// session). Under GPU_LAYOUT the sums go through workgroup memory first (`row_store_staged`),
+// and neighbouring invocations store neighbouring texels; llvmpipe, which stores a lane at a
+// time anyway and gathers workgroup memory slowly, stores them straight. The same values
+// either way (`tests/fused.rs` compares both).
+override GPU_LAYOUT: bool = false;
+
+// GPU_LAYOUT: stores the row's outputs, which every invocation has written into workgroup
+// memory at their x (after a barrier: its taps were read from there), neighbouring invocations
+// on neighbouring texels. Every invocation of the workgroup calls it (it has a barrier).
+fn row_store_staged(t: Tile, li: u32) {
+    workgroupBarrier();
+    for (var j = i32(li); j < t.outs.x; j += i32(WG_SIZE)) {
+        store(t, vec2<i32>(j, 0), sh_tile[j]);
+    }
+}
+
 // The row's blur along x in runs of 2 (ROW = 2·WG_SIZE): invocation li's outputs x = 2li and
 // 2li + 1, from 2 + 2r texels of the encoded row read once into two sliding windows (v_{k−i},
 // v_{k+i} of output k as i grows), each output summed in `sum_x`'s order, so the results are
@@ -406,8 +427,15 @@ fn blur_row_pairs(t: Tile, li: u32) {
         s0 += w * (l0 + r0);
         s1 += w * (l1 + r1);
     }
-    store(t, vec2<i32>(x, 0), s0);
-    store(t, vec2<i32>(x + 1, 0), s1);
+    if GPU_LAYOUT {
+        workgroupBarrier();
+        sh_tile[x] = s0;
+        sh_tile[x + 1] = s1;
+        row_store_staged(t, li);
+    } else {
+        store(t, vec2<i32>(x, 0), s0);
+        store(t, vec2<i32>(x + 1, 0), s1);
+    }
 }
 
 // The row's blur along x in runs of 4 (ROW = 4·WG_SIZE, `vsm_blur_row`): invocation li's
@@ -464,10 +492,19 @@ fn blur_row_quads(t: Tile, li: u32) {
         s2 += w * (l2 + r2);
         s3 += w * (l3 + r3);
     }
-    store(t, vec2<i32>(x, 0), s0);
-    store(t, vec2<i32>(x + 1, 0), s1);
-    store(t, vec2<i32>(x + 2, 0), s2);
-    store(t, vec2<i32>(x + 3, 0), s3);
+    if GPU_LAYOUT {
+        workgroupBarrier();
+        sh_tile[x] = s0;
+        sh_tile[x + 1] = s1;
+        sh_tile[x + 2] = s2;
+        sh_tile[x + 3] = s3;
+        row_store_staged(t, li);
+    } else {
+        store(t, vec2<i32>(x, 0), s0);
+        store(t, vec2<i32>(x + 1, 0), s1);
+        store(t, vec2<i32>(x + 2, 0), s2);
+        store(t, vec2<i32>(x + 3, 0), s3);
+    }
 }
 
 // The importing kernel's `main`: workgroup `wg`, invocation `li`.
