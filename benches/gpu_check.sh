@@ -104,14 +104,15 @@ for v in shipped no_srgb no_lookup gbuffer_only store_only wg16 store_only_wg16;
     SHADOWGRAPH_KERNEL_DIR="$V/$v" step shade.txt 40 "$B" bench --lookup 3 --repeat 20 \
         --image 1920x1080 --map 2048 --only hard
 done
-# Issue 15: the blur's two row layouts (exec::KernelLayout) on the same machine, alternated,
-# at 2048² and 4096²: `gpu` stages each row through workgroup memory (the default on a GPU),
-# `cpu` reads it in runs straight from the texture (the layout timed on 2026-11-27).
+# Issue 15: the two row layouts (exec::KernelLayout) on the same machine, alternated, at
+# 2048² and 4096²: `gpu` (the default on a GPU) stages the separable blur's rows and the fused
+# row kernels' outputs through workgroup memory, `cpu` reads and stores them in runs straight
+# (the layout timed on 2026-11-27).
 for round in 1 2; do
     for layout in cpu gpu; do
         echo "## layout $layout, round $round" >>"$OUT/layouts.txt"
         SHADOWGRAPH_KERNEL_LAYOUT=$layout step layouts.txt 60 "$B" bench --sizes 2048,4096 \
-            --repeat 20 --only 'blur rg32f,blur log,+blur r4 (old)' --passes
+            --repeat 20 --only 'blur rg32f,blur log,+blur r4 (old),blur r32' --passes
     done
 done
 if [ -n "$BASE" ]; then
