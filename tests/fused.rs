@@ -82,18 +82,8 @@ fn run_both(
     let staged = run_in(light, raw, outputs, Some(KernelLayout::Gpu));
     let direct = run_in(light, raw, outputs, Some(KernelLayout::Cpu));
     for (k, (a, b)) in staged.0.iter().zip(&direct.0).enumerate() {
-        let bits =
-            |t: &Texels| -> Vec<u32> { t.data.iter().map(|&v| (v as f32).to_bits()).collect() };
-        let (x, y) = (bits(a), bits(b));
-        if let Some(i) = (0..x.len()).find(|&i| x[i] != y[i]) {
-            panic!(
-                "{what}, {}: the layouts differ at value {i} (texel {}): GPU layout {}, CPU layout {}",
-                outputs[k],
-                i / a.channels,
-                a.data[i],
-                b.data[i]
-            );
-        }
+        let what = format!("{what}, {}: GPU layout against CPU layout", outputs[k]);
+        common::assert_same_bits(&what, a, b);
     }
     assert_eq!(staged.1, direct.1, "{what}: the layouts' counts");
     staged

@@ -43,16 +43,11 @@ fn run(g: &Gpu, graph: &Graph, output: &str, input: wgpu::Texture) -> Texels {
 fn run_both(g: &Gpu, graph: &Graph, output: &str, input: wgpu::Texture, what: &str) -> Texels {
     let staged = run_layout(g, graph, output, &input, Some(KernelLayout::Gpu)).swap_remove(0);
     let direct = run_layout(g, graph, output, &input, Some(KernelLayout::Cpu)).swap_remove(0);
-    let bits = |t: &Texels| -> Vec<u32> { t.data.iter().map(|&v| (v as f32).to_bits()).collect() };
-    let (a, b) = (bits(&staged), bits(&direct));
-    if let Some(i) = (0..a.len()).find(|&i| a[i] != b[i]) {
-        panic!(
-            "{what}: the layouts differ at value {i} (texel {}): GPU layout {}, CPU layout {}",
-            i / staged.channels,
-            staged.data[i],
-            direct.data[i]
-        );
-    }
+    common::assert_same_bits(
+        &format!("{what}: GPU layout against CPU layout"),
+        &staged,
+        &direct,
+    );
     staged
 }
 

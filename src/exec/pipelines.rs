@@ -50,10 +50,9 @@ impl KernelLayout {
         match std::env::var(KERNEL_LAYOUT_ENV) {
             Ok(v) if v == "gpu" => Ok(Self::Gpu),
             Ok(v) if v == "cpu" => Ok(Self::Cpu),
-            Ok(v) => Err(Error::Kernel {
-                kernel: GPU_LAYOUT_CONSTANT.to_string(),
-                message: format!("{KERNEL_LAYOUT_ENV}={v}: expected `gpu` or `cpu`"),
-            }),
+            Ok(v) => Err(Error::Invalid(format!(
+                "{KERNEL_LAYOUT_ENV}={v}: expected `gpu` or `cpu`"
+            ))),
             Err(_) if crate::timer::is_gpu(device) => Ok(Self::Gpu),
             Err(_) => Ok(Self::Cpu),
         }

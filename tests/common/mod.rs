@@ -22,6 +22,22 @@ pub fn rng(seed: u64) -> SmallRng {
     SmallRng::seed_from_u64(seed)
 }
 
+/// Asserts that two GPU read-backs of the same map (e.g. one run in each kernel layout,
+/// `exec::KernelLayout`) hold the same f32 bits everywhere, NaNs included; names the first
+/// value that differs.
+pub fn assert_same_bits(what: &str, a: &shadowgraph::cpu::Texels, b: &shadowgraph::cpu::Texels) {
+    assert_eq!(a.data.len(), b.data.len(), "{what}: length");
+    let bits = |v: f64| (v as f32).to_bits();
+    if let Some(i) = (0..a.data.len()).find(|&i| bits(a.data[i]) != bits(b.data[i])) {
+        panic!(
+            "{what}: differ at value {i} (texel {}): {} against {}",
+            i / a.channels.max(1),
+            a.data[i],
+            b.data[i]
+        );
+    }
+}
+
 /// Asserts `|gpu − ref| ≤ atol + rtol·|ref|` everywhere, reporting the worst index, its error
 /// and the number of mismatches.
 pub fn assert_close(what: &str, gpu: &[f32], reference: &[f64], atol: f64, rtol: f64) {
