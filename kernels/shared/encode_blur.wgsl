@@ -15,6 +15,11 @@
 // texel. Reading the depth at clamped coordinates gives exactly that for `vsm`'s derivatives too:
 // a clamped texel's outward difference is 0, as the border texel's is.
 // Each workgroup counts the non-finite depths of its own outputs, so each is counted once.
+// The depth goes through workgroup memory on a GPU only (`GPU_LAYOUT`, below): there the tile's
+// depths are staged once and each encoding reads its five from workgroup memory; llvmpipe,
+// which gathers workgroup memory a lane at a time, runs the encodings faster reading their five
+// depths straight from the texture (`depth_direct`; the fused blurs 1.0–1.28× faster there,
+// benches/RESULTS.md, 2026-11-27, twelfth session), the same values either way.
 //
 // It holds the kernels' entry point, `main`. The importing kernel declares `const CHANNELS`
 // (2 or 4), `struct Params` (its encoding's fields, then `blur: BlurSpec`), `fn encode(z, left, right, up, down) -> vec4<f32>`, the
@@ -69,6 +74,18 @@ const MAX_RADIUS: u32 = 32u;
 // The depth tile (in x), then the encoded tile, then the horizontal sums, each over the one
 // before.
 var<workgroup> sh_tile: array<Texel, SH_TEXELS>;
+
+// The memory layout, a pipeline constant the executor sets by device (`exec::KernelLayout`:
+// true on a GPU): the depth staged in workgroup memory (`load_depth`) or read straight
+// (`depth_direct`, below), and a row workgroup's stores. An invocation's run of outputs lies side by
+// side with its neighbours' runs, so storing them straight from its sums puts one store
+// instruction's texels a run apart, a cache sector each (the separable blur's row pass, stored
+// that way, took 3–5× its column pass on an H200: benches/RESULTS.md, 2026-11-27, twelfth
+// session). Under GPU_LAYOUT the sums go through workgroup memory first (`row_store_staged`),
+// and neighbouring invocations store neighbouring texels; llvmpipe, which stores a lane at a
+// time anyway and gathers workgroup memory slowly, stores them straight. The same values
+// either way (`tests/fused.rs` compares both).
+override GPU_LAYOUT: bool = false;
 
 // The most encoded texels a tile holds (at TILE_RADIUS): the blocks of WG_SIZE past the first
 // four are compiled only where a kernel's tile needs them.
@@ -164,11 +181,35 @@ fn load_depth(t: Tile, li: u32, packed: bool) {
     }
 }
 
+// The linear depth at map texel p, clamped to the map, read straight from the texture (the CPU
+// layout's encodings: `encode_at`).
+fn depth_direct(t: Tile, p: vec2<i32>) -> f32 {
+    let q = clamp(p, vec2<i32>(0), t.size - 1);
+    return linear_depth(textureLoad(src, q, 0).r, params.depth);
+}
+
 // The encoding of encoded-tile texel i (clamped to the tile: an invocation past its end computes
 // a texel it does not store, so none branches).
 fn encode_at(t: Tile, i: i32, packed: bool) -> Texel {
     let e = min(i, t.enc.x * t.enc.y - 1);
     let yx = div_mod(e, t.enc.x);
+    if !GPU_LAYOUT {
+        // The texel's map position (depth-tile index d below, less the halo of one), its own
+        // non-finite depth counted here as `load_depth` counts it (i == e: not a clamped copy).
+        let p = t.origin - t.r + vec2<i32>(yx.y, yx.x);
+        let raw = textureLoad(src, clamp(p, vec2<i32>(0), t.size - 1), 0).r;
+        let own = i == e && all(p >= t.origin) && all(p < t.origin + t.outs);
+        if own && !depth_is_finite(raw) {
+            atomicAdd(&stats[0], 1u);
+        }
+        return texel_of(encode(
+            linear_depth(raw, params.depth),
+            depth_direct(t, p - vec2<i32>(1, 0)),
+            depth_direct(t, p + vec2<i32>(1, 0)),
+            depth_direct(t, p - vec2<i32>(0, 1)),
+            depth_direct(t, p + vec2<i32>(0, 1))
+        ));
+    }
     let d = (yx.x + 1) * t.dep.x + yx.y + 1;
     return texel_of(encode(
         sh_depth(d, packed),
@@ -369,17 +410,6 @@ fn blur_tile_single(t: Tile, li: u32) {
     }
 }
 
-// The memory layout of a row workgroup's stores, a pipeline constant the executor sets by
-// device (`exec::KernelLayout`: true on a GPU). An invocation's run of outputs lies side by
-// side with its neighbours' runs, so storing them straight from its sums puts one store
-// instruction's texels a run apart, a cache sector each (the separable blur's row pass, stored
-// that way, took 3–5× its column pass on an H200: benches/RESULTS.md, 2026-11-27, twelfth
-// session). Under GPU_LAYOUT the sums go through workgroup memory first (`row_store_staged`),
-// and neighbouring invocations store neighbouring texels; llvmpipe, which stores a lane at a
-// time anyway and gathers workgroup memory slowly, stores them straight. The same values
-// either way (`tests/fused.rs` compares both).
-override GPU_LAYOUT: bool = false;
-
 // GPU_LAYOUT: stores the row's outputs, which every invocation has written into workgroup
 // memory at their x (after a barrier: its taps were read from there), neighbouring invocations
 // on neighbouring texels. Every invocation of the workgroup calls it (it has a barrier).
@@ -512,8 +542,11 @@ fn encode_blur(wg: vec2<u32>, li: u32) {
     let t = tile_of(wg);
     // Uniform; a constant false but in `vsm_blur_row`.
     let packed = ROW_PACKED && params.blur.axis != 2u;
-    load_depth(t, li, packed);
-    workgroupBarrier();
+    // A constant: the CPU layout's encodings read the depth themselves.
+    if GPU_LAYOUT {
+        load_depth(t, li, packed);
+        workgroupBarrier();
+    }
     encode_tile(t, li, packed);
     if params.blur.axis == 2u {
         // A constant condition: each kernel compiles one of the two.
