@@ -91,7 +91,7 @@ enum Command {
         map: Option<u32>,
         /// Time only the kernels whose name contains one of these (e.g. `sat,mips`); the
         /// texture copies, their yardsticks, always run. With `--lookup`: only these soft
-        /// configurations (e.g. `cssm`), and PCSS 16+32, their yardstick.
+        /// configurations (e.g. `cssm`), `hard` and PCSS 16+32, their yardstick.
         #[arg(long, value_delimiter = ',')]
         only: Vec<String>,
         /// What the kernels' imported textures hold: `random` values, a `smooth` field or a

@@ -130,15 +130,16 @@ fn soft_benchmark_reports_every_configuration() {
         table.contains("prefilter ms") && table.contains("wall ms"),
         "{table}"
     );
-    // `--only` keeps the named configurations and the yardstick, whose ratios stay 1.
+    // `--only` keeps the named configurations, `hard` and the yardstick, whose ratios stay 1.
     let only = ["cssm".to_string()];
     let some = shadowgraph::bench::soft_cost(&g, &[0.5], 1, Some((48, 36)), Some(128), &only)
         .expect("soft bench, only cssm");
     let names: Vec<&str> = some.iter().map(|r| r.technique.as_str()).collect();
-    assert_eq!(names, ["pcss 16+32", "cssm M=8", "cssm M=8 csm_z"]);
+    assert_eq!(names, ["hard", "pcss 16+32", "cssm M=8", "cssm M=8 csm_z"]);
     let table = shadowgraph::bench::format_soft_table("test", true, 1, &[0.5], &some);
     let pcss = table.lines().find(|l| l.starts_with("pcss 16+32")).unwrap();
     assert!(pcss.contains("( 1.00)"), "{table}");
+    assert!(table.contains("above hard"), "{table}");
 }
 
 /// `bench --lookup`: one row per width with positive, finite times for the three lookups;

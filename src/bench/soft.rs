@@ -120,7 +120,8 @@ fn shading_fetches(scene: &Scene) -> Result<f64> {
 ///
 /// `image` shades at that size instead of the scene's 200×150, and `map` renders the light's
 /// shadow map at that size instead of the scene's 512². A non-empty `only` keeps the
-/// configurations whose name contains one of its strings, and the yardstick.
+/// configurations whose name contains one of its strings, `hard` (the floor of the table's
+/// "above hard" ratios) and the yardstick.
 pub fn soft_cost(
     gpu: &Gpu,
     sizes: &[f32],
@@ -151,7 +152,9 @@ pub fn soft_cost(
     let picked: Vec<&(&str, &str)> = SOFT_TECHNIQUES
         .iter()
         .enumerate()
-        .filter(|(k, (name, _))| *k == YARDSTICK || only.is_empty() || named(name))
+        .filter(|(k, (name, _))| {
+            *k == YARDSTICK || *name == "hard" || only.is_empty() || named(name)
+        })
         .map(|(_, t)| t)
         .collect();
     if !only.is_empty() && !SOFT_TECHNIQUES.iter().any(|(name, _)| named(name)) {
@@ -299,12 +302,87 @@ pub fn format_soft_table(
             r.prefilter_ms, r.frame_ms, r.wall_ms
         );
     }
+    s.push_str(&above_hard(name, rows));
+    s
+}
+
+/// The lookups' own cost: at each light size, (technique − `hard`) / (PCSS 16+32 − `hard`),
+/// the shading pass less what one fetch a pixel costs, against PCSS's taps measured the same
+/// way (the measure issue 14 filed CSSM's cost in). Empty without `hard` and the yardstick.
+/// On an H200 `hard` itself was 0.29–0.32× PCSS, half of it a floor that a kernel storing a
+/// constant colour a pixel still read (benches/RESULTS.md, 2026-11-27).
+fn above_hard(name: usize, rows: &[SoftRow]) -> String {
+    let find = |n: &str| rows.iter().find(|r| r.technique == n);
+    let (Some(hard), Some(pcss)) = (find("hard"), find(SOFT_TECHNIQUES[YARDSTICK].0)) else {
+        return String::new();
+    };
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "above hard: (technique − hard) / (pcss 16+32 − hard) at each size: the lookups' own \
+         cost against PCSS's taps"
+    );
+    for r in rows.iter().filter(|r| r.technique != hard.technique) {
+        let _ = write!(s, "{:<name$} {:>10}", r.technique, "");
+        for (i, ms) in r.shade_ms.iter().enumerate() {
+            let ratio = match (hard.shade_ms.get(i), pcss.shade_ms.get(i)) {
+                (Some(h), Some(p)) if p > h => (ms - h) / (p - h),
+                _ => f64::NAN,
+            };
+            let _ = write!(s, "  {:>17}", format!("({ratio:.2})"));
+        }
+        s.push('\n');
+    }
     s
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn row(technique: &str, shade_ms: &[f64]) -> SoftRow {
+        SoftRow {
+            technique: technique.into(),
+            fetches: 1.0,
+            shade_ms: shade_ms.to_vec(),
+            prefilter_ms: 0.0,
+            frame_ms: 1.0,
+            wall_ms: 1.0,
+            image: (8, 8),
+            map: 64,
+        }
+    }
+
+    /// (technique − hard) / (pcss − hard) at each size, by hand: vssm 1/4 and 2/5, PCSS 1, and
+    /// no block without `hard`.
+    #[test]
+    fn above_hard_is_the_lookups_own_cost_against_pcss() {
+        let rows = [
+            row("hard", &[1.0, 2.0]),
+            row("pcss 16+32", &[5.0, 7.0]),
+            row("vssm", &[2.0, 4.0]),
+        ];
+        let table = format_soft_table("test", false, 1, &[0.5, 1.0], &rows);
+        let line = |name: &str| {
+            let block = table
+                .split("above hard")
+                .nth(1)
+                .expect("an above-hard block");
+            block
+                .lines()
+                .find(|l| l.starts_with(name))
+                .map(str::to_string)
+        };
+        let vssm = line("vssm").expect("vssm's line");
+        assert!(
+            vssm.contains("(0.25)") && vssm.contains("(0.40)"),
+            "{table}"
+        );
+        assert!(line("pcss 16+32").unwrap().contains("(1.00)"), "{table}");
+        assert!(line("hard").is_none(), "{table}");
+        let without = format_soft_table("test", false, 1, &[0.5, 1.0], &rows[1..]);
+        assert!(!without.contains("above hard"), "{without}");
+    }
 
     /// The prefilter is every timed pass of a vssm frame but the raster, the G-buffer and the
     /// shading: the encoding and the table's three passes, read off a real frame's names.
