@@ -45,7 +45,7 @@ fn spot_sized(shadow: &str, n: u32) -> Light {
 }
 
 /// A raw depth buffer: values spread over [0, 1] (perspective depth crowds near 1), with
-/// `bad` NaN and ±Inf texels.
+/// `bad` NaN and ±Inf texels at random and three on the map's last column and row.
 fn raw_depth(bad: usize) -> Vec<f32> {
     raw_depth_sized(bad, MAP)
 }
@@ -60,6 +60,12 @@ fn raw_depth_sized(bad: usize, n: u32) -> Vec<f32> {
         let at = rng.random_range(0..raw.len());
         raw[at] = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY][k % 3];
     }
+    // And on the last column, the last row and the corner: a ragged tile's or row's texels
+    // past the map read these at clamped coordinates, and must not count them again.
+    let n = n as usize;
+    raw[n / 2 * n + n - 1] = f32::NAN;
+    raw[(n - 1) * n + n / 3] = f32::INFINITY;
+    raw[n * n - 1] = f32::NEG_INFINITY;
     raw
 }
 

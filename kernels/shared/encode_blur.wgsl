@@ -195,10 +195,12 @@ fn encode_at(t: Tile, i: i32, packed: bool) -> Texel {
     let yx = div_mod(e, t.enc.x);
     if !GPU_LAYOUT {
         // The texel's map position (depth-tile index d below, less the halo of one), its own
-        // non-finite depth counted here as `load_depth` counts it (i == e: not a clamped copy).
+        // non-finite depth counted here as `load_depth` counts it: an output of the tile inside
+        // the map (a ragged tile's texels past it read the border at clamped coordinates), and
+        // not a clamped copy of the last index (i == e).
         let p = t.origin - t.r + vec2<i32>(yx.y, yx.x);
         let raw = textureLoad(src, clamp(p, vec2<i32>(0), t.size - 1), 0).r;
-        let own = i == e && all(p >= t.origin) && all(p < t.origin + t.outs);
+        let own = i == e && all(p >= t.origin) && all(p < min(t.origin + t.outs, t.size));
         if own && !depth_is_finite(raw) {
             atomicAdd(&stats[0], 1u);
         }
