@@ -123,7 +123,7 @@ fn put(b: BlurLine, k: i32, v: vec4<f32>, vertical: bool) {
 // (`exec::KernelLayout`: true on a GPU). Under it rows are staged through workgroup memory
 // (below); without it each invocation reads its run's taps straight from the texture and
 // writes its outputs there, as llvmpipe runs fastest: its SIMD lanes gather texel by texel
-// anyway, and staging made the horizontal pass 1.4–2× slower there (benches/RESULTS.md,
+// anyway, and staging made the horizontal pass 1.2–2.5× slower there (benches/RESULTS.md,
 // 2026-11-27, twelfth session). A constant at pipeline creation: each layout compiles alone.
 override GPU_LAYOUT: bool = false;
 
