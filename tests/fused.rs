@@ -402,7 +402,7 @@ fn fused_blurs_match_encode_then_blur() {
             format!("\nfilter = \"blur\"\nfilter_radius = {radius}\nfilter_sigma = {sigma}");
         let stores = if radius > 8 { 2.0 } else { 1.0 };
         for c in blur_cases() {
-            let (shadow, encoded, reference) = (c.shadow, c.encoded, c.reference);
+            let (shadow, encoded) = (c.shadow, c.encoded);
             let (atol, rtol) = c.tolerance(stores);
             let light = spot(&format!("{shadow}{filter}"));
             // f16 two moments are stored packed, 4 bytes a texel, not in rgba16float.
@@ -413,22 +413,40 @@ fn fused_blurs_match_encode_then_blur() {
             );
             let map = format!("{encoded}.blur");
             let what = format!("{map} (r = {radius}, {shadow})");
-            let (maps, stats) = run_both(&light, &raw, std::slice::from_ref(&map), &what);
-            let (lin, replaced) = linear(&light, &raw);
-            let want = reference(&lin, radius.into(), sigma);
-            let got = &maps[0];
-            let n = want.channels.min(got.channels);
-            let got: Vec<f32> = channels(got, 0, n).iter().map(|&v| v as f32).collect();
-            // The moments of one sign per channel, weighted by positive f32 weights (each
-            // rounded once, u) summing to 1: a pass's sum of r + 1 terms (the centre and r
-            // symmetric pairs, each pair one more addition) is off by at most (r + 3)·u of its
-            // value, and two passes by twice that, on top of the encoding's own error, which the
-            // normalized weights carry through unchanged.
-            let blur_rtol = 2.0 * (f64::from(radius) + 3.0) * U;
-            common::assert_close(&what, &got, &channels(&want, 0, n), atol, rtol + blur_rtol);
-            assert_counted(&what, &stats, steps, replaced);
+            check_blur(&c, &light, &raw, &map, radius, (atol, rtol), steps, &what);
         }
     }
+}
+
+/// Runs `light`'s graph for `map` in both kernel layouts ([`run_both`]) and compares it with
+/// `c`'s f64 reference (encoding, then both blur passes at `radius`, σ = r/2) within the
+/// encoding's `tolerance` (atol, rtol) plus the blur's own, and its counts of non-finite
+/// texels with `steps` counting steps.
+#[allow(clippy::too_many_arguments)]
+fn check_blur(
+    c: &BlurCase,
+    light: &Light,
+    raw: &[f32],
+    map: &str,
+    radius: u32,
+    (atol, rtol): (f64, f64),
+    steps: usize,
+    what: &str,
+) {
+    let (maps, stats) = run_both(light, raw, &[map.to_string()], what);
+    let (lin, replaced) = linear(light, raw);
+    let want = (c.reference)(&lin, radius.into(), f64::from(radius) / 2.0);
+    let got = &maps[0];
+    let n = want.channels.min(got.channels);
+    let got: Vec<f32> = channels(got, 0, n).iter().map(|&v| v as f32).collect();
+    // The moments of one sign per channel, weighted by positive f32 weights (each rounded
+    // once, u) summing to 1: a pass's sum of r + 1 terms (the centre and r symmetric pairs,
+    // each pair one more addition) is off by at most (r + 3)·u of its value, and two passes by
+    // twice that, on top of the encoding's own error, which the normalized weights carry
+    // through unchanged.
+    let blur_rtol = 2.0 * (f64::from(radius) + 3.0) * U;
+    common::assert_close(what, &got, &channels(&want, 0, n), atol, rtol + blur_rtol);
+    assert_counted(what, &stats, steps, replaced);
 }
 
 /// The row kernels past the tile's radius 7 on a map wide enough for them (1100²:
@@ -445,8 +463,7 @@ fn row_kernels_span_row_workgroups() {
     for radius in [12u32, 32] {
         let sigma = f64::from(radius) / 2.0;
         for c in blur_cases() {
-            let (shadow, encoded, kernel, reference) =
-                (c.shadow, c.encoded, c.row_kernel, c.reference);
+            let (shadow, encoded, kernel) = (c.shadow, c.encoded, c.row_kernel);
             let light = spot_sized(
                 &format!(
                     "{shadow}\nfilter = \"blur\"\nfilter_radius = {radius}\nfilter_sigma = {sigma}"
@@ -464,17 +481,8 @@ fn row_kernels_span_row_workgroups() {
                 .map(|s| s.node.kernel.as_str())
                 .collect();
             assert_eq!(kernels, [kernel, "blur"], "{what}");
-            let (maps, stats) = run_both(&light, &raw, std::slice::from_ref(&map), &what);
-            let (lin, replaced) = linear(&light, &raw);
-            let want = reference(&lin, radius.into(), sigma);
-            let got = &maps[0];
-            let n = want.channels.min(got.channels);
-            let got: Vec<f32> = channels(got, 0, n).iter().map(|&v| v as f32).collect();
             // Two stores, f16 in the packed cases.
-            let (atol, rtol) = c.tolerance(2.0);
-            let blur_rtol = 2.0 * (f64::from(radius) + 3.0) * U;
-            common::assert_close(&what, &got, &channels(&want, 0, n), atol, rtol + blur_rtol);
-            assert_counted(&what, &stats, 1, replaced);
+            check_blur(&c, &light, &raw, &map, radius, c.tolerance(2.0), 1, &what);
         }
     }
 }

@@ -4,6 +4,7 @@
 //! `SHADOWGRAPH_KERNEL_LAYOUT`, which picks the kernels' memory layout: `info` prints it, a bad
 //! value is one line.
 
+use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -17,20 +18,35 @@ fn temp_dir(tag: &str) -> PathBuf {
     d
 }
 
-/// `shadowgraph render sphere_on_plane.toml -o png`, with the kernels of `dir` (if any).
-fn render(dir: Option<&Path>, png: &Path) -> Output {
-    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/sphere_on_plane.toml");
+/// Runs the CLI with `args`, neither switch set but those in `envs`.
+fn shadowgraph(args: &[&OsStr], envs: &[(&str, &OsStr)]) -> Output {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_shadowgraph"));
-    cmd.arg("render")
-        .arg(&scene)
-        .arg("-o")
-        .arg(png)
+    cmd.args(args)
         .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .env_remove(KERNEL_DIR_ENV);
-    if let Some(dir) = dir {
-        cmd.env(KERNEL_DIR_ENV, dir);
-    }
+        .env_remove(KERNEL_DIR_ENV)
+        .env_remove(KERNEL_LAYOUT_ENV)
+        .envs(envs.iter().copied());
     cmd.output().expect("run shadowgraph")
+}
+
+/// `shadowgraph render sphere_on_plane.toml -o png` with `envs`.
+fn render_with(png: &Path, envs: &[(&str, &OsStr)]) -> Output {
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/sphere_on_plane.toml");
+    let args = [
+        OsStr::new("render"),
+        scene.as_os_str(),
+        OsStr::new("-o"),
+        png.as_os_str(),
+    ];
+    shadowgraph(&args, envs)
+}
+
+/// [`render_with`] the kernels of `dir` (if any).
+fn render(dir: Option<&Path>, png: &Path) -> Output {
+    match dir {
+        Some(dir) => render_with(png, &[(KERNEL_DIR_ENV, dir.as_os_str())]),
+        None => render_with(png, &[]),
+    }
 }
 
 /// Status 1 and one line on stderr after the note, containing every needle.
@@ -137,16 +153,13 @@ fn bad_replacements_are_one_line_errors() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// `shadowgraph info` with `SHADOWGRAPH_KERNEL_LAYOUT` set to `value` (unset: `None`).
+/// `shadowgraph info` with `SHADOWGRAPH_KERNEL_LAYOUT` set to `layout` (unset: `None`).
 fn info(layout: Option<&str>) -> Output {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_shadowgraph"));
-    cmd.arg("info")
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .env_remove(KERNEL_LAYOUT_ENV);
-    if let Some(layout) = layout {
-        cmd.env(KERNEL_LAYOUT_ENV, layout);
-    }
-    cmd.output().expect("run shadowgraph")
+    let envs: Vec<(&str, &OsStr)> = layout
+        .map(|l| (KERNEL_LAYOUT_ENV, OsStr::new(l)))
+        .into_iter()
+        .collect();
+    shadowgraph(&[OsStr::new("info")], &envs)
 }
 
 /// The layout line of `info`: lavapipe is a CPU driver, so `cpu` unless forced.
@@ -167,17 +180,10 @@ fn kernel_layout_is_the_devices_unless_forced() {
     assert!(line(&info(Some("cpu"))).ends_with(" cpu"));
 
     let dir = temp_dir("layout");
-    let png = dir.join("out.png");
-    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/sphere_on_plane.toml");
-    let o = Command::new(env!("CARGO_BIN_EXE_shadowgraph"))
-        .arg("render")
-        .arg(&scene)
-        .arg("-o")
-        .arg(&png)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .env(KERNEL_LAYOUT_ENV, "fast")
-        .output()
-        .expect("run shadowgraph");
+    let o = render_with(
+        &dir.join("out.png"),
+        &[(KERNEL_LAYOUT_ENV, OsStr::new("fast"))],
+    );
     refused(&o, &[KERNEL_LAYOUT_ENV, "fast", "`gpu` or `cpu`"]);
     let _ = std::fs::remove_dir_all(&dir);
 }
