@@ -7,7 +7,9 @@
 #   benches/gpu_check.sh [BINARY] [OUT]     # defaults: target/release/shadowgraph, gpu-out
 #
 # On an H200 (2026-11-27) the steps took: soft table 76 s, shade floor 7 × 13 s, each 2048²
-# kernel round 13 s, the 2048² table 23 s, each 4096²/8192² round 127 s; give the call 560 s.
+# kernel round 13 s, the 2048² table 23 s, each 4096²/8192² round 127 s; with the layouts'
+# rounds (untimed on a GPU: four blur rounds at 2048² and 4096², four table rounds at 2048²)
+# about 500 s: give the call 560 s.
 # The steps run most wanted first, each under its own time box, and append to at most seven
 # files in OUT (the device tool brings back eight), so a call stopped by its time box still
 # returns what ran. A second binary to compare against goes in as BASE=path/to/other/shadowgraph:
@@ -105,6 +107,17 @@ for round in 1 2; do
         echo "## layout $layout, round $round" >>"$OUT/layouts.txt"
         SHADOWGRAPH_KERNEL_LAYOUT=$layout step layouts.txt 60 "$B" bench --sizes 2048,4096 \
             --repeat 20 --only 'blur rg32f,blur log,+blur r4 (old),blur r32' --passes
+    done
+done
+# The table build's tile passes in both layouts at 2048² (issue 14's ≤ 0.2 ms): `gpu` stages
+# the depth tile and pass 3's table rows through workgroup memory (commit after b7dae6e),
+# `cpu` reads and writes each invocation's 4 × 4 sub-block straight (the layout the twelfth
+# session timed: tile sums 0.109, tables 0.170 ms for `chain vssm`).
+for round in 1 2; do
+    for layout in cpu gpu; do
+        echo "## table layout $layout, round $round" >>"$OUT/layouts.txt"
+        SHADOWGRAPH_KERNEL_LAYOUT=$layout step layouts.txt 30 "$B" bench --sizes 2048 \
+            --repeat 20 --only 'sat,chain vssm,chain msm_soft,chain esm,chain cssm' --passes
     done
 done
 if [ -n "$BASE" ]; then

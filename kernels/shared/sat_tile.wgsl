@@ -11,6 +11,21 @@
 // #import shared/csm_maps
 // #import shared/linear_depth
 
+// The memory layout of the tile passes, a pipeline constant the executor sets by device
+// (`exec::KernelLayout`: true on a GPU). An invocation's sub-block lies SUB texels from its
+// neighbours', so one load or store instruction of a SIMD group straight from the texture
+// touches texels SUB apart, a cache sector each (the separable blur's row pass, which reads and
+// writes that way, took 3–5× its column pass on an H200: benches/RESULTS.md, 2026-11-27,
+// twelfth session; the table build's tile passes, reading so, ran 3–6× their bandwidth bound
+// there). Under GPU_LAYOUT the depth sources' tile is staged through workgroup memory, loaded
+// with neighbouring invocations on neighbouring texels (shared/sat_tile_texel,
+// `sat_tile_begin`), and pass 3 writes its table a row of sub-blocks at a time through the
+// same memory (shared/sat_tile_scan, `sat_tile_table`). Without it each invocation reads and
+// writes its sub-block straight from the texture, as llvmpipe, whose SIMD lanes gather texel by
+// texel and which gathers workgroup memory slowly, runs fastest. The same sums in the same
+// order either way: tables bit for bit the same (`tests/sat.rs` compares both).
+override GPU_LAYOUT: bool = false;
+
 // Keep in sync with `SAT_TILE` in src/sat/mod.rs.
 const SUB: u32 = 4u;
 const GRID: u32 = 8u;

@@ -73,11 +73,9 @@ fn sat_tile_prepare(
     } else {
         sh_carry[li] = textureLoad(col_carry, vec2<u32>(q.x, s.band.y + tile.y), 0);
     }
-    // A literal condition: only the VSM and ESM sources' kernels compile it. Both sweeps of
-    // the pass read the block.
-    if sat_blocked(s) {
-        sat_block_fill(origin, size, s);
-    }
+    // The sub-block's values that both sweeps read (shared/sat_tile_texel; the blocked sources'
+    // or, under GPU_LAYOUT, every depth source's).
+    sat_tile_begin(tile, origin, size, s, li);
     var col: array<vec4<u32>, SUB>;
     for (var j = 0u; j < SUB; j++) {
         sat_sweep_row(origin, j, p, fs, s, &col);
@@ -138,8 +136,17 @@ fn sat_row_add(fs: bool, li: u32, j: u32) -> vec4<u32> {
     return add;
 }
 
+// The output stage's slot of channel c of staged row r (0 ≤ r < OUT_ROWS), tile column x
+// (shared/sat_tile_texel's `sh_stage`, free once `sat_tile_prepare` has passed its barriers).
+fn stage_out_slot(c: u32, r: u32, x: u32) -> u32 {
+    return c * OUT_PLANE + r * OUT_PITCH + x;
+}
+
 // Pass 3 for tile `tile`: its table with the carries of band `s.band`, every texel inside the
-// map handed to the importer's `sat_store(slot, q, v)`. Every invocation calls it.
+// map handed to the importer's `sat_store(slot, q, v)`. Every invocation calls it (it has
+// barriers). Under GPU_LAYOUT each texel row j of the sub-blocks (tile rows b·SUB + j, one a
+// sub-block row) goes through workgroup memory and is stored with neighbouring invocations on
+// neighbouring texels.
 fn sat_tile_table(p: SatParams, fs: bool, s: SatSource, tile: vec2<u32>, li: u32, slot: u32) {
     var col_add: array<vec4<u32>, SUB>;
     sat_tile_prepare(col_carry, row_carry, p, fs, s, tile, li, &col_add);
@@ -152,9 +159,30 @@ fn sat_tile_table(p: SatParams, fs: bool, s: SatSource, tile: vec2<u32>, li: u32
         for (var i = 0u; i < SUB; i++) {
             let q = origin + vec2<u32>(i, j);
             let sum = sat_sum(sat_sum(col[i], row_add, fs), col_add[i], fs);
-            if all(q < size) {
+            if GPU_LAYOUT {
+                let x = li % GRID * SUB + i;
+                for (var c = 0u; c < 4u; c++) {
+                    sh_stage[stage_out_slot(c, li / GRID, x)] = sum[c];
+                }
+            } else if all(q < size) {
                 sat_store(slot, q, sum);
             }
+        }
+        if GPU_LAYOUT {
+            workgroupBarrier();
+            for (var k = li; k < OUT_ROWS * TILE; k += WG_SIZE) {
+                let r = k / TILE;
+                let x = k % TILE;
+                let q = tile * TILE + vec2<u32>(x, r * SUB + j);
+                if all(q < size) {
+                    var v: vec4<u32>;
+                    for (var c = 0u; c < 4u; c++) {
+                        v[c] = sh_stage[stage_out_slot(c, r, x)];
+                    }
+                    sat_store(slot, q, v);
+                }
+            }
+            workgroupBarrier();
         }
     }
 }

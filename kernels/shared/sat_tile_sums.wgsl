@@ -29,10 +29,9 @@ fn sat_tile_edges(
     let b = li / GRID;
     let size = textureDimensions(src);
     let origin = sat_sub_origin(tile, li);
-    // A literal condition: only the VSM and ESM sources' kernels compile it.
-    if sat_blocked(s) {
-        sat_block_fill(origin, size, s);
-    }
+    // The sub-block's values that both sweeps read (shared/sat_tile_texel; the blocked sources'
+    // or, under GPU_LAYOUT, every depth source's).
+    sat_tile_begin(tile, origin, size, s, li);
     // Row sums prefixed down the sub-block (its table's last column), and column sums, then
     // prefixed along it (its last row).
     var down = vec4<u32>(0u);

@@ -16,8 +16,79 @@
 var<private> sat_non_finite: u32;
 
 // The moments of the sub-block a pass sweeps (SUB × SUB, row-major) for the sources that
-// `sat_blocked` names, filled by `sat_block_fill` before its sweeps and read by `sat_texel`.
+// `sat_blocked` names, filled by `sat_block_fill` before its sweeps and read by `sat_texel`;
+// under GPU_LAYOUT, for the other depth sources, the sub-block's raw depths (in x).
 var<private> sat_block: array<vec2<f32>, 16>; // SUB · SUB
+
+// GPU_LAYOUT's workgroup memory (shared/sat_tile): first the raw depth of the tile and a
+// one-texel border, (TILE + 2)² texels at `stage_depth_slot` (`sat_stage_depth`), which each
+// invocation copies its sub-block from; then, in pass 3, a row of sub-blocks' table texels at a
+// time, channel by channel (`stage_out_slot`, shared/sat_tile_scan).
+const STAGE_SIDE: u32 = TILE + 2u;
+// Depth row pitch: 42 = 2 (mod 8) with a slot of padding every 4 texels, so that the 32 lanes
+// of a SIMD group reading their sub-blocks' texels (4 apart along a row, 4 rows apart down)
+// hit 32 distinct banks.
+const STAGE_PITCH: u32 = 42u;
+// Table rows staged at a time (one texel row of each of the GRID sub-block rows) and their row
+// pitch: 33 words, the same banks-apart property for the sub-blocks' stores and the row's loads.
+const OUT_ROWS: u32 = GRID;
+const OUT_PITCH: u32 = TILE + 1u;
+const OUT_PLANE: u32 = OUT_ROWS * OUT_PITCH;
+var<workgroup> sh_stage: array<u32, 1428>; // STAGE_SIDE · STAGE_PITCH ≥ 4 · OUT_PLANE (1056)
+
+// The depth stage's slot of bordered-tile texel (x, y), 0 ≤ x, y < STAGE_SIDE.
+fn stage_depth_slot(x: u32, y: u32) -> u32 {
+    return y * STAGE_PITCH + x + x / 4u;
+}
+
+// GPU_LAYOUT: stages the raw depth of tile `tile` and its one-texel border, at clamped
+// coordinates, neighbouring invocations on neighbouring texels, and counts the non-finite
+// depths of the tile's own texels inside the map (`sat_non_finite`, each texel once: the
+// straight layout counts them in `sat_texel`). Every invocation calls it (it has a barrier).
+fn sat_stage_depth(tile: vec2<u32>, size: vec2<u32>, li: u32) {
+    let corner = vec2<i32>(tile * TILE) - 1;
+    for (var k = li; k < STAGE_SIDE * STAGE_SIDE; k += WG_SIZE) {
+        let x = k % STAGE_SIDE;
+        let y = k / STAGE_SIDE;
+        let p = corner + vec2<i32>(i32(x), i32(y));
+        let q = clamp(p, vec2<i32>(0), vec2<i32>(size) - 1);
+        let raw = textureLoad(src, q, 0).r;
+        sh_stage[stage_depth_slot(x, y)] = bitcast<u32>(raw);
+        let own = all(p == q) && x >= 1u && y >= 1u && x <= TILE && y <= TILE;
+        if own && !depth_is_finite(raw) {
+            sat_non_finite += 1u;
+        }
+    }
+    workgroupBarrier();
+}
+
+// The staged raw depth at map texel p (within one texel of tile `tile`).
+fn sat_staged_depth(p: vec2<i32>, tile: vec2<u32>) -> f32 {
+    let l = vec2<u32>(p - vec2<i32>(tile * TILE) + 1);
+    return bitcast<f32>(sh_stage[stage_depth_slot(l.x, l.y)]);
+}
+
+// What a tile pass does before sweeping the sub-block at `origin` of tile `tile`: the
+// sub-block's values that `sat_texel` reads from `sat_block` (the blocked sources'; under
+// GPU_LAYOUT every depth source's, from the staged tile). Every invocation calls it (under
+// GPU_LAYOUT it has a barrier).
+fn sat_tile_begin(tile: vec2<u32>, origin: vec2<u32>, size: vec2<u32>, s: SatSource, li: u32) {
+    if GPU_LAYOUT {
+        if s.from_depth {
+            sat_stage_depth(tile, size, li);
+        }
+        if sat_blocked(s) {
+            sat_block_fill(origin, size, s);
+        } else if s.from_depth {
+            for (var k = 0u; k < SUB * SUB; k++) {
+                let p = vec2<i32>(origin) + vec2<i32>(i32(k % SUB), i32(k / SUB));
+                sat_block[k] = vec2<f32>(sat_staged_depth(p, tile), 0.0);
+            }
+        }
+    } else if sat_blocked(s) {
+        sat_block_fill(origin, size, s);
+    }
+}
 
 // Whether `s` (literal fields) is computed a sub-block at a time: VSM, whose texels share
 // their neighbours' depth, and ESM, whose exp pass 3's two sweeps then share. One- and
@@ -37,7 +108,7 @@ fn sat_block_fill(origin: vec2<u32>, size: vec2<u32>, s: SatSource) {
     if s.kind == SAT_ESM {
         for (var k = 0u; k < SUB * SUB; k++) {
             let at = vec2<i32>(origin) + vec2<i32>(i32(k % SUB), i32(k / SUB));
-            let z = sat_depth_at(at, size, s.depth);
+            let z = sat_depth_at(at, origin, size, s.depth);
             sat_block[k] = vec2<f32>(exp(s.exp_pos * (z - 1.0)), 0.0);
         }
         return;
@@ -46,7 +117,7 @@ fn sat_block_fill(origin: vec2<u32>, size: vec2<u32>, s: SatSource) {
     var z: array<f32, 36>; // BORDERED²
     for (var k = 0u; k < BORDERED * BORDERED; k++) {
         let at = vec2<i32>(origin) + vec2<i32>(i32(k % BORDERED), i32(k / BORDERED)) - 1;
-        z[k] = sat_depth_at(at, size, s.depth);
+        z[k] = sat_depth_at(at, origin, size, s.depth);
     }
     for (var k = 0u; k < SUB * SUB; k++) {
         let c = (k / SUB + 1u) * BORDERED + k % SUB + 1u;
@@ -54,8 +125,12 @@ fn sat_block_fill(origin: vec2<u32>, size: vec2<u32>, s: SatSource) {
     }
 }
 
-// The linear depth of `src` (the depth buffer) at p clamped to the map of `size`.
-fn sat_depth_at(p: vec2<i32>, size: vec2<u32>, depth: DepthParams) -> f32 {
+// The linear depth of `src` (the depth buffer) at p clamped to the map of `size` (p within
+// one texel of the tile of sub-block origin `origin`: under GPU_LAYOUT, from the staged tile).
+fn sat_depth_at(p: vec2<i32>, origin: vec2<u32>, size: vec2<u32>, depth: DepthParams) -> f32 {
+    if GPU_LAYOUT {
+        return linear_depth(sat_staged_depth(p, origin / TILE), depth);
+    }
     let q = clamp(p, vec2<i32>(0), vec2<i32>(size) - 1);
     return linear_depth(textureLoad(src, q, 0).r, depth);
 }
@@ -74,11 +149,19 @@ fn sat_texel(
     s: SatSource,
 ) -> vec4<u32> {
     let inside = all(q < size);
-    var v = textureLoad(src, min(q, size - 1u), 0);
+    // The sub-block's texel (`sat_block`'s index) for the sources it holds.
+    let own = q.y % SUB * SUB + q.x % SUB;
+    var v: vec4<f32>;
     if s.from_depth {
-        let raw = v.r;
-        if inside && !depth_is_finite(raw) {
-            sat_non_finite += 1u;
+        var raw: f32;
+        if GPU_LAYOUT {
+            // Staged by `sat_tile_begin` (unused by the blocked sources below), counted there.
+            raw = sat_block[own].x;
+        } else {
+            raw = textureLoad(src, min(q, size - 1u), 0).r;
+            if inside && !depth_is_finite(raw) {
+                sat_non_finite += 1u;
+            }
         }
         let z = linear_depth(raw, s.depth);
         if s.kind == SAT_MSM {
@@ -90,7 +173,7 @@ fn sat_texel(
             // VSM's moments or ESM's exp(c (z − 1)) (`esm`'s moment for a summed-area table)
             // of the invocation's sub-block, computed once a pass (`sat_block_fill`;
             // sub-blocks start at multiples of SUB).
-            v = vec4<f32>(sat_block[q.y % SUB * SUB + q.x % SUB], 0.0, 0.0);
+            v = vec4<f32>(sat_block[own], 0.0, 0.0);
         } else if s.kind == SAT_EVSM {
             v = evsm_moments(z, s.exp_pos, s.exp_neg);
         } else {
@@ -100,6 +183,8 @@ fn sat_texel(
         // body for every lane, and both roundings are a few integer operations.
         v = select(v, round_f16(v), s.f16);
         v = select(v, round_unorm16(v), s.unorm16);
+    } else {
+        v = textureLoad(src, min(q, size - 1u), 0);
     }
     return select(vec4<u32>(0u), sat_encode_as(v, p, fs), inside);
 }
