@@ -30,17 +30,21 @@ const SIDE: u32 = 7u; // GRID − 1
 // carry.
 var<workgroup> sh_carry: array<vec4<u32>, 64>; // 2 · TILE = WG_SIZE
 
-// Row j of the sub-block at `origin`: its encoded texels prefixed along the row, added to the
-// running column sums `col`, which then hold row j of the sub-block's own inclusive table.
+// Row j of the sub-block at `origin` (invocation li's): its encoded texels prefixed along the
+// row, added to the running column sums `col`, which then hold row j of the sub-block's own
+// inclusive table. Every invocation calls it (under GPU_LAYOUT a stored source's row j is
+// staged first: it has barriers).
 fn sat_sweep_row(
     origin: vec2<u32>,
     j: u32,
     p: SatParams,
     fs: bool,
     s: SatSource,
+    li: u32,
     col: ptr<function, array<vec4<u32>, SUB>>,
 ) {
     let size = textureDimensions(src);
+    sat_stage_row(origin / TILE, j, size, s, li);
     var run = vec4<u32>(0u);
     for (var i = 0u; i < SUB; i++) {
         run = sat_sum(run, sat_texel(origin + vec2<u32>(i, j), size, p, fs, s), fs);
@@ -78,7 +82,7 @@ fn sat_tile_prepare(
     sat_tile_begin(tile, origin, size, s, li);
     var col: array<vec4<u32>, SUB>;
     for (var j = 0u; j < SUB; j++) {
-        sat_sweep_row(origin, j, p, fs, s, &col);
+        sat_sweep_row(origin, j, p, fs, s, li, &col);
         if a < SIDE {
             sh_right[(b * SUB + j) * SIDE + a] = col[SUB - 1u];
         }
@@ -136,12 +140,6 @@ fn sat_row_add(fs: bool, li: u32, j: u32) -> vec4<u32> {
     return add;
 }
 
-// The output stage's slot of channel c of staged row r (0 ≤ r < OUT_ROWS), tile column x
-// (shared/sat_tile_texel's `sh_stage`, free once `sat_tile_prepare` has passed its barriers).
-fn stage_out_slot(c: u32, r: u32, x: u32) -> u32 {
-    return c * OUT_PLANE + r * OUT_PITCH + x;
-}
-
 // Pass 3 for tile `tile`: its table with the carries of band `s.band`, every texel inside the
 // map handed to the importer's `sat_store(slot, q, v)`. Every invocation calls it (it has
 // barriers). Under GPU_LAYOUT each texel row j of the sub-blocks (tile rows b·SUB + j, one a
@@ -154,30 +152,35 @@ fn sat_tile_table(p: SatParams, fs: bool, s: SatSource, tile: vec2<u32>, li: u32
     let size = textureDimensions(src);
     var col: array<vec4<u32>, SUB>;
     for (var j = 0u; j < SUB; j++) {
-        sat_sweep_row(origin, j, p, fs, s, &col);
+        sat_sweep_row(origin, j, p, fs, s, li, &col);
         let row_add = sat_row_add(fs, li, j);
-        for (var i = 0u; i < SUB; i++) {
-            let q = origin + vec2<u32>(i, j);
-            let sum = sat_sum(sat_sum(col[i], row_add, fs), col_add[i], fs);
-            if GPU_LAYOUT {
-                let x = li % GRID * SUB + i;
-                for (var c = 0u; c < 4u; c++) {
-                    sh_stage[stage_out_slot(c, li / GRID, x)] = sum[c];
+        if !GPU_LAYOUT {
+            for (var i = 0u; i < SUB; i++) {
+                let q = origin + vec2<u32>(i, j);
+                if all(q < size) {
+                    sat_store(slot, q, sat_sum(sat_sum(col[i], row_add, fs), col_add[i], fs));
                 }
-            } else if all(q < size) {
-                sat_store(slot, q, sum);
             }
-        }
-        if GPU_LAYOUT {
+        } else {
+            // Into the stage that a stored source's row j was read from (`sat_sweep_row`):
+            // after every invocation has read it, and stored from after every invocation has
+            // written its sums.
             workgroupBarrier();
-            for (var k = li; k < OUT_ROWS * TILE; k += WG_SIZE) {
+            for (var i = 0u; i < SUB; i++) {
+                let sum = sat_sum(sat_sum(col[i], row_add, fs), col_add[i], fs);
+                for (var c = 0u; c < 4u; c++) {
+                    sh_stage[stage_row_slot(c, li / GRID, li % GRID * SUB + i)] = sum[c];
+                }
+            }
+            workgroupBarrier();
+            for (var k = li; k < STAGE_ROWS * TILE; k += WG_SIZE) {
                 let r = k / TILE;
                 let x = k % TILE;
                 let q = tile * TILE + vec2<u32>(x, r * SUB + j);
                 if all(q < size) {
                     var v: vec4<u32>;
                     for (var c = 0u; c < 4u; c++) {
-                        v[c] = sh_stage[stage_out_slot(c, r, x)];
+                        v[c] = sh_stage[stage_row_slot(c, r, x)];
                     }
                     sat_store(slot, q, v);
                 }

@@ -20,21 +20,51 @@ var<private> sat_non_finite: u32;
 // under GPU_LAYOUT, for the other depth sources, the sub-block's raw depths (in x).
 var<private> sat_block: array<vec2<f32>, 16>; // SUB · SUB
 
-// GPU_LAYOUT's workgroup memory (shared/sat_tile): first the raw depth of the tile and a
-// one-texel border, (TILE + 2)² texels at `stage_depth_slot` (`sat_stage_depth`), which each
-// invocation copies its sub-block from; then, in pass 3, a row of sub-blocks' table texels at a
-// time, channel by channel (`stage_out_slot`, shared/sat_tile_scan).
+// GPU_LAYOUT's workgroup memory (shared/sat_tile). A depth source's tile passes stage the raw
+// depth of the tile and a one-texel border in it, (TILE + 2)² texels at `stage_depth_slot`
+// (`sat_stage_depth`), which each invocation copies its sub-block from; a stored source's
+// stage texel row j of every sub-block row at a time, the row each sweep reads next, channel
+// by channel at `stage_row_slot` (`sat_stage_row`); pass 3 writes its table through it the
+// same way (shared/sat_tile_scan).
 const STAGE_SIDE: u32 = TILE + 2u;
 // Depth row pitch: 42 = 2 (mod 8) with a slot of padding every 4 texels, so that the 32 lanes
 // of a SIMD group reading their sub-blocks' texels (4 apart along a row, 4 rows apart down)
 // hit 32 distinct banks.
 const STAGE_PITCH: u32 = 42u;
-// Table rows staged at a time (one texel row of each of the GRID sub-block rows) and their row
-// pitch: 33 words, the same banks-apart property for the sub-blocks' stores and the row's loads.
-const OUT_ROWS: u32 = GRID;
-const OUT_PITCH: u32 = TILE + 1u;
-const OUT_PLANE: u32 = OUT_ROWS * OUT_PITCH;
-var<workgroup> sh_stage: array<u32, 1428>; // STAGE_SIDE · STAGE_PITCH ≥ 4 · OUT_PLANE (1056)
+// Rows staged at a time (one texel row of each of the GRID sub-block rows) and their pitch:
+// 33 words, the same banks-apart property for the sub-blocks' accesses and the row's.
+const STAGE_ROWS: u32 = GRID;
+const STAGE_ROW_PITCH: u32 = TILE + 1u;
+const STAGE_PLANE: u32 = STAGE_ROWS * STAGE_ROW_PITCH;
+var<workgroup> sh_stage: array<u32, 1428>; // STAGE_SIDE · STAGE_PITCH ≥ 4 · STAGE_PLANE (1056)
+const_assert STAGE_SIDE * STAGE_PITCH == 1428u && 4u * STAGE_PLANE <= 1428u;
+
+// The row stage's slot of channel c of staged row r (tile row r·SUB + j of round j, 0 ≤ r <
+// STAGE_ROWS), tile column x.
+fn stage_row_slot(c: u32, r: u32, x: u32) -> u32 {
+    return c * STAGE_PLANE + r * STAGE_ROW_PITCH + x;
+}
+
+// GPU_LAYOUT, a stored source (`s.from_depth` false; a no-op otherwise): stages texel row j of
+// every sub-block row of tile `tile` (tile rows r·SUB + j), at clamped coordinates as
+// `sat_texel` reads them, neighbouring invocations on neighbouring texels. Every invocation
+// calls it where a sweep reads row j (it has barriers: the stage's last readers are done
+// before it is written, and it is written before it is read).
+fn sat_stage_row(tile: vec2<u32>, j: u32, size: vec2<u32>, s: SatSource, li: u32) {
+    if GPU_LAYOUT && !s.from_depth {
+        workgroupBarrier();
+        for (var k = li; k < STAGE_ROWS * TILE; k += WG_SIZE) {
+            let r = k / TILE;
+            let x = k % TILE;
+            let q = tile * TILE + vec2<u32>(x, r * SUB + j);
+            let v = bitcast<vec4<u32>>(textureLoad(src, min(q, size - 1u), 0));
+            for (var c = 0u; c < 4u; c++) {
+                sh_stage[stage_row_slot(c, r, x)] = v[c];
+            }
+        }
+        workgroupBarrier();
+    }
+}
 
 // The depth stage's slot of bordered-tile texel (x, y), 0 ≤ x, y < STAGE_SIDE.
 fn stage_depth_slot(x: u32, y: u32) -> u32 {
@@ -183,6 +213,14 @@ fn sat_texel(
         // body for every lane, and both roundings are a few integer operations.
         v = select(v, round_f16(v), s.f16);
         v = select(v, round_unorm16(v), s.unorm16);
+    } else if GPU_LAYOUT {
+        // Staged by `sat_stage_row` for this row of the sweep.
+        let l = q % TILE;
+        var w: vec4<u32>;
+        for (var c = 0u; c < 4u; c++) {
+            w[c] = sh_stage[stage_row_slot(c, l.y / SUB, l.x)];
+        }
+        v = bitcast<vec4<f32>>(w);
     } else {
         v = textureLoad(src, min(q, size - 1u), 0);
     }
