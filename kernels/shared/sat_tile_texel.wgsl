@@ -133,12 +133,13 @@ fn sat_blocked(s: SatSource) -> bool {
 // texel's own five would be 5·SUB² (80 against 36 at SUB = 4; on llvmpipe the table built with
 // them per texel ran 1.1× slower than the stored map's, `benches/RESULTS.md`, 2026-11-27).
 // ESM's exp(c (z − 1)), one exp a texel a pass instead of one a sweep. Texels past the map's
-// edge (ragged tiles) get values that `sat_texel` discards.
+// edge (ragged tiles) get values that `sat_texel` discards. The sub-block's own non-finite
+// depths are counted here (`sat_raw_own`): the sweeps load no depth.
 fn sat_block_fill(origin: vec2<u32>, size: vec2<u32>, s: SatSource) {
     if s.kind == SAT_ESM {
         for (var k = 0u; k < SUB * SUB; k++) {
             let at = vec2<i32>(origin) + vec2<i32>(i32(k % SUB), i32(k / SUB));
-            let z = sat_depth_at(at, origin, size, s.depth);
+            let z = linear_depth(sat_raw_own(at, origin, size), s.depth);
             sat_block[k] = vec2<f32>(exp(s.exp_pos * (z - 1.0)), 0.0);
         }
         return;
@@ -147,7 +148,7 @@ fn sat_block_fill(origin: vec2<u32>, size: vec2<u32>, s: SatSource) {
     var z: array<f32, 36>; // BORDERED²
     for (var k = 0u; k < BORDERED * BORDERED; k++) {
         let at = vec2<i32>(origin) + vec2<i32>(i32(k % BORDERED), i32(k / BORDERED)) - 1;
-        z[k] = sat_depth_at(at, origin, size, s.depth);
+        z[k] = linear_depth(sat_raw_own(at, origin, size), s.depth);
     }
     for (var k = 0u; k < SUB * SUB; k++) {
         let c = (k / SUB + 1u) * BORDERED + k % SUB + 1u;
@@ -155,14 +156,22 @@ fn sat_block_fill(origin: vec2<u32>, size: vec2<u32>, s: SatSource) {
     }
 }
 
-// The linear depth of `src` (the depth buffer) at p clamped to the map of `size` (p within
-// one texel of the tile of sub-block origin `origin`: under GPU_LAYOUT, from the staged tile).
-fn sat_depth_at(p: vec2<i32>, origin: vec2<u32>, size: vec2<u32>, depth: DepthParams) -> f32 {
+// The raw depth of `src` (the depth buffer) at p clamped to the map of `size`, p within one
+// texel of the sub-block at `origin`: under GPU_LAYOUT from the staged tile (counted there),
+// else loaded, a non-finite depth counted here (`sat_non_finite`) when p is a texel of the
+// sub-block inside the map, so that the blocked sources' sweeps load nothing more.
+fn sat_raw_own(p: vec2<i32>, origin: vec2<u32>, size: vec2<u32>) -> f32 {
     if GPU_LAYOUT {
-        return linear_depth(sat_staged_depth(p, origin / TILE), depth);
+        return sat_staged_depth(p, origin / TILE);
     }
     let q = clamp(p, vec2<i32>(0), vec2<i32>(size) - 1);
-    return linear_depth(textureLoad(src, q, 0).r, depth);
+    let raw = textureLoad(src, q, 0).r;
+    let o = vec2<i32>(origin);
+    let own = all(p == q) && all(p >= o) && all(p < o + i32(SUB));
+    if own && !depth_is_finite(raw) {
+        sat_non_finite += 1u;
+    }
+    return raw;
 }
 
 // The encoded texel `q` of `src` (`size` its size) read as `s` says, 0 outside the map (the
@@ -183,11 +192,12 @@ fn sat_texel(
     let own = q.y % SUB * SUB + q.x % SUB;
     var v: vec4<f32>;
     if s.from_depth {
-        var raw: f32;
+        // Unused by the blocked sources below, whose `sat_block_fill` loaded and counted it.
+        var raw = 0.0;
         if GPU_LAYOUT {
-            // Staged by `sat_tile_begin` (unused by the blocked sources below), counted there.
+            // Staged by `sat_tile_begin`, counted there.
             raw = sat_block[own].x;
-        } else {
+        } else if !sat_blocked(s) {
             raw = textureLoad(src, min(q, size - 1u), 0).r;
             if inside && !depth_is_finite(raw) {
                 sat_non_finite += 1u;
