@@ -9,7 +9,8 @@
 // it, added to running column sums); a texel adds the sums left of its sub-block on its row
 // (prefix of the sub-blocks' last columns) and above it on its column (prefix of their last
 // rows, each with the sub-row's totals left of the sub-block). The representation is read
-// once more here (swept twice, the second time from cache) and the table written once: two
+// once more here (swept twice: the second time from cache on a GPU, from the first sweep's
+// encoded texels, `sat_enc`, on a CPU driver) and the table written once: two
 // reads and one write per texel over the three passes.
 // #import shared/sat_tile
 // #import shared/sat_tile_texel
@@ -30,10 +31,17 @@ const SIDE: u32 = 7u; // GRID − 1
 // carry.
 var<workgroup> sh_carry: array<vec4<u32>, 64>; // 2 · TILE = WG_SIZE
 
+// Without GPU_LAYOUT: the sub-block's encoded texels (row-major), kept from the pass's first
+// sweep for its second, which then neither loads nor encodes (MSM's tables 1.1×, CSSM's
+// 1.2× faster on llvmpipe, benches/RESULTS.md, 2026-11-27, thirteenth session). Under it the
+// second sweep encodes again: sixteen four-channel values more an invocation would cost a GPU
+// registers, and what that costs it is not measured.
+var<private> sat_enc: array<vec4<u32>, 16>; // SUB · SUB
+
 // Row j of the sub-block at `origin` (invocation li's): its encoded texels prefixed along the
 // row, added to the running column sums `col`, which then hold row j of the sub-block's own
-// inclusive table. Every invocation calls it (under GPU_LAYOUT a stored source's row j is
-// staged first: it has barriers).
+// inclusive table; `again`: the pass's second sweep. Every invocation calls it (under
+// GPU_LAYOUT a stored source's row j is staged first: it has barriers).
 fn sat_sweep_row(
     origin: vec2<u32>,
     j: u32,
@@ -41,13 +49,23 @@ fn sat_sweep_row(
     fs: bool,
     s: SatSource,
     li: u32,
+    again: bool,
     col: ptr<function, array<vec4<u32>, SUB>>,
 ) {
     let size = textureDimensions(src);
     sat_stage_row(origin / TILE, j, size, s, li);
     var run = vec4<u32>(0u);
     for (var i = 0u; i < SUB; i++) {
-        run = sat_sum(run, sat_texel(origin + vec2<u32>(i, j), size, p, fs, s), fs);
+        var e: vec4<u32>;
+        if GPU_LAYOUT {
+            e = sat_texel(origin + vec2<u32>(i, j), size, p, fs, s);
+        } else if again {
+            e = sat_enc[j * SUB + i];
+        } else {
+            e = sat_texel(origin + vec2<u32>(i, j), size, p, fs, s);
+            sat_enc[j * SUB + i] = e;
+        }
+        run = sat_sum(run, e, fs);
         (*col)[i] = sat_sum((*col)[i], run, fs);
     }
 }
@@ -82,7 +100,7 @@ fn sat_tile_prepare(
     sat_tile_begin(tile, origin, size, s, li);
     var col: array<vec4<u32>, SUB>;
     for (var j = 0u; j < SUB; j++) {
-        sat_sweep_row(origin, j, p, fs, s, li, &col);
+        sat_sweep_row(origin, j, p, fs, s, li, false, &col);
         if a < SIDE {
             sh_right[(b * SUB + j) * SIDE + a] = col[SUB - 1u];
         }
@@ -152,7 +170,7 @@ fn sat_tile_table(p: SatParams, fs: bool, s: SatSource, tile: vec2<u32>, li: u32
     let size = textureDimensions(src);
     var col: array<vec4<u32>, SUB>;
     for (var j = 0u; j < SUB; j++) {
-        sat_sweep_row(origin, j, p, fs, s, li, &col);
+        sat_sweep_row(origin, j, p, fs, s, li, true, &col);
         let row_add = sat_row_add(fs, li, j);
         if !GPU_LAYOUT {
             for (var i = 0u; i < SUB; i++) {
