@@ -9,7 +9,8 @@
 # On an H200 (2026-11-27) the steps took: soft table 76 s, shade floor 7 × 13 s, each 2048²
 # kernel round 13 s, the 2048² table 23 s, each 4096²/8192² round 127 s; with the layouts'
 # rounds (untimed on a GPU: four blur rounds at 2048² and 4096², four table rounds at 2048²)
-# about 500 s: give the call 560 s.
+# about 500 s, then (if time is left) the fused blurs' ablation, 3 × about 10 s: give the call
+# 560 s.
 # The steps run most wanted first, each under its own time box, and append to at most seven
 # files in OUT (the device tool brings back eight), so a call stopped by its time box still
 # returns what ran. A second binary to compare against goes in as BASE=path/to/other/shadowgraph:
@@ -130,6 +131,31 @@ fi
 # `chain vssm`, `chain msm_soft`), then the chains the targets name at 4096² and 8192².
 step kernels_2048.txt 60 "$B" bench --sizes 2048 --repeat 20 --passes
 step kernels_large.txt 150 "$B" bench --sizes 4096,8192 --repeat 20 --only chain,blur,mips,sat --passes
+# Where the fused tile blurs' time goes (they ran at 0.26-0.30x their copy on the H200, 3x
+# their bytes' time): the shipped kernels beside variants of kernels/shared/encode_blur.wgsl
+# whose tiles store their encoded centres unblurred (`no_blur`: load, encode, store) and their
+# depth unencoded too (`no_encode`: load and store, the tile's halo included). Timings only:
+# the variants' outputs are not the filter's.
+E=kernels/shared/encode_blur.wgsl
+UNBLURRED='            for (var k = i32(li); k < t.outs.x * t.outs.y; k += i32(WG_SIZE)) {
+                let yx = div_mod(k, t.outs.x);
+                store(t, vec2<i32>(yx.y, yx.x), sh_get((yx.x + t.r.y) * t.enc.x + yx.y + t.r.x));
+            }'
+mkdir -p "$V/fused_shipped/shared" "$V/fused_no_blur/shared" "$V/fused_no_encode/shared"
+cp "$E" "$V/fused_shipped/shared/encode_blur.wgsl"
+awk -v body="$UNBLURRED" '/^            blur_tile_(runs|single)\(t, li\);$/ { print body; next } { print }' \
+    "$E" >"$V/fused_no_blur/shared/encode_blur.wgsl"
+sed 's/^    encode_tile(t, li, packed);$/    workgroupBarrier();/' "$V/fused_no_blur/shared/encode_blur.wgsl" \
+    >"$V/fused_no_encode/shared/encode_blur.wgsl"
+for v in fused_no_blur fused_no_encode; do
+    cmp -s "$E" "$V/$v/shared/encode_blur.wgsl" && echo "variant $v: its edit no longer applies to $E" |
+        tee -a "$OUT/steps.txt"
+done
+for v in fused_shipped fused_no_blur fused_no_encode; do
+    echo "## variant $v" >>"$OUT/layouts.txt"
+    SHADOWGRAPH_KERNEL_DIR="$V/$v" step layouts.txt 30 "$B" bench --sizes 2048 --repeat 20 \
+        --only 'vsm_blur r4,msm_blur r4,evsm_blur 4 r4'
+done
 # The timer against the wall clock on a bundled scene.
 step env.txt 30 "$B" render scenes/bunny.toml --timings --repeat 20 -o "$V/bunny.png"
 command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=clocks.sm --format=csv \
