@@ -19,11 +19,12 @@
 // twelfth session; the table build's tile passes, reading so, ran 3–6× their bandwidth bound
 // there). Under GPU_LAYOUT the depth sources' tile is staged through workgroup memory, loaded
 // with neighbouring invocations on neighbouring texels (shared/sat_tile_texel,
-// `sat_tile_begin`), and pass 3 writes its table a row of sub-blocks at a time through the
-// same memory (shared/sat_tile_scan, `sat_tile_table`). Without it each invocation reads and
-// writes its sub-block straight from the texture, as llvmpipe, whose SIMD lanes gather texel by
-// texel and which gathers workgroup memory slowly, runs fastest. The same sums in the same
-// order either way: tables bit for bit the same (`tests/sat.rs` compares both).
+// `sat_tile_begin`), a stored map's one texel row of every sub-block row at a time
+// (`sat_stage_row`), and pass 3 writes its table the same way through the same memory
+// (shared/sat_tile_scan, `sat_tile_table`). Without it each invocation reads and writes its
+// sub-block straight from the texture, as llvmpipe, whose SIMD lanes gather texel by texel and
+// which gathers workgroup memory slowly, runs fastest. The same sums in the same order either
+// way: tables bit for bit the same (`tests/sat.rs` and `tests/csm_sat.rs` compare both).
 override GPU_LAYOUT: bool = false;
 
 // Keep in sync with `SAT_TILE` in src/sat/mod.rs.

@@ -74,7 +74,8 @@ fn stage_depth_slot(x: u32, y: u32) -> u32 {
 // GPU_LAYOUT: stages the raw depth of tile `tile` and its one-texel border, at clamped
 // coordinates, neighbouring invocations on neighbouring texels, and counts the non-finite
 // depths of the tile's own texels inside the map (`sat_non_finite`, each texel once: the
-// straight layout counts them in `sat_texel`). Every invocation calls it (it has a barrier).
+// straight layout counts them where it loads them, `sat_raw_own` or `sat_texel`). Every
+// invocation calls it (it has a barrier).
 fn sat_stage_depth(tile: vec2<u32>, size: vec2<u32>, li: u32) {
     let corner = vec2<i32>(tile * TILE) - 1;
     for (var k = li; k < STAGE_SIDE * STAGE_SIDE; k += WG_SIZE) {
