@@ -8,9 +8,9 @@
 #
 # On an H200 (2026-11-27) the steps took: soft table 76 s, shade floor 7 × 13 s, each 2048²
 # kernel round 13 s, the 2048² table 23 s, each 4096²/8192² round 127 s; with the layouts'
-# rounds (untimed on a GPU: four blur rounds at 2048² and 4096², four table rounds at 2048²)
-# about 500 s, then (if time is left) the fused blurs' ablation, 3 × about 10 s: give the call
-# 560 s.
+# rounds (untimed on a GPU: two of the blurs at 2048² and 4096², two of the tables at 2048²,
+# each case in both layouts) about 480 s, then (if time is left) the fused blurs' ablation,
+# 3 × about 10 s: give the call 560 s.
 # The steps run most wanted first, each under its own time box, and append to at most seven
 # files in OUT (the device tool brings back eight), so a call stopped by its time box still
 # returns what ran. A second binary to compare against goes in as BASE=path/to/other/shadowgraph:
@@ -99,27 +99,21 @@ for v in shipped no_srgb no_lookup gbuffer_only store_only wg16 store_only_wg16;
     SHADOWGRAPH_KERNEL_DIR="$V/$v" step shade.txt 40 "$B" bench --lookup 3 --repeat 20 \
         --image 1920x1080 --map 2048 --only hard
 done
-# Issue 15: the two row layouts (exec::KernelLayout) on the same machine, alternated, at
-# 2048² and 4096²: `gpu` (the default on a GPU) stages the separable blur's rows and the fused
-# row kernels' outputs through workgroup memory, `cpu` reads and stores them in runs straight
-# (the layout timed on 2026-11-27).
-for round in 1 2; do
-    for layout in cpu gpu; do
-        echo "## layout $layout, round $round" >>"$OUT/layouts.txt"
-        SHADOWGRAPH_KERNEL_LAYOUT=$layout step layouts.txt 60 "$B" bench --sizes 2048,4096 \
-            --repeat 20 --only 'blur rg32f,blur log,+blur r4 (old),blur r32' --passes
-    done
+# Issue 15: the kernels' two memory layouts (exec::KernelLayout) in one process each round,
+# every case in both side by side (`bench --layouts`), the order swapped in the second round:
+# `gpu` (the default on a GPU) stages the separable blur's rows and the fused row kernels'
+# outputs through workgroup memory, `cpu` reads and stores them in runs straight (the layout
+# timed on 2026-11-27), at 2048² and 4096²; then the table build's tile passes at 2048²
+# (issue 14's ≤ 0.2 ms): `gpu` stages the depth tile, a stored map's rows and pass 3's table
+# rows, `cpu` reads and writes each invocation's 4 × 4 sub-block straight (twelfth session:
+# tile sums 0.109, tables 0.170 ms for `chain vssm`).
+for order in cpu,gpu gpu,cpu; do
+    step layouts.txt 120 "$B" bench --sizes 2048,4096 --repeat 20 \
+        --only 'blur rg32f,blur log,+blur r4 (old),blur r32' --passes --layouts "$order"
 done
-# The table build's tile passes in both layouts at 2048² (issue 14's ≤ 0.2 ms): `gpu` stages
-# the depth tile and pass 3's table rows through workgroup memory (commit after b7dae6e),
-# `cpu` reads and writes each invocation's 4 × 4 sub-block straight (the layout the twelfth
-# session timed: tile sums 0.109, tables 0.170 ms for `chain vssm`).
-for round in 1 2; do
-    for layout in cpu gpu; do
-        echo "## table layout $layout, round $round" >>"$OUT/layouts.txt"
-        SHADOWGRAPH_KERNEL_LAYOUT=$layout step layouts.txt 30 "$B" bench --sizes 2048 \
-            --repeat 20 --only 'sat,chain vssm,chain msm_soft,chain esm,chain cssm' --passes
-    done
+for order in cpu,gpu gpu,cpu; do
+    step layouts.txt 60 "$B" bench --sizes 2048 --repeat 20 \
+        --only 'sat,chain vssm,chain msm_soft,chain esm,chain cssm' --passes --layouts "$order"
 done
 if [ -n "$BASE" ]; then
     for round in 1 2; do

@@ -152,8 +152,7 @@ impl Gpu {
             format!("{}", self.queue.get_timestamp_period()),
         );
         let layout = match crate::exec::KernelLayout::for_device(&self.device) {
-            Ok(crate::exec::KernelLayout::Gpu) => "gpu".to_string(),
-            Ok(crate::exec::KernelLayout::Cpu) => "cpu".to_string(),
+            Ok(layout) => layout.name().to_string(),
             Err(e) => e.to_string(),
         };
         line("kernel layout", layout);

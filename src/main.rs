@@ -102,6 +102,11 @@ enum Command {
         /// Also print each dispatch's median time under a kernel of several.
         #[arg(long, conflicts_with = "lookup")]
         passes: bool,
+        /// Time each kernel in each of these memory layouts in turn (`gpu`, `cpu`: the
+        /// kernels' two, see SHADOWGRAPH_KERNEL_LAYOUT), rows named `<kernel> [gpu]`, …
+        /// (default: the device's layout alone).
+        #[arg(long, value_delimiter = ',', value_parser = parse_layout, conflicts_with = "lookup")]
+        layouts: Vec<shadowgraph::exec::KernelLayout>,
     },
     /// Sweep techniques and their accuracy knobs, time each on the GPU and measure its error
     /// against ground truth: report.html/.md/.csv/.json, pareto{,_penumbra,_flip}.svg, grid.png
@@ -149,6 +154,11 @@ enum Command {
 /// `bench --inputs`: one of `Inputs::NAMES`.
 fn parse_inputs(name: &str) -> Result<shadowgraph::bench::Inputs, String> {
     shadowgraph::bench::Inputs::parse(name).map_err(|e| e.to_string())
+}
+
+fn parse_layout(name: &str) -> Result<shadowgraph::exec::KernelLayout, String> {
+    shadowgraph::exec::KernelLayout::parse(name)
+        .ok_or_else(|| format!("`{name}`: expected `gpu` or `cpu`"))
 }
 
 /// `--repeat` of every command: 1 to `render::MAX_REPEAT` frames (each keeps a row of timings).
@@ -259,6 +269,7 @@ fn run(args: Args) -> Result<()> {
             only,
             inputs,
             passes,
+            layouts,
         } => {
             let gpu = Gpu::new()?;
             match lookup {
@@ -296,7 +307,9 @@ fn run(args: Args) -> Result<()> {
                 None => {
                     print!(
                         "{}",
-                        shadowgraph::bench::run(&gpu, &sizes, repeat, &only, inputs, passes)?
+                        shadowgraph::bench::run(
+                            &gpu, &sizes, repeat, &only, inputs, passes, &layouts
+                        )?
                     )
                 }
             }

@@ -1,7 +1,7 @@
 //! Unbounded command-line inputs are refused up front, the same way by every command: `--repeat`
 //! is 1 to 1000 for `render`, `evaluate` and `bench`; `evaluate --truth-resolution 0` says what
-//! is wrong; `plan /dev/zero` stops reading. Each is one line and status 1, within seconds (no
-//! GPU work starts).
+//! is wrong; `plan /dev/zero` stops reading; `bench --layouts` takes `gpu` and `cpu` only. Each
+//! is one line and status 1, within seconds (no GPU work starts).
 
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
@@ -144,5 +144,33 @@ fn lookup_options_need_the_lookup_and_sane_values() {
             "bench", "--lookup", "3", "--repeat", "1", "--only", "nosuch",
         ],
         &["--only nosuch", "matches no soft configuration", "vssm"],
+    );
+}
+
+#[test]
+fn layouts_are_named_and_not_for_the_lookup() {
+    refused(
+        &[
+            "bench",
+            "--sizes",
+            "64",
+            "--repeat",
+            "1",
+            "--layouts",
+            "gpu,fast",
+        ],
+        &["--layouts", "`fast`", "expected `gpu` or `cpu`"],
+    );
+    refused(
+        &[
+            "bench",
+            "--lookup",
+            "3",
+            "--repeat",
+            "1",
+            "--layouts",
+            "gpu",
+        ],
+        &["--lookup", "cannot be used with", "--layouts"],
     );
 }

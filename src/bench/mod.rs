@@ -28,7 +28,7 @@ use self::harness::{gb_per_s, time_graph};
 pub use self::lookup::{LOOKUP_WIDTHS, LookupRow, format_lookup_table, lookup_cost};
 pub use self::soft::{SOFT_LIGHT_SIZES, SOFT_TECHNIQUES, SoftRow, format_soft_table, soft_cost};
 use crate::error::{Error, Result};
-use crate::exec::Executor;
+use crate::exec::{Executor, KernelLayout};
 use crate::filter::{BlurMode, add_filter};
 use crate::gpu::Gpu;
 use crate::graph::{Graph, Plan, cost};
@@ -604,10 +604,35 @@ pub fn measure(
     only: &[String],
     inputs: Inputs,
 ) -> Result<Vec<BenchRow>> {
+    measure_layouts(device, queue, sizes, repeat, only, inputs, &[])
+}
+
+/// [`measure`], each case timed in each of `layouts` in turn, adjacent in time, its rows named
+/// `<case> [gpu]`, `<case> [cpu]` (the kernels' two memory layouts, `exec::KernelLayout`,
+/// compared within one process: one warm-up, one clock, one set of copies); no layouts: the
+/// device's, rows named by their case alone.
+pub fn measure_layouts(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    sizes: &[u32],
+    repeat: u32,
+    only: &[String],
+    inputs: Inputs,
+    layouts: &[KernelLayout],
+) -> Result<Vec<BenchRow>> {
     check_args(device, sizes, repeat)?;
     let cases = select_cases(only)?;
     harness::timer(device, queue, 1)?;
     let mut executor = Executor::new();
+    // One executor a layout (its own pipelines), or the device's layout unnamed.
+    let mut variants: Vec<(String, Executor)> = layouts
+        .iter()
+        .map(|&layout| {
+            let mut e = Executor::new();
+            e.kernels.set_layout(layout);
+            (format!(" [{}]", layout.name()), e)
+        })
+        .collect();
     let mut rows = Vec::new();
     for &n in sizes {
         let buffer = texels(n) * 16;
@@ -654,24 +679,34 @@ pub fn measure(
         let mut cases_rows = Vec::new();
         for case in &cases {
             let built = (case.build)(n);
-            let (plan, t) = time_graph(
-                device,
-                queue,
-                &mut executor,
-                &built.graph,
-                &built.outputs,
-                repeat,
-                inputs,
-            )?;
-            let output = built.outputs.first().and_then(|o| plan.resource(o));
-            // The texture's own format (a packed f16 pair is an r32uint texture).
-            let format = output
-                .map(|r| crate::graph::texture_format(r.resource.format))
-                .ok_or_else(|| {
-                    Error::Invalid(format!("benchmark `{}` plans no output", case.name))
-                })?;
-            cases_rows.push((format, row(case.name, format_name(format), n, &plan, t)?));
-            executor.release_textures();
+            let mut time_in = |suffix: &str, executor: &mut Executor| -> Result<()> {
+                let (plan, t) = time_graph(
+                    device,
+                    queue,
+                    executor,
+                    &built.graph,
+                    &built.outputs,
+                    repeat,
+                    inputs,
+                )?;
+                let output = built.outputs.first().and_then(|o| plan.resource(o));
+                // The texture's own format (a packed f16 pair is an r32uint texture).
+                let format = output
+                    .map(|r| crate::graph::texture_format(r.resource.format))
+                    .ok_or_else(|| {
+                        Error::Invalid(format!("benchmark `{}` plans no output", case.name))
+                    })?;
+                let name = format!("{}{suffix}", case.name);
+                cases_rows.push((format, row(&name, format_name(format), n, &plan, t)?));
+                executor.release_textures();
+                Ok(())
+            };
+            if variants.is_empty() {
+                time_in("", &mut executor)?;
+            }
+            for (suffix, executor) in &mut variants {
+                time_in(suffix, executor)?;
+            }
         }
         // The copies again: each format's row keeps the faster of its two runs.
         for (k, again) in time_copies(&mut executor)?.into_iter().enumerate() {
@@ -707,8 +742,17 @@ pub fn run(
     only: &[String],
     inputs: Inputs,
     passes: bool,
+    layouts: &[KernelLayout],
 ) -> Result<String> {
-    let rows = measure(&gpu.device, &gpu.queue, sizes, repeat, only, inputs)?;
+    let rows = measure_layouts(
+        &gpu.device,
+        &gpu.queue,
+        sizes,
+        repeat,
+        only,
+        inputs,
+        layouts,
+    )?;
     let cpu = gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu;
     Ok(format_table(
         &gpu.describe(),
@@ -993,6 +1037,46 @@ mod tests {
             e.to_string().contains("--only no such: matches no kernel"),
             "{e}"
         );
+    }
+
+    /// `--layouts gpu,cpu`: each case once per layout, in that order, side by side, named by
+    /// its layout, with the same bytes (one plan); the copies once.
+    #[test]
+    fn each_case_runs_in_each_layout_side_by_side() {
+        let gpu = gpu();
+        let only = vec!["sat fixed".to_string(), "blur rg32f r4".to_string()];
+        let layouts = [KernelLayout::Gpu, KernelLayout::Cpu];
+        let rows = measure_layouts(
+            &gpu.device,
+            &gpu.queue,
+            &[32],
+            1,
+            &only,
+            Inputs::Random,
+            &layouts,
+        )
+        .unwrap();
+        let cases: Vec<&BenchRow> = rows
+            .iter()
+            .filter(|r| !r.kernel.starts_with("copy"))
+            .collect();
+        let want: Vec<String> = CASES
+            .iter()
+            .map(|c| c.name)
+            .filter(|n| n.contains("sat fixed") || n.contains("blur rg32f r4"))
+            .flat_map(|n| [format!("{n} [gpu]"), format!("{n} [cpu]")])
+            .collect();
+        let names: Vec<&str> = cases.iter().map(|r| r.kernel.as_str()).collect();
+        assert_eq!(names, want);
+        for pair in cases.chunks(2) {
+            assert_eq!(
+                pair[0].bytes_moved, pair[1].bytes_moved,
+                "{}",
+                pair[0].kernel
+            );
+        }
+        let copies = rows.iter().filter(|r| r.kernel == "copy texture").count();
+        assert_eq!(copies, COPY_FORMATS.len());
     }
 
     /// Per size: the buffer copy, a texture copy per format, then every case, each case's

@@ -30,11 +30,13 @@ pub const KERNEL_LAYOUT_ENV: &str = "SHADOWGRAPH_KERNEL_LAYOUT";
 pub const GPU_LAYOUT_CONSTANT: &str = "GPU_LAYOUT";
 
 /// Which of its two memory layouts a kernel that has two compiles (`override GPU_LAYOUT:
-/// bool`; the blur's row pass, `kernels/shared/blur_pass.wgsl`). A GPU coalesces a SIMD group's
-/// loads and stores only where its lanes touch neighbouring texels, which the row pass gets by
-/// staging its texels through workgroup memory; llvmpipe's lanes gather texel by texel anyway,
-/// and its workgroup memory is slow, so there the row pass reads and writes the texture in
-/// runs. Both layouts give the same results bit for bit (`tests/fused.rs`).
+/// bool`: the blur's row pass, `kernels/shared/blur_pass.wgsl`; the fused blurs' rows,
+/// `shared/encode_blur.wgsl`; the summed-area tables' tile passes, `shared/sat_tile*.wgsl`). A
+/// GPU coalesces a SIMD group's loads and stores only where its lanes touch neighbouring
+/// texels, which those kernels get by staging their texels through workgroup memory; llvmpipe's
+/// lanes gather texel by texel anyway, and its workgroup memory is slow, so there they read and
+/// write the texture in runs or blocks. Both layouts give the same results bit for bit
+/// (`tests/prefilter.rs`, `tests/fused.rs`, `tests/sat.rs`, `tests/csm_sat.rs`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum KernelLayout {
     /// Neighbouring lanes on neighbouring texels (`GPU_LAYOUT = true`).
@@ -48,16 +50,33 @@ impl KernelLayout {
     /// ([`wgpu::DeviceType::Cpu`]) and [`KernelLayout::Gpu`] on anything else.
     pub fn for_device(device: &wgpu::Device) -> Result<Self> {
         match std::env::var(KERNEL_LAYOUT_ENV) {
-            Ok(v) if v == "gpu" => Ok(Self::Gpu),
-            Ok(v) if v == "cpu" => Ok(Self::Cpu),
-            Ok(v) => Err(Error::Invalid(format!(
-                "{KERNEL_LAYOUT_ENV}={v}: expected `gpu` or `cpu`"
-            ))),
+            Ok(v) => Self::parse(&v)
+                .ok_or_else(|| Error::Invalid(format!("{KERNEL_LAYOUT_ENV}={v}: {EXPECTED}"))),
             Err(_) if crate::timer::is_gpu(device) => Ok(Self::Gpu),
             Err(_) => Ok(Self::Cpu),
         }
     }
+
+    /// `gpu` or `cpu`, as [`KERNEL_LAYOUT_ENV`] and `shadowgraph bench --layouts` spell it.
+    pub fn parse(name: &str) -> Option<Self> {
+        match name {
+            "gpu" => Some(Self::Gpu),
+            "cpu" => Some(Self::Cpu),
+            _ => None,
+        }
+    }
+
+    /// The name [`KernelLayout::parse`] reads.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Gpu => "gpu",
+            Self::Cpu => "cpu",
+        }
+    }
 }
+
+/// What a layout's name must be.
+const EXPECTED: &str = "expected `gpu` or `cpu`";
 
 impl ComputeKernel {
     /// Validates, reflects and compiles `wgsl` in the device's [`KernelLayout`]; errors name
