@@ -3,7 +3,7 @@
 //! Per texture and mip level: one 32-bit float OpenEXR with named channels, one grayscale PNG
 //! preview per channel (normalized by that channel's own finite range, non-finite texels red),
 //! and an entry in `manifest.json` with provenance and per-channel statistics. Two-moment VSM
-//! maps also get a variance view, σ² = max(E[z²] − E[z]², 0).
+//! maps also get a variance view, σ² = max(E\[z²\] − E\[z\]², 0).
 
 use std::collections::HashSet;
 use std::fmt::Write;
@@ -300,7 +300,7 @@ pub fn preview_rgba(values: &[f32], stats: &ChannelStats) -> Vec<u8> {
         .collect()
 }
 
-/// σ² = max(E[z²] − E[z]², 0) per texel, in f64; NaN where the moments give no number.
+/// σ² = max(E\[z²\] − E\[z\]², 0) per texel, in f64; NaN where the moments give no number.
 pub fn variance_view(z: &[f32], z2: &[f32]) -> Vec<f32> {
     z.iter()
         .zip(z2)

@@ -359,7 +359,7 @@ pub enum GraphError {
     #[error("cycle through nodes {}", .0.join(" → "))]
     Cycle(Vec<String>),
     /// A plan (built or edited by hand) breaks what the executor relies on: a slot or a
-    /// resource out of range, mismatched, or missing (see [`Plan::check`]).
+    /// resource out of range, mismatched, or missing (see [`crate::graph::Plan::check`]).
     #[error("malformed plan: {0}")]
     BadPlan(String),
     /// A size rule refers to a missing resource or to itself.

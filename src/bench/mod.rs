@@ -78,7 +78,7 @@ pub struct BenchRow {
 pub struct BenchGraph {
     /// The graph; its imports are R32Float textures the harness fills with random depths.
     pub graph: Graph,
-    /// Resources requested from [`graph::plan`].
+    /// Resources requested from [`crate::graph::plan`].
     pub outputs: Vec<String>,
 }
 

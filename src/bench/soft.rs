@@ -114,7 +114,7 @@ fn shading_fetches(scene: &Scene) -> Result<f64> {
 
 /// The shading pass's cost of every configuration of [`SOFT_TECHNIQUES`] at each light size in
 /// `sizes`: the median over `repeat` rounds (after [`WARMUP`] untimed ones, on a GPU at least [`super::GPU_WARMUP_MS`] of them) of the `shade`
-/// pass. Rounds interleave the configurations (each renders [`STEADY_FRAMES`] consecutive
+/// pass. Rounds interleave the configurations (each renders `STEADY_FRAMES` consecutive
 /// frames in turn, the last timed), so that a change of load on a shared machine reaches every
 /// configuration alike while each timed frame follows frames of its own configuration.
 ///

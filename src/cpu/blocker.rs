@@ -111,7 +111,7 @@ pub fn csm_z_series(zb: &[f64], l: &LightGpu, d: f64) -> f64 {
             .sum::<f64>()
 }
 
-/// `blocker_csm_z`: share `½ − below` (`below` = the CSM series = E[f] − ½), depth
+/// `blocker_csm_z`: share `½ − below` (`below` = the CSM series = E\[f\] − ½), depth
 /// `zsum / share`.
 pub fn csm_z(below: f64, zsum: f64, d: f64) -> Blocker {
     let share = 0.5 - below;

@@ -23,7 +23,7 @@ pub struct Maps<'a> {
 }
 
 /// The search's means over the search square snapped outward to texel edges: the four
-/// moments, or the two series `[below, zsum]` = [E[f] − ½, E[f̄·z]].
+/// moments, or the two series `[below, zsum]` = \[E\[f\] − ½, E\[f̄·z\]\].
 pub fn search(maps: Maps, l: &LightGpu, s: &LightSample) -> Vec<f64> {
     let w = blocker::search_width(l, s);
     let means = maps.search.snapped_square_mean(l.map_size, s.uv, w);

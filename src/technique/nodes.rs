@@ -59,7 +59,7 @@ impl LightNodes<'_> {
 
     /// The encoding `kernel` (raw depth → representation, named after the kernel) with
     /// `params`, then the light's filter over it in `mode`: what the shading reads. A linear
-    /// blur of an encoding that has a fused kernel ([`fused_blur`]) reads the depth itself
+    /// blur of an encoding that has a fused kernel (`fused_blur`) reads the depth itself
     /// (`filter::add_encode_blur`); the unfused encoding stays in the graph for whatever else
     /// reads it (the planner drops it otherwise).
     pub fn encoded(

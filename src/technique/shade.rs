@@ -212,7 +212,7 @@ pub fn shading_block(lights: &[Light]) -> String {
 /// lights (a cascaded one as its cascade 0) followed by every group's further cascades, each
 /// a light of its own (bindings and visibility function); `light_visibility` dispatches on the
 /// scene's lights only, and a cascaded light's case picks its cascade per pixel
-/// ([`super::cascade_shade`]).
+/// (`cascade_shade`).
 pub fn shading_block_cascaded(lights: &[Light], groups: &[CascadeGroup]) -> String {
     let visible = lights.len() - groups.iter().map(|g| g.extra()).sum::<usize>();
     let mut imports: Vec<&str> = Vec::new();

@@ -21,7 +21,7 @@ pub struct PeeledTexel {
     pub z1: f64,
     /// Second depth (1.0 where nothing lies behind the first).
     pub z2: f64,
-    /// Whether rays [`JITTER`] texels off the centre, either way on each axis, meet the same
+    /// Whether rays `JITTER` texels off the centre, either way on each axis, meet the same
     /// two triangles: the texel is no edge case of coverage.
     pub robust: bool,
     /// The largest change of either depth per texel seen across the jitter (a plane's depth
