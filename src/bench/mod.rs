@@ -754,8 +754,18 @@ pub fn run(
         layouts,
     )?;
     let cpu = gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu;
+    // Which layout the kernels ran in: the rows say it under `--layouts`.
+    let layout = if layouts.is_empty() {
+        format!(
+            "kernel layout {}",
+            KernelLayout::for_device(&gpu.device)?.name()
+        )
+    } else {
+        let names: Vec<&str> = layouts.iter().map(|l| l.name()).collect();
+        format!("kernel layouts {}, each kernel in each", names.join(", "))
+    };
     Ok(format_table(
-        &gpu.describe(),
+        &format!("{} ({layout})", gpu.describe()),
         cpu,
         repeat,
         inputs,
@@ -1040,7 +1050,8 @@ mod tests {
     }
 
     /// `--layouts gpu,cpu`: each case once per layout, in that order, side by side, named by
-    /// its layout, with the same bytes (one plan); the copies once.
+    /// its layout, with the same bytes (one plan); the copies once; the report's header names
+    /// the layouts, or the device's one without them.
     #[test]
     fn each_case_runs_in_each_layout_side_by_side() {
         let gpu = gpu();
@@ -1077,6 +1088,21 @@ mod tests {
         }
         let copies = rows.iter().filter(|r| r.kernel == "copy texture").count();
         assert_eq!(copies, COPY_FORMATS.len());
+        // The report's first line says which layout the kernels ran in.
+        let only = ["linearize".to_string()];
+        let both = run(&gpu, &[32], 1, &only, Inputs::Random, false, &layouts).unwrap();
+        let first = both.lines().next().unwrap_or_default();
+        assert!(
+            first.ends_with("(kernel layouts gpu, cpu, each kernel in each)"),
+            "{first}"
+        );
+        let device = KernelLayout::for_device(&gpu.device).unwrap().name();
+        let one = run(&gpu, &[32], 1, &only, Inputs::Random, false, &[]).unwrap();
+        let first = one.lines().next().unwrap_or_default();
+        assert!(
+            first.ends_with(&format!("(kernel layout {device})")),
+            "{first}"
+        );
     }
 
     /// Per size: the buffer copy, a texture copy per format, then every case, each case's
