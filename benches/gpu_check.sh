@@ -27,6 +27,13 @@ T0=$(date +%s)
 
 # Runs a command (at most $2 seconds) with its output appended to $OUT/$1, then says how long
 # it took in $OUT/steps.txt.
+# Says in $OUT/steps.txt if variant file $2 came out the same as $1, the file it was edited
+# from (the edit no longer applies: its rows would time the file it came from).
+edited() {
+    cmp -s "$1" "$2" && echo "variant $2: its edit no longer applies to $1" | tee -a "$OUT/steps.txt"
+    return 0
+}
+
 step() {
     local file=$1 limit=$2
     shift 2
@@ -97,9 +104,9 @@ sed 's/^const WG_SIZE: u32 = 8u;/const WG_SIZE: u32 = 16u;/' "$S" >"$V/wg16/shad
 sed 's/^const WG_SIZE: u32 = 8u;/const WG_SIZE: u32 = 16u;/' "$V/store_only/shade.wgsl" \
     >"$V/store_only_wg16/shade.wgsl"
 for v in no_lookup wg16; do
-    cmp -s "$S" "$V/$v/shade.wgsl" && echo "variant $v: its edit no longer applies to $S" |
-        tee -a "$OUT/steps.txt"
+    edited "$S" "$V/$v/shade.wgsl"
 done
+edited "$V/store_only/shade.wgsl" "$V/store_only_wg16/shade.wgsl"
 for v in shipped empty no_lookup gbuffer_only store_only wg16 store_only_wg16; do
     echo "## variant $v" >>"$OUT/shade.txt"
     SHADOWGRAPH_KERNEL_DIR="$V/$v" step shade.txt 40 "$B" bench --lookup 3 --repeat 20 \
@@ -147,10 +154,8 @@ awk -v body="$UNBLURRED" '/^            blur_tile_(runs|single)\(t, li\);$/ { pr
     "$E" >"$V/fused_no_blur/shared/encode_blur.wgsl"
 sed 's/^    encode_tile(t, li, packed);$/    workgroupBarrier();/' "$V/fused_no_blur/shared/encode_blur.wgsl" \
     >"$V/fused_no_encode/shared/encode_blur.wgsl"
-for v in fused_no_blur fused_no_encode; do
-    cmp -s "$E" "$V/$v/shared/encode_blur.wgsl" && echo "variant $v: its edit no longer applies to $E" |
-        tee -a "$OUT/steps.txt"
-done
+edited "$E" "$V/fused_no_blur/shared/encode_blur.wgsl"
+edited "$V/fused_no_blur/shared/encode_blur.wgsl" "$V/fused_no_encode/shared/encode_blur.wgsl"
 for v in fused_shipped fused_no_blur fused_no_encode; do
     echo "## variant $v" >>"$OUT/layouts.txt"
     SHADOWGRAPH_KERNEL_DIR="$V/$v" step layouts.txt 30 "$B" bench --sizes 2048 --repeat 20 \

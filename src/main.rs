@@ -105,7 +105,7 @@ enum Command {
         /// Time each kernel in each of these memory layouts in turn (`gpu`, `cpu`: the
         /// kernels' two, see SHADOWGRAPH_KERNEL_LAYOUT), rows named `<kernel> [gpu]`, …
         /// (default: the device's layout alone).
-        #[arg(long, value_delimiter = ',', value_parser = parse_layout, conflicts_with = "lookup")]
+        #[arg(long, value_delimiter = ',', value_parser = shadowgraph::exec::KernelLayout::parse, conflicts_with = "lookup")]
         layouts: Vec<shadowgraph::exec::KernelLayout>,
     },
     /// Sweep techniques and their accuracy knobs, time each on the GPU and measure its error
@@ -154,11 +154,6 @@ enum Command {
 /// `bench --inputs`: one of `Inputs::NAMES`.
 fn parse_inputs(name: &str) -> Result<shadowgraph::bench::Inputs, String> {
     shadowgraph::bench::Inputs::parse(name).map_err(|e| e.to_string())
-}
-
-fn parse_layout(name: &str) -> Result<shadowgraph::exec::KernelLayout, String> {
-    shadowgraph::exec::KernelLayout::parse(name)
-        .ok_or_else(|| format!("`{name}`: expected `gpu` or `cpu`"))
 }
 
 /// `--repeat` of every command: 1 to `render::MAX_REPEAT` frames (each keeps a row of timings).

@@ -651,19 +651,21 @@ pub fn measure_layouts(
             yardstick: String::new(),
             passes: Vec::new(),
         });
+        let time = |executor: &mut Executor, built: &BenchGraph| {
+            time_graph(
+                device,
+                queue,
+                executor,
+                &built.graph,
+                &built.outputs,
+                repeat,
+                inputs,
+            )
+        };
         let time_copies = |executor: &mut Executor| -> Result<Vec<BenchRow>> {
             let mut copies = Vec::new();
             for &format in COPY_FORMATS {
-                let built = copy::copy_texture_graph(n, format);
-                let (plan, t) = time_graph(
-                    device,
-                    queue,
-                    executor,
-                    &built.graph,
-                    &built.outputs,
-                    repeat,
-                    inputs,
-                )?;
+                let (plan, t) = time(executor, &copy::copy_texture_graph(n, format))?;
                 let mut r = row("copy texture", format_name(format), n, &plan, t)?;
                 r.ratio = r.gbps / buffer_gbps;
                 r.yardstick = "copy buffer".into();
@@ -680,15 +682,7 @@ pub fn measure_layouts(
         for case in &cases {
             let built = (case.build)(n);
             let mut time_in = |suffix: &str, executor: &mut Executor| -> Result<()> {
-                let (plan, t) = time_graph(
-                    device,
-                    queue,
-                    executor,
-                    &built.graph,
-                    &built.outputs,
-                    repeat,
-                    inputs,
-                )?;
+                let (plan, t) = time(executor, &built)?;
                 let output = built.outputs.first().and_then(|o| plan.resource(o));
                 // The texture's own format (a packed f16 pair is an r32uint texture).
                 let format = output

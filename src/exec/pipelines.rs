@@ -50,19 +50,21 @@ impl KernelLayout {
     /// ([`wgpu::DeviceType::Cpu`]) and [`KernelLayout::Gpu`] on anything else.
     pub fn for_device(device: &wgpu::Device) -> Result<Self> {
         match std::env::var(KERNEL_LAYOUT_ENV) {
-            Ok(v) => Self::parse(&v)
-                .ok_or_else(|| Error::Invalid(format!("{KERNEL_LAYOUT_ENV}={v}: {EXPECTED}"))),
+            Ok(v) => {
+                Self::parse(&v).map_err(|e| Error::Invalid(format!("{KERNEL_LAYOUT_ENV}: {e}")))
+            }
             Err(_) if crate::timer::is_gpu(device) => Ok(Self::Gpu),
             Err(_) => Ok(Self::Cpu),
         }
     }
 
-    /// `gpu` or `cpu`, as [`KERNEL_LAYOUT_ENV`] and `shadowgraph bench --layouts` spell it.
-    pub fn parse(name: &str) -> Option<Self> {
+    /// `gpu` or `cpu`, as [`KERNEL_LAYOUT_ENV`] and `shadowgraph bench --layouts` spell it;
+    /// else what is wrong with `name`.
+    pub fn parse(name: &str) -> std::result::Result<Self, String> {
         match name {
-            "gpu" => Some(Self::Gpu),
-            "cpu" => Some(Self::Cpu),
-            _ => None,
+            "gpu" => Ok(Self::Gpu),
+            "cpu" => Ok(Self::Cpu),
+            _ => Err(format!("`{name}`: expected `gpu` or `cpu`")),
         }
     }
 
@@ -74,9 +76,6 @@ impl KernelLayout {
         }
     }
 }
-
-/// What a layout's name must be.
-const EXPECTED: &str = "expected `gpu` or `cpu`";
 
 impl ComputeKernel {
     /// Validates, reflects and compiles `wgsl` in the device's [`KernelLayout`]; errors name
