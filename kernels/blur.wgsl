@@ -35,8 +35,6 @@ const DST_CHANNELS: u32 = 2u; // #channels dst
 // of power-of-two rows as much as the 24 live vec4); on a GPU the taps a run reads fall 4.5× at
 // r = 4 (2 an output against 9), for 24 live values an invocation.
 const RUN: i32 = 8;
-// The GPU layout's row pass sums one run an invocation (shared/blur_pass, `row_stage`).
-const_assert RUN == i32(PER);
 const COL_RUN: i32 = select(RUN, 2, DST_CHANNELS > 2u);
 
 // The run of outputs `o` .. `o + 7` along the line (`vertical`: a constant at each call). The
@@ -179,23 +177,14 @@ fn blur_outputs(b: BlurLine, vertical: bool) {
 
 @compute @workgroup_size(WG_SIZE)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    let b = blur_line(wg.xy, li, u32(select(RUN, COL_RUN, params.axis == 1u)), COL_PER);
+    if !blur_active(b) {
+        return;
+    }
     // The axis tested once, not at every tap (shared/blur_pass's `tap`).
     if params.axis == 1u {
-        let b = blur_line(wg.xy, li, u32(COL_RUN), COL_PER);
-        if blur_active(b) {
-            blur_outputs(b, true);
-        }
-    } else if GPU_LAYOUT {
-        // A row: every invocation stages, sums its one run (PER = RUN; past the map's edge
-        // too, from clamped texels, unwritten) and unstages (shared/blur_pass).
-        let b = blur_line(wg.xy, li, u32(RUN), COL_PER);
-        row_stage(wg.xy, li);
-        blur_run(b, 0, false);
-        row_unstage(wg.xy, li);
+        blur_outputs(b, true);
     } else {
-        let b = blur_line(wg.xy, li, u32(RUN), COL_PER);
-        if blur_active(b) {
-            blur_outputs(b, false);
-        }
+        blur_outputs(b, false);
     }
 }

@@ -1,8 +1,7 @@
 // The first of two passes past the tile's TILE_RADIUS on maps at least 512 texels wide (then
 // `blur` along y), evsm_blur's encoding fused into the blur along x: 512 outputs a workgroup in
-// runs of 2, every invocation busy, its three depth rows packed four to a texel of workgroup
-// memory (shared/encode_blur's ROW_PACKED). A kernel of its own so that `evsm_blur`'s tile
-// compiles no packing (on llvmpipe packing code slowed a tile, benches/RESULTS.md 2026-11-27).
+// runs of 2, every invocation busy. A kernel of its own: `evsm_blur`'s one-row fallback has
+// one output an invocation (256 a workgroup).
 
 // #import shared/evsm_blur_kernel
 

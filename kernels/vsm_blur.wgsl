@@ -13,7 +13,7 @@
 
 // Outputs of a one-row workgroup and the run an invocation sums there (shared/encode_blur):
 // the row pass of maps narrower than `vsm_blur_row`'s 1024-texel rows (which would leave half
-// its invocations idle). Its three depth rows fit one a texel (`ROW_PACKED` false). Keep in
+// its invocations idle). Keep in
 // sync with `encode_blur_row` in src/filter/encode_blur.rs.
 const ROW: u32 = 512u;
 const ROW_RUN: u32 = 2u;

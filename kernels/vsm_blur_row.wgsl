@@ -1,8 +1,7 @@
 // Rasterized depth → variance-shadow-map moments blurred along x, the first of two passes past
 // the tile's TILE_RADIUS (then `blur` along y): 1024 outputs a workgroup in runs of 4, every
-// invocation busy, its three depth rows packed two to a texel of workgroup memory
-// (shared/encode_blur's ROW_PACKED). A kernel of its own so that `vsm_blur`'s tile compiles no
-// packing (on llvmpipe any of it slowed the tile 12–40%, benches/RESULTS.md 2026-11-27).
+// invocation busy. A kernel of its own: `vsm_blur`'s one-row fallback has 512 outputs a
+// workgroup in runs of 2, for maps narrower than 1024 texels.
 
 // #import shared/vsm_blur_kernel
 

@@ -52,10 +52,10 @@ struct Case {
 }
 
 /// An orthographic depth buffer (linear already): smooth ramps with steps, values over
-/// [0, 1], and `bad` NaN / ±Inf texels at distinct places, the first on a tile's edges (the
-/// staged layout's border texels, read by two tiles and counted by one: tile columns and rows
-/// SAT_TILE − 1 and SAT_TILE, and the map's last column and row, where they exist), the rest
-/// at random; with the f64 linear depth (non-finite → 1.0).
+/// [0, 1], and `bad` NaN / ±Inf texels at distinct places, the first on a tile's edges (in
+/// the one-texel border that VSM's moments read around a sub-block: read by two tiles and
+/// counted by one, tile columns and rows SAT_TILE − 1 and SAT_TILE, and the map's last column
+/// and row, where they exist), the rest at random; with the f64 linear depth (non-finite → 1.0).
 fn depth(rng: &mut impl Rng, w: usize, h: usize, bad: usize) -> (Vec<f32>, Texels) {
     let (a, b): (f32, f32) = (rng.random_range(-0.4..0.4), rng.random_range(-0.4..0.4));
     let mut raw: Vec<f32> = (0..w * h)
@@ -108,10 +108,10 @@ fn depth(rng: &mut impl Rng, w: usize, h: usize, bad: usize) -> (Vec<f32>, Texel
 }
 
 /// The tables of `case` on the GPU (every planned texture poisoned first, all bits set), as
-/// raw words, with the plan's step count and each step's non-finite count; in each of the tile
-/// passes' two memory layouts (`exec::KernelLayout`: the depth tile and the table's rows
-/// staged through workgroup memory, as on a GPU, or each sub-block straight from the
-/// textures, as on a CPU driver), which must agree bit for bit, counts included.
+/// raw words, with the plan's step count and each step's non-finite count; in each of the
+/// kernels' two layouts (`exec::KernelLayout`: pass 3's second sweep loading and encoding its
+/// texels again, as on a GPU, or reading the first sweep's kept in private memory, as on a
+/// CPU driver), which must agree bit for bit, counts included.
 fn run(
     g: &Gpu,
     case: &Case,
@@ -119,9 +119,9 @@ fn run(
     coding: SatCoding,
     interleave: u32,
 ) -> (Vec<Vec<u32>>, usize, Vec<u32>) {
-    let staged = run_in(g, case, raw, coding, interleave, KernelLayout::Gpu);
-    let direct = run_in(g, case, raw, coding, interleave, KernelLayout::Cpu);
-    for (m, (a, b)) in staged.0.iter().zip(&direct.0).enumerate() {
+    let recomputed = run_in(g, case, raw, coding, interleave, KernelLayout::Gpu);
+    let kept = run_in(g, case, raw, coding, interleave, KernelLayout::Cpu);
+    for (m, (a, b)) in recomputed.0.iter().zip(&kept.0).enumerate() {
         if let Some(i) = (0..a.len()).find(|&i| a[i] != b[i]) {
             panic!(
                 "{}×{} {:?} interleave {interleave}: table {m}, GPU layout against CPU layout: \
@@ -130,12 +130,12 @@ fn run(
             );
         }
     }
-    assert_eq!(staged.1, direct.1, "steps in the two layouts");
+    assert_eq!(recomputed.1, kept.1, "steps in the two layouts");
     assert_eq!(
-        staged.2, direct.2,
+        recomputed.2, kept.2,
         "non-finite counts, GPU layout against CPU layout"
     );
-    staged
+    recomputed
 }
 
 /// [`run`] in one layout.

@@ -13,7 +13,7 @@ use std::collections::HashMap;
 
 use rand::Rng;
 use shadowgraph::cpu::{self, Texels};
-use shadowgraph::exec::{Executor, KernelLayout};
+use shadowgraph::exec::Executor;
 use shadowgraph::gpu::{read_resource_texture, submit_and_wait, write_texture};
 use shadowgraph::graph::{Graph, plan, texel_bytes};
 use shadowgraph::scene::{Light, Scene};
@@ -72,36 +72,6 @@ fn raw_depth_sized(bad: usize, n: u32) -> Vec<f32> {
 /// Runs `light`'s graph on `raw` for `outputs` (each in its own texture, poisoned with NaN
 /// first so unwritten texels show); returns them and each step's non-finite count.
 fn run(light: &Light, raw: &[f32], outputs: &[String]) -> (Vec<Texels>, Vec<(String, u32)>) {
-    run_in(light, raw, outputs, None)
-}
-
-/// [`run`] in each of the kernels' two memory layouts (`exec::KernelLayout`: a row workgroup's
-/// outputs staged through workgroup memory before they are stored, as on a GPU, or stored
-/// straight, as on a CPU driver), which must agree bit for bit, counts included; returns the
-/// first.
-fn run_both(
-    light: &Light,
-    raw: &[f32],
-    outputs: &[String],
-    what: &str,
-) -> (Vec<Texels>, Vec<(String, u32)>) {
-    let staged = run_in(light, raw, outputs, Some(KernelLayout::Gpu));
-    let direct = run_in(light, raw, outputs, Some(KernelLayout::Cpu));
-    for (k, (a, b)) in staged.0.iter().zip(&direct.0).enumerate() {
-        let what = format!("{what}, {}: GPU layout against CPU layout", outputs[k]);
-        common::assert_same_bits(&what, a, b);
-    }
-    assert_eq!(staged.1, direct.1, "{what}: the layouts' counts");
-    staged
-}
-
-/// [`run`] with the kernels compiled in `layout` (`None`: the device's).
-fn run_in(
-    light: &Light,
-    raw: &[f32],
-    outputs: &[String],
-    layout: Option<KernelLayout>,
-) -> (Vec<Texels>, Vec<(String, u32)>) {
     let n = side(raw);
     let g = common::gpu();
     let mut graph = Graph::default();
@@ -125,9 +95,6 @@ fn run_in(
     write_texture(&g.queue, &depth, bytemuck::cast_slice(raw));
     let imports = HashMap::from([(technique::depth_name(0), depth)]);
     let mut exec = Executor::new();
-    if let Some(layout) = layout {
-        exec.kernels.set_layout(layout);
-    }
     let mut enc = g.device.create_command_encoder(&Default::default());
     let out = exec
         .record(&g.device, &mut enc, &plan, &imports, None)
@@ -418,7 +385,7 @@ fn fused_blurs_match_encode_then_blur() {
     }
 }
 
-/// Runs `light`'s graph for `map` in both kernel layouts ([`run_both`]) and compares it with
+/// Runs `light`'s graph for `map` ([`run`]) and compares it with
 /// `c`'s f64 reference (encoding, then both blur passes at `radius`, σ = r/2) within the
 /// encoding's `tolerance` (atol, rtol) plus the blur's own, and its counts of non-finite
 /// texels with `steps` counting steps.
@@ -433,7 +400,7 @@ fn check_blur(
     steps: usize,
     what: &str,
 ) {
-    let (maps, stats) = run_both(light, raw, &[map.to_string()], what);
+    let (maps, stats) = run(light, raw, &[map.to_string()]);
     let (lin, replaced) = linear(light, raw);
     let want = (c.reference)(&lin, radius.into(), f64::from(radius) / 2.0);
     let got = &maps[0];

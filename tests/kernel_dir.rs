@@ -1,7 +1,7 @@
 //! `SHADOWGRAPH_KERNEL_DIR`: a folder of `.wgsl` files replaces the embedded kernels of the same
 //! names for one process (one build runs kernel variants). The replacement is what runs; a
 //! stray file, a missing folder or broken WGSL is one line and status 1. And
-//! `SHADOWGRAPH_KERNEL_LAYOUT`, which picks the kernels' memory layout: `info` prints it, a bad
+//! `SHADOWGRAPH_KERNEL_LAYOUT`, which picks the kernels' layout (`exec::KernelLayout`): `info` prints it, a bad
 //! value is one line.
 
 use std::ffi::OsStr;

@@ -7,7 +7,7 @@ use std::collections::HashMap;
 
 use rand::Rng;
 use shadowgraph::cpu::{self, Texels};
-use shadowgraph::exec::{Executor, KernelLayout};
+use shadowgraph::exec::Executor;
 use shadowgraph::gpu::{Gpu, read_resource_texture, submit_and_wait, write_texture};
 use shadowgraph::graph::{Graph, SizeRule, plan};
 use shadowgraph::scene::{BlurKernel, Filter};
@@ -37,39 +37,11 @@ fn run(g: &Gpu, graph: &Graph, output: &str, input: wgpu::Texture) -> Texels {
     run_levels(g, graph, output, input).swap_remove(0)
 }
 
-/// [`run`] in each of the kernels' two memory layouts (`exec::KernelLayout`: the blur's row
-/// pass staged through workgroup memory, as on a GPU, or straight from the texture, as on a
-/// CPU driver), which must agree bit for bit; returns the output.
-fn run_both(g: &Gpu, graph: &Graph, output: &str, input: wgpu::Texture, what: &str) -> Texels {
-    let staged = run_layout(g, graph, output, &input, Some(KernelLayout::Gpu)).swap_remove(0);
-    let direct = run_layout(g, graph, output, &input, Some(KernelLayout::Cpu)).swap_remove(0);
-    common::assert_same_bits(
-        &format!("{what}: GPU layout against CPU layout"),
-        &staged,
-        &direct,
-    );
-    staged
-}
-
 /// [`run`], reading back every mip level of the output.
 fn run_levels(g: &Gpu, graph: &Graph, output: &str, input: wgpu::Texture) -> Vec<Texels> {
-    run_layout(g, graph, output, &input, None)
-}
-
-/// [`run_levels`] with the kernels compiled in `layout` (`None`: the device's).
-fn run_layout(
-    g: &Gpu,
-    graph: &Graph,
-    output: &str,
-    input: &wgpu::Texture,
-    layout: Option<KernelLayout>,
-) -> Vec<Texels> {
     let plan = plan(graph, &[output]).expect("plan");
     let mut exec = Executor::new();
-    if let Some(layout) = layout {
-        exec.kernels.set_layout(layout);
-    }
-    let imports = HashMap::from([("in".to_string(), input.clone())]);
+    let imports = HashMap::from([("in".to_string(), input)]);
     let mut enc = g.device.create_command_encoder(&Default::default());
     let first = exec
         .record(&g.device, &mut enc, &plan, &imports, None)
@@ -270,7 +242,7 @@ fn blur_matches_reference_for_each_kernel_and_storage() {
             let (graph, out) = vsm_graph(w, h, format, Some(filter));
             let what = format!("blur {w}x{h} r{radius} {kernel:?} {format:?}");
             let input = upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin);
-            let gpu = run_both(&g, &graph, &out, input, &what);
+            let gpu = run(&g, &graph, &out, input);
             common::assert_close(&what, &channels(&gpu, 2), &expected.data, atol, rtol);
         }
     }
@@ -353,7 +325,7 @@ fn evsm_and_esm_encodings_match_reference() {
             BlurMode::Linear,
         );
         let depth = upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin);
-        let gpu = run_both(&g, &graph, &out, depth, &format!("evsm {format:?}"));
+        let gpu = run(&g, &graph, &out, depth);
         let mut expected = cpu::evsm::evsm(&input, 42.0, 5.0);
         if filter.is_some() {
             expected = cpu::blur::blur(&expected, 3.0, 1.5, BlurKernel::Gaussian);
@@ -405,7 +377,7 @@ fn evsm_and_esm_encodings_match_reference() {
             BlurMode::log_sum_exp(c),
         );
         let depth = upload(&g, w, h, wgpu::TextureFormat::R32Float, &edges);
-        let gpu = run_both(&g, &graph, &out, depth, &format!("esm c={c}"));
+        let gpu = run(&g, &graph, &out, depth);
         let expected = cpu::blur::blur_mode(
             &cpu::esm::esm(&input, f64::from(c)),
             3.0,
@@ -486,7 +458,7 @@ fn msm_encoding_matches_reference_for_each_storage() {
         .to_vec();
         let (graph, out) = encode_graph("msm", params, w, h, format, filter, BlurMode::Linear);
         let depth = upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin);
-        let gpu = run_both(&g, &graph, &out, depth, &format!("msm {format:?}"));
+        let gpu = run(&g, &graph, &out, depth);
         let mut expected = cpu::msm::msm(&input, quantized);
         if filter.is_some() {
             expected = cpu::blur::blur(&expected, 2.0, 1.0, BlurKernel::Gaussian);

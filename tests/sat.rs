@@ -377,18 +377,18 @@ fn fixed_sat_is_bit_identical_to_the_integer_reference() {
     }
 }
 
-/// The tile passes' two memory layouts (`exec::KernelLayout`: pass 3's table rows staged
-/// through workgroup memory, as on a GPU, or each sub-block stored straight, as on a CPU
+/// The kernels' two layouts (`exec::KernelLayout`: pass 3's second sweep loading its texels
+/// again, as on a GPU, or reading the first sweep's kept in private memory, as on a CPU
 /// driver) build the same tables bit for bit, fixed point and f32, one, two and four channels,
 /// ragged tiles and single lines (the references above run the device's layout; this ties the
 /// other to it).
 #[test]
 fn both_layouts_build_the_same_tables() {
     let g = common::gpu();
-    let mut staged = Executor::new();
-    staged.kernels.set_layout(KernelLayout::Gpu);
-    let mut direct = Executor::new();
-    direct.kernels.set_layout(KernelLayout::Cpu);
+    let mut recomputed = Executor::new();
+    recomputed.kernels.set_layout(KernelLayout::Gpu);
+    let mut kept = Executor::new();
+    kept.kernels.set_layout(KernelLayout::Cpu);
     let mut rng = common::rng(76);
     for (i, (w, h)) in [(1, 57), (61, 1), (100, 70), (33, 200)]
         .into_iter()
@@ -401,8 +401,8 @@ fn both_layouts_build_the_same_tables() {
             SatCoding::float([-0.5; 4], [1.0; 4]).unwrap(),
         ];
         for coding in codings {
-            let a = build(&g, &mut staged, &map, &coding).bytes;
-            let b = build(&g, &mut direct, &map, &coding).bytes;
+            let a = build(&g, &mut recomputed, &map, &coding).bytes;
+            let b = build(&g, &mut kept, &map, &coding).bytes;
             let words = |x: &[u8]| bytemuck::cast_slice::<u8, u32>(x).to_vec();
             let (a, b) = (words(&a), words(&b));
             if let Some(k) = (0..a.len()).find(|&k| a[k] != b[k]) {

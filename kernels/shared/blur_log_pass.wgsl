@@ -50,18 +50,13 @@ fn put_x(b: BlurLine, k: i32, v: f32, vertical: bool) {
 // The pass for workgroup `wg`, invocation `li` (the importing kernel's `main`).
 fn blur_log(wg: vec2<u32>, li: u32) {
     let b = blur_line(wg, li, PER, COL_PER);
+    if !blur_active(b) {
+        return;
+    }
     // The axis tested once, not at every tap (shared/blur_pass's `tap`).
     if params.axis == 1u {
-        if blur_active(b) {
-            blur_log_outputs(b, true);
-        }
-    } else if GPU_LAYOUT {
-        // A row: every invocation stages, sums its outputs (past the map's edge too, from
-        // clamped texels, unwritten) and unstages (shared/blur_pass).
-        row_stage(wg, li);
-        blur_log_outputs(b, false);
-        row_unstage(wg, li);
-    } else if blur_active(b) {
+        blur_log_outputs(b, true);
+    } else {
         blur_log_outputs(b, false);
     }
 }

@@ -1,7 +1,7 @@
 // Encode and blur fused (import-only module of `vsm_blur`, `evsm_blur`, `msm_blur`): a workgroup
-// reads its tile of the rasterized depth once, with a halo of r + 1 texels (the blur's r and one
-// more for an encoding that differentiates the depth), linearizes it into workgroup memory,
-// encodes every texel of the tile and halo once (the importing kernel's `encode`), runs the
+// reads its tile of the rasterized depth, with a halo of r + 1 texels (the blur's r and one
+// more for an encoding that differentiates the depth), encodes every texel of the tile and
+// halo once (the importing kernel's `encode`), runs the
 // separable blur along x and then y in workgroup memory, and writes the filtered moments once
 // (Peters, HPG 2017: resolve, two Gaussian passes in shared memory, one write).
 //
@@ -15,11 +15,10 @@
 // texel. Reading the depth at clamped coordinates gives exactly that for `vsm`'s derivatives too:
 // a clamped texel's outward difference is 0, as the border texel's is.
 // Each workgroup counts the non-finite depths of its own outputs, so each is counted once.
-// The depth goes through workgroup memory on a GPU only (`GPU_LAYOUT`, below): there the tile's
-// depths are staged once and each encoding reads its five from workgroup memory; llvmpipe,
-// which gathers workgroup memory a lane at a time, runs the encodings faster reading their five
-// depths straight from the texture (`depth_direct`; the fused blurs 1.0–1.28× faster there,
-// benches/RESULTS.md, 2026-11-27, twelfth session), the same values either way.
+// Each encoding reads its five depths straight from the texture (`depth_direct`), on every
+// device: staging the tile's depth through workgroup memory first made the fused tiles
+// 1.0–1.28× slower on llvmpipe (benches/RESULTS.md, twelfth session) and 1.13–1.20× slower on
+// an H200 (fourteenth session), where the texture cache serves the neighbours' reads.
 //
 // It holds the kernels' entry point, `main`. The importing kernel declares `const CHANNELS`
 // (2 or 4), `struct Params` (its encoding's fields, then `blur: BlurSpec`), `fn encode(z, left, right, up, down) -> vec4<f32>`, the
@@ -27,13 +26,12 @@
 // vec4<f32> for four), `fn texel_of(v: vec4<f32>) -> Texel` and `fn texel_out(t: Texel) ->
 // vec4<f32>` (two channels in vec2s halve the workgroup memory and its traffic), and the tile
 // that memory allows, `const TILE` (outputs per side) and `const SH_TEXELS` (texels of
-// workgroup memory: at least the depth tile at TILE_RADIUS, (TILE + 2·TILE_RADIUS + 2)², and
-// three rows of the fallback, 3·(ROW + 2·MAX_RADIUS + 2): 966 at ROW = 256, or half that
-// packed two depths a texel (`ROW_PACKED`); 16 KiB at most): 24 and 1734 with two channels
+// workgroup memory: at least the encoded tile at TILE_RADIUS, (TILE + 2·TILE_RADIUS)², and
+// the fallback's encoded row, ROW + 2·MAX_RADIUS; 16 KiB at most): 24 and 1734 with two channels
 // (13.5 KiB), 16 and 1024 with four (16 KiB); `const RUN`, the outputs an invocation sums in a
 // tile's blur passes: 4 with two channels, 1 with four (see `run_sums`); and the fallback's row,
 // `const ROW` outputs a workgroup in runs of `const ROW_RUN` an invocation (ROW = ROW_RUN ·
-// WG_SIZE): 1024 in runs of 4 for `vsm_blur_row` (its depth rows packed; see `blur_row_quads`),
+// WG_SIZE): 1024 in runs of 4 for `vsm_blur_row` (see `blur_row_quads`),
 // 512 in runs of 2 for `vsm_blur` (see `blur_row_pairs`), 256 one an invocation with four
 // channels:
 // #completed-by-importer
@@ -67,25 +65,11 @@ const MAX_RADIUS: u32 = 32u;
 // condition, compiled away for a 16² tile: as a run-time test llvmpipe computed the blocks
 // anyway and EVSM4/MSM ran 12–20% slower), and are skipped where the radius leaves them empty
 // (`k·WG_SIZE < n`, the same for the whole workgroup). Workgroup memory (SH_TEXELS, a `Texel`
-// each, one access a tap) holds in turn the depth tile ((TILE + 2·TILE_RADIUS + 2)², or three
-// rows of ROW + 2·MAX_RADIUS + 2), the encoded tile ((TILE + 2·TILE_RADIUS)², or
+// each, one access a tap) holds in turn the encoded tile ((TILE + 2·TILE_RADIUS)², or
 // ROW + 2·MAX_RADIUS) and the horizontal sums.
 
-// The depth tile (in x), then the encoded tile, then the horizontal sums, each over the one
-// before.
+// The encoded tile, then the horizontal sums over it.
 var<workgroup> sh_tile: array<Texel, SH_TEXELS>;
-
-// The memory layout, a pipeline constant the executor sets by device (`exec::KernelLayout`:
-// true on a GPU): the depth staged in workgroup memory (`load_depth`) or read straight
-// (`depth_direct`, below), and a row workgroup's stores. An invocation's run of outputs lies side by
-// side with its neighbours' runs, so storing them straight from its sums puts one store
-// instruction's texels a run apart, a cache sector each (the separable blur's row pass, stored
-// that way, took 3–5× its column pass on an H200: benches/RESULTS.md, 2026-11-27, twelfth
-// session). Under GPU_LAYOUT the sums go through workgroup memory first (`row_store_staged`),
-// and neighbouring invocations store neighbouring texels; llvmpipe, which stores a lane at a
-// time anyway and gathers workgroup memory slowly, stores them straight. The same values
-// either way (`tests/fused.rs` compares both).
-override GPU_LAYOUT: bool = false;
 
 // The most encoded texels a tile holds (at TILE_RADIUS): the blocks of WG_SIZE past the first
 // four are compiled only where a kernel's tile needs them.
@@ -101,7 +85,6 @@ struct Tile {
     outs: vec2<i32>,   // outputs along x and y
     r: vec2<i32>,      // blur radius along x and y (0 along y for a row)
     enc: vec2<i32>,    // encoded extent: outs + 2r
-    dep: vec2<i32>,    // depth extent: enc + 2 (the encoding's neighbours)
     size: vec2<i32>,   // the map
 }
 
@@ -120,7 +103,6 @@ fn tile_of(wg: vec2<u32>) -> Tile {
         t.r = vec2<i32>(i32(min(params.blur.radius, MAX_RADIUS)), 0);
     }
     t.enc = t.outs + 2 * t.r;
-    t.dep = t.enc + 2;
     return t;
 }
 
@@ -142,47 +124,8 @@ fn sh_get(i: i32) -> Texel {
     return sh_tile[i];
 }
 
-// Depths a texel of workgroup memory holds in a packed row: one a channel.
-const DEPTHS: i32 = i32(CHANNELS);
-
-// Whether a row workgroup packs its depths (`vsm_blur_row`): only where its three depth rows
-// at MAX_RADIUS would not fit a depth a texel. A constant false for the other kernels, whose
-// code then has no packing: on llvmpipe, which gathers workgroup memory a lane at a time, any
-// (even behind a uniform test) slowed `vsm_blur`'s tile 12–40% (benches/RESULTS.md).
-const ROW_PACKED: bool = 3u * (ROW + 2u * MAX_RADIUS + 2u) > SH_TEXELS;
-
-// The linear depth at depth-tile index i (`packed`: uniform, a packed row's layout).
-fn sh_depth(i: i32, packed: bool) -> f32 {
-    if packed {
-        return sh_tile[i / DEPTHS][i % DEPTHS];
-    }
-    return sh_tile[i].x;
-}
-
-// Phase 1: the linear depth of the tile, its halo and one texel more, at clamped coordinates
-// (`packed` as `sh_depth`'s).
-fn load_depth(t: Tile, li: u32, packed: bool) {
-    let n = t.dep.x * t.dep.y;
-    for (var i = i32(li); i < n; i += i32(WG_SIZE)) {
-        let yx = div_mod(i, t.dep.x);
-        let p = t.origin - t.r - 1 + vec2<i32>(yx.y, yx.x);
-        let q = clamp(p, vec2<i32>(0), t.size - 1);
-        let raw = textureLoad(src, q, 0).r;
-        let z = linear_depth(raw, params.depth);
-        if packed {
-            sh_tile[i / DEPTHS][i % DEPTHS] = z;
-        } else {
-            sh_tile[i] = texel_of(vec4<f32>(z, 0.0, 0.0, 0.0));
-        }
-        let own = all(p == q) && all(p >= t.origin) && all(p < t.origin + t.outs);
-        if own && !depth_is_finite(raw) {
-            atomicAdd(&stats[0], 1u);
-        }
-    }
-}
-
-// The linear depth at map texel p, clamped to the map, read straight from the texture (the CPU
-// layout's encodings: `encode_at`).
+// The linear depth at map texel p, clamped to the map, read straight from the texture
+// (`encode_at`).
 fn depth_direct(t: Tile, p: vec2<i32>) -> f32 {
     let q = clamp(p, vec2<i32>(0), t.size - 1);
     return linear_depth(textureLoad(src, q, 0).r, params.depth);
@@ -190,35 +133,24 @@ fn depth_direct(t: Tile, p: vec2<i32>) -> f32 {
 
 // The encoding of encoded-tile texel i (clamped to the tile: an invocation past its end computes
 // a texel it does not store, so none branches).
-fn encode_at(t: Tile, i: i32, packed: bool) -> Texel {
+fn encode_at(t: Tile, i: i32) -> Texel {
     let e = min(i, t.enc.x * t.enc.y - 1);
     let yx = div_mod(e, t.enc.x);
-    if !GPU_LAYOUT {
-        // The texel's map position (depth-tile index d below, less the halo of one), its own
-        // non-finite depth counted here as `load_depth` counts it: an output of the tile inside
-        // the map (a ragged tile's texels past it read the border at clamped coordinates), and
-        // not a clamped copy of the last index (i == e).
-        let p = t.origin - t.r + vec2<i32>(yx.y, yx.x);
-        let raw = textureLoad(src, clamp(p, vec2<i32>(0), t.size - 1), 0).r;
-        let own = i == e && all(p >= t.origin) && all(p < min(t.origin + t.outs, t.size));
-        if own && !depth_is_finite(raw) {
-            atomicAdd(&stats[0], 1u);
-        }
-        return texel_of(encode(
-            linear_depth(raw, params.depth),
-            depth_direct(t, p - vec2<i32>(1, 0)),
-            depth_direct(t, p + vec2<i32>(1, 0)),
-            depth_direct(t, p - vec2<i32>(0, 1)),
-            depth_direct(t, p + vec2<i32>(0, 1))
-        ));
+    // The texel's map position, its own non-finite depth counted here: an output of the tile
+    // inside the map (a ragged tile's texels past it read the border at clamped coordinates),
+    // and not a clamped copy of the last index (i == e).
+    let p = t.origin - t.r + vec2<i32>(yx.y, yx.x);
+    let raw = textureLoad(src, clamp(p, vec2<i32>(0), t.size - 1), 0).r;
+    let own = i == e && all(p >= t.origin) && all(p < min(t.origin + t.outs, t.size));
+    if own && !depth_is_finite(raw) {
+        atomicAdd(&stats[0], 1u);
     }
-    let d = (yx.x + 1) * t.dep.x + yx.y + 1;
     return texel_of(encode(
-        sh_depth(d, packed),
-        sh_depth(d - 1, packed),
-        sh_depth(d + 1, packed),
-        sh_depth(d - t.dep.x, packed),
-        sh_depth(d + t.dep.x, packed)
+        linear_depth(raw, params.depth),
+        depth_direct(t, p - vec2<i32>(1, 0)),
+        depth_direct(t, p + vec2<i32>(1, 0)),
+        depth_direct(t, p - vec2<i32>(0, 1)),
+        depth_direct(t, p + vec2<i32>(0, 1))
     ));
 }
 
@@ -229,23 +161,23 @@ fn put_below(i: i32, n: i32, v: Texel) {
     }
 }
 
-// Phase 2: every texel of the tile and its blur halo encoded once, over the depth. The
+// Phase 1: every texel of the tile and its blur halo encoded once. The
 // ENC_PER values an invocation holds are named, not an array: llvmpipe keeps an array indexed
 // in a loop in memory.
-fn encode_tile(t: Tile, li: u32, packed: bool) {
+fn encode_tile(t: Tile, li: u32) {
     let n = t.enc.x * t.enc.y;
     let i = i32(li);
     let s = i32(WG_SIZE);
-    let e0 = encode_at(t, i, packed);
-    let e1 = encode_at(t, i + s, packed);
-    let e2 = encode_at(t, i + 2 * s, packed);
-    let e3 = encode_at(t, i + 3 * s, packed);
+    let e0 = encode_at(t, i);
+    let e1 = encode_at(t, i + s);
+    let e2 = encode_at(t, i + 2 * s);
+    let e3 = encode_at(t, i + 3 * s);
     var e4 = e3;
     var e5 = e3;
     // Constant for each kernel: a 16² tile has no such block, and no code for it.
     if ENC_MAX > 4u * WG_SIZE && 4 * s < n {
-        e4 = encode_at(t, i + 4 * s, packed);
-        e5 = encode_at(t, i + 5 * s, packed);
+        e4 = encode_at(t, i + 4 * s);
+        e5 = encode_at(t, i + 5 * s);
     }
     workgroupBarrier();
     put_below(i, n, e0);
@@ -318,7 +250,7 @@ fn run_sums(first: i32, step: i32, r: i32) -> Run {
     return o;
 }
 
-// Phases 3 and 4 in runs (RUN = 4): along x into workgroup memory (outs.x × enc.y sums, a run an
+// Phases 2 and 3 in runs (RUN = 4): along x into workgroup memory (outs.x × enc.y sums, a run an
 // invocation), then along y into `dst` (outs.x × outs.y outputs, a run down a column an
 // invocation). Invocations past the last run idle through the barriers.
 fn blur_tile_runs(t: Tile, li: u32) {
@@ -375,7 +307,7 @@ fn sum_y(t: Tile, q: i32) {
     store(t, o, v);
 }
 
-// Phases 3 and 4 one output an invocation (RUN = 1): along x into workgroup memory (outs.x ×
+// Phases 2 and 3 one output an invocation (RUN = 1): along x into workgroup memory (outs.x ×
 // enc.y sums, in up to four blocks of WG_SIZE), then along y into `dst` (WG_SIZE at a time).
 fn blur_tile_single(t: Tile, li: u32) {
     let n = t.outs.x * t.enc.y;
@@ -409,16 +341,6 @@ fn blur_tile_single(t: Tile, li: u32) {
         for (var q = i + w; q < t.outs.x * t.outs.y; q += w) {
             sum_y(t, q);
         }
-    }
-}
-
-// GPU_LAYOUT: stores the row's outputs, which every invocation has written into workgroup
-// memory at their x (after a barrier: its taps were read from there), neighbouring invocations
-// on neighbouring texels. Every invocation of the workgroup calls it (it has a barrier).
-fn row_store_staged(t: Tile, li: u32) {
-    workgroupBarrier();
-    for (var j = i32(li); j < t.outs.x; j += i32(WG_SIZE)) {
-        store(t, vec2<i32>(j, 0), sh_tile[j]);
     }
 }
 
@@ -459,15 +381,8 @@ fn blur_row_pairs(t: Tile, li: u32) {
         s0 += w * (l0 + r0);
         s1 += w * (l1 + r1);
     }
-    if GPU_LAYOUT {
-        workgroupBarrier();
-        sh_tile[x] = s0;
-        sh_tile[x + 1] = s1;
-        row_store_staged(t, li);
-    } else {
-        store(t, vec2<i32>(x, 0), s0);
-        store(t, vec2<i32>(x + 1, 0), s1);
-    }
+    store(t, vec2<i32>(x, 0), s0);
+    store(t, vec2<i32>(x + 1, 0), s1);
 }
 
 // The row's blur along x in runs of 4 (ROW = 4·WG_SIZE, `vsm_blur_row`): invocation li's
@@ -524,32 +439,16 @@ fn blur_row_quads(t: Tile, li: u32) {
         s2 += w * (l2 + r2);
         s3 += w * (l3 + r3);
     }
-    if GPU_LAYOUT {
-        workgroupBarrier();
-        sh_tile[x] = s0;
-        sh_tile[x + 1] = s1;
-        sh_tile[x + 2] = s2;
-        sh_tile[x + 3] = s3;
-        row_store_staged(t, li);
-    } else {
-        store(t, vec2<i32>(x, 0), s0);
-        store(t, vec2<i32>(x + 1, 0), s1);
-        store(t, vec2<i32>(x + 2, 0), s2);
-        store(t, vec2<i32>(x + 3, 0), s3);
-    }
+    store(t, vec2<i32>(x, 0), s0);
+    store(t, vec2<i32>(x + 1, 0), s1);
+    store(t, vec2<i32>(x + 2, 0), s2);
+    store(t, vec2<i32>(x + 3, 0), s3);
 }
 
 // The importing kernel's `main`: workgroup `wg`, invocation `li`.
 fn encode_blur(wg: vec2<u32>, li: u32) {
     let t = tile_of(wg);
-    // Uniform; a constant false but in `vsm_blur_row`.
-    let packed = ROW_PACKED && params.blur.axis != 2u;
-    // A constant: the CPU layout's encodings read the depth themselves.
-    if GPU_LAYOUT {
-        load_depth(t, li, packed);
-        workgroupBarrier();
-    }
-    encode_tile(t, li, packed);
+    encode_tile(t, li);
     if params.blur.axis == 2u {
         // A constant condition: each kernel compiles one of the two.
         if RUN == 4u {

@@ -11,20 +11,15 @@
 // #import shared/csm_maps
 // #import shared/linear_depth
 
-// The memory layout of the tile passes, a pipeline constant the executor sets by device
-// (`exec::KernelLayout`: true on a GPU). An invocation's sub-block lies SUB texels from its
-// neighbours', so one load or store instruction of a SIMD group straight from the texture
-// touches texels SUB apart, a cache sector each (the separable blur's row pass, which reads and
-// writes that way, took 3–5× its column pass on an H200: benches/RESULTS.md, 2026-11-27,
-// twelfth session; the table build's tile passes, reading so, ran 3–6× their bandwidth bound
-// there). Under GPU_LAYOUT the depth sources' tile is staged through workgroup memory, loaded
-// with neighbouring invocations on neighbouring texels (shared/sat_tile_texel,
-// `sat_tile_begin`), a stored map's one texel row of every sub-block row at a time
-// (`sat_stage_row`), and pass 3 writes its table the same way through the same memory
-// (shared/sat_tile_scan, `sat_tile_table`). Without it each invocation reads and writes its
-// sub-block straight from the texture, as llvmpipe, whose SIMD lanes gather texel by texel and
-// which gathers workgroup memory slowly, runs fastest. The same sums in the same order either
-// way: tables bit for bit the same (`tests/sat.rs` and `tests/csm_sat.rs` compare both).
+// Whether pass 3's second sweep loads and encodes its texels again (true: a GPU, from its
+// texture cache) or reads the first sweep's encoded texels kept in private memory (false: a CPU
+// driver), a pipeline constant the executor sets by device (`exec::KernelLayout`; see
+// `sat_enc` in shared/sat_tile_scan). Either way an invocation reads and writes its own SUB ×
+// SUB sub-block straight from and to the texture: staging the tile through workgroup memory so
+// that neighbouring lanes touch neighbouring texels made the tables 1.1–2.7× slower on an H200
+// and 1.5–2.5× on llvmpipe (benches/RESULTS.md, 2026-11-27, thirteenth and fourteenth
+// sessions). The same sums in the same order either way: tables bit for bit the same
+// (`tests/sat.rs` and `tests/csm_sat.rs` compare both).
 override GPU_LAYOUT: bool = false;
 
 // Keep in sync with `SAT_TILE` in src/sat/mod.rs.

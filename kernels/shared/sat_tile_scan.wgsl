@@ -34,26 +34,24 @@ var<workgroup> sh_carry: array<vec4<u32>, 64>; // 2 · TILE = WG_SIZE
 // Without GPU_LAYOUT: the sub-block's encoded texels (row-major), kept from the pass's first
 // sweep for its second, which then neither loads nor encodes (MSM's tables 1.1×, CSSM's
 // 1.2× faster on llvmpipe, benches/RESULTS.md, 2026-11-27, thirteenth session). Under it the
-// second sweep encodes again: sixteen four-channel values more an invocation would cost a GPU
-// registers, and what that costs it is not measured.
+// second sweep loads and encodes again, from the texture cache: pass 3 7–13% faster on an
+// H200 than with the kept texels, sixteen four-channel values more an invocation
+// (fourteenth session).
 var<private> sat_enc: array<vec4<u32>, 16>; // SUB · SUB
 
-// Row j of the sub-block at `origin` (invocation li's): its encoded texels prefixed along the
+// Row j of the sub-block at `origin`: its encoded texels prefixed along the
 // row, added to the running column sums `col`, which then hold row j of the sub-block's own
-// inclusive table; `again`: the pass's second sweep. Every invocation calls it (under
-// GPU_LAYOUT a stored source's row j is staged first: it has barriers).
+// inclusive table; `again`: the pass's second sweep.
 fn sat_sweep_row(
     origin: vec2<u32>,
     j: u32,
     p: SatParams,
     fs: bool,
     s: SatSource,
-    li: u32,
     again: bool,
     col: ptr<function, array<vec4<u32>, SUB>>,
 ) {
     let size = textureDimensions(src);
-    sat_stage_row(origin / TILE, j, size, s, li);
     var run = vec4<u32>(0u);
     for (var i = 0u; i < SUB; i++) {
         var e: vec4<u32>;
@@ -95,12 +93,14 @@ fn sat_tile_prepare(
     } else {
         sh_carry[li] = textureLoad(col_carry, vec2<u32>(q.x, s.band.y + tile.y), 0);
     }
-    // The sub-block's values that both sweeps read (shared/sat_tile_texel; the blocked sources'
-    // or, under GPU_LAYOUT, every depth source's).
-    sat_tile_begin(tile, origin, size, s, li);
+    // A literal condition: only the VSM and ESM sources' kernels compile it (both sweeps read
+    // the block).
+    if sat_blocked(s) {
+        sat_block_fill(origin, size, s);
+    }
     var col: array<vec4<u32>, SUB>;
     for (var j = 0u; j < SUB; j++) {
-        sat_sweep_row(origin, j, p, fs, s, li, false, &col);
+        sat_sweep_row(origin, j, p, fs, s, false, &col);
         if a < SIDE {
             sh_right[(b * SUB + j) * SIDE + a] = col[SUB - 1u];
         }
@@ -160,9 +160,7 @@ fn sat_row_add(fs: bool, li: u32, j: u32) -> vec4<u32> {
 
 // Pass 3 for tile `tile`: its table with the carries of band `s.band`, every texel inside the
 // map handed to the importer's `sat_store(slot, q, v)`. Every invocation calls it (it has
-// barriers). Under GPU_LAYOUT each texel row j of the sub-blocks (tile rows b·SUB + j, one a
-// sub-block row) goes through workgroup memory and is stored with neighbouring invocations on
-// neighbouring texels.
+// barriers).
 fn sat_tile_table(p: SatParams, fs: bool, s: SatSource, tile: vec2<u32>, li: u32, slot: u32) {
     var col_add: array<vec4<u32>, SUB>;
     sat_tile_prepare(col_carry, row_carry, p, fs, s, tile, li, &col_add);
@@ -170,40 +168,13 @@ fn sat_tile_table(p: SatParams, fs: bool, s: SatSource, tile: vec2<u32>, li: u32
     let size = textureDimensions(src);
     var col: array<vec4<u32>, SUB>;
     for (var j = 0u; j < SUB; j++) {
-        sat_sweep_row(origin, j, p, fs, s, li, true, &col);
+        sat_sweep_row(origin, j, p, fs, s, true, &col);
         let row_add = sat_row_add(fs, li, j);
-        if !GPU_LAYOUT {
-            for (var i = 0u; i < SUB; i++) {
-                let q = origin + vec2<u32>(i, j);
-                if all(q < size) {
-                    sat_store(slot, q, sat_sum(sat_sum(col[i], row_add, fs), col_add[i], fs));
-                }
+        for (var i = 0u; i < SUB; i++) {
+            let q = origin + vec2<u32>(i, j);
+            if all(q < size) {
+                sat_store(slot, q, sat_sum(sat_sum(col[i], row_add, fs), col_add[i], fs));
             }
-        } else {
-            // Into the stage that a stored source's row j was read from (`sat_sweep_row`):
-            // after every invocation has read it, and stored from after every invocation has
-            // written its sums.
-            workgroupBarrier();
-            for (var i = 0u; i < SUB; i++) {
-                let sum = sat_sum(sat_sum(col[i], row_add, fs), col_add[i], fs);
-                for (var c = 0u; c < 4u; c++) {
-                    sh_stage[stage_row_slot(c, li / GRID, li % GRID * SUB + i)] = sum[c];
-                }
-            }
-            workgroupBarrier();
-            for (var k = li; k < STAGE_ROWS * TILE; k += WG_SIZE) {
-                let r = k / TILE;
-                let x = k % TILE;
-                let q = tile * TILE + vec2<u32>(x, r * SUB + j);
-                if all(q < size) {
-                    var v: vec4<u32>;
-                    for (var c = 0u; c < 4u; c++) {
-                        v[c] = sh_stage[stage_row_slot(c, r, x)];
-                    }
-                    sat_store(slot, q, v);
-                }
-            }
-            workgroupBarrier();
         }
     }
 }

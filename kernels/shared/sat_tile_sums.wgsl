@@ -29,15 +29,16 @@ fn sat_tile_edges(
     let b = li / GRID;
     let size = textureDimensions(src);
     let origin = sat_sub_origin(tile, li);
-    // The sub-block's values that the sweep reads (shared/sat_tile_texel; the blocked sources'
-    // or, under GPU_LAYOUT, every depth source's).
-    sat_tile_begin(tile, origin, size, s, li);
+    // A literal condition: only the VSM and ESM sources' kernels compile it (the sweep reads
+    // the block).
+    if sat_blocked(s) {
+        sat_block_fill(origin, size, s);
+    }
     // Row sums prefixed down the sub-block (its table's last column), and column sums, then
     // prefixed along it (its last row).
     var down = vec4<u32>(0u);
     var col: array<vec4<u32>, SUB>;
     for (var j = 0u; j < SUB; j++) {
-        sat_stage_row(tile, j, size, s, li);
         var row = vec4<u32>(0u);
         for (var i = 0u; i < SUB; i++) {
             let e = sat_texel(origin + vec2<u32>(i, j), size, p, fs, s);

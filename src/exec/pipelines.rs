@@ -26,22 +26,26 @@ pub struct ComputeKernel {
 pub const KERNEL_LAYOUT_ENV: &str = "SHADOWGRAPH_KERNEL_LAYOUT";
 
 /// The pipeline constant a kernel declares (`override GPU_LAYOUT: bool`) where it has two
-/// memory layouts.
+/// layouts.
 pub const GPU_LAYOUT_CONSTANT: &str = "GPU_LAYOUT";
 
-/// Which of its two memory layouts a kernel that has two compiles (`override GPU_LAYOUT:
-/// bool`: the blur's row pass, `kernels/shared/blur_pass.wgsl`; the fused blurs' rows,
-/// `shared/encode_blur.wgsl`; the summed-area tables' tile passes, `shared/sat_tile*.wgsl`). A
-/// GPU coalesces a SIMD group's loads and stores only where its lanes touch neighbouring
-/// texels, which those kernels get by staging their texels through workgroup memory; llvmpipe's
-/// lanes gather texel by texel anyway, and its workgroup memory is slow, so there they read and
-/// write the texture in runs or blocks. Both layouts give the same results bit for bit
-/// (`tests/prefilter.rs`, `tests/fused.rs`, `tests/sat.rs`, `tests/csm_sat.rs`).
+/// Which of its two variants a kernel that has two compiles (`override GPU_LAYOUT: bool`): today
+/// the summed-area tables' pass 3 (`kernels/shared/sat_tile*.wgsl`), whose second sweep over an
+/// invocation's sub-block loads and encodes its texels again on a GPU (from its texture cache:
+/// 7–13% faster on an H200 than keeping them) and reads the first sweep's encoded texels kept in
+/// private memory on a CPU driver (1.1–1.2× faster on llvmpipe). Both give the same tables bit
+/// for bit (`tests/sat.rs`, `tests/csm_sat.rs`).
+///
+/// Variants that staged texels through workgroup memory so that a SIMD group's lanes touch
+/// neighbouring texels (the blur's row pass, the fused blurs, the tables' tile passes) were
+/// slower on the H200 than each invocation reading its own run or block straight, 1.1–2.7×,
+/// and their workgroup memory, declared in both variants, slowed the straight one too
+/// (`benches/RESULTS.md`, 2026-11-27, fourteenth session): they are gone.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum KernelLayout {
-    /// Neighbouring lanes on neighbouring texels (`GPU_LAYOUT = true`).
+    /// A GPU's (`GPU_LAYOUT = true`): recompute from the texture cache.
     Gpu,
-    /// Each invocation's run straight from the texture (`GPU_LAYOUT = false`).
+    /// A CPU driver's (`GPU_LAYOUT = false`): keep in private memory.
     Cpu,
 }
 
