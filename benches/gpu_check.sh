@@ -1,21 +1,20 @@
 #!/bin/bash
 # The device checks to run first when a GPU is lent: the figures issues 14 (soft shading, the
-# shading pass's floor, table build) and 15 (kernels against a texture copy, the blur's two
-# row layouts) are measured by, in one call. From the repository root, after
+# shading pass's floor, table build) and 15 (kernels against a texture copy) are measured by,
+# in one call. From the repository root, after
 # `cargo build --release`:
 #
 #   benches/gpu_check.sh [BINARY] [OUT]     # defaults: target/release/shadowgraph, gpu-out
 #
-# On an H200 (2026-11-27) the steps took: soft table 76 s, shade floor 7 × 13 s, each 2048²
-# kernel round 13 s, the 2048² table 23 s, each 4096²/8192² round 127 s; with the layouts'
-# rounds (untimed on a GPU: two of the blurs at 2048² and 4096², two of the tables at 2048²,
-# each case in both layouts) about 480 s, then (if time is left) the fused blurs' ablation,
-# 3 × about 10 s: give the call 560 s.
+# On an H200 (2026-11-27, fourteenth session) the steps took: soft table 66 s, shade floor
+# 8 × 12 s, the tables' two layouts 2 × 18 s, every kernel at 2048² 20 s, 4096²/8192² 123 s,
+# the fused blurs' ablation 3 × 9 s: about 370 s, with BASE about 60 s more. Give the call
+# 480 s.
 # The steps run most wanted first, each under its own time box, and append to at most seven
 # files in OUT (the device tool brings back eight), so a call stopped by its time box still
 # returns what ran. A second binary to compare against goes in as BASE=path/to/other/shadowgraph:
-# its 2048² blur rows are then timed alternately with BINARY's (compare timings only within
-# one call). Record the results in benches/RESULTS.md (device, date, commit, command, table).
+# its 2048² blur and table rows are then timed alternately with BINARY's (compare timings
+# only within one call). Record the results in benches/RESULTS.md (device, date, commit, command, table).
 set -u
 B=${1:-target/release/shadowgraph}
 OUT=${2:-gpu-out}
@@ -74,7 +73,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let xy = id.xy;'
 mkdir -p "$V/shipped" "$V/empty" "$V/no_lookup" "$V/gbuffer_only" "$V/store_only" \
-    "$V/wg16" "$V/store_only_wg16"
+    "$V/wg16" "$V/store_only_wg16" "$V/wg16x4"
 cp "$S" "$V/shipped/shade.wgsl"
 # Nothing a pixel (the same 32 400 workgroups, each invocation testing its bounds and
 # returning): the pass's own cost, its transitions and launch (the twelfth session's `no_srgb`
@@ -103,35 +102,35 @@ sed 's/let v = light_visibility(i, gp.xyz, n, dp.dpdx, dp.dpdy);/let v = 1.0;/' 
 sed 's/^const WG_SIZE: u32 = 8u;/const WG_SIZE: u32 = 16u;/' "$S" >"$V/wg16/shade.wgsl"
 sed 's/^const WG_SIZE: u32 = 8u;/const WG_SIZE: u32 = 16u;/' "$V/store_only/shade.wgsl" \
     >"$V/store_only_wg16/shade.wgsl"
-for v in no_lookup wg16; do
+# 16 × 4 (64 invocations, as 8 × 8, on rows twice as long): store_only ran 0.058 ms in 8 × 8
+# workgroups and 0.025 in 16 × 16, but the shipped kernel slower in 16 × 16 (0.112 against
+# 0.094, twelfth session).
+sed 's/^@compute @workgroup_size(WG_SIZE, WG_SIZE)$/@compute @workgroup_size(16, 4)/' "$S" \
+    >"$V/wg16x4/shade.wgsl"
+for v in no_lookup wg16 wg16x4; do
     edited "$S" "$V/$v/shade.wgsl"
 done
 edited "$V/store_only/shade.wgsl" "$V/store_only_wg16/shade.wgsl"
-for v in shipped empty no_lookup gbuffer_only store_only wg16 store_only_wg16; do
+for v in shipped empty no_lookup gbuffer_only store_only wg16 store_only_wg16 wg16x4; do
     echo "## variant $v" >>"$OUT/shade.txt"
     SHADOWGRAPH_KERNEL_DIR="$V/$v" step shade.txt 40 "$B" bench --lookup 3 --repeat 20 \
         --image 1920x1080 --map 2048 --only hard
 done
-# Issue 15: the kernels' two memory layouts (exec::KernelLayout) in one process each round,
-# every case in both side by side (`bench --layouts`), the order swapped in the second round:
-# `gpu` (the default on a GPU) stages the separable blur's rows and the fused row kernels'
-# outputs through workgroup memory, `cpu` reads and stores them in runs straight (the layout
-# timed on 2026-11-27), at 2048² and 4096²; then the table build's tile passes at 2048²
-# (issue 14's ≤ 0.2 ms): `gpu` stages the depth tile, a stored map's rows and pass 3's table
-# rows, `cpu` reads and writes each invocation's 4 × 4 sub-block straight (twelfth session:
-# tile sums 0.109, tables 0.170 ms for `chain vssm`).
-for order in cpu,gpu gpu,cpu; do
-    step layouts.txt 120 "$B" bench --sizes 2048,4096 --repeat 20 \
-        --only 'blur rg32f,blur log,+blur r4 (old),blur r32' --passes --layouts "$order"
-done
+# Issue 14's table build at 2048² (≤ 0.2 ms) in the kernels' two layouts (exec::KernelLayout)
+# in one process each round, every case in both side by side (`bench --layouts`), the order
+# swapped in the second round: `gpu` (the default on a GPU) loads and encodes pass 3's texels
+# again, `cpu` keeps the first sweep's (fourteenth session: `chain vssm` 0.313 against 0.336
+# ms).
 for order in cpu,gpu gpu,cpu; do
     step layouts.txt 60 "$B" bench --sizes 2048 --repeat 20 \
         --only 'sat,chain vssm,chain msm_soft,chain esm,chain cssm' --passes --layouts "$order"
 done
 if [ -n "$BASE" ]; then
     for round in 1 2; do
-        step layouts.txt 40 "$BASE" bench --sizes 2048 --repeat 20 --only blur --passes
-        step layouts.txt 40 "$B" bench --sizes 2048 --repeat 20 --only blur --passes
+        for b in "$BASE" "$B"; do
+            step layouts.txt 40 "$b" bench --sizes 2048 --repeat 20 \
+                --only 'blur,sat fixed,chain vssm,chain msm_soft' --passes
+        done
     done
 fi
 # Every kernel at 2048² by dispatch (the soft tables' build: issue 14's ≤ 0.2 ms at 2048²,
@@ -140,8 +139,9 @@ step kernels_2048.txt 60 "$B" bench --sizes 2048 --repeat 20 --passes
 step kernels_large.txt 150 "$B" bench --sizes 4096,8192 --repeat 20 --only chain,blur,mips,sat --passes
 # Where the fused tile blurs' time goes (they ran at 0.26-0.30x their copy on the H200, 3x
 # their bytes' time): the shipped kernels beside variants of kernels/shared/encode_blur.wgsl
-# whose tiles store their encoded centres unblurred (`no_blur`: load, encode, store) and their
-# depth unencoded too (`no_encode`: load and store, the tile's halo included). Timings only:
+# whose tiles store their encoded centres unblurred (`no_blur`: load, encode, store) and
+# store without loading or encoding (`no_encode`: the stores alone, of workgroup memory's
+# stale contents). Timings only:
 # the variants' outputs are not the filter's.
 E=kernels/shared/encode_blur.wgsl
 UNBLURRED='            for (var k = i32(li); k < t.outs.x * t.outs.y; k += i32(WG_SIZE)) {
@@ -152,7 +152,7 @@ mkdir -p "$V/fused_shipped/shared" "$V/fused_no_blur/shared" "$V/fused_no_encode
 cp "$E" "$V/fused_shipped/shared/encode_blur.wgsl"
 awk -v body="$UNBLURRED" '/^            blur_tile_(runs|single)\(t, li\);$/ { print body; next } { print }' \
     "$E" >"$V/fused_no_blur/shared/encode_blur.wgsl"
-sed 's/^    encode_tile(t, li, packed);$/    workgroupBarrier();/' "$V/fused_no_blur/shared/encode_blur.wgsl" \
+sed 's/^    encode_tile(t, li);$/    workgroupBarrier();/' "$V/fused_no_blur/shared/encode_blur.wgsl" \
     >"$V/fused_no_encode/shared/encode_blur.wgsl"
 edited "$E" "$V/fused_no_blur/shared/encode_blur.wgsl"
 edited "$V/fused_no_blur/shared/encode_blur.wgsl" "$V/fused_no_encode/shared/encode_blur.wgsl"
