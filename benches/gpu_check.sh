@@ -7,9 +7,9 @@
 #   benches/gpu_check.sh [BINARY] [OUT]     # defaults: target/release/shadowgraph, gpu-out
 #
 # On an H200 (2026-11-27, fourteenth session) the steps took: soft table 66 s, shade floor
-# 8 × 12 s, the tables' two layouts 2 × 18 s, every kernel at 2048² 20 s, 4096²/8192² 123 s,
-# the fused blurs' ablation 3 × 9 s: about 370 s, with BASE about 60 s more. Give the call
-# 480 s.
+# about 12 s a variant with `hard` alone (8 variants, four of them with `vssm` too, perhaps
+# 20 s), the tables' two layouts 2 × 18 s, every kernel at 2048² 20 s, 4096²/8192² 123 s, the
+# fused blurs' ablation 3 × 9 s: about 400 s, with BASE about 60 s more. Give the call 480 s.
 # The steps run most wanted first, each under its own time box, and append to at most seven
 # files in OUT (the device tool brings back eight), so a call stopped by its time box still
 # returns what ran. A second binary to compare against goes in as BASE=path/to/other/shadowgraph:
@@ -73,7 +73,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let xy = id.xy;'
 mkdir -p "$V/shipped" "$V/empty" "$V/no_lookup" "$V/gbuffer_only" "$V/store_only" \
-    "$V/wg16" "$V/store_only_wg16" "$V/wg16x4"
+    "$V/wg16x4" "$V/tx2" "$V/tx4"
 cp "$S" "$V/shipped/shade.wgsl"
 # Nothing a pixel (the same 32 400 workgroups, each invocation testing its bounds and
 # returning): the pass's own cost, its transitions and launch (the twelfth session's `no_srgb`
@@ -97,24 +97,24 @@ sed 's/let v = light_visibility(i, gp.xyz, n, dp.dpdx, dp.dpdy);/let v = 1.0;/' 
     printf '%s\n' "$MAIN"
     printf '    textureStore(out_color, xy, vec4<f32>(0.5, 0.5, 0.5, 1.0));\n}\n'
 } >"$V/store_only/shade.wgsl"
-# 16 × 16 workgroups instead of 8 × 8 (the dispatch follows the reflected size): is the floor
-# the launch of 32 400 workgroups of 64 invocations at 1080p, each with little to do?
-sed 's/^const WG_SIZE: u32 = 8u;/const WG_SIZE: u32 = 16u;/' "$S" >"$V/wg16/shade.wgsl"
-sed 's/^const WG_SIZE: u32 = 8u;/const WG_SIZE: u32 = 16u;/' "$V/store_only/shade.wgsl" \
-    >"$V/store_only_wg16/shade.wgsl"
-# 16 × 4 (64 invocations, as 8 × 8, on rows twice as long): store_only ran 0.058 ms in 8 × 8
-# workgroups and 0.025 in 16 × 16, but the shipped kernel slower in 16 × 16 (0.112 against
-# 0.094, twelfth session).
+# Fewer workgroups (fourteenth session: an empty 8 × 8 kernel over 1080p 0.040 ms of `hard`'s
+# 0.066, a constant store 0.058 in 8 × 8 and 0.025 in 16 × 16 workgroups, but the shipped
+# kernel slower in 16 × 16, 0.112 against 0.094): 16 × 4 (64 invocations on rows twice as
+# long), and 2 or 4 pixels an invocation along its row (`TEXELS_X`: the dispatch follows).
 sed 's/^@compute @workgroup_size(WG_SIZE, WG_SIZE)$/@compute @workgroup_size(16, 4)/' "$S" \
     >"$V/wg16x4/shade.wgsl"
-for v in no_lookup wg16 wg16x4; do
+sed 's/^const TEXELS_X: u32 = 1u;$/const TEXELS_X: u32 = 2u;/' "$S" >"$V/tx2/shade.wgsl"
+sed 's/^const TEXELS_X: u32 = 1u;$/const TEXELS_X: u32 = 4u;/' "$S" >"$V/tx4/shade.wgsl"
+for v in no_lookup wg16x4 tx2 tx4; do
     edited "$S" "$V/$v/shade.wgsl"
 done
-edited "$V/store_only/shade.wgsl" "$V/store_only_wg16/shade.wgsl"
-for v in shipped empty no_lookup gbuffer_only store_only wg16 store_only_wg16 wg16x4; do
+# `vssm` beside `hard` where the whole pass is kept (issue 14's ratio with each shape).
+for v in shipped empty no_lookup gbuffer_only store_only wg16x4 tx2 tx4; do
+    only=hard
+    case $v in shipped | wg16x4 | tx2 | tx4) only=hard,vssm ;; esac
     echo "## variant $v" >>"$OUT/shade.txt"
     SHADOWGRAPH_KERNEL_DIR="$V/$v" step shade.txt 40 "$B" bench --lookup 3 --repeat 20 \
-        --image 1920x1080 --map 2048 --only hard
+        --image 1920x1080 --map 2048 --only "$only"
 done
 # Issue 14's table build at 2048² (≤ 0.2 ms) in the kernels' two layouts (exec::KernelLayout)
 # in one process each round, every case in both side by side (`bench --layouts`), the order

@@ -44,6 +44,13 @@ struct Frame {
 // #generated
 
 const WG_SIZE: u32 = 8u;
+// Pixels an invocation shades along a row, WG_SIZE apart, so that neighbouring lanes stay on
+// neighbouring pixels (`kernels::TEXELS_X_CONSTANT`: the dispatch covers WG_SIZE · TEXELS_X
+// columns a workgroup). On an H200 a kernel that only tests its bounds costs 0.040 ms over
+// 1080p in 8 × 8 workgroups, most of `hard`'s 0.066 (benches/RESULTS.md, 2026-11-27,
+// fourteenth session): fewer workgroups are the candidate, to be measured there
+// (`benches/gpu_check.sh`'s tx2 and tx4 variants).
+const TEXELS_X: u32 = 1u;
 
 fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
     let x = clamp(c, vec3<f32>(0.0), vec3<f32>(1.0));
@@ -87,11 +94,17 @@ fn cone(l: Light, p: vec3<f32>) -> f32 {
 }
 
 @compute @workgroup_size(WG_SIZE, WG_SIZE)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    if any(id.xy >= frame.size) {
-        return;
+fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>) {
+    for (var k = 0u; k < TEXELS_X; k++) {
+        let xy = vec2<u32>((wg.x * TEXELS_X + k) * WG_SIZE + lid.x, wg.y * WG_SIZE + lid.y);
+        if all(xy < frame.size) {
+            shade_pixel(xy);
+        }
     }
-    let xy = id.xy;
+}
+
+// Pixel xy's colour and visibilities.
+fn shade_pixel(xy: vec2<u32>) {
     let base = (xy.y * frame.size.x + xy.x) * frame.light_count;
     let gp = textureLoad(g_position, xy, 0);
     if gp.w == 0.0 {

@@ -216,11 +216,29 @@ pub struct Reflection {
     pub bindings: Vec<Binding>,
     /// `@workgroup_size` of the compute entry point `main`, if there is one.
     pub workgroup_size: Option<[u32; 3]>,
+    /// Texels an invocation of `main` covers along x ([`TEXELS_X_CONSTANT`]; 1 where the
+    /// kernel declares none): a workgroup covers `workgroup_size[0] · texels_x` columns.
+    pub texels_x: u32,
     /// Shader stages of the entry points.
     pub stages: wgpu::ShaderStages,
 }
 
+/// The constant (`const TEXELS_X: u32`) by which a compute kernel says that each invocation of
+/// `main` covers that many texels along x, `@workgroup_size`'s x apart (`kernels/shade.wgsl`:
+/// pixels a lane shades). The dispatch ([`Reflection::groups_for`]) follows it.
+pub const TEXELS_X_CONSTANT: &str = "TEXELS_X";
+
+/// The most texels along x a kernel may give an invocation ([`TEXELS_X_CONSTANT`]).
+pub const MAX_TEXELS_X: u32 = 64;
+
 impl Reflection {
+    /// Workgroups of `main` covering a `w × h` texel grid: `workgroup_size[0] · texels_x`
+    /// columns and `workgroup_size[1]` rows a workgroup.
+    pub fn groups_for(&self, w: u32, h: u32) -> [u32; 3] {
+        let wg = self.workgroup_size.unwrap_or([1, 1, 1]);
+        [w.div_ceil(wg[0] * self.texels_x), h.div_ceil(wg[1]), 1]
+    }
+
     /// The binding named `name`.
     pub fn binding(&self, name: &str) -> Option<&Binding> {
         self.bindings.iter().find(|b| b.name == name)
@@ -327,14 +345,38 @@ pub fn reflect(kernel: &str, wgsl: &str) -> Result<(naga::Module, Reflection)> {
             _ => {}
         }
     }
+    let texels_x = texels_x(kernel, &module)?;
     Ok((
         module,
         Reflection {
             bindings,
             workgroup_size,
+            texels_x,
             stages,
         },
     ))
+}
+
+/// `kernel`'s [`TEXELS_X_CONSTANT`]: 1 if it declares none, else a u32 in 1..=[`MAX_TEXELS_X`].
+fn texels_x(kernel: &str, module: &naga::Module) -> Result<u32> {
+    let Some((_, c)) = module
+        .constants
+        .iter()
+        .find(|(_, c)| c.name.as_deref() == Some(TEXELS_X_CONSTANT))
+    else {
+        return Ok(1);
+    };
+    match module.global_expressions[c.init] {
+        naga::Expression::Literal(naga::Literal::U32(n)) if (1..=MAX_TEXELS_X).contains(&n) => {
+            Ok(n)
+        }
+        _ => Err(Error::Kernel {
+            kernel: kernel.to_string(),
+            message: format!(
+                "`const {TEXELS_X_CONSTANT}` must be a u32 literal in 1..={MAX_TEXELS_X}"
+            ),
+        }),
+    }
 }
 
 /// The texture globals that some `textureSample*` without a depth reference reads, directly or

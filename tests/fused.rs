@@ -417,8 +417,8 @@ fn check_blur(
 }
 
 /// The row kernels past the tile's radius 7 on a map wide enough for them (1100²:
-/// `vsm_blur_row`, 1024 outputs a workgroup in runs of 4, its depth rows packed two to a texel;
-/// `evsm_blur_row` and `msm_blur_row`, 512 in runs of 2, packed four to a texel; the last row
+/// `vsm_blur_row`, 1024 outputs a workgroup in runs of 4; `evsm_blur_row` and `msm_blur_row`,
+/// 512 in runs of 2; the last row
 /// workgroup of each row ragged, clipped to the map), then `blur`'s vertical pass, at radius 12
 /// and 32, VSM and EVSM2 in f32 and f16 (packed), EVSM4 and MSM in f32, against the f64 encoding
 /// then both blur passes; tolerances as `fused_blurs_match_encode_then_blur`'s (whose 300² map

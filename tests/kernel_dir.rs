@@ -95,6 +95,40 @@ fn a_replaced_kernel_is_the_one_that_runs() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// The shading kernel with each invocation shading 2 or 7 pixels along its row (`TEXELS_X`,
+/// the dispatch narrowed to match; 7 leaves the last workgroup of every row ragged on the 480-
+/// pixel-wide image) renders the embedded kernel's image pixel for pixel (a variant whose
+/// invocations skip the wrong columns, `wg.x + k` for `wg.x · TEXELS_X + k`, differs).
+#[test]
+fn shading_several_pixels_an_invocation_renders_the_same() {
+    let shade = kernels::source("shade").expect("embedded shade");
+    let one = "const TEXELS_X: u32 = 1u;\n";
+    assert!(shade.contains(one), "shade.wgsl's TEXELS_X moved");
+    let dir = temp_dir("texels");
+    let png = dir.join("embedded.png");
+    let o = render(None, &png);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let want = image::open(&png).expect("png").to_rgba8();
+    for n in [2, 7] {
+        let variant = dir.join(format!("x{n}"));
+        std::fs::create_dir_all(&variant).unwrap();
+        let src = shade.replace(one, &format!("const TEXELS_X: u32 = {n}u;\n"));
+        std::fs::write(variant.join("shade.wgsl"), src).unwrap();
+        let png = dir.join(format!("x{n}.png"));
+        let o = render(Some(&variant), &png);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let got = image::open(&png).expect("png").to_rgba8();
+        assert_eq!(got.dimensions(), want.dimensions());
+        let differ = got
+            .pixels()
+            .zip(want.pixels())
+            .filter(|(a, b)| a != b)
+            .count();
+        assert_eq!(differ, 0, "TEXELS_X = {n}: {differ} pixels differ");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Files are named by their path below the folder (`shared/` for modules); anything else is
 /// refused by name.
 #[test]

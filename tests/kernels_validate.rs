@@ -275,6 +275,56 @@ fn compute_kernels_reflect_bindings_and_workgroup_size() {
     ));
 }
 
+/// `const TEXELS_X` (texels an invocation covers along x) widens a workgroup's columns in the
+/// dispatch, exactly; without it a workgroup covers its `@workgroup_size`; a value that is not a
+/// u32 literal in 1..=64 is refused by name. Only the shading kernel declares it (the graph's
+/// kernels size their dispatches by their nodes' own geometry, which does not read it).
+#[test]
+fn texels_x_widens_the_dispatch() {
+    let kernel = |decl: &str| {
+        format!(
+            "{decl}\n@group(0) @binding(0) var dst: texture_storage_2d<r32float, write>;\n\
+             @compute @workgroup_size(8, 4)\nfn main(@builtin(global_invocation_id) id: vec3<u32>) {{\n\
+             textureStore(dst, id.xy, vec4<f32>(1.0));\n}}\n"
+        )
+    };
+    let groups = |decl: &str| {
+        let (_, r) = kernels::reflect("t", &kernel(decl)).expect("reflect");
+        (r.texels_x, r.groups_for(100, 17))
+    };
+    assert_eq!(groups(""), (1, [13, 5, 1]));
+    assert_eq!(groups("const TEXELS_X: u32 = 1u;"), (1, [13, 5, 1]));
+    // 100 columns in workgroups of 8 · 4 = 32: 4; 17 rows in 4s: 5.
+    assert_eq!(groups("const TEXELS_X: u32 = 4u;"), (4, [4, 5, 1]));
+    assert_eq!(groups("const TEXELS_X: u32 = 64u;"), (64, [1, 5, 1]));
+    for bad in [
+        "const TEXELS_X: u32 = 0u;",
+        "const TEXELS_X: u32 = 65u;",
+        "const TEXELS_X: f32 = 2.0;",
+    ] {
+        let e = kernels::reflect("t", &kernel(bad)).unwrap_err().to_string();
+        assert!(e.contains("TEXELS_X") && e.contains("1..=64"), "{bad}: {e}");
+    }
+    for name in SOURCES
+        .iter()
+        .map(|s| s.name)
+        .filter(|n| !n.starts_with("shared/"))
+    {
+        // The shading kernel resolves only with its generated block; every other kernel does.
+        let Ok(wgsl) = kernels::resolve(name, None) else {
+            assert_eq!(name, "shade");
+            continue;
+        };
+        let (module, r) = kernels::reflect(name, &wgsl).expect("reflect");
+        assert_eq!(
+            wgsl_const(&module, "TEXELS_X"),
+            None,
+            "{name} declares TEXELS_X"
+        );
+        assert_eq!(r.texels_x, 1, "{name}");
+    }
+}
+
 #[test]
 fn missing_import_and_missing_block_are_named_errors() {
     assert!(kernels::resolve("nonexistent", None).is_err());
@@ -709,27 +759,25 @@ fn encode_blur_dispatch_constants_match_the_wgsl() {
                 assert!(tile * enc <= 4 * wg, "{name}: horizontal sums");
             }
         }
-        // Workgroup memory: the depth tile with its halo, the fallback's three rows (packed
-        // `channels` depths a texel where one a texel would not fit: `ROW_PACKED`), and the
-        // encoded row.
+        // Workgroup memory: the encoded tile with its halo and the fallback's encoded row
+        // (each encoding reads its depths straight from the texture), no more.
         let sh = wgsl_const(&module, "SH_TEXELS").expect("SH_TEXELS");
         let max_radius = wgsl_const(&module, "MAX_RADIUS").expect("MAX_RADIUS");
-        let dep = enc + 2;
-        let rows = 3 * (row + 2 * max_radius + 2);
-        let packed = rows > sh;
+        let widest_row = [
+            KernelId::VsmBlurRow,
+            KernelId::EvsmBlurRow,
+            KernelId::MsmBlurRow,
+        ]
+        .into_iter()
+        .chain([kernel])
+        .filter(|k| encode_blur_tile(*k) == tile)
+        .map(encode_blur_row)
+        .max()
+        .unwrap();
         assert_eq!(
-            packed,
-            matches!(
-                kernel,
-                KernelId::VsmBlurRow | KernelId::EvsmBlurRow | KernelId::MsmBlurRow
-            ),
-            "{name}: packed rows"
-        );
-        assert!(
-            dep * dep <= sh
-                && rows.div_ceil(if packed { channels } else { 1 }) <= sh
-                && row + 2 * max_radius <= sh,
-            "{name}: SH_TEXELS"
+            sh,
+            (enc * enc).max(widest_row + 2 * max_radius),
+            "{name}: SH_TEXELS (the encoded tile or the widest encoded row sharing the module)"
         );
         assert!(
             sh * 4 * channels <= 16384,

@@ -27,8 +27,8 @@
 // vec4<f32>` (two channels in vec2s halve the workgroup memory and its traffic), and the tile
 // that memory allows, `const TILE` (outputs per side) and `const SH_TEXELS` (texels of
 // workgroup memory: at least the encoded tile at TILE_RADIUS, (TILE + 2·TILE_RADIUS)², and
-// the fallback's encoded row, ROW + 2·MAX_RADIUS; 16 KiB at most): 24 and 1734 with two channels
-// (13.5 KiB), 16 and 1024 with four (16 KiB); `const RUN`, the outputs an invocation sums in a
+// the fallback's encoded row, ROW + 2·MAX_RADIUS; 16 KiB at most): 24 and 1444 with two channels
+// (11.3 KiB), 16 and 900 with four (14.1 KiB); `const RUN`, the outputs an invocation sums in a
 // tile's blur passes: 4 with two channels, 1 with four (see `run_sums`); and the fallback's row,
 // `const ROW` outputs a workgroup in runs of `const ROW_RUN` an invocation (ROW = ROW_RUN ·
 // WG_SIZE): 1024 in runs of 4 for `vsm_blur_row` (see `blur_row_quads`),

@@ -1,13 +1,14 @@
 // The four-channel texel of the encodings fused into the blur (import-only module of
 // shared/evsm_blur_kernel and shared/msm_blur_kernel): what shared/encode_blur asks of its
-// importer for four channels — a vec4<f32> texel, the 16² tile that 16 KiB of workgroup memory
-// allows at TILE_RADIUS (SH_TEXELS of 16 B), one output an invocation in the tile's blur.
+// importer for four channels — a vec4<f32> texel, a 16² tile (its encoded texels at
+// TILE_RADIUS, SH_TEXELS of 16 B, in 14.1 of WebGPU's 16 KiB of workgroup memory), one output an
+// invocation in the tile's blur.
 
 const CHANNELS: u32 = 4u;
 // The tile its workgroup memory allows (shared/encode_blur). Keep in sync with
 // `encode_blur_tile` in src/filter/encode_blur.rs.
 const TILE: u32 = 16u;
-const SH_TEXELS: u32 = 1024u;
+const SH_TEXELS: u32 = 900u;
 // Outputs an invocation sums in the tile's blur passes, four channels: one output an invocation (shared/encode_blur, `run_sums`).
 const RUN: u32 = 1u;
 alias Texel = vec4<f32>;

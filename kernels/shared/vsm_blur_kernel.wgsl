@@ -17,7 +17,7 @@ const CHANNELS: u32 = 2u;
 // The tile its workgroup memory allows (shared/encode_blur). Keep in sync with
 // `encode_blur_tile` in src/filter/encode_blur.rs.
 const TILE: u32 = 24u;
-const SH_TEXELS: u32 = 1734u;
+const SH_TEXELS: u32 = 1444u;
 // Outputs an invocation sums in the tile's blur passes, two channels: runs of 4 (shared/encode_blur, `run_sums`).
 const RUN: u32 = 4u;
 alias Texel = vec2<f32>;

@@ -163,10 +163,9 @@ impl ComputeKernel {
         })
     }
 
-    /// Workgroups covering a `w × h` texel grid.
+    /// Workgroups covering a `w × h` texel grid ([`crate::kernels::Reflection::groups_for`]).
     pub fn groups_for(&self, w: u32, h: u32) -> [u32; 3] {
-        let wg = self.reflection.workgroup_size.unwrap_or([1, 1, 1]);
-        [w.div_ceil(wg[0]), h.div_ceil(wg[1]), 1]
+        self.reflection.groups_for(w, h)
     }
 }
 

@@ -25,11 +25,9 @@ pub fn encode_blur_tile(kernel: KernelId) -> u32 {
 
 /// Outputs of a one-row workgroup, the two-pass fallback (`ROW`, which each fused kernel
 /// declares for `kernels/shared/encode_blur.wgsl`). Four channels: 256 one an invocation
-/// (`evsm_blur`, `msm_blur`), or on maps at least 512 wide 512 in runs of 2, the depth rows
-/// packed four to a texel (`evsm_blur_row`, `msm_blur_row`). Two (VSM): 512 in runs of 2
-/// (`vsm_blur`), its three rows of depths with their halo, 3·(512 + 2·32 + 2) texels, fitting
-/// its workgroup memory one a texel, or on maps at least 1024 wide 1024 in runs of 4
-/// (`vsm_blur_row`), its rows packed two depths a texel ([`encode_blur_row_kernel`]). Every
+/// (`evsm_blur`, `msm_blur`), or on maps at least 512 wide 512 in runs of 2 (`evsm_blur_row`,
+/// `msm_blur_row`). Two (VSM): 512 in runs of 2 (`vsm_blur`), or on maps at least 1024 wide
+/// 1024 in runs of 4 (`vsm_blur_row`, [`encode_blur_row_kernel`]). Every
 /// invocation stays busy, each row texel is read 2 + 2r times for a run of outputs instead of
 /// 2r + 1 for each, and the halo is loaded once for more outputs.
 pub fn encode_blur_row(kernel: KernelId) -> u32 {
@@ -42,8 +40,7 @@ pub fn encode_blur_row(kernel: KernelId) -> u32 {
 
 /// The kernel of `kernel`'s row pass over a map `width` texels wide: the `*_blur_row` kernel
 /// where its rows are full — VSM's 1024 texels in runs of 4, EVSM's and MSM's 512 in runs of 2,
-/// their depth rows packed in workgroup memory (kernels of their own: packing compiled into the
-/// tile kernels slowed their tiles on llvmpipe), 1.14–1.29× (VSM) and 1.17–1.19× (MSM) faster
+/// 1.14–1.29× (VSM) and 1.17–1.19× (MSM) faster
 /// at r = 32 on llvmpipe — else the tile kernel's own shorter rows (on a 512² map VSM's longer
 /// rows left half the invocations idle: 1.2× slower; `benches/RESULTS.md`, 2026-11-27).
 pub fn encode_blur_row_kernel(kernel: KernelId, width: u32) -> KernelId {
