@@ -51,7 +51,8 @@ step env.txt 30 "$B" info
 # Issue 14: the soft techniques' shading against PCSS 16 + 32 at 1920×1080 with a 2048² map,
 # each configuration's prefilter, and each frame's passes against its wall time.
 # The SM clock sampled through it (the twelfth session's soft table read its prefilter
-# 2.4× the kernel bench's time for the same chain, and its frames 7 ms: is the clock low?).
+# 2.4× the kernel bench's time for the same chain at a clock of 345-735 MHz; the fourteenth's
+# 1.5× at 1980 MHz: the table's last block, the prefilter pass by pass, says which pass).
 SAMPLER=
 if command -v nvidia-smi >/dev/null; then
     echo "## clocks during the soft table" >>"$OUT/env.txt"

@@ -88,8 +88,9 @@ fn bad_scene_path_is_an_error_naming_the_file() {
 /// `bench --lookup`'s soft table: one row per configuration with positive, finite shading
 /// times per light size; the prefilter's time is the light's passes after its raster (tables
 /// for the soft techniques, none of them for `hard`'s one-pass linearization to outweigh), the
-/// frame's passes add up to at least shade + prefilter, and `--image` and `--map` reach the
-/// scene and the table's header.
+/// frame's passes add up to at least shade + prefilter, the prefilter's passes (their table's
+/// among them for the soft techniques) add up to it in one round, and `--image` and `--map`
+/// reach the scene and the table's header.
 #[test]
 fn soft_benchmark_reports_every_configuration() {
     let g = common::gpu();
@@ -111,6 +112,12 @@ fn soft_benchmark_reports_every_configuration() {
             assert!(v.is_finite() && *v > 0.0, "{r:?}");
         }
         assert!(r.prefilter_ms.is_finite() && r.prefilter_ms >= 0.0, "{r:?}");
+        // One round: the passes' medians are the round's own times, and add up to the total.
+        let by_pass: f64 = r.prefilter_passes.iter().map(|(_, ms)| ms).sum();
+        assert!(
+            (by_pass - r.prefilter_ms).abs() <= 1e-9 * r.prefilter_ms.max(1.0),
+            "prefilter by pass: {r:?}"
+        );
         assert!(
             r.frame_ms >= r.shade_ms[0] + r.prefilter_ms - 1e-9,
             "the frame's passes include shade and prefilter: {r:?}"
@@ -118,6 +125,14 @@ fn soft_benchmark_reports_every_configuration() {
     }
     let tables = |name: &str| rows.iter().find(|r| r.technique == name).unwrap();
     for soft in ["vssm", "msm_soft", "cssm M=8", "cssm M=8 csm_z"] {
+        assert!(
+            tables(soft)
+                .prefilter_passes
+                .iter()
+                .any(|(n, _)| n.contains(".sat")),
+            "{soft}'s passes name its table: {:?}",
+            tables(soft)
+        );
         assert!(
             tables(soft).prefilter_ms > 0.0,
             "{soft} builds tables: {:?}",

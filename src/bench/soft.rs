@@ -62,6 +62,9 @@ pub struct SoftRow {
     /// blurs, tables, mips), ms, at the first light size (the light's size changes no
     /// prefilter pass).
     pub prefilter_ms: f64,
+    /// The same, pass by pass (each pass's median, in the frame's order): where the prefilter's
+    /// time goes in a frame, against the kernel benchmark's standalone chain.
+    pub prefilter_passes: Vec<(String, f64)>,
     /// The whole frame's median GPU time (every timed pass), ms, at the first light size.
     pub frame_ms: f64,
     /// The same frames' median wall time from submission to completion, ms: the cross-check
@@ -183,6 +186,7 @@ pub fn soft_cost(
     let mut renderer = Renderer::new(&gpu.device);
     let mut times = vec![Vec::new(); scenes.len()];
     let mut prefilter = vec![Vec::new(); scenes.len()];
+    let mut by_pass: Vec<Vec<(String, Vec<f64>)>> = vec![Vec::new(); scenes.len()];
     let mut frame_wall = vec![(Vec::new(), Vec::new()); scenes.len()];
     let opts = RenderOptions {
         repeat: STEADY_FRAMES,
@@ -217,6 +221,12 @@ pub fn soft_cost(
                     .sum()
             };
             prefilter[k].push(sum(&is_prefilter));
+            for (name, ms) in passes.iter().filter(|(name, _)| is_prefilter(name)) {
+                match by_pass[k].iter_mut().find(|(n, _)| n == name) {
+                    Some((_, v)) => v.push(*ms),
+                    None => by_pass[k].push((name.clone(), vec![*ms])),
+                }
+            }
             frame_wall[k].0.push(sum(&|_| true));
             frame_wall[k].1.push(*wall);
         }
@@ -232,6 +242,10 @@ pub fn soft_cost(
                 .map(|t| median(t))
                 .collect(),
             prefilter_ms: median(&mut prefilter[at]),
+            prefilter_passes: by_pass[at]
+                .iter_mut()
+                .map(|(n, v)| (n.clone(), median(v)))
+                .collect(),
             frame_ms: median(&mut frame_wall[at].0),
             wall_ms: median(&mut frame_wall[at].1),
             image: (scenes[at].width, scenes[at].height),
@@ -303,6 +317,25 @@ pub fn format_soft_table(
         );
     }
     s.push_str(&above_hard(name, rows));
+    s.push_str(&prefilter_by_pass(rows));
+    s
+}
+
+/// The prefilter of each configuration that has one, pass by pass (first light size): one line
+/// each, `technique: pass ms, …`, the light's `light0.` prefix dropped.
+fn prefilter_by_pass(rows: &[SoftRow]) -> String {
+    let mut s = String::new();
+    for r in rows.iter().filter(|r| !r.prefilter_passes.is_empty()) {
+        if s.is_empty() {
+            s.push_str("prefilter by pass (ms, first size):\n");
+        }
+        let passes: Vec<String> = r
+            .prefilter_passes
+            .iter()
+            .map(|(n, ms)| format!("{} {ms:.3}", n.strip_prefix("light0.").unwrap_or(n)))
+            .collect();
+        let _ = writeln!(s, "  {}: {}", r.technique, passes.join(", "));
+    }
     s
 }
 
@@ -346,6 +379,7 @@ mod tests {
             fetches: 1.0,
             shade_ms: shade_ms.to_vec(),
             prefilter_ms: 0.0,
+            prefilter_passes: Vec::new(),
             frame_ms: 1.0,
             wall_ms: 1.0,
             image: (8, 8),
@@ -384,6 +418,32 @@ mod tests {
         assert!(line("hard").is_none(), "{table}");
         let without = format_soft_table("test", false, 1, &[0.5, 1.0, 2.0], &rows[1..]);
         assert!(!without.contains("above hard"), "{without}");
+    }
+
+    /// The by-pass block lists each configuration with a prefilter, its passes in order with
+    /// the light's prefix dropped, and is absent where none has one.
+    #[test]
+    fn prefilter_by_pass_lists_each_configurations_passes() {
+        let mut vssm = row("vssm", &[1.0]);
+        vssm.prefilter_passes = vec![
+            ("light0.vsm.sat.tile_sums".into(), 0.1104),
+            ("light0.vsm.sat.carries".into(), 0.034),
+            ("light0.vsm.sat.0".into(), 0.17),
+        ];
+        let rows = [row("hard", &[1.0]), row("pcss 16+32", &[2.0]), vssm];
+        let table = format_soft_table("test", false, 1, &[1.0], &rows);
+        let block = table
+            .split("prefilter by pass")
+            .nth(1)
+            .expect("a by-pass block");
+        let lines: Vec<&str> = block.lines().skip(1).collect();
+        assert_eq!(
+            lines,
+            ["  vssm: vsm.sat.tile_sums 0.110, vsm.sat.carries 0.034, vsm.sat.0 0.170"],
+            "{table}"
+        );
+        let none = format_soft_table("test", false, 1, &[1.0], &rows[..2]);
+        assert!(!none.contains("prefilter by pass"), "{none}");
     }
 
     /// The prefilter is every timed pass of a vssm frame but the raster, the G-buffer and the
