@@ -725,7 +725,7 @@ fn encode_blur_dispatch_constants_match_the_wgsl() {
             );
         }
         // One invocation per output of a row; a tile's encoded texels in at most six blocks of
-        // WG_SIZE (`encode_tile`'s e0 … e5). Its blur: with two channels in runs of RUN = 4
+        // WG_SIZE (`encode_tile`). Its blur: with two channels in runs of RUN = 4
         // (four named sums), one run an invocation along x (TILE / RUN a row of the encoded
         // tile) and along y; with four, one output an invocation, the horizontal sums in at
         // most four blocks of WG_SIZE (`blur_tile_single`'s h0 … h3).

@@ -57,9 +57,9 @@ struct BlurSpec {
 const WG_SIZE: u32 = 256u;
 const TILE_RADIUS: u32 = 7u;
 const MAX_RADIUS: u32 = 32u;
-// Encoded texels an invocation holds between barriers (`encode_tile`: e0 … e5): at least
-// ⌈(TILE + 2·TILE_RADIUS)² / WG_SIZE⌉ of a tile (6 at TILE = 24) and ⌈(ROW + 2·MAX_RADIUS) /
-// WG_SIZE⌉ of a row; the blur's sums, a run of RUN (`blur_tile_runs`) or up to four blocks of
+// Encoded texels an invocation computes and stores (`encode_tile`, blocks of WG_SIZE): at
+// least ⌈(TILE + 2·TILE_RADIUS)² / WG_SIZE⌉ of a tile (6 at TILE = 24) and ⌈(ROW +
+// 2·MAX_RADIUS) / WG_SIZE⌉ of a row; the blur's sums held between barriers, a run of RUN (`blur_tile_runs`) or up to four blocks of
 // WG_SIZE (`blur_tile_single`, h0 … h3). The blocks past the first four (two) exist only in
 // kernels whose tile can need them (`ENC_MAX`, `H_MAX`: a constant
 // condition, compiled away for a 16² tile: as a run-time test llvmpipe computed the blocks
@@ -161,32 +161,20 @@ fn put_below(i: i32, n: i32, v: Texel) {
     }
 }
 
-// Phase 1: every texel of the tile and its blur halo encoded once. The
-// ENC_PER values an invocation holds are named, not an array: llvmpipe keeps an array indexed
-// in a loop in memory.
+// Phase 1: every texel of the tile and its blur halo encoded once, each stored as it is
+// computed (nothing else is in workgroup memory yet: one barrier, after the stores).
 fn encode_tile(t: Tile, li: u32) {
     let n = t.enc.x * t.enc.y;
     let i = i32(li);
     let s = i32(WG_SIZE);
-    let e0 = encode_at(t, i);
-    let e1 = encode_at(t, i + s);
-    let e2 = encode_at(t, i + 2 * s);
-    let e3 = encode_at(t, i + 3 * s);
-    var e4 = e3;
-    var e5 = e3;
+    put_below(i, n, encode_at(t, i));
+    put_below(i + s, n, encode_at(t, i + s));
+    put_below(i + 2 * s, n, encode_at(t, i + 2 * s));
+    put_below(i + 3 * s, n, encode_at(t, i + 3 * s));
     // Constant for each kernel: a 16² tile has no such block, and no code for it.
     if ENC_MAX > 4u * WG_SIZE && 4 * s < n {
-        e4 = encode_at(t, i + 4 * s);
-        e5 = encode_at(t, i + 5 * s);
-    }
-    workgroupBarrier();
-    put_below(i, n, e0);
-    put_below(i + s, n, e1);
-    put_below(i + 2 * s, n, e2);
-    put_below(i + 3 * s, n, e3);
-    if ENC_MAX > 4u * WG_SIZE && 4 * s < n {
-        put_below(i + 4 * s, n, e4);
-        put_below(i + 5 * s, n, e5);
+        put_below(i + 4 * s, n, encode_at(t, i + 4 * s));
+        put_below(i + 5 * s, n, encode_at(t, i + 5 * s));
     }
     workgroupBarrier();
 }
