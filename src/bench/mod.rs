@@ -608,7 +608,7 @@ pub fn measure(
 }
 
 /// [`measure`], each case timed in each of `layouts` in turn, adjacent in time, its rows named
-/// `<case> [gpu]`, `<case> [cpu]` (the kernels' two memory layouts, `exec::KernelLayout`,
+/// `<case> [gpu]`, `<case> [cpu]` (the kernels' two variants, `exec::KernelLayout`,
 /// compared within one process: one warm-up, one clock, one set of copies); no layouts: the
 /// device's, rows named by their case alone.
 pub fn measure_layouts(
