@@ -9,7 +9,8 @@
 # On an H200 (2026-11-27, fourteenth session) the steps took: soft table 66 s, shade floor
 # about 12 s a variant with `hard` alone (8 variants, four of them with `vssm` too, perhaps
 # 20 s), the tables' two layouts 2 × 18 s, every kernel at 2048² 20 s, 4096²/8192² 123 s, the
-# fused blurs' ablation 3 × 9 s: about 400 s, with BASE about 60 s more. Give the call 480 s.
+# fused blurs' ablation 3 × 9 s, the mip variant 4 × about 10 s: about 440 s, with BASE about
+# 60 s more. Give the call 500 s (the machine's start, about 50 s, counts too).
 # The steps run most wanted first, each under its own time box, and append to at most seven
 # files in OUT (the device tool brings back eight), so a call stopped by its time box still
 # returns what ran. A second binary to compare against goes in as BASE=path/to/other/shadowgraph:
@@ -161,6 +162,16 @@ for v in fused_shipped fused_no_blur fused_no_encode; do
     echo "## variant $v" >>"$OUT/layouts.txt"
     SHADOWGRAPH_KERNEL_DIR="$V/$v" step layouts.txt 30 "$B" bench --sizes 2048 --repeat 20 \
         --only 'vsm_blur r4,msm_blur r4,evsm_blur 4 r4'
+done
+# The mip chain without level s + 1 in workgroup memory (benches/variants/mip_quads: 5.4 of
+# the shipped kernel's 21.3 KiB, which admits 10 workgroups of 64 an SM; the same chain bit for
+# bit, tests/kernel_dir.rs), alternated with the shipped kernel twice.
+for round in 1 2; do
+    echo "## mips shipped, round $round" >>"$OUT/layouts.txt"
+    step layouts.txt 30 "$B" bench --sizes 2048,4096 --repeat 20 --only mips
+    echo "## mips quads, round $round" >>"$OUT/layouts.txt"
+    SHADOWGRAPH_KERNEL_DIR=benches/variants/mip_quads step layouts.txt 30 "$B" bench \
+        --sizes 2048,4096 --repeat 20 --only mips
 done
 # The timer against the wall clock on a bundled scene.
 step env.txt 30 "$B" render scenes/bunny.toml --timings --repeat 20 -o "$V/bunny.png"

@@ -129,6 +129,98 @@ fn shading_several_pixels_an_invocation_renders_the_same() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Every sample of every level of `resource`'s mip chain as `shadowgraph dump` writes it for
+/// `scene`, with `envs`, level by level.
+fn dumped_chain(
+    scene: &Path,
+    resource: &str,
+    out: &Path,
+    envs: &[(&str, &OsStr)],
+) -> Vec<Vec<u32>> {
+    let args = [
+        OsStr::new("dump"),
+        scene.as_os_str(),
+        OsStr::new("--out"),
+        out.as_os_str(),
+        OsStr::new("--only"),
+        OsStr::new(resource),
+    ];
+    let o = shadowgraph(&args, envs);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut levels = Vec::new();
+    for level in 0.. {
+        let name = match level {
+            0 => format!("{resource}.exr"),
+            l => format!("{resource}.mip{l}.exr"),
+        };
+        let Ok(img) = exr::prelude::read_all_flat_layers_from_file(out.join(&name)) else {
+            break;
+        };
+        let bits = img.layer_data[0]
+            .channel_data
+            .list
+            .iter()
+            .flat_map(|c| c.sample_data.values_as_f32().map(f32::to_bits))
+            .collect();
+        levels.push(bits);
+    }
+    levels
+}
+
+/// `benches/variants/mip_quads` (the mip chain without level s + 1 in workgroup memory, a
+/// benchmark variant `benches/gpu_check.sh` times beside the shipped kernel) builds the shipped
+/// chain bit for bit: VSM at 512² (two halving dispatches) and 300² (odd levels: the general
+/// path, and tiles cut by the level's edge), ESM's log-sum-exp chain at 200². A variant whose
+/// level s + 2 reads its quad's texels in another order fails it.
+#[test]
+fn the_mip_chain_benchmark_variant_builds_the_same_chain() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let variant = root.join("benches/variants/mip_quads");
+    let dir = temp_dir("mips");
+    for (scene, from, to, resource) in [
+        (
+            "vsm_mips.toml",
+            "shadow_map = 512",
+            "shadow_map = 512",
+            "light0.vsm.mips",
+        ),
+        (
+            "vsm_mips.toml",
+            "shadow_map = 512",
+            "shadow_map = 300",
+            "light0.vsm.mips",
+        ),
+        (
+            "esm_mips_aniso.toml",
+            "shadow_map = 1024",
+            "shadow_map = 200",
+            "light0.esm.mips",
+        ),
+    ] {
+        let text = std::fs::read_to_string(root.join("scenes/techniques").join(scene)).unwrap();
+        assert!(text.contains(from), "{scene}: `{from}` moved");
+        let path = dir.join(format!("{}.toml", to.replace([' ', '='], "")));
+        std::fs::write(&path, text.replace(from, to)).unwrap();
+        let shipped = dumped_chain(&path, resource, &dir.join("shipped"), &[]);
+        let envs = [(KERNEL_DIR_ENV, variant.as_os_str())];
+        let quads = dumped_chain(&path, resource, &dir.join("quads"), &envs);
+        assert!(shipped.len() >= 8, "{scene} {to}: {} levels", shipped.len());
+        assert_eq!(quads.len(), shipped.len(), "{scene} {to}: levels");
+        for (l, (a, b)) in shipped.iter().zip(&quads).enumerate() {
+            let differ = a.iter().zip(b).filter(|(x, y)| x != y).count();
+            assert_eq!(
+                differ, 0,
+                "{scene} {to}: level {l}, {differ} samples differ"
+            );
+            assert!(
+                a.iter().any(|&v| v != 0),
+                "{scene} {to}: level {l} is all zeros"
+            );
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Files are named by their path below the folder (`shared/` for modules); anything else is
 /// refused by name.
 #[test]
