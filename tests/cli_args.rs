@@ -1,6 +1,6 @@
 //! Unbounded command-line inputs are refused up front, the same way by every command: `--repeat`
 //! is 1 to 1000 for `render`, `evaluate` and `bench`; `evaluate --truth-resolution 0` says what
-//! is wrong; `plan /dev/zero` stops reading; `bench --layouts` takes `gpu` and `cpu` only. Each
+//! is wrong; `plan /dev/zero` stops reading; `bench --layouts` takes `gpu` and `cpu` only, each once. Each
 //! is one line and status 1, within seconds (no GPU work starts).
 
 use std::path::Path;
@@ -172,5 +172,17 @@ fn layouts_are_named_and_not_for_the_lookup() {
             "gpu",
         ],
         &["--lookup", "cannot be used with", "--layouts"],
+    );
+    refused(
+        &[
+            "bench",
+            "--sizes",
+            "64",
+            "--repeat",
+            "1",
+            "--layouts",
+            "cpu,gpu,cpu",
+        ],
+        &["--layouts", "`cpu` twice", "entry 3"],
     );
 }

@@ -129,6 +129,23 @@ fn shading_several_pixels_an_invocation_renders_the_same() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A graph kernel replaced by one declaring `TEXELS_X` (which only the shading kernel's
+/// dispatch reads: a graph node's would cover the wrong texels) is refused by name, in one
+/// line.
+#[test]
+fn texels_x_in_a_graph_kernel_is_refused() {
+    let dir = temp_dir("texels-graph");
+    let linearize = kernels::source("linearize").expect("embedded linearize");
+    std::fs::write(
+        dir.join("linearize.wgsl"),
+        format!("const TEXELS_X: u32 = 2u;\n{linearize}"),
+    )
+    .unwrap();
+    let o = render(Some(&dir), &dir.join("out.png"));
+    refused(&o, &["linearize", "TEXELS_X", "only the shading kernel"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Every sample of every level of `resource`'s mip chain as `shadowgraph dump` writes it for
 /// `scene`, with `envs`, level by level.
 fn dumped_chain(

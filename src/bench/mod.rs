@@ -621,6 +621,17 @@ pub fn measure_layouts(
     layouts: &[KernelLayout],
 ) -> Result<Vec<BenchRow>> {
     check_args(device, sizes, repeat)?;
+    if let Some((k, l)) = layouts
+        .iter()
+        .enumerate()
+        .find(|(k, l)| layouts[..*k].contains(l))
+    {
+        return Err(Error::Invalid(format!(
+            "--layouts names `{}` twice (entry {})",
+            l.name(),
+            k + 1
+        )));
+    }
     let cases = select_cases(only)?;
     harness::timer(device, queue, 1)?;
     let mut executor = Executor::new();

@@ -159,6 +159,17 @@ pub(super) fn bind_step(
     let specs = specs(&base, node)?;
     let formats = bound_formats(&specs, |r| textures.get(r).map(|t| t.format()));
     let kernel = kernels.get_specialized(device, node.kernel.name(), &formats)?;
+    // A graph node's dispatch follows its node's geometry, which does not read `TEXELS_X`:
+    // a kernel (a `SHADOWGRAPH_KERNEL_DIR` variant) declaring it would cover the wrong texels.
+    if kernel.reflection.texels_x != 1 {
+        return Err(Error::Kernel {
+            kernel: node.kernel.name().to_string(),
+            message: format!(
+                "declares `const {}`, which only the shading kernel's dispatch reads",
+                crate::kernels::TEXELS_X_CONSTANT
+            ),
+        });
+    }
     let wg = kernel.reflection.workgroup_size.unwrap_or([1, 1, 1]);
     let size = |r: &str| textures.get(r).map(|t| (t.width(), t.height()));
     let mut dispatches = Vec::new();
