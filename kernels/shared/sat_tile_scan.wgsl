@@ -56,11 +56,11 @@ fn sat_sweep_row(
     for (var i = 0u; i < SUB; i++) {
         var e: vec4<u32>;
         if GPU_LAYOUT {
-            e = sat_texel(origin + vec2<u32>(i, j), size, p, fs, s);
+            e = sat_texel(origin + vec2<u32>(i, j), j * SUB + i, size, p, fs, s);
         } else if again {
             e = sat_enc[j * SUB + i];
         } else {
-            e = sat_texel(origin + vec2<u32>(i, j), size, p, fs, s);
+            e = sat_texel(origin + vec2<u32>(i, j), j * SUB + i, size, p, fs, s);
             sat_enc[j * SUB + i] = e;
         }
         run = sat_sum(run, e, fs);

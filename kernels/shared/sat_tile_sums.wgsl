@@ -41,7 +41,7 @@ fn sat_tile_edges(
     for (var j = 0u; j < SUB; j++) {
         var row = vec4<u32>(0u);
         for (var i = 0u; i < SUB; i++) {
-            let e = sat_texel(origin + vec2<u32>(i, j), size, p, fs, s);
+            let e = sat_texel(origin + vec2<u32>(i, j), j * SUB + i, size, p, fs, s);
             row = sat_sum(row, e, fs);
             col[i] = sat_sum(col[i], e, fs);
         }

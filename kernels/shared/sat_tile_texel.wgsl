@@ -70,21 +70,23 @@ fn sat_raw_own(p: vec2<i32>, origin: vec2<u32>, size: vec2<u32>) -> f32 {
 }
 
 // The encoded texel `q` of `src` (`size` its size) read as `s` says, 0 outside the map (the
-// load is clamped to the map and its value discarded, so no invocation branches).
+// load is clamped to the map and its value discarded, so no invocation branches). `own` is
+// q's index in its sub-block (`sat_block`'s, row-major), which the callers' sweeps know as
+// their loop counters: a constant once a driver unrolls them, where recovering it from q
+// (q % SUB) leaves a private array indexed at run time.
 // `src` is the importing kernel's binding, read here and not passed down: the executor's
 // packed variant (src/exec/packed.rs) re-declares it `texture_2d<u32>` and unpacks this load
 // when the representation is f16 pairs in r32uint words, which a `texture_2d<f32>` parameter
 // would not let it do.
 fn sat_texel(
     q: vec2<u32>,
+    own: u32,
     size: vec2<u32>,
     p: SatParams,
     fs: bool,
     s: SatSource,
 ) -> vec4<u32> {
     let inside = all(q < size);
-    // The sub-block's texel (`sat_block`'s index) for the sources it holds.
-    let own = q.y % SUB * SUB + q.x % SUB;
     var v: vec4<f32>;
     if s.from_depth {
         // Unused by the blocked sources below, whose `sat_block_fill` loaded and counted it.
