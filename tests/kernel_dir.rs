@@ -238,6 +238,133 @@ fn the_mip_chain_benchmark_variant_builds_the_same_chain() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `benches/variants/blur_rows_run1` and `blur_rows_run2` (the separable blur's row pass one
+/// output an invocation, and in runs of 2, benchmark variants `benches/gpu_check.sh` times
+/// beside the shipped runs of 8) blur as the shipped kernel does, bit for bit: CSM's four
+/// basis maps (`blur` along x, then y) at radius 3 on 512² and at radius 20 on 300² (rows
+/// cut by the map's edge, a window wider than a run). A variant that weights the two taps of
+/// a pair apart (w·l + w·r) fails it at 577 724 samples.
+#[test]
+fn the_blur_row_benchmark_variants_blur_the_same() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = temp_dir("blur_rows");
+    let text = std::fs::read_to_string(root.join("scenes/techniques/csm.toml")).unwrap();
+    for (tag, edits) in [
+        (
+            "512_r3",
+            [
+                ("shadow_map = 512", "shadow_map = 512"),
+                ("filter_radius = 3", "filter_radius = 3"),
+            ],
+        ),
+        (
+            "300_r20",
+            [
+                ("shadow_map = 512", "shadow_map = 300"),
+                ("filter_radius = 3", "filter_radius = 20"),
+            ],
+        ),
+    ] {
+        let mut scene = text.clone();
+        for (from, to) in edits {
+            assert!(scene.contains(from), "csm.toml: `{from}` moved");
+            scene = scene.replace(from, to);
+        }
+        let path = dir.join(format!("csm_{tag}.toml"));
+        std::fs::write(&path, scene).unwrap();
+        for resource in ["light0.csm0.blur_h", "light0.csm3.blur_v"] {
+            let shipped = dumped_chain(&path, resource, &dir.join(format!("shipped_{tag}")), &[]);
+            assert_eq!(shipped.len(), 1, "{tag} {resource}: one level");
+            assert!(
+                shipped[0].iter().filter(|&&v| v != 0).count() > shipped[0].len() / 2,
+                "{tag} {resource}: mostly zeros"
+            );
+            for variant in ["blur_rows_run1", "blur_rows_run2"] {
+                let envs = [(
+                    KERNEL_DIR_ENV,
+                    root.join("benches/variants").join(variant).into_os_string(),
+                )];
+                let envs: Vec<(&str, &OsStr)> =
+                    envs.iter().map(|(k, v)| (*k, v.as_os_str())).collect();
+                let got = dumped_chain(
+                    &path,
+                    resource,
+                    &dir.join(format!("{variant}_{tag}")),
+                    &envs,
+                );
+                assert_eq!(got.len(), 1, "{variant} {tag} {resource}: one level");
+                let differ = shipped[0]
+                    .iter()
+                    .zip(&got[0])
+                    .filter(|(a, b)| a != b)
+                    .count();
+                assert_eq!(
+                    differ, 0,
+                    "{variant} {tag} {resource}: {differ} samples differ"
+                );
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `benches/variants/sat_vsm_texel` (VSM's table texels each from its own five depth loads
+/// instead of a sub-block's depths in private arrays, a benchmark variant
+/// `benches/gpu_check.sh` times beside the shipped kernels) builds the shipped tables bit for
+/// bit: the fixed-point (`vsm_sat.toml`) and f32 (`vssm.toml`) tables at 512² and at 300²
+/// (ragged tiles: clamped neighbours at the map's edge), in both kernel layouts (pass 3's
+/// second sweep loaded again, or kept). A variant that takes a neighbour one texel off fails
+/// it.
+#[test]
+fn the_vsm_table_benchmark_variant_builds_the_same_tables() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let variant = root.join("benches/variants/sat_vsm_texel");
+    let dir = temp_dir("sat_vsm");
+    for (scene, size) in [
+        ("vsm_sat.toml", 512),
+        ("vsm_sat.toml", 300),
+        ("vssm.toml", 300),
+    ] {
+        let text = std::fs::read_to_string(root.join("scenes/techniques").join(scene)).unwrap();
+        assert!(
+            text.contains("shadow_map = 512"),
+            "{scene}: `shadow_map = 512` moved"
+        );
+        let path = dir.join(format!("{size}_{scene}"));
+        let sized = text.replace("shadow_map = 512", &format!("shadow_map = {size}"));
+        std::fs::write(&path, sized).unwrap();
+        for layout in ["gpu", "cpu"] {
+            let tag = format!("{scene}_{size}_{layout}");
+            let shipped_envs = [(KERNEL_LAYOUT_ENV, OsStr::new(layout))];
+            let resource = "light0.vsm.sat";
+            let shipped = dumped_chain(
+                &path,
+                resource,
+                &dir.join(format!("s_{tag}")),
+                &shipped_envs,
+            );
+            assert_eq!(shipped.len(), 1, "{tag}: one level");
+            assert!(
+                shipped[0].iter().filter(|&&v| v != 0).count() > shipped[0].len() / 2,
+                "{tag}: mostly zeros"
+            );
+            let envs = [
+                (KERNEL_LAYOUT_ENV, OsStr::new(layout)),
+                (KERNEL_DIR_ENV, variant.as_os_str()),
+            ];
+            let got = dumped_chain(&path, resource, &dir.join(format!("v_{tag}")), &envs);
+            assert_eq!(got.len(), 1, "{tag}: one level");
+            let differ = shipped[0]
+                .iter()
+                .zip(&got[0])
+                .filter(|(a, b)| a != b)
+                .count();
+            assert_eq!(differ, 0, "{tag}: {differ} samples differ");
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Files are named by their path below the folder (`shared/` for modules); anything else is
 /// refused by name.
 #[test]
