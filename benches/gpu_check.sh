@@ -6,11 +6,15 @@
 #
 #   benches/gpu_check.sh [BINARY] [OUT]     # defaults: target/release/shadowgraph, gpu-out
 #
-# On an H200 (2026-11-27, fourteenth session) the steps took: soft table 66 s, shade floor
-# about 12 s a variant with `hard` alone (8 variants, four of them with `vssm` too, perhaps
-# 20 s), the tables' two layouts 2 × 18 s, every kernel at 2048² 20 s, 4096²/8192² 123 s, the
-# fused blurs' ablation 3 × 9 s, the mip variant 4 × about 10 s: about 440 s, with BASE about
-# 60 s more. Give the call 500 s (the machine's start, about 50 s, counts too).
+# On an H200 (2026-11-27, fourteenth session) the steps took: soft table 66 s, a shading
+# variant with `hard` alone about 12 s (with `vssm` too perhaps 20 s), every kernel at 2048²
+# 20 s, 4096²/8192² 123 s, the fused blurs' ablation 3 × 9 s, the tables' two layouts 18 s a
+# round, the mip variant about 10 s a run. In order now: soft table, four shading shapes
+# (about 80 s), the blur's row variants (6 runs, perhaps 70 s), VSM's table variant (4 runs,
+# perhaps 35 s), the mip variant (4 runs, 40 s), every kernel at 2048², 4096²/8192², the
+# fused ablation, one round of the layouts, the bunny frame: about 490 s, with BASE about 60 s
+# more. Give the call 560 s (the machine's start, about 50 s, counts too); a step cut off by the
+# call's end loses only the steps after it.
 # The steps run most wanted first, each under its own time box, and append to at most seven
 # files in OUT (the device tool brings back eight), so a call stopped by its time box still
 # returns what ran. A second binary to compare against goes in as BASE=path/to/other/shadowgraph:
@@ -74,7 +78,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let xy = id.xy;'
-mkdir -p "$V/shipped" "$V/empty" "$V/no_lookup" "$V/gbuffer_only" "$V/store_only" \
+mkdir -p "$V/shipped_none" "$V/shipped" "$V/empty" "$V/no_lookup" "$V/gbuffer_only" "$V/store_only" \
     "$V/wg16x4" "$V/tx2" "$V/tx4"
 cp "$S" "$V/shipped/shade.wgsl"
 # Nothing a pixel (the same 32 400 workgroups, each invocation testing its bounds and
@@ -111,30 +115,56 @@ for v in no_lookup wg16x4 tx2 tx4; do
     edited "$S" "$V/$v/shade.wgsl"
 done
 # `vssm` beside `hard` where the whole pass is kept (issue 14's ratio with each shape).
-for v in shipped empty no_lookup gbuffer_only store_only wg16x4 tx2 tx4; do
+# The floor's parts (empty, no_lookup, gbuffer_only, store_only) were timed in the fourteenth
+# session (0.040, 0.055-0.059, 0.060-0.061, 0.057-0.058 ms): set SHADE_PARTS=1 to time them again.
+SHAPES="shipped wg16x4 tx2 tx4"
+[ -n "${SHADE_PARTS:-}" ] && SHAPES="$SHAPES empty no_lookup gbuffer_only store_only"
+for v in $SHAPES; do
     only=hard
     case $v in shipped | wg16x4 | tx2 | tx4) only=hard,vssm ;; esac
     echo "## variant $v" >>"$OUT/shade.txt"
     SHADOWGRAPH_KERNEL_DIR="$V/$v" step shade.txt 40 "$B" bench --lookup 3 --repeat 20 \
         --image 1920x1080 --map 2048 --only "$only"
 done
-# Issue 14's table build at 2048² (≤ 0.2 ms) in the kernels' two layouts (exec::KernelLayout)
-# in one process each round, every case in both side by side (`bench --layouts`), the order
-# swapped in the second round: `gpu` (the default on a GPU) loads and encodes pass 3's texels
-# again, `cpu` keeps the first sweep's (fourteenth session: `chain vssm` 0.313 against 0.336
-# ms).
-for order in cpu,gpu gpu,cpu; do
-    step layouts.txt 60 "$B" bench --sizes 2048 --repeat 20 \
-        --only 'sat,chain vssm,chain msm_soft,chain esm,chain cssm' --passes --layouts "$order"
-done
-if [ -n "$BASE" ]; then
-    for round in 1 2; do
-        for b in "$BASE" "$B"; do
-            step layouts.txt 40 "$b" bench --sizes 2048 --repeat 20 \
-                --only 'blur,sat fixed,chain vssm,chain msm_soft' --passes
-        done
+# The separable blur's row pass (H200: 3-5x its column pass over the same texels; both passes
+# took 0.139 ms at 2048² one output an invocation in the sixth session, 0.164 with the runs of
+# 8 since, which were chosen on llvmpipe): benches/variants/blur_rows_run1 (one output an
+# invocation, neighbouring invocations on neighbouring texels) and blur_rows_run2 (runs of 2)
+# against the shipped runs of 8, columns as shipped, the same blur bit for bit
+# (tests/kernel_dir.rs), alternated twice. On llvmpipe the row pass is 2.1x (run1) and
+# 1.4-1.6x (run2) slower than shipped (benches/RESULTS.md, fifteenth session).
+for round in 1 2; do
+    for v in shipped blur_rows_run1 blur_rows_run2; do
+        echo "## blur rows $v, round $round" >>"$OUT/variants.txt"
+        dir=benches/variants/$v
+        [ "$v" = shipped ] && dir="$V/shipped_none"
+        SHADOWGRAPH_KERNEL_DIR="$dir" step variants.txt 40 "$B" bench --sizes 2048,4096 \
+            --repeat 20 --only 'blur rg32f,evsm4+blur' --passes
     done
-fi
+done
+# VSM's table texels each from five depth loads (benches/variants/sat_vsm_texel) against the
+# shipped 4 x 4 sub-block of depths in private arrays (H200, fourteenth session: VSM's tile
+# sums 0.110 ms at 2048² against MSM's 0.063; llvmpipe 1.3x slower with the variant), the same
+# tables bit for bit, alternated twice.
+for round in 1 2; do
+    for v in shipped sat_vsm_texel; do
+        echo "## vsm table $v, round $round" >>"$OUT/variants.txt"
+        dir=benches/variants/$v
+        [ "$v" = shipped ] && dir="$V/shipped_none"
+        SHADOWGRAPH_KERNEL_DIR="$dir" step variants.txt 30 "$B" bench --sizes 2048,4096 \
+            --repeat 20 --only 'chain vssm,chain msm_soft' --passes
+    done
+done
+# The mip chain without level s + 1 in workgroup memory (benches/variants/mip_quads: 5.4 of
+# the shipped kernel's 21.3 KiB, which admits 10 workgroups of 64 an SM; the same chain bit for
+# bit, tests/kernel_dir.rs), alternated with the shipped kernel twice.
+for round in 1 2; do
+    echo "## mips shipped, round $round" >>"$OUT/variants.txt"
+    step variants.txt 30 "$B" bench --sizes 2048,4096 --repeat 20 --only mips
+    echo "## mips quads, round $round" >>"$OUT/variants.txt"
+    SHADOWGRAPH_KERNEL_DIR=benches/variants/mip_quads step variants.txt 30 "$B" bench \
+        --sizes 2048,4096 --repeat 20 --only mips
+done
 # Every kernel at 2048² by dispatch (the soft tables' build: issue 14's ≤ 0.2 ms at 2048²,
 # `chain vssm`, `chain msm_soft`), then the chains the targets name at 4096² and 8192².
 step kernels_2048.txt 60 "$B" bench --sizes 2048 --repeat 20 --passes
@@ -159,20 +189,27 @@ sed 's/^    encode_tile(t, li);$/    workgroupBarrier();/' "$V/fused_no_blur/sha
 edited "$E" "$V/fused_no_blur/shared/encode_blur.wgsl"
 edited "$V/fused_no_blur/shared/encode_blur.wgsl" "$V/fused_no_encode/shared/encode_blur.wgsl"
 for v in fused_shipped fused_no_blur fused_no_encode; do
-    echo "## variant $v" >>"$OUT/layouts.txt"
-    SHADOWGRAPH_KERNEL_DIR="$V/$v" step layouts.txt 30 "$B" bench --sizes 2048 --repeat 20 \
+    echo "## variant $v" >>"$OUT/variants.txt"
+    SHADOWGRAPH_KERNEL_DIR="$V/$v" step variants.txt 30 "$B" bench --sizes 2048 --repeat 20 \
         --only 'vsm_blur r4,msm_blur r4,evsm_blur 4 r4'
 done
-# The mip chain without level s + 1 in workgroup memory (benches/variants/mip_quads: 5.4 of
-# the shipped kernel's 21.3 KiB, which admits 10 workgroups of 64 an SM; the same chain bit for
-# bit, tests/kernel_dir.rs), alternated with the shipped kernel twice.
-for round in 1 2; do
-    echo "## mips shipped, round $round" >>"$OUT/layouts.txt"
-    step layouts.txt 30 "$B" bench --sizes 2048,4096 --repeat 20 --only mips
-    echo "## mips quads, round $round" >>"$OUT/layouts.txt"
-    SHADOWGRAPH_KERNEL_DIR=benches/variants/mip_quads step layouts.txt 30 "$B" bench \
-        --sizes 2048,4096 --repeat 20 --only mips
+# Issue 14's table build at 2048² (≤ 0.2 ms) in the kernels' two layouts (exec::KernelLayout)
+# in one process, every case in both side by side (`bench --layouts`), one round (the
+# fourteenth session's two agreed within 1%): `gpu` (the default on a GPU) loads and encodes pass 3's texels
+# again, `cpu` keeps the first sweep's (fourteenth session: `chain vssm` 0.313 against 0.336
+# ms).
+for order in gpu,cpu; do
+    step variants.txt 60 "$B" bench --sizes 2048 --repeat 20 \
+        --only 'sat,chain vssm,chain msm_soft,chain esm,chain cssm' --passes --layouts "$order"
 done
+if [ -n "$BASE" ]; then
+    for round in 1 2; do
+        for b in "$BASE" "$B"; do
+            step variants.txt 40 "$b" bench --sizes 2048 --repeat 20 \
+                --only 'blur,sat fixed,chain vssm,chain msm_soft' --passes
+        done
+    done
+fi
 # The timer against the wall clock on a bundled scene.
 step env.txt 30 "$B" render scenes/bunny.toml --timings --repeat 20 -o "$V/bunny.png"
 command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=clocks.sm --format=csv \
