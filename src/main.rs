@@ -78,7 +78,8 @@ enum Command {
             long,
             value_delimiter = ',',
             default_value = "0.25,0.5,1,2",
-            requires = "lookup"
+            requires = "lookup",
+            allow_negative_numbers = true
         )]
         light_sizes: Vec<f32>,
         /// With `--lookup`: shade at this image size, WIDTHxHEIGHT (default: the scenes' own,
@@ -266,6 +267,10 @@ fn run(args: Args) -> Result<()> {
             passes,
             layouts,
         } => {
+            if lookup.is_some() {
+                // Refused before the first table, not after it.
+                shadowgraph::bench::check_soft_args(&light_sizes, repeat, &only)?;
+            }
             let gpu = Gpu::new()?;
             match lookup {
                 Some(widths) => {

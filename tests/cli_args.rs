@@ -123,7 +123,8 @@ fn library_entry_points_check_the_same_bounds() {
 /// The lookup benchmark's options apply to `--lookup` only: given without it they are refused
 /// naming `--lookup` (clap's message on one line), as is a `--map` of 32768 (past lavapipe's
 /// texture side, named as `--map`; past the memory budget where a device allows that side) and
-/// an `--only` that names no soft configuration.
+/// an `--only` that names no soft configuration or a light size that is not a positive width,
+/// both before any table is printed.
 #[test]
 fn lookup_options_need_the_lookup_and_sane_values() {
     for extra in [
@@ -139,12 +140,27 @@ fn lookup_options_need_the_lookup_and_sane_values() {
         &["bench", "--lookup", "3", "--repeat", "1", "--map", "32768"],
         &["32768"],
     );
-    refused(
-        &[
-            "bench", "--lookup", "3", "--repeat", "1", "--only", "nosuch",
-        ],
-        &["--only nosuch", "matches no soft configuration", "vssm"],
-    );
+    // Refused before the first table (the PCF lookup table), not after it: nothing on stdout.
+    for (extra, needles) in [
+        (
+            &["--only", "nosuch"][..],
+            &["--only nosuch", "matches no soft configuration", "vssm"][..],
+        ),
+        (&["--light-sizes", "nan"], &["light size NaN", "positive"]),
+        (&["--light-sizes", "0.5,-1"], &["light size -1", "positive"]),
+        (&["--light-sizes", "0"], &["light size 0", "positive"]),
+    ] {
+        let mut args = vec!["bench", "--lookup", "3", "--repeat", "1"];
+        args.extend_from_slice(extra);
+        refused(&args, needles);
+        let out = shadowgraph(&args).stdout;
+        assert!(
+            out.is_empty(),
+            "`{}`: {}",
+            args.join(" "),
+            String::from_utf8_lossy(&out)
+        );
+    }
 }
 
 #[test]

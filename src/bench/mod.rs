@@ -26,7 +26,9 @@ pub use self::copy::{COPY, COPY_FORMATS, copy_texture_graph, format_name};
 pub use self::harness::{Inputs, Timed, fill_imports, random_imports};
 use self::harness::{gb_per_s, time_graph};
 pub use self::lookup::{LOOKUP_WIDTHS, LookupRow, format_lookup_table, lookup_cost};
-pub use self::soft::{SOFT_LIGHT_SIZES, SOFT_TECHNIQUES, SoftRow, format_soft_table, soft_cost};
+pub use self::soft::{
+    SOFT_LIGHT_SIZES, SOFT_TECHNIQUES, SoftRow, check_soft_args, format_soft_table, soft_cost,
+};
 use crate::error::{Error, Result};
 use crate::exec::{Executor, KernelLayout};
 use crate::filter::{BlurMode, add_filter};

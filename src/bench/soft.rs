@@ -115,6 +115,33 @@ fn shading_fetches(scene: &Scene) -> Result<f64> {
         .count("light0_visibility")
 }
 
+/// The checks [`soft_cost`] makes of its arguments before any work: light sizes (at least one,
+/// each a positive finite world width), `repeat` ≥ 1, and an `only` that names at least one
+/// configuration of [`SOFT_TECHNIQUES`]. The command line makes them before `bench --lookup`'s
+/// first table, so a bad argument is refused at once rather than after it.
+pub fn check_soft_args(sizes: &[f32], repeat: u32, only: &[String]) -> Result<()> {
+    if sizes.is_empty() || repeat == 0 {
+        return Err(Error::Invalid(
+            "soft benchmark needs light sizes and repeat ≥ 1".into(),
+        ));
+    }
+    if let Some(s) = sizes.iter().find(|s| !(s.is_finite() && **s > 0.0)) {
+        return Err(Error::Invalid(format!(
+            "soft benchmark light size {s}: sizes are positive world widths"
+        )));
+    }
+    let named = |name: &str| only.iter().any(|o| name.contains(o.as_str()));
+    if !only.is_empty() && !SOFT_TECHNIQUES.iter().any(|(name, _)| named(name)) {
+        let names: Vec<&str> = SOFT_TECHNIQUES.iter().map(|(n, _)| *n).collect();
+        return Err(Error::Invalid(format!(
+            "bench --lookup --only {}: matches no soft configuration; they are: {}",
+            only.join(","),
+            names.join("; ")
+        )));
+    }
+    Ok(())
+}
+
 /// The shading pass's cost of every configuration of [`SOFT_TECHNIQUES`] at each light size in
 /// `sizes`: the median over `repeat` rounds (after [`WARMUP`] untimed ones, on a GPU at least [`super::GPU_WARMUP_MS`] of them) of the `shade`
 /// pass. Rounds interleave the configurations (each renders `STEADY_FRAMES` consecutive
@@ -133,16 +160,7 @@ pub fn soft_cost(
     map: Option<u32>,
     only: &[String],
 ) -> Result<Vec<SoftRow>> {
-    if sizes.is_empty() || repeat == 0 {
-        return Err(Error::Invalid(
-            "soft benchmark needs light sizes and repeat ≥ 1".into(),
-        ));
-    }
-    if let Some(s) = sizes.iter().find(|s| !(s.is_finite() && **s > 0.0)) {
-        return Err(Error::Invalid(format!(
-            "soft benchmark light size {s}: sizes are positive world widths"
-        )));
-    }
+    check_soft_args(sizes, repeat, only)?;
     if !gpu.can_time() {
         return Err(Error::Invalid(
             "this device cannot time kernels: it lacks TIMESTAMP_QUERY or \
@@ -160,14 +178,6 @@ pub fn soft_cost(
         })
         .map(|(_, t)| t)
         .collect();
-    if !only.is_empty() && !SOFT_TECHNIQUES.iter().any(|(name, _)| named(name)) {
-        let names: Vec<&str> = SOFT_TECHNIQUES.iter().map(|(n, _)| *n).collect();
-        return Err(Error::Invalid(format!(
-            "bench --lookup --only {}: matches no soft configuration; they are: {}",
-            only.join(","),
-            names.join("; ")
-        )));
-    }
     let mut scenes = Vec::new();
     for (_, shadow) in &picked {
         let mut base = scene_with(shadow)?;
