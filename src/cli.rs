@@ -115,6 +115,23 @@ pub fn render(
     repeat: u32,
 ) -> Result<String> {
     let scene = Scene::load(scene_path)?;
+    // What would fail after the frames is refused before them.
+    let png = output
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if !png {
+        return Err(Error::Invalid(format!(
+            "-o {}: render writes a PNG; name a `.png` file",
+            output.display()
+        )));
+    }
+    if let Some(dir) = aux {
+        std::fs::create_dir_all(dir).map_err(|error| Error::Io {
+            path: dir.to_path_buf(),
+            error,
+        })?;
+    }
     let mut renderer = Renderer::new(&gpu.device);
     // Timings on a GPU: untimed frames first until its clocks have risen.
     if timings {

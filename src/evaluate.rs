@@ -206,6 +206,7 @@ pub fn run(gpu: &Gpu, scene_path: &Path, out: &Path, opts: &EvaluateOptions) -> 
     check_options(opts)?;
     let scene = scene_for(scene_path, opts)?;
     let configs = sweep(&scene, opts)?;
+    output::check_dir(out)?;
     let (report, images) = evaluate(gpu, &scene, &configs, opts)?;
     let files = output::write_all(out, &report, &images)?;
     let mut s = format!(

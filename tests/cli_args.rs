@@ -1,7 +1,9 @@
 //! Unbounded command-line inputs are refused up front, the same way by every command: `--repeat`
 //! is 1 to 1000 for `render`, `evaluate` and `bench`; `evaluate --truth-resolution 0` says what
 //! is wrong; `plan /dev/zero` stops reading; `bench --layouts` takes `gpu` and `cpu` only, each once. Each
-//! is one line and status 1, within seconds (no GPU work starts).
+//! is one line and status 1, within seconds (no GPU work starts); so is an `evaluate --out` folder
+//! that cannot be made, and a `render` output that is not a PNG or an `--aux` folder that
+//! cannot be made.
 
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
@@ -201,4 +203,79 @@ fn layouts_are_named_and_not_for_the_lookup() {
         ],
         &["--layouts", "`cpu` twice", "entry 3"],
     );
+}
+
+/// `evaluate --out` that cannot be made (its parent is a file) is refused before the sweep: with
+/// a sweep that would run for minutes (`--k 4096 --repeat 1000`), the refusal comes within the
+/// helper's 60 s and names the folder, with nothing on stdout.
+#[test]
+fn evaluate_refuses_an_output_folder_before_the_sweep() {
+    let dir = std::env::temp_dir().join(format!("shadowgraph-cli-args-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("a_file");
+    std::fs::write(&file, b"not a folder").unwrap();
+    let out = file.join("report");
+    let out = out.to_str().unwrap();
+    let scene = scene();
+    let args = [
+        "evaluate",
+        &scene,
+        "--techniques",
+        "hard,pcss",
+        "--k",
+        "4096",
+        "--repeat",
+        "1000",
+        "--out",
+        out,
+    ];
+    refused(&args, &["a_file"]);
+    assert!(shadowgraph(&args).stdout.is_empty());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `render -o` that is not a `.png` file, or an `--aux` folder that cannot be made, is refused
+/// before the frames (with `--repeat 1000`, minutes of them on a CPU driver): one line naming
+/// it, nothing on stdout.
+#[test]
+fn render_refuses_its_outputs_before_the_frames() {
+    let dir = std::env::temp_dir().join(format!("shadowgraph-cli-render-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("a_file");
+    std::fs::write(&file, b"not a folder").unwrap();
+    let jpg = dir.join("out.jpg");
+    let png = dir.join("out.png");
+    let aux = file.join("aux");
+    let scene = scene();
+    for (args, needles) in [
+        (
+            vec![
+                "render",
+                &scene,
+                "-o",
+                jpg.to_str().unwrap(),
+                "--repeat",
+                "1000",
+            ],
+            &["out.jpg", "PNG"][..],
+        ),
+        (
+            vec![
+                "render",
+                &scene,
+                "-o",
+                png.to_str().unwrap(),
+                "--aux",
+                aux.to_str().unwrap(),
+                "--repeat",
+                "1000",
+            ],
+            &["a_file"][..],
+        ),
+    ] {
+        refused(&args, needles);
+        assert!(shadowgraph(&args).stdout.is_empty());
+    }
+    assert!(!png.exists() && !jpg.exists());
+    let _ = std::fs::remove_dir_all(&dir);
 }

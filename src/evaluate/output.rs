@@ -9,6 +9,18 @@ use super::svg::{Metric, front};
 use super::{EDGE_BAND, ErrorStats, Images, PENUMBRA_HIGH, PENUMBRA_LOW, Report, out_path};
 use crate::error::{Error, Result};
 
+/// Makes the output folder `dir` and writes (then removes) an empty file in it, so that a
+/// folder that cannot be made or written is refused before the sweep's GPU work, not after it.
+pub fn check_dir(dir: &Path) -> Result<()> {
+    let probe = out_path(dir, ".shadowgraph-write-check")?;
+    std::fs::write(&probe, b"").map_err(|error| Error::Io {
+        path: dir.to_path_buf(),
+        error,
+    })?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}
+
 /// Writes every output file into `dir`; returns their paths.
 pub fn write_all(dir: &Path, report: &Report, images: &Images) -> Result<Vec<PathBuf>> {
     let mut written = Vec::new();
