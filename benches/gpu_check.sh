@@ -20,6 +20,22 @@
 # returns what ran. A second binary to compare against goes in as BASE=path/to/other/shadowgraph:
 # its 2048² blur and table rows are then timed alternately with BINARY's (compare timings
 # only within one call). Record the results in benches/RESULTS.md (device, date, commit, command, table).
+#
+# Reading the results (decided before the run, so that a lent GPU's time goes to the change):
+# - shade.txt: a shape (wg16x4, tx2, tx4) ships where `hard` and `vssm` both fall below the
+#   shipped kernel's in the same step at every light size. tx2/tx4 made llvmpipe 1.1-1.7x
+#   slower, so they ship per device: TEXELS_X becomes an `override` set from
+#   exec::KernelLayout, and the dispatch (kernels::Reflection::groups_for) reads the value the
+#   pipeline was created with; wg16x4 may ship everywhere if llvmpipe is no slower.
+# - variants.txt, blur rows: the row pass (`blur_h`) of run1/run2 against shipped at each
+#   radius and size, both rounds agreeing. A faster variant ships for GPUs through
+#   exec::KernelLayout (the rows' run length an `override`; llvmpipe keeps 8), possibly by
+#   radius (the runs of 8 halved r = 32's time on the H200); tests compare both layouts.
+# - variants.txt, VSM's table: tile sums + tiles of sat_vsm_texel against shipped for `chain
+#   vssm`. Faster: VSM's sub-block fill becomes `!GPU_LAYOUT` only (sat_tile.wgsl's existing
+#   override), its per-texel branch the GPU's; `tests/sat.rs` already builds both layouts.
+# - variants.txt, mips: mip_quads faster at 2048² and 4096² in both rounds ships everywhere
+#   (llvmpipe as fast or faster): copy it over kernels/shared/mip_chain.wgsl, less its header.
 set -u
 B=${1:-target/release/shadowgraph}
 OUT=${2:-gpu-out}
