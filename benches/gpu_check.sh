@@ -8,13 +8,13 @@
 #
 # On an H200 (2026-11-27, fourteenth session) the steps took: soft table 66 s, a shading
 # variant with `hard` alone about 12 s (with `vssm` too perhaps 20 s), every kernel at 2048²
-# 20 s, 4096²/8192² 123 s, the fused blurs' ablation 3 × 9 s, the tables' two layouts 18 s a
-# round, the mip variant about 10 s a run. In order now: soft table, four shading shapes
-# (about 80 s), the blur's row variants (6 runs, perhaps 70 s), VSM's table variant (4 runs,
-# perhaps 35 s), the mip variant (4 runs, 40 s), every kernel at 2048², 4096²/8192², the
-# fused ablation, one round of the layouts, the bunny frame: about 490 s, with BASE about 60 s
-# more. Give the call 560 s (the machine's start, about 50 s, counts too); a step cut off by the
-# call's end loses only the steps after it.
+# 20 s, 4096²/8192² 123 s, a kernel bench process at two sizes about 8 s of texture copies
+# before its kernels. In order now: soft table, four shading shapes (about 80 s), the blur's
+# row variants (two processes, `bench --kernel-dirs`, perhaps 35 s), VSM's table variant (two,
+# 25 s), the mip variant (two, 20 s), every kernel at 2048², 4096²/8192², the fused ablation
+# (one, 10 s), one round of the layouts, the bunny frame: about 420 s, with BASE about 60 s
+# more. Give the call 520 s (the machine's start, about 50 s, counts too); a step cut off by
+# the call's end loses only the steps after it.
 # The steps run most wanted first, each under its own time box, and append to at most seven
 # files in OUT (the device tool brings back eight), so a call stopped by its time box still
 # returns what ran. A second binary to compare against goes in as BASE=path/to/other/shadowgraph:
@@ -94,7 +94,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let xy = id.xy;'
-mkdir -p "$V/shipped_none" "$V/shipped" "$V/empty" "$V/no_lookup" "$V/gbuffer_only" "$V/store_only" \
+mkdir -p "$V/shipped" "$V/empty" "$V/no_lookup" "$V/gbuffer_only" "$V/store_only" \
     "$V/wg16x4" "$V/tx2" "$V/tx4"
 cp "$S" "$V/shipped/shade.wgsl"
 # Nothing a pixel (the same 32 400 workgroups, each invocation testing its bounds and
@@ -149,37 +149,28 @@ done
 # against the shipped runs of 8, columns as shipped, the same blur bit for bit
 # (tests/kernel_dir.rs), alternated twice. On llvmpipe the row pass is 2.1x (run1) and
 # 1.4-1.6x (run2) slower than shipped (benches/RESULTS.md, fifteenth session).
-for round in 1 2; do
-    for v in shipped blur_rows_run1 blur_rows_run2; do
-        echo "## blur rows $v, round $round" >>"$OUT/variants.txt"
-        dir=benches/variants/$v
-        [ "$v" = shipped ] && dir="$V/shipped_none"
-        SHADOWGRAPH_KERNEL_DIR="$dir" step variants.txt 40 "$B" bench --sizes 2048,4096 \
-            --repeat 20 --only 'blur rg32f,evsm4+blur' --passes
-    done
+# One process a round (`bench --kernel-dirs`: one warm-up, one set of copies, each kernel in
+# each folder adjacent in time), the folders' order reversed in the second.
+R1=benches/variants/blur_rows_run1
+R2=benches/variants/blur_rows_run2
+for dirs in "shipped,$R1,$R2" "$R2,$R1,shipped"; do
+    step variants.txt 60 "$B" bench --sizes 2048,4096 --repeat 20 \
+        --only 'blur rg32f,evsm4+blur' --passes --kernel-dirs "$dirs"
 done
 # VSM's table texels each from five depth loads (benches/variants/sat_vsm_texel) against the
 # shipped 4 x 4 sub-block of depths in private arrays (H200, fourteenth session: VSM's tile
 # sums 0.110 ms at 2048² against MSM's 0.063; llvmpipe 1.3x slower with the variant), the same
 # tables bit for bit, alternated twice.
-for round in 1 2; do
-    for v in shipped sat_vsm_texel; do
-        echo "## vsm table $v, round $round" >>"$OUT/variants.txt"
-        dir=benches/variants/$v
-        [ "$v" = shipped ] && dir="$V/shipped_none"
-        SHADOWGRAPH_KERNEL_DIR="$dir" step variants.txt 30 "$B" bench --sizes 2048,4096 \
-            --repeat 20 --only 'chain vssm,chain msm_soft' --passes
-    done
+for dirs in shipped,benches/variants/sat_vsm_texel benches/variants/sat_vsm_texel,shipped; do
+    step variants.txt 40 "$B" bench --sizes 2048,4096 --repeat 20 \
+        --only 'chain vssm,chain msm_soft' --passes --kernel-dirs "$dirs"
 done
 # The mip chain without level s + 1 in workgroup memory (benches/variants/mip_quads: 5.4 of
 # the shipped kernel's 21.3 KiB, which admits 10 workgroups of 64 an SM; the same chain bit for
 # bit, tests/kernel_dir.rs), alternated with the shipped kernel twice.
-for round in 1 2; do
-    echo "## mips shipped, round $round" >>"$OUT/variants.txt"
-    step variants.txt 30 "$B" bench --sizes 2048,4096 --repeat 20 --only mips
-    echo "## mips quads, round $round" >>"$OUT/variants.txt"
-    SHADOWGRAPH_KERNEL_DIR=benches/variants/mip_quads step variants.txt 30 "$B" bench \
-        --sizes 2048,4096 --repeat 20 --only mips
+for dirs in shipped,benches/variants/mip_quads benches/variants/mip_quads,shipped; do
+    step variants.txt 40 "$B" bench --sizes 2048,4096 --repeat 20 --only mips \
+        --kernel-dirs "$dirs"
 done
 # Every kernel at 2048² by dispatch (the soft tables' build: issue 14's ≤ 0.2 ms at 2048²,
 # `chain vssm`, `chain msm_soft`), then the chains the targets name at 4096² and 8192².
@@ -196,19 +187,16 @@ UNBLURRED='            for (var k = i32(li); k < t.outs.x * t.outs.y; k += i32(W
                 let yx = div_mod(k, t.outs.x);
                 store(t, vec2<i32>(yx.y, yx.x), sh_get((yx.x + t.r.y) * t.enc.x + yx.y + t.r.x));
             }'
-mkdir -p "$V/fused_shipped/shared" "$V/fused_no_blur/shared" "$V/fused_no_encode/shared"
-cp "$E" "$V/fused_shipped/shared/encode_blur.wgsl"
+mkdir -p "$V/fused_no_blur/shared" "$V/fused_no_encode/shared"
 awk -v body="$UNBLURRED" '/^            blur_tile_(runs|single)\(t, li\);$/ { print body; next } { print }' \
     "$E" >"$V/fused_no_blur/shared/encode_blur.wgsl"
 sed 's/^    encode_tile(t, li);$/    workgroupBarrier();/' "$V/fused_no_blur/shared/encode_blur.wgsl" \
     >"$V/fused_no_encode/shared/encode_blur.wgsl"
 edited "$E" "$V/fused_no_blur/shared/encode_blur.wgsl"
 edited "$V/fused_no_blur/shared/encode_blur.wgsl" "$V/fused_no_encode/shared/encode_blur.wgsl"
-for v in fused_shipped fused_no_blur fused_no_encode; do
-    echo "## variant $v" >>"$OUT/variants.txt"
-    SHADOWGRAPH_KERNEL_DIR="$V/$v" step variants.txt 30 "$B" bench --sizes 2048 --repeat 20 \
-        --only 'vsm_blur r4,msm_blur r4,evsm_blur 4 r4'
-done
+step variants.txt 40 "$B" bench --sizes 2048 --repeat 20 \
+    --only 'vsm_blur r4,msm_blur r4,evsm_blur 4 r4' \
+    --kernel-dirs "shipped,$V/fused_no_blur,$V/fused_no_encode"
 # Issue 14's table build at 2048² (≤ 0.2 ms) in the kernels' two layouts (exec::KernelLayout)
 # in one process, every case in both side by side (`bench --layouts`), one round (the
 # fourteenth session's two agreed within 1%): `gpu` (the default on a GPU) loads and encodes pass 3's texels

@@ -38,8 +38,17 @@ fn repeat() -> Result<u32, String> {
 fn run() -> Result<String, String> {
     let (sizes, repeat) = (sizes()?, repeat()?);
     let gpu = Gpu::new().map_err(|e| e.to_string())?;
-    let mut report = bench::run(&gpu, &sizes, repeat, &[], bench::Inputs::Random, false, &[])
-        .map_err(|e| e.to_string())?;
+    let mut report = bench::run(
+        &gpu,
+        &sizes,
+        repeat,
+        &[],
+        bench::Inputs::Random,
+        false,
+        &[],
+        &[],
+    )
+    .map_err(|e| e.to_string())?;
     if std::env::var_os("SHADOWGRAPH_BENCH_LOOKUP").is_some() {
         let rows = bench::lookup_cost(&gpu, bench::LOOKUP_WIDTHS, repeat, None, None)
             .map_err(|e| e.to_string())?;

@@ -127,6 +127,20 @@ pub fn read_replacements(dir: &Path) -> std::result::Result<HashMap<String, Stri
     Ok(out)
 }
 
+/// A set of replacement kernels (name below `kernels/` without `.wgsl` → text), as
+/// [`read_replacements`] reads a folder: what one [`crate::exec::KernelCache`] compiles instead
+/// of the embedded files (`shadowgraph bench --kernel-dirs`: variants side by side in one
+/// process).
+pub type Replacements = HashMap<String, String>;
+
+/// The text of `kernels/<name>.wgsl`: from `extra` if it replaces it, else [`source`].
+pub fn source_in<'a>(name: &str, extra: Option<&'a Replacements>) -> Result<&'a str> {
+    if let Some(text) = extra.and_then(|r| r.get(name)) {
+        return Ok(text);
+    }
+    source(name)
+}
+
 /// The text of `kernels/<name>.wgsl`: embedded, or its replacement from [`KERNEL_DIR_ENV`].
 pub fn source(name: &str) -> Result<&'static str> {
     let replaced = replacements().map_err(|message| Error::Kernel {
@@ -149,9 +163,25 @@ pub fn source(name: &str) -> Result<&'static str> {
 /// Resolves `// #import` lines (and `// #generated`, replaced by `generated`, whose own
 /// imports are resolved too) of kernel `name`.
 pub fn resolve(name: &str, generated: Option<&str>) -> Result<String> {
+    resolve_in(name, generated, None)
+}
+
+/// [`resolve`], with the kernel and its imports taken from `extra` where it replaces them.
+pub fn resolve_in(
+    name: &str,
+    generated: Option<&str>,
+    extra: Option<&Replacements>,
+) -> Result<String> {
     let mut seen = HashSet::from([name.to_string()]);
     let mut out = String::new();
-    resolve_text(name, source(name)?, generated, &mut seen, &mut out)?;
+    resolve_text(
+        name,
+        source_in(name, extra)?,
+        generated,
+        extra,
+        &mut seen,
+        &mut out,
+    )?;
     Ok(out)
 }
 
@@ -160,7 +190,7 @@ pub fn resolve(name: &str, generated: Option<&str>) -> Result<String> {
 pub fn resolve_source(name: &str, text: &str) -> Result<String> {
     let mut seen = HashSet::new();
     let mut out = String::new();
-    resolve_text(name, text, None, &mut seen, &mut out)?;
+    resolve_text(name, text, None, None, &mut seen, &mut out)?;
     Ok(out)
 }
 
@@ -168,6 +198,7 @@ fn resolve_text(
     name: &str,
     text: &str,
     generated: Option<&str>,
+    extra: Option<&Replacements>,
     seen: &mut HashSet<String>,
     out: &mut String,
 ) -> Result<()> {
@@ -176,18 +207,18 @@ fn resolve_text(
         if let Some(module) = t.strip_prefix("// #import ") {
             let module = module.trim();
             if seen.insert(module.to_string()) {
-                let imported = source(module).map_err(|e| Error::Kernel {
+                let imported = source_in(module, extra).map_err(|e| Error::Kernel {
                     kernel: name.to_string(),
                     message: format!("import `{module}`: {e}"),
                 })?;
-                resolve_text(module, imported, None, seen, out)?;
+                resolve_text(module, imported, None, extra, seen, out)?;
             }
         } else if t == "// #generated" {
             let block = generated.ok_or_else(|| Error::Kernel {
                 kernel: name.to_string(),
                 message: "has a `// #generated` block but none was supplied".into(),
             })?;
-            resolve_text(name, block, None, seen, out)?;
+            resolve_text(name, block, None, extra, seen, out)?;
         } else {
             out.push_str(line);
             out.push('\n');
@@ -268,18 +299,27 @@ impl Reflection {
 /// kernels, an error is one line (naga's message and its line in the kernel with its imports
 /// spliced in), as for any other input; the embedded kernels keep naga's annotated source.
 pub fn validate(kernel: &str, wgsl: &str) -> Result<naga::Module> {
-    let one_line = replacements().is_ok_and(|r| !r.is_empty());
+    let replaced = replacements().is_ok_and(|r| !r.is_empty());
+    let origin = format!("kernels replaced by {KERNEL_DIR_ENV}");
+    validate_from(kernel, wgsl, replaced.then_some(origin.as_str()))
+}
+
+/// [`validate`], its errors one line tagged `[origin]` where `origin` is given (replaced
+/// kernels: the folder they came from), else naga's annotated source.
+fn validate_from(kernel: &str, wgsl: &str, origin: Option<&str>) -> Result<naga::Module> {
+    let one_line = origin.is_some();
     let error = |message: String, line: Option<u32>| Error::Kernel {
         kernel: kernel.to_string(),
-        message: if one_line {
-            let at = line.map(|l| format!(" (line {l} of the kernel with its imports)"));
-            format!(
-                "{}{} [kernels replaced by {KERNEL_DIR_ENV}]",
-                message.lines().next().unwrap_or_default(),
-                at.unwrap_or_default()
-            )
-        } else {
-            message
+        message: match origin {
+            Some(origin) => {
+                let at = line.map(|l| format!(" (line {l} of the kernel with its imports)"));
+                format!(
+                    "{}{} [{origin}]",
+                    message.lines().next().unwrap_or_default(),
+                    at.unwrap_or_default()
+                )
+            }
+            None => message,
         },
     };
     let module = naga::front::wgsl::parse_str(wgsl).map_err(|e| {
@@ -312,7 +352,20 @@ pub fn validate(kernel: &str, wgsl: &str) -> Result<naga::Module> {
 
 /// Validates `wgsl` and reads its bindings and workgroup size.
 pub fn reflect(kernel: &str, wgsl: &str) -> Result<(naga::Module, Reflection)> {
-    let module = validate(kernel, wgsl)?;
+    reflect_module(kernel, validate(kernel, wgsl)?)
+}
+
+/// [`reflect`] of a kernel replaced from `origin` (a folder of variants): a validation error
+/// is one line tagged `[origin]`.
+pub fn reflect_replaced(
+    kernel: &str,
+    wgsl: &str,
+    origin: &str,
+) -> Result<(naga::Module, Reflection)> {
+    reflect_module(kernel, validate_from(kernel, wgsl, Some(origin))?)
+}
+
+fn reflect_module(kernel: &str, module: naga::Module) -> Result<(naga::Module, Reflection)> {
     let sampled = sampled_images(&module);
     let mut bindings = Vec::new();
     for (h, g) in module.global_variables.iter() {

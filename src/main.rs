@@ -108,6 +108,11 @@ enum Command {
         /// named `<kernel> [gpu]`, … (default: the device's variant alone).
         #[arg(long, value_delimiter = ',', value_parser = shadowgraph::exec::KernelLayout::parse, conflicts_with = "lookup")]
         layouts: Vec<shadowgraph::exec::KernelLayout>,
+        /// Time each kernel compiled from each of these folders of `.wgsl` replacements in
+        /// turn (as SHADOWGRAPH_KERNEL_DIR reads one; `shipped`: the embedded kernels), in one
+        /// process, rows named `<kernel> [<folder's name>]`: kernel variants side by side.
+        #[arg(long, value_delimiter = ',', conflicts_with_all = ["lookup", "layouts"])]
+        kernel_dirs: Vec<PathBuf>,
     },
     /// Sweep techniques and their accuracy knobs, time each on the GPU and measure its error
     /// against ground truth: report.html/.md/.csv/.json, pareto{,_penumbra,_flip}.svg, grid.png
@@ -203,9 +208,26 @@ fn main() {
         Err(e) => e.exit(),
     };
     if let Err(e) = run(args) {
-        eprintln!("error: {e:#}");
+        eprintln!("error: {}", one_line(&e));
         std::process::exit(1);
     }
+}
+
+/// `e` and its causes joined by ": ", each cause left out where the text so far already says
+/// it (`Error::Exec`'s "executor: {0}" names the error that is also its source).
+fn one_line(e: &anyhow::Error) -> String {
+    let mut s = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if s.contains(&text) {
+            continue;
+        }
+        if !s.is_empty() {
+            s.push_str(": ");
+        }
+        s.push_str(&text);
+    }
+    s
 }
 
 fn run(args: Args) -> Result<()> {
@@ -266,6 +288,7 @@ fn run(args: Args) -> Result<()> {
             inputs,
             passes,
             layouts,
+            kernel_dirs,
         } => {
             if lookup.is_some() {
                 // Refused before the first table, not after it.
@@ -308,7 +331,14 @@ fn run(args: Args) -> Result<()> {
                     print!(
                         "{}",
                         shadowgraph::bench::run(
-                            &gpu, &sizes, repeat, &only, inputs, passes, &layouts
+                            &gpu,
+                            &sizes,
+                            repeat,
+                            &only,
+                            inputs,
+                            passes,
+                            &layouts,
+                            &kernel_dirs
                         )?
                     )
                 }

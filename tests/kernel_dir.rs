@@ -365,6 +365,111 @@ fn the_vsm_table_benchmark_variant_builds_the_same_tables() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `bench --kernel-dirs shipped,<folder>,…` times each kernel compiled from each folder in one
+/// process, rows `<kernel> [shipped]` and `<kernel> [<folder's name>]`. A folder's kernel that
+/// does not validate is named; one that reads a binding no node binds is refused by the
+/// executor (so the folder's kernel is what the executor compiles, not the embedded file); a
+/// replaced kernel with another workgroup size (the plan's dispatches assume the shipped one),
+/// a name given twice, `--layouts` beside it and `SHADOWGRAPH_KERNEL_DIR` set under it are each
+/// one line and status 1.
+#[test]
+fn bench_times_kernel_folders_side_by_side() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let variant = root.join("benches/variants/blur_rows_run1");
+    let dirs = format!("shipped,{}", variant.display());
+    let bench = |dirs: &str, envs: &[(&str, &OsStr)]| {
+        let args = [
+            "bench",
+            "--sizes",
+            "64",
+            "--repeat",
+            "1",
+            "--only",
+            "blur rg32f r4",
+            "--kernel-dirs",
+            dirs,
+        ];
+        let args: Vec<&OsStr> = args.iter().map(OsStr::new).collect();
+        shadowgraph(&args, envs)
+    };
+    let o = bench(&dirs, &[]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for row in ["blur rg32f r4 [shipped]", "blur rg32f r4 [blur_rows_run1]"] {
+        assert_eq!(out.matches(row).count(), 1, "`{row}` in {out}");
+    }
+    assert!(
+        out.contains("kernel folders shipped, blur_rows_run1"),
+        "{out}"
+    );
+
+    let dir = temp_dir("bench_dirs");
+    let blur = std::fs::read_to_string(root.join("kernels/blur.wgsl")).unwrap();
+    let broken = dir.join("broken");
+    std::fs::create_dir_all(&broken).unwrap();
+    std::fs::write(
+        broken.join("blur.wgsl"),
+        format!("{blur}\nfn f() -> u32 {{\n    return 1.5;\n}}\n"),
+    )
+    .unwrap();
+    refused(
+        &bench(&format!("shipped,{}", broken.display()), &[]),
+        &["--kernel-dirs", "broken", "kernel `blur`"],
+    );
+    let wide = dir.join("wide");
+    std::fs::create_dir_all(&wide).unwrap();
+    let from = "@compute @workgroup_size(WG_SIZE)";
+    assert!(blur.contains(from), "blur.wgsl: `{from}` moved");
+    std::fs::write(
+        wide.join("blur.wgsl"),
+        blur.replace(from, "@compute @workgroup_size(32)"),
+    )
+    .unwrap();
+    refused(
+        &bench(&format!("shipped,{}", wide.display()), &[]),
+        &["wide", "kernel `blur`", "workgroup size"],
+    );
+    // A variant that validates and keeps the geometry but reads a binding no node binds: only
+    // the executor's pipeline meets it, so the refusal says the folder's kernel is what runs.
+    let extra = dir.join("extra");
+    std::fs::create_dir_all(&extra).unwrap();
+    let entry = "fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {\n";
+    assert!(blur.contains(entry), "blur.wgsl: its `main` moved");
+    let with_extra = blur
+        .replace(entry, &format!("{entry}    _ = sg_extra[li];\n"))
+        .replace(
+            from,
+            &format!("@group(0) @binding(9) var<storage, read> sg_extra: array<u32>;\n\n{from}"),
+        );
+    std::fs::write(extra.join("blur.wgsl"), with_extra).unwrap();
+    refused(
+        &bench(&format!("shipped,{}", extra.display()), &[]),
+        &["binds nothing to `sg_extra`"],
+    );
+    refused(
+        &bench("shipped,shipped", &[]),
+        &["--kernel-dirs", "`shipped` twice"],
+    );
+    refused(
+        &bench(&dirs, &[(KERNEL_DIR_ENV, variant.as_os_str())]),
+        &["--kernel-dirs", KERNEL_DIR_ENV],
+    );
+    let args: Vec<&OsStr> = [
+        "bench",
+        "--sizes",
+        "64",
+        "--layouts",
+        "gpu",
+        "--kernel-dirs",
+        "shipped",
+    ]
+    .iter()
+    .map(OsStr::new)
+    .collect();
+    refused(&shadowgraph(&args, &[]), &["cannot be used with"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Files are named by their path below the folder (`shared/` for modules); anything else is
 /// refused by name.
 #[test]

@@ -622,29 +622,137 @@ pub fn measure_layouts(
     inputs: Inputs,
     layouts: &[KernelLayout],
 ) -> Result<Vec<BenchRow>> {
+    let variants: Vec<KernelVariant> = layouts.iter().map(|&l| KernelVariant::layout(l)).collect();
+    measure_variants(device, queue, sizes, repeat, only, inputs, &variants)
+}
+
+/// One way to compile the kernels that [`measure_variants`] times beside others: a layout
+/// (`--layouts`) or a folder of replacement kernels (`--kernel-dirs`), named in its rows.
+pub struct KernelVariant {
+    /// The rows' suffix, `<case> [name]`: `gpu`, `cpu`, `shipped` or the folder's name.
+    pub name: String,
+    layout: Option<KernelLayout>,
+    replaced: Option<std::sync::Arc<crate::kernels::Replacements>>,
+}
+
+/// The `--kernel-dirs` entry that stands for the embedded kernels.
+pub const SHIPPED: &str = "shipped";
+
+impl KernelVariant {
+    /// The kernels in `layout` (`exec::KernelLayout`).
+    pub fn layout(layout: KernelLayout) -> Self {
+        Self {
+            name: layout.name().to_string(),
+            layout: Some(layout),
+            replaced: None,
+        }
+    }
+
+    /// The embedded kernels, named [`SHIPPED`].
+    pub fn shipped() -> Self {
+        Self {
+            name: SHIPPED.to_string(),
+            layout: None,
+            replaced: None,
+        }
+    }
+
+    /// The kernels with the `.wgsl` files of `dir` in place of those they name (as
+    /// [`crate::kernels::KERNEL_DIR_ENV`] reads a folder), named by the folder's last
+    /// component; [`SHIPPED`] is [`KernelVariant::shipped`]. A folder that cannot be read, a
+    /// file naming no kernel, or a replaced kernel whose workgroup size or `TEXELS_X` differs
+    /// from the shipped one's (the plan's dispatches assume the shipped geometry) is an error
+    /// naming it.
+    pub fn folder(dir: &std::path::Path) -> Result<Self> {
+        if dir.as_os_str() == SHIPPED {
+            return Ok(Self::shipped());
+        }
+        let replaced = crate::kernels::read_replacements(dir).map_err(Error::Invalid)?;
+        for name in crate::kernels::KernelId::ALL.iter().map(|k| k.name()) {
+            let variant = crate::kernels::resolve_in(name, None, Some(&replaced));
+            let shipped = crate::kernels::resolve(name, None);
+            let (Ok(variant), Ok(shipped)) = (variant, shipped) else {
+                continue; // a kernel with a `// #generated` block (the shading pass)
+            };
+            if variant == shipped {
+                continue;
+            }
+            let origin = format!("--kernel-dirs {}", dir.display());
+            let (_, v) = crate::kernels::reflect_replaced(name, &variant, &origin)?;
+            let (_, k) = crate::kernels::reflect(name, &shipped)?;
+            if v.workgroup_size != k.workgroup_size || v.texels_x != k.texels_x {
+                return Err(Error::Invalid(format!(
+                    "--kernel-dirs {}: kernel `{name}`'s workgroup size is {:?} and its \
+                     TEXELS_X {} where the shipped one's are {:?} and {}: the plan's \
+                     dispatches assume the shipped geometry",
+                    dir.display(),
+                    v.workgroup_size,
+                    v.texels_x,
+                    k.workgroup_size,
+                    k.texels_x
+                )));
+            }
+        }
+        let name = dir
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_else(|| dir.display().to_string());
+        Ok(Self {
+            name,
+            layout: None,
+            replaced: Some(std::sync::Arc::new(replaced)),
+        })
+    }
+
+    /// An executor compiling its kernels this way.
+    fn executor(&self) -> Executor {
+        let mut e = Executor::new();
+        if let Some(layout) = self.layout {
+            e.kernels.set_layout(layout);
+        }
+        if let Some(replaced) = &self.replaced {
+            e.kernels.set_replacements(replaced.clone());
+        }
+        e
+    }
+}
+
+/// [`measure`], each case timed in each of `variants` in turn, adjacent in time (one warm-up,
+/// one clock, one set of copies), its rows named `<case> [<variant>]`; no variants: the
+/// device's kernels, rows named by their case alone. Two variants of one name are refused.
+pub fn measure_variants(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    sizes: &[u32],
+    repeat: u32,
+    only: &[String],
+    inputs: Inputs,
+    variants: &[KernelVariant],
+) -> Result<Vec<BenchRow>> {
     check_args(device, sizes, repeat)?;
-    if let Some((k, l)) = layouts
+    if let Some((k, v)) = variants
         .iter()
         .enumerate()
-        .find(|(k, l)| layouts[..*k].contains(l))
+        .find(|(k, v)| variants[..*k].iter().any(|u| u.name == v.name))
     {
+        let flag = if v.layout.is_some() {
+            "--layouts"
+        } else {
+            "--kernel-dirs"
+        };
         return Err(Error::Invalid(format!(
-            "--layouts names `{}` twice (entry {})",
-            l.name(),
+            "{flag} names `{}` twice (entry {})",
+            v.name,
             k + 1
         )));
     }
     let cases = select_cases(only)?;
     harness::timer(device, queue, 1)?;
     let mut executor = Executor::new();
-    // One executor a layout (its own pipelines), or the device's layout unnamed.
-    let mut variants: Vec<(String, Executor)> = layouts
+    // One executor a variant (its own pipelines), or the device's kernels unnamed.
+    let mut variants: Vec<(String, Executor)> = variants
         .iter()
-        .map(|&layout| {
-            let mut e = Executor::new();
-            e.kernels.set_layout(layout);
-            (format!(" [{}]", layout.name()), e)
-        })
+        .map(|v| (format!(" [{}]", v.name), v.executor()))
         .collect();
     let mut rows = Vec::new();
     for &n in sizes {
@@ -741,7 +849,11 @@ pub fn measure_layouts(
     Ok(rows)
 }
 
-/// Runs [`measure`] on `gpu` and formats the report.
+/// Runs [`measure`] on `gpu` and formats the report: each kernel in each of `layouts` in turn
+/// (`--layouts`), or in each folder of `kernel_dirs` (`--kernel-dirs`, [`KernelVariant::folder`];
+/// [`SHIPPED`] the embedded kernels), or the device's kernels alone. Layouts and folders are
+/// not combined.
+#[allow(clippy::too_many_arguments)]
 pub fn run(
     gpu: &Gpu,
     sizes: &[u32],
@@ -750,26 +862,50 @@ pub fn run(
     inputs: Inputs,
     passes: bool,
     layouts: &[KernelLayout],
+    kernel_dirs: &[std::path::PathBuf],
 ) -> Result<String> {
-    let rows = measure_layouts(
+    if !layouts.is_empty() && !kernel_dirs.is_empty() {
+        return Err(Error::Invalid(
+            "--layouts and --kernel-dirs: give one of them".into(),
+        ));
+    }
+    if !kernel_dirs.is_empty() && std::env::var_os(crate::kernels::KERNEL_DIR_ENV).is_some() {
+        return Err(Error::Invalid(format!(
+            "--kernel-dirs with {} set: its replacements would lie under every folder, \
+             `{SHIPPED}` included; unset it",
+            crate::kernels::KERNEL_DIR_ENV
+        )));
+    }
+    let variants: Vec<KernelVariant> = if kernel_dirs.is_empty() {
+        layouts.iter().map(|&l| KernelVariant::layout(l)).collect()
+    } else {
+        kernel_dirs
+            .iter()
+            .map(|d| KernelVariant::folder(d))
+            .collect::<Result<_>>()?
+    };
+    let rows = measure_variants(
         &gpu.device,
         &gpu.queue,
         sizes,
         repeat,
         only,
         inputs,
-        layouts,
+        &variants,
     )?;
     let cpu = gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu;
     // Which layout the kernels ran in: the rows say it under `--layouts`.
-    let layout = if layouts.is_empty() {
-        format!(
-            "kernel layout {}",
-            KernelLayout::for_device(&gpu.device)?.name()
-        )
-    } else {
-        let names: Vec<&str> = layouts.iter().map(|l| l.name()).collect();
+    let device_layout = KernelLayout::for_device(&gpu.device)?.name();
+    let names: Vec<&str> = variants.iter().map(|v| v.name.as_str()).collect();
+    let layout = if variants.is_empty() {
+        format!("kernel layout {device_layout}")
+    } else if kernel_dirs.is_empty() {
         format!("kernel layouts {}, each kernel in each", names.join(", "))
+    } else {
+        format!(
+            "kernel layout {device_layout}; kernel folders {}, each kernel in each",
+            names.join(", ")
+        )
     };
     Ok(format_table(
         &format!("{} ({layout})", gpu.describe()),
@@ -1097,14 +1233,14 @@ mod tests {
         assert_eq!(copies, COPY_FORMATS.len());
         // The report's first line says which layout the kernels ran in.
         let only = ["linearize".to_string()];
-        let both = run(&gpu, &[32], 1, &only, Inputs::Random, false, &layouts).unwrap();
+        let both = run(&gpu, &[32], 1, &only, Inputs::Random, false, &layouts, &[]).unwrap();
         let first = both.lines().next().unwrap_or_default();
         assert!(
             first.ends_with("(kernel layouts gpu, cpu, each kernel in each)"),
             "{first}"
         );
         let device = KernelLayout::for_device(&gpu.device).unwrap().name();
-        let one = run(&gpu, &[32], 1, &only, Inputs::Random, false, &[]).unwrap();
+        let one = run(&gpu, &[32], 1, &only, Inputs::Random, false, &[], &[]).unwrap();
         let first = one.lines().next().unwrap_or_default();
         assert!(
             first.ends_with(&format!("(kernel layout {device})")),

@@ -175,9 +175,20 @@ pub struct KernelCache {
     kernels: HashMap<String, Arc<ComputeKernel>>,
     /// The layout kernels compile in; `None`: [`KernelLayout::for_device`].
     layout: Option<KernelLayout>,
+    /// Kernels compiled from these texts instead of the embedded ones (and
+    /// [`kernels::KERNEL_DIR_ENV`]'s), where they name them.
+    replaced: Option<Arc<kernels::Replacements>>,
 }
 
 impl KernelCache {
+    /// Compiles every kernel from now on with `replaced` in place of the files it names (the
+    /// pipelines made so far are dropped): kernel variants side by side in one process
+    /// (`shadowgraph bench --kernel-dirs`).
+    pub fn set_replacements(&mut self, replaced: Arc<kernels::Replacements>) {
+        self.replaced = Some(replaced);
+        self.kernels.clear();
+    }
+
     /// Compiles every kernel from now on in `layout` whatever the device (the pipelines made
     /// so far are dropped): both layouts tested on one device.
     pub fn set_layout(&mut self, layout: KernelLayout) {
@@ -219,7 +230,7 @@ impl KernelCache {
         if let Some(k) = self.kernels.get(&key) {
             return Ok(k.clone());
         }
-        let wgsl = apply(name, &changes)?;
+        let wgsl = apply(name, &changes, self.replaced.as_deref())?;
         let k = Arc::new(self.compile(device, name, &wgsl)?);
         self.kernels.insert(key, k.clone());
         Ok(k)
@@ -236,7 +247,7 @@ impl KernelCache {
         if let Some(k) = self.kernels.get(&key) {
             return Ok(k.clone());
         }
-        let wgsl = kernels::resolve(name, generated)?;
+        let wgsl = kernels::resolve_in(name, generated, self.replaced.as_deref())?;
         let k = Arc::new(self.compile(device, name, &wgsl)?);
         self.kernels.insert(key, k.clone());
         Ok(k)
@@ -256,7 +267,7 @@ impl KernelCache {
         if let Some(k) = self.kernels.get(key) {
             return Ok(k.clone());
         }
-        let wgsl = kernels::resolve(name, Some(&generated()))?;
+        let wgsl = kernels::resolve_in(name, Some(&generated()), self.replaced.as_deref())?;
         let k = Arc::new(self.compile(device, name, &wgsl)?);
         self.kernels.insert(key.to_string(), k.clone());
         Ok(k)
@@ -325,7 +336,7 @@ pub(super) fn no_layout(kernel: &str) -> Error {
 /// validates every variant a technique can bind).
 pub fn specialized_source(name: &str, formats: &[(String, wgpu::TextureFormat)]) -> Result<String> {
     let (_, reflection) = kernels::reflect(name, &kernels::resolve(name, None)?)?;
-    apply(name, &changes(name, &reflection, formats)?)
+    apply(name, &changes(name, &reflection, formats)?, None)
 }
 
 /// The changes binding `formats` to kernel `name` needs.
@@ -348,9 +359,9 @@ fn changes(
     Ok(changes)
 }
 
-/// Kernel `name`'s resolved WGSL with `changes` applied.
-fn apply(name: &str, changes: &[Change]) -> Result<String> {
-    let mut wgsl = kernels::resolve(name, None)?;
+/// Kernel `name`'s resolved WGSL (with `extra`'s replacements) with `changes` applied.
+fn apply(name: &str, changes: &[Change], extra: Option<&kernels::Replacements>) -> Result<String> {
+    let mut wgsl = kernels::resolve_in(name, None, extra)?;
     for change in changes {
         wgsl = change.apply(&wgsl).ok_or_else(|| Error::Kernel {
             kernel: name.to_string(),
