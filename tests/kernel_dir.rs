@@ -446,6 +446,11 @@ fn bench_times_kernel_folders_side_by_side() {
         &bench(&format!("shipped,{}", extra.display()), &[]),
         &["binds nothing to `sg_extra`"],
     );
+    let missing = dir.join("missing");
+    refused(
+        &bench(&format!("shipped,{}", missing.display()), &[]),
+        &["--kernel-dirs: ", "missing"],
+    );
     refused(
         &bench("shipped,shipped", &[]),
         &["--kernel-dirs", "`shipped` twice"],

@@ -667,7 +667,10 @@ impl KernelVariant {
         if dir.as_os_str() == SHIPPED {
             return Ok(Self::shipped());
         }
-        let replaced = crate::kernels::read_replacements(dir).map_err(Error::Invalid)?;
+        // Its messages name the environment variable that usually gives the folder.
+        let env = format!("{}: ", crate::kernels::KERNEL_DIR_ENV);
+        let replaced = crate::kernels::read_replacements(dir)
+            .map_err(|e| Error::Invalid(e.replacen(&env, "--kernel-dirs: ", 1)))?;
         for name in crate::kernels::KernelId::ALL.iter().map(|k| k.name()) {
             let variant = crate::kernels::resolve_in(name, None, Some(&replaced));
             let shipped = crate::kernels::resolve(name, None);
