@@ -416,8 +416,9 @@ fn warn_non_finite(report: &mut String, entries: &[ManifestEntry]) {
 }
 
 /// `shadowgraph dump`: renders `scene` and writes every resource of the executed plan (or only
-/// the resource named `only`) into `out` (created if missing) as OpenEXR, PNG previews and
-/// `manifest.json`. Returns one line per file written. An unknown `only` is
+/// the resource named `only`: a texture, or one of the tables interleaved in one, whose
+/// texture named by `only` writes each of them) into `out` (created if missing) as OpenEXR,
+/// PNG previews and `manifest.json`. Returns one line per file written. An unknown `only` is
 /// [`Error::Invalid`], listing the resource names.
 pub fn dump(gpu: &Gpu, scene: &Path, out: &Path, only: Option<&str>) -> Result<String> {
     let loaded = Scene::load(scene)?;
@@ -428,11 +429,16 @@ pub fn dump(gpu: &Gpu, scene: &Path, out: &Path, only: Option<&str>) -> Result<S
     };
     let sp = plan_lights_for(&loaded.lights, &opts)?;
     if let Some(name) = only {
+        // The plan's textures, and the tables interleaved in one of them, which are dumped
+        // (and named) one by one.
         let names: Vec<&str> = sp
             .plan
             .resources
             .iter()
-            .map(|r| r.resource.name.as_str())
+            .flat_map(|r| {
+                std::iter::once(r.resource.name.as_str())
+                    .chain(r.resource.layers.iter().map(String::as_str))
+            })
             .collect();
         if !names.contains(&name) {
             return Err(Error::Invalid(format!(
@@ -455,7 +461,8 @@ pub fn dump(gpu: &Gpu, scene: &Path, out: &Path, only: Option<&str>) -> Result<S
     let mut entries = Vec::new();
     for res in &frame.resources {
         let name = res.levels.first().map(|l| l.resource.as_str());
-        if only.is_none() || name == only {
+        // An interleaved texture named by `only` is dumped as the tables it holds.
+        if only.is_none() || name == only || only == Some(res.texture.as_str()) {
             write_resource(&mut w, res, &mut entries)?;
         }
     }

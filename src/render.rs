@@ -180,6 +180,10 @@ pub struct DumpedResource {
     pub producer: Option<String>,
     /// Texel format.
     pub format: wgpu::TextureFormat,
+    /// The plan's resource (texture) it was read from: its own name, or for a table
+    /// interleaved with others in one texture ([`crate::graph::Graph::interleaved`]) that
+    /// texture's.
+    pub texture: String,
 }
 
 /// A rendered frame read back to the CPU.
@@ -437,6 +441,7 @@ fn dump_resources(
                     light: r.resource.light,
                     producer: producer.clone(),
                     format: r.resource.format,
+                    texture: name.clone(),
                 })
                 .collect::<Vec<_>>())
         })

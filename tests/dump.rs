@@ -318,6 +318,54 @@ fn only_dumps_one_resource() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Tables interleaved in one texture (CSM's four, `techniques/csm_sat.toml`) are dumped one by
+/// one: `--only` the texture writes each of its tables (it wrote nothing, silently, before
+/// 2026-11-27's fifteenth session), and `--only` one table's name, which a full dump writes,
+/// writes that table, the same values as the full dump's.
+#[test]
+fn only_an_interleaved_texture_or_one_of_its_tables() {
+    let g = common::gpu();
+    let path = scene("techniques/csm_sat.toml");
+    let all = temp_dir("only_layers_all");
+    dump::dump(&g, &path, &all, None).expect("dump");
+    let tables = [
+        "light0.csm0.sat",
+        "light0.csm1.sat",
+        "light0.csm2.sat",
+        "light0.csm3.sat",
+    ];
+    for t in tables {
+        assert!(
+            all.join(format!("{t}.exr")).exists(),
+            "{t} in the full dump"
+        );
+    }
+    let texture = temp_dir("only_layers_texture");
+    dump::dump(&g, &path, &texture, Some("light0.csm.sat.layers0")).expect("dump");
+    let exrs: BTreeSet<String> = files_in(&texture)
+        .into_iter()
+        .filter(|f| f.ends_with(".exr"))
+        .collect();
+    let want: BTreeSet<String> = tables.iter().map(|t| format!("{t}.exr")).collect();
+    assert_eq!(exrs, want);
+    let one = temp_dir("only_layers_one");
+    dump::dump(&g, &path, &one, Some("light0.csm2.sat")).expect("dump");
+    let exrs: Vec<String> = files_in(&one)
+        .into_iter()
+        .filter(|f| f.ends_with(".exr"))
+        .collect();
+    assert_eq!(exrs, ["light0.csm2.sat.exr"]);
+    let full = read_exr(&all.join("light0.csm2.sat.exr"));
+    assert_eq!(read_exr(&one.join("light0.csm2.sat.exr")), full);
+    assert!(
+        full.values().flatten().any(|&v| v != 0.0),
+        "csm2's table is all zeros"
+    );
+    for d in [all, texture, one] {
+        let _ = std::fs::remove_dir_all(&d);
+    }
+}
+
 #[test]
 fn unknown_only_is_an_error_naming_the_resources() {
     let g = common::gpu();
