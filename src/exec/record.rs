@@ -171,6 +171,20 @@ pub(super) fn bind_step(
         });
     }
     let wg = kernel.reflection.workgroup_size.unwrap_or([1, 1, 1]);
+    // A line an invocation: the node counts its lines a workgroup, which must be the kernel's
+    // workgroup (a variant with another would leave lines out or run past them).
+    if let Some(per_group) = node.dispatch.lines_per_group()
+        && per_group != wg[0]
+    {
+        return Err(Error::Kernel {
+            kernel: node.kernel.name().to_string(),
+            message: format!(
+                "node `{}` dispatches {per_group} lines a workgroup, but the kernel's workgroup \
+                 is {} invocations",
+                node.name, wg[0]
+            ),
+        });
+    }
     let size = |r: &str| textures.get(r).map(|t| (t.width(), t.height()));
     let mut dispatches = Vec::new();
     for (k, spec) in specs.iter().enumerate() {

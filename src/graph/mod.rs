@@ -165,6 +165,17 @@ impl Node {
 }
 
 impl Dispatch {
+    /// The lines a workgroup of a [`Dispatch::Lines`] covers (within [`Dispatch::Layers`] or
+    /// [`Dispatch::Interleaved`] too): the kernel's workgroup size it assumes. `None` for the
+    /// other kinds.
+    pub fn lines_per_group(&self) -> Option<u32> {
+        match self {
+            Self::Lines { per_group, .. } => Some(*per_group),
+            Self::Layers { base, .. } | Self::Interleaved { base, .. } => base.lines_per_group(),
+            _ => None,
+        }
+    }
+
     /// Workgroup counts of a dispatch of a kernel whose workgroup is `workgroup`, with
     /// `size(resource)` the planned `(width, height)` of a resource; `None` when a resource it
     /// counts is unknown, or for [`Dispatch::Several`] (each of which has its own).
