@@ -10,8 +10,8 @@
 # variant with `hard` alone about 12 s (with `vssm` too perhaps 20 s), every kernel at 2048²
 # 20 s, 4096²/8192² 123 s, a kernel bench process at two sizes about 8 s of texture copies
 # before its kernels. In order now: soft table, four shading shapes (about 80 s), the blur's
-# row variants (two processes, `bench --kernel-dirs`, perhaps 35 s), VSM's table variant (two,
-# 25 s), the mip variant (two, 20 s), every kernel at 2048², 4096²/8192², the fused ablation
+# row variants (two processes, `bench --kernel-dirs`, perhaps 35 s), the tables' two variants
+# (two, 30 s), the mip variant (two, 20 s), every kernel at 2048², 4096²/8192², the fused ablation
 # (one, 10 s), one round of the layouts, the bunny frame: about 420 s, with BASE about 60 s
 # more. Give the call 520 s (the machine's start, about 50 s, counts too); a step cut off by
 # the call's end loses only the steps after it.
@@ -34,6 +34,11 @@
 # - variants.txt, VSM's table: tile sums + tiles of sat_vsm_texel against shipped for `chain
 #   vssm`. Faster: VSM's sub-block fill becomes `!GPU_LAYOUT` only (sat_tile.wgsl's existing
 #   override), its per-texel branch the GPU's; `tests/sat.rs` already builds both layouts.
+# - variants.txt, sat_sub2: tile sums + tiles against shipped for `sat fixed`, `chain vssm`,
+#   `chain msm_soft` and CSSM, both rounds agreeing. Faster: the 2 x 2 sub-blocks ship for
+#   GPUs (SUB, GRID and the tile kernels' workgroup size from exec::KernelLayout, the carries
+#   kernel keeping 64; its f32 tables then differ from llvmpipe's in their last bits, within
+#   tests/sat.rs's tolerances) or everywhere if the suite's time allows.
 # - variants.txt, mips: mip_quads faster at 2048² and 4096² in both rounds ships everywhere
 #   (llvmpipe as fast or faster): copy it over kernels/shared/mip_chain.wgsl, less its header.
 set -u
@@ -161,9 +166,15 @@ done
 # shipped 4 x 4 sub-block of depths in private arrays (H200, fourteenth session: VSM's tile
 # sums 0.110 ms at 2048² against MSM's 0.063; llvmpipe 1.3x slower with the variant), the same
 # tables bit for bit, alternated twice.
-for dirs in shipped,benches/variants/sat_vsm_texel benches/variants/sat_vsm_texel,shipped; do
-    step variants.txt 40 "$B" bench --sizes 2048,4096 --repeat 20 \
-        --only 'chain vssm,chain msm_soft' --passes --kernel-dirs "$dirs"
+# And the tables' tile passes with 2 x 2 sub-blocks, 256 invocations a tile
+# (benches/variants/sat_sub2: lanes 2 texels apart instead of 4, four times the invocations;
+# fixed-point tables bit for bit the same; llvmpipe 1.15-1.5x slower).
+TV=benches/variants/sat_vsm_texel
+TS=benches/variants/sat_sub2
+for dirs in "shipped,$TV,$TS" "$TS,$TV,shipped"; do
+    step variants.txt 60 "$B" bench --sizes 2048,4096 --repeat 20 \
+        --only 'sat fixed,chain vssm,chain msm_soft,chain cssm 8 terms (depth → 5' --passes \
+        --kernel-dirs "$dirs"
 done
 # The mip chain without level s + 1 in workgroup memory (benches/variants/mip_quads: 5.4 of
 # the shipped kernel's 21.3 KiB, which admits 10 workgroups of 64 an SM; the same chain bit for

@@ -365,12 +365,87 @@ fn the_vsm_table_benchmark_variant_builds_the_same_tables() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `benches/variants/sat_sub2` (the tables' tile passes with 2 × 2 sub-blocks, 256 invocations a
+/// tile, and its own carries kernel) builds every fixed-point table bit for bit as the shipped
+/// 4 × 4 sub-blocks do (integer sums in any order): VSM's, MSM's, ESM's, EVSM's and CSM's
+/// tables computed from the depth, CSSM's interleaved ones (its moment table), at the scenes'
+/// 512² in both kernel layouts and at 300² (ragged tiles) in the CPU layout, ESM's carries
+/// too. A variant whose line sums skip the last line fails it at 459 712 samples.
+#[test]
+fn the_small_sub_block_table_variant_builds_the_same_tables() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let variant = root.join("benches/variants/sat_sub2");
+    let dir = temp_dir("sat_sub2");
+    let cases: [(&str, &[&str]); 6] = [
+        ("vsm_sat.toml", &["light0.vsm.sat"]),
+        ("msm_sat.toml", &["light0.msm.sat"]),
+        (
+            "esm_sat.toml",
+            &["light0.esm.sat", "light0.esm.sat.row_carry"],
+        ),
+        (
+            "evsm4_sat.toml",
+            &["light0.evsm.sat", "light0.evsm.sat.col_part"],
+        ),
+        (
+            "csm_sat.toml",
+            &[
+                "light0.csm0.sat",
+                "light0.csm3.sat",
+                "light0.csm.sat.row_carry",
+            ],
+        ),
+        ("cssm.toml", &["light0.csm1.sat", "light0.csm_moments.sat"]),
+    ];
+    for (scene, resources) in cases {
+        let text = std::fs::read_to_string(root.join("scenes/techniques").join(scene)).unwrap();
+        for size in [512, 300] {
+            let from = "shadow_map = 512";
+            assert!(text.contains(from), "{scene}: `{from}` moved");
+            let path = dir.join(format!("{size}_{scene}"));
+            std::fs::write(&path, text.replace(from, &format!("shadow_map = {size}"))).unwrap();
+            // The GPU layout on the two larger cases only: the suite's time.
+            let layouts: &[&str] = if size == 300 {
+                &["cpu"]
+            } else {
+                &["gpu", "cpu"]
+            };
+            for &layout in layouts {
+                for resource in resources {
+                    let tag = format!("{scene}_{size}_{layout}_{resource}");
+                    let envs = [(KERNEL_LAYOUT_ENV, OsStr::new(layout))];
+                    let shipped =
+                        dumped_chain(&path, resource, &dir.join(format!("s_{tag}")), &envs);
+                    assert_eq!(shipped.len(), 1, "{tag}: one level");
+                    assert!(
+                        shipped[0].iter().filter(|&&v| v != 0).count() > shipped[0].len() / 4,
+                        "{tag}: mostly zeros"
+                    );
+                    let envs = [
+                        (KERNEL_LAYOUT_ENV, OsStr::new(layout)),
+                        (KERNEL_DIR_ENV, variant.as_os_str()),
+                    ];
+                    let got = dumped_chain(&path, resource, &dir.join(format!("v_{tag}")), &envs);
+                    assert_eq!(got.len(), 1, "{tag}: one level");
+                    let differ = shipped[0]
+                        .iter()
+                        .zip(&got[0])
+                        .filter(|(a, b)| a != b)
+                        .count();
+                    assert_eq!(differ, 0, "{tag}: {differ} samples differ");
+                }
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// `bench --kernel-dirs shipped,<folder>,…` times each kernel compiled from each folder in one
 /// process, rows `<kernel> [shipped]` and `<kernel> [<folder's name>]`. A folder's kernel that
 /// does not validate is named; one that reads a binding no node binds is refused by the
-/// executor (so the folder's kernel is what the executor compiles, not the embedded file); a
-/// replaced kernel with another workgroup size (the plan's dispatches assume the shipped one),
-/// a name given twice, `--layouts` beside it and `SHADOWGRAPH_KERNEL_DIR` set under it are each
+/// executor (so the folder's kernel is what the executor compiles, not the embedded file), as
+/// is a kernel dispatched a line an invocation with another workgroup size than its node's
+/// lines a workgroup; a name given twice, `--layouts` beside it and `SHADOWGRAPH_KERNEL_DIR` set under it are each
 /// one line and status 1.
 #[test]
 fn bench_times_kernel_folders_side_by_side() {
@@ -416,18 +491,41 @@ fn bench_times_kernel_folders_side_by_side() {
         &bench(&format!("shipped,{}", broken.display()), &[]),
         &["--kernel-dirs", "broken", "kernel `blur`"],
     );
+    // The tables' carries, dispatched a line an invocation (`Dispatch::Lines`, 64 lines a
+    // workgroup): a variant with another workgroup size is refused by the executor.
     let wide = dir.join("wide");
     std::fs::create_dir_all(&wide).unwrap();
+    let carries = std::fs::read_to_string(root.join("kernels/sat_carries.wgsl")).unwrap();
     let from = "@compute @workgroup_size(WG_SIZE)";
+    assert!(carries.contains(from), "sat_carries.wgsl: `{from}` moved");
     assert!(blur.contains(from), "blur.wgsl: `{from}` moved");
     std::fs::write(
-        wide.join("blur.wgsl"),
-        blur.replace(from, "@compute @workgroup_size(32)"),
+        wide.join("sat_carries.wgsl"),
+        carries.replace(from, "@compute @workgroup_size(32)"),
     )
     .unwrap();
+    let wide_dirs = std::ffi::OsString::from(format!("shipped,{}", wide.display()));
+    let args: Vec<&OsStr> = [
+        "bench",
+        "--sizes",
+        "64",
+        "--repeat",
+        "1",
+        "--only",
+        "sat fixed",
+        "--kernel-dirs",
+    ]
+    .iter()
+    .map(OsStr::new)
+    .chain([wide_dirs.as_os_str()])
+    .collect();
     refused(
-        &bench(&format!("shipped,{}", wide.display()), &[]),
-        &["wide", "kernel `blur`", "workgroup size"],
+        &shadowgraph(&args, &[]),
+        &[
+            "kernel `sat_carries`",
+            "64 lines a workgroup",
+            "32 invocations",
+        ],
     );
     // A variant that validates and keeps the geometry but reads a binding no node binds: only
     // the executor's pipeline meets it, so the refusal says the folder's kernel is what runs.
