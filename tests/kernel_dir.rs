@@ -445,7 +445,8 @@ fn the_small_sub_block_table_variant_builds_the_same_tables() {
 /// does not validate is named; one that reads a binding no node binds is refused by the
 /// executor (so the folder's kernel is what the executor compiles, not the embedded file), as
 /// is a kernel dispatched a line an invocation with another workgroup size than its node's
-/// lines a workgroup; a name given twice, `--layouts` beside it and `SHADOWGRAPH_KERNEL_DIR` set under it are each
+/// lines a workgroup; a folder that replaces nothing or cannot be read, a name given twice,
+/// `--layouts` beside it and `SHADOWGRAPH_KERNEL_DIR` set under it are each
 /// one line and status 1.
 #[test]
 fn bench_times_kernel_folders_side_by_side() {
@@ -543,6 +544,12 @@ fn bench_times_kernel_folders_side_by_side() {
     refused(
         &bench(&format!("shipped,{}", extra.display()), &[]),
         &["binds nothing to `sg_extra`"],
+    );
+    let empty = dir.join("empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    refused(
+        &bench(&format!("shipped,{}", empty.display()), &[]),
+        &["--kernel-dirs", "empty", "replaces no kernel"],
     );
     let missing = dir.join("missing");
     refused(

@@ -659,9 +659,9 @@ impl KernelVariant {
 
     /// The kernels with the `.wgsl` files of `dir` in place of those they name (as
     /// [`crate::kernels::KERNEL_DIR_ENV`] reads a folder), named by the folder's last
-    /// component; [`SHIPPED`] is [`KernelVariant::shipped`]. A folder that cannot be read, a
-    /// file naming no kernel, or a replaced kernel that does not validate is an error naming
-    /// it. The plan (its dispatches' geometry, the bytes of the rows) is the shipped kernels':
+    /// component; [`SHIPPED`] is [`KernelVariant::shipped`]. A folder that cannot be read or
+    /// replaces nothing, a file naming no kernel, or a replaced kernel that does not validate
+    /// is an error naming it. The plan (its dispatches' geometry, the bytes of the rows) is the shipped kernels':
     /// a variant may change a kernel's workgroup size only where its node's dispatch does not
     /// follow it (the tables' tile passes: one workgroup a tile), as a variant's bit-for-bit
     /// test shows; one dispatched a line an invocation is refused by the executor.
@@ -673,6 +673,13 @@ impl KernelVariant {
         let env = format!("{}: ", crate::kernels::KERNEL_DIR_ENV);
         let replaced = crate::kernels::read_replacements(dir)
             .map_err(|e| Error::Invalid(e.replacen(&env, "--kernel-dirs: ", 1)))?;
+        if replaced.is_empty() {
+            return Err(Error::Invalid(format!(
+                "--kernel-dirs {}: replaces no kernel (no `.wgsl` file naming one; `{SHIPPED}` \
+                 stands for the embedded kernels)",
+                dir.display()
+            )));
+        }
         // Each replaced kernel validated here, so that an error is one line naming the folder.
         let origin = format!("--kernel-dirs {}", dir.display());
         for name in crate::kernels::KernelId::ALL.iter().map(|k| k.name()) {
