@@ -580,6 +580,78 @@ fn bench_times_kernel_folders_side_by_side() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Each benchmark variant in `benches/variants/<name>/` is a whole-file copy of a shipped kernel
+/// with a few lines changed (`SHADOWGRAPH_KERNEL_DIR` and `bench --kernel-dirs` replace whole
+/// files), so a later change to the shipped file would leave the variant timing the old code
+/// while its bit-for-bit test still passed. This pins, for every variant file, how many of the
+/// shipped file's lines it lacks and how many of its own the shipped file lacks (as multisets):
+/// an edit to either side moves a count and fails here, naming the file to bring up to date.
+/// Every file below `benches/variants` must be listed.
+#[test]
+fn benchmark_variants_track_the_shipped_kernels() {
+    use std::collections::HashMap;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    // (variant file below benches/variants/<name>/, its lines missing, its own lines added)
+    let expected: HashMap<&str, (usize, usize)> = HashMap::from([
+        ("blur_rows_run1/blur.wgsl", (3, 21)),
+        ("blur_rows_run2/blur.wgsl", (2, 7)),
+        ("mip_quads/shared/mip_chain.wgsl", (23, 21)),
+        ("sat_sub2/sat_carries.wgsl", (9, 16)),
+        ("sat_sub2/shared/sat_tile.wgsl", (5, 16)),
+        ("sat_sub2/shared/sat_tile_scan.wgsl", (8, 15)),
+        ("sat_sub2/shared/sat_tile_sums.wgsl", (11, 23)),
+        ("sat_vsm_texel/shared/sat_tile_texel.wgsl", (1, 18)),
+    ]);
+    let counts = |text: &str| {
+        let mut m: HashMap<String, usize> = HashMap::new();
+        for line in text.lines() {
+            *m.entry(line.to_string()).or_default() += 1;
+        }
+        m
+    };
+    let only_in = |a: &HashMap<String, usize>, b: &HashMap<String, usize>| -> usize {
+        a.iter()
+            .map(|(line, n)| n.saturating_sub(b.get(line).copied().unwrap_or(0)))
+            .sum()
+    };
+    let variants = root.join("benches/variants");
+    let mut seen = Vec::new();
+    let mut stack = vec![variants.clone()];
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+                continue;
+            }
+            let rel = path.strip_prefix(&variants).unwrap();
+            let key = rel.to_string_lossy().replace('\\', "/");
+            let Some(&(missing, added)) = expected.get(key.as_str()) else {
+                panic!("benches/variants/{key}: not listed here");
+            };
+            // benches/variants/<name>/<path> varies kernels/<path>.
+            let shipped_path = root
+                .join("kernels")
+                .join(rel.components().skip(1).collect::<PathBuf>());
+            let shipped = counts(&std::fs::read_to_string(&shipped_path).unwrap());
+            let variant = counts(&std::fs::read_to_string(&path).unwrap());
+            assert_eq!(
+                (only_in(&shipped, &variant), only_in(&variant, &shipped)),
+                (missing, added),
+                "benches/variants/{key} against {}: the shipped file or the variant changed; \
+                 bring the variant up to date (and its bit-for-bit test), then these counts",
+                shipped_path.display()
+            );
+            seen.push(key);
+        }
+    }
+    assert_eq!(
+        seen.len(),
+        expected.len(),
+        "listed but missing: {expected:?} against {seen:?}"
+    );
+}
+
 /// Files are named by their path below the folder (`shared/` for modules); anything else is
 /// refused by name.
 #[test]
