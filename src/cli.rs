@@ -127,10 +127,7 @@ pub fn render(
         )));
     }
     if let Some(dir) = aux {
-        std::fs::create_dir_all(dir).map_err(|error| Error::Io {
-            path: dir.to_path_buf(),
-            error,
-        })?;
+        crate::io::make_dir(dir)?;
     }
     let mut renderer = Renderer::new(&gpu.device);
     // Timings on a GPU: untimed frames first until its clocks have risen.
@@ -188,10 +185,7 @@ fn warnings(scene: &Scene) -> String {
 }
 
 fn write_aux(dir: &Path, scene: &Scene, frame: &Frame) -> Result<()> {
-    std::fs::create_dir_all(dir).map_err(|error| Error::Io {
-        path: dir.to_path_buf(),
-        error,
-    })?;
+    crate::io::make_dir(dir)?;
     let (w, h) = (frame.width, frame.height);
     write_exr(
         &dir.join("position.exr"),

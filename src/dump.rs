@@ -448,11 +448,9 @@ pub fn dump(gpu: &Gpu, scene: &Path, out: &Path, only: Option<&str>) -> Result<S
             )));
         }
     }
+    // Before the frame: an unusable folder is refused before the GPU work.
+    crate::io::make_dir(out)?;
     let frame = Renderer::new(&gpu.device).render(&gpu.device, &gpu.queue, &loaded, opts)?;
-    std::fs::create_dir_all(out).map_err(|error| Error::Io {
-        path: out.to_path_buf(),
-        error,
-    })?;
     let mut w = Writer {
         out,
         written: HashSet::new(),

@@ -364,9 +364,6 @@ fn light0<T: Copy>(v: &[T], lights: usize) -> Vec<T> {
 
 /// Output folder helper: creates `dir` and names `file` in it.
 fn out_path(dir: &Path, file: &str) -> Result<PathBuf> {
-    std::fs::create_dir_all(dir).map_err(|error| Error::Io {
-        path: dir.to_path_buf(),
-        error,
-    })?;
+    crate::io::make_dir(dir)?;
     Ok(dir.join(file))
 }

@@ -1,8 +1,27 @@
-//! Writing images: PNG previews and 32-bit float OpenEXR with named channels.
+//! Writing images: PNG previews and 32-bit float OpenEXR with named channels, and the output
+//! folders they go into.
 
 use std::path::Path;
 
 use crate::error::{Error, Result};
+
+/// Makes the output folder `dir` (and its parents) if missing. A path that exists as something
+/// other than a folder is refused naming it (the OS says only "File exists").
+pub fn make_dir(dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|error| {
+        if dir.exists() && !dir.is_dir() {
+            Error::Invalid(format!(
+                "{}: exists and is not a folder; name a folder for the output",
+                dir.display()
+            ))
+        } else {
+            Error::Io {
+                path: dir.to_path_buf(),
+                error,
+            }
+        }
+    })
+}
 
 /// Writes 8-bit RGBA pixels as PNG.
 pub fn write_png(path: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<()> {

@@ -145,7 +145,7 @@ enum Command {
         #[arg(long, value_parser = parse_size)]
         image: Option<(u32, u32)>,
         /// Run every MSM configuration at each of these moment biases (default: the storage's).
-        #[arg(long, value_delimiter = ',')]
+        #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
         moment_bias: Option<Vec<f32>>,
     },
     /// Run the numerical-stability suite: each hard input through the real kernels against its

@@ -1,9 +1,10 @@
 //! Unbounded command-line inputs are refused up front, the same way by every command: `--repeat`
 //! is 1 to 1000 for `render`, `evaluate` and `bench`; `evaluate --truth-resolution 0` says what
-//! is wrong; `plan /dev/zero` stops reading; `bench --layouts` takes `gpu` and `cpu` only, each once. Each
-//! is one line and status 1, within seconds (no GPU work starts); so is an `evaluate --out` folder
-//! that cannot be made, and a `render` output that is not a PNG or an `--aux` folder that
-//! cannot be made.
+//! is wrong; `plan /dev/zero` stops reading; `bench --layouts` takes `gpu` and `cpu` only, each
+//! once. Each is one line and status 1, within seconds (no GPU work starts); so are an `evaluate
+//! --out` folder that cannot be made, a `render` output that is not a PNG, an `--aux` folder
+//! that cannot be made, a `dump --out` that names a file, an empty `bench --only` entry and a
+//! `bench --image` past the device.
 
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
@@ -272,10 +273,97 @@ fn render_refuses_its_outputs_before_the_frames() {
             ],
             &["a_file"][..],
         ),
+        (
+            vec![
+                "render",
+                &scene,
+                "-o",
+                png.to_str().unwrap(),
+                "--aux",
+                file.to_str().unwrap(),
+                "--repeat",
+                "1000",
+            ],
+            &["a_file", "exists and is not a folder"][..],
+        ),
     ] {
         refused(&args, needles);
         assert!(shadowgraph(&args).stdout.is_empty());
     }
     assert!(!png.exists() && !jpg.exists());
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `dump --out` naming a file is refused before the frame, saying it is not a folder (the OS's
+/// own words are "File exists").
+#[test]
+fn dump_refuses_a_file_as_its_folder() {
+    let dir = std::env::temp_dir().join(format!("shadowgraph-cli-dump-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("a_file");
+    std::fs::write(&file, b"not a folder").unwrap();
+    let scene = scene();
+    let args = ["dump", &scene, "--out", file.to_str().unwrap()];
+    refused(&args, &["a_file", "exists and is not a folder"]);
+    assert!(shadowgraph(&args).stdout.is_empty());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// An empty entry of `bench --only` (`sat,`, `,`) would keep every kernel, since every name
+/// contains it: refused naming the entry, with and without `--lookup`, before any table. An
+/// `--image` past the device's texture side is named as `--image`, not as the bench's own
+/// scene file; a negative `evaluate --moment-bias` gets its range, not clap's "unexpected
+/// argument".
+#[test]
+fn empty_filters_and_oversized_images_are_named() {
+    for (args, needles) in [
+        (
+            &["bench", "--sizes", "64", "--repeat", "1", "--only", "sat,"][..],
+            &["--only sat,", "entry 2 is empty"][..],
+        ),
+        (
+            &["bench", "--lookup", "3", "--repeat", "1", "--only", ","],
+            &["--lookup --only ,", "entry 1 is empty"],
+        ),
+        (
+            &[
+                "bench",
+                "--lookup",
+                "3",
+                "--repeat",
+                "1",
+                "--image",
+                "100000x48",
+            ],
+            &["--image (width)", "100000"],
+        ),
+        (
+            &[
+                "bench",
+                "--lookup",
+                "3",
+                "--repeat",
+                "1",
+                "--image",
+                "64x100000",
+            ],
+            &["--image (height)", "100000"],
+        ),
+    ] {
+        refused(args, needles);
+        assert!(shadowgraph(args).stdout.is_empty(), "{}", args.join(" "));
+    }
+    let s = scene();
+    let out = std::env::temp_dir().join(format!("shadowgraph-bias-{}", std::process::id()));
+    refused(
+        &[
+            "evaluate",
+            &s,
+            "--out",
+            out.to_str().unwrap(),
+            "--moment-bias",
+            "0.1,-1",
+        ],
+        &["--moment-bias", "-1", "[0, 0.5]"],
+    );
 }

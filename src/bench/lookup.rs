@@ -69,7 +69,7 @@ pub fn lookup_cost(
                 .to_string(),
         ));
     }
-    super::check_map(&gpu.device, map)?;
+    super::check_map(&gpu.device, map, image)?;
     let mut base = crate::scene::Scene::parse(std::path::Path::new("vsm.toml"), LOOKUP_SCENE)?;
     if let Some((w, h)) = image {
         (base.width, base.height) = (w, h);

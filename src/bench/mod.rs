@@ -571,9 +571,24 @@ fn row(name: &str, format: String, n: u32, plan: &Plan, t: Timed) -> Result<Benc
     })
 }
 
+/// Refuses an empty entry of an `--only` list (`--only sat,` or `--only ,`): every name
+/// contains the empty string, so it would keep everything while the user meant a filter.
+pub(crate) fn check_only(flag: &str, only: &[String]) -> Result<()> {
+    match only.iter().position(|o| o.trim().is_empty()) {
+        Some(i) => Err(Error::Invalid(format!(
+            "{flag} {}: entry {} is empty (every name contains it); name part of a kernel or \
+             configuration",
+            only.join(","),
+            i + 1
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// The cases of [`CASES`] whose name contains one of `only` (all of them when `only` is
 /// empty); a filter that names no case is an error listing the names.
 pub fn select_cases(only: &[String]) -> Result<Vec<&'static BenchCase>> {
+    check_only("bench --only", only)?;
     let picked: Vec<&BenchCase> = CASES
         .iter()
         .filter(|c| only.is_empty() || only.iter().any(|o| c.name.contains(o.as_str())))
@@ -1006,11 +1021,18 @@ pub const CPU_CHECKED_MS: f64 = 2.0;
 
 /// A `--map` size the device can make: past its largest texture side it is an error naming
 /// the flag (the scene's own `shadow_map` line would name a key the user did not write).
-fn check_map(device: &wgpu::Device, map: Option<u32>) -> Result<()> {
+/// `bench --lookup`'s `--map` and `--image` against the device's largest texture side, named
+/// by their flags (the scenes they resize are the bench's own, not files the user gave).
+fn check_map(device: &wgpu::Device, map: Option<u32>, image: Option<(u32, u32)>) -> Result<()> {
     let max = device.limits().max_texture_dimension_2d;
-    match map {
-        Some(n) if n > max => Err(Error::Limit {
-            what: "bench --map (shadow-map side)".into(),
+    let sides = [
+        ("bench --map (shadow-map side)", map),
+        ("bench --image (width)", image.map(|(w, _)| w)),
+        ("bench --image (height)", image.map(|(_, h)| h)),
+    ];
+    match sides.into_iter().find(|(_, n)| n.is_some_and(|n| n > max)) {
+        Some((what, Some(n))) => Err(Error::Limit {
+            what: what.into(),
             requested: u64::from(n),
             limit: u64::from(max),
         }),

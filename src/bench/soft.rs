@@ -130,6 +130,7 @@ pub fn check_soft_args(sizes: &[f32], repeat: u32, only: &[String]) -> Result<()
             "soft benchmark light size {s}: sizes are positive world widths"
         )));
     }
+    super::check_only("bench --lookup --only", only)?;
     let named = |name: &str| only.iter().any(|o| name.contains(o.as_str()));
     if !only.is_empty() && !SOFT_TECHNIQUES.iter().any(|(name, _)| named(name)) {
         let names: Vec<&str> = SOFT_TECHNIQUES.iter().map(|(n, _)| *n).collect();
@@ -168,7 +169,7 @@ pub fn soft_cost(
                 .to_string(),
         ));
     }
-    super::check_map(&gpu.device, map)?;
+    super::check_map(&gpu.device, map, image)?;
     let named = |name: &str| only.iter().any(|o| name.contains(o.as_str()));
     let picked: Vec<&(&str, &str)> = SOFT_TECHNIQUES
         .iter()
