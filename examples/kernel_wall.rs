@@ -17,7 +17,7 @@
 
 use std::time::Instant;
 
-use shadowgraph::bench::{BenchCase, CASES, random_imports};
+use shadowgraph::bench::{BenchCase, random_imports};
 use shadowgraph::exec::{ComputeKernel, Executor, wgsl_storage_format};
 use shadowgraph::gpu::{Gpu, submit_and_wait};
 use shadowgraph::graph;
@@ -51,10 +51,19 @@ fn run() -> Result<(), String> {
             "--passes" => passes = true,
             "--min" => MIN.store(true, std::sync::atomic::Ordering::Relaxed),
             "--cpu" => CPU.store(true, std::sync::atomic::Ordering::Relaxed),
+            flag if flag.starts_with('-') => {
+                return Err(format!(
+                    "unknown option `{flag}` (options: --sizes, --repeat, --passes, --min, --cpu)"
+                ));
+            }
             _ => names.push(a),
         }
     }
+    // The bench's own checks: a case filter that names nothing or holds an empty entry, a size
+    // of 0 or past the device, `--repeat 0`.
+    let cases = shadowgraph::bench::select_cases(&names).map_err(|e| e.to_string())?;
     let gpu = Gpu::new().map_err(|e| e.to_string())?;
+    shadowgraph::bench::check_args(&gpu.device, &sizes, repeat).map_err(|e| e.to_string())?;
     println!(
         "wall clock on {}; median of {repeat} after 2 warm-up runs",
         gpu.describe()
@@ -65,10 +74,7 @@ fn run() -> Result<(), String> {
     );
     let mut exec = Executor::new();
     for &n in &sizes {
-        for case in CASES
-            .iter()
-            .filter(|c| names.is_empty() || names.iter().any(|m| c.name.contains(m.as_str())))
-        {
+        for &case in &cases {
             let (ms, copy_ms, format) = time_case(&gpu, &mut exec, case, n, repeat)?;
             if passes {
                 for (name, ms) in time_passes(&gpu, &mut exec, case, n, repeat)? {

@@ -1040,7 +1040,10 @@ fn check_map(device: &wgpu::Device, map: Option<u32>, image: Option<(u32, u32)>)
     }
 }
 
-fn check_args(device: &wgpu::Device, sizes: &[u32], repeat: u32) -> Result<()> {
+/// The kernel benchmark's sizes (at least one, each 1 to the device's largest texture side) and
+/// `repeat` (at least 1), checked before any work; [`run`] and the `kernel_wall` example share
+/// it.
+pub fn check_args(device: &wgpu::Device, sizes: &[u32], repeat: u32) -> Result<()> {
     if sizes.is_empty() {
         return Err(Error::Invalid("no benchmark sizes given".into()));
     }
