@@ -41,7 +41,15 @@ const MODES: &[Mode] = &[
     ),
 ];
 
-fn main() -> anyhow::Result<()> {
+/// Errors as one line, causes joined (`{:#}`), status 1.
+fn main() {
+    if let Err(e) = run() {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn run() -> anyhow::Result<()> {
     let path = std::env::args()
         .nth(1)
         .unwrap_or("scenes/grazing.toml".into());

@@ -4,7 +4,15 @@
 //!
 //!     cargo run --release --example fronts_table -- [DIR]
 
-fn main() -> anyhow::Result<()> {
+/// Errors as one line, causes joined (`{:#}`), status 1.
+fn main() {
+    if let Err(e) = run() {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn run() -> anyhow::Result<()> {
     let dir = std::env::args()
         .nth(1)
         .unwrap_or_else(|| "benches/evaluation".into());

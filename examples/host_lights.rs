@@ -123,7 +123,15 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
 }
 ";
 
-fn main() -> Result<()> {
+/// Errors as one line, causes joined (`{:#}`), status 1.
+fn main() {
+    if let Err(e) = run() {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn run() -> anyhow::Result<()> {
     let out = std::env::args()
         .nth(1)
         .unwrap_or_else(|| "target/host_lights.png".into());

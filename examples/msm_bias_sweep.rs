@@ -8,7 +8,15 @@
 use shadowgraph::gpu::Gpu;
 use shadowgraph::stability::{BiasSweep, bias_table, msm_bias_sweep};
 
-fn main() -> anyhow::Result<()> {
+/// Errors as one line, causes joined (`{:#}`), status 1.
+fn main() {
+    if let Err(e) = run() {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn run() -> anyhow::Result<()> {
     let mut sweep = BiasSweep::default();
     if let Some(list) = std::env::args().nth(1) {
         sweep.alphas = list
