@@ -428,6 +428,11 @@ fn sizes_and_kernels_past_the_device_limits_are_named() {
         e.contains("`vsm_blur`") && e.contains("max_compute_workgroup_storage_size"),
         "{e}"
     );
+    // docs/PLUGIN.md quotes this message as its example: word for word.
+    let guide = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/PLUGIN.md"))
+        .expect("docs/PLUGIN.md")
+        .replace("\n  ", " ");
+    assert!(guide.contains(&e), "docs/PLUGIN.md's example is not `{e}`");
 
     // A device made for WebGL 2 runs no compute shaders: one message says what to request
     // (not the first kernel's workgroup width against a limit of 0).
