@@ -1019,10 +1019,9 @@ pub const CPU_LEAST_SHARE: f64 = 0.5;
 /// 0.3 ms of 0.43), so the wall clock cannot check them.
 pub const CPU_CHECKED_MS: f64 = 2.0;
 
-/// A `--map` size the device can make: past its largest texture side it is an error naming
-/// the flag (the scene's own `shadow_map` line would name a key the user did not write).
-/// `bench --lookup`'s `--map` and `--image` against the device's largest texture side, named
-/// by their flags (the scenes they resize are the bench's own, not files the user gave).
+/// `bench --lookup`'s `--map` and `--image` against the device's largest texture side: past
+/// it an error naming the flag (the bench's own scene file would name a key and a line the
+/// user did not write).
 fn check_map(device: &wgpu::Device, map: Option<u32>, image: Option<(u32, u32)>) -> Result<()> {
     let max = device.limits().max_texture_dimension_2d;
     let sides = [
