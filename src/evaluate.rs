@@ -248,6 +248,12 @@ pub fn check_options(opts: &EvaluateOptions) -> Result<()> {
             "--k 0: the truth needs at least one emitter sample".into(),
         ));
     }
+    let most = crate::truth::MAX_EMITTER_SAMPLES;
+    if let Some(k) = opts.samples.filter(|&k| k as usize > most) {
+        return Err(Error::Invalid(format!(
+            "--k {k}: the truth takes at most {most} emitter samples (a shadow map each)"
+        )));
+    }
     Ok(())
 }
 

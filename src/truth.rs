@@ -44,6 +44,11 @@ const BATCH: usize = 16;
 /// Largest default truth resolution (a 8192² depth map is 256 MiB).
 const MAX_DEFAULT_RESOLUTION: u32 = 8192;
 
+/// Most emitter samples the truth takes: it rasterizes a shadow map a sample and keeps a record
+/// of about half a KiB a sample, so `--k 100000000` asked for 50 GB at once and aborted (and
+/// would render for hours on any GPU). 65 536 is 256 times the default K.
+pub const MAX_EMITTER_SAMPLES: usize = 65_536;
+
 /// Where the emitter is sampled.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Emitter {
@@ -59,6 +64,14 @@ pub enum Emitter {
 }
 
 impl Emitter {
+    /// How many samples it takes (before any are made).
+    pub fn count(&self) -> usize {
+        match self {
+            Emitter::Stratified { k, .. } => *k as usize,
+            Emitter::Offsets(o) => o.len(),
+        }
+    }
+
     /// The offsets (units of the light's size).
     pub fn offsets(&self) -> Vec<[f64; 2]> {
         match self {
@@ -154,6 +167,13 @@ pub fn area_light_truth(
     scene: &Scene,
     opts: &TruthOptions,
 ) -> Result<Truth> {
+    if opts.emitter.count() > MAX_EMITTER_SAMPLES {
+        return Err(Error::Limit {
+            what: "truth emitter samples (K)".into(),
+            requested: opts.emitter.count() as u64,
+            limit: MAX_EMITTER_SAMPLES as u64,
+        });
+    }
     let offsets = opts.emitter.offsets();
     if offsets.is_empty()
         || offsets

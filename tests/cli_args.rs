@@ -120,6 +120,12 @@ fn library_entry_points_check_the_same_bounds() {
         .to_string();
     assert!(shown.contains("--truth-resolution 0"), "{shown}");
     opts.truth_resolution = None;
+    opts.samples = Some(shadowgraph::truth::MAX_EMITTER_SAMPLES as u32 + 1);
+    let shown = shadowgraph::evaluate::check_options(&opts)
+        .unwrap_err()
+        .to_string();
+    assert!(shown.contains("--k 65537"), "{shown}");
+    opts.samples = None;
     shadowgraph::evaluate::check_options(&opts).expect("defaults are valid");
 }
 
@@ -366,4 +372,18 @@ fn empty_filters_and_oversized_images_are_named() {
         ],
         &["--moment-bias", "-1", "[0, 0.5]"],
     );
+    // A bias no configuration of the sweep takes, and more emitter samples than the truth
+    // takes (10⁸ aborted on a 50 GB allocation).
+    for (extra, needles) in [
+        (
+            &["--techniques", "hard,pcss", "--moment-bias", "0.1"][..],
+            &["--moment-bias", "no technique", "msm, msm_soft"][..],
+        ),
+        (&["--k", "100000000"], &["--k 100000000", "at most 65536"]),
+    ] {
+        let mut args = vec!["evaluate", &s, "--out", out.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        refused(&args, needles);
+        assert!(shadowgraph(&args).stdout.is_empty());
+    }
 }

@@ -275,3 +275,41 @@ fn pcf_truth_matches_supersampling() {
     eprintln!("{partial} of 400 boxes partly lit; worst error / tolerance {worst:.3}");
     assert!(partial > 100, "only {partial} boxes straddle an edge");
 }
+
+/// More emitter samples than `MAX_EMITTER_SAMPLES`, stratified or as explicit offsets, is an
+/// `Error::Limit` naming K, before any offset is made (10⁸ asked for 50 GB at once and aborted
+/// the process).
+#[test]
+fn too_many_emitter_samples_are_a_limit() {
+    let s = scene("sphere_on_plane.toml", 32, 24);
+    let g = common::gpu();
+    let mut renderer = Renderer::new(&g.device);
+    let most = shadowgraph::truth::MAX_EMITTER_SAMPLES;
+    for emitter in [
+        Emitter::Stratified {
+            k: most as u32 + 1,
+            seed: 7,
+        },
+        Emitter::Stratified {
+            k: 100_000_000,
+            seed: 7,
+        },
+        Emitter::Offsets(vec![[0.0, 0.0]; most + 1]),
+    ] {
+        let k = emitter.count();
+        let opts = TruthOptions {
+            emitter,
+            resolution: Some(16),
+        };
+        match area_light_truth(&mut renderer, &g.device, &g.queue, &s, &opts) {
+            Err(e @ shadowgraph::Error::Limit { .. }) => {
+                let e = e.to_string();
+                assert!(
+                    e.contains("emitter samples") && e.contains(&k.to_string()),
+                    "{e}"
+                );
+            }
+            other => panic!("K = {k}: {:?}", other.map(|t| t.samples)),
+        }
+    }
+}

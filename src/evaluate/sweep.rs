@@ -133,13 +133,25 @@ fn with_moment_biases(configs: Vec<Config>, biases: &[f32]) -> Result<Vec<Config
             "--moment-bias: {a} is outside [0, 0.5]"
         )));
     }
+    let biased = |def: &technique::TechniqueDef| {
+        def.params
+            .iter()
+            .any(|t| t.iter().any(|s| s.key == "moment_bias"))
+    };
+    if !configs.iter().any(|c| biased(technique::of(&c.technique))) {
+        let takers: Vec<&str> = technique::REGISTRY
+            .iter()
+            .filter(|d| biased(d))
+            .map(|d| d.name)
+            .collect();
+        return Err(Error::Invalid(format!(
+            "--moment-bias: no technique of the sweep has a moment bias (those that do: {})",
+            takers.join(", ")
+        )));
+    }
     let mut out = Vec::new();
     for c in configs {
-        if technique::of(&c.technique)
-            .params
-            .iter()
-            .all(|t| t.iter().all(|s| s.key != "moment_bias"))
-        {
+        if !biased(technique::of(&c.technique)) {
             out.push(c);
             continue;
         }
