@@ -60,10 +60,12 @@ fn run() -> Result<(), String> {
         }
     }
     // The bench's own checks: a case filter that names nothing or holds an empty entry, a size
-    // of 0 or past the device, `--repeat 0`.
+    // of 0 or past the device, `--repeat 0`, a case past the memory budget.
     let cases = shadowgraph::bench::select_cases(&names).map_err(|e| e.to_string())?;
     let gpu = Gpu::new().map_err(|e| e.to_string())?;
     shadowgraph::bench::check_args(&gpu.device, &sizes, repeat).map_err(|e| e.to_string())?;
+    let budget = shadowgraph::limits::memory_budget().map_err(|e| e.to_string())?;
+    shadowgraph::bench::check_memory(&cases, &sizes, budget).map_err(|e| e.to_string())?;
     println!(
         "wall clock on {}; median of {repeat} after 2 warm-up runs",
         gpu.describe()
