@@ -184,6 +184,62 @@ fn dumped_chain(
     levels
 }
 
+/// `scenes/techniques/<scene>` with each `(from, to)` of `edits` replaced (each `from` must be
+/// there), written into `dir` as `name`.
+fn edited_scene(dir: &Path, scene: &str, edits: &[(&str, &str)], name: &str) -> PathBuf {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut text = std::fs::read_to_string(root.join("scenes/techniques").join(scene)).unwrap();
+    for (from, to) in edits {
+        assert!(text.contains(from), "{scene}: `{from}` moved");
+        text = text.replace(from, to);
+    }
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// `resource` of the scene at `path` dumped with the shipped kernels and with each benchmark
+/// variant of `variants` (`benches/variants/<name>`), in kernel layout `layout` (the device's
+/// with `None`): the same levels, each at least a quarter non-zero (never a comparison of
+/// zeros), bit for bit. Returns how many levels the chain has.
+fn variants_match(
+    path: &Path,
+    resource: &str,
+    dir: &Path,
+    layout: Option<&str>,
+    variants: &[&str],
+) -> usize {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let name = path.file_stem().unwrap().to_string_lossy();
+    let tag = format!("{name}_{}_{resource}", layout.unwrap_or("device"));
+    let layout_env = layout.map(|l| (KERNEL_LAYOUT_ENV, OsStr::new(l)));
+    let dump = |folder: Option<&Path>, out: &str| {
+        let envs: Vec<(&str, &OsStr)> = layout_env
+            .into_iter()
+            .chain(folder.map(|f| (KERNEL_DIR_ENV, f.as_os_str())))
+            .collect();
+        dumped_chain(path, resource, &dir.join(format!("{out}_{tag}")), &envs)
+    };
+    let shipped = dump(None, "shipped");
+    assert!(!shipped.is_empty(), "{tag}: nothing dumped");
+    for (l, level) in shipped.iter().enumerate() {
+        let nonzero = level.iter().filter(|&&v| v != 0).count();
+        assert!(4 * nonzero >= level.len(), "{tag}: level {l} mostly zeros");
+    }
+    for variant in variants {
+        let got = dump(Some(&root.join("benches/variants").join(variant)), variant);
+        assert_eq!(got.len(), shipped.len(), "{variant} {tag}: levels");
+        for (l, (a, b)) in shipped.iter().zip(&got).enumerate() {
+            let differ = a.iter().zip(b).filter(|(x, y)| x != y).count();
+            assert_eq!(
+                differ, 0,
+                "{variant} {tag}: level {l}, {differ} samples differ"
+            );
+        }
+    }
+    shipped.len()
+}
+
 /// `benches/variants/mip_quads` (the mip chain without level s + 1 in workgroup memory, a
 /// benchmark variant `benches/gpu_check.sh` times beside the shipped kernel) builds the shipped
 /// chain bit for bit: VSM at 512² (two halving dispatches) and 300² (odd levels: the general
@@ -191,8 +247,6 @@ fn dumped_chain(
 /// level s + 2 reads its quad's texels in another order fails it.
 #[test]
 fn the_mip_chain_benchmark_variant_builds_the_same_chain() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let variant = root.join("benches/variants/mip_quads");
     let dir = temp_dir("mips");
     for (scene, from, to, resource) in [
         (
@@ -214,26 +268,10 @@ fn the_mip_chain_benchmark_variant_builds_the_same_chain() {
             "light0.esm.mips",
         ),
     ] {
-        let text = std::fs::read_to_string(root.join("scenes/techniques").join(scene)).unwrap();
-        assert!(text.contains(from), "{scene}: `{from}` moved");
-        let path = dir.join(format!("{}.toml", to.replace([' ', '='], "")));
-        std::fs::write(&path, text.replace(from, to)).unwrap();
-        let shipped = dumped_chain(&path, resource, &dir.join("shipped"), &[]);
-        let envs = [(KERNEL_DIR_ENV, variant.as_os_str())];
-        let quads = dumped_chain(&path, resource, &dir.join("quads"), &envs);
-        assert!(shipped.len() >= 8, "{scene} {to}: {} levels", shipped.len());
-        assert_eq!(quads.len(), shipped.len(), "{scene} {to}: levels");
-        for (l, (a, b)) in shipped.iter().zip(&quads).enumerate() {
-            let differ = a.iter().zip(b).filter(|(x, y)| x != y).count();
-            assert_eq!(
-                differ, 0,
-                "{scene} {to}: level {l}, {differ} samples differ"
-            );
-            assert!(
-                a.iter().any(|&v| v != 0),
-                "{scene} {to}: level {l} is all zeros"
-            );
-        }
+        let name = format!("{}_{}", to.replace([' ', '='], ""), scene);
+        let path = edited_scene(&dir, scene, &[(from, to)], &name);
+        let levels = variants_match(&path, resource, &dir, None, &["mip_quads"]);
+        assert!(levels >= 8, "{scene} {to}: {levels} levels");
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -246,63 +284,21 @@ fn the_mip_chain_benchmark_variant_builds_the_same_chain() {
 /// a pair apart (w·l + w·r) fails it at 577 724 samples.
 #[test]
 fn the_blur_row_benchmark_variants_blur_the_same() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let dir = temp_dir("blur_rows");
-    let text = std::fs::read_to_string(root.join("scenes/techniques/csm.toml")).unwrap();
-    for (tag, edits) in [
-        (
-            "512_r3",
-            [
-                ("shadow_map = 512", "shadow_map = 512"),
-                ("filter_radius = 3", "filter_radius = 3"),
-            ],
-        ),
-        (
-            "300_r20",
-            [
-                ("shadow_map = 512", "shadow_map = 300"),
-                ("filter_radius = 3", "filter_radius = 20"),
-            ],
-        ),
-    ] {
-        let mut scene = text.clone();
-        for (from, to) in edits {
-            assert!(scene.contains(from), "csm.toml: `{from}` moved");
-            scene = scene.replace(from, to);
-        }
-        let path = dir.join(format!("csm_{tag}.toml"));
-        std::fs::write(&path, scene).unwrap();
+    for (size, radius) in [("512", "3"), ("300", "20")] {
+        let edits = [
+            ("shadow_map = 512", &*format!("shadow_map = {size}")),
+            ("filter_radius = 3", &*format!("filter_radius = {radius}")),
+        ];
+        let path = edited_scene(
+            &dir,
+            "csm.toml",
+            &edits,
+            &format!("csm_{size}_r{radius}.toml"),
+        );
         for resource in ["light0.csm0.blur_h", "light0.csm3.blur_v"] {
-            let shipped = dumped_chain(&path, resource, &dir.join(format!("shipped_{tag}")), &[]);
-            assert_eq!(shipped.len(), 1, "{tag} {resource}: one level");
-            assert!(
-                shipped[0].iter().filter(|&&v| v != 0).count() > shipped[0].len() / 2,
-                "{tag} {resource}: mostly zeros"
-            );
-            for variant in ["blur_rows_run1", "blur_rows_run2"] {
-                let envs = [(
-                    KERNEL_DIR_ENV,
-                    root.join("benches/variants").join(variant).into_os_string(),
-                )];
-                let envs: Vec<(&str, &OsStr)> =
-                    envs.iter().map(|(k, v)| (*k, v.as_os_str())).collect();
-                let got = dumped_chain(
-                    &path,
-                    resource,
-                    &dir.join(format!("{variant}_{tag}")),
-                    &envs,
-                );
-                assert_eq!(got.len(), 1, "{variant} {tag} {resource}: one level");
-                let differ = shipped[0]
-                    .iter()
-                    .zip(&got[0])
-                    .filter(|(a, b)| a != b)
-                    .count();
-                assert_eq!(
-                    differ, 0,
-                    "{variant} {tag} {resource}: {differ} samples differ"
-                );
-            }
+            let variants = ["blur_rows_run1", "blur_rows_run2"];
+            assert_eq!(variants_match(&path, resource, &dir, None, &variants), 1);
         }
     }
     let _ = std::fs::remove_dir_all(&dir);
@@ -317,49 +313,23 @@ fn the_blur_row_benchmark_variants_blur_the_same() {
 /// it.
 #[test]
 fn the_vsm_table_benchmark_variant_builds_the_same_tables() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let variant = root.join("benches/variants/sat_vsm_texel");
     let dir = temp_dir("sat_vsm");
     for (scene, size) in [
         ("vsm_sat.toml", 512),
         ("vsm_sat.toml", 300),
         ("vssm.toml", 300),
     ] {
-        let text = std::fs::read_to_string(root.join("scenes/techniques").join(scene)).unwrap();
-        assert!(
-            text.contains("shadow_map = 512"),
-            "{scene}: `shadow_map = 512` moved"
-        );
-        let path = dir.join(format!("{size}_{scene}"));
-        let sized = text.replace("shadow_map = 512", &format!("shadow_map = {size}"));
-        std::fs::write(&path, sized).unwrap();
+        let edits = [("shadow_map = 512", &*format!("shadow_map = {size}"))];
+        let path = edited_scene(&dir, scene, &edits, &format!("{size}_{scene}"));
         for layout in ["gpu", "cpu"] {
-            let tag = format!("{scene}_{size}_{layout}");
-            let shipped_envs = [(KERNEL_LAYOUT_ENV, OsStr::new(layout))];
-            let resource = "light0.vsm.sat";
-            let shipped = dumped_chain(
+            let levels = variants_match(
                 &path,
-                resource,
-                &dir.join(format!("s_{tag}")),
-                &shipped_envs,
+                "light0.vsm.sat",
+                &dir,
+                Some(layout),
+                &["sat_vsm_texel"],
             );
-            assert_eq!(shipped.len(), 1, "{tag}: one level");
-            assert!(
-                shipped[0].iter().filter(|&&v| v != 0).count() > shipped[0].len() / 2,
-                "{tag}: mostly zeros"
-            );
-            let envs = [
-                (KERNEL_LAYOUT_ENV, OsStr::new(layout)),
-                (KERNEL_DIR_ENV, variant.as_os_str()),
-            ];
-            let got = dumped_chain(&path, resource, &dir.join(format!("v_{tag}")), &envs);
-            assert_eq!(got.len(), 1, "{tag}: one level");
-            let differ = shipped[0]
-                .iter()
-                .zip(&got[0])
-                .filter(|(a, b)| a != b)
-                .count();
-            assert_eq!(differ, 0, "{tag}: {differ} samples differ");
+            assert_eq!(levels, 1);
         }
     }
     let _ = std::fs::remove_dir_all(&dir);
@@ -373,8 +343,6 @@ fn the_vsm_table_benchmark_variant_builds_the_same_tables() {
 /// too. A variant whose line sums skip the last line fails it at 459 712 samples.
 #[test]
 fn the_small_sub_block_table_variant_builds_the_same_tables() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let variant = root.join("benches/variants/sat_sub2");
     let dir = temp_dir("sat_sub2");
     let cases: [(&str, &[&str]); 6] = [
         ("vsm_sat.toml", &["light0.vsm.sat"]),
@@ -398,12 +366,9 @@ fn the_small_sub_block_table_variant_builds_the_same_tables() {
         ("cssm.toml", &["light0.csm1.sat", "light0.csm_moments.sat"]),
     ];
     for (scene, resources) in cases {
-        let text = std::fs::read_to_string(root.join("scenes/techniques").join(scene)).unwrap();
         for size in [512, 300] {
-            let from = "shadow_map = 512";
-            assert!(text.contains(from), "{scene}: `{from}` moved");
-            let path = dir.join(format!("{size}_{scene}"));
-            std::fs::write(&path, text.replace(from, &format!("shadow_map = {size}"))).unwrap();
+            let edits = [("shadow_map = 512", &*format!("shadow_map = {size}"))];
+            let path = edited_scene(&dir, scene, &edits, &format!("{size}_{scene}"));
             // The GPU layout on the two larger cases only: the suite's time.
             let layouts: &[&str] = if size == 300 {
                 &["cpu"]
@@ -412,27 +377,8 @@ fn the_small_sub_block_table_variant_builds_the_same_tables() {
             };
             for &layout in layouts {
                 for resource in resources {
-                    let tag = format!("{scene}_{size}_{layout}_{resource}");
-                    let envs = [(KERNEL_LAYOUT_ENV, OsStr::new(layout))];
-                    let shipped =
-                        dumped_chain(&path, resource, &dir.join(format!("s_{tag}")), &envs);
-                    assert_eq!(shipped.len(), 1, "{tag}: one level");
-                    assert!(
-                        shipped[0].iter().filter(|&&v| v != 0).count() > shipped[0].len() / 4,
-                        "{tag}: mostly zeros"
-                    );
-                    let envs = [
-                        (KERNEL_LAYOUT_ENV, OsStr::new(layout)),
-                        (KERNEL_DIR_ENV, variant.as_os_str()),
-                    ];
-                    let got = dumped_chain(&path, resource, &dir.join(format!("v_{tag}")), &envs);
-                    assert_eq!(got.len(), 1, "{tag}: one level");
-                    let differ = shipped[0]
-                        .iter()
-                        .zip(&got[0])
-                        .filter(|(a, b)| a != b)
-                        .count();
-                    assert_eq!(differ, 0, "{tag}: {differ} samples differ");
+                    let levels = variants_match(&path, resource, &dir, Some(layout), &["sat_sub2"]);
+                    assert_eq!(levels, 1);
                 }
             }
         }
