@@ -62,9 +62,10 @@ enum Command {
     /// Time kernels by GPU timestamps against a texture copy of their output's format (and the
     /// texture copies against a buffer copy), bytes from the plan's cost model.
     Bench {
-        /// Square map sizes.
-        #[arg(long, value_delimiter = ',', default_value = "512,1024,2048,4096")]
-        sizes: Vec<u32>,
+        /// Square map sizes (default 512,1024,2048,4096; not with `--lookup`, whose map is
+        /// `--map`).
+        #[arg(long, value_delimiter = ',')]
+        sizes: Option<Vec<u32>>,
         /// Timed repetitions per kernel and size (the median is reported), 1 to 1000.
         #[arg(long, default_value_t = 10, value_parser = repeat_range())]
         repeat: u32,
@@ -291,9 +292,16 @@ fn run(args: Args) -> Result<()> {
             kernel_dirs,
         } => {
             if lookup.is_some() {
-                // Refused before the first table, not after it.
+                // Refused before the first table, not after it. (Not a clap conflict: one
+                // would lift `--map`'s and `--image`'s requirement of `--lookup`.)
+                if sizes.is_some() {
+                    anyhow::bail!(
+                        "--sizes is the kernel bench's; `--lookup` renders its map at `--map`"
+                    );
+                }
                 shadowgraph::bench::check_soft_args(&light_sizes, repeat, &only)?;
             }
+            let sizes = sizes.unwrap_or_else(|| vec![512, 1024, 2048, 4096]);
             let gpu = Gpu::new()?;
             match lookup {
                 Some(widths) => {

@@ -149,6 +149,12 @@ fn lookup_options_need_the_lookup_and_sane_values() {
         &["bench", "--lookup", "3", "--repeat", "1", "--map", "32768"],
         &["32768"],
     );
+    // The kernel bench's sizes do not apply to the lookup (its map is `--map`): refused, not
+    // ignored.
+    refused(
+        &["bench", "--lookup", "3", "--repeat", "1", "--sizes", "64"],
+        &["--sizes", "kernel bench", "--map"],
+    );
     // Refused before the first table (the PCF lookup table), not after it: nothing on stdout.
     for (extra, needles) in [
         (
