@@ -590,30 +590,49 @@ pub fn case_bytes(case: &BenchCase, n: u32) -> Result<u64> {
 /// `budget` ([`crate::limits::memory_budget`], as a scene's frame is checked): at 16384² CSSM's
 /// nine tables alone are 36 GiB, which a CPU driver would try to take from system memory.
 pub fn check_memory(cases: &[&BenchCase], sizes: &[u32], budget: u64) -> Result<()> {
-    let past = |what: String, need: u64, fix: &str| {
-        Error::Invalid(format!(
-            "bench: {what} needs an estimated {}, more than the memory budget of {} ({}): {fix}",
-            crate::graph::print::human_bytes(need),
-            crate::graph::print::human_bytes(budget),
-            crate::limits::MEMORY_BUDGET_ENV
-        ))
-    };
     for &n in sizes {
-        // The yardsticks every run times: a buffer copy of two rgba32-sized buffers.
-        let copies = 2 * texels(n) * 16;
-        if copies > budget {
-            let what = format!("the buffer copy at {n}² (every run's yardstick)");
-            return Err(past(what, copies, "lower --sizes or raise the budget"));
-        }
         for case in cases {
             let need = case_bytes(case, n)?;
             if need > budget {
                 let fix = "leave it out with --only, lower --sizes or raise the budget";
-                return Err(past(format!("`{}` at {n}²", case.name), need, fix));
+                return Err(past_budget(
+                    &format!("`{}` at {n}²", case.name),
+                    need,
+                    budget,
+                    fix,
+                ));
             }
         }
     }
     Ok(())
+}
+
+/// [`check_memory`] for the yardstick [`measure_variants`] times at every size: a buffer copy
+/// of two rgba32-sized buffers (8 GiB at 16384²).
+fn check_yardstick_memory(sizes: &[u32], budget: u64) -> Result<()> {
+    for &n in sizes {
+        let copies = 2 * texels(n) * 16;
+        if copies > budget {
+            let what = format!("the buffer copy at {n}² (every run's yardstick)");
+            return Err(past_budget(
+                &what,
+                copies,
+                budget,
+                "lower --sizes or raise the budget",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The error of [`check_memory`]: `what` needs `need` bytes, past `budget`; `fix` says what to do.
+fn past_budget(what: &str, need: u64, budget: u64, fix: &str) -> Error {
+    Error::Invalid(format!(
+        "bench: {what} needs an estimated {}, more than the memory budget of {} ({}): {fix}",
+        crate::graph::print::human_bytes(need),
+        crate::graph::print::human_bytes(budget),
+        crate::limits::MEMORY_BUDGET_ENV
+    ))
 }
 
 /// Refuses an empty entry of an `--only` list (`--only sat,` or `--only ,`): every name
@@ -805,7 +824,9 @@ pub fn measure_variants(
         )));
     }
     let cases = select_cases(only)?;
-    check_memory(&cases, sizes, crate::limits::memory_budget()?)?;
+    let budget = crate::limits::memory_budget()?;
+    check_yardstick_memory(sizes, budget)?;
+    check_memory(&cases, sizes, budget)?;
     harness::timer(device, queue, 1)?;
     let mut executor = Executor::new();
     // One executor a variant (its own pipelines), or the device's kernels unnamed.
@@ -1116,24 +1137,25 @@ mod tests {
     use super::*;
 
     /// `shadowgraph bench` at its default sizes (up to 4096²) fits the default memory budget
-    /// with every case, so its default run is never refused; at 16384² the buffer copy every
-    /// run times (8 GiB) is refused under it, and under 16 GiB CSSM with the CSM-Z search
-    /// (nine tables, 36 GiB) is, naming the case, its estimate and the variable; a budget at the
-    /// case's own estimate takes it. (Plans only, no GPU.)
+    /// with every case and its yardstick, so its default run is never refused; at 16384² the
+    /// buffer copy every run times (8 GiB) is refused under it, and so is CSSM with the CSM-Z
+    /// search (nine tables, 36 GiB), naming the case, its estimate and the variable; a budget
+    /// at the case's own estimate takes it. (Plans only, no GPU.)
     #[test]
     fn the_bench_checks_its_memory_against_the_budget() {
         let all = select_cases(&[]).expect("cases");
         let budget = crate::limits::DEFAULT_MEMORY_BUDGET;
         check_memory(&all, &[512, 1024, 2048, 4096], budget).expect("defaults fit");
         let csm_z = select_cases(&["csm_z".into()]).expect("csm_z");
-        let e = check_memory(&csm_z, &[16384], budget)
+        check_yardstick_memory(&[4096], budget).expect("the default sizes' copies fit");
+        let e = check_yardstick_memory(&[16384], budget)
             .unwrap_err()
             .to_string();
         assert!(
             e.contains("buffer copy at 16384²") && e.contains("8.0 GiB"),
             "{e}"
         );
-        let e = check_memory(&csm_z, &[16384], 16 << 30)
+        let e = check_memory(&csm_z, &[16384], budget)
             .unwrap_err()
             .to_string();
         assert!(
