@@ -58,36 +58,37 @@
 // `sg_` and `shadowgraph_`):
 //   sg_BLOCKER_MIN_SHARE sg_CSM_PI sg_CSSM_BLOCKER_FLOOR sg_CSSM_FULL_CONTRAST
 //   sg_CSSM_MIN_CONTRAST sg_CascadePick sg_CsmTerms sg_GOLDEN_ANGLE sg_Light sg_LightSample
-//   sg_MSM_B0 sg_MSM_B0_COV sg_MSM_B0_SCHUR sg_MipTaps sg_MsmMoments sg_SAT_GRID
-//   sg_SAT_MIN_EXTENT sg_SatLayer sg_SatNodes sg_SoftLookup sg_TECHNIQUE_CSM sg_TECHNIQUE_CSSM
-//   sg_TECHNIQUE_ESM sg_TECHNIQUE_EVSM sg_TECHNIQUE_HARD sg_TECHNIQUE_MIDPOINT sg_TECHNIQUE_MSM
-//   sg_TECHNIQUE_MSM_SOFT sg_TECHNIQUE_PCF sg_TECHNIQUE_PCSS sg_TECHNIQUE_SECOND_DEPTH
-//   sg_TECHNIQUE_SMRT sg_TECHNIQUE_VSM sg_TECHNIQUE_VSSM sg_bilinear_level
-//   sg_bilinear_level_packed sg_bilinear_log_level sg_blocker_csm_z sg_blocker_filter_width
-//   sg_blocker_msm sg_blocker_result sg_blocker_search_width sg_blocker_vsm sg_blocker_width
-//   sg_cascade_far_of sg_cascade_pick sg_chebyshev_upper sg_csm_chunk sg_csm_chunk_of
-//   sg_csm_resolve sg_csm_sin_cos sg_csm_terms_advance sg_csm_terms_chunk sg_csm_terms_start
-//   sg_csm_weight sg_csm_z_chunk_of sg_cssm_blocker sg_cssm_blocker_moments
-//   sg_cssm_filter_blockers sg_cssm_resolve sg_cssm_sharpen sg_cssm_two_series sg_level_size
-//   sg_level_size_of sg_light_depth_slope sg_light_depth_slope_view sg_light_faces
-//   sg_light_footprint sg_light_linear_to_ndc sg_light_linear_to_z sg_light_map_width
-//   sg_light_plane_slope sg_light_receiver_offset sg_light_sample sg_light_tap_offset
-//   sg_light_texel sg_light_to_light sg_linstep sg_load_depth sg_map_sample sg_mip_tap_uv
-//   sg_mip_taps sg_msm_biased sg_msm_dequantize sg_msm_expect sg_msm_intensity sg_msm_moments
-//   sg_msm_quantize sg_msm_roots sg_msm_soft_blocker sg_pack_f16x2 sg_pcss_search_radius
-//   sg_point_coords sg_point_face sg_point_sample sg_sample_bilinear sg_sample_bilinear_log
-//   sg_sample_map sg_sample_map_log sg_sample_map_packed sg_sat_alone sg_sat_box
-//   sg_sat_box_fixed sg_sat_box_float sg_sat_clamp sg_sat_corner_linear sg_sat_filter_fixed
-//   sg_sat_filter_float sg_sat_filter_window sg_sat_grid sg_sat_layer_box sg_sat_layer_mean
-//   sg_sat_layer_node sg_sat_layer_size sg_sat_layer_window sg_sat_mean_fixed sg_sat_mean_float
-//   sg_sat_mean_linear sg_sat_nearest sg_sat_node_f32 sg_sat_nodes sg_sat_rect
-//   sg_sat_sample_fixed sg_sat_sample_float sg_sat_sample_layer sg_sat_search_fixed
-//   sg_sat_search_float sg_sat_search_layer sg_sat_span_weights sg_smrt_emitter_point
-//   sg_smrt_ray sg_soft_blockers sg_soft_filter_trips sg_texel_of sg_trilinear sg_trilinear_log
-//   sg_trilinear_packed sg_unpack_f16x2 sg_vis_esm sg_vis_esm_of_log sg_vis_esm_of_sat
-//   sg_vis_evsm sg_vis_evsm_of sg_vis_hard sg_vis_msm sg_vis_msm_of sg_vis_msm_soft_fixed
-//   sg_vis_msm_soft_float sg_vis_pcf sg_vis_pcf_hardware sg_vis_pcss sg_vis_smrt sg_vis_vsm
-//   sg_vis_vsm_of sg_vis_vssm_fixed sg_vis_vssm_float sg_vogel_disc sg_vssm_blocker
+//   sg_MSM_B0 sg_MSM_B0_COV sg_MSM_B0_SCHUR sg_MSM_ROOT_LIMIT sg_MipTaps sg_MsmMoments
+//   sg_SAT_GRID sg_SAT_MIN_EXTENT sg_SatLayer sg_SatNodes sg_SoftLookup sg_TECHNIQUE_CSM
+//   sg_TECHNIQUE_CSSM sg_TECHNIQUE_ESM sg_TECHNIQUE_EVSM sg_TECHNIQUE_HARD sg_TECHNIQUE_MIDPOINT
+//   sg_TECHNIQUE_MSM sg_TECHNIQUE_MSM_SOFT sg_TECHNIQUE_PCF sg_TECHNIQUE_PCSS
+//   sg_TECHNIQUE_SECOND_DEPTH sg_TECHNIQUE_SMRT sg_TECHNIQUE_VSM sg_TECHNIQUE_VSSM
+//   sg_bilinear_level sg_bilinear_level_packed sg_bilinear_log_level sg_blocker_csm_z
+//   sg_blocker_filter_width sg_blocker_msm sg_blocker_result sg_blocker_search_width
+//   sg_blocker_vsm sg_blocker_width sg_cascade_far_of sg_cascade_pick sg_chebyshev_upper
+//   sg_csm_chunk sg_csm_chunk_of sg_csm_resolve sg_csm_sin_cos sg_csm_terms_advance
+//   sg_csm_terms_chunk sg_csm_terms_start sg_csm_weight sg_csm_z_chunk_of sg_cssm_blocker
+//   sg_cssm_blocker_moments sg_cssm_filter_blockers sg_cssm_resolve sg_cssm_sharpen
+//   sg_cssm_two_series sg_level_size sg_level_size_of sg_light_depth_slope
+//   sg_light_depth_slope_view sg_light_faces sg_light_footprint sg_light_linear_to_ndc
+//   sg_light_linear_to_z sg_light_map_width sg_light_plane_slope sg_light_receiver_offset
+//   sg_light_sample sg_light_tap_offset sg_light_texel sg_light_to_light sg_linstep
+//   sg_load_depth sg_map_sample sg_mip_tap_uv sg_mip_taps sg_msm_biased sg_msm_dequantize
+//   sg_msm_expect sg_msm_intensity sg_msm_moments sg_msm_quantize sg_msm_roots
+//   sg_msm_soft_blocker sg_pack_f16x2 sg_pcss_search_radius sg_point_coords sg_point_face
+//   sg_point_sample sg_sample_bilinear sg_sample_bilinear_log sg_sample_map sg_sample_map_log
+//   sg_sample_map_packed sg_sat_alone sg_sat_box sg_sat_box_fixed sg_sat_box_float sg_sat_clamp
+//   sg_sat_corner_linear sg_sat_filter_fixed sg_sat_filter_float sg_sat_filter_window
+//   sg_sat_grid sg_sat_layer_box sg_sat_layer_mean sg_sat_layer_node sg_sat_layer_size
+//   sg_sat_layer_window sg_sat_mean_fixed sg_sat_mean_float sg_sat_mean_linear sg_sat_nearest
+//   sg_sat_node_f32 sg_sat_nodes sg_sat_rect sg_sat_sample_fixed sg_sat_sample_float
+//   sg_sat_sample_layer sg_sat_search_fixed sg_sat_search_float sg_sat_search_layer
+//   sg_sat_span_weights sg_smrt_emitter_point sg_smrt_ray sg_soft_blockers sg_soft_filter_trips
+//   sg_texel_of sg_trilinear sg_trilinear_log sg_trilinear_packed sg_unpack_f16x2 sg_vis_esm
+//   sg_vis_esm_of_log sg_vis_esm_of_sat sg_vis_evsm sg_vis_evsm_of sg_vis_hard sg_vis_msm
+//   sg_vis_msm_of sg_vis_msm_soft_fixed sg_vis_msm_soft_float sg_vis_pcf sg_vis_pcf_hardware
+//   sg_vis_pcss sg_vis_smrt sg_vis_vsm sg_vis_vsm_of sg_vis_vssm_fixed sg_vis_vssm_float
+//   sg_vogel_disc sg_vssm_blocker
 
 // Shared light description and light-space helpers (import-only module).
 //
@@ -1253,10 +1254,19 @@ fn sg_msm_roots(mm: sg_MsmMoments, d: f32) -> vec3<f32> {
     // c₁/c₃: −p/2 ± √(p²/4 − q) loses the smaller root when the other is far away (c₃ → 0,
     // as behind a flat occluder), and with it the weights, which cancel against it.
     let t = -0.5 * (c2 + select(-1.0, 1.0, c2 >= 0.0) * sqrt(max(c2 * c2 - 4.0 * c3 * c1, 0.0)));
-    let r1 = t / c3;
-    let r2 = c1 / t;
+    // Each root held within ±MSM_ROOT_LIMIT: where c₃ (or t) rounds to 0 the far support point
+    // is at ±∞ in f32 (huge but finite in exact arithmetic), and the weights' quotients become
+    // ∞/∞ = NaN, which read as lit or unshadowed (measured: a receiver in `city_street`'s
+    // umbra read lit under `cssm`'s moment search). Held there, the point's weight vanishes as
+    // it should: the error is O(1/MSM_ROOT_LIMIT).
+    let r1 = clamp(t / c3, -sg_MSM_ROOT_LIMIT, sg_MSM_ROOT_LIMIT);
+    let r2 = clamp(c1 / t, -sg_MSM_ROOT_LIMIT, sg_MSM_ROOT_LIMIT);
     return vec3<f32>(min(r1, r2), max(r1, r2), 0.0);
 }
+
+// The largest magnitude of a support point msm_roots returns (see there); the weights' products
+// of two such distances stay far inside f32's range.
+const sg_MSM_ROOT_LIMIT: f32 = 1e8;
 
 // E[(z − x)(z − y)] under the biased moments: (μ − x)(μ − y) + Var z, free of the
 // cancellation in E z² − (x + y)·μ + x·y.

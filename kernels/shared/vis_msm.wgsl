@@ -97,10 +97,19 @@ fn msm_roots(mm: MsmMoments, d: f32) -> vec3<f32> {
     // c₁/c₃: −p/2 ± √(p²/4 − q) loses the smaller root when the other is far away (c₃ → 0,
     // as behind a flat occluder), and with it the weights, which cancel against it.
     let t = -0.5 * (c2 + select(-1.0, 1.0, c2 >= 0.0) * sqrt(max(c2 * c2 - 4.0 * c3 * c1, 0.0)));
-    let r1 = t / c3;
-    let r2 = c1 / t;
+    // Each root held within ±MSM_ROOT_LIMIT: where c₃ (or t) rounds to 0 the far support point
+    // is at ±∞ in f32 (huge but finite in exact arithmetic), and the weights' quotients become
+    // ∞/∞ = NaN, which read as lit or unshadowed (measured: a receiver in `city_street`'s
+    // umbra read lit under `cssm`'s moment search). Held there, the point's weight vanishes as
+    // it should: the error is O(1/MSM_ROOT_LIMIT).
+    let r1 = clamp(t / c3, -MSM_ROOT_LIMIT, MSM_ROOT_LIMIT);
+    let r2 = clamp(c1 / t, -MSM_ROOT_LIMIT, MSM_ROOT_LIMIT);
     return vec3<f32>(min(r1, r2), max(r1, r2), 0.0);
 }
+
+// The largest magnitude of a support point msm_roots returns (see there); the weights' products
+// of two such distances stay far inside f32's range.
+const MSM_ROOT_LIMIT: f32 = 1e8;
 
 // E[(z − x)(z − y)] under the biased moments: (μ − x)(μ − y) + Var z, free of the
 // cancellation in E z² − (x + y)·μ + x·y.

@@ -109,9 +109,16 @@ pub fn roots(m: &Biased, d: f64) -> Roots {
     if big == 0.0 {
         return Roots::Regular(0.0, 0.0);
     }
-    let (r1, r2) = (big / c[2], c[0] / big);
+    // Held within ±ROOT_LIMIT as `msm_roots` holds them (a root at ±∞ where c₃ is 0).
+    let (r1, r2) = (
+        (big / c[2]).clamp(-ROOT_LIMIT, ROOT_LIMIT),
+        (c[0] / big).clamp(-ROOT_LIMIT, ROOT_LIMIT),
+    );
     Roots::Regular(r1.min(r2), r1.max(r2))
 }
+
+/// `MSM_ROOT_LIMIT` of `kernels/shared/vis_msm.wgsl`: the largest magnitude of a support point.
+pub const ROOT_LIMIT: f64 = 1e8;
 
 /// `E[(z − x)(z − y)]` under moments `b`.
 pub fn expect(b: [f64; 4], x: f64, y: f64) -> f64 {
