@@ -218,8 +218,9 @@ pub fn linear_maps(
         .shade_maps)
 }
 
-/// Error against the box-PCF truth over each light's linear map `linear` (1 where the
-/// receiver leaves the map, as the shading returns).
+/// Error against the box-PCF truth over each drawn light's linear map `linear` (1 where the
+/// receiver leaves the map, as the shading returns). A cascaded light's reference is each
+/// cascade's, picked and blended as the shading does (`cpu::cascade`).
 fn pcf_stats(
     scene: &Scene,
     frame: &Frame,
@@ -228,22 +229,24 @@ fn pcf_stats(
     width: f64,
 ) -> Result<ErrorStats> {
     let lights = scene.lights.len();
-    let mut reference = vec![1.0; frame.visibility.len()];
-    for (li, light) in scene.lights.iter().enumerate() {
-        let Some(linear) = linear.get(li) else {
+    let drawn = crate::render::drawn_lights(scene)?;
+    // The linear maps are a `hard` render's: sample each as its drawn light (the same map for
+    // every technique but a point light's and a soft technique's cascades, whose guard bands
+    // follow the technique; neither has a box width).
+    let mut maps = Vec::with_capacity(drawn.lights.len());
+    for (k, light) in drawn.lights.iter().enumerate() {
+        let Some(linear) = linear.get(k) else {
             return Err(Error::Invalid(format!(
-                "light {li} has no linear map to take the PCF truth over"
+                "drawn light {k} has no linear map to take the PCF truth over"
             )));
         };
-        let map = Map {
-            size: linear.width as usize,
-            texels: &linear.data,
-        };
-        // The linear map is a `hard` render's: sample it as that light (the same map for every
-        // technique but a point light's, whose guard band follows its technique).
         let mut hard = light.clone();
         hard.shadow.technique = Technique::Hard;
-        let g = LightGpu::new(&hard);
+        maps.push((LightGpu::new(&hard), linear, f64::from(light.shadow.bias)));
+    }
+    let mut reference = vec![1.0; frame.visibility.len()];
+    for li in 0..lights {
+        let group = drawn.groups.iter().find(|g| g.light == li);
         for px in 0..(frame.width * frame.height) as usize {
             let i = px * lights + li;
             if !truth.mask[i] {
@@ -253,14 +256,30 @@ fn pcf_stats(
                 DVec3::new(d[4 * px].into(), d[4 * px + 1].into(), d[4 * px + 2].into())
             };
             let (p, n) = (at(&frame.position), at(&frame.normal).normalize_or_zero());
-            let s = crate::cpu::light::sample(&g, p, n);
-            if s.inside {
+            let pcf = |k: usize| {
+                let (g, linear, bias) = &maps[k];
+                let s = crate::cpu::light::sample(g, p, n);
+                if !s.inside {
+                    return 1.0;
+                }
+                let map = Map {
+                    size: linear.width as usize,
+                    texels: &linear.data,
+                };
                 let r = Receiver {
                     uv: s.uv,
                     depth: s.depth,
                 };
-                reference[i] = pcf_box(&map, &r, width, f64::from(light.shadow.bias));
-            }
+                pcf_box(&map, &r, width, *bias)
+            };
+            reference[i] = match group {
+                None => pcf(li),
+                Some(g) => {
+                    // The pick reads cascade 0's cascade fields, which the drawn light holds.
+                    let pick = crate::cpu::cascade::pick(&drawn.gpu[li], p);
+                    crate::cpu::cascade::blend(&pick, |c| pcf(g.index(c)))
+                }
+            };
         }
     }
     Ok(ErrorStats::new(&frame.visibility, &reference, &truth.mask))
