@@ -77,8 +77,17 @@ fn drawn_labels(scene: &Scene, drawn: &DrawnLights) -> Vec<String> {
                 None => light.label(),
                 Some(g) => {
                     let (near, far) = ranges(i).get(c).copied().unwrap_or((0.0, 0.0));
+                    let guard = crate::model::cascades::guard(&scene.lights[i]);
+                    let band = if guard == crate::model::cascades::SliceGuard::NONE {
+                        String::new()
+                    } else {
+                        format!(
+                            ", guard band {:.3} units + {} texels",
+                            guard.world, guard.texels
+                        )
+                    };
                     format!(
-                        "{}, cascade {c} of {} of light {i} (view distances {near:.2}–{far:.2}, half-width {:.3})",
+                        "{}, cascade {c} of {} of light {i} (view distances {near:.2}–{far:.2}, half-width {:.3}{band})",
                         light.label(),
                         g.count,
                         0.5 * light.width_at_unit()

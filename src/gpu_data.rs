@@ -137,8 +137,9 @@ pub struct LightGpu {
     /// depth over the filter square (`"two_depth"` with the moment search). Non-zero also has
     /// the receiver plane's slope computed.
     pub cssm_two_depth: u32,
-    /// Padding to the struct's 16-byte alignment.
-    pub _pad_end: u32,
+    /// PCSS: 1 where the filter radius is capped at `max_search` as the search's is, so that
+    /// no tap leaves the map's guard band (a point light's faces, a cascade's band); else 0.
+    pub capped_filter: u32,
 }
 
 /// Technique id of `hard` (`LightGpu::technique`; `TECHNIQUE_HARD` in

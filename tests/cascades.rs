@@ -202,7 +202,8 @@ fn cascades_do_not_shimmer() {
 /// `PrefilterConfig::from_light`, fitted by `Prefilter::fit_cascades` and handed to the exported
 /// `sg_cascade_pick` through `pick_fields`, give the pick fields the renderer gives the same
 /// light (`city_street`: four PCF cascades), so a host's pick and blend band are the
-/// renderer's; bad keys and a soft technique in cascades are named by validation.
+/// renderer's; bad keys and a soft technique in the stage's cascades (which have no guard band:
+/// the renderer's do) are named by validation.
 #[test]
 fn the_stages_cascade_config_matches_the_renderers_pick() {
     use shadowgraph::prefilter::{Prefilter, PrefilterConfig};
@@ -249,7 +250,7 @@ fn the_stages_cascade_config_matches_the_renderers_pick() {
         assert!(!c.light.perspective && !c.light.point);
     }
 
-    // Validation: the scene's ranges, and soft techniques refuse cascades.
+    // Validation: the scene's ranges, and the stage refuses soft techniques in cascades.
     for (count, lambda, blend, field) in [
         (9, 0.5, 0.1, "cascades"),
         (0, 0.5, 0.1, "cascades"),
@@ -270,7 +271,10 @@ fn the_stages_cascade_config_matches_the_renderers_pick() {
     {
         Err(StageError::Config { field, message }) => {
             assert_eq!(field, "cascades");
-            assert!(message.contains("soft techniques"), "{message}");
+            assert!(
+                message.contains("max_search") && message.contains("guard band"),
+                "{message}"
+            );
         }
         other => panic!("vssm in cascades: {other:?}"),
     }
@@ -280,4 +284,72 @@ fn the_stages_cascade_config_matches_the_renderers_pick() {
             .validated()
             .is_ok()
     );
+}
+
+/// The renderer's cascades of PCSS and the soft techniques (`render::cascade`): every cascade
+/// caps search and filter at one world reach R (its `max_search` in its own map's UV times
+/// the map's width is R, to f32 rounding) and filters with PCSS's filter capped too; and
+/// around every corner of each slice of the camera's view (f64, the renderer's split), a
+/// square of half-width R plus the guard's texels, less the one kept for the snapped centre,
+/// lies inside the cascade's map: no lookup of a receiver in the slice reads past the map's
+/// edge. Random street-level cameras over `city_street`; R = min(max_search · 2·extent,
+/// size·(far − near)/(2·near)) = 2.8 units there.
+#[test]
+fn soft_cascades_keep_one_reach_inside_their_maps() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/city_street.toml");
+    let base = shadowgraph::scene::Scene::load(&path).expect("city_street loads");
+    let mut rng = common::rng(11);
+    for name in ["pcss", "vssm", "msm_soft", "cssm"] {
+        for _ in 0..8 {
+            let mut scene = base.clone();
+            let light = &mut scene.lights[0];
+            light.shadow.technique = shadowgraph::technique::named(name, &[]).expect("registered");
+            let eye = Vec3::new(
+                rng.random_range(-20.0..20.0),
+                rng.random_range(1.0..6.0),
+                rng.random_range(-20.0..26.0),
+            );
+            scene.camera.position = eye;
+            scene.camera.target = eye
+                + Vec3::new(
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-0.4..0.1),
+                    rng.random_range(-1.0..1.0),
+                );
+            let guard = shadowgraph::model::cascades::guard(&scene.lights[0]);
+            let reach = f64::from(guard.world);
+            assert!(
+                (reach - 2.8).abs() < 1e-5,
+                "{name}: reach {reach} (size·(far − near)/(2·near) = 2.8)"
+            );
+            let drawn = shadowgraph::render::drawn_lights(&scene).expect("drawn lights");
+            let group = drawn.groups[0];
+            let camera = shadowgraph::render::cascade_camera(&scene).expect("camera");
+            let c = scene.lights[0].shadow.cascades;
+            let fars = split_distances(camera.near, camera.far, c.count, c.lambda).expect("split");
+            let mut near = f64::from(camera.near);
+            for (i, &far) in fars.iter().enumerate() {
+                let k = group.index(i);
+                let l = &drawn.lights[k];
+                let width = f64::from(l.width_at_unit());
+                let cap = f64::from(l.shadow.technique.max_search().expect("capped")) * width;
+                assert!(
+                    (cap - reach).abs() <= 1e-6 * reach,
+                    "{name} cascade {i}: cap {cap} world units, reach {reach}"
+                );
+                assert_eq!(drawn.gpu[k].capped_filter, 1, "{name} cascade {i}");
+                let texel = width / f64::from(l.shadow_map);
+                let needed = reach + (f64::from(guard.texels) - 1.0) * texel;
+                for p in slice_corners(&camera, near, f64::from(far)) {
+                    let q = light_ndc(l.view(), l.projection(), p);
+                    let room = (1.0 - q.x.abs().max(q.y.abs())) * 0.5 * width;
+                    assert!(
+                        room >= needed,
+                        "{name} cascade {i}: corner {p} has {room} units to the map's edge, the reach needs {needed}"
+                    );
+                }
+                near = f64::from(far);
+            }
+        }
+    }
 }

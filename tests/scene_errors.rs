@@ -1221,8 +1221,9 @@ fn soft_techniques_keys_defaults_and_errors() {
     parse(&text).expect("f32 sums have no window limit");
 }
 
-/// The cascade keys: ranges by the one checker, techniques and light kinds that cannot have
-/// cascades, each named with its key and line; a valid table gives its values.
+/// The cascade keys: ranges by the one checker, techniques (`smrt`, the second-depth ones) and
+/// light kinds that cannot have cascades, each named with its key and line; a valid table
+/// gives its values, PCSS's and the soft techniques' too.
 #[test]
 fn cascade_keys_are_checked() {
     let tech = "technique = \"hard\"";
@@ -1248,9 +1249,14 @@ fn cascade_keys_are_checked() {
             &["cascade_blend"][..],
         ),
         (
-            "technique = \"pcss\"\ncascades = 4",
+            "technique = \"smrt\"\ncascades = 4",
             "cascades = 4",
-            &["cascades", "pcss", "soft techniques"][..],
+            &["cascades", "smrt", "guard band"][..],
+        ),
+        (
+            "technique = \"midpoint\"\ncascades = 2",
+            "cascades = 2",
+            &["cascades", "midpoint", "second-depth"][..],
         ),
     ] {
         let text = scene_with(&[(tech, edit)]);
@@ -1273,6 +1279,34 @@ fn cascade_keys_are_checked() {
         .shadow
         .cascades;
     assert_eq!((c.count, c.lambda, c.blend), (4, 0.8, 0.2));
+    // A guard band past a quarter of each cascade's map (normal_bias 80: 80 + 3 texels of a
+    // 256² map) is named at normal_bias's line with the smallest map that fits.
+    let wide = scene_with(&[
+        (
+            "extent = 4.0\n",
+            "extent = 4.0\nsize = 0.2\nshadow_map = 256\n",
+        ),
+        (
+            tech,
+            "technique = \"vssm\"\ncascades = 3\nnormal_bias = 80.0",
+        ),
+    ]);
+    expect(
+        &wide,
+        "normal_bias = 80.0",
+        &["guard band of 83 texels", "256", "332", "normal_bias"],
+    );
+    // PCSS and the soft techniques take cascades (each with a guard band).
+    for t in ["pcss", "vssm", "msm_soft", "cssm"] {
+        let text = scene_with(&[
+            ("extent = 4.0\n", "extent = 4.0\nsize = 0.2\n"),
+            (tech, &format!("technique = \"{t}\"\ncascades = 3")),
+        ]);
+        let c = parse(&text).unwrap_or_else(|e| panic!("{t}: {e}")).lights[0]
+            .shadow
+            .cascades;
+        assert_eq!(c.count, 3, "{t}");
+    }
     let c = parse(BASE).expect("base").lights[0].shadow.cascades;
     assert_eq!(c, shadowgraph::model::Cascades::SINGLE);
 }

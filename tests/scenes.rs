@@ -249,7 +249,7 @@ fn every_scene_renders_and_matches_the_references() {
         );
         for li in 0..lights {
             if drawn.groups.iter().any(|g| g.light == li) {
-                cascades::check_light(&scene, &frame, &drawn, li);
+                cascades::check_light(&scene, &frame, &drawn, li, e_trig);
                 continue;
             }
             check_prefilter_chain(&scene, &frame, li);
@@ -913,7 +913,7 @@ fn every_technique_renders_every_bundled_scene() {
             (scene.width, scene.height) = (120, 90);
             for l in &mut scene.lights {
                 l.shadow.technique = t;
-                // Soft techniques refuse cascades (`params::cascade_support`): one map.
+                // A technique that refuses cascades (`params::cascade_support`): one map.
                 if shadowgraph::technique::params::cascade_support(&t).is_err() {
                     l.shadow.cascades = shadowgraph::model::Cascades::SINGLE;
                 }
@@ -979,6 +979,7 @@ mod cascades {
         frame: &shadowgraph::render::Frame,
         drawn: &DrawnLights,
         li: usize,
+        e_trig: f64,
     ) {
         let group = drawn
             .groups
@@ -988,6 +989,12 @@ mod cascades {
         let technique = scene.lights[li].shadow.technique;
         let maps: Vec<Vec<Texels>> = (0..group.count)
             .map(|c| moments(frame, technique, group.index(c)))
+            .collect();
+        // A soft technique's inputs per cascade: its own table and `max_search`.
+        let softs: Vec<Option<common::soft::SoftInputs>> = (0..group.count)
+            .map(|c| {
+                common::soft::SoftInputs::new(&drawn.lights[group.index(c)], &maps[c][0], e_trig)
+            })
             .collect();
         let lg = drawn.gpu[li];
         let lights = scene.lights.len();
@@ -1012,7 +1019,8 @@ mod cascades {
                 continue;
             }
             let reference = |c: usize| {
-                pixel_reference(scene, frame, &maps[c], None, (drawn, group.index(c)), px)
+                let soft = softs[c].as_ref();
+                pixel_reference(scene, frame, &maps[c], soft, (drawn, group.index(c)), px)
             };
             let Some((v0, t0)) = reference(pick.index) else {
                 continue;
@@ -1061,13 +1069,20 @@ mod cascades {
     }
 }
 
+/// Technique `name` with its registry defaults.
+fn soft_technique(name: &str) -> Technique {
+    shadowgraph::technique::named(name, &[]).unwrap_or_else(|| panic!("{name} is registered"))
+}
+
 /// The cascaded street view with the other techniques that take cascades: each cascade's map
-/// prefiltered by the same graph (hard; VSM blurred; MSM through a float table; ESM mipmapped),
-/// every pixel against the f64 pick and references (`cascades::check_light`).
+/// prefiltered by the same graph (hard; VSM blurred; MSM through a float table; ESM mipmapped;
+/// PCSS and the soft techniques, each cascade with its guard band and `max_search`), every
+/// pixel against the f64 pick and references (`cascades::check_light`).
 #[test]
 fn cascaded_techniques_match_the_references() {
     use shadowgraph::scene::{BlurKernel, Filter, Prefilter, Storage};
     let g = common::gpu();
+    let e_trig = common::soft_maps::trig_error(&g);
     let mut renderer = Renderer::new(&g.device);
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/city_street.toml");
     let mut scene = Scene::load(&path).expect("scene loads");
@@ -1101,6 +1116,10 @@ fn cascaded_techniques_match_the_references() {
             },
             exponent: 40.0,
         },
+        soft_technique("pcss"),
+        soft_technique("vssm"),
+        soft_technique("msm_soft"),
+        soft_technique("cssm"),
     ] {
         scene.lights[0].shadow.technique = t;
         let frame = renderer
@@ -1117,6 +1136,6 @@ fn cascaded_techniques_match_the_references() {
             .unwrap_or_else(|e| panic!("{}: {e}", t.name()));
         let drawn = drawn_lights(&scene).expect("drawn lights");
         assert_eq!(drawn.lights.len(), 4, "{}: four cascades drawn", t.name());
-        cascades::check_light(&scene, &frame, &drawn, 0);
+        cascades::check_light(&scene, &frame, &drawn, 0, e_trig);
     }
 }

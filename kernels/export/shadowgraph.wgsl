@@ -154,7 +154,7 @@ struct sg_Light {
     sat_filtered: u32,       // tables: 1 where f32 and read with filtered fetches (the CPU references read it)
     sat_amplitude: f32,      // tables: the largest |v − sat_offset| over the value range (the CPU references read it)
     cssm_two_depth: u32,     // cssm: 0 sharpening alone; two-depth resolve (needs the receiver plane's slope) with the search's z_avg 1, the filter square's 2
-    _pad_end: u32,
+    capped_filter: u32,      // pcss: 1 where the filter radius is capped at max_search (a point light's faces, a cascade's guard band)
 }
 
 // `Light::technique` (keep in sync with the `TECHNIQUE_*` constants of src/gpu_data.rs; a test
@@ -1703,8 +1703,9 @@ fn sg_vis_pcf_hardware(map: texture_depth_2d, cmp: sampler_comparison, l: sg_Lig
 // its texel's centre.
 
 // Radii are in units of a face's UV (the map's, but for a point light's atlas, whose UV is
-// face UV · face_uv). On a point light the filter radius is capped at max_search as the search
-// is, so that no tap leaves the face's guard band (src/model/point.rs).
+// face UV · face_uv). On a point light and in cascades (`capped_filter`) the filter radius is
+// capped at max_search as the search is, so that no tap leaves the guard band of the face
+// (src/model/point.rs) or of the cascade (src/render/cascade.rs).
 // Radius (UV) of the blocker search: the cone from the receiver to the light's width, at the
 // near plane where it is widest, capped by max_search.
 fn sg_pcss_search_radius(l: sg_Light, s: sg_LightSample) -> f32 {
@@ -1731,7 +1732,7 @@ fn sg_vis_pcss(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
     let z_blocker = sg_light_linear_to_z(l, sum / f32(count));
     let penumbra_world = l.size * (s.view_z - z_blocker) / z_blocker;
     var radius = max(0.5 * penumbra_world / sg_light_map_width(l, s.view_z), 0.5 / (l.map_size.x * l.face_uv.x));
-    if l.kind == 2u {
+    if l.capped_filter != 0u {
         radius = min(radius, l.max_search);
     }
     var lit = 0.0;

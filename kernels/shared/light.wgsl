@@ -62,7 +62,7 @@ struct Light {
     sat_filtered: u32,       // tables: 1 where f32 and read with filtered fetches (the CPU references read it)
     sat_amplitude: f32,      // tables: the largest |v − sat_offset| over the value range (the CPU references read it)
     cssm_two_depth: u32,     // cssm: 0 sharpening alone; two-depth resolve (needs the receiver plane's slope) with the search's z_avg 1, the filter square's 2
-    _pad_end: u32,
+    capped_filter: u32,      // pcss: 1 where the filter radius is capped at max_search (a point light's faces, a cascade's guard band)
 }
 
 // `Light::technique` (keep in sync with the `TECHNIQUE_*` constants of src/gpu_data.rs; a test

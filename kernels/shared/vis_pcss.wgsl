@@ -7,8 +7,9 @@
 // #import shared/sampling
 
 // Radii are in units of a face's UV (the map's, but for a point light's atlas, whose UV is
-// face UV · face_uv). On a point light the filter radius is capped at max_search as the search
-// is, so that no tap leaves the face's guard band (src/model/point.rs).
+// face UV · face_uv). On a point light and in cascades (`capped_filter`) the filter radius is
+// capped at max_search as the search is, so that no tap leaves the guard band of the face
+// (src/model/point.rs) or of the cascade (src/render/cascade.rs).
 // Radius (UV) of the blocker search: the cone from the receiver to the light's width, at the
 // near plane where it is widest, capped by max_search.
 fn pcss_search_radius(l: Light, s: LightSample) -> f32 {
@@ -35,7 +36,7 @@ fn vis_pcss(map: texture_2d<f32>, l: Light, s: LightSample) -> f32 {
     let z_blocker = light_linear_to_z(l, sum / f32(count));
     let penumbra_world = l.size * (s.view_z - z_blocker) / z_blocker;
     var radius = max(0.5 * penumbra_world / light_map_width(l, s.view_z), 0.5 / (l.map_size.x * l.face_uv.x));
-    if l.kind == 2u {
+    if l.capped_filter != 0u {
         radius = min(radius, l.max_search);
     }
     var lit = 0.0;

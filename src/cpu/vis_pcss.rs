@@ -32,8 +32,9 @@ pub fn vis_pcss(map: &Map, l: &LightGpu, s: &LightSample) -> f64 {
     let penumbra = f64::from(l.size) * (s.view_z - z_blocker) / z_blocker;
     let mut radius = (0.5 * penumbra / map_width(l, s.view_z))
         .max(0.5 / (f64::from(l.map_size[0]) * f64::from(l.face_uv[0])));
-    if l.kind == 2 {
-        // A point light's filter stays within the search cap, hence its faces' guard bands.
+    if l.capped_filter != 0 {
+        // A point light's or a cascade's filter stays within the search cap, hence within the
+        // guard band of its face or cascade.
         radius = radius.min(f64::from(l.max_search));
     }
     let mut lit = 0.0;

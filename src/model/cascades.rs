@@ -58,8 +58,67 @@ pub struct CascadeSlice {
     /// The bounding sphere's centre (world), snapped to the cascade's texel grid across the
     /// light's direction.
     pub center: Vec3,
-    /// The bounding sphere's radius: the cascade map's half-width.
+    /// The cascade map's half-width: the bounding sphere's radius, widened by the guard band.
     pub radius: f32,
+}
+
+/// A band around each slice that its cascade's map covers too, so that a lookup around any
+/// receiver of the slice reads texels of that map rather than its clamped edge: `world` units
+/// (a soft technique's reach, the same in every cascade) plus `texels` of the cascade's own
+/// map (a filter's taps beyond that reach, the centre's snapping, the normal offset).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SliceGuard {
+    /// World units beyond the slice's bounding sphere, across the light's direction.
+    pub world: f32,
+    /// Texels of the cascade's map beyond that.
+    pub texels: f32,
+}
+
+impl SliceGuard {
+    /// No band: the map is the slice's bounding sphere.
+    pub const NONE: Self = Self {
+        world: 0.0,
+        texels: 0.0,
+    };
+
+    /// The half-width of a `map_size`² map that covers a sphere of `radius` and this band:
+    /// `(radius + world) / (1 − 2·texels / map_size)`, its texel then `2·half-width / map_size`.
+    pub fn half_width(&self, radius: f32, map_size: u32) -> f32 {
+        (radius + self.world) / (1.0 - 2.0 * self.texels / map_size as f32)
+    }
+}
+
+/// The guard band of a cascaded directional `light`'s maps. PCSS and the soft techniques:
+/// their reach `R` in world units — the cap on search and filter radius that `max_search`
+/// sets on the light's one map (`max_search · 2·extent`), or the widest radius they can
+/// read, `0.5 · size · (far − near) / near` (the penumbra of a blocker at the near plane over
+/// a receiver at the far one; every search radius is smaller), whichever is less — plus the
+/// texels their lookups read past a radius (PCSS's nearest texel 1, a table's window edges 2,
+/// as a point light's [`super::point::reach`]), one for the snapped centre (half a texel each
+/// way) and the normal offset (`normal_bias` texels). The other techniques keep the slice's
+/// bounding sphere (their filters read a few texels around receivers that lie inside it).
+pub fn guard(light: &super::Light) -> SliceGuard {
+    use super::Technique as T;
+    let Some(max_search) = light.shadow.technique.max_search() else {
+        return SliceGuard::NONE;
+    };
+    let super::LightKind::Directional { extent } = light.kind else {
+        return SliceGuard::NONE;
+    };
+    let widest = if light.near > 0.0 {
+        0.5 * light.size * (light.far - light.near) / light.near
+    } else {
+        f32::INFINITY
+    };
+    let taps = if matches!(light.shadow.technique, T::Pcss { .. }) {
+        1.0
+    } else {
+        2.0
+    };
+    SliceGuard {
+        world: (max_search * 2.0 * extent).min(widest),
+        texels: taps + 1.0 + light.shadow.normal_bias.max(0.0),
+    }
 }
 
 fn bad(field: &'static str, message: String) -> StageError {
@@ -114,14 +173,15 @@ pub fn light_rotation(direction: Vec3) -> (Mat4, Vec3) {
 }
 
 /// The slices of `camera`'s view for `count` cascades split with `lambda`, each with its
-/// bounding sphere snapped to the grid of a `map_size`² map in the orientation of a light
-/// shining along `direction`.
+/// bounding sphere widened by `guard` and snapped to the grid of a `map_size`² map in the
+/// orientation of a light shining along `direction`.
 pub fn fit_slices(
     camera: &CascadeCamera,
     direction: Vec3,
     count: u32,
     lambda: f32,
     map_size: u32,
+    guard: SliceGuard,
 ) -> Result<Vec<CascadeSlice>, StageError> {
     if !direction.is_finite() || direction.length_squared() < 1e-12 {
         return Err(bad("direction", format!("{direction} is not a direction")));
@@ -142,13 +202,39 @@ pub fn fit_slices(
     if map_size == 0 {
         return Err(bad("map_size", "need map_size > 0".into()));
     }
+    let finite = |x: f32| x.is_finite() && x >= 0.0;
+    if !(finite(guard.world) && finite(guard.texels)) {
+        return Err(bad(
+            "guard",
+            format!(
+                "need a finite band ≥ 0; got {} world units and {} texels",
+                guard.world, guard.texels
+            ),
+        ));
+    }
+    // As a point light's faces: a band past a quarter of the map is refused.
+    if 4.0 * guard.texels > map_size as f32 {
+        let fits = (4.0 * guard.texels).ceil() as u32;
+        return Err(bad(
+            "shadow_map",
+            format!(
+                "a guard band of {} texels is wider than a quarter of a {map_size}² cascade; the smallest map that fits it is {fits}",
+                guard.texels
+            ),
+        ));
+    }
     let fars = split_distances(camera.near, camera.far, count, lambda)?;
     let to_world = camera.view.inverse();
     let (rotation, _) = light_rotation(direction.normalize());
     let mut near = camera.near;
     let mut out = Vec::with_capacity(fars.len());
     for far in fars {
-        let (center, radius) = slice_sphere(camera, near, far);
+        let (center, sphere) = slice_sphere(camera, near, far);
+        let radius = if guard == SliceGuard::NONE {
+            sphere
+        } else {
+            quantize_up(guard.half_width(sphere, map_size))
+        };
         let texel = 2.0 * radius / map_size as f32;
         let c = rotation.transform_point3(to_world.transform_point3(center));
         let snapped = Vec3::new(

@@ -387,6 +387,26 @@ impl Technique {
         }
     }
 
+    /// The cap on the blocker search's radius (and the soft techniques' filter's), shadow-map
+    /// UV, of PCSS and the soft techniques (`max_search`); `None` for the others.
+    pub fn max_search(&self) -> Option<f32> {
+        match *self {
+            Technique::Pcss { max_search, .. } => Some(max_search),
+            _ => self.soft().map(|s| s.max_search),
+        }
+    }
+
+    /// This technique with its [`Technique::max_search`] set to `uv` (unchanged without one).
+    pub fn with_max_search(mut self, uv: f32) -> Self {
+        if let Technique::Pcss { max_search, .. } = &mut self {
+            *max_search = uv;
+        }
+        if let Some(s) = self.soft_mut() {
+            s.max_search = uv;
+        }
+        self
+    }
+
     /// The variant of the summed-area table it reads, if it reads one (the `sat` filter or a
     /// soft technique's table).
     pub fn sat_variant(&self) -> Option<SatVariant> {

@@ -18,7 +18,7 @@ use glam::{Mat4, Vec3, Vec4Swizzles};
 use super::{LightGpu, LightParams};
 use crate::error::StageError;
 pub use crate::model::cascades::{CascadeCamera, MAX_CASCADES, split_distances};
-use crate::model::cascades::{fit_slices, light_rotation};
+use crate::model::cascades::{SliceGuard, fit_slices, light_rotation};
 
 /// How the cascades are laid out.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -70,6 +70,7 @@ pub fn fit_cascades(
         layout.count,
         layout.lambda,
         layout.map_size,
+        SliceGuard::NONE,
     )?;
     let dir = direction.normalize();
     let (_, up) = light_rotation(dir);

@@ -339,12 +339,14 @@ impl PrefilterConfig {
         ]);
         crate::model::check(&[CASCADES], &Given(&cascades)).map_err(given_err)?;
         if c.count > 1 {
-            technique::params::cascade_support(&self.technique).map_err(|why| {
-                config_err(
-                    "cascades",
-                    format!("{} cascades of technique \"{}\": {why}", c.count, def.name),
-                )
-            })?;
+            technique::params::cascade_support(&self.technique)
+                .and_then(|()| stage_cascade_support(&self.technique))
+                .map_err(|why| {
+                    config_err(
+                        "cascades",
+                        format!("{} cascades of technique \"{}\": {why}", c.count, def.name),
+                    )
+                })?;
         }
         if !self.light_size.is_finite() || !(0.0..=1e6).contains(&self.light_size) {
             return Err(config_err(
@@ -614,5 +616,18 @@ impl LightParams {
         g.map_size = [size as f32; 2];
         g.cos_outer = -1.0;
         g
+    }
+}
+
+/// What the stage adds to [`technique::params::cascade_support`]: the renderer gives each
+/// cascade of PCSS and the soft techniques a guard band and its own `max_search`
+/// (`render::cascade`), but the stage's light slots share one config, hence one `max_search`
+/// in each map's UV, and [`super::cascades::fit_cascades`] fits maps without a band.
+fn stage_cascade_support(t: &crate::model::Technique) -> Result<(), &'static str> {
+    match t.max_search() {
+        Some(_) => Err(
+            "the stage's cascades share one max_search (UV of each map) and have no guard band, so a soft shadow would change at each split (the renderer draws them: `shadowgraph render`); use hard, pcf, vsm, evsm2, evsm4, esm, msm or csm",
+        ),
+        None => Ok(()),
     }
 }

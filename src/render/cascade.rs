@@ -6,11 +6,18 @@
 //! planes — hence its biases and every technique's depth units — are the scene light's. Each
 //! gets its own raster pass, graph nodes (the light's technique, filtered per cascade) and
 //! visibility function; the shading picks one per pixel (`kernels/shared/cascade.wgsl`).
+//!
+//! PCSS and the soft techniques size their search and penumbra in world units from those
+//! depths, so every cascade estimates the same shadow at its own resolution. What differs is
+//! each map's coverage: a cascade's map is widened by a guard band ([`cascade_guard`]) as wide
+//! as the technique's reach, the same in world units in every cascade, and its `max_search`
+//! (UV of its own map) caps search and filter at that reach, so no lookup of a receiver in the
+//! slice reads past the map's edge and no cap changes from one cascade to the next.
 
 use glam::{Mat4, Vec3};
 
 use crate::error::{Error, Result};
-use crate::model::cascades::{CascadeCamera, CascadeSlice, fit_slices};
+use crate::model::cascades::{CascadeCamera, CascadeSlice, SliceGuard, fit_slices, guard};
 use crate::model::{Cascades, Light, LightKind};
 use crate::scene::Scene;
 use crate::technique::{CascadeGroup, LightGpu};
@@ -96,12 +103,14 @@ pub fn drawn_lights(scene: &Scene) -> Result<DrawnLights> {
             ))
         })?;
         let camera = cascade_camera(scene)?;
+        let guard = guard(light);
         let slices = fit_slices(
             &camera,
             light.direction(),
             c.count,
             c.lambda,
             light.shadow_map,
+            guard,
         )
         .map_err(|e| Error::Invalid(format!("light[{i}]: {e}")))?;
         let group = CascadeGroup {
@@ -109,11 +118,18 @@ pub fn drawn_lights(scene: &Scene) -> Result<DrawnLights> {
             first: lights.len(),
             count: slices.len(),
         };
-        let cascade_lights: Vec<Light> = slices.iter().map(|s| cascade_light(light, s)).collect();
+        let cascade_lights: Vec<Light> = slices
+            .iter()
+            .map(|s| cascade_light(light, s, guard))
+            .collect();
+        let capped = guard != SliceGuard::NONE;
         lights[i] = cascade_lights[0].clone();
         gpu[i] = cascade_gpu(&cascade_lights[0], &group, &camera, c, &slices);
+        gpu[i].capped_filter |= u32::from(capped);
         for l in &cascade_lights[1..] {
-            gpu.push(LightGpu::new(l));
+            let mut g = LightGpu::new(l);
+            g.capped_filter |= u32::from(capped);
+            gpu.push(g);
             lights.push(l.clone());
         }
         groups.push(group);
@@ -127,8 +143,9 @@ pub fn drawn_lights(scene: &Scene) -> Result<DrawnLights> {
 }
 
 /// `light` moved across its direction so that its axis passes through `slice`'s centre, with
-/// the slice's radius as its half-width.
-fn cascade_light(light: &Light, slice: &CascadeSlice) -> Light {
+/// the slice's (guarded) radius as its half-width and, for PCSS and the soft techniques, the
+/// guard's world reach as `max_search` in its own map's UV.
+fn cascade_light(light: &Light, slice: &CascadeSlice, guard: SliceGuard) -> Light {
     let dir = light.direction();
     let to_center = slice.center - light.position;
     let across = to_center - dir * to_center.dot(dir);
@@ -139,6 +156,12 @@ fn cascade_light(light: &Light, slice: &CascadeSlice) -> Light {
         extent: slice.radius,
     };
     l.shadow.cascades = Cascades::SINGLE;
+    if guard != SliceGuard::NONE {
+        l.shadow.technique = l
+            .shadow
+            .technique
+            .with_max_search(guard.world / (2.0 * slice.radius));
+    }
     l
 }
 

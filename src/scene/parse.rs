@@ -248,7 +248,7 @@ fn light(ctx: &Ctx, i: usize, l: &LightFile) -> Result<Light> {
             ));
         }
     }
-    Ok(Light {
+    let light = Light {
         kind,
         position,
         target,
@@ -258,7 +258,38 @@ fn light(ctx: &Ctx, i: usize, l: &LightFile) -> Result<Light> {
         radiance: color * intensity,
         shadow_map,
         shadow,
-    })
+    };
+    if light.shadow.cascades.count > 1 {
+        cascade_band(ctx, i, l, &light)?;
+    }
+    Ok(light)
+}
+
+/// A cascaded light's guard band (`model::cascades::guard`: PCSS and the soft techniques) must
+/// leave at least half of each cascade's map, as a point light's faces must; named with the
+/// line of `normal_bias` (most of a wide band's texels) or of the technique.
+fn cascade_band(ctx: &Ctx, i: usize, l: &LightFile, light: &Light) -> Result<()> {
+    let guard = crate::model::cascades::guard(light);
+    let map = light.shadow_map as f32;
+    if 4.0 * guard.texels <= map {
+        return Ok(());
+    }
+    let file = l.shadow.as_ref();
+    let span = file
+        .and_then(|s| s.normal_bias.as_ref())
+        .map(|v| v.span())
+        .or(file.map(|s| s.technique.span()))
+        .or(l.shadow_map.as_ref().map(|v| v.span()));
+    Err(ctx.err(
+        span,
+        format!(
+            "`light[{i}].shadow`: cascades of technique \"{}\" need a guard band of {} texels (the lookups' reach past a radius and `normal_bias`), which leaves less than half of a {}² cascade: raise `shadow_map` to at least {} or lower `normal_bias`",
+            light.shadow.technique.name(),
+            guard.texels,
+            light.shadow_map,
+            (4.0 * guard.texels).ceil()
+        ),
+    ))
 }
 
 /// What a point light's six faces refuse: cascades and techniques whose reach no guard band

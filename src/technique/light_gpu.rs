@@ -61,6 +61,9 @@ impl LightGpu {
             max_anisotropy,
             sat_scale: [1.0; 4],
             max_width: soft_max_width(light).unwrap_or(0.0),
+            // A point light's faces have guard bands as wide as the search cap; a cascade's
+            // band is set where the cascades are fitted (`render::cascade`).
+            capped_filter: u32::from(matches!(light.kind, LightKind::Point)),
             ..bytemuck::Zeroable::zeroed()
         };
         if let Some(soft) = t.soft() {
