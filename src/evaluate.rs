@@ -318,8 +318,7 @@ pub fn evaluate(
         for l in &mut s.lights {
             l.shadow.technique = c.technique;
             l.shadow_map = c.shadow_map;
-            // A technique that refuses cascades (`smrt`, the second-depth ones) runs on the
-            // light's one map.
+            // A technique that refuses cascades (`smrt`) runs on the light's one map.
             if crate::technique::params::cascade_support(&c.technique).is_err() {
                 l.shadow.cascades = crate::model::Cascades::SINGLE;
             }

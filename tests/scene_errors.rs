@@ -1221,9 +1221,9 @@ fn soft_techniques_keys_defaults_and_errors() {
     parse(&text).expect("f32 sums have no window limit");
 }
 
-/// The cascade keys: ranges by the one checker, techniques (`smrt`, the second-depth ones) and
-/// light kinds that cannot have cascades, each named with its key and line; a valid table
-/// gives its values, PCSS's and the soft techniques' too.
+/// The cascade keys: ranges by the one checker, the technique (`smrt`) and light kinds that
+/// cannot have cascades, each named with its key and line; a valid table gives its values,
+/// PCSS's, the soft techniques' and the second-depth techniques' too.
 #[test]
 fn cascade_keys_are_checked() {
     let tech = "technique = \"hard\"";
@@ -1252,11 +1252,6 @@ fn cascade_keys_are_checked() {
             "technique = \"smrt\"\ncascades = 4",
             "cascades = 4",
             &["cascades", "smrt", "guard band"][..],
-        ),
-        (
-            "technique = \"midpoint\"\ncascades = 2",
-            "cascades = 2",
-            &["cascades", "midpoint", "second-depth"][..],
         ),
     ] {
         let text = scene_with(&[(tech, edit)]);
@@ -1296,8 +1291,16 @@ fn cascade_keys_are_checked() {
         "normal_bias = 80.0",
         &["guard band of 83 texels", "256", "332", "normal_bias"],
     );
-    // PCSS and the soft techniques take cascades (each with a guard band).
-    for t in ["pcss", "vssm", "msm_soft", "cssm"] {
+    // PCSS and the soft techniques take cascades (each with a guard band), and so do the
+    // second-depth techniques (each cascade peeled).
+    for t in [
+        "pcss",
+        "vssm",
+        "msm_soft",
+        "cssm",
+        "midpoint",
+        "second_depth",
+    ] {
         let text = scene_with(&[
             ("extent = 4.0\n", "extent = 4.0\nsize = 0.2\n"),
             (tech, &format!("technique = \"{t}\"\ncascades = 3")),

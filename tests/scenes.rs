@@ -1070,14 +1070,15 @@ mod cascades {
 }
 
 /// Technique `name` with its registry defaults.
-fn soft_technique(name: &str) -> Technique {
+fn registered(name: &str) -> Technique {
     shadowgraph::technique::named(name, &[]).unwrap_or_else(|| panic!("{name} is registered"))
 }
 
 /// The cascaded street view with the other techniques that take cascades: each cascade's map
 /// prefiltered by the same graph (hard; VSM blurred; MSM through a float table; ESM mipmapped;
-/// PCSS and the soft techniques, each cascade with its guard band and `max_search`), every
-/// pixel against the f64 pick and references (`cascades::check_light`).
+/// PCSS and the soft techniques, each cascade with its guard band and `max_search`; the
+/// second-depth techniques, each cascade peeled), every pixel against the f64 pick and
+/// references (`cascades::check_light`).
 #[test]
 fn cascaded_techniques_match_the_references() {
     use shadowgraph::scene::{BlurKernel, Filter, Prefilter, Storage};
@@ -1116,10 +1117,12 @@ fn cascaded_techniques_match_the_references() {
             },
             exponent: 40.0,
         },
-        soft_technique("pcss"),
-        soft_technique("vssm"),
-        soft_technique("msm_soft"),
-        soft_technique("cssm"),
+        registered("pcss"),
+        registered("vssm"),
+        registered("msm_soft"),
+        registered("cssm"),
+        registered("midpoint"),
+        registered("second_depth"),
     ] {
         scene.lights[0].shadow.technique = t;
         let frame = renderer

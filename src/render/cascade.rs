@@ -9,7 +9,7 @@
 //!
 //! PCSS and the soft techniques size their search and penumbra in world units from those
 //! depths, so every cascade estimates the same shadow at its own resolution. What differs is
-//! each map's coverage: a cascade's map is widened by a guard band ([`cascade_guard`]) as wide
+//! each map's coverage: a cascade's map is widened by a guard band ([`guard`]) as wide
 //! as the technique's reach, the same in world units in every cascade, and its `max_search`
 //! (UV of its own map) caps search and filter at that reach, so no lookup of a receiver in the
 //! slice reads past the map's edge and no cap changes from one cascade to the next.

@@ -582,19 +582,17 @@ pub fn cascades(v: &ParamValues) -> crate::model::Cascades {
 
 /// Whether a technique works in cascades: `Err` says why not. PCSS and the soft techniques
 /// size search and penumbra in world units from the light's depths, which every cascade keeps,
-/// and each cascade's map carries a guard band of their reach (`render::cascade`); SMRT's rays
-/// march across the map toward the emitter's far side, which no band bounds.
+/// and each cascade's map carries a guard band of their reach (`model::cascades::guard`); the
+/// second-depth techniques peel each cascade's depth as a light's (every cascade is a drawn
+/// light); SMRT's rays march across the map toward the emitter's far side, which no band bounds.
 pub fn cascade_support(t: &crate::model::Technique) -> Result<(), &'static str> {
     use crate::model::Technique as T;
     match t {
-        T::Hard | T::Pcf { .. } | T::Vsm { .. } | T::Evsm { .. } | T::Esm { .. } => Ok(()),
-        T::Msm { .. } | T::Csm { .. } => Ok(()),
-        T::Pcss { .. } | T::Cssm { .. } | T::Vssm { .. } | T::MsmSoft { .. } => Ok(()),
         T::Smrt { .. } => Err(
             "its rays march across the map toward the emitter's far side, which a cascade's guard band does not bound; use pcss, vssm, msm_soft or cssm",
         ),
-        T::Midpoint { .. } | T::SecondDepth { .. } => Err(
-            "second-depth techniques are not yet drawn in cascades; use hard, pcf, pcss, vsm, evsm2, evsm4, esm, msm, csm, vssm, msm_soft or cssm",
-        ),
+        T::Hard | T::Pcf { .. } | T::Vsm { .. } | T::Evsm { .. } | T::Esm { .. } => Ok(()),
+        T::Msm { .. } | T::Csm { .. } | T::Midpoint { .. } | T::SecondDepth { .. } => Ok(()),
+        T::Pcss { .. } | T::Cssm { .. } | T::Vssm { .. } | T::MsmSoft { .. } => Ok(()),
     }
 }

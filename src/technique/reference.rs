@@ -21,9 +21,9 @@ pub fn parameters_markdown() -> String {
     table(&mut s, &[params::COMMON]);
     s.push_str(
         "\n## Directional cascades\n\nKeys of every technique's table on a directional light; \
-         more than one cascade is refused for a spot light, for `smrt` and for the second-depth \
-         techniques (`midpoint`, `second_depth`); PCSS and the soft techniques give each cascade \
-         a guard band of their reach — see [Cascades](SCENES.md#cascades).\n\n",
+         more than one cascade is refused for a spot light and for `smrt`; PCSS and the soft \
+         techniques give each cascade a guard band of their reach — see \
+         [Cascades](SCENES.md#cascades).\n\n",
     );
     table(&mut s, &[params::CASCADES]);
     for def in REGISTRY {
