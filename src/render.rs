@@ -146,6 +146,9 @@ pub fn check_render(device: &wgpu::Device, scene: &Scene, opts: &RenderOptions) 
         device.features(),
         opts,
         crate::limits::memory_budget()?,
+        &(0..drawn.lights.len())
+            .map(|k| drawn.owner(k).0)
+            .collect::<Vec<_>>(),
     )
 }
 

@@ -186,6 +186,39 @@ fn large_maps_exceed_the_memory_budget() {
     );
 }
 
+/// A cascaded light past the budget is named as the scene file's light, with its line and its
+/// cascades (`city_street`'s light in eight 4096² `cssm` cascades: 10.7 GiB), not as the drawn
+/// cascade that holds the most (`light[7]`, which the file does not have).
+#[test]
+fn cascades_past_the_memory_budget_name_their_light() {
+    let g = common::gpu();
+    if std::env::var_os(shadowgraph::limits::MEMORY_BUDGET_ENV).is_some() {
+        panic!(
+            "unset {} to run this test",
+            shadowgraph::limits::MEMORY_BUDGET_ENV
+        );
+    }
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/city_street.toml");
+    let text = std::fs::read_to_string(&path)
+        .expect("city_street")
+        .replace("shadow_map = 512", "shadow_map = 4096")
+        .replace("cascades = 4", "cascades = 8")
+        .replace("technique = \"pcf\"\nradius = 1", "technique = \"cssm\"");
+    let s = Scene::parse(std::path::Path::new("limits.toml"), &text).expect("parses");
+    assert_eq!(s.lights[0].shadow.cascades.count, 8);
+    refused(
+        &g,
+        &s,
+        RenderOptions::default(),
+        nth_line(&text, "shadow_map", 0),
+        &[
+            "`light[0]`'s 8 cascades of 4096² maps",
+            "light[0].shadow_map",
+            "memory budget",
+        ],
+    );
+}
+
 /// The memory estimate of a PCF frame, counted by hand: the depth map and the linear map
 /// (4 bytes a texel each), the G-buffer (16 + 16 + 4 bytes a pixel), colour (4), visibility
 /// (4 per light), the vertices (28 bytes each) and the colour and visibility read-backs
@@ -226,6 +259,7 @@ fn a_point_lights_atlas_is_checked_whole() {
         wgpu::Features::empty(),
         &RenderOptions::default(),
         1 << 30,
+        &[],
     )
     .expect_err("a 3072-wide atlas on a 2048 device")
     .to_string();
@@ -264,6 +298,7 @@ fn interleaved_tables_past_the_largest_side_name_the_map_size() {
             wgpu::Features::empty(),
             &RenderOptions::default(),
             1 << 30,
+            &[],
         )
         .map_err(|e| e.to_string())
     };
@@ -311,7 +346,7 @@ fn lowered_limits_and_budgets_name_the_key() {
     let sp = plan_lights(&s.lights).unwrap();
     let full = wgpu::Limits::default();
     let check = |l: &wgpu::Limits, f: wgpu::Features, budget: u64| {
-        shadowgraph::limits::check_scene(&s, &sp, l, f, &RenderOptions::default(), budget)
+        shadowgraph::limits::check_scene(&s, &sp, l, f, &RenderOptions::default(), budget, &[])
             .map_err(|e| e.to_string())
     };
     check(&full, wgpu::Features::empty(), 1 << 30).expect("fits");
@@ -357,6 +392,7 @@ fn lowered_limits_and_budgets_name_the_key() {
         wgpu::Features::empty(),
         &RenderOptions::default(),
         1 << 30,
+        &[],
     )
     .expect_err("unorm16 without the feature")
     .to_string();
@@ -383,6 +419,7 @@ fn lowered_limits_and_budgets_name_the_key() {
             features,
             &RenderOptions::default(),
             1 << 30,
+            &[],
         )
     };
     let shown = check_with(wgpu::Features::empty())

@@ -88,7 +88,9 @@ pub fn render_memory(scene: &Scene, plan: &Plan, opts: &RenderOptions) -> Memory
 }
 
 /// Checks `scene` rendered with `opts` against a device's `limits` and `features` and the
-/// memory `budget`; `sp` is the scene's plan.
+/// memory `budget`; `sp` is the scene's plan. `owner` maps each light of `scene` to the light of
+/// the scene file that errors name: a cascaded light is checked as the lights it draws (its
+/// cascades after the file's lights, `render::DrawnLights::owner`); empty: each its own.
 pub fn check_scene(
     scene: &Scene,
     sp: &ScenePlan,
@@ -96,8 +98,13 @@ pub fn check_scene(
     features: wgpu::Features,
     opts: &RenderOptions,
     budget: u64,
+    owner: &[usize],
 ) -> Result<()> {
-    let c = Checker { scene, limits };
+    let c = Checker {
+        scene,
+        limits,
+        owner,
+    };
     c.sides()?;
     c.features(features)?;
     c.plan(&sp.plan)?;
@@ -109,9 +116,15 @@ pub fn check_scene(
 struct Checker<'a> {
     scene: &'a Scene,
     limits: &'a wgpu::Limits,
+    owner: &'a [usize],
 }
 
 impl Checker<'_> {
+    /// The scene file's light of checked light `i` (a cascade's: its scene light).
+    fn file_light(&self, i: usize) -> usize {
+        self.owner.get(i).copied().unwrap_or(i)
+    }
+
     fn err(&self, key: &str, message: String) -> Error {
         Error::SceneLimit {
             path: self.scene.path.clone(),
@@ -192,8 +205,9 @@ impl Checker<'_> {
         let Some(over) = super::plan_over(plan, self.limits)? else {
             return Ok(());
         };
-        let i = over.light.unwrap_or(0);
-        let l = self.scene.lights.get(i);
+        let drawn = over.light.unwrap_or(0);
+        let l = self.scene.lights.get(drawn);
+        let i = self.file_light(drawn);
         let (key, fix) = if over.dispatch {
             (format!("light[{i}].shadow_map"), "lower it".to_string())
         } else {
@@ -260,7 +274,7 @@ impl Checker<'_> {
         for (i, input) in sp.shade_inputs.iter().enumerate() {
             count += input.maps.len() as u64;
             if count > n.limit {
-                first = i;
+                first = self.file_light(i);
                 break;
             }
         }
@@ -354,7 +368,7 @@ impl Checker<'_> {
             let bytes = padded(r.width, texel_bytes(r.resource.format)) * u64::from(r.height);
             let read = opts.dump || plan.outputs.contains(&r.resource.name);
             if read && bytes > max {
-                let key = format!("light[{i}].shadow_map");
+                let key = format!("light[{}].shadow_map", self.file_light(i));
                 return Err(self.err(
                     &key,
                     format!(
@@ -372,18 +386,31 @@ impl Checker<'_> {
         if m.total <= budget {
             return Ok(());
         }
-        let (i, most) = m
-            .lights
+        // Per light of the scene file: a cascaded light's bytes are its cascades'.
+        let mut per_file = vec![(0u64, 0usize); m.lights.len()];
+        for (k, &b) in m.lights.iter().enumerate() {
+            let i = self.file_light(k).min(per_file.len() - 1);
+            per_file[i].0 += b;
+            per_file[i].1 += 1;
+        }
+        let (i, (most, drawn)) = per_file
             .iter()
             .copied()
             .enumerate()
-            .max_by_key(|&(_, b)| b)
-            .unwrap_or((0, 0));
+            .max_by_key(|&(_, (b, _))| b)
+            .unwrap_or((0, (0, 1)));
+        // Counted per resource, a light's bytes may pass the total, whose pooled slots its
+        // resources share: shown as at most the total.
+        let most = most.min(m.total);
         let (key, part) = if most >= m.frame {
             let maps = match self.scene.lights.get(i) {
                 Some(l) if l.kind == crate::model::LightKind::Point => {
                     format!("six {}² faces", l.shadow_map)
                 }
+                l if drawn > 1 => format!(
+                    "{drawn} cascades of {}² maps",
+                    l.map_or(0, |l| l.shadow_map)
+                ),
                 l => format!("{}² maps", l.map_or(0, |l| l.shadow_map)),
             };
             (
