@@ -275,7 +275,7 @@ pub const SOFT: &[ParamSpec] = &[
         1e-4,
         1.0,
         DEFAULT_MAX_SEARCH,
-        "cap on the blocker-search and filter half-widths, shadow-map UV",
+        "cap on the blocker-search and filter half-widths, shadow-map UV (in cascades: of the light's one map, 2·extent wide, the same world reach in every cascade)",
     ),
 ];
 

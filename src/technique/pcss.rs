@@ -16,7 +16,7 @@ const PARAMS: &[ParamSpec] = &[
         1e-4,
         1.0,
         DEFAULT_MAX_SEARCH,
-        "cap on the blocker-search radius, shadow-map UV",
+        "cap on the blocker-search radius, shadow-map UV (and on the filter's on a point light and in cascades, where it is of the light's one map, 2·extent wide)",
     ),
 ];
 
