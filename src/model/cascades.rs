@@ -93,27 +93,23 @@ impl SliceGuard {
 /// sets on the light's one map (`max_search · 2·extent`), or the widest radius they can
 /// read, `0.5 · size · (far − near) / near` (the penumbra of a blocker at the near plane over
 /// a receiver at the far one; every search radius is smaller), whichever is less — plus the
-/// texels their lookups read past a radius (PCSS's nearest texel 1, a table's window edges 2,
-/// as a point light's [`super::point::reach`]), one for the snapped centre (half a texel each
+/// texels their lookups read past a radius ([`super::point::texels_past_radius`], as a point
+/// light's faces), one for the snapped centre (half a texel each
 /// way) and the normal offset (`normal_bias` texels). The other techniques keep the slice's
 /// bounding sphere (their filters read a few texels around receivers that lie inside it).
 pub fn guard(light: &super::Light) -> SliceGuard {
-    use super::Technique as T;
-    let Some(max_search) = light.shadow.technique.max_search() else {
-        return SliceGuard::NONE;
-    };
-    let super::LightKind::Directional { extent } = light.kind else {
+    let t = &light.shadow.technique;
+    let (Some(max_search), Some(taps), super::LightKind::Directional { extent }) = (
+        t.max_search(),
+        super::point::texels_past_radius(t),
+        light.kind,
+    ) else {
         return SliceGuard::NONE;
     };
     let widest = if light.near > 0.0 {
         0.5 * light.size * (light.far - light.near) / light.near
     } else {
         f32::INFINITY
-    };
-    let taps = if matches!(light.shadow.technique, T::Pcss { .. }) {
-        1.0
-    } else {
-        2.0
     };
     SliceGuard {
         world: (max_search * 2.0 * extent).min(widest),
@@ -230,11 +226,8 @@ pub fn fit_slices(
     let mut out = Vec::with_capacity(fars.len());
     for far in fars {
         let (center, sphere) = slice_sphere(camera, near, far);
-        let radius = if guard == SliceGuard::NONE {
-            sphere
-        } else {
-            quantize_up(guard.half_width(sphere, map_size))
-        };
+        // Without a band: the sphere's radius, already a multiple of its quantum, so unchanged.
+        let radius = quantize_up(guard.half_width(sphere, map_size));
         let texel = 2.0 * radius / map_size as f32;
         let c = rotation.transform_point3(to_world.transform_point3(center));
         let snapped = Vec3::new(

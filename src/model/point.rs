@@ -111,6 +111,19 @@ impl PointLayout {
     }
 }
 
+/// The texels PCSS's and the soft techniques' lookups read past their radius (capped at
+/// `max_search`): PCSS's taps take the nearest texel (1); a table's window rounds its edges
+/// to texels and snaps the blocker window outward (2). `None` for the other techniques.
+/// Shared by a point light's faces ([`reach`]) and a cascade's guard band
+/// ([`super::cascades::guard`]).
+pub fn texels_past_radius(technique: &Technique) -> Option<f32> {
+    match technique {
+        Technique::Pcss { .. } => Some(1.0),
+        Technique::Cssm { .. } | Technique::Vssm { .. } | Technique::MsmSoft { .. } => Some(2.0),
+        _ => None,
+    }
+}
+
 /// How far around a receiver's texel `technique`'s lookup reads a point light's map, in
 /// face texels, counting what its prefilter folded into the texels it reads (`face`: the face's
 /// side); an error says why a technique cannot be bounded to one face.
@@ -122,18 +135,18 @@ pub fn reach(technique: &Technique, face: u32) -> Result<f32, String> {
             PcfKernel::Hardware => 1.0,
             PcfKernel::Box | PcfKernel::Tent => radius as f32 + 1.0,
         }),
-        // The search radius and (on a point light) the filter radius are capped at max_search.
-        Technique::Pcss { max_search, .. } => Ok(soft(max_search) + 1.0),
+        // The search radius and (on a point light) the filter radius are capped at max_search,
+        // and so is a soft technique's window (at most max_width texels); see
+        // texels_past_radius for what each reads beyond.
+        Technique::Pcss { .. } | Technique::Cssm { .. } | Technique::Vssm { .. } | Technique::MsmSoft { .. } => {
+            let past = texels_past_radius(technique).unwrap_or(0.0);
+            Ok(soft(technique.max_search().unwrap_or(0.0)) + past)
+        }
         Technique::Vsm { prefilter, .. }
         | Technique::Evsm { prefilter, .. }
         | Technique::Msm { prefilter, .. }
         | Technique::Csm { prefilter, .. } => filter_reach(prefilter.filter, face),
         Technique::Esm { filter, .. } => filter_reach(filter, face),
-        // A window of at most max_width texels, its sub-texel edges, and the blocker window
-        // snapped outward to whole texels.
-        Technique::Cssm { soft: s, .. }
-        | Technique::Vssm { soft: s, .. }
-        | Technique::MsmSoft { soft: s, .. } => Ok(soft(s.max_search) + 2.0),
         Technique::Smrt { .. } => Err(
             "point lights do not support \"smrt\": its rays march across the map toward the emitter's far side, which a face's guard band does not bound".into(),
         ),

@@ -156,12 +156,11 @@ fn cascade_light(light: &Light, slice: &CascadeSlice, guard: SliceGuard) -> Ligh
         extent: slice.radius,
     };
     l.shadow.cascades = Cascades::SINGLE;
-    if guard != SliceGuard::NONE {
-        l.shadow.technique = l
-            .shadow
-            .technique
-            .with_max_search(guard.world / (2.0 * slice.radius));
-    }
+    // A technique without `max_search` (no band) keeps its parameters.
+    l.shadow.technique = l
+        .shadow
+        .technique
+        .with_max_search(guard.world / (2.0 * slice.radius));
     l
 }
 
