@@ -108,6 +108,8 @@ struct PlanKey {
     point: bool,
     near: u32,
     far: u32,
+    /// A cascade's own `max_search` (it codes a fixed-point table's window).
+    max_search: Option<u32>,
 }
 
 impl PlanKey {
@@ -118,6 +120,7 @@ impl PlanKey {
             point: light.point,
             near: light.near.to_bits(),
             far: light.far.to_bits(),
+            max_search: light.max_search.map(f32::to_bits),
         }
     }
 }
@@ -287,13 +290,25 @@ impl Prefilter {
     /// by the config's `cascades` (count and split; see [`PrefilterConfig::with_cascades`]) on
     /// `size`² maps, casters kept `caster_margin` world units toward the light: record cascade
     /// `k` in light slot `k` with `cascades[k].light`, and give cascade 0's `sg_Light` the pick
-    /// fields ([`cascades::pick_fields`] with the config's blend band).
+    /// fields ([`cascades::pick_fields`] with the config's blend band). Each cascade has its
+    /// own depth range, so PCSS and the soft techniques are refused here: their cascades share
+    /// the light's depth axis ([`Prefilter::fit_light_cascades`]).
     pub fn fit_cascades(
         &self,
         camera: &cascades::CascadeCamera,
         direction: Vec3,
         caster_margin: f32,
     ) -> Result<Vec<cascades::Cascade>> {
+        if self.config.technique.max_search().is_some() {
+            return Err(StageError::Config {
+                field: "technique".into(),
+                message: format!(
+                    "\"{}\" sizes its penumbra from depths along the light's axis, which fit_cascades gives each cascade anew: fit its cascades with fit_light_cascades(&camera, &light), which keeps the light's plane and widens each map by the technique's reach",
+                    self.config.technique.name()
+                ),
+            }
+            .into());
+        }
         let c = self.config.cascades;
         let layout = cascades::CascadeLayout {
             count: c.count,
@@ -302,6 +317,21 @@ impl Prefilter {
             caster_margin,
         };
         Ok(cascades::fit_cascades(camera, direction, &layout)?)
+    }
+
+    /// The cascades of the host's directional `light` (its one orthographic map: view, planes,
+    /// half-width) for `camera`, for every technique the stage runs in cascades, PCSS and the
+    /// soft techniques included ([`cascades::fit_light_cascades`]: `light` moved across its
+    /// direction onto each slice, the same planes, each map widened by the technique's reach
+    /// and capped at it by its own [`LightParams::max_search`]). Record cascade `k` in light
+    /// slot `k` with `cascades[k].light` and fill cascade 0's pick fields as for
+    /// [`Prefilter::fit_cascades`]; `light`'s near and far planes must hold every caster.
+    pub fn fit_light_cascades(
+        &self,
+        camera: &cascades::CascadeCamera,
+        light: &LightParams,
+    ) -> Result<Vec<cascades::Cascade>> {
+        Ok(cascades::fit_light_cascades(camera, light, &self.config)?)
     }
 
     /// A point light's faces for the host's depth pass into a `3·face × 2·face` depth

@@ -202,8 +202,9 @@ fn cascades_do_not_shimmer() {
 /// `PrefilterConfig::from_light`, fitted by `Prefilter::fit_cascades` and handed to the exported
 /// `sg_cascade_pick` through `pick_fields`, give the pick fields the renderer gives the same
 /// light (`city_street`: four PCF cascades), so a host's pick and blend band are the
-/// renderer's; bad keys and a soft technique in the stage's cascades (which have no guard band:
-/// the renderer's do) are named by validation.
+/// renderer's; bad keys are named by validation, and a soft technique's cascades fitted without
+/// the light's plane, a spot light's cascades and a guard band past a quarter of the map by
+/// the fitting.
 #[test]
 fn the_stages_cascade_config_matches_the_renderers_pick() {
     use shadowgraph::prefilter::{Prefilter, PrefilterConfig};
@@ -250,7 +251,7 @@ fn the_stages_cascade_config_matches_the_renderers_pick() {
         assert!(!c.light.perspective && !c.light.point);
     }
 
-    // Validation: the scene's ranges, and the stage refuses soft techniques in cascades.
+    // Validation: the scene's ranges.
     for (count, lambda, blend, field) in [
         (9, 0.5, 0.1, "cascades"),
         (0, 0.5, 0.1, "cascades"),
@@ -265,18 +266,34 @@ fn the_stages_cascade_config_matches_the_renderers_pick() {
             other => panic!("({count}, {lambda}, {blend}): {other:?}"),
         }
     }
-    match PrefilterConfig::vssm(512, 0.5)
-        .with_cascades(4, 0.5, 0.1)
-        .validated()
-    {
-        Err(StageError::Config { field, message }) => {
-            assert_eq!(field, "cascades");
-            assert!(
-                message.contains("max_search") && message.contains("guard band"),
-                "{message}"
-            );
+    // PCSS and the soft techniques take cascades that keep the light's plane
+    // (`fit_light_cascades`, checked against the renderer's in tests/plugin.rs); the
+    // per-cascade depth ranges of `fit_cascades` are refused for them by name.
+    let soft = PrefilterConfig::vssm(512, 0.5).with_cascades(4, 0.5, 0.1);
+    assert!(soft.validated().is_ok());
+    let soft_stage = Prefilter::new(&g.device, &soft).expect("soft stage");
+    match soft_stage.fit_cascades(&camera, light.direction(), 10.0) {
+        Err(shadowgraph::Error::Stage(StageError::Config { field, message })) => {
+            assert_eq!(field, "technique");
+            assert!(message.contains("fit_light_cascades"), "{message}");
         }
-        other => panic!("vssm in cascades: {other:?}"),
+        other => panic!("vssm through fit_cascades: {other:?}"),
+    }
+    let sun = shadowgraph::prefilter::LightParams::from_light(light);
+    let spot = shadowgraph::prefilter::LightParams::perspective(sun.view, 1.0, sun.near, sun.far);
+    match soft_stage.fit_light_cascades(&camera, &spot) {
+        Err(shadowgraph::Error::Stage(StageError::LightParams { field, .. })) => {
+            assert_eq!(field, "projection")
+        }
+        other => panic!("a spot light's cascades: {other:?}"),
+    }
+    // A guard band past a quarter of the map is named (vssm: 3 texels past its reach, of 8).
+    let wide = Prefilter::new(&g.device, &soft.with_size(8)).expect("stage");
+    match wide.fit_light_cascades(&camera, &sun) {
+        Err(shadowgraph::Error::Stage(StageError::Config { field, message })) => {
+            assert_eq!(field, "shadow_map", "{message}");
+        }
+        other => panic!("an 8² soft cascade: {other:?}"),
     }
     assert!(
         PrefilterConfig::msm(512)

@@ -96,7 +96,7 @@ Ok((shader, out, light))
 }
 
 /// README.md's comments: many lights in the layers of one array, a point light's faces, a sun
-/// in cascades.
+/// in cascades (and in soft cascades).
 #[rustfmt::skip]
 fn readme_comments(g: &Gpu) -> anyhow::Result<(Vec<PrefilterOutput>, String, usize, usize)> {
 use shadowgraph::prefilter::{LightParams, Prefilter, PrefilterConfig};
@@ -118,7 +118,11 @@ let config = PrefilterConfig::vsm(n).with_cascades(4, 0.75, 0.1);
 let sun = Prefilter::new(&device, &config)?;
 let camera = CascadeCamera { view: view(), fov_y: 1.0, aspect: 1.5, near: 0.1, far: 50.0 };
 let cascades = sun.fit_cascades(&camera, Vec3::new(0.3, -1.0, 0.2), 5.0)?.len();
-Ok((outs, block, faces, cascades))
+let stage = Prefilter::new(&device, &PrefilterConfig::vssm(n, 0.5).with_cascades(4, 0.75, 0.1))?;
+let sun = LightParams::orthographic(view(), 25.0, 1.0, 60.0);
+let soft = stage.fit_light_cascades(&camera, &sun)?;
+assert!(soft.iter().all(|c| c.light.max_search.is_some()), "soft cascades carry their cap");
+Ok((outs, block, faces, cascades.min(soft.len())))
 }
 
 /// docs/PLUGIN.md's library API: a scene loaded, planned and rendered.

@@ -373,6 +373,10 @@ fn stage_outputs_equal_the_renderers() {
                 covered += 1;
                 let diff = f64::from((v - frame.visibility[px * lights + li]).abs());
                 total += diff;
+                // Every allowance is at least 1e-5: the f64 reference only where it can matter.
+                if diff <= 1e-5 {
+                    continue;
+                }
                 let allowed = match &soft {
                     Some(soft) => soft_allowance(soft, light, &frame, px),
                     None => Some(1e-5),
@@ -523,4 +527,134 @@ fn soft_allowance(
     );
     let v = common::robust(&s, light.shadow_map as usize, |t| soft.reference(&lg, t))?;
     soft.tolerance(&lg, &s, v).map(|t| (2.0 * t).max(1e-5))
+}
+
+/// PCSS and the soft techniques in a host's cascades: `Prefilter::fit_light_cascades` on
+/// `city_street`'s sun (four 512² cascades) gives each cascade the renderer's light (planes
+/// exact; matrices to 1e-5 of their largest element, as the host's light is rebuilt from
+/// inverted matrices; its own `max_search` to 1e-6 and PCSS's capped filter), and its pick
+/// fields the renderer's. Drawn by the host with those matrices, filtered by the stage and
+/// shaded through the exported WGSL, then picked and blended by the f64 reference
+/// (`cpu::cascade`), every covered pixel's visibility is the renderer's by the rule of
+/// `stage_outputs_equal_the_renderers` (the host's rasters differ from the renderer's by
+/// those ulps too), the soft allowance taken from the cascades the pixel reads.
+#[test]
+fn stage_soft_cascades_equal_the_renderers() {
+    use shadowgraph::cpu::cascade::{blend, pick};
+    use shadowgraph::prefilter::cascades::pick_fields;
+    use shadowgraph::render::{cascade_camera, drawn_lights};
+    let g = common::gpu();
+    let mut renderer = Renderer::new(&g.device);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/city_street.toml");
+    let mut scene = Scene::load(&path).expect("city_street loads");
+    let vertices = scene.vertices();
+    for name in ["pcss", "vssm", "msm_soft", "cssm"] {
+        scene.lights[0].shadow.technique =
+            shadowgraph::technique::named(name, &[]).expect("registered");
+        let frame = renderer
+            .render(
+                &g.device,
+                &g.queue,
+                &scene,
+                RenderOptions {
+                    aux: true,
+                    repeat: 1,
+                    dump: false,
+                },
+            )
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let drawn = drawn_lights(&scene).expect("drawn lights");
+        let light = &scene.lights[0];
+        let config = PrefilterConfig::from_light(light);
+        let mut stage = Prefilter::new(&g.device, &config).expect("stage");
+        let camera = cascade_camera(&scene).expect("camera");
+        let cascades = stage
+            .fit_light_cascades(&camera, &LightParams::from_light(light))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(cascades.len(), 4, "{name}");
+        let mut first = cascades[0].light.light_gpu(&config, config.size);
+        pick_fields(&mut first, &camera, &cascades, config.cascades.blend).expect("pick");
+        let index = |k: usize| {
+            if k == 0 {
+                0
+            } else {
+                drawn.groups[0].first + k - 1
+            }
+        };
+        let mut vis = Vec::new();
+        let mut soft = Vec::new();
+        for (k, c) in cascades.iter().enumerate() {
+            let what = format!("{name} cascade {k}");
+            let theirs = &drawn.lights[index(k)];
+            let r = LightParams::from_light(theirs);
+            for (a, b) in [(c.light.view, r.view), (c.light.projection, r.projection)] {
+                let scale = b.to_cols_array().iter().fold(1f32, |m, x| m.max(x.abs()));
+                let worst = (a - b)
+                    .to_cols_array()
+                    .iter()
+                    .fold(0f32, |m, x| m.max(x.abs()));
+                assert!(worst <= 1e-5 * scale, "{what}: matrix off by {worst}");
+            }
+            assert_eq!(
+                (c.light.near, c.light.far),
+                (r.near, r.far),
+                "{what}: planes"
+            );
+            let (ours, rg) = (c.light.light_gpu(&config, config.size), drawn.gpu[index(k)]);
+            let m = theirs.shadow.technique.max_search().expect("a search cap");
+            assert!(
+                (c.light.max_search.expect("own cap") - m).abs() <= 1e-6 * m,
+                "{what}: max_search"
+            );
+            assert!(
+                (ours.max_search - rg.max_search).abs() <= 1e-6 * m,
+                "{what}"
+            );
+            assert_eq!((ours.capped_filter, rg.capped_filter), (1, 1), "{what}");
+            let depth = host_depth(
+                &g,
+                &vertices,
+                &c.light,
+                light.shadow.slope_bias,
+                config.size,
+            );
+            vis.push(host_visibility(
+                &g, &mut stage, &depth, &c.light, &frame, &scene,
+            ));
+            soft.push(soft_inputs(&g, &frame, theirs, index(k)));
+        }
+        let lights = scene.lights.len();
+        let (mut covered, mut off, mut total) = (0, 0, 0.0f64);
+        for (px, p) in frame.position.chunks_exact(4).enumerate() {
+            if p[3] == 0.0 {
+                continue;
+            }
+            covered += 1;
+            let pk = pick(&first, glam::Vec3::from_slice(&p[..3]).as_dvec3());
+            let v = blend(&pk, |c| f64::from(vis[c][px]));
+            let diff = (v - f64::from(frame.visibility[px * lights])).abs();
+            total += diff;
+            if diff <= 1e-5 {
+                continue;
+            }
+            // The allowance (an f64 reference and its tolerance) only where it is needed.
+            let read = [pk.index, (pk.index + 1).min(3)];
+            let allowed = read.iter().try_fold(1e-5f64, |a, &c| match &soft[c] {
+                Some(s) => soft_allowance(s, &drawn.lights[index(c)], &frame, px).map(|t| a.max(t)),
+                None => Some(a),
+            });
+            if allowed.is_some_and(|a| diff > a) {
+                off += 1;
+            }
+        }
+        assert!(
+            off * 1000 <= covered && total <= 1e-3 * covered as f64,
+            "{name}: {off} of {covered} pixels off, mean |Δ| {:e}",
+            total / covered as f64
+        );
+        eprintln!(
+            "{name}: {off} of {covered} pixels off, mean |Δ| {:e}",
+            total / covered as f64
+        );
+    }
 }

@@ -117,6 +117,32 @@ pub fn guard(light: &super::Light) -> SliceGuard {
     }
 }
 
+/// `light` moved across its direction so that its axis passes through `slice`'s centre, with
+/// the slice's (guarded) radius as its half-width and, for PCSS and the soft techniques, the
+/// guard's world reach as `max_search` in its own map's UV.
+pub fn cascade_light(
+    light: &super::Light,
+    slice: &CascadeSlice,
+    guard: SliceGuard,
+) -> super::Light {
+    let dir = light.direction();
+    let to_center = slice.center - light.position;
+    let across = to_center - dir * to_center.dot(dir);
+    let mut l = light.clone();
+    l.position += across;
+    l.target += across;
+    l.kind = super::LightKind::Directional {
+        extent: slice.radius,
+    };
+    l.shadow.cascades = Cascades::SINGLE;
+    // A technique without `max_search` (no band) keeps its parameters.
+    l.shadow.technique = l
+        .shadow
+        .technique
+        .with_max_search(guard.world / (2.0 * slice.radius));
+    l
+}
+
 fn bad(field: &'static str, message: String) -> StageError {
     StageError::Config {
         field: field.into(),

@@ -12,13 +12,22 @@
 //! [`super::Prefilter`] (`record_light(k, …, DepthLayer::new(&array, k), &cascade.light)`);
 //! the host picks the cascade by the pixel's view depth against [`Cascade::far`]
 //! (`examples/host_lights.rs`).
+//!
+//! Two fittings: [`fit_cascades`] gives each cascade its own depth range (the slice's sphere
+//! and a caster margin: the tightest depth for the techniques that compare depths near the
+//! receiver), and [`fit_light_cascades`] moves the host's one directional light across its
+//! direction onto each slice, keeping its depth axis and planes, so that PCSS and the soft
+//! techniques, whose penumbrae follow depths from the light's plane, estimate the same shadow
+//! in every cascade; each of its maps is widened by a guard band as wide as the technique's
+//! reach and given that reach as its own `max_search` (the renderer's cascades, bit for bit
+//! the same fitting: `model::cascades`).
 
 use glam::{Mat4, Vec3, Vec4Swizzles};
 
-use super::{LightGpu, LightParams};
+use super::{LightGpu, LightParams, PrefilterConfig};
 use crate::error::StageError;
 pub use crate::model::cascades::{CascadeCamera, MAX_CASCADES, split_distances};
-use crate::model::cascades::{SliceGuard, fit_slices, light_rotation};
+use crate::model::cascades::{SliceGuard, cascade_light, fit_slices, guard, light_rotation};
 
 /// How the cascades are laid out.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -95,6 +104,60 @@ pub fn fit_cascades(
         });
     }
     Ok(out)
+}
+
+/// The cascades of the host's directional `light` (orthographic: the one map it would draw
+/// without cascades; its view's origin is the emitter's plane, its near and far planes the
+/// depth range, its half-width what `config`'s `max_search` is a fraction of) for `camera`,
+/// laid out by `config`'s `cascades` on `config.size`² maps. Each cascade is `light` moved
+/// across its direction onto a slice of the camera's view (oriented as the renderer orients a
+/// directional light, so the texel snapping holds; the host's roll is not kept), with the same
+/// planes and depth axis. For PCSS and the soft techniques each map is widened by a guard
+/// band: the technique's reach `R` in world units (`max_search · 2·half-width`, or the widest
+/// penumbra `0.5 · light_size · (far − near) / near`, whichever is less) plus the texels its
+/// lookups read past a radius, the snapped centre and `normal_bias`; each cascade's
+/// [`LightParams::max_search`] is `R` in its own map's UV, capping PCSS's filter too. A band
+/// past a quarter of the map is refused.
+pub fn fit_light_cascades(
+    camera: &CascadeCamera,
+    light: &LightParams,
+    config: &PrefilterConfig,
+) -> Result<Vec<Cascade>, StageError> {
+    light.validate()?;
+    if light.perspective || light.point {
+        return Err(StageError::LightParams {
+            field: "projection",
+            message: "cascades need a directional light's orthographic projection".into(),
+        });
+    }
+    let (config, _) = config.validated()?;
+    let base = light.scene_light(&config, config.size);
+    let band = guard(&base);
+    let c = config.cascades;
+    let slices = fit_slices(
+        camera,
+        base.direction(),
+        c.count,
+        c.lambda,
+        config.size,
+        band,
+    )?;
+    let capped = band != SliceGuard::NONE;
+    slices
+        .iter()
+        .map(|s| {
+            let l = cascade_light(&base, s, band);
+            let mut params = LightParams::from_light(&l);
+            params.max_search = l.shadow.technique.max_search().filter(|_| capped);
+            params.validate()?;
+            Ok(Cascade {
+                light: params,
+                near: s.near,
+                far: s.far,
+                radius: s.radius,
+            })
+        })
+        .collect()
 }
 
 /// The view distance of world point `p` for `camera` (what selects its cascade).

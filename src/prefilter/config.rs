@@ -339,14 +339,12 @@ impl PrefilterConfig {
         ]);
         crate::model::check(&[CASCADES], &Given(&cascades)).map_err(given_err)?;
         if c.count > 1 {
-            technique::params::cascade_support(&self.technique)
-                .and_then(|()| stage_cascade_support(&self.technique))
-                .map_err(|why| {
-                    config_err(
-                        "cascades",
-                        format!("{} cascades of technique \"{}\": {why}", c.count, def.name),
-                    )
-                })?;
+            technique::params::cascade_support(&self.technique).map_err(|why| {
+                config_err(
+                    "cascades",
+                    format!("{} cascades of technique \"{}\": {why}", c.count, def.name),
+                )
+            })?;
         }
         if !self.light_size.is_finite() || !(0.0..=1e6).contains(&self.light_size) {
             return Err(config_err(
@@ -430,6 +428,12 @@ pub struct LightParams {
     /// `light_size / target_distance` (what `smrt`'s parallel rays follow, as the renderer's
     /// truth does). The constructors set 1; [`LightParams::from_light`] the scene's.
     pub target_distance: f32,
+    /// This map's cap on PCSS's and the soft techniques' search and filter half-widths
+    /// (shadow-map UV), in place of the config's `max_search`, with PCSS's filter capped there
+    /// as its search is: one cascade's share of its light's world reach, which
+    /// [`crate::prefilter::Prefilter::fit_light_cascades`] sets so that every cascade estimates
+    /// the same penumbra. `None` (what the constructors set): the config's.
+    pub max_search: Option<f32>,
 }
 
 impl LightParams {
@@ -444,6 +448,7 @@ impl LightParams {
             near,
             far,
             target_distance: 1.0,
+            max_search: None,
         }
     }
 
@@ -457,6 +462,7 @@ impl LightParams {
             near,
             far,
             target_distance: 1.0,
+            max_search: None,
         }
     }
 
@@ -473,6 +479,7 @@ impl LightParams {
             near,
             far,
             target_distance: 1.0,
+            max_search: None,
         }
     }
 
@@ -490,6 +497,7 @@ impl LightParams {
             near: light.near,
             far: light.far,
             target_distance: (light.target - light.position).length(),
+            max_search: None,
         }
     }
 
@@ -521,6 +529,14 @@ impl LightParams {
             return Err(err(
                 "target_distance",
                 format!("{} must be finite and positive", self.target_distance),
+            ));
+        }
+        if let Some(m) = self.max_search
+            && !(m.is_finite() && m > 0.0 && m <= 1.0)
+        {
+            return Err(err(
+                "max_search",
+                format!("{m} is outside (0, 1] (shadow-map UV)"),
             ));
         }
         if self.far <= self.near {
@@ -586,7 +602,10 @@ impl LightParams {
             radiance: Vec3::ONE,
             shadow_map: size,
             shadow: Shadow {
-                technique: config.technique,
+                technique: match self.max_search {
+                    Some(uv) => config.technique.with_max_search(uv),
+                    None => config.technique,
+                },
                 bias: config.bias,
                 // Slope-scaled bias is rasterization state: the host's depth pass owns it.
                 slope_bias: 0.0,
@@ -604,6 +623,8 @@ impl LightParams {
     pub fn light_gpu(&self, config: &PrefilterConfig, size: u32) -> LightGpu {
         let light = self.scene_light(config, size);
         let mut g = LightGpu::new(&light);
+        // A cascade's own cap bounds PCSS's filter too, as its guard band allows.
+        g.capped_filter |= u32::from(self.max_search.is_some());
         if self.point {
             // The faces' matrices are the stage's (`point_views`); the light is its position.
             return g;
@@ -616,18 +637,5 @@ impl LightParams {
         g.map_size = [size as f32; 2];
         g.cos_outer = -1.0;
         g
-    }
-}
-
-/// What the stage adds to [`technique::params::cascade_support`]: the renderer gives each
-/// cascade of PCSS and the soft techniques a guard band and its own `max_search`
-/// (`render::cascade`), but the stage's light slots share one config, hence one `max_search`
-/// in each map's UV, and [`super::cascades::fit_cascades`] fits maps without a band.
-fn stage_cascade_support(t: &crate::model::Technique) -> Result<(), &'static str> {
-    match t.max_search() {
-        Some(_) => Err(
-            "the stage's cascades share one max_search (UV of each map) and have no guard band, so a soft shadow would change at each split (the renderer draws them: `shadowgraph render`); use hard, pcf, vsm, evsm2, evsm4, esm, msm or csm",
-        ),
-        None => Ok(()),
     }
 }

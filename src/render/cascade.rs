@@ -17,7 +17,9 @@
 use glam::{Mat4, Vec3};
 
 use crate::error::{Error, Result};
-use crate::model::cascades::{CascadeCamera, CascadeSlice, SliceGuard, fit_slices, guard};
+use crate::model::cascades::{
+    CascadeCamera, CascadeSlice, SliceGuard, cascade_light, fit_slices, guard,
+};
 use crate::model::{Cascades, Light, LightKind};
 use crate::scene::Scene;
 use crate::technique::{CascadeGroup, LightGpu};
@@ -140,28 +142,6 @@ pub fn drawn_lights(scene: &Scene) -> Result<DrawnLights> {
         groups,
         visible,
     })
-}
-
-/// `light` moved across its direction so that its axis passes through `slice`'s centre, with
-/// the slice's (guarded) radius as its half-width and, for PCSS and the soft techniques, the
-/// guard's world reach as `max_search` in its own map's UV.
-fn cascade_light(light: &Light, slice: &CascadeSlice, guard: SliceGuard) -> Light {
-    let dir = light.direction();
-    let to_center = slice.center - light.position;
-    let across = to_center - dir * to_center.dot(dir);
-    let mut l = light.clone();
-    l.position += across;
-    l.target += across;
-    l.kind = LightKind::Directional {
-        extent: slice.radius,
-    };
-    l.shadow.cascades = Cascades::SINGLE;
-    // A technique without `max_search` (no band) keeps its parameters.
-    l.shadow.technique = l
-        .shadow
-        .technique
-        .with_max_search(guard.world / (2.0 * slice.radius));
-    l
 }
 
 /// Cascade 0's description with the cascade fields the pick reads.
