@@ -12,8 +12,8 @@
 # before its kernels. In order now: soft table, four shading shapes (about 80 s), the blur's
 # row variants (two processes, `bench --kernel-dirs`, perhaps 35 s), the tables' two variants
 # (two, 30 s), the mip variant (two, 20 s), every kernel at 2048², 4096²/8192², the fused ablation
-# (one, 10 s), one round of the layouts, the bunny frame: about 420 s, with BASE about 60 s
-# more. Give the call 520 s (the machine's start, about 50 s, counts too); a step cut off by
+# (one, 10 s), one round of the layouts, the bunny frame, six cascaded frames (perhaps 20 s):
+# about 440 s, with BASE about 60 s more. Give the call 520 s (the machine's start, about 50 s, counts too); a step cut off by
 # the call's end loses only the steps after it.
 # The steps run most wanted first, each under its own time box, and append to at most seven
 # files in OUT (the device tool brings back eight), so a call stopped by its time box still
@@ -227,6 +227,17 @@ if [ -n "$BASE" ]; then
 fi
 # The timer against the wall clock on a bundled scene.
 step env.txt 30 "$B" render scenes/bunny.toml --timings --repeat 20 -o "$V/bunny.png"
+# Cascades on a GPU (never timed there; llvmpipe runs every cascade's case, 3.3-4.7x one map's
+# wall time): city_street at 1920x1080, its four 512² cascades against one 512² map
+# (`cascades = 1`), with hard, PCSS 16 + 32 and vssm; each frame's passes against its wall time.
+for t in hard pcss vssm; do
+    for c in 4 1; do
+        sed -e "s/^technique = \"pcf\"$/technique = \"$t\"/" -e '/^radius = 1$/d' \
+            -e "s/^cascades = 4$/cascades = $c/" -e 's/^width = 480$/width = 1920/' \
+            -e 's/^height = 360$/height = 1080/' scenes/city_street.toml >"$V/city_${t}_$c.toml"
+        step env.txt 20 "$B" render "$V/city_${t}_$c.toml" --timings --repeat 20 -o "$V/city.png"
+    done
+done
 command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=clocks.sm --format=csv \
     >>"$OUT/env.txt" 2>&1
 rm -rf "$V"
