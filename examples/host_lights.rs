@@ -1,23 +1,25 @@
 //! A host with several lights, as real renderers keep them: one `Depth32Float` array texture
-//! with a layer per shadow map, rendered by the host's own depth pass: two spot lights and a
-//! directional sun in three cascades (`prefilter::cascades`: practical split, texel-snapped).
-//! ONE `Prefilter` serves every map (one set of pipelines, `record_light(k, …,
-//! DepthLayer::new(&array, k), …)` reads each layer in place, and each map lives until its slot
-//! is recorded again); the host's shader holds the technique's functions once and one generated
+//! with a layer per shadow map, rendered by the host's own depth pass: two spot lights with
+//! MSM and a directional sun with soft shadows (`vssm`) in three cascades
+//! (`Prefilter::fit_light_cascades`: practical split, texel-snapped, the sun's plane kept and
+//! each map widened by the penumbra's reach). One `Prefilter` per technique serves its maps
+//! (one set of pipelines, `record_light(k, …, DepthLayer::new(&array, layer), …)` reads each
+//! layer in place, and each map lives until its slot is recorded again); the host's shader
+//! holds both techniques' functions once (`prefilter::wgsl::functions_for`) and one generated
 //! block per map (`shadowgraph_visibility_key`, `…_fill`, `…_sun0` …), next to its own names,
-//! and picks the sun's cascade by view distance. Writes a PNG.
+//! and picks and blends the sun's cascades with the exported `sg_cascade_pick`. Writes a PNG.
 //!
 //!     cargo run --release --example host_lights [-- out.png]     (default target/host_lights.png)
 
 mod common;
 
-use anyhow::{Context, Result};
+use anyhow::Context;
 use common::{
     begin_shade_pass, copy_color, depth_pass, depth_pipeline, device, read, scene, shade_pipeline,
     target, uniform_entry,
 };
 use glam::{Mat4, Vec3};
-use shadowgraph::prefilter::cascades::{CascadeCamera, CascadeLayout, fit_cascades};
+use shadowgraph::prefilter::cascades::{CascadeCamera, pick_fields};
 use shadowgraph::prefilter::{DepthLayer, LightParams, Prefilter, PrefilterConfig};
 use wgpu::util::DeviceExt;
 
@@ -38,36 +40,32 @@ fn camera() -> CascadeCamera {
     }
 }
 
-/// Each map's light: the two spots, then the sun's cascades (and their far distances).
-fn light_params() -> Result<(Vec<LightParams>, [f32; 4])> {
+/// The spot lights' parameters.
+fn spots() -> Vec<LightParams> {
     let spot = |eye: Vec3| {
         LightParams::perspective(Mat4::look_at_rh(eye, Vec3::ZERO, Vec3::Y), 1.0, 2.0, 20.0)
     };
-    let layout = CascadeLayout {
-        count: 3,
-        lambda: 0.7,
-        map_size: SHADOW_MAP,
-        caster_margin: 10.0,
-    };
-    let cascades = fit_cascades(&camera(), Vec3::new(6.0, -9.0, -2.0), &layout)?;
-    let mut fars = [0.0; 4];
-    for (f, c) in fars.iter_mut().zip(&cascades) {
-        *f = c.far;
-    }
-    let mut lights = vec![
+    vec![
         spot(Vec3::new(4.0, 6.0, 4.0)),
         spot(Vec3::new(-5.0, 4.0, 3.0)),
-    ];
-    lights.extend(cascades.iter().map(|c| c.light));
-    Ok((lights, fars))
+    ]
+}
+
+/// The sun as one orthographic map over the whole scene: its view's origin is the emitter's
+/// plane (soft penumbrae are sized from depths along it), its planes hold every caster, and
+/// `max_search` is a fraction of its width; `fit_light_cascades` moves it onto each slice.
+fn sun() -> LightParams {
+    let direction = Vec3::new(6.0, -9.0, -2.0).normalize();
+    let view = Mat4::look_to_rh(-15.0 * direction, direction, Vec3::Y);
+    LightParams::orthographic(view, 9.0, 1.0, 30.0)
 }
 
 /// The host's own shading and names (a `struct Light` of its own, unrelated to
 /// shadowgraph's `sg_Light`); `VISIBILITY` becomes one term per light.
 const SHADE: &str = "
 struct Light { color: vec4<f32> }
-// The lights' colours, the camera's view and the sun's cascade ends (view distances).
-struct Frame { colors: array<Light, 3>, view: mat4x4<f32>, cascade_far: vec4<f32> }
+// The lights' colours.
+struct Frame { colors: array<Light, 3> }
 @group(0) @binding(0) var<uniform> camera: mat4x4<f32>;
 @group(0) @binding(1) var<uniform> frame: Frame;
 // The maps' lights as the stage describes them (`PrefilterOutput::light`, one after another,
@@ -93,20 +91,24 @@ fn lambert(l: sg_Light, p: vec3<f32>, n: vec3<f32>) -> f32 {
     return max(dot(n, to_light), 0.0);
 }
 
-// The sun's visibility from the first cascade whose range holds the pixel (lit beyond the last).
+// Cascade c of the sun.
+fn sun_cascade(c: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
+    switch c {
+        case 0u: { return shadowgraph_visibility_sun0(shadows[2], p, n); }
+        case 1u: { return shadowgraph_visibility_sun1(shadows[3], p, n); }
+        default: { return shadowgraph_visibility_sun2(shadows[4], p, n); }
+    }
+}
+
+// The sun's visibility: the cascade the pixel's view distance picks (cascade 0's sg_Light
+// holds the pick fields), faded to the next one's across the blend band.
 fn sun_visibility(p: vec3<f32>, n: vec3<f32>) -> f32 {
-    let d = -(frame.view * vec4<f32>(p, 1.0)).z;
-    let cascade_far = frame.cascade_far;
-    if d <= cascade_far.x {
-        return shadowgraph_visibility_sun0(shadows[2], p, n);
+    let pick = sg_cascade_pick(shadows[2], p);
+    let v = sun_cascade(pick.index, p, n);
+    if pick.blend <= 0.0 {
+        return v;
     }
-    if d <= cascade_far.y {
-        return shadowgraph_visibility_sun1(shadows[3], p, n);
-    }
-    if d <= cascade_far.z {
-        return shadowgraph_visibility_sun2(shadows[4], p, n);
-    }
-    return 1.0;
+    return mix(v, sun_cascade(pick.index + 1u, p, n), pick.blend);
 }
 
 @fragment
@@ -143,18 +145,28 @@ fn run() -> anyhow::Result<()> {
         contents: bytemuck::cast_slice(&verts),
         usage: wgpu::BufferUsages::VERTEX,
     });
-    let (params, cascade_far) = light_params()?;
+    // One stage per technique: the spots' MSM, the sun's soft VSM in three cascades (each
+    // cascade a light slot of its stage with its own `max_search`, and a layer of the array).
+    let mut spot_stage = Prefilter::new(&device, &PrefilterConfig::msm(SHADOW_MAP))?;
+    let sun_config = PrefilterConfig::vssm(SHADOW_MAP, 1.5).with_cascades(3, 0.7, 0.1);
+    let mut sun_stage = Prefilter::new(&device, &sun_config)?;
+    let cascades = sun_stage.fit_light_cascades(&camera(), &sun())?;
+    let mut params: Vec<(usize, LightParams)> = spots().into_iter().enumerate().collect();
+    params.extend(
+        cascades
+            .iter()
+            .enumerate()
+            .map(|(c, cascade)| (c, cascade.light)),
+    );
     let shadows = shadow_array(&device, MAPS.len() as u32);
 
-    // One stage for every light: pipelines once.
-    let mut stage = Prefilter::new(&device, &PrefilterConfig::msm(SHADOW_MAP))?;
-    // Each light's maps at their own bindings of group 1: the technique's functions once, then
-    // one block per light.
-    let per_light = stage.layout_entries(0, wgpu::ShaderStages::FRAGMENT)?.len() as u32;
-    let mut wgsl = stage.wgsl_functions()?;
+    // Both techniques' functions once, then one block per map at its bindings of group 1.
+    let techniques = [spot_stage.config().technique, sun_config.technique];
+    let mut wgsl = shadowgraph::prefilter::wgsl::functions_for(&techniques)?;
     let mut maps_entries = Vec::new();
     for (k, name) in MAPS.iter().enumerate() {
-        let first = k as u32 * per_light;
+        let stage = if k < 2 { &spot_stage } else { &sun_stage };
+        let first = maps_entries.len() as u32;
         wgsl.push_str(&stage.wgsl_light(name, 1, first)?);
         maps_entries.extend(stage.layout_entries(first, wgpu::ShaderStages::FRAGMENT)?);
     }
@@ -183,8 +195,8 @@ fn run() -> anyhow::Result<()> {
 
     let mut enc = device.create_command_encoder(&Default::default());
     let mut outputs = Vec::new();
-    for (k, light) in params.iter().enumerate() {
-        let layer = k as u32;
+    for (layer, &(slot, light)) in params.iter().enumerate() {
+        let layer = layer as u32;
         let view = shadows.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2),
             base_array_layer: layer,
@@ -192,10 +204,22 @@ fn run() -> anyhow::Result<()> {
             ..Default::default()
         });
         let geometry = (&vertices, verts.len() as u32);
-        depth_pass(&device, &mut enc, &depth_pipeline, geometry, &view, light);
+        depth_pass(&device, &mut enc, &depth_pipeline, geometry, &view, &light);
         let depth = DepthLayer::new(&shadows, layer);
-        outputs.push(stage.record_light(k, &device, &mut enc, depth, light)?);
+        let stage = if layer < 2 {
+            &mut spot_stage
+        } else {
+            &mut sun_stage
+        };
+        outputs.push(stage.record_light(slot, &device, &mut enc, depth, &light)?);
     }
+    // Cascade 0's sg_Light carries the pick: the camera, the cascades' far distances, the band.
+    pick_fields(
+        &mut outputs[2].light,
+        &camera(),
+        &cascades,
+        sun_config.cascades.blend,
+    )?;
     let views: Vec<&wgpu::TextureView> = outputs
         .iter()
         .flat_map(|o| o.maps.iter().map(|m| &m.view))
@@ -219,8 +243,6 @@ fn run() -> anyhow::Result<()> {
         COLORS
             .iter()
             .flat_map(|c| bytemuck::cast_slice(&[c[0], c[1], c[2], 0.0]).to_vec())
-            .chain(bytemuck::cast_slice(&cam.view.to_cols_array()).to_vec())
-            .chain(bytemuck::cast_slice(&cascade_far).to_vec())
             .collect(),
     ];
     uniforms.push(
@@ -271,14 +293,16 @@ fn run() -> anyhow::Result<()> {
     image::save_buffer(&out, &rgba, IMAGE.0, IMAGE.1, image::ColorType::Rgba8)
         .with_context(|| format!("writing {out}"))?;
     println!(
-        "wrote {out} ({}x{}: two spot lights and a sun in three cascades, {} maps from one {}² msm \
-         stage, layers of one depth array; {} pipelines, {} textures) in {:.2} s",
+        "wrote {out} ({}x{}: two MSM spot lights and a soft vssm sun in three cascades, {} + {} \
+         {}² maps from two stages, layers of one depth array; {} pipelines, {} textures) in \
+         {:.2} s",
         IMAGE.0,
         IMAGE.1,
-        stage.light_count(),
+        spot_stage.light_count(),
+        sun_stage.light_count(),
         SHADOW_MAP,
-        stage.pipeline_count(),
-        stage.texture_count(),
+        spot_stage.pipeline_count() + sun_stage.pipeline_count(),
+        spot_stage.texture_count() + sun_stage.texture_count(),
         start.elapsed().as_secs_f64()
     );
     Ok(())

@@ -10,8 +10,8 @@
 //!
 //! Each cascade is one layer of the host's depth array, filtered by one light slot of a
 //! [`super::Prefilter`] (`record_light(k, …, DepthLayer::new(&array, k), &cascade.light)`);
-//! the host picks the cascade by the pixel's view depth against [`Cascade::far`]
-//! (`examples/host_lights.rs`).
+//! the host picks the cascade by the pixel's view depth against [`Cascade::far`], or with the
+//! exported `sg_cascade_pick` and the fields [`pick_fields`] fills (`examples/host_lights.rs`).
 //!
 //! Two fittings: [`fit_cascades`] gives each cascade its own depth range (the slice's sphere
 //! and a caster margin: the tightest depth for the techniques that compare depths near the
