@@ -39,28 +39,47 @@ impl CascadeGroup {
     }
 }
 
-/// `light<i>_cascade(c, …)`, one case per cascade as a plain light's, and
-/// `light<i>_cascaded(…)`, the pick and the blend.
+/// `light<i>_cascade<c>(…)`, one function per cascade with a plain light's case as its body,
+/// and `light<i>_cascaded(…)`, the pick and the blend. Each cascade's function is called once,
+/// where the pixel reads it (its picked cascade, and the next one inside the blend band): a
+/// GPU branches per warp, as it did for a `switch` on the cascade called once for each of the
+/// two, and a CPU driver that runs every branch under a lane mask (llvmpipe) evaluates each
+/// cascade once instead of twice. The result is the same `mix` of the same two values.
 pub(super) fn cascade_functions(g: &CascadeGroup, lights: &[Light]) -> String {
     let i = g.light;
-    let mut cases = String::new();
+    let mut out = String::new();
+    let mut calls = String::new();
     for c in 0..g.count {
         let k = g.index(c);
         let body = lights.get(k).map_or_else(
             || "\n            return 1.0;".to_string(),
             |l| light_case(k, l),
         );
-        let _ = writeln!(cases, "        case {c}u: {{{body}\n        }}");
+        let _ = writeln!(
+            out,
+            "fn light{i}_cascade{c}(p: vec3<f32>, n: vec3<f32>, dpdx: vec3<f32>, dpdy: vec3<f32>) -> f32 {{{body}\n}}"
+        );
+        let _ = write!(
+            calls,
+            "    if pick.index == {c}u || next == {c}u {{\n        \
+             let x = light{i}_cascade{c}(p, n, dpdx, dpdy);\n        \
+             v = select(v, x, pick.index == {c}u);\n        \
+             w = select(w, x, next == {c}u);\n    }}\n"
+        );
     }
-    format!(
-        "fn light{i}_cascade(c: u32, p: vec3<f32>, n: vec3<f32>, dpdx: vec3<f32>, dpdy: vec3<f32>) -> f32 {{\n    \
-         switch c {{\n{cases}        default: {{ return 1.0; }}\n    }}\n}}\n\
-         fn light{i}_cascaded(p: vec3<f32>, n: vec3<f32>, dpdx: vec3<f32>, dpdy: vec3<f32>) -> f32 {{\n    \
+    let _ = write!(
+        out,
+        "fn light{i}_cascaded(p: vec3<f32>, n: vec3<f32>, dpdx: vec3<f32>, dpdy: vec3<f32>) -> f32 {{\n    \
          let pick = cascade_pick(lights[{i}], p);\n    \
-         let v = light{i}_cascade(pick.index, p, n, dpdx, dpdy);\n    \
+         // The cascade the blend fades to (none outside the band).\n    \
+         let next = select(0xffffffffu, pick.index + 1u, pick.blend > 0.0);\n    \
+         var v = 1.0;\n    \
+         var w = 1.0;\n\
+         {calls}    \
          if pick.blend <= 0.0 {{\n        return v;\n    }}\n    \
-         return mix(v, light{i}_cascade(pick.index + 1u, p, n, dpdx, dpdy), pick.blend);\n}}\n"
-    )
+         return mix(v, w, pick.blend);\n}}\n"
+    );
+    out
 }
 
 /// [`super::shade_key`] of the drawn `lights` with these cascades.
