@@ -240,6 +240,16 @@ impl Prefilter {
     ) -> Result<PrefilterOutput> {
         let depth = depth.into();
         light.validate()?;
+        if light.max_search.is_some() && self.config.technique.max_search().is_none() {
+            return Err(StageError::LightParams {
+                field: "max_search",
+                message: format!(
+                    "technique \"{}\" has no search to cap (PCSS and the soft techniques do)",
+                    self.config.technique.name()
+                ),
+            }
+            .into());
+        }
         if slot >= MAX_LIGHTS {
             return Err(StageError::LightSlot {
                 slot,

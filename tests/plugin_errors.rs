@@ -233,6 +233,22 @@ fn inconsistent_light_params_are_named() {
             },
             "view",
         ),
+        // A search cap on a technique without a search (the stage here runs VSM), and one
+        // that is not a UV fraction.
+        (
+            LightParams {
+                max_search: Some(0.1),
+                ..light()
+            },
+            "max_search",
+        ),
+        (
+            LightParams {
+                max_search: Some(f32::NAN),
+                ..light()
+            },
+            "max_search",
+        ),
         // Reversed Z: depth 1 at near, 0 at far.
         (
             LightParams {

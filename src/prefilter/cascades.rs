@@ -19,8 +19,8 @@
 //! direction onto each slice, keeping its depth axis and planes, so that PCSS and the soft
 //! techniques, whose penumbrae follow depths from the light's plane, estimate the same shadow
 //! in every cascade; each of its maps is widened by a guard band as wide as the technique's
-//! reach and given that reach as its own `max_search` (the renderer's cascades, bit for bit
-//! the same fitting: `model::cascades`).
+//! reach and given that reach as its own `max_search`: the fitting of the renderer's cascades
+//! (`model::cascades`), from the host's matrices.
 
 use glam::{Mat4, Vec3, Vec4Swizzles};
 
