@@ -115,6 +115,10 @@ pub struct Row {
     pub total_ms: Option<f64>,
     /// Camera G-buffer, ms (the same work for every configuration).
     pub gbuffer_ms: Option<f64>,
+    /// A frame's wall time from submission to completion (every pass, the G-buffer
+    /// included), median over the timed frames, ms: what the timestamps are checked against.
+    #[serde(default)]
+    pub wall_ms: Option<f64>,
     /// Peak live texture bytes of the plan plus the depth maps.
     pub memory_bytes: u64,
     /// Error against the area-light truth.

@@ -131,6 +131,7 @@ fn quick_sweep_writes_every_file_consistently() {
             // parse's own rounding (11.5575 printed as 11.558 differs by 5e-4 and one ulp).
             ("total_ms", r.total_ms.unwrap(), 5e-4 + 1e-12),
             ("shade_ms", r.shade_ms.unwrap(), 5e-4 + 1e-12),
+            ("wall_ms", r.wall_ms.unwrap(), 5e-4 + 1e-12),
         ] {
             assert!(
                 (num(name) - v).abs() <= tol,
@@ -189,6 +190,9 @@ fn quick_sweep_writes_every_file_consistently() {
     assert_eq!(legend.lines().count(), 2 + 2 * report.rows.len());
     let md = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(md.contains("CPU-driver times") == report.cpu_driver);
+    // The timestamps' cross-check against the wall clock, over every configuration.
+    let check = format!("in each of the {} configurations", report.rows.len());
+    assert!(md.contains(&check), "report.md lacks the wall check");
     for r in &report.rows {
         assert!(
             md.contains(&format!("| {} |", r.label)),

@@ -9,7 +9,7 @@ use base64::Engine;
 
 use super::crops::{self, Crop};
 use super::flip::{flip_map, magma};
-use super::output::region_text;
+use super::output::{region_text, wall_check};
 use super::svg::{Metric, colour, front};
 use super::{ErrorStats, Images, Report, Row};
 use crate::error::Result;
@@ -161,7 +161,8 @@ fn fronts_of(report: &Report, i: usize) -> String {
 
 fn table(s: &mut String, report: &Report) {
     s.push_str(
-        "<h2>Every configuration</h2>\n<p class=\"note\">Click a heading to sort. Times in ms, \
+        "<h2>Every configuration</h2>\n<p class=\"note\">Click a heading to sort. Times in ms \
+         (wall: a whole frame, G-buffer included, from submission to completion), \
          errors are mean |visibility − truth| over the relevant pixels (soft), the penumbra, \
          umbra and lit regions, and against the box-PCF truth of the configuration's own map \
          (pcf); FLIP is the mean perceptual error of the shaded image. <i>front</i>: on the \
@@ -175,6 +176,7 @@ fn table(s: &mut String, report: &Report) {
         "kernels",
         "shade",
         "total",
+        "wall",
         "MiB",
         "soft mean",
         "soft p99",
@@ -206,7 +208,7 @@ fn table(s: &mut String, report: &Report) {
             escape(&r.label)
         );
         s.push_str(&num(Some(f64::from(r.shadow_map)), 0));
-        for t in [r.raster_ms, r.kernels_ms, r.shade_ms, r.total_ms] {
+        for t in [r.raster_ms, r.kernels_ms, r.shade_ms, r.total_ms, r.wall_ms] {
             s.push_str(&num(t, 2));
         }
         s.push_str(&num(Some(r.memory_bytes as f64 / 1048576.0), 1));
@@ -221,6 +223,10 @@ fn table(s: &mut String, report: &Report) {
         let _ = writeln!(s, "<td>{fronts}</td></tr>");
     }
     s.push_str("</tbody></table>\n");
+    let check = wall_check(report);
+    if !check.is_empty() {
+        let _ = writeln!(s, "<p class=\"note\">{}</p>", escape(check.trim()));
+    }
 }
 
 /// The union of the fronts, fastest first.

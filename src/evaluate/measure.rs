@@ -109,6 +109,9 @@ pub fn measure(
         None => None,
     };
     let passes = median_passes(frame.timings.get(1..).unwrap_or_default());
+    let mut walls = frame.wall_ms.get(1..).unwrap_or_default().to_vec();
+    walls.sort_by(f64::total_cmp);
+    let wall_ms = walls.get(walls.len() / 2).copied();
     let sum = |f: &dyn Fn(&str) -> bool| -> Option<f64> {
         (!passes.is_empty()).then(|| passes.iter().filter(|(l, _)| f(l)).map(|p| p.1).sum())
     };
@@ -149,6 +152,7 @@ pub fn measure(
         shade_ms,
         total_ms,
         gbuffer_ms,
+        wall_ms,
         memory_bytes: plan.plan.peak_live_bytes() + depth,
         soft,
         penumbra,

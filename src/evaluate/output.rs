@@ -86,7 +86,7 @@ fn stats_cells(s: Option<&ErrorStats>) -> String {
 /// One line per configuration; per-pass times as `name=ms` pairs separated by `;`.
 pub fn csv(report: &Report) -> String {
     let mut s = format!(
-        "label,technique,shadow_map,storage,filter,box_width,raster_ms,kernels_ms,shade_ms,total_ms,gbuffer_ms,memory_bytes,{},{},{},{},{},{},passes\n",
+        "label,technique,shadow_map,storage,filter,box_width,raster_ms,kernels_ms,shade_ms,total_ms,gbuffer_ms,wall_ms,memory_bytes,{},{},{},{},{},{},passes\n",
         stats_header("soft"),
         stats_header("penumbra"),
         stats_header("umbra"),
@@ -102,7 +102,7 @@ pub fn csv(report: &Report) -> String {
             .collect();
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             r.label,
             r.technique,
             r.shadow_map,
@@ -114,6 +114,7 @@ pub fn csv(report: &Report) -> String {
             ms(r.shade_ms),
             ms(r.total_ms),
             ms(r.gbuffer_ms),
+            ms(r.wall_ms),
             r.memory_bytes,
             stats_cells(Some(&r.soft)),
             stats_cells(Some(&r.penumbra)),
@@ -156,6 +157,28 @@ fn mean_cell(s: &ErrorStats) -> String {
     } else {
         format!("{:.4}", s.mean_abs)
     }
+}
+
+/// The timestamps against the wall clock: per configuration, its passes with the G-buffer
+/// over its frame's wall time, the range over the report (empty without timings).
+pub fn wall_check(report: &Report) -> String {
+    let ratios: Vec<f64> = report
+        .rows
+        .iter()
+        .filter_map(|r| Some((r.total_ms? + r.gbuffer_ms?) / r.wall_ms.filter(|w| *w > 0.0)?))
+        .collect();
+    let lo = ratios.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = ratios.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if ratios.is_empty() {
+        return String::new();
+    }
+    format!(
+        "\nTimestamps against the wall clock: in each of the {} configurations, the passes \
+         (G-buffer included) sum to {lo:.2}–{hi:.2}× the frame's wall time (a frame's submission \
+         to its completion; on a GPU the difference is submission and scheduling, on a CPU \
+         driver a stamp's wait for its own work).\n",
+        ratios.len()
+    )
 }
 
 /// The Pareto fronts, one list per metric.
@@ -213,7 +236,9 @@ pub fn markdown(report: &Report) -> String {
     s.push_str(
         "Columns: GPU time per part (median over the repeats, from timestamps): raster = shadow \
          map (and the peel pass of a second-depth technique), kernels = the graph (linearize, encode, filter), shade = the shading pass, total = \
-         their sum (the camera G-buffer is common to all and left out); memory = the plan's peak \
+         their sum (the camera G-buffer is common to all and left out); wall = a whole frame, \
+         G-buffer included, from submission to completion (median), which the timestamps are \
+         checked against below the table; memory = the plan's peak \
          live textures plus the depth maps. *soft*: error against the area-light truth (the \
          scene as it should look); *pcf*: error against brute-force box PCF of the \
          configuration's own map with the same box width (what a prefiltered technique \
@@ -225,9 +250,9 @@ pub fn markdown(report: &Report) -> String {
     s.push_str(&region_text(report));
     s.push_str("\n\n");
     s.push_str(
-        "| configuration | raster ms | kernels ms | shade ms | total ms | MiB | soft mean | soft rmse | soft p99 | soft max | soft >0.05 | soft >0.2 | penumbra mean | umbra mean | lit mean | FLIP mean | pcf mean | pcf p99 | pcf >0.05 |\n",
+        "| configuration | raster ms | kernels ms | shade ms | total ms | wall ms | MiB | soft mean | soft rmse | soft p99 | soft max | soft >0.05 | soft >0.2 | penumbra mean | umbra mean | lit mean | FLIP mean | pcf mean | pcf p99 | pcf >0.05 |\n",
     );
-    s.push_str("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+    s.push_str("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
     for r in &report.rows {
         let (pm, pp, po) =
             r.pcf
@@ -241,12 +266,13 @@ pub fn markdown(report: &Report) -> String {
                 });
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.3} | {:.3} | {:.2}% | {:.2}% | {} | {} | {} | {:.4} | {pm} | {pp} | {po} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.3} | {:.3} | {:.2}% | {:.2}% | {} | {} | {} | {:.4} | {pm} | {pp} | {po} |",
             r.label,
             ms(r.raster_ms),
             ms(r.kernels_ms),
             ms(r.shade_ms),
             ms(r.total_ms),
+            ms(r.wall_ms),
             mib(r.memory_bytes),
             r.soft.mean_abs,
             r.soft.rmse,
@@ -260,6 +286,7 @@ pub fn markdown(report: &Report) -> String {
             r.flip.mean_abs,
         );
     }
+    s.push_str(&wall_check(report));
     s.push_str(&fronts_text(report));
     for (label, why) in &report.skipped {
         let _ = writeln!(s, "\nSkipped {label}: {why}");
