@@ -6,8 +6,9 @@
 //! (one set of pipelines, `record_light(k, …, DepthLayer::new(&array, layer), …)` reads each
 //! layer in place, and each map lives until its slot is recorded again); the host's shader
 //! holds both techniques' functions once (`prefilter::wgsl::functions_for`) and one generated
-//! block per map (`shadowgraph_visibility_key`, `…_fill`, `…_sun0` …), next to its own names,
-//! and picks and blends the sun's cascades with the exported `sg_cascade_pick`. Writes a PNG.
+//! block per map (`shadowgraph_visibility_key`, `…_fill`, and the sun's cascades with
+//! `shadowgraph_visibility_cascaded_sun`, which picks and blends them: `wgsl_cascades`), next
+//! to its own names. Writes a PNG.
 //!
 //!     cargo run --release --example host_lights [-- out.png]     (default target/host_lights.png)
 
@@ -91,24 +92,12 @@ fn lambert(l: sg_Light, p: vec3<f32>, n: vec3<f32>) -> f32 {
     return max(dot(n, to_light), 0.0);
 }
 
-// Cascade c of the sun.
-fn sun_cascade(c: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
-    switch c {
-        case 0u: { return shadowgraph_visibility_sun0(shadows[2], p, n); }
-        case 1u: { return shadowgraph_visibility_sun1(shadows[3], p, n); }
-        default: { return shadowgraph_visibility_sun2(shadows[4], p, n); }
-    }
-}
-
-// The sun's visibility: the cascade the pixel's view distance picks (cascade 0's sg_Light
-// holds the pick fields), faded to the next one's across the blend band.
+// The sun's visibility: `shadowgraph_visibility_cascaded_sun` (the stage's `wgsl_cascades`)
+// picks the pixel's cascade (cascade 0's sg_Light holds the pick fields) and fades to the next
+// one's across the blend band.
 fn sun_visibility(p: vec3<f32>, n: vec3<f32>) -> f32 {
-    let pick = sg_cascade_pick(shadows[2], p);
-    let v = sun_cascade(pick.index, p, n);
-    if pick.blend <= 0.0 {
-        return v;
-    }
-    return mix(v, sun_cascade(pick.index + 1u, p, n), pick.blend);
+    let sun = array<sg_Light, 3>(shadows[2], shadows[3], shadows[4]);
+    return shadowgraph_visibility_cascaded_sun(sun, p, n);
 }
 
 @fragment
@@ -167,7 +156,13 @@ fn run() -> anyhow::Result<()> {
     for (k, name) in MAPS.iter().enumerate() {
         let stage = if k < 2 { &spot_stage } else { &sun_stage };
         let first = maps_entries.len() as u32;
-        wgsl.push_str(&stage.wgsl_light(name, 1, first)?);
+        // The spots' blocks one by one; the sun's three cascades in one call, with the
+        // function that picks and blends them.
+        match k {
+            0 | 1 => wgsl.push_str(&stage.wgsl_light(name, 1, first)?),
+            2 => wgsl.push_str(&stage.wgsl_cascades("sun", 1, first)?),
+            _ => {}
+        }
         maps_entries.extend(stage.layout_entries(first, wgpu::ShaderStages::FRAGMENT)?);
     }
     let maps_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {

@@ -453,6 +453,22 @@ impl Prefilter {
         self.lights.first().and_then(Option::as_ref)
     }
 
+    /// A cascaded directional light's blocks for the config's cascade count, and
+    /// `shadowgraph_visibility_cascaded_{name}(l: array<sg_Light, count>, p, n)`, which picks
+    /// the receiver's cascade (`l[0]` holding the pick fields, [`cascades::pick_fields`]) and
+    /// blends toward the next across the band ([`wgsl::cascades_block`]); cascade `c`'s
+    /// bindings start at `first_binding + c · layout_entries(0, …).len()`. Include the
+    /// functions once, as for [`Prefilter::wgsl_light`].
+    pub fn wgsl_cascades(&self, name: &str, group: u32, first_binding: u32) -> Result<String> {
+        wgsl::cascades_block(
+            &self.config.technique,
+            name,
+            group,
+            first_binding,
+            self.config.cascades.count,
+        )
+    }
+
     /// One light's bindings and functions for a shader module holding several lights, without
     /// the functions they call: include [`Prefilter::wgsl_functions`] (or
     /// [`wgsl::functions_for`] the techniques of several stages) once, then one block per

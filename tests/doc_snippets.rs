@@ -122,6 +122,9 @@ let stage = Prefilter::new(&device, &PrefilterConfig::vssm(n, 0.5).with_cascades
 let sun = LightParams::orthographic(view(), 25.0, 1.0, 60.0);
 let soft = stage.fit_light_cascades(&camera, &sun)?;
 assert!(soft.iter().all(|c| c.light.max_search.is_some()), "soft cascades carry their cap");
+let b = 0;
+let sun_block = stage.wgsl_cascades("sun", 1, b)?;
+assert!(sun_block.contains("fn shadowgraph_visibility_cascaded_sun("), "the cascades' function");
 Ok((outs, block, faces, cascades.min(soft.len())))
 }
 

@@ -195,6 +195,64 @@ fn fs_main(@location(0) p: vec3<f32>) -> @location(0) vec4<f32> {{
     assert!(failures.is_empty(), "{}", failures.join("\n\n"));
 }
 
+/// Every technique's cascades block (`wgsl::cascades_block`, three cascades) validates in a
+/// host fragment shader calling `shadowgraph_visibility_cascaded_sun` with its lights, and
+/// binds cascade `c`'s maps and samplers at `first + c · per_light`, each cascade's names its
+/// own (`shadowgraph_sun{c}_…`), exactly the layout entries `layout_entries` gives per light.
+#[test]
+fn cascades_block_of_every_technique_validates_with_its_bindings() {
+    let mut failures = Vec::new();
+    for t in every_technique() {
+        let functions = wgsl::functions_for(&[t]).expect("functions");
+        let block = wgsl::cascades_block(&t, "sun", 2, 3, 3).expect("cascades block");
+        let host = format!(
+            "{functions}{block}
+@group(0) @binding(0) var<uniform> l: array<sg_Light, 3>;
+@fragment
+fn fs_main(@location(0) p: vec3<f32>) -> @location(0) vec4<f32> {{
+    return vec4<f32>(shadowgraph_visibility_cascaded_sun(l, p, vec3<f32>(0.0, 1.0, 0.0)));
+}}"
+        );
+        let per_light = wgsl::layout_entries(&t, 0, wgpu::ShaderStages::FRAGMENT)
+            .expect("entries")
+            .len() as u32;
+        match kernels::reflect(t.name(), &host) {
+            Err(e) => failures.push(format!("{}: {e}", t.name())),
+            Ok((_, r)) => {
+                let mut group2: Vec<(u32, String)> = r
+                    .bindings
+                    .iter()
+                    .filter(|b| b.group == 2)
+                    .map(|b| (b.binding, b.name.clone()))
+                    .collect();
+                group2.sort();
+                let mut expected = Vec::new();
+                for c in 0..3u32 {
+                    let first = 3 + c * per_light;
+                    for (b, e) in wgsl::layout_entries(&t, first, wgpu::ShaderStages::FRAGMENT)
+                        .expect("entries")
+                        .iter()
+                        .enumerate()
+                    {
+                        assert_eq!(e.binding, first + b as u32);
+                        expected.push(e.binding);
+                    }
+                }
+                let bindings: Vec<u32> = group2.iter().map(|b| b.0).collect();
+                let named = group2.iter().all(|(b, n)| {
+                    let c = (b - 3) / per_light;
+                    n.starts_with(&format!("shadowgraph_sun{c}_"))
+                });
+                if bindings != expected || !named {
+                    failures.push(format!("{}: bindings {group2:?}", t.name()));
+                }
+            }
+        }
+    }
+    assert!(wgsl::cascades_block(&Technique::Hard, "sun", 0, 0, 9).is_err());
+    assert!(failures.is_empty(), "{}", failures.join("\n\n"));
+}
+
 /// A one-light scene whose `[light.shadow]` table holds `keys`.
 fn scene_with(technique: &str, keys: &str, light_size: f32) -> shadowgraph::Result<Scene> {
     let text = format!(

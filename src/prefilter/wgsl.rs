@@ -364,6 +364,66 @@ pub fn light_block(
     Ok(prefix_names(&s, &library_names))
 }
 
+/// The blocks of a directional light's `count` cascades (1–8) and the function that picks and
+/// blends them: [`light_block`] `{light}0` … `{light}{count − 1}`, cascade `c`'s at
+/// `first_binding + c · per_light` (`per_light` = [`layout_entries`]' length), then
+/// `shadowgraph_visibility_cascaded_{light}(l: array<sg_Light, count>, p, n)`: the cascade
+/// the receiver's view distance picks (`sg_cascade_pick(l[0], p)`: cascade 0's `sg_Light`
+/// holds the pick fields, [`super::cascades::pick_fields`]), faded to the next one's
+/// visibility across the blend band, as the renderer shades its cascades. Each cascade's
+/// visibility is called at one site, where the receiver reads it, so a driver that runs every
+/// branch under lane masks evaluates it once.
+pub fn cascades_block(
+    technique: &Technique,
+    light: &str,
+    group: u32,
+    first_binding: u32,
+    count: u32,
+) -> Result<String> {
+    if !(1..=crate::model::cascades::MAX_CASCADES).contains(&count) {
+        return Err(Error::Invalid(format!(
+            "{count} cascades for the exported WGSL: need 1–{}",
+            crate::model::cascades::MAX_CASCADES
+        )));
+    }
+    let per_light = layout_entries(technique, 0, wgpu::ShaderStages::FRAGMENT)?.len() as u32;
+    let mut s = String::new();
+    let mut calls = String::new();
+    for c in 0..count {
+        let name = format!("{light}{c}");
+        s.push_str(&light_block(
+            technique,
+            &name,
+            group,
+            first_binding + c * per_light,
+        )?);
+        let visibility = BlockNames::new(&name).visibility;
+        let _ = write!(
+            calls,
+            "    if pick.index == {c}u || next == {c}u {{\n        \
+             let x = {visibility}(l[{c}], p, n);\n        \
+             v = select(v, x, pick.index == {c}u);\n        \
+             w = select(w, x, next == {c}u);\n    }}\n"
+        );
+    }
+    let block = block_of(technique)?;
+    let modules: Vec<&str> = block.imports.iter().map(String::as_str).collect();
+    let (_, library_names) = resolve_unprefixed(&format!("export/{}", technique.name()), &modules)?;
+    let function = format!(
+        "// The cascade the receiver's view distance picks, faded to the next across the band.\n\
+         fn shadowgraph_visibility_cascaded_{light}(l: array<Light, {count}>, p: vec3<f32>, n: vec3<f32>) -> f32 {{\n    \
+         let pick = cascade_pick(l[0], p);\n    \
+         let next = select(0xffffffffu, pick.index + 1u, pick.blend > 0.0);\n    \
+         var v = 1.0;\n    \
+         var w = 1.0;\n\
+         {calls}    \
+         if pick.blend <= 0.0 {{\n        return v;\n    }}\n    \
+         return mix(v, w, pick.blend);\n}}\n"
+    );
+    s.push_str(&prefix_names(&function, &library_names));
+    Ok(s)
+}
+
 /// The names one light's block declares.
 struct BlockNames {
     map: String,
