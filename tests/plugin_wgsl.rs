@@ -196,7 +196,8 @@ fn fs_main(@location(0) p: vec3<f32>) -> @location(0) vec4<f32> {{
 }
 
 /// Every technique's cascades block (`wgsl::cascades_block`, three cascades) validates in a
-/// host fragment shader calling `shadowgraph_visibility_cascaded_sun` with its lights, and
+/// host fragment shader calling `shadowgraph_visibility_cascaded_sun` and its footprint
+/// variant with its lights, and
 /// binds cascade `c`'s maps and samplers at `first + c · per_light`, each cascade's names its
 /// own (`shadowgraph_sun{c}_…`), exactly the layout entries `layout_entries` gives per light.
 #[test]
@@ -210,7 +211,11 @@ fn cascades_block_of_every_technique_validates_with_its_bindings() {
 @group(0) @binding(0) var<uniform> l: array<sg_Light, 3>;
 @fragment
 fn fs_main(@location(0) p: vec3<f32>) -> @location(0) vec4<f32> {{
-    return vec4<f32>(shadowgraph_visibility_cascaded_sun(l, p, vec3<f32>(0.0, 1.0, 0.0)));
+    let n = vec3<f32>(0.0, 1.0, 0.0);
+    let dx = dpdx(p);
+    let dy = dpdy(p);
+    return vec4<f32>(shadowgraph_visibility_cascaded_sun(l, p, n)
+        + shadowgraph_visibility_footprint_cascaded_sun(l, p, n, dx, dy));
 }}"
         );
         let per_light = wgsl::layout_entries(&t, 0, wgpu::ShaderStages::FRAGMENT)

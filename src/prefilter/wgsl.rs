@@ -370,7 +370,9 @@ pub fn light_block(
 /// `shadowgraph_visibility_cascaded_{light}(l: array<sg_Light, count>, p, n)`: the cascade
 /// the receiver's view distance picks (`sg_cascade_pick(l[0], p)`: cascade 0's `sg_Light`
 /// holds the pick fields, [`super::cascades::pick_fields`]), faded to the next one's
-/// visibility across the blend band, as the renderer shades its cascades. Each cascade's
+/// visibility across the blend band, as the renderer shades its cascades, and
+/// `shadowgraph_visibility_footprint_cascaded_{light}(l, p, n, dpdx, dpdy)` with the pixel's
+/// footprint (what anisotropic mip lookups follow). Each cascade's
 /// visibility is called at one site, where the receiver reads it, so a driver that runs every
 /// branch under lane masks evaluates it once.
 pub fn cascades_block(
@@ -388,7 +390,9 @@ pub fn cascades_block(
     }
     let per_light = layout_entries(technique, 0, wgpu::ShaderStages::FRAGMENT)?.len() as u32;
     let mut s = String::new();
-    let mut calls = String::new();
+    // The cascade the receiver's view distance picks, faded to the next across the band: the
+    // plain visibility and the one with the pixel's footprint (anisotropic mip lookups).
+    let (mut calls, mut footprint_calls) = (String::new(), String::new());
     for c in 0..count {
         let name = format!("{light}{c}");
         s.push_str(&light_block(
@@ -397,29 +401,44 @@ pub fn cascades_block(
             group,
             first_binding + c * per_light,
         )?);
-        let visibility = BlockNames::new(&name).visibility;
-        let _ = write!(
-            calls,
-            "    if pick.index == {c}u || next == {c}u {{\n        \
-             let x = {visibility}(l[{c}], p, n);\n        \
-             v = select(v, x, pick.index == {c}u);\n        \
-             w = select(w, x, next == {c}u);\n    }}\n"
-        );
+        let names = BlockNames::new(&name);
+        for (out, f, args) in [
+            (&mut calls, &names.visibility, "p, n"),
+            (&mut footprint_calls, &names.footprint, "p, n, dpdx, dpdy"),
+        ] {
+            let _ = write!(
+                out,
+                "    if pick.index == {c}u || next == {c}u {{\n        \
+                 let x = {f}(l[{c}], {args});\n        \
+                 v = select(v, x, pick.index == {c}u);\n        \
+                 w = select(w, x, next == {c}u);\n    }}\n"
+            );
+        }
     }
     let block = block_of(technique)?;
     let modules: Vec<&str> = block.imports.iter().map(String::as_str).collect();
     let (_, library_names) = resolve_unprefixed(&format!("export/{}", technique.name()), &modules)?;
-    let function = format!(
-        "// The cascade the receiver's view distance picks, faded to the next across the band.\n\
-         fn shadowgraph_visibility_cascaded_{light}(l: array<Light, {count}>, p: vec3<f32>, n: vec3<f32>) -> f32 {{\n    \
-         let pick = cascade_pick(l[0], p);\n    \
-         let next = select(0xffffffffu, pick.index + 1u, pick.blend > 0.0);\n    \
-         var v = 1.0;\n    \
-         var w = 1.0;\n\
-         {calls}    \
-         if pick.blend <= 0.0 {{\n        return v;\n    }}\n    \
-         return mix(v, w, pick.blend);\n}}\n"
-    );
+    let mut function = String::new();
+    for (name, params, calls) in [
+        ("visibility_cascaded", "", calls),
+        (
+            "visibility_footprint_cascaded",
+            ", dpdx: vec3<f32>, dpdy: vec3<f32>",
+            footprint_calls,
+        ),
+    ] {
+        let _ = write!(
+            function,
+            "fn shadowgraph_{name}_{light}(l: array<Light, {count}>, p: vec3<f32>, n: vec3<f32>{params}) -> f32 {{\n    \
+             let pick = cascade_pick(l[0], p);\n    \
+             let next = select(0xffffffffu, pick.index + 1u, pick.blend > 0.0);\n    \
+             var v = 1.0;\n    \
+             var w = 1.0;\n\
+             {calls}    \
+             if pick.blend <= 0.0 {{\n        return v;\n    }}\n    \
+             return mix(v, w, pick.blend);\n}}\n"
+        );
+    }
     s.push_str(&prefix_names(&function, &library_names));
     Ok(s)
 }
