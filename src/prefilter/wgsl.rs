@@ -390,54 +390,43 @@ pub fn cascades_block(
     }
     let per_light = layout_entries(technique, 0, wgpu::ShaderStages::FRAGMENT)?.len() as u32;
     let mut s = String::new();
-    // The cascade the receiver's view distance picks, faded to the next across the band: the
-    // plain visibility and the one with the pixel's footprint (anisotropic mip lookups).
-    let (mut calls, mut footprint_calls) = (String::new(), String::new());
     for c in 0..count {
-        let name = format!("{light}{c}");
         s.push_str(&light_block(
             technique,
-            &name,
+            &format!("{light}{c}"),
             group,
             first_binding + c * per_light,
         )?);
-        let names = BlockNames::new(&name);
-        for (out, f, args) in [
-            (&mut calls, &names.visibility, "p, n"),
-            (&mut footprint_calls, &names.footprint, "p, n, dpdx, dpdy"),
-        ] {
-            let _ = write!(
-                out,
-                "    if pick.index == {c}u || next == {c}u {{\n        \
-                 let x = {f}(l[{c}], {args});\n        \
-                 v = select(v, x, pick.index == {c}u);\n        \
-                 w = select(w, x, next == {c}u);\n    }}\n"
-            );
-        }
     }
     let block = block_of(technique)?;
     let modules: Vec<&str> = block.imports.iter().map(String::as_str).collect();
     let (_, library_names) = resolve_unprefixed(&format!("export/{}", technique.name()), &modules)?;
+    // The plain visibility, and the one with the pixel's footprint (anisotropic mip lookups).
     let mut function = String::new();
-    for (name, params, calls) in [
-        ("visibility_cascaded", "", calls),
+    for (name, params, args) in [
+        ("visibility_cascaded", "", "p, n"),
         (
             "visibility_footprint_cascaded",
             ", dpdx: vec3<f32>, dpdy: vec3<f32>",
-            footprint_calls,
+            "p, n, dpdx, dpdy",
         ),
     ] {
-        let _ = write!(
-            function,
-            "fn shadowgraph_{name}_{light}(l: array<Light, {count}>, p: vec3<f32>, n: vec3<f32>{params}) -> f32 {{\n    \
-             let pick = cascade_pick(l[0], p);\n    \
-             let next = select(0xffffffffu, pick.index + 1u, pick.blend > 0.0);\n    \
-             var v = 1.0;\n    \
-             var w = 1.0;\n\
-             {calls}    \
-             if pick.blend <= 0.0 {{\n        return v;\n    }}\n    \
-             return mix(v, w, pick.blend);\n}}\n"
-        );
+        function.push_str(&crate::technique::pick_and_blend(
+            &format!(
+                "shadowgraph_{name}_{light}(l: array<Light, {count}>, p: vec3<f32>, n: vec3<f32>{params})"
+            ),
+            "l[0]",
+            count as usize,
+            |c| {
+                let names = BlockNames::new(&format!("{light}{c}"));
+                let f = if params.is_empty() {
+                    names.visibility
+                } else {
+                    names.footprint
+                };
+                format!("{f}(l[{c}], {args})")
+            },
+        ));
     }
     s.push_str(&prefix_names(&function, &library_names));
     Ok(s)

@@ -48,7 +48,6 @@ impl CascadeGroup {
 pub(super) fn cascade_functions(g: &CascadeGroup, lights: &[Light]) -> String {
     let i = g.light;
     let mut out = String::new();
-    let mut calls = String::new();
     for c in 0..g.count {
         let k = g.index(c);
         let body = lights.get(k).map_or_else(
@@ -59,18 +58,42 @@ pub(super) fn cascade_functions(g: &CascadeGroup, lights: &[Light]) -> String {
             out,
             "fn light{i}_cascade{c}(p: vec3<f32>, n: vec3<f32>, dpdx: vec3<f32>, dpdy: vec3<f32>) -> f32 {{{body}\n}}"
         );
+    }
+    out.push_str(&pick_and_blend(
+        &format!("light{i}_cascaded(p: vec3<f32>, n: vec3<f32>, dpdx: vec3<f32>, dpdy: vec3<f32>)"),
+        &format!("lights[{i}]"),
+        g.count,
+        |c| format!("light{i}_cascade{c}(p, n, dpdx, dpdy)"),
+    ));
+    out
+}
+
+/// The WGSL of a cascaded light's pick and blend, the renderer's and the plug-in's export's
+/// (`prefilter::wgsl::cascades_block`): `fn {signature} -> f32` picks the receiver's cascade
+/// with `cascade_pick({first}, p)` and fades to the next one's visibility across the blend
+/// band, `call(c)` being cascade `c`'s visibility (an expression). Each cascade's is evaluated
+/// at one site, where the receiver reads it (its cascade, or the next inside the band), and
+/// the same two values are mixed.
+pub(crate) fn pick_and_blend(
+    signature: &str,
+    first: &str,
+    count: usize,
+    call: impl Fn(usize) -> String,
+) -> String {
+    let mut calls = String::new();
+    for c in 0..count {
         let _ = write!(
             calls,
             "    if pick.index == {c}u || next == {c}u {{\n        \
-             let x = light{i}_cascade{c}(p, n, dpdx, dpdy);\n        \
+             let x = {};\n        \
              v = select(v, x, pick.index == {c}u);\n        \
-             w = select(w, x, next == {c}u);\n    }}\n"
+             w = select(w, x, next == {c}u);\n    }}\n",
+            call(c)
         );
     }
-    let _ = write!(
-        out,
-        "fn light{i}_cascaded(p: vec3<f32>, n: vec3<f32>, dpdx: vec3<f32>, dpdy: vec3<f32>) -> f32 {{\n    \
-         let pick = cascade_pick(lights[{i}], p);\n    \
+    format!(
+        "fn {signature} -> f32 {{\n    \
+         let pick = cascade_pick({first}, p);\n    \
          // The cascade the blend fades to (none outside the band).\n    \
          let next = select(0xffffffffu, pick.index + 1u, pick.blend > 0.0);\n    \
          var v = 1.0;\n    \
@@ -78,8 +101,7 @@ pub(super) fn cascade_functions(g: &CascadeGroup, lights: &[Light]) -> String {
          {calls}    \
          if pick.blend <= 0.0 {{\n        return v;\n    }}\n    \
          return mix(v, w, pick.blend);\n}}\n"
-    );
-    out
+    )
 }
 
 /// [`super::shade_key`] of the drawn `lights` with these cascades.

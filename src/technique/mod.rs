@@ -34,6 +34,7 @@ pub use crate::gpu_data::{
 };
 pub use crate::model::mip_levels;
 use crate::model::{Light, ParamSource, ParamSpec, ParamValues, Technique};
+pub(crate) use cascade_shade::pick_and_blend;
 pub use cascade_shade::{CascadeGroup, shade_key_cascaded};
 pub use csm::{basis_sequence, csm_maps, csm_z_channels, csm_z_maps, search_maps};
 pub use csm_sat::{
