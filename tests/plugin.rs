@@ -210,15 +210,30 @@ fn host_visibility(
             resource: wgpu::BindingResource::Sampler(&sat_sampler),
         });
     }
+    run_probe(g, &kernel, enc, &bg0, &entries, &vis, n)
+}
+
+/// A host probe's last steps: its maps' bind group from `entries`, one invocation a pixel,
+/// `vis` read back.
+fn run_probe(
+    g: &Gpu,
+    kernel: &ComputeKernel,
+    mut enc: wgpu::CommandEncoder,
+    bg0: &wgpu::BindGroup,
+    entries: &[wgpu::BindGroupEntry],
+    vis: &wgpu::Buffer,
+    n: usize,
+) -> Vec<f32> {
+    let d = &g.device;
     let bg1 = d.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("host.probe.maps"),
         layout: &kernel.layouts[1],
-        entries: &entries,
+        entries,
     });
     {
         let mut pass = enc.begin_compute_pass(&Default::default());
         pass.set_pipeline(&kernel.pipeline);
-        pass.set_bind_group(0, &bg0, &[]);
+        pass.set_bind_group(0, bg0, &[]);
         pass.set_bind_group(1, &bg1, &[]);
         pass.dispatch_workgroups((n as u32).div_ceil(64), 1, 1);
     }
@@ -228,7 +243,7 @@ fn host_visibility(
         usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
         mapped_at_creation: false,
     });
-    enc.copy_buffer_to_buffer(&vis, 0, &readback, 0, vis.size());
+    enc.copy_buffer_to_buffer(vis, 0, &readback, 0, vis.size());
     submit_and_wait(d, &g.queue, enc, "host probe").expect("submit");
     let raw = shadowgraph::gpu::read_buffer(d, &readback).expect("readback");
     bytemuck::cast_slice(&raw).to_vec()
@@ -361,28 +376,7 @@ fn host_cascaded_visibility(
                 }),
         );
     }
-    let bg1 = d.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("host.cascade_probe.maps"),
-        layout: &kernel.layouts[1],
-        entries: &entries,
-    });
-    {
-        let mut pass = enc.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&kernel.pipeline);
-        pass.set_bind_group(0, &bg0, &[]);
-        pass.set_bind_group(1, &bg1, &[]);
-        pass.dispatch_workgroups((n as u32).div_ceil(64), 1, 1);
-    }
-    let readback = d.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("host.cascade_probe.readback"),
-        size: vis.size(),
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
-    enc.copy_buffer_to_buffer(&vis, 0, &readback, 0, vis.size());
-    submit_and_wait(d, &g.queue, enc, "host cascade probe").expect("submit");
-    let raw = shadowgraph::gpu::read_buffer(d, &readback).expect("readback");
-    bytemuck::cast_slice(&raw).to_vec()
+    run_probe(g, &kernel, enc, &bg0, &entries, &vis, n)
 }
 
 fn scenes() -> Vec<PathBuf> {
