@@ -66,6 +66,8 @@ fn bad_layouts_are_named() {
         (4, f32::NAN, 1.0, 10.0, "cascade_lambda"),
         (4, 0.5, 10.0, 1.0, "near/far"),
         (4, 0.5, 0.0, 1.0, "near/far"),
+        (4, 0.5, 1.0, 1e30, "near/far"),
+        (4, 0.5, 1e-9, 1.0, "near/far"),
     ] {
         let e = split_distances(near, far, count, lambda).unwrap_err();
         assert!(
@@ -76,6 +78,16 @@ fn bad_layouts_are_named() {
     let cam = camera(Vec3::new(0.0, 5.0, 10.0), Vec3::ZERO);
     let e = fit_cascades(&cam, Vec3::ZERO, &LAYOUT).unwrap_err();
     assert!(e.to_string().contains("direction"), "{e}");
+    // A camera past f32's comfort is named, not a light with a non-finite matrix.
+    let far = CascadeCamera { far: 1e30, ..cam };
+    let e = fit_cascades(&far, sun(), &LAYOUT).unwrap_err();
+    assert!(e.to_string().contains("near/far"), "{e}");
+    let nan = CascadeCamera {
+        view: Mat4::from_cols_array(&[f32::NAN; 16]),
+        ..cam
+    };
+    let e = fit_cascades(&nan, sun(), &LAYOUT).unwrap_err();
+    assert!(e.to_string().contains("camera"), "{e}");
 }
 
 /// The 8 corners of the camera's frustum slice between view distances `n` and `f`, world

@@ -167,10 +167,12 @@ pub fn split_distances(
     if !(0.0..=1.0).contains(&lambda) {
         return Err(bad("cascade_lambda", format!("{lambda} is outside [0, 1]")));
     }
-    if !(near.is_finite() && far.is_finite() && near > 0.0 && far > near) {
+    // A light's planes' range (`LightParams::validate`): the slices' spheres stay far from
+    // f32's limits.
+    if !(near.is_finite() && far.is_finite() && near >= 1e-6 && far > near && far <= 1e7) {
         return Err(bad(
             "cascade near/far",
-            format!("need 0 < near < far, finite; got near {near}, far {far}"),
+            format!("need 1e-6 ≤ near < far ≤ 1e7; got near {near}, far {far}"),
         ));
     }
     let (n, f) = (f64::from(near), f64::from(far));
@@ -207,6 +209,12 @@ pub fn fit_slices(
 ) -> Result<Vec<CascadeSlice>, StageError> {
     if !direction.is_finite() || direction.length_squared() < 1e-12 {
         return Err(bad("direction", format!("{direction} is not a direction")));
+    }
+    if !camera.view.is_finite() || camera.view.determinant().abs() < 1e-12 {
+        return Err(bad(
+            "camera",
+            "its view matrix is not finite and invertible".into(),
+        ));
     }
     if !(camera.fov_y > 0.0
         && camera.fov_y < 3.1
