@@ -37,6 +37,7 @@ mod svg;
 mod sweep;
 
 pub use flip::{Shader, flip_map, flip_stats, to_unorm8};
+pub use output::{WALL_TOLERANCE, untrusted_times, wall_check, wall_ratios};
 pub use stats::{EDGE_BAND, ErrorStats, PENUMBRA_HIGH, PENUMBRA_LOW, Region, Regions};
 pub use svg::{Metric, front, pareto, pareto_front};
 use sweep::storage_name;
@@ -224,6 +225,11 @@ pub fn run(gpu: &Gpu, scene_path: &Path, out: &Path, opts: &EvaluateOptions) -> 
     );
     for (label, why) in &report.skipped {
         s.push_str(&format!("skipped {label}: {why}\n"));
+    }
+    for (label, q) in output::untrusted_times(&report) {
+        s.push_str(&format!(
+            "times not trusted: {label}'s passes sum to {q:.2}x its wall time (rerun on an idle machine)\n"
+        ));
     }
     for f in files {
         s.push_str(&format!("wrote {}\n", f.display()));

@@ -11,6 +11,7 @@ use std::process::Command;
 use rand::Rng;
 use shadowgraph::evaluate::{
     Config, ErrorStats, EvaluateOptions, FILTERS, Metric, Report, evaluate, front, scene_for,
+    untrusted_times, wall_check,
 };
 use shadowgraph::render::{RenderOptions, Renderer};
 use shadowgraph::scene::{Filter, PcfKernel, Scene, Technique};
@@ -193,6 +194,24 @@ fn quick_sweep_writes_every_file_consistently() {
     // The timestamps' cross-check against the wall clock, over every configuration.
     let check = format!("in each of the {} configurations", report.rows.len());
     assert!(md.contains(&check), "report.md lacks the wall check");
+    // On a CPU driver, a configuration whose passes sum more than 25% from its wall time is
+    // named as untrusted (its wall set to twice its passes here; the others' to their sum, so
+    // the check does not depend on this machine's load); on a GPU none is.
+    let mut skewed = report.clone();
+    skewed.cpu_driver = true;
+    for (i, r) in skewed.rows.iter_mut().enumerate() {
+        let passes = r.total_ms.unwrap() + r.gbuffer_ms.unwrap();
+        r.wall_ms = Some(if i == 0 { 2.0 * passes } else { passes });
+    }
+    let off = untrusted_times(&skewed);
+    assert_eq!(off.len(), 1, "{off:?}");
+    assert_eq!(off[0].0, skewed.rows[0].label);
+    assert!((off[0].1 - 0.5).abs() < 1e-12);
+    let text = wall_check(&skewed);
+    assert!(text.contains("Times not trusted") && text.contains(&skewed.rows[0].label));
+    skewed.cpu_driver = false;
+    assert!(untrusted_times(&skewed).is_empty());
+    assert!(!wall_check(&skewed).contains("not trusted"));
     for r in &report.rows {
         assert!(
             md.contains(&format!("| {} |", r.label)),

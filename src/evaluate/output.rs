@@ -159,26 +159,63 @@ fn mean_cell(s: &ErrorStats) -> String {
     }
 }
 
-/// The timestamps against the wall clock: per configuration, its passes with the G-buffer
-/// over its frame's wall time, the range over the report (empty without timings).
-pub fn wall_check(report: &Report) -> String {
-    let ratios: Vec<f64> = report
+/// How far a CPU driver's passes may sum from a frame's wall time before the report calls the
+/// configuration's times untrusted: `tests/timing.rs`'s tolerance for the same instrument.
+pub const WALL_TOLERANCE: f64 = 0.25;
+
+/// Per configuration with timings: its label and its passes' sum, G-buffer included, over its
+/// frame's wall time.
+pub fn wall_ratios(report: &Report) -> Vec<(&str, f64)> {
+    report
         .rows
         .iter()
-        .filter_map(|r| Some((r.total_ms? + r.gbuffer_ms?) / r.wall_ms.filter(|w| *w > 0.0)?))
-        .collect();
-    let lo = ratios.iter().copied().fold(f64::INFINITY, f64::min);
-    let hi = ratios.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        .filter_map(|r| {
+            let wall = r.wall_ms.filter(|w| *w > 0.0)?;
+            Some((r.label.as_str(), (r.total_ms? + r.gbuffer_ms?) / wall))
+        })
+        .collect()
+}
+
+/// The configurations of a CPU-driver report whose passes sum further than
+/// [`WALL_TOLERANCE`] from their wall time (none on a GPU, where the difference is the
+/// submission's latency, a fixed 0.1–0.3 ms).
+pub fn untrusted_times(report: &Report) -> Vec<(&str, f64)> {
+    if !report.cpu_driver {
+        return Vec::new();
+    }
+    wall_ratios(report)
+        .into_iter()
+        .filter(|(_, q)| (q - 1.0).abs() > WALL_TOLERANCE)
+        .collect()
+}
+
+/// The timestamps against the wall clock: the range of [`wall_ratios`] over the report, and
+/// the configurations whose times it does not trust (empty without timings).
+pub fn wall_check(report: &Report) -> String {
+    let ratios = wall_ratios(report);
     if ratios.is_empty() {
         return String::new();
     }
-    format!(
+    let lo = ratios.iter().map(|r| r.1).fold(f64::INFINITY, f64::min);
+    let hi = ratios.iter().map(|r| r.1).fold(f64::NEG_INFINITY, f64::max);
+    let mut s = format!(
         "\nTimestamps against the wall clock: in each of the {} configurations, the passes \
          (G-buffer included) sum to {lo:.2}–{hi:.2}× the frame's wall time (a frame's submission \
          to its completion; on a GPU the difference is submission and scheduling, on a CPU \
          driver a stamp's wait for its own work).\n",
         ratios.len()
-    )
+    );
+    let off = untrusted_times(report);
+    if !off.is_empty() {
+        let list: Vec<String> = off.iter().map(|(l, q)| format!("{l} ({q:.2}×)")).collect();
+        s.push_str(&format!(
+            "\n**Times not trusted** (passes more than {:.0}% from the wall time on a CPU driver; \
+             rerun on an idle machine): {}.\n",
+            100.0 * WALL_TOLERANCE,
+            list.join(", ")
+        ));
+    }
+    s
 }
 
 /// The Pareto fronts, one list per metric.
