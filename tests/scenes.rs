@@ -1075,7 +1075,8 @@ fn registered(name: &str) -> Technique {
 }
 
 /// The cascaded street view with the other techniques that take cascades: each cascade's map
-/// prefiltered by the same graph (hard; VSM blurred; MSM through a float table; ESM mipmapped;
+/// prefiltered by the same graph (hard; VSM blurred; MSM through a float table; ESM mipmapped,
+/// isotropic and anisotropic;
 /// PCSS and the soft techniques, each cascade with its guard band and `max_search`; the
 /// second-depth techniques, each cascade peeled), every pixel against the f64 pick and
 /// references (`cascades::check_light`).
@@ -1114,6 +1115,14 @@ fn cascaded_techniques_match_the_references() {
             filter: Filter::Mips {
                 width: 2.0,
                 max_anisotropy: 0,
+            },
+            exponent: 40.0,
+        },
+        // Anisotropic: each cascade's lookups follow the pixel's footprint in its own map.
+        Technique::Esm {
+            filter: Filter::Mips {
+                width: 2.0,
+                max_anisotropy: 8,
             },
             exponent: 40.0,
         },
