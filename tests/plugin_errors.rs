@@ -274,6 +274,19 @@ fn inconsistent_light_params_are_named() {
             "projection",
         ),
     ];
+    // A point light's own cap would read past the faces' bands, which follow the config's
+    // (refused by the light itself, whatever the stage's technique).
+    let point = LightParams {
+        max_search: Some(0.1),
+        ..LightParams::point(glam::Vec3::ZERO, 0.5, 10.0)
+    };
+    match point.validate() {
+        Err(StageError::LightParams { field, message }) => {
+            assert_eq!(field, "max_search");
+            assert!(message.contains("point light"), "{message}");
+        }
+        other => panic!("a point light's own max_search: {other:?}"),
+    }
     for (params, field) in cases {
         let e = record_err(&g, &depth, &params);
         assert!(

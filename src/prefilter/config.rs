@@ -432,7 +432,9 @@ pub struct LightParams {
     /// (shadow-map UV), in place of the config's `max_search`, with PCSS's filter capped there
     /// as its search is: one cascade's share of its light's world reach, which
     /// [`crate::prefilter::Prefilter::fit_light_cascades`] sets so that every cascade estimates
-    /// the same penumbra. `None` (what the constructors set): the config's.
+    /// the same penumbra. `None` (what the constructors set): the config's. Refused on a point
+    /// light, whose faces' guard bands follow the config's, and on a technique without a
+    /// search.
     pub max_search: Option<f32>,
 }
 
@@ -537,6 +539,15 @@ impl LightParams {
             return Err(err(
                 "max_search",
                 format!("{m} is outside (0, 1] (shadow-map UV)"),
+            ));
+        }
+        // A point light's faces are widened for the config's reach (`point_views`): a cap of
+        // its own would read past their guard bands.
+        if self.point && self.max_search.is_some() {
+            return Err(err(
+                "max_search",
+                "a point light's faces are banded for the config's max_search; leave it None"
+                    .into(),
             ));
         }
         if self.far <= self.near {
