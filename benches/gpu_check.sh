@@ -12,8 +12,8 @@
 # before its kernels. In order now: soft table, four shading shapes (about 80 s), the blur's
 # row variants (two processes, `bench --kernel-dirs`, perhaps 35 s), the tables' two variants
 # (two, 30 s), the mip variant (two, 20 s), every kernel at 2048², 4096²/8192², the fused ablation
-# (one, 10 s), one round of the layouts, the bunny frame, six cascaded frames (perhaps 20 s):
-# about 440 s, with BASE about 60 s more. Give the call 520 s (the machine's start, about 50 s, counts too); a step cut off by
+# (one, 10 s), one round of the layouts, the workgroup memory zeroed or not (two, perhaps 30 s),
+# the bunny frame, six cascaded frames (perhaps 20 s): about 470 s, with BASE about 60 s more. Give the call 520 s (the machine's start, about 50 s, counts too); a step cut off by
 # the call's end loses only the steps after it.
 # The steps run most wanted first, each under its own time box, and append to at most seven
 # files in OUT (the device tool brings back eight), so a call stopped by its time box still
@@ -216,6 +216,18 @@ step variants.txt 40 "$B" bench --sizes 2048 --repeat 20 \
 for order in gpu,cpu; do
     step variants.txt 60 "$B" bench --sizes 2048 --repeat 20 \
         --only 'sat,chain vssm,chain msm_soft,chain esm,chain cssm' --passes --layouts "$order"
+done
+# The kernels' workgroup memory left as the device leaves it (shipped: exec::WorkgroupInit::AsLeft,
+# safe because tests/workgroup_memory.rs finds every kernel writing it before reading it)
+# against wgpu's default of zeroing it first (`zeroed`: each workgroup stores its whole declared
+# workgroup memory and waits at a barrier), alternated twice. The fourteenth session found
+# declared workgroup memory costing the H200 1.1-2x even where no branch used it; this says how
+# much of that was the zeroing. Informational: AsLeft ships (less work); llvmpipe showed no
+# difference beyond its spread.
+for dirs in shipped,zeroed zeroed,shipped; do
+    step variants.txt 40 "$B" bench --sizes 2048 --repeat 20 \
+        --only 'vsm_blur r4,msm_blur r4,mips,sat fixed,chain vssm,chain msm_soft' --passes \
+        --kernel-dirs "$dirs"
 done
 if [ -n "$BASE" ]; then
     for round in 1 2; do

@@ -110,8 +110,10 @@ enum Command {
         #[arg(long, value_delimiter = ',', value_parser = shadowgraph::exec::KernelLayout::parse, conflicts_with = "lookup")]
         layouts: Vec<shadowgraph::exec::KernelLayout>,
         /// Time each kernel compiled from each of these folders of `.wgsl` replacements in
-        /// turn (as SHADOWGRAPH_KERNEL_DIR reads one; `shipped`: the embedded kernels), in one
-        /// process, rows named `<kernel> [<folder's name>]`: kernel variants side by side.
+        /// turn (as SHADOWGRAPH_KERNEL_DIR reads one; `shipped`: the embedded kernels;
+        /// `zeroed`: the embedded kernels with their workgroup memory zeroed first, wgpu's
+        /// default), in one process, rows named `<kernel> [<folder's name>]`: kernel variants
+        /// side by side.
         #[arg(long, value_delimiter = ',', conflicts_with_all = ["lookup", "layouts"])]
         kernel_dirs: Vec<PathBuf>,
     },

@@ -387,7 +387,8 @@ fn the_small_sub_block_table_variant_builds_the_same_tables() {
 }
 
 /// `bench --kernel-dirs shipped,<folder>,…` times each kernel compiled from each folder in one
-/// process, rows `<kernel> [shipped]` and `<kernel> [<folder's name>]`. A folder's kernel that
+/// process, rows `<kernel> [shipped]`, `<kernel> [<folder's name>]` and `<kernel> [zeroed]` (the
+/// embedded kernels with their workgroup memory zeroed first). A folder's kernel that
 /// does not validate is named; one that reads a binding no node binds is refused by the
 /// executor (so the folder's kernel is what the executor compiles, not the embedded file), as
 /// is a kernel dispatched a line an invocation with another workgroup size than its node's
@@ -398,7 +399,7 @@ fn the_small_sub_block_table_variant_builds_the_same_tables() {
 fn bench_times_kernel_folders_side_by_side() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let variant = root.join("benches/variants/blur_rows_run1");
-    let dirs = format!("shipped,{}", variant.display());
+    let dirs = format!("shipped,{},zeroed", variant.display());
     let bench = |dirs: &str, envs: &[(&str, &OsStr)]| {
         let args = [
             "bench",
@@ -418,7 +419,11 @@ fn bench_times_kernel_folders_side_by_side() {
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     // Table rows only: a busy machine may add a WARNING line that names a row too.
-    for row in ["blur rg32f r4 [shipped]", "blur rg32f r4 [blur_rows_run1]"] {
+    for row in [
+        "blur rg32f r4 [shipped]",
+        "blur rg32f r4 [blur_rows_run1]",
+        "blur rg32f r4 [zeroed]",
+    ] {
         let rows = out
             .lines()
             .filter(|l| l.trim_start().starts_with("64 ") && l.contains(row))
@@ -426,7 +431,7 @@ fn bench_times_kernel_folders_side_by_side() {
         assert_eq!(rows, 1, "`{row}` in {out}");
     }
     assert!(
-        out.contains("kernel folders shipped, blur_rows_run1"),
+        out.contains("kernel folders shipped, blur_rows_run1, zeroed"),
         "{out}"
     );
 

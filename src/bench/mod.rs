@@ -712,10 +712,16 @@ pub struct KernelVariant {
     pub name: String,
     layout: Option<KernelLayout>,
     replaced: Option<std::sync::Arc<crate::kernels::Replacements>>,
+    /// Workgroup memory zeroed first ([`ZEROED`]).
+    zeroed: bool,
 }
 
 /// The `--kernel-dirs` entry that stands for the embedded kernels.
 pub const SHIPPED: &str = "shipped";
+
+/// The `--kernel-dirs` entry that stands for the embedded kernels with their workgroup memory
+/// zeroed first, as wgpu does by default (`exec::WorkgroupInit`): what opting out saves.
+pub const ZEROED: &str = "zeroed";
 
 impl KernelVariant {
     /// The kernels in `layout` (`exec::KernelLayout`).
@@ -724,6 +730,7 @@ impl KernelVariant {
             name: layout.name().to_string(),
             layout: Some(layout),
             replaced: None,
+            zeroed: false,
         }
     }
 
@@ -733,12 +740,23 @@ impl KernelVariant {
             name: SHIPPED.to_string(),
             layout: None,
             replaced: None,
+            zeroed: false,
+        }
+    }
+
+    /// The embedded kernels with their workgroup memory zeroed first, named [`ZEROED`].
+    pub fn zeroed() -> Self {
+        Self {
+            name: ZEROED.to_string(),
+            zeroed: true,
+            ..Self::shipped()
         }
     }
 
     /// The kernels with the `.wgsl` files of `dir` in place of those they name (as
     /// [`crate::kernels::KERNEL_DIR_ENV`] reads a folder), named by the folder's last
-    /// component; [`SHIPPED`] is [`KernelVariant::shipped`]. A folder that cannot be read or
+    /// component; [`SHIPPED`] is [`KernelVariant::shipped`], [`ZEROED`]
+    /// [`KernelVariant::zeroed`]. A folder that cannot be read or
     /// replaces nothing, a file naming no kernel, or a replaced kernel that does not validate
     /// is an error naming it. The plan (its dispatches' geometry, the bytes of the rows) is the shipped kernels':
     /// a variant may change a kernel's workgroup size only where its node's dispatch does not
@@ -747,6 +765,9 @@ impl KernelVariant {
     pub fn folder(dir: &std::path::Path) -> Result<Self> {
         if dir.as_os_str() == SHIPPED {
             return Ok(Self::shipped());
+        }
+        if dir.as_os_str() == ZEROED {
+            return Ok(Self::zeroed());
         }
         // Its messages name the environment variable that usually gives the folder.
         let env = format!("{}: ", crate::kernels::KERNEL_DIR_ENV);
@@ -778,6 +799,7 @@ impl KernelVariant {
             name,
             layout: None,
             replaced: Some(std::sync::Arc::new(replaced)),
+            zeroed: false,
         })
     }
 
@@ -789,6 +811,9 @@ impl KernelVariant {
         }
         if let Some(replaced) = &self.replaced {
             e.kernels.set_replacements(replaced.clone());
+        }
+        if self.zeroed {
+            e.kernels.set_zeroed_workgroup_memory();
         }
         e
     }

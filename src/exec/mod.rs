@@ -24,7 +24,7 @@ use crate::graph::{Plan, Slot};
 pub use crate::timer::GpuTimer;
 pub use pipelines::{
     ComputeKernel, GPU_LAYOUT_CONSTANT, KERNEL_LAYOUT_ENV, KernelCache, KernelLayout,
-    specialized_source, wgsl_storage_format,
+    WorkgroupInit, specialized_source, wgsl_storage_format,
 };
 pub use pool::{Outputs, TexturePool};
 

@@ -81,9 +81,29 @@ impl KernelLayout {
     }
 }
 
+/// How a kernel's workgroup memory starts. WebGPU guarantees zeros, and wgpu keeps the
+/// guarantee by default: each workgroup first stores its whole declared workgroup memory and
+/// waits at a barrier (the driver's zeroing, or code naga writes where the driver has none),
+/// whichever of its entries the kernel reads. Every kernel in `kernels/` writes each entry of
+/// its workgroup memory before it reads it, so [`KernelCache`] compiles them
+/// [`WorkgroupInit::AsLeft`]: `tests/workgroup_memory.rs` fills that memory with NaN bit
+/// patterns before each kernel's body runs, and every map of every plan that runs the kernels
+/// stays the same bit for bit. (On the H200 a kernel's declared workgroup memory cost time even
+/// where the branch using it never ran: `benches/RESULTS.md`, 2026-11-27, fourteenth session;
+/// `shadowgraph bench --kernel-dirs shipped,zeroed` times both.)
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum WorkgroupInit {
+    /// Zeroed before the kernel's body runs (wgpu's default).
+    #[default]
+    Zeroed,
+    /// Left as the device leaves it: for kernels that write before they read.
+    AsLeft,
+}
+
 impl ComputeKernel {
-    /// Validates, reflects and compiles `wgsl` in the device's [`KernelLayout`]; errors name
-    /// the kernel.
+    /// Validates, reflects and compiles `wgsl` in the device's [`KernelLayout`], its workgroup
+    /// memory zeroed ([`WorkgroupInit::Zeroed`]: any WGSL may rely on it); errors name the
+    /// kernel.
     pub fn new(device: &wgpu::Device, name: &str, wgsl: &str) -> Result<Self> {
         Self::with_layout(device, name, wgsl, KernelLayout::for_device(device)?)
     }
@@ -94,6 +114,17 @@ impl ComputeKernel {
         name: &str,
         wgsl: &str,
         layout: KernelLayout,
+    ) -> Result<Self> {
+        Self::with_options(device, name, wgsl, layout, WorkgroupInit::Zeroed)
+    }
+
+    /// [`ComputeKernel::with_layout`], its workgroup memory started as `init` says.
+    pub fn with_options(
+        device: &wgpu::Device,
+        name: &str,
+        wgsl: &str,
+        layout: KernelLayout,
+        init: WorkgroupInit,
     ) -> Result<Self> {
         let (module, reflection) = kernels::reflect(name, wgsl)?;
         let two_layouts = module
@@ -143,7 +174,7 @@ impl ComputeKernel {
                         entry_point: Some("main"),
                         compilation_options: wgpu::PipelineCompilationOptions {
                             constants,
-                            ..Default::default()
+                            zero_initialize_workgroup_memory: init == WorkgroupInit::Zeroed,
                         },
                         cache: None,
                     },
@@ -178,6 +209,9 @@ pub struct KernelCache {
     /// Kernels compiled from these texts instead of the embedded ones (and
     /// [`kernels::KERNEL_DIR_ENV`]'s), where they name them.
     replaced: Option<Arc<kernels::Replacements>>,
+    /// Zero every kernel's workgroup memory first ([`WorkgroupInit::Zeroed`]); `false`, the
+    /// default: [`WorkgroupInit::AsLeft`].
+    zeroed: bool,
 }
 
 impl KernelCache {
@@ -196,12 +230,25 @@ impl KernelCache {
         self.kernels.clear();
     }
 
+    /// Compiles every kernel from now on with its workgroup memory zeroed first
+    /// ([`WorkgroupInit::Zeroed`], wgpu's default; the pipelines made so far are dropped): what
+    /// the kernels' [`WorkgroupInit::AsLeft`] saves, timed on one device.
+    pub fn set_zeroed_workgroup_memory(&mut self) {
+        self.zeroed = true;
+        self.kernels.clear();
+    }
+
     fn compile(&self, device: &wgpu::Device, name: &str, wgsl: &str) -> Result<ComputeKernel> {
         let layout = match self.layout {
             Some(layout) => layout,
             None => KernelLayout::for_device(device)?,
         };
-        ComputeKernel::with_layout(device, name, wgsl, layout)
+        let init = if self.zeroed {
+            WorkgroupInit::Zeroed
+        } else {
+            WorkgroupInit::AsLeft
+        };
+        ComputeKernel::with_options(device, name, wgsl, layout, init)
     }
 
     /// The pipeline of `kernels/<name>.wgsl`, compiled on first use.

@@ -3,6 +3,7 @@
 
 pub mod evaluate;
 pub mod host;
+pub mod poison;
 pub mod soft;
 pub mod soft_maps;
 

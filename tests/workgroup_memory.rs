@@ -1,0 +1,245 @@
+//! The kernels run without wgpu's zeroing of workgroup memory (`exec::WorkgroupInit::AsLeft`),
+//! which is sound only if each kernel writes every workgroup entry before it reads it. Here
+//! every kernel that declares workgroup memory runs with that memory first filled with a NaN
+//! bit pattern (`common::poison`), through the plans of the bundled technique scenes (and the
+//! five-pass table `shadowgraph bench` keeps as its baseline), and every resource of every plan,
+//! and the shaded frame, must be the same bit for bit as without the poison. No tolerance: a
+//! kernel either reads what it wrote or reads the poison, which every sum, mean and table
+//! carries into its output. The test fails if a kernel with workgroup memory is run by none of
+//! the plans, so a new one cannot go unchecked.
+
+mod common;
+
+use std::collections::{BTreeSet, HashMap};
+use std::path::Path;
+use std::sync::Arc;
+
+use shadowgraph::exec::Executor;
+use shadowgraph::gpu::{Gpu, read_texture, submit_and_wait, write_texture};
+use shadowgraph::graph::{Graph, plan};
+use shadowgraph::render::{Frame, RenderOptions, Renderer};
+use shadowgraph::sat::five_pass::add_sat_five_pass;
+use shadowgraph::sat::{SatCoding, add_sat, lookup_area};
+use shadowgraph::scene::Scene;
+
+/// A bundled technique scene with its text edited (`edits`: each `from` must occur), shaded at
+/// 64 × 48 (the maps are what is checked; the frame only has to read them).
+fn scene(file: &str, edits: &[(&str, &str)]) -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes/techniques")
+        .join(file);
+    let mut text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{file}: {e}"));
+    for (from, to) in edits {
+        assert!(text.contains(from), "{file}: `{from}` not found");
+        text = text.replace(from, to);
+    }
+    let mut s = Scene::parse(&path, &text).unwrap_or_else(|e| panic!("{file} {edits:?}: {e}"));
+    s.width = 64;
+    s.height = 48;
+    s
+}
+
+/// The scenes whose plans run every kernel with workgroup memory: the fused blurs in tiles and
+/// (past the tile's radius, on maps wide enough for the row kernels) in rows, both mip chains,
+/// and the tables of every representation, fixed point and f32.
+fn scenes() -> Vec<(String, Scene)> {
+    let r12 = [("filter_radius = 3", "filter_radius = 12")];
+    let float_sat = "filter = \"sat\"\nsat_sums = \"float\"";
+    let f32_sums = "format = \"f32\"\nsat_sums = \"float\"";
+    let cases: Vec<(&str, Vec<(&str, &str)>)> = vec![
+        ("vsm.toml", vec![]),
+        (
+            "vsm.toml",
+            vec![r12[0], ("shadow_map = 512", "shadow_map = 1024")],
+        ),
+        ("evsm4.toml", vec![]),
+        ("evsm4.toml", r12.to_vec()),
+        ("msm.toml", vec![]),
+        (
+            "msm.toml",
+            vec![("filter_radius = 2", "filter_radius = 12")],
+        ),
+        ("vsm_mips.toml", vec![]),
+        ("esm_mips_aniso.toml", vec![]),
+        ("vssm.toml", vec![]),
+        (
+            "vssm.toml",
+            vec![("sat_sums = \"float\"", "sat_sums = \"fixed\"")],
+        ),
+        ("vsm_sat.toml", vec![]),
+        ("vsm_sat_float.toml", vec![]),
+        ("msm_soft.toml", vec![]),
+        ("msm_soft.toml", vec![("format = \"f16\"", f32_sums)]),
+        ("msm_sat.toml", vec![]),
+        ("msm_sat.toml", vec![("format = \"f16\"", f32_sums)]),
+        ("esm_sat.toml", vec![]),
+        ("esm_sat.toml", vec![("filter = \"sat\"", float_sat)]),
+        ("evsm4_sat.toml", vec![]),
+        ("evsm4_sat.toml", vec![("filter = \"sat\"", float_sat)]),
+        ("cssm.toml", vec![]),
+        (
+            "cssm.toml",
+            vec![("terms = 8", "terms = 8\nsat_sums = \"float\"")],
+        ),
+        ("csm_sat.toml", vec![]),
+        ("csm_sat.toml", vec![("filter = \"sat\"", float_sat)]),
+    ];
+    cases
+        .into_iter()
+        .map(|(file, edits)| (format!("{file} {edits:?}"), scene(file, &edits)))
+        .collect()
+}
+
+fn render(g: &Gpu, r: &mut Renderer, what: &str, s: &Scene) -> Frame {
+    let opts = RenderOptions {
+        aux: false,
+        repeat: 1,
+        dump: true,
+    };
+    r.render(&g.device, &g.queue, s, opts)
+        .unwrap_or_else(|e| panic!("{what}: {e}"))
+}
+
+/// Same length and the same bits at every index; names the first difference.
+#[track_caller]
+fn same_bits<T: Copy + PartialEq + std::fmt::Debug>(what: &str, a: &[T], b: &[T]) {
+    assert_eq!(a.len(), b.len(), "{what}: length");
+    if let Some(i) = (0..a.len()).find(|&i| a[i] != b[i]) {
+        let n = (0..a.len()).filter(|&i| a[i] != b[i]).count();
+        panic!(
+            "{what}: {n} of {} values differ with poisoned workgroup memory, first at {i}: {:?} \
+             against {:?}",
+            a.len(),
+            a[i],
+            b[i]
+        );
+    }
+}
+
+fn bits(v: &[f32]) -> Vec<u32> {
+    v.iter().map(|x| x.to_bits()).collect()
+}
+
+#[test]
+fn every_kernel_writes_its_workgroup_memory_before_reading_it() {
+    let g = common::gpu();
+    let poisoned = common::poison::poisoned_kernels();
+    let mut plain = Renderer::new(&g.device);
+    let mut poison = Renderer::new(&g.device);
+    poison
+        .executor
+        .kernels
+        .set_replacements(Arc::new(poisoned.clone()));
+    let mut ran = BTreeSet::new();
+    for (what, s) in scenes() {
+        let a = render(&g, &mut plain, &what, &s);
+        let b = render(&g, &mut poison, &what, &s);
+        assert_eq!(a.resources.len(), b.resources.len(), "{what}: resources");
+        for (x, y) in a.resources.iter().zip(&b.resources) {
+            assert_eq!(x.texture, y.texture, "{what}");
+            if let Some(k) = &x.producer {
+                ran.insert(k.clone());
+            }
+            assert_eq!(x.levels.len(), y.levels.len(), "{what}: {}", x.texture);
+            for (level, (m, n)) in x.levels.iter().zip(&y.levels).enumerate() {
+                let name = format!("{what}: `{}` level {level}", m.resource);
+                same_bits(&name, &bits(&m.data), &bits(&n.data));
+            }
+        }
+        same_bits(
+            &format!("{what}: visibility"),
+            &bits(&a.visibility),
+            &bits(&b.visibility),
+        );
+        same_bits(&format!("{what}: frame"), &a.rgba, &b.rgba);
+    }
+    // The library's tables from an imported map and the five-pass baseline: in
+    // `the_library_tables_and_the_five_pass_baseline_too`.
+    let baseline = [
+        "sat_tile_sums",
+        "sat_tile_sums_f32",
+        "sat_tiles",
+        "sat_tiles_f32",
+        "sat_rows",
+        "sat_carry",
+        "sat_cols_reduce",
+        "sat_cols",
+        "sat_cols_f32",
+    ];
+    let unchecked: Vec<&String> = poisoned
+        .keys()
+        .filter(|k| !ran.contains(*k) && !baseline.contains(&k.as_str()))
+        .collect();
+    assert!(
+        unchecked.is_empty(),
+        "kernels with workgroup memory that no scene here runs: {unchecked:?} (ran: {ran:?})"
+    );
+    for k in baseline {
+        assert!(
+            poisoned.contains_key(k),
+            "`{k}` declares no workgroup memory now"
+        );
+    }
+}
+
+/// The summed-area tables of the library's `sat::add_sat` (an imported map: the generic tile
+/// kernels) and of the five-pass baseline `shadowgraph bench` keeps, fixed point and f32, on a
+/// random two-channel map of 1500 × 70 (ragged tiles, two column blocks of the baseline), with
+/// and without the poison.
+#[test]
+fn the_library_tables_and_the_five_pass_baseline_too() {
+    type AddSat = fn(&mut Graph, usize, &str, &SatCoding) -> String;
+    let g = common::gpu();
+    let mut rng = common::rng(0x9015);
+    let (w, h) = (1500u32, 70u32);
+    let values: Vec<f32> = (0..w * h * 2)
+        .map(|_| rand::Rng::random_range(&mut rng, 0.05f32..1.0))
+        .collect();
+    let format = wgpu::TextureFormat::Rg32Float;
+    let input = g.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("test.poison.input"),
+        size: wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    write_texture(&g.queue, &input, bytemuck::cast_slice(&values));
+    let imports = HashMap::from([("in".to_string(), input)]);
+    let mut plain = Executor::new();
+    let mut poison = Executor::new();
+    poison
+        .kernels
+        .set_replacements(Arc::new(common::poison::poisoned_kernels()));
+    let fixed = SatCoding::fixed(lookup_area(16.0, 16.0), [0.0; 4], [1.0; 4]).unwrap();
+    let float = SatCoding::float([0.0; 4], [1.0; 4]).unwrap();
+    let builds: [(&str, AddSat); 2] = [("add_sat", add_sat), ("five-pass", add_sat_five_pass)];
+    for (what, add) in builds {
+        for coding in [&fixed, &float] {
+            let what = format!("{what} {:?}", coding.variant);
+            let mut graph = Graph::default();
+            graph.import("in", format, w, h, Some(0));
+            let out = add(&mut graph, 0, "in", coding);
+            let plan = plan(&graph, &[&out]).expect("plan");
+            let run = |exec: &mut Executor| {
+                let mut enc = g.device.create_command_encoder(&Default::default());
+                let outputs = exec
+                    .record(&g.device, &mut enc, &plan, &imports, None)
+                    .expect("record");
+                submit_and_wait(&g.device, &g.queue, enc, &what).expect("run");
+                read_texture(&g.device, &g.queue, &outputs.textures[&out], 0).expect("readback")
+            };
+            let a = run(&mut plain);
+            let b = run(&mut poison);
+            // A table of sums of random values: the check compares something.
+            assert!(a.iter().any(|&x| x != 0), "{what}: the table is all zeros");
+            same_bits(&what, &a, &b);
+        }
+    }
+}
