@@ -39,6 +39,9 @@
 #   GPUs (SUB, GRID and the tile kernels' workgroup size from exec::KernelLayout, the carries
 #   kernel keeping 64; its f32 tables then differ from llvmpipe's in their last bits, within
 #   tests/sat.rs's tolerances) or everywhere if the suite's time allows.
+# - variants.txt, sat_carries_serial: the `carries` pass against shipped's in `sat fixed`,
+#   `chain vssm` and `chain msm_soft`, both rounds. The batched loads stay unless the serial
+#   kernel is faster in both (then restore it from the variant, less its header).
 # - variants.txt, mips: mip_quads faster at 2048² and 4096² in both rounds ships everywhere
 #   (llvmpipe as fast or faster): copy it over kernels/shared/mip_chain.wgsl, less its header.
 set -u
@@ -169,9 +172,14 @@ done
 # And the tables' tile passes with 2 x 2 sub-blocks, 256 invocations a tile
 # (benches/variants/sat_sub2: lanes 2 texels apart instead of 4, four times the invocations;
 # fixed-point tables bit for bit the same; llvmpipe 1.15-1.5x slower).
+# And the carries kernel loading one edge texel at a time as its serial sum reaches it
+# (benches/variants/sat_carries_serial, shipped until the nineteenth session; the H200's
+# carries took 0.034 ms at 2048² and 0.082 at 4096², 0.5-0.6 us a tile of a line: a load's
+# latency each), against the shipped loads eight ahead of the sums; the same carries bit for bit.
 TV=benches/variants/sat_vsm_texel
 TS=benches/variants/sat_sub2
-for dirs in "shipped,$TV,$TS" "$TS,$TV,shipped"; do
+TC=benches/variants/sat_carries_serial
+for dirs in "shipped,$TV,$TS,$TC" "$TC,$TS,$TV,shipped"; do
     step variants.txt 60 "$B" bench --sizes 2048,4096 --repeat 20 \
         --only 'sat fixed,chain vssm,chain msm_soft,chain cssm 8 terms (depth → 5' --passes \
         --kernel-dirs "$dirs"

@@ -386,6 +386,45 @@ fn the_small_sub_block_table_variant_builds_the_same_tables() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `benches/variants/sat_carries_serial` (the carries kernel loading each edge texel as its
+/// serial sum reaches it, as before its loads ran eight ahead) gives the same carries and
+/// tables bit for bit, f32 sums included (the sums keep their order): VSM's f32 table and ESM's
+/// fixed-point one at 300² (10 tiles a line: a batch of eight and two after it) and 520²
+/// (17: two batches and one). Carries added in another order (the row's tiles above taken
+/// from the tile beside) fail it.
+#[test]
+fn the_serial_carries_variant_builds_the_same_tables() {
+    let dir = temp_dir("carries");
+    for (scene, resources) in [
+        (
+            "vsm_sat_float.toml",
+            [
+                "light0.vsm.sat",
+                "light0.vsm.sat.row_carry",
+                "light0.vsm.sat.col_carry",
+            ],
+        ),
+        (
+            "esm_sat.toml",
+            [
+                "light0.esm.sat",
+                "light0.esm.sat.row_carry",
+                "light0.esm.sat.col_carry",
+            ],
+        ),
+    ] {
+        for size in [300, 520] {
+            let edits = [("shadow_map = 512", &*format!("shadow_map = {size}"))];
+            let path = edited_scene(&dir, scene, &edits, &format!("{size}_{scene}"));
+            for resource in resources {
+                let levels = variants_match(&path, resource, &dir, None, &["sat_carries_serial"]);
+                assert_eq!(levels, 1);
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// `bench --kernel-dirs shipped,<folder>,…` times each kernel compiled from each folder in one
 /// process, rows `<kernel> [shipped]`, `<kernel> [<folder's name>]` and `<kernel> [zeroed]` (the
 /// embedded kernels with their workgroup memory zeroed first). A folder's kernel that
@@ -552,6 +591,7 @@ fn benchmark_variants_track_the_shipped_kernels() {
         ("blur_rows_run1/blur.wgsl", (3, 21)),
         ("blur_rows_run2/blur.wgsl", (2, 7)),
         ("mip_quads/shared/mip_chain.wgsl", (23, 21)),
+        ("sat_carries_serial/sat_carries.wgsl", (106, 7)),
         ("sat_sub2/sat_carries.wgsl", (9, 16)),
         ("sat_sub2/shared/sat_tile.wgsl", (5, 16)),
         ("sat_sub2/shared/sat_tile_scan.wgsl", (8, 15)),
