@@ -66,21 +66,14 @@ fn csm_z_on_gpu(
     }
     let names: Vec<&str> = outputs.iter().map(String::as_str).collect();
     let p = plan(&graph, &names).expect("plan");
-    let texture = g.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("test.csm_z.in"),
-        size: wgpu::Extent3d {
-            width: w,
-            height: h,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::R32Float,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
-    shadowgraph::gpu::write_texture(&g.queue, &texture, bytemuck::cast_slice(input));
+    let texture = common::upload(
+        &g.device,
+        &g.queue,
+        "test.csm_z.in",
+        (w, h),
+        wgpu::TextureFormat::R32Float,
+        bytemuck::cast_slice(input),
+    );
     let imports = std::collections::HashMap::from([("in".to_string(), texture)]);
     let mut exec = shadowgraph::exec::Executor::new();
     let record = |exec: &mut shadowgraph::exec::Executor| {
@@ -217,21 +210,14 @@ fn blocker_harness(
     let views: Vec<wgpu::TextureView> = tables
         .iter()
         .map(|words| {
-            let t = d.create_texture(&wgpu::TextureDescriptor {
-                label: Some("test.blocker.table"),
-                size: wgpu::Extent3d {
-                    width: size,
-                    height: size,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rgba32Uint,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                view_formats: &[],
-            });
-            shadowgraph::gpu::write_texture(&g.queue, &t, bytemuck::cast_slice(words));
+            let t = common::upload(
+                d,
+                &g.queue,
+                "test.blocker.table",
+                (size, size),
+                wgpu::TextureFormat::Rgba32Uint,
+                bytemuck::cast_slice(words),
+            );
             t.create_view(&Default::default())
         })
         .collect();

@@ -170,21 +170,14 @@ fn run_in(
     };
     let names: Vec<&str> = tables.iter().map(String::as_str).collect();
     let plan = plan(&graph, &names).expect("plan");
-    let input = g.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("test.csm_sat.depth"),
-        size: wgpu::Extent3d {
-            width: w,
-            height: h,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::R32Float,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
-    write_texture(&g.queue, &input, bytemuck::cast_slice(raw));
+    let input = common::upload(
+        &g.device,
+        &g.queue,
+        "test.csm_sat.depth",
+        (w, h),
+        wgpu::TextureFormat::R32Float,
+        bytemuck::cast_slice(raw),
+    );
     let imports = HashMap::from([("in".to_string(), input)]);
     let mut exec = Executor::new();
     exec.kernels.set_layout(layout);

@@ -78,21 +78,14 @@ fn run(light: &Light, raw: &[f32], outputs: &[String]) -> (Vec<Texels>, Vec<(Str
     technique::add_light_nodes(&mut graph, 0, light);
     let names: Vec<&str> = outputs.iter().map(String::as_str).collect();
     let plan = plan(&graph, &names).expect("plan").unaliased();
-    let depth = g.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("test.depth"),
-        size: wgpu::Extent3d {
-            width: n,
-            height: n,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::R32Float,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
-    write_texture(&g.queue, &depth, bytemuck::cast_slice(raw));
+    let depth = common::upload(
+        &g.device,
+        &g.queue,
+        "test.depth",
+        (n, n),
+        wgpu::TextureFormat::R32Float,
+        bytemuck::cast_slice(raw),
+    );
     let imports = HashMap::from([(technique::depth_name(0), depth)]);
     let mut exec = Executor::new();
     let mut enc = g.device.create_command_encoder(&Default::default());

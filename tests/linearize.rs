@@ -46,21 +46,14 @@ fn run_linearize(
         light: None,
     });
     let plan = plan(&graph, &["out"]).expect("plan");
-    let tex = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("test.raw"),
-        size: wgpu::Extent3d {
-            width: w,
-            height: h,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::R32Float,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
-    write_texture(queue, &tex, bytemuck::cast_slice(raw));
+    let tex = common::upload(
+        device,
+        queue,
+        "test.raw",
+        (w, h),
+        wgpu::TextureFormat::R32Float,
+        bytemuck::cast_slice(raw),
+    );
     let mut exec = Executor::new();
     let mut enc = device.create_command_encoder(&Default::default());
     let imports = HashMap::from([("in".to_string(), tex)]);

@@ -13,22 +13,8 @@ use shadowgraph::graph::{Graph, SizeRule, plan};
 use shadowgraph::scene::{BlurKernel, Filter};
 
 fn upload(g: &Gpu, w: u32, h: u32, format: wgpu::TextureFormat, data: &[f32]) -> wgpu::Texture {
-    let t = g.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("test.input"),
-        size: wgpu::Extent3d {
-            width: w,
-            height: h,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
-    write_texture(&g.queue, &t, bytemuck::cast_slice(data));
-    t
+    let data = bytemuck::cast_slice(data);
+    common::upload(&g.device, &g.queue, "test.input", (w, h), format, data)
 }
 
 /// Plans `graph` for `output`, runs it with `input` imported as "in" (the output poisoned with

@@ -114,21 +114,14 @@ fn build_with(g: &Gpu, exec: &mut Executor, map: &Map, coding: &SatCoding, add: 
     graph.import("in", map.format(), map.w as u32, map.h as u32, Some(0));
     let out = add(&mut graph, 0, "in", coding);
     let plan = plan(&graph, &[&out]).expect("plan");
-    let input = g.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("test.sat.input"),
-        size: wgpu::Extent3d {
-            width: map.w as u32,
-            height: map.h as u32,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: map.format(),
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
-    write_texture(&g.queue, &input, bytemuck::cast_slice(&map.values));
+    let input = common::upload(
+        &g.device,
+        &g.queue,
+        "test.sat.input",
+        (map.w as u32, map.h as u32),
+        map.format(),
+        bytemuck::cast_slice(&map.values),
+    );
     let imports = HashMap::from([("in".to_string(), input)]);
     let mut enc = g.device.create_command_encoder(&Default::default());
     let outputs = exec

@@ -15,7 +15,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use shadowgraph::exec::Executor;
-use shadowgraph::gpu::{Gpu, read_texture, submit_and_wait, write_texture};
+use shadowgraph::gpu::{Gpu, read_texture, submit_and_wait};
 use shadowgraph::graph::{Graph, plan};
 use shadowgraph::render::{Frame, RenderOptions, Renderer};
 use shadowgraph::sat::five_pass::add_sat_five_pass;
@@ -196,21 +196,14 @@ fn the_library_tables_and_the_five_pass_baseline_too() {
         .map(|_| rand::Rng::random_range(&mut rng, 0.05f32..1.0))
         .collect();
     let format = wgpu::TextureFormat::Rg32Float;
-    let input = g.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("test.poison.input"),
-        size: wgpu::Extent3d {
-            width: w,
-            height: h,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
+    let input = common::upload(
+        &g.device,
+        &g.queue,
+        "test.poison.input",
+        (w, h),
         format,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
-    write_texture(&g.queue, &input, bytemuck::cast_slice(&values));
+        bytemuck::cast_slice(&values),
+    );
     let imports = HashMap::from([("in".to_string(), input)]);
     let mut plain = Executor::new();
     let mut poison = Executor::new();

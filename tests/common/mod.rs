@@ -18,6 +18,34 @@ pub fn gpu() -> Gpu {
     }
 }
 
+/// A 2-D `w × h` texture of `format` that kernels sample (`TEXTURE_BINDING | COPY_DST`), holding
+/// `data` (its texels' bytes, rows packed): a graph's imported input.
+pub fn upload(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    label: &str,
+    (w, h): (u32, u32),
+    format: wgpu::TextureFormat,
+    data: &[u8],
+) -> wgpu::Texture {
+    let t = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    shadowgraph::gpu::write_texture(queue, &t, data);
+    t
+}
+
 /// A seeded RNG so failures reproduce.
 pub fn rng(seed: u64) -> SmallRng {
     SmallRng::seed_from_u64(seed)

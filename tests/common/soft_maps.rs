@@ -66,21 +66,14 @@ pub fn trig_error(g: &Gpu) -> f64 {
     }
     let names: Vec<&str> = outputs.iter().map(String::as_str).collect();
     let p = plan(&graph, &names).expect("plan");
-    let input = g.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("test.trig"),
-        size: wgpu::Extent3d {
-            width: w,
-            height: h,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::R32Float,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
-    shadowgraph::gpu::write_texture(&g.queue, &input, bytemuck::cast_slice(&z));
+    let input = super::upload(
+        &g.device,
+        &g.queue,
+        "test.trig",
+        (w, h),
+        wgpu::TextureFormat::R32Float,
+        bytemuck::cast_slice(&z),
+    );
     let mut exec = shadowgraph::exec::Executor::new();
     let csm = shadowgraph::kernels::resolve("csm", None).expect("csm");
     let unclamped = csm.replace("let z = depth.z;", "let z = textureLoad(src, id.xy, 0).r;");
