@@ -17,6 +17,7 @@ use std::sync::Arc;
 use shadowgraph::exec::Executor;
 use shadowgraph::gpu::{Gpu, read_texture, submit_and_wait};
 use shadowgraph::graph::{Graph, plan};
+use shadowgraph::kernels::{self, Replacements};
 use shadowgraph::render::{Frame, RenderOptions, Renderer};
 use shadowgraph::sat::five_pass::add_sat_five_pass;
 use shadowgraph::sat::{SatCoding, add_sat, lookup_area};
@@ -120,20 +121,28 @@ fn bits(v: &[f32]) -> Vec<u32> {
     v.iter().map(|x| x.to_bits()).collect()
 }
 
-#[test]
-fn every_kernel_writes_its_workgroup_memory_before_reading_it() {
-    let g = common::gpu();
-    let poisoned = common::poison::poisoned_kernels();
+/// Renders each scene of `scenes` with `variant`'s kernels (the shipped ones with `None`), once
+/// as they are and once with their workgroup memory poisoned, and requires every resource of
+/// every plan, the visibility and the frame to be the same bit for bit. Returns the kernels
+/// that wrote the resources.
+fn same_with_poison(
+    g: &Gpu,
+    variant: Option<&Replacements>,
+    scenes: &[(String, Scene)],
+) -> BTreeSet<String> {
     let mut plain = Renderer::new(&g.device);
     let mut poison = Renderer::new(&g.device);
+    if let Some(v) = variant {
+        plain.executor.kernels.set_replacements(Arc::new(v.clone()));
+    }
     poison
         .executor
         .kernels
-        .set_replacements(Arc::new(poisoned.clone()));
+        .set_replacements(Arc::new(common::poison::poisoned_kernels_in(variant)));
     let mut ran = BTreeSet::new();
-    for (what, s) in scenes() {
-        let a = render(&g, &mut plain, &what, &s);
-        let b = render(&g, &mut poison, &what, &s);
+    for (what, s) in scenes {
+        let a = render(g, &mut plain, what, s);
+        let b = render(g, &mut poison, what, s);
         assert_eq!(a.resources.len(), b.resources.len(), "{what}: resources");
         for (x, y) in a.resources.iter().zip(&b.resources) {
             assert_eq!(x.texture, y.texture, "{what}");
@@ -153,6 +162,14 @@ fn every_kernel_writes_its_workgroup_memory_before_reading_it() {
         );
         same_bits(&format!("{what}: frame"), &a.rgba, &b.rgba);
     }
+    ran
+}
+
+#[test]
+fn every_kernel_writes_its_workgroup_memory_before_reading_it() {
+    let g = common::gpu();
+    let poisoned = common::poison::poisoned_kernels();
+    let ran = same_with_poison(&g, None, &scenes());
     // The library's tables from an imported map and the five-pass baseline: in
     // `the_library_tables_and_the_five_pass_baseline_too`.
     let baseline = [
@@ -234,5 +251,33 @@ fn the_library_tables_and_the_five_pass_baseline_too() {
             assert!(a.iter().any(|&x| x != 0), "{what}: the table is all zeros");
             same_bits(&what, &a, &b);
         }
+    }
+}
+
+/// The benchmark variants in `benches/variants/` run without the zeroing too (`bench
+/// --kernel-dirs` compiles them as the shipped kernels): those with workgroup memory, each
+/// through the scenes whose plans run its kernels, poisoned and not, bit for bit.
+#[test]
+fn the_benchmark_variants_write_it_before_reading_it_too() {
+    let g = common::gpu();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/variants");
+    let all = scenes();
+    let pick = |variant: &str, names: &[&str]| -> Vec<(String, Scene)> {
+        all.iter()
+            .filter(|(what, _)| names.iter().any(|n| what.starts_with(n)))
+            .map(|(what, s)| (format!("{variant}: {what}"), s.clone()))
+            .collect()
+    };
+    let tables = ["vssm.toml", "msm_soft.toml", "esm_sat.toml", "cssm.toml"];
+    for (variant, names) in [
+        ("sat_sub2", &tables[..]),
+        ("sat_vsm_texel", &["vssm.toml"][..]),
+        ("sat_carries_serial", &tables[..]),
+        ("mip_quads", &["vsm_mips.toml", "esm_mips_aniso.toml"][..]),
+    ] {
+        let files = kernels::read_replacements(&root.join(variant))
+            .unwrap_or_else(|e| panic!("{variant}: {e}"));
+        let ran = same_with_poison(&g, Some(&files), &pick(variant, names));
+        assert!(!ran.is_empty(), "{variant}: nothing ran");
     }
 }

@@ -4,8 +4,6 @@
 //! in this workgroup then reads the poison instead of what the device left there, so its outputs
 //! change; one that writes before it reads gives the same bits (`tests/workgroup_memory.rs`).
 
-use std::collections::HashMap;
-
 use naga::{AddressSpace, ArraySize, Binding, BuiltIn, ScalarKind, TypeInner};
 use shadowgraph::kernels::{self, KernelId, Replacements};
 
@@ -112,10 +110,17 @@ pub fn poisoned(name: &str, wgsl: &str) -> Option<String> {
 /// Every kernel of `kernels/` that declares workgroup memory, poisoned (as replacements of the
 /// kernels' files: their imports resolved), by name.
 pub fn poisoned_kernels() -> Replacements {
-    let mut out = HashMap::new();
+    poisoned_kernels_in(None)
+}
+
+/// [`poisoned_kernels`] with the files of `variant` (a benchmark variant's folder, as
+/// `kernels::read_replacements` reads it) in place of those they name, and those files too.
+pub fn poisoned_kernels_in(variant: Option<&Replacements>) -> Replacements {
+    // The variant's own files stay for the kernels without workgroup memory.
+    let mut out: Replacements = variant.cloned().unwrap_or_default();
     for id in KernelId::ALL {
         // A kernel with a `// #generated` block (the shading pass) resolves only with one.
-        let Ok(wgsl) = kernels::resolve(id.name(), None) else {
+        let Ok(wgsl) = kernels::resolve_in(id.name(), None, variant) else {
             continue;
         };
         if let Some(p) = poisoned(id.name(), &wgsl) {
