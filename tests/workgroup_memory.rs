@@ -161,6 +161,13 @@ fn same_with_poison(
             &bits(&b.visibility),
         );
         same_bits(&format!("{what}: frame"), &a.rgba, &b.rgba);
+        // Maps of a lit scene: the comparisons compare something.
+        let nonzero = a
+            .resources
+            .iter()
+            .flat_map(|r| &r.levels)
+            .any(|m| m.data.iter().any(|&v| v != 0.0));
+        assert!(nonzero, "{what}: every map is all zeros");
     }
     ran
 }

@@ -11,7 +11,7 @@ use shadowgraph::kernels::{self, KernelId, Replacements};
 pub const POISON: u32 = 0x7FC0_0001;
 
 /// WGSL for the poison as a value of scalar or vector type `inner`.
-fn poison_value(module: &naga::Module, inner: &TypeInner, what: &str) -> String {
+fn poison_value(inner: &TypeInner, what: &str) -> String {
     let scalar = |s: naga::Scalar| -> (&'static str, String) {
         assert_eq!(s.width, 4, "{what}: a {}-byte scalar", s.width);
         match s.kind {
@@ -27,10 +27,7 @@ fn poison_value(module: &naga::Module, inner: &TypeInner, what: &str) -> String 
             let (name, v) = scalar(s);
             format!("vec{}<{name}>({v})", size as u8)
         }
-        ref other => panic!(
-            "{what}: no poison for {other:?} in {} types",
-            module.types.len()
-        ),
+        ref other => panic!("{what}: no poison for {other:?}"),
     }
 }
 
@@ -73,13 +70,13 @@ pub fn poisoned(name: &str, wgsl: &str) -> Option<String> {
                 size: ArraySize::Constant(n),
                 ..
             } => {
-                let v = poison_value(&module, &module.types[base].inner, &what);
+                let v = poison_value(&module.types[base].inner, &what);
                 block += &format!(
                     "    for (var sg_i = {li}; sg_i < {n}u; sg_i += {invocations}u) {{ {var}[sg_i] = {v}; }}\n"
                 );
             }
             ref inner => {
-                let v = poison_value(&module, inner, &what);
+                let v = poison_value(inner, &what);
                 block += &format!("    if {li} == 0u {{ {var} = {v}; }}\n");
             }
         }
