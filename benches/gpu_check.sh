@@ -207,9 +207,9 @@ UNBLURRED='            for (var k = i32(li); k < t.outs.x * t.outs.y; k += i32(W
                 store(t, vec2<i32>(yx.y, yx.x), sh_get((yx.x + t.r.y) * t.enc.x + yx.y + t.r.x));
             }'
 mkdir -p "$V/fused_no_blur/shared" "$V/fused_no_encode/shared"
-awk -v body="$UNBLURRED" '/^            blur_tile_(runs|single)\(t, li\);$/ { print body; next } { print }' \
+awk -v body="$UNBLURRED" '/^                blur_tile_(runs|single)\(t, li\);$/ { print body; next } { print }' \
     "$E" >"$V/fused_no_blur/shared/encode_blur.wgsl"
-sed 's/^    encode_tile(t, li);$/    workgroupBarrier();/' "$V/fused_no_blur/shared/encode_blur.wgsl" \
+sed 's/^        encode_tile(t, li);$/        workgroupBarrier();/' "$V/fused_no_blur/shared/encode_blur.wgsl" \
     >"$V/fused_no_encode/shared/encode_blur.wgsl"
 edited "$E" "$V/fused_no_blur/shared/encode_blur.wgsl"
 edited "$V/fused_no_blur/shared/encode_blur.wgsl" "$V/fused_no_encode/shared/encode_blur.wgsl"
@@ -220,10 +220,14 @@ step variants.txt 40 "$B" bench --sizes 2048 --repeat 20 \
 # in one process, every case in both side by side (`bench --layouts`), one round (the
 # fourteenth session's two agreed within 1%): `gpu` (the default on a GPU) loads and encodes pass 3's texels
 # again, `cpu` keeps the first sweep's (fourteenth session: `chain vssm` 0.313 against 0.336
-# ms).
+# ms). The fused tile blurs too: `gpu` blurs a tile in workgroup memory with 256 invocations,
+# `cpu` walks it in strips with 8 (2-3x faster on llvmpipe, twentieth session). The strips
+# ship for GPUs only if faster there in this step at 2048² (then GPU_LAYOUT's branches in
+# shared/encode_blur.wgsl go, and LANES becomes a constant).
 for order in gpu,cpu; do
     step variants.txt 60 "$B" bench --sizes 2048 --repeat 20 \
-        --only 'sat,chain vssm,chain msm_soft,chain esm,chain cssm' --passes --layouts "$order"
+        --only 'sat,chain vssm,chain msm_soft,chain esm,chain cssm,vsm_blur r4,msm_blur r4,evsm_blur 4 r4' \
+        --passes --layouts "$order"
 done
 # The kernels' workgroup memory left as the device leaves it (shipped: exec::WorkgroupInit::AsLeft,
 # safe because tests/workgroup_memory.rs finds every kernel writing it before reading it)

@@ -245,8 +245,13 @@ pub struct Binding {
 pub struct Reflection {
     /// All resource bindings, sorted by (group, binding).
     pub bindings: Vec<Binding>,
-    /// `@workgroup_size` of the compute entry point `main`, if there is one.
+    /// `@workgroup_size` of the compute entry point `main`, if there is one, as a GPU compiles
+    /// it: where the size is an `override` of the layout ([`GPU_LAYOUT_CONSTANT`] true), that
+    /// layout's. A [`crate::exec::ComputeKernel`]'s reflection holds its own layout's.
     pub workgroup_size: Option<[u32; 3]>,
+    /// The same as a CPU driver compiles it ([`GPU_LAYOUT_CONSTANT`] false): where the kernel's
+    /// size does not depend on the layout, [`Reflection::workgroup_size`].
+    pub cpu_workgroup_size: Option<[u32; 3]>,
     /// Texels an invocation of `main` covers along x ([`TEXELS_X_CONSTANT`]; 1 where the
     /// kernel declares none): a workgroup covers `workgroup_size[0] · texels_x` columns.
     pub texels_x: u32,
@@ -262,7 +267,30 @@ pub const TEXELS_X_CONSTANT: &str = "TEXELS_X";
 /// The most texels along x a kernel may give an invocation ([`TEXELS_X_CONSTANT`]).
 pub const MAX_TEXELS_X: u32 = 64;
 
+/// The pipeline constant a kernel declares (`override GPU_LAYOUT: bool`) where it has two
+/// layouts, one for GPUs and one for CPU drivers (`crate::exec::KernelLayout`). Its workgroup
+/// size may depend on it (`kernels/shared/encode_blur.wgsl`: `@workgroup_size(LANES)`).
+pub const GPU_LAYOUT_CONSTANT: &str = "GPU_LAYOUT";
+
 impl Reflection {
+    /// This reflection as the kernel compiles in one layout (`gpu`: [`GPU_LAYOUT_CONSTANT`]
+    /// true): its workgroup size that layout's.
+    pub fn in_layout(mut self, gpu: bool) -> Self {
+        if !gpu {
+            self.workgroup_size = self.cpu_workgroup_size;
+        }
+        self
+    }
+
+    /// The largest workgroup of either layout, dimension by dimension (what the device's limits
+    /// must allow).
+    pub fn largest_workgroup(&self) -> Option<[u32; 3]> {
+        match (self.workgroup_size, self.cpu_workgroup_size) {
+            (Some(a), Some(b)) => Some([a[0].max(b[0]), a[1].max(b[1]), a[2].max(b[2])]),
+            (a, b) => a.or(b),
+        }
+    }
+
     /// Workgroups of `main` covering a `w × h` texel grid: `workgroup_size[0] · texels_x`
     /// columns and `workgroup_size[1]` rows a workgroup.
     pub fn groups_for(&self, w: u32, h: u32) -> [u32; 3] {
@@ -307,6 +335,15 @@ pub fn validate(kernel: &str, wgsl: &str) -> Result<naga::Module> {
 /// [`validate`], its errors one line tagged `[origin]` where `origin` is given (replaced
 /// kernels: the folder they came from), else naga's annotated source.
 fn validate_from(kernel: &str, wgsl: &str, origin: Option<&str>) -> Result<naga::Module> {
+    validate_with_info(kernel, wgsl, origin).map(|(module, _)| module)
+}
+
+/// [`validate_from`], with naga's analysis of the module.
+fn validate_with_info(
+    kernel: &str,
+    wgsl: &str,
+    origin: Option<&str>,
+) -> Result<(naga::Module, naga::valid::ModuleInfo)> {
     let one_line = origin.is_some();
     let error = |message: String, line: Option<u32>| Error::Kernel {
         kernel: kernel.to_string(),
@@ -333,7 +370,7 @@ fn validate_from(kernel: &str, wgsl: &str, origin: Option<&str>) -> Result<naga:
             line,
         )
     })?;
-    naga::valid::Validator::new(
+    let info = naga::valid::Validator::new(
         naga::valid::ValidationFlags::all(),
         naga::valid::Capabilities::all(),
     )
@@ -347,12 +384,15 @@ fn validate_from(kernel: &str, wgsl: &str, origin: Option<&str>) -> Result<naga:
         };
         error(message, line)
     })?;
-    Ok(module)
+    Ok((module, info))
 }
 
 /// Validates `wgsl` and reads its bindings and workgroup size.
 pub fn reflect(kernel: &str, wgsl: &str) -> Result<(naga::Module, Reflection)> {
-    reflect_module(kernel, validate(kernel, wgsl)?)
+    let replaced = replacements().is_ok_and(|r| !r.is_empty());
+    let origin = format!("kernels replaced by {KERNEL_DIR_ENV}");
+    let (module, info) = validate_with_info(kernel, wgsl, replaced.then_some(origin.as_str()))?;
+    reflect_module(kernel, module, &info)
 }
 
 /// [`reflect`] of a kernel replaced from `origin` (a folder of variants): a validation error
@@ -362,10 +402,15 @@ pub fn reflect_replaced(
     wgsl: &str,
     origin: &str,
 ) -> Result<(naga::Module, Reflection)> {
-    reflect_module(kernel, validate_from(kernel, wgsl, Some(origin))?)
+    let (module, info) = validate_with_info(kernel, wgsl, Some(origin))?;
+    reflect_module(kernel, module, &info)
 }
 
-fn reflect_module(kernel: &str, module: naga::Module) -> Result<(naga::Module, Reflection)> {
+fn reflect_module(
+    kernel: &str,
+    module: naga::Module,
+    info: &naga::valid::ModuleInfo,
+) -> Result<(naga::Module, Reflection)> {
     let sampled = sampled_images(&module);
     let mut bindings = Vec::new();
     for (h, g) in module.global_variables.iter() {
@@ -385,12 +430,20 @@ fn reflect_module(kernel: &str, module: naga::Module) -> Result<(naga::Module, R
     bindings.sort_by_key(|b| (b.group, b.binding));
     let mut stages = wgpu::ShaderStages::NONE;
     let mut workgroup_size = None;
+    let mut cpu_workgroup_size = None;
     for ep in &module.entry_points {
         match ep.stage {
             naga::ShaderStage::Compute => {
                 stages |= wgpu::ShaderStages::COMPUTE;
                 if ep.name == "main" {
-                    workgroup_size = Some(ep.workgroup_size);
+                    let sizes = if ep.workgroup_size_overrides.is_some() {
+                        [true, false].map(|gpu| layout_workgroup_size(kernel, &module, info, gpu))
+                    } else {
+                        [Ok(ep.workgroup_size), Ok(ep.workgroup_size)]
+                    };
+                    let [gpu, cpu] = sizes;
+                    workgroup_size = Some(gpu?);
+                    cpu_workgroup_size = Some(cpu?);
                 }
             }
             naga::ShaderStage::Vertex => stages |= wgpu::ShaderStages::VERTEX,
@@ -404,10 +457,43 @@ fn reflect_module(kernel: &str, module: naga::Module) -> Result<(naga::Module, R
         Reflection {
             bindings,
             workgroup_size,
+            cpu_workgroup_size,
             texels_x,
             stages,
         },
     ))
+}
+
+/// `main`'s workgroup size where it is an `override` expression: as the layout `gpu` compiles
+/// it ([`GPU_LAYOUT_CONSTANT`] set where the kernel declares it, every other override its
+/// default), naga's own evaluation of the pipeline constants.
+fn layout_workgroup_size(
+    kernel: &str,
+    module: &naga::Module,
+    info: &naga::valid::ModuleInfo,
+    gpu: bool,
+) -> Result<[u32; 3]> {
+    let mut constants = naga::back::PipelineConstants::default();
+    if module
+        .overrides
+        .iter()
+        .any(|(_, o)| o.name.as_deref() == Some(GPU_LAYOUT_CONSTANT))
+    {
+        constants.insert(GPU_LAYOUT_CONSTANT.to_string(), f64::from(u8::from(gpu)));
+    }
+    let stage = (naga::ShaderStage::Compute, "main");
+    let (resolved, _) =
+        naga::back::pipeline_constants::process_overrides(module, info, Some(stage), &constants)
+            .map_err(|e| Error::Kernel {
+                kernel: kernel.to_string(),
+                message: format!("its workgroup size's overrides: {e}"),
+            })?;
+    let ep = resolved
+        .entry_points
+        .iter()
+        .find(|e| e.name == "main")
+        .expect("process_overrides keeps the entry point it was given");
+    Ok(ep.workgroup_size)
 }
 
 /// `kernel`'s [`TEXELS_X_CONSTANT`]: 1 if it declares none, else a u32 in 1..=[`MAX_TEXELS_X`].

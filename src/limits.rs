@@ -84,7 +84,7 @@ pub fn kernel_needs(
 
 /// The workgroup's shape, size and memory (`shared` bytes) against `l`.
 fn workgroup_needs(refl: &kernels::Reflection, shared: u64, l: &wgpu::Limits) -> [Need; 5] {
-    let wg = refl.workgroup_size.unwrap_or([1, 1, 1]).map(u64::from);
+    let wg = refl.largest_workgroup().unwrap_or([1, 1, 1]).map(u64::from);
     [
         Need::new(
             "workgroup width",

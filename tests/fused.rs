@@ -13,7 +13,7 @@ use std::collections::HashMap;
 
 use rand::Rng;
 use shadowgraph::cpu::{self, Texels};
-use shadowgraph::exec::Executor;
+use shadowgraph::exec::{Executor, KernelLayout};
 use shadowgraph::gpu::{read_resource_texture, submit_and_wait, write_texture};
 use shadowgraph::graph::{Graph, plan, texel_bytes};
 use shadowgraph::scene::{Light, Scene};
@@ -72,6 +72,16 @@ fn raw_depth_sized(bad: usize, n: u32) -> Vec<f32> {
 /// Runs `light`'s graph on `raw` for `outputs` (each in its own texture, poisoned with NaN
 /// first so unwritten texels show); returns them and each step's non-finite count.
 fn run(light: &Light, raw: &[f32], outputs: &[String]) -> (Vec<Texels>, Vec<(String, u32)>) {
+    run_in(light, raw, outputs, None)
+}
+
+/// [`run`] with the kernels in `layout` (`None`: the device's).
+fn run_in(
+    light: &Light,
+    raw: &[f32],
+    outputs: &[String],
+    layout: Option<KernelLayout>,
+) -> (Vec<Texels>, Vec<(String, u32)>) {
     let n = side(raw);
     let g = common::gpu();
     let mut graph = Graph::default();
@@ -88,6 +98,9 @@ fn run(light: &Light, raw: &[f32], outputs: &[String]) -> (Vec<Texels>, Vec<(Str
     );
     let imports = HashMap::from([(technique::depth_name(0), depth)]);
     let mut exec = Executor::new();
+    if let Some(layout) = layout {
+        exec.kernels.set_layout(layout);
+    }
     let mut enc = g.device.create_command_encoder(&Default::default());
     let out = exec
         .record(&g.device, &mut enc, &plan, &imports, None)
@@ -378,7 +391,9 @@ fn fused_blurs_match_encode_then_blur() {
     }
 }
 
-/// Runs `light`'s graph for `map` ([`run`]) and compares it with
+/// Runs `light`'s graph for `map` ([`run_in`]) in each of the kernels' layouts
+/// (`exec::KernelLayout`: a GPU's tile in workgroup memory, a CPU driver's strips; the row
+/// path's invocations all at once or CPU_LANES at a time) and compares it with
 /// `c`'s f64 reference (encoding, then both blur passes at `radius`, σ = r/2) within the
 /// encoding's `tolerance` (atol, rtol) plus the blur's own, and its counts of non-finite
 /// texels with `steps` counting steps.
@@ -393,20 +408,23 @@ fn check_blur(
     steps: usize,
     what: &str,
 ) {
-    let (maps, stats) = run(light, raw, &[map.to_string()]);
     let (lin, replaced) = linear(light, raw);
     let want = (c.reference)(&lin, radius.into(), f64::from(radius) / 2.0);
-    let got = &maps[0];
-    let n = want.channels.min(got.channels);
-    let got: Vec<f32> = channels(got, 0, n).iter().map(|&v| v as f32).collect();
-    // The moments of one sign per channel, weighted by positive f32 weights (each rounded
-    // once, u) summing to 1: a pass's sum of r + 1 terms (the centre and r symmetric pairs,
-    // each pair one more addition) is off by at most (r + 3)·u of its value, and two passes by
-    // twice that, on top of the encoding's own error, which the normalized weights carry
-    // through unchanged.
-    let blur_rtol = 2.0 * (f64::from(radius) + 3.0) * U;
-    common::assert_close(what, &got, &channels(&want, 0, n), atol, rtol + blur_rtol);
-    assert_counted(what, &stats, steps, replaced);
+    for layout in [KernelLayout::Gpu, KernelLayout::Cpu] {
+        let what = format!("{what}, {} layout", layout.name());
+        let (maps, stats) = run_in(light, raw, &[map.to_string()], Some(layout));
+        let got = &maps[0];
+        let n = want.channels.min(got.channels);
+        let got: Vec<f32> = channels(got, 0, n).iter().map(|&v| v as f32).collect();
+        // The moments of one sign per channel, weighted by positive f32 weights (each rounded
+        // once, u) summing to 1: a pass's sum of r + 1 terms (the centre and r symmetric
+        // pairs, each pair one more addition; the strips' pairs past r add exact zeros) is off
+        // by at most (r + 3)·u of its value, and two passes by twice that, on top of the
+        // encoding's own error, which the normalized weights carry through unchanged.
+        let blur_rtol = 2.0 * (f64::from(radius) + 3.0) * U;
+        common::assert_close(&what, &got, &channels(&want, 0, n), atol, rtol + blur_rtol);
+        assert_counted(&what, &stats, steps, replaced);
+    }
 }
 
 /// The row kernels past the tile's radius 7 on a map wide enough for them (1100²:

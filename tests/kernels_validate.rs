@@ -266,6 +266,7 @@ fn compute_kernels_reflect_bindings_and_workgroup_size() {
     let names: Vec<&str> = r.bindings.iter().map(|b| b.name.as_str()).collect();
     assert_eq!(names, ["src", "dst", "params", "stats"]);
     assert_eq!(r.workgroup_size, Some([16, 16, 1]));
+    assert_eq!(r.cpu_workgroup_size, r.workgroup_size, "one layout");
     assert!(matches!(
         r.binding("src").unwrap().ty,
         wgpu::BindingType::Texture {
@@ -273,6 +274,33 @@ fn compute_kernels_reflect_bindings_and_workgroup_size() {
             ..
         }
     ));
+}
+
+/// A workgroup size that is an `override` of the layout (`GPU_LAYOUT`): reflection gives each
+/// layout's, naga's evaluation of the overrides, and one whose value is unknown is an error
+/// naming the kernel.
+#[test]
+fn workgroup_sizes_that_depend_on_the_layout_are_each_layouts() {
+    let wgsl = "override GPU_LAYOUT: bool = false;\n\
+                override N: u32 = select(4u, 64u, GPU_LAYOUT);\n\
+                @compute @workgroup_size(N, 2)\nfn main() {}\n";
+    let (_, r) = kernels::reflect("sized", wgsl).unwrap();
+    assert_eq!(r.workgroup_size, Some([64, 2, 1]));
+    assert_eq!(r.cpu_workgroup_size, Some([4, 2, 1]));
+    assert_eq!(r.largest_workgroup(), Some([64, 2, 1]));
+    assert_eq!(r.clone().in_layout(false).workgroup_size, Some([4, 2, 1]));
+    assert_eq!(r.in_layout(true).workgroup_size, Some([64, 2, 1]));
+    // The fused blurs: 256 invocations a tile on a GPU, CPU_LANES on a CPU driver.
+    let wgsl = kernels::resolve("vsm_blur", None).unwrap();
+    let (_, r) = kernels::reflect("vsm_blur", &wgsl).unwrap();
+    assert_eq!(r.workgroup_size, Some([256, 1, 1]));
+    assert_eq!(r.cpu_workgroup_size, Some([8, 1, 1]));
+    let unknown = "override N: u32;\n@compute @workgroup_size(N)\nfn main() {}\n";
+    let e = kernels::reflect("unsized", unknown)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("unsized") && e.contains("workgroup size"), "{e}");
+    assert_eq!(e.lines().count(), 1, "{e}");
 }
 
 /// `const TEXELS_X` (texels an invocation covers along x) widens a workgroup's columns in the
@@ -731,6 +759,15 @@ fn encode_blur_dispatch_constants_match_the_wgsl() {
         // most four blocks of WG_SIZE (`blur_tile_single`'s h0 … h3).
         let wg = r.workgroup_size.expect("workgroup size")[0];
         assert_eq!(wg, 256, "{name}: workgroup");
+        // A CPU driver's layout: CPU_LANES invocations walk the tile in strips (and run the
+        // row path's WG_SIZE invocations' work in turn).
+        let lanes = wgsl_const(&module, "CPU_LANES").expect("CPU_LANES");
+        assert_eq!(
+            r.cpu_workgroup_size,
+            Some([lanes, 1, 1]),
+            "{name}: CPU workgroup"
+        );
+        assert!(lanes < wg && wg % lanes == 0, "{name}: CPU_LANES");
         // The row: ROW_RUN outputs an invocation, every invocation busy (2 with two channels,
         // `blur_row_pairs`; 1 with four).
         let row = encode_blur_row(kernel);

@@ -5,8 +5,9 @@
 //! five-pass table `shadowgraph bench` keeps as its baseline), and every resource of every plan,
 //! and the shaded frame, must be the same bit for bit as without the poison. No tolerance: a
 //! kernel either reads what it wrote or reads the poison, which every sum, mean and table
-//! carries into its output. The test fails if a kernel with workgroup memory is run by none of
-//! the plans, so a new one cannot go unchecked.
+//! carries into its output. The scenes run in both kernel layouts (`exec::KernelLayout`), so
+//! the GPU's variants are checked here too. The test fails if a kernel with workgroup memory is
+//! run by none of the plans, so a new one cannot go unchecked.
 
 mod common;
 
@@ -14,7 +15,7 @@ use std::collections::{BTreeSet, HashMap};
 use std::path::Path;
 use std::sync::Arc;
 
-use shadowgraph::exec::Executor;
+use shadowgraph::exec::{Executor, KernelLayout};
 use shadowgraph::gpu::{Gpu, read_texture, submit_and_wait};
 use shadowgraph::graph::{Graph, plan};
 use shadowgraph::kernels::{self, Replacements};
@@ -129,9 +130,14 @@ fn same_with_poison(
     g: &Gpu,
     variant: Option<&Replacements>,
     scenes: &[(String, Scene)],
+    layout: Option<KernelLayout>,
 ) -> BTreeSet<String> {
     let mut plain = Renderer::new(&g.device);
     let mut poison = Renderer::new(&g.device);
+    if let Some(layout) = layout {
+        plain.executor.kernels.set_layout(layout);
+        poison.executor.kernels.set_layout(layout);
+    }
     if let Some(v) = variant {
         plain.executor.kernels.set_replacements(Arc::new(v.clone()));
     }
@@ -176,7 +182,12 @@ fn same_with_poison(
 fn every_kernel_writes_its_workgroup_memory_before_reading_it() {
     let g = common::gpu();
     let poisoned = common::poison::poisoned_kernels();
-    let ran = same_with_poison(&g, None, &scenes());
+    // Both layouts of the kernels that have two (`exec::KernelLayout`: the fused blurs' tile
+    // or strips, the tables' pass 3).
+    let mut ran = BTreeSet::new();
+    for layout in [KernelLayout::Gpu, KernelLayout::Cpu] {
+        ran.extend(same_with_poison(&g, None, &scenes(), Some(layout)));
+    }
     // The library's tables from an imported map and the five-pass baseline: in
     // `the_library_tables_and_the_five_pass_baseline_too`.
     let baseline = [
@@ -284,7 +295,7 @@ fn the_benchmark_variants_write_it_before_reading_it_too() {
     ] {
         let files = kernels::read_replacements(&root.join(variant))
             .unwrap_or_else(|e| panic!("{variant}: {e}"));
-        let ran = same_with_poison(&g, Some(&files), &pick(variant, names));
+        let ran = same_with_poison(&g, Some(&files), &pick(variant, names), None);
         assert!(!ran.is_empty(), "{variant}: nothing ran");
     }
 }

@@ -20,6 +20,18 @@
 // 1.0–1.28× slower on llvmpipe (benches/RESULTS.md, twelfth session) and 1.13–1.20× slower on
 // an H200 (fourteenth session), where the texture cache serves the neighbours' reads.
 //
+// Two layouts (`exec::KernelLayout`, the override GPU_LAYOUT) blur a tile:
+//   a GPU's: WG_SIZE invocations encode the tile with its halo into workgroup memory, one texel
+//     each, then blur it along x and along y there (`blur_tile_runs`, `blur_tile_single`);
+//   a CPU driver's: CPU_LANES invocations walk the tile in strips (`blur_tile_strips`): each
+//     walks an encoded row along x, loading each depth once and encoding it in registers, and
+//     keeps the horizontal sums; then each walks a column of those sums and stores. On
+//     llvmpipe, which runs every SIMD group of a workgroup through every branch and barrier
+//     under masks, this ran 2–3× faster than the GPU's layout (benches/RESULTS.md, twentieth
+//     session); on a GPU its few invocations a tile would leave most of each SM idle.
+// The row path is the same in both; a CPU driver's CPU_LANES invocations run its WG_SIZE
+// invocations' work CPU_LANES at a time.
+//
 // It holds the kernels' entry point, `main`. The importing kernel declares `const CHANNELS`
 // (2 or 4), `struct Params` (its encoding's fields, then `blur: BlurSpec`), `fn encode(z, left, right, up, down) -> vec4<f32>`, the
 // texel its channels need in workgroup memory: `alias Texel` (vec2<f32> for two channels,
@@ -55,6 +67,15 @@ struct BlurSpec {
 
 // Keep in sync with `ENCODE_BLUR_*` in src/filter.rs.
 const WG_SIZE: u32 = 256u;
+// The layout the executor compiles (`exec::KernelLayout`): true on a GPU.
+override GPU_LAYOUT: bool = false;
+// A CPU driver's workgroup: one of llvmpipe's SIMD groups (8 lanes of AVX2's 256-bit vectors).
+// Strips of 32 and of 8 lanes ran alike on llvmpipe's wall clock and 8 took 1.2–1.6× less CPU
+// time (benches/RESULTS.md, twentieth session): each extra SIMD group is one more coroutine
+// through the barrier.
+const CPU_LANES: u32 = 8u;
+// The invocations of a workgroup: WG_SIZE on a GPU, CPU_LANES on a CPU driver.
+override LANES: u32 = select(CPU_LANES, WG_SIZE, GPU_LAYOUT);
 const TILE_RADIUS: u32 = 7u;
 const MAX_RADIUS: u32 = 32u;
 // Encoded texels an invocation computes and stores (`encode_tile`, blocks of WG_SIZE): at
@@ -164,6 +185,12 @@ fn put_below(i: i32, n: i32, v: Texel) {
 // Phase 1: every texel of the tile and its blur halo encoded once, each stored as it is
 // computed (nothing else is in workgroup memory yet: one barrier, after the stores).
 fn encode_tile(t: Tile, li: u32) {
+    encode_blocks(t, li);
+    workgroupBarrier();
+}
+
+// Invocation li's encoded texels of phase 1: li + k·WG_SIZE.
+fn encode_blocks(t: Tile, li: u32) {
     let n = t.enc.x * t.enc.y;
     let i = i32(li);
     let s = i32(WG_SIZE);
@@ -176,7 +203,6 @@ fn encode_tile(t: Tile, li: u32) {
         put_below(i + 4 * s, n, encode_at(t, i + 4 * s));
         put_below(i + 5 * s, n, encode_at(t, i + 5 * s));
     }
-    workgroupBarrier();
 }
 
 fn store(t: Tile, o: vec2<i32>, v: Texel) {
@@ -332,6 +358,194 @@ fn blur_tile_single(t: Tile, li: u32) {
     }
 }
 
+// The CPU layout's tile (GPU_LAYOUT false): strips. A window of the 2·TILE_RADIUS + 1 latest
+// texels of a line, centre a7: the sum of output k, whose centre is a7, is
+// w₀·a7 + Σᵢ wᵢ·(a(7−i) + a(7+i)), i = 1 … 7, the centre and then the symmetric pairs as
+// `sum_x`'s, with wᵢ = 0 past the radius (exact zeros added to the finite sum; every texel
+// the window holds is an encoding or a horizontal sum of the map, or 0). Named values, not an
+// array (llvmpipe kept arrays indexed in a loop in memory: see `blur`'s runs).
+struct Window {
+    a0: Texel,
+    a1: Texel,
+    a2: Texel,
+    a3: Texel,
+    a4: Texel,
+    a5: Texel,
+    a6: Texel,
+    a7: Texel,
+    a8: Texel,
+    a9: Texel,
+    a10: Texel,
+    a11: Texel,
+    a12: Texel,
+    a13: Texel,
+    a14: Texel,
+}
+
+// The window's pairs are TILE_RADIUS's, and the horizontal sums of a tile at TILE_RADIUS fit
+// workgroup memory.
+const_assert TILE_RADIUS == 7u;
+const_assert TILE * (TILE + 2u * TILE_RADIUS) <= SH_TEXELS;
+
+fn empty_window() -> Window {
+    let z = Texel(0.0);
+    return Window(z, z, z, z, z, z, z, z, z, z, z, z, z, z, z);
+}
+
+// The window moved on by one texel, v.
+fn window_push(w: ptr<function, Window>, v: Texel) {
+    (*w).a0 = (*w).a1;
+    (*w).a1 = (*w).a2;
+    (*w).a2 = (*w).a3;
+    (*w).a3 = (*w).a4;
+    (*w).a4 = (*w).a5;
+    (*w).a5 = (*w).a6;
+    (*w).a6 = (*w).a7;
+    (*w).a7 = (*w).a8;
+    (*w).a8 = (*w).a9;
+    (*w).a9 = (*w).a10;
+    (*w).a10 = (*w).a11;
+    (*w).a11 = (*w).a12;
+    (*w).a12 = (*w).a13;
+    (*w).a13 = (*w).a14;
+    (*w).a14 = v;
+}
+
+// The weights of offsets 0 … 7, 0 past radius r.
+struct PairWeights {
+    w0: f32,
+    w1: f32,
+    w2: f32,
+    w3: f32,
+    w4: f32,
+    w5: f32,
+    w6: f32,
+    w7: f32,
+}
+
+fn pair_weights(r: i32) -> PairWeights {
+    let a = params.blur.weights[0];
+    let b = params.blur.weights[1];
+    return PairWeights(
+        a.x,
+        select(0.0, a.y, r >= 1),
+        select(0.0, a.z, r >= 2),
+        select(0.0, a.w, r >= 3),
+        select(0.0, b.x, r >= 4),
+        select(0.0, b.y, r >= 5),
+        select(0.0, b.z, r >= 6),
+        select(0.0, b.w, r >= 7)
+    );
+}
+
+// The output whose centre is the window's a7.
+fn window_sum(w: Window, k: PairWeights) -> Texel {
+    var s = k.w0 * w.a7;
+    s += k.w1 * (w.a6 + w.a8);
+    s += k.w2 * (w.a5 + w.a9);
+    s += k.w3 * (w.a4 + w.a10);
+    s += k.w4 * (w.a3 + w.a11);
+    s += k.w5 * (w.a2 + w.a12);
+    s += k.w6 * (w.a1 + w.a13);
+    s += k.w7 * (w.a0 + w.a14);
+    return s;
+}
+
+// A walk along an encoded row: the position reached, the linear depth before it and the raw
+// depth at it.
+struct Walk {
+    p: vec2<i32>,
+    before: f32,
+    raw: f32,
+}
+
+fn walk_start(t: Tile, p: vec2<i32>) -> Walk {
+    let raw = textureLoad(src, clamp(p, vec2<i32>(0), t.size - 1), 0).r;
+    return Walk(p, depth_direct(t, p - vec2<i32>(1, 0)), raw);
+}
+
+// The encoding at the walk's position, the walk moved on by one texel: three depth loads (the
+// next texel along the row, and above and below), the texel's own non-finite depth counted as
+// `encode_at` counts it.
+fn walk_step(t: Tile, w: ptr<function, Walk>) -> Texel {
+    let p = (*w).p;
+    let raw = (*w).raw;
+    if all(p >= t.origin) && all(p < min(t.origin + t.outs, t.size)) && !depth_is_finite(raw) {
+        atomicAdd(&stats[0], 1u);
+    }
+    let z = linear_depth(raw, params.depth);
+    let next = clamp(p + vec2<i32>(1, 0), vec2<i32>(0), t.size - 1);
+    let raw_next = textureLoad(src, next, 0).r;
+    let right = linear_depth(raw_next, params.depth);
+    let e = texel_of(encode(
+        z,
+        (*w).before,
+        right,
+        depth_direct(t, p - vec2<i32>(0, 1)),
+        depth_direct(t, p + vec2<i32>(0, 1))
+    ));
+    *w = Walk(p + vec2<i32>(1, 0), z, raw_next);
+    return e;
+}
+
+// Strips along x: invocation li walks encoded rows li, li + LANES, … (enc.y rows: the tile's
+// with its halo) from the halo's left end, and stores each row's outs.x horizontal sums in
+// workgroup memory (row-major, outs.x a row). Output k's sum is complete when the walk has
+// pushed texel k + r + 7: the window's a7 is then texel k + r, its centre. Three loops, so that
+// no step tests which part of the walk it is in (llvmpipe would run both sides): the first
+// r + 7 texels fill the window, the rest of the row sums as it goes, and 7 − r zeros finish
+// the last outputs past the row's end.
+fn strip_rows(t: Tile, li: u32, k: PairWeights) {
+    let r = t.r.x;
+    for (var row = i32(li); row < t.enc.y; row += i32(LANES)) {
+        var walk = walk_start(t, t.origin - t.r + vec2<i32>(0, row));
+        var win = empty_window();
+        var j = 0;
+        for (; j < r + 7; j++) {
+            window_push(&win, walk_step(t, &walk));
+        }
+        let at = row * t.outs.x - r - 7;
+        for (; j < t.enc.x; j++) {
+            window_push(&win, walk_step(t, &walk));
+            sh_tile[at + j] = window_sum(win, k);
+        }
+        for (; j < t.enc.x + 7 - r; j++) {
+            window_push(&win, Texel(0.0));
+            sh_tile[at + j] = window_sum(win, k);
+        }
+    }
+}
+
+// Strips along y: invocation li walks columns li, li + LANES, … of the horizontal sums down,
+// in `strip_rows`' three loops, and stores each output.
+fn strip_columns(t: Tile, li: u32, k: PairWeights) {
+    let r = t.r.y;
+    for (var c = i32(li); c < t.outs.x; c += i32(LANES)) {
+        var win = empty_window();
+        var j = 0;
+        for (; j < r + 7; j++) {
+            window_push(&win, sh_get(j * t.outs.x + c));
+        }
+        for (; j < t.enc.y; j++) {
+            window_push(&win, sh_get(j * t.outs.x + c));
+            store(t, vec2<i32>(c, j - r - 7), window_sum(win, k));
+        }
+        for (; j < t.enc.y + 7 - r; j++) {
+            window_push(&win, Texel(0.0));
+            store(t, vec2<i32>(c, j - r - 7), window_sum(win, k));
+        }
+    }
+}
+
+// The tile in strips (the CPU layout): along x into workgroup memory (outs.x × enc.y sums),
+// one barrier, then along y into `dst`.
+fn blur_tile_strips(t: Tile, li: u32) {
+    let k = pair_weights(t.r.x);
+    strip_rows(t, li, k);
+    workgroupBarrier();
+    strip_columns(t, li, k);
+}
+
 // The row's blur along x in runs of 2 (ROW = 2·WG_SIZE): invocation li's outputs x = 2li and
 // 2li + 1, from 2 + 2r texels of the encoded row read once into two sliding windows (v_{k−i},
 // v_{k+i} of output k as i grows), each output summed in `sum_x`'s order, so the results are
@@ -433,30 +647,51 @@ fn blur_row_quads(t: Tile, li: u32) {
     store(t, vec2<i32>(x + 3, 0), s3);
 }
 
-// The importing kernel's `main`: workgroup `wg`, invocation `li`.
-fn encode_blur(wg: vec2<u32>, li: u32) {
-    let t = tile_of(wg);
-    encode_tile(t, li);
-    if params.blur.axis == 2u {
-        // A constant condition: each kernel compiles one of the two.
-        if RUN == 4u {
-            blur_tile_runs(t, li);
-        } else {
-            blur_tile_single(t, li);
-        }
-    } else if ROW_RUN == 4u {
+// The row's blur along x, invocation li's outputs.
+fn blur_row(t: Tile, li: u32) {
+    if ROW_RUN == 4u {
         // A constant condition, as RUN's.
         blur_row_quads(t, li);
     } else if ROW_RUN == 2u {
         blur_row_pairs(t, li);
     } else {
-        // The row's blur along x: one output an invocation (ROW = WG_SIZE).
+        // One output an invocation (ROW = WG_SIZE).
         store(t, vec2<i32>(i32(li), 0), sum_x(t, i32(li), 0));
     }
 }
 
+// The importing kernel's `main`: workgroup `wg`, invocation `li`.
+fn encode_blur(wg: vec2<u32>, li: u32) {
+    let t = tile_of(wg);
+    // GPU_LAYOUT is a constant at each pipeline: each layout compiles its own branches.
+    if GPU_LAYOUT {
+        encode_tile(t, li);
+        if params.blur.axis == 2u {
+            // A constant condition: each kernel compiles one of the two.
+            if RUN == 4u {
+                blur_tile_runs(t, li);
+            } else {
+                blur_tile_single(t, li);
+            }
+        } else {
+            blur_row(t, li);
+        }
+    } else if params.blur.axis == 2u {
+        blur_tile_strips(t, li);
+    } else {
+        // The row path's WG_SIZE invocations, CPU_LANES at a time.
+        for (var v = li; v < WG_SIZE; v += LANES) {
+            encode_blocks(t, v);
+        }
+        workgroupBarrier();
+        for (var v = li; v < WG_SIZE; v += LANES) {
+            blur_row(t, v);
+        }
+    }
+}
+
 // The entry point of every kernel that imports this module.
-@compute @workgroup_size(WG_SIZE)
+@compute @workgroup_size(LANES)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     encode_blur(wg.xy, li);
 }

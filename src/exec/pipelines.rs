@@ -25,16 +25,18 @@ pub struct ComputeKernel {
 /// (unset: by the device's type). A/B of the two layouts on one machine.
 pub const KERNEL_LAYOUT_ENV: &str = "SHADOWGRAPH_KERNEL_LAYOUT";
 
-/// The pipeline constant a kernel declares (`override GPU_LAYOUT: bool`) where it has two
-/// layouts.
-pub const GPU_LAYOUT_CONSTANT: &str = "GPU_LAYOUT";
+pub use crate::kernels::GPU_LAYOUT_CONSTANT;
 
 /// Which of its two variants a kernel that has two compiles (`override GPU_LAYOUT: bool`): today
 /// the summed-area tables' pass 3 (`kernels/shared/sat_tile*.wgsl`), whose second sweep over an
 /// invocation's sub-block loads and encodes its texels again on a GPU (from its texture cache:
 /// 7–13% faster on an H200 than keeping them) and reads the first sweep's encoded texels kept in
-/// private memory on a CPU driver (1.1–1.2× faster on llvmpipe). Both give the same tables bit
-/// for bit (`tests/sat.rs`, `tests/csm_sat.rs`).
+/// private memory on a CPU driver (1.1–1.2× faster on llvmpipe); both give the same tables bit
+/// for bit (`tests/sat.rs`, `tests/csm_sat.rs`). And the encodings fused into the blur
+/// (`kernels/shared/encode_blur.wgsl`): a tile blurred in workgroup memory by 256 invocations on
+/// a GPU, walked in strips by 8 on a CPU driver (2–3× less CPU time on llvmpipe), the workgroup
+/// size itself an override (`kernels::Reflection::cpu_workgroup_size`); both within
+/// `tests/fused.rs`'s tolerances of the f64 reference.
 ///
 /// Variants that staged texels through workgroup memory so that a SIMD group's lanes touch
 /// neighbouring texels (the blur's row pass, the fused blurs, the tables' tile passes) were
@@ -188,7 +190,7 @@ impl ComputeKernel {
         )?;
         Ok(Self {
             name: name.to_string(),
-            reflection,
+            reflection: reflection.in_layout(layout == KernelLayout::Gpu),
             layouts,
             pipeline,
         })

@@ -49,7 +49,16 @@ pub fn poisoned(name: &str, wgsl: &str) -> Option<String> {
         .iter()
         .find(|e| e.name == "main")
         .unwrap_or_else(|| panic!("{name}: no entry point `main`"));
-    let invocations: u32 = entry.workgroup_size.iter().product();
+    // The workgroup's invocations, a WGSL expression: a number, or where the size is an
+    // override of the layout (`shared/encode_blur`'s `LANES`), the override's name.
+    let invocations = match entry.workgroup_size_overrides {
+        None => format!("{}u", entry.workgroup_size.iter().product::<u32>()),
+        Some([Some(x), None, None]) => match module.global_expressions[x] {
+            naga::Expression::Override(o) => module.overrides[o].name.clone().expect("named"),
+            ref e => panic!("{name}: a workgroup size of {e:?}"),
+        },
+        Some(sizes) => panic!("{name}: a workgroup size of {sizes:?}"),
+    };
     // The invocation's index: `main`'s own argument, or one added.
     let index = entry
         .function
@@ -72,7 +81,7 @@ pub fn poisoned(name: &str, wgsl: &str) -> Option<String> {
             } => {
                 let v = poison_value(&module.types[base].inner, &what);
                 block += &format!(
-                    "    for (var sg_i = {li}; sg_i < {n}u; sg_i += {invocations}u) {{ {var}[sg_i] = {v}; }}\n"
+                    "    for (var sg_i = {li}; sg_i < {n}u; sg_i += {invocations}) {{ {var}[sg_i] = {v}; }}\n"
                 );
             }
             ref inner => {
