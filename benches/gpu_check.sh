@@ -12,8 +12,9 @@
 # before its kernels. In order now: soft table, four shading shapes (about 80 s), the blur's
 # row variants (two processes, `bench --kernel-dirs`, perhaps 35 s), the tables' two variants
 # (two, 30 s), the mip variant (two, 20 s), every kernel at 2048², 4096²/8192², the fused ablation
-# (one, 10 s), one round of the layouts, the workgroup memory zeroed or not (two, perhaps 30 s),
-# the bunny frame, six cascaded frames (perhaps 20 s): about 470 s, with BASE about 60 s more. Give the call 520 s (the machine's start, about 50 s, counts too); a step cut off by
+# (one, 10 s), one round of the layouts (tables and fused blurs, perhaps 70 s), the workgroup
+# memory zeroed or not (two, perhaps 30 s),
+# the bunny frame, six cascaded frames (perhaps 20 s): about 480 s, with BASE about 60 s more. Give the call 520 s (the machine's start, about 50 s, counts too); a step cut off by
 # the call's end loses only the steps after it.
 # The steps run most wanted first, each under its own time box, and append to at most seven
 # files in OUT (the device tool brings back eight), so a call stopped by its time box still
@@ -44,6 +45,10 @@
 #   kernel is faster in both (then restore it from the variant, less its header).
 # - variants.txt, mips: mip_quads faster at 2048² and 4096² in both rounds ships everywhere
 #   (llvmpipe as fast or faster): copy it over kernels/shared/mip_chain.wgsl, less its header.
+# - variants.txt, layouts: the fused tile blurs' `[cpu]` rows (strips, 8 invocations a tile)
+#   against `[gpu]` (the tile, 256). The strips ship for GPUs only where faster for VSM, MSM
+#   and EVSM4 alike: GPU_LAYOUT's branches in shared/encode_blur.wgsl go, LANES becomes the
+#   constant CPU_LANES (then rename it).
 set -u
 B=${1:-target/release/shadowgraph}
 OUT=${2:-gpu-out}

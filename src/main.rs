@@ -105,7 +105,8 @@ enum Command {
         #[arg(long, conflicts_with = "lookup")]
         passes: bool,
         /// Time each kernel in each of these variants in turn (`gpu`, `cpu`: the kernels'
-        /// two, today the summed-area tables' pass 3; see SHADOWGRAPH_KERNEL_LAYOUT), rows
+        /// two, today the summed-area tables' pass 3 and the fused tile blurs; see
+        /// SHADOWGRAPH_KERNEL_LAYOUT), rows
         /// named `<kernel> [gpu]`, … (default: the device's variant alone).
         #[arg(long, value_delimiter = ',', value_parser = shadowgraph::exec::KernelLayout::parse, conflicts_with = "lookup")]
         layouts: Vec<shadowgraph::exec::KernelLayout>,
