@@ -369,7 +369,7 @@ fn blur_cases() -> [BlurCase; 6] {
 #[test]
 fn fused_blurs_match_encode_then_blur() {
     let raw = raw_depth(12);
-    for (radius, steps) in [(3u32, 1usize), (7, 1), (12, 1)] {
+    for (radius, steps) in [(3u32, 1usize), (4, 1), (5, 1), (7, 1), (12, 1)] {
         let sigma = f64::from(radius) / 2.0;
         let filter =
             format!("\nfilter = \"blur\"\nfilter_radius = {radius}\nfilter_sigma = {sigma}");
@@ -461,6 +461,43 @@ fn row_kernels_span_row_workgroups() {
             assert_eq!(kernels, [kernel, "blur"], "{what}");
             // Two stores, f16 in the packed cases.
             check_blur(&c, &light, &raw, &map, radius, c.tolerance(2.0), 1, &what);
+        }
+    }
+}
+
+/// The strips' window (`STRIP_RADIUS`, a pipeline constant each fused tile node sets from its
+/// radius through `// #override`): 9 texels up to radius 4, 15 past it, for every fused
+/// kernel's tile node. No GPU: the values the executor would compile the node with.
+#[test]
+fn strip_windows_follow_each_nodes_radius() {
+    let mut cache = shadowgraph::exec::KernelCache::default();
+    for (shadow, map) in [
+        ("technique = \"vsm\"\nformat = \"f32\"", "light0.vsm.blur"),
+        (
+            "technique = \"evsm4\"\nformat = \"f32\"\nexponent_pos = 5.0\nexponent_neg = 5.0",
+            "light0.evsm.blur",
+        ),
+        ("technique = \"msm\"\nformat = \"f32\"", "light0.msm.blur"),
+    ] {
+        for (radius, want) in [(1u32, 4.0), (4, 4.0), (5, 7.0), (7, 7.0)] {
+            let light = spot(&format!(
+                "{shadow}\nfilter = \"blur\"\nfilter_radius = {radius}\nfilter_sigma = 1.0"
+            ));
+            let mut graph = Graph::default();
+            technique::add_light_nodes(&mut graph, 0, &light);
+            let node = graph
+                .nodes
+                .iter()
+                .find(|n| n.name == map)
+                .unwrap_or_else(|| panic!("{map}: no node"));
+            let values = cache
+                .node_constants(node.kernel.name(), &node.name, &node.params)
+                .expect("node constants");
+            assert_eq!(
+                values,
+                [("STRIP_RADIUS".to_string(), want)],
+                "{map} at r = {radius}"
+            );
         }
     }
 }

@@ -358,12 +358,23 @@ fn blur_tile_single(t: Tile, li: u32) {
     }
 }
 
-// The CPU layout's tile (GPU_LAYOUT false): strips. A window of the 2·TILE_RADIUS + 1 latest
-// texels of a line, centre a7: the sum of output k, whose centre is a7, is
-// w₀·a7 + Σᵢ wᵢ·(a(7−i) + a(7+i)), i = 1 … 7, the centre and then the symmetric pairs as
-// `sum_x`'s, with wᵢ = 0 past the radius (exact zeros added to the finite sum; every texel
-// the window holds is an encoding or a horizontal sum of the map, or 0). Named values, not an
-// array (llvmpipe kept arrays indexed in a loop in memory: see `blur`'s runs).
+// The CPU layout's tile (GPU_LAYOUT false): strips. A window of the 2·STRIP_RADIUS + 1 latest
+// texels of a line, centre a7 (a3 … a11, or a0 … a14): the sum of output k, whose centre is
+// a7, is w₀·a7 + Σᵢ wᵢ·(a(7−i) + a(7+i)), i = 1 … STRIP_RADIUS, the centre and then the
+// symmetric pairs as `sum_x`'s, with wᵢ = 0 past the radius (exact zeros added to the finite
+// sum; every texel the window holds is an encoding or a horizontal sum of the map, or 0).
+// Named values, not an array (llvmpipe kept arrays indexed in a loop in memory: see `blur`'s
+// runs).
+//
+// STRIP_RADIUS is a constant of each pipeline, set from the node's radius
+// (`exec::KernelCache::node_constants`): 4 up to radius 4, else TILE_RADIUS. A window of 9
+// texels in place of 15 took the MSM strips 1.27× less CPU time on llvmpipe, VSM's 1.05–1.1×
+// (benches/RESULTS.md, twentieth session); as a run-time test llvmpipe would run both.
+// #override STRIP_RADIUS: select(TILE_RADIUS, 4, params.blur.radius <= 4)
+override STRIP_RADIUS: u32 = TILE_RADIUS;
+// The window's outer pairs (a0 … a2, a12 … a14): only where STRIP_RADIUS is TILE_RADIUS.
+override STRIP_WIDE: bool = STRIP_RADIUS > 4u;
+
 struct Window {
     a0: Texel,
     a1: Texel,
@@ -394,9 +405,11 @@ fn empty_window() -> Window {
 
 // The window moved on by one texel, v.
 fn window_push(w: ptr<function, Window>, v: Texel) {
-    (*w).a0 = (*w).a1;
-    (*w).a1 = (*w).a2;
-    (*w).a2 = (*w).a3;
+    if STRIP_WIDE {
+        (*w).a0 = (*w).a1;
+        (*w).a1 = (*w).a2;
+        (*w).a2 = (*w).a3;
+    }
     (*w).a3 = (*w).a4;
     (*w).a4 = (*w).a5;
     (*w).a5 = (*w).a6;
@@ -405,10 +418,14 @@ fn window_push(w: ptr<function, Window>, v: Texel) {
     (*w).a8 = (*w).a9;
     (*w).a9 = (*w).a10;
     (*w).a10 = (*w).a11;
-    (*w).a11 = (*w).a12;
-    (*w).a12 = (*w).a13;
-    (*w).a13 = (*w).a14;
-    (*w).a14 = v;
+    if STRIP_WIDE {
+        (*w).a11 = (*w).a12;
+        (*w).a12 = (*w).a13;
+        (*w).a13 = (*w).a14;
+        (*w).a14 = v;
+    } else {
+        (*w).a11 = v;
+    }
 }
 
 // The weights of offsets 0 … 7, 0 past radius r.
@@ -445,9 +462,11 @@ fn window_sum(w: Window, k: PairWeights) -> Texel {
     s += k.w2 * (w.a5 + w.a9);
     s += k.w3 * (w.a4 + w.a10);
     s += k.w4 * (w.a3 + w.a11);
-    s += k.w5 * (w.a2 + w.a12);
-    s += k.w6 * (w.a1 + w.a13);
-    s += k.w7 * (w.a0 + w.a14);
+    if STRIP_WIDE {
+        s += k.w5 * (w.a2 + w.a12);
+        s += k.w6 * (w.a1 + w.a13);
+        s += k.w7 * (w.a0 + w.a14);
+    }
     return s;
 }
 
@@ -490,26 +509,27 @@ fn walk_step(t: Tile, w: ptr<function, Walk>) -> Texel {
 
 // Strips along x: invocation li walks encoded rows li, li + LANES, … (enc.y rows: the tile's
 // with its halo) from the halo's left end, and stores each row's outs.x horizontal sums in
-// workgroup memory (row-major, outs.x a row). Output k's sum is complete when the walk has
-// pushed texel k + r + 7: the window's a7 is then texel k + r, its centre. Three loops, so that
-// no step tests which part of the walk it is in (llvmpipe would run both sides): the first
-// r + 7 texels fill the window, the rest of the row sums as it goes, and 7 − r zeros finish
-// the last outputs past the row's end.
+// workgroup memory (row-major, outs.x a row). With R = STRIP_RADIUS, output k's sum is
+// complete when the walk has pushed texel k + r + R: the window's a7 is then texel k + r, its
+// centre. Three loops, so that no step tests which part of the walk it is in (llvmpipe would
+// run both sides): the first r + R texels fill the window, the rest of the row sums as it goes,
+// and R − r zeros finish the last outputs past the row's end.
 fn strip_rows(t: Tile, li: u32, k: PairWeights) {
     let r = t.r.x;
+    let rr = i32(STRIP_RADIUS);
     for (var row = i32(li); row < t.enc.y; row += i32(LANES)) {
         var walk = walk_start(t, t.origin - t.r + vec2<i32>(0, row));
         var win = empty_window();
         var j = 0;
-        for (; j < r + 7; j++) {
+        for (; j < r + rr; j++) {
             window_push(&win, walk_step(t, &walk));
         }
-        let at = row * t.outs.x - r - 7;
+        let at = row * t.outs.x - r - rr;
         for (; j < t.enc.x; j++) {
             window_push(&win, walk_step(t, &walk));
             sh_tile[at + j] = window_sum(win, k);
         }
-        for (; j < t.enc.x + 7 - r; j++) {
+        for (; j < t.enc.x + rr - r; j++) {
             window_push(&win, Texel(0.0));
             sh_tile[at + j] = window_sum(win, k);
         }
@@ -520,19 +540,20 @@ fn strip_rows(t: Tile, li: u32, k: PairWeights) {
 // in `strip_rows`' three loops, and stores each output.
 fn strip_columns(t: Tile, li: u32, k: PairWeights) {
     let r = t.r.y;
+    let rr = i32(STRIP_RADIUS);
     for (var c = i32(li); c < t.outs.x; c += i32(LANES)) {
         var win = empty_window();
         var j = 0;
-        for (; j < r + 7; j++) {
+        for (; j < r + rr; j++) {
             window_push(&win, sh_get(j * t.outs.x + c));
         }
         for (; j < t.enc.y; j++) {
             window_push(&win, sh_get(j * t.outs.x + c));
-            store(t, vec2<i32>(c, j - r - 7), window_sum(win, k));
+            store(t, vec2<i32>(c, j - r - rr), window_sum(win, k));
         }
-        for (; j < t.enc.y + 7 - r; j++) {
+        for (; j < t.enc.y + rr - r; j++) {
             window_push(&win, Texel(0.0));
-            store(t, vec2<i32>(c, j - r - 7), window_sum(win, k));
+            store(t, vec2<i32>(c, j - r - rr), window_sum(win, k));
         }
     }
 }

@@ -10,6 +10,7 @@
 //! levels included. By concern: [`pipelines`] (kernels compiled once and cached), [`pool`]
 //! (textures by shape, the run's outputs), `record` (bind groups and the passes).
 
+mod node_constants;
 mod packed;
 pub mod pipelines;
 pub mod pool;

@@ -4,6 +4,7 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
+use super::node_constants::NodeOverrides;
 use crate::created;
 use crate::error::{Error, Result};
 use crate::gpu::scoped;
@@ -128,14 +129,31 @@ impl ComputeKernel {
         layout: KernelLayout,
         init: WorkgroupInit,
     ) -> Result<Self> {
+        Self::with_constants(device, name, wgsl, layout, init, &[])
+    }
+
+    /// [`ComputeKernel::with_options`] with these pipeline constants set too (a node's
+    /// `// #override` values, `exec::KernelCache`).
+    pub fn with_constants(
+        device: &wgpu::Device,
+        name: &str,
+        wgsl: &str,
+        layout: KernelLayout,
+        init: WorkgroupInit,
+        overrides: &[(String, f64)],
+    ) -> Result<Self> {
         let (module, reflection) = kernels::reflect(name, wgsl)?;
         let two_layouts = module
             .overrides
             .iter()
             .any(|(_, o)| o.name.as_deref() == Some(GPU_LAYOUT_CONSTANT));
         let gpu = f64::from(u8::from(layout == KernelLayout::Gpu));
-        let constants = [(GPU_LAYOUT_CONSTANT, gpu)];
-        let constants: &[(&str, f64)] = if two_layouts { &constants } else { &[] };
+        let mut constants: Vec<(&str, f64)> =
+            overrides.iter().map(|(n, v)| (n.as_str(), *v)).collect();
+        if two_layouts {
+            constants.push((GPU_LAYOUT_CONSTANT, gpu));
+        }
+        let constants: &[(&str, f64)] = &constants;
         let label = format!("shadowgraph.{name}");
         let (layouts, pipeline) = scoped(
             device,
@@ -214,6 +232,8 @@ pub struct KernelCache {
     /// Zero every kernel's workgroup memory first ([`WorkgroupInit::Zeroed`]); `false`, the
     /// default: [`WorkgroupInit::AsLeft`].
     zeroed: bool,
+    /// Each kernel's `// #override` declarations, read on first use.
+    node_overrides: HashMap<String, Arc<NodeOverrides>>,
 }
 
 impl KernelCache {
@@ -223,6 +243,7 @@ impl KernelCache {
     pub fn set_replacements(&mut self, replaced: Arc<kernels::Replacements>) {
         self.replaced = Some(replaced);
         self.kernels.clear();
+        self.node_overrides.clear();
     }
 
     /// Compiles every kernel from now on in `layout` whatever the device (the pipelines made
@@ -241,6 +262,16 @@ impl KernelCache {
     }
 
     fn compile(&self, device: &wgpu::Device, name: &str, wgsl: &str) -> Result<ComputeKernel> {
+        self.compile_with(device, name, wgsl, &[])
+    }
+
+    fn compile_with(
+        &self,
+        device: &wgpu::Device,
+        name: &str,
+        wgsl: &str,
+        overrides: &[(String, f64)],
+    ) -> Result<ComputeKernel> {
         let layout = match self.layout {
             Some(layout) => layout,
             None => KernelLayout::for_device(device)?,
@@ -250,7 +281,30 @@ impl KernelCache {
         } else {
             WorkgroupInit::AsLeft
         };
-        ComputeKernel::with_options(device, name, wgsl, layout, init)
+        ComputeKernel::with_constants(device, name, wgsl, layout, init, overrides)
+    }
+
+    /// The pipeline constants a node of kernel `name` named `node` with parameters `params`
+    /// sets (the kernel's `// #override` declarations; none for most kernels).
+    pub fn node_constants(
+        &mut self,
+        name: &str,
+        node: &str,
+        params: &[u8],
+    ) -> Result<Vec<(String, f64)>> {
+        let decls = match self.node_overrides.get(name) {
+            Some(d) => d.clone(),
+            None => {
+                let wgsl = kernels::resolve_in(name, None, self.replaced.as_deref())?;
+                let d = Arc::new(NodeOverrides::new(name, &wgsl)?);
+                self.node_overrides.insert(name.to_string(), d.clone());
+                d
+            }
+        };
+        if decls.is_empty() {
+            return Ok(Vec::new());
+        }
+        decls.values(name, node, params)
     }
 
     /// The pipeline of `kernels/<name>.wgsl`, compiled on first use.
@@ -270,17 +324,29 @@ impl KernelCache {
         name: &str,
         formats: &[(String, wgpu::TextureFormat)],
     ) -> Result<Arc<ComputeKernel>> {
+        self.get_for_node(device, name, formats, &[])
+    }
+
+    /// [`KernelCache::get_specialized`] with the pipeline constants `overrides` set (a node's,
+    /// [`KernelCache::node_constants`]): one pipeline for each set of values.
+    pub fn get_for_node(
+        &mut self,
+        device: &wgpu::Device,
+        name: &str,
+        formats: &[(String, wgpu::TextureFormat)],
+        overrides: &[(String, f64)],
+    ) -> Result<Arc<ComputeKernel>> {
         let base = self.get(device, name)?;
         let changes = changes(name, &base.reflection, formats)?;
-        if changes.is_empty() {
+        if changes.is_empty() && overrides.is_empty() {
             return Ok(base);
         }
-        let key = format!("{name}@{changes:?}");
+        let key = format!("{name}@{changes:?}#{overrides:?}");
         if let Some(k) = self.kernels.get(&key) {
             return Ok(k.clone());
         }
         let wgsl = apply(name, &changes, self.replaced.as_deref())?;
-        let k = Arc::new(self.compile(device, name, &wgsl)?);
+        let k = Arc::new(self.compile_with(device, name, &wgsl, overrides)?);
         self.kernels.insert(key, k.clone());
         Ok(k)
     }

@@ -134,7 +134,8 @@ pub(super) fn compile(
         plan.resource(r)
             .map(|p| crate::graph::texture_format(p.resource.format))
     });
-    kernels.get_specialized(device, node.kernel.name(), &formats)?;
+    let overrides = kernels.node_constants(node.kernel.name(), &node.name, &node.params)?;
+    kernels.get_for_node(device, node.kernel.name(), &formats, &overrides)?;
     Ok(())
 }
 
@@ -158,7 +159,8 @@ pub(super) fn bind_step(
     let base = kernels.get(device, node.kernel.name())?;
     let specs = specs(&base, node)?;
     let formats = bound_formats(&specs, |r| textures.get(r).map(|t| t.format()));
-    let kernel = kernels.get_specialized(device, node.kernel.name(), &formats)?;
+    let overrides = kernels.node_constants(node.kernel.name(), &node.name, &node.params)?;
+    let kernel = kernels.get_for_node(device, node.kernel.name(), &formats, &overrides)?;
     // A graph node's dispatch follows its node's geometry, which does not read `TEXELS_X`:
     // a kernel (a `SHADOWGRAPH_KERNEL_DIR` variant) declaring it would cover the wrong texels.
     if kernel.reflection.texels_x != 1 {

@@ -25,6 +25,17 @@
 //!
 //! over the fields of the light, `l.<field>` (WGSL's `struct Light`), WGSL constants, and the
 //! fetches of other declared functions by name.
+//!
+//! A kernel may have a pipeline constant set per graph node from the node's parameters,
+//! compiling one pipeline for each value (`exec::KernelCache`):
+//!
+//! ```text
+//! // #override STRIP_RADIUS: select(7, 4, params.blur.radius <= 4)
+//! ```
+//!
+//! names an `override` of the kernel and an [`Expr`] over its WGSL constants and
+//! `params.<field>`. A CPU driver runs both sides of a branch on a run-time value; a constant
+//! folds one away.
 
 use std::collections::HashMap;
 
@@ -96,6 +107,24 @@ pub fn traffic(kernel: &str, text: &str) -> Result<HashMap<String, Pattern>> {
                 format!("line {line}: binding `{name}` is declared twice"),
             ));
         }
+    }
+    Ok(out)
+}
+
+/// The `// #override` declarations in `text` (a resolved kernel: imports included): the
+/// pipeline constants a node's parameters set, as (override name, expression), in order.
+pub fn node_overrides(kernel: &str, text: &str) -> Result<Vec<(String, Expr)>> {
+    let mut out: Vec<(String, Expr)> = Vec::new();
+    for (name, value, line) in directives(text, "override") {
+        let e = Expr::parse(value)
+            .map_err(|m| kernel_error(kernel, format!("line {line}: #override {name}: {m}")))?;
+        if out.iter().any(|(n, _)| n == name) {
+            return Err(kernel_error(
+                kernel,
+                format!("line {line}: override `{name}` is declared twice"),
+            ));
+        }
+        out.push((name.to_string(), e));
     }
     Ok(out)
 }
