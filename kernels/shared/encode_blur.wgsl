@@ -145,11 +145,21 @@ fn sh_get(i: i32) -> Texel {
     return sh_tile[i];
 }
 
+// The raw depth at map texel p, clamped to the map.
+fn raw_depth(t: Tile, p: vec2<i32>) -> f32 {
+    return textureLoad(src, clamp(p, vec2<i32>(0), t.size - 1), 0).r;
+}
+
 // The linear depth at map texel p, clamped to the map, read straight from the texture
 // (`encode_at`).
 fn depth_direct(t: Tile, p: vec2<i32>) -> f32 {
-    let q = clamp(p, vec2<i32>(0), t.size - 1);
-    return linear_depth(textureLoad(src, q, 0).r, params.depth);
+    return linear_depth(raw_depth(t, p), params.depth);
+}
+
+// Whether map texel p is an output of the tile inside the map: where its own non-finite depth
+// is counted (a ragged tile's texels past the map read the border at clamped coordinates).
+fn owns(t: Tile, p: vec2<i32>) -> bool {
+    return all(p >= t.origin) && all(p < min(t.origin + t.outs, t.size));
 }
 
 // The encoding of encoded-tile texel i (clamped to the tile: an invocation past its end computes
@@ -161,9 +171,8 @@ fn encode_at(t: Tile, i: i32) -> Texel {
     // inside the map (a ragged tile's texels past it read the border at clamped coordinates),
     // and not a clamped copy of the last index (i == e).
     let p = t.origin - t.r + vec2<i32>(yx.y, yx.x);
-    let raw = textureLoad(src, clamp(p, vec2<i32>(0), t.size - 1), 0).r;
-    let own = i == e && all(p >= t.origin) && all(p < min(t.origin + t.outs, t.size));
-    if own && !depth_is_finite(raw) {
+    let raw = raw_depth(t, p);
+    if i == e && owns(t, p) && !depth_is_finite(raw) {
         atomicAdd(&stats[0], 1u);
     }
     return texel_of(encode(
@@ -441,17 +450,15 @@ struct PairWeights {
 }
 
 fn pair_weights(r: i32) -> PairWeights {
-    let a = params.blur.weights[0];
-    let b = params.blur.weights[1];
     return PairWeights(
-        a.x,
-        select(0.0, a.y, r >= 1),
-        select(0.0, a.z, r >= 2),
-        select(0.0, a.w, r >= 3),
-        select(0.0, b.x, r >= 4),
-        select(0.0, b.y, r >= 5),
-        select(0.0, b.z, r >= 6),
-        select(0.0, b.w, r >= 7)
+        run_weight(0, r),
+        run_weight(1, r),
+        run_weight(2, r),
+        run_weight(3, r),
+        run_weight(4, r),
+        run_weight(5, r),
+        run_weight(6, r),
+        run_weight(7, r)
     );
 }
 
@@ -479,8 +486,7 @@ struct Walk {
 }
 
 fn walk_start(t: Tile, p: vec2<i32>) -> Walk {
-    let raw = textureLoad(src, clamp(p, vec2<i32>(0), t.size - 1), 0).r;
-    return Walk(p, depth_direct(t, p - vec2<i32>(1, 0)), raw);
+    return Walk(p, depth_direct(t, p - vec2<i32>(1, 0)), raw_depth(t, p));
 }
 
 // The encoding at the walk's position, the walk moved on by one texel: three depth loads (the
@@ -489,12 +495,11 @@ fn walk_start(t: Tile, p: vec2<i32>) -> Walk {
 fn walk_step(t: Tile, w: ptr<function, Walk>) -> Texel {
     let p = (*w).p;
     let raw = (*w).raw;
-    if all(p >= t.origin) && all(p < min(t.origin + t.outs, t.size)) && !depth_is_finite(raw) {
+    if owns(t, p) && !depth_is_finite(raw) {
         atomicAdd(&stats[0], 1u);
     }
     let z = linear_depth(raw, params.depth);
-    let next = clamp(p + vec2<i32>(1, 0), vec2<i32>(0), t.size - 1);
-    let raw_next = textureLoad(src, next, 0).r;
+    let raw_next = raw_depth(t, p + vec2<i32>(1, 0));
     let right = linear_depth(raw_next, params.depth);
     let e = texel_of(encode(
         z,

@@ -65,21 +65,23 @@ impl NodeOverrides {
         self.decls
             .iter()
             .map(|(name, e)| {
-                let mut lookup = |n: &str| -> std::result::Result<f64, String> {
-                    if let Some(v) = self.consts.get(n) {
-                        return Ok(*v);
-                    }
-                    match (n.strip_prefix("params."), self.params, &self.module) {
-                        (Some(field), Some(ty), Some(module)) => {
-                            declare::struct_field(module, ty, params, field)
-                        }
-                        _ => Err(format!("`{n}` is neither a constant nor `params.<field>`")),
-                    }
-                };
-                let v = e.eval(&mut lookup).map_err(|m| Error::Kernel {
+                let error = |m: String| Error::Kernel {
                     kernel: kernel.to_string(),
                     message: format!("node `{node}`: #override {name}: {m}"),
-                })?;
+                };
+                let module = self
+                    .module
+                    .as_ref()
+                    .expect("parsed where there are declarations");
+                let mut lookup = |n: &str| {
+                    let bound = self.params.map(|ty| (ty, params));
+                    declare::constant_or_param(n, &self.consts, module, bound)
+                };
+                let v = e.eval(&mut lookup).map_err(error)?;
+                // A pipeline constant wgpu would refuse with its own text.
+                if !v.is_finite() {
+                    return Err(error(format!("{v} is not a number a pipeline takes")));
+                }
                 Ok((name.clone(), v))
             })
             .collect()
@@ -117,6 +119,12 @@ mod tests {
         // Too few bytes: an error naming the node, not a guess.
         let e = o.values("k", "short", &[0u8; 2]).unwrap_err().to_string();
         assert!(e.contains("short") && e.contains("#override N"), "{e}");
+        // A value past any number: refused before wgpu sees it.
+        let inf = KERNEL.replace("select(7, LIMIT, params.a <= LIMIT)", "1 / params.b");
+        let o = NodeOverrides::new("k", &inf).unwrap();
+        let params = bytemuck::bytes_of(&[1u32, 0]).to_vec();
+        let e = o.values("k", "zero", &params).unwrap_err().to_string();
+        assert!(e.contains("zero") && e.contains("not a number"), "{e}");
     }
 
     #[test]

@@ -211,6 +211,24 @@ pub fn struct_field(
     }
 }
 
+/// The value of name `n` in a kernel's declarations: one of its constants (`consts`, as
+/// [`constants`] reads them), or `params.<field>` of its `params` uniform (`params`: the
+/// uniform's type and the bytes a dispatch binds). Other names are the caller's to resolve.
+pub fn constant_or_param(
+    n: &str,
+    consts: &HashMap<String, f64>,
+    module: &naga::Module,
+    params: Option<(naga::Handle<naga::Type>, &[u8])>,
+) -> std::result::Result<f64, String> {
+    if let Some(v) = consts.get(n) {
+        return Ok(*v);
+    }
+    match (n.strip_prefix("params."), params) {
+        (Some(field), Some((ty, bytes))) => struct_field(module, ty, bytes, field),
+        _ => Err(format!("`{n}` is neither a constant nor `params.<field>`")),
+    }
+}
+
 /// The type of the global variable `name` (e.g. the kernel's `params` uniform).
 pub fn global_type(module: &naga::Module, name: &str) -> Option<naga::Handle<naga::Type>> {
     module

@@ -143,9 +143,6 @@ pub fn node_traffic(plan: &Plan, node: &Node) -> Result<Traffic> {
     };
     for d in &dispatched {
         let mut name = |n: &str| -> std::result::Result<f64, String> {
-            if let Some(v) = consts.get(n) {
-                return Ok(*v);
-            }
             // `<binding>.width` / `.height`: the bound texture's (level's) size.
             if let Some((b, side)) = n.split_once('.').filter(|(b, _)| *b != "params") {
                 let bound = d
@@ -158,10 +155,7 @@ pub fn node_traffic(plan: &Plan, node: &Node) -> Result<Traffic> {
                     _ => Err(format!("`{n}`: a binding has `.width` and `.height`")),
                 };
             }
-            match (n.strip_prefix("params."), params) {
-                (Some(field), Some(ty)) => declare::struct_field(&module, ty, d.params, field),
-                _ => Err(format!("`{n}` is neither a constant nor `params.<field>`")),
-            }
+            declare::constant_or_param(n, &consts, &module, params.map(|ty| (ty, d.params)))
         };
         let groups = d.groups.iter().map(|&g| f64::from(g)).product::<f64>();
         for b in reflection.bindings.iter().filter(|b| b.group == 0) {
