@@ -41,7 +41,9 @@
 // workgroup memory: at least the encoded tile at TILE_RADIUS, (TILE + 2·TILE_RADIUS)², and
 // the fallback's encoded row, ROW + 2·MAX_RADIUS; 16 KiB at most): 24 and 1444 with two channels
 // (11.3 KiB), 16 and 900 with four (14.1 KiB); `const RUN`, the outputs an invocation sums in a
-// tile's blur passes: 4 with two channels, 1 with four (see `run_sums`); and the fallback's row,
+// tile's blur passes: 4 with two channels, 1 with four (see `run_sums`); `const WALK_ROWS`, the
+// encoded rows a CPU driver's strip walks at once (`walk_step`): 2 where the encoding reads the
+// depths above and below (VSM), else 1; and the fallback's row,
 // `const ROW` outputs a workgroup in runs of `const ROW_RUN` an invocation (ROW = ROW_RUN ·
 // WG_SIZE): 1024 in runs of 4 for `vsm_blur_row` (see `blur_row_quads`),
 // 512 in runs of 2 for `vsm_blur` (see `blur_row_pairs`), 256 one an invocation with four
@@ -406,6 +408,8 @@ struct Window {
 // workgroup memory.
 const_assert TILE_RADIUS == 7u;
 const_assert TILE * (TILE + 2u * TILE_RADIUS) <= SH_TEXELS;
+// Rows walked in pairs: every tile's encoded rows, TILE + 2r, pair up.
+const_assert WALK_ROWS == 1u || (WALK_ROWS == 2u && TILE % 2u == 0u);
 
 fn empty_window() -> Window {
     let z = Texel(0.0);
@@ -477,67 +481,140 @@ fn window_sum(w: Window, k: PairWeights) -> Texel {
     return s;
 }
 
-// A walk along an encoded row: the position reached, the linear depth before it and the raw
-// depth at it.
+// A walk along WALK_ROWS encoded rows, y (and y + 1): the position reached in row y, the linear
+// depths before it and the raw depths at it (row y's, then row y + 1's), and the non-finite
+// depths of the tile's own outputs met so far. Counted in a register, added to `stats` once an
+// invocation (`strip_rows`): an atomic in the walk's step, under a mask, took 7% of the strips'
+// instructions on llvmpipe (benches/RESULTS.md, twenty-first session).
 struct Walk {
     p: vec2<i32>,
-    before: f32,
-    raw: f32,
+    before0: f32,
+    before1: f32,
+    raw0: f32,
+    raw1: f32,
+    bad: u32,
 }
 
 fn walk_start(t: Tile, p: vec2<i32>) -> Walk {
-    return Walk(p, depth_direct(t, p - vec2<i32>(1, 0)), raw_depth(t, p));
+    let q = p + vec2<i32>(0, 1);
+    return Walk(
+        p,
+        depth_direct(t, p - vec2<i32>(1, 0)),
+        depth_direct(t, q - vec2<i32>(1, 0)),
+        raw_depth(t, p),
+        raw_depth(t, q),
+        0u
+    );
 }
 
-// The encoding at the walk's position, the walk moved on by one texel: three depth loads (the
-// next texel along the row, and above and below), the texel's own non-finite depth counted as
-// `encode_at` counts it.
-fn walk_step(t: Tile, w: ptr<function, Walk>) -> Texel {
+// 1 where map texel p is an output of the tile with a non-finite depth (`encode_at`'s count).
+fn bad_at(t: Tile, p: vec2<i32>, raw: f32) -> u32 {
+    return u32(owns(t, p) && !depth_is_finite(raw));
+}
+
+// The encodings at the walk's position in its rows (e1: row y + 1's, where WALK_ROWS is 2).
+struct Encoded {
+    e0: Texel,
+    e1: Texel,
+}
+
+// The encodings at the walk's position, the walk moved on by one texel. One row: three depth
+// loads (the next texel along the row, and above and below). Two rows: four (the next texel
+// along each, above the first and below the second), as each row's texel is the other's
+// neighbour below or above; both read their depths at clamped coordinates, so a row's
+// neighbour is the other row's texel at the map's edges too.
+fn walk_step(t: Tile, w: ptr<function, Walk>) -> Encoded {
     let p = (*w).p;
-    let raw = (*w).raw;
-    if owns(t, p) && !depth_is_finite(raw) {
-        atomicAdd(&stats[0], 1u);
+    let q = p + vec2<i32>(0, 1);
+    let dx = vec2<i32>(1, 0);
+    let raw0 = (*w).raw0;
+    (*w).bad += bad_at(t, p, raw0);
+    let z0 = linear_depth(raw0, params.depth);
+    let next0 = raw_depth(t, p + dx);
+    let up0 = depth_direct(t, p - vec2<i32>(0, 1));
+    var e: Encoded;
+    // A constant condition: each kernel compiles one of the two.
+    if WALK_ROWS == 2u {
+        let raw1 = (*w).raw1;
+        (*w).bad += bad_at(t, q, raw1);
+        let z1 = linear_depth(raw1, params.depth);
+        let next1 = raw_depth(t, q + dx);
+        e.e0 = texel_of(encode(z0, (*w).before0, linear_depth(next0, params.depth), up0, z1));
+        e.e1 = texel_of(encode(
+            z1,
+            (*w).before1,
+            linear_depth(next1, params.depth),
+            z0,
+            depth_direct(t, q + vec2<i32>(0, 1))
+        ));
+        (*w).before1 = z1;
+        (*w).raw1 = next1;
+    } else {
+        e.e0 = texel_of(encode(
+            z0,
+            (*w).before0,
+            linear_depth(next0, params.depth),
+            up0,
+            depth_direct(t, q)
+        ));
     }
-    let z = linear_depth(raw, params.depth);
-    let raw_next = raw_depth(t, p + vec2<i32>(1, 0));
-    let right = linear_depth(raw_next, params.depth);
-    let e = texel_of(encode(
-        z,
-        (*w).before,
-        right,
-        depth_direct(t, p - vec2<i32>(0, 1)),
-        depth_direct(t, p + vec2<i32>(0, 1))
-    ));
-    *w = Walk(p + vec2<i32>(1, 0), z, raw_next);
+    (*w).p = p + dx;
+    (*w).before0 = z0;
+    (*w).raw0 = next0;
     return e;
 }
 
-// Strips along x: invocation li walks encoded rows li, li + LANES, … (enc.y rows: the tile's
-// with its halo) from the halo's left end, and stores each row's outs.x horizontal sums in
-// workgroup memory (row-major, outs.x a row). With R = STRIP_RADIUS, output k's sum is
-// complete when the walk has pushed texel k + r + R: the window's a7 is then texel k + r, its
-// centre. Three loops, so that no step tests which part of the walk it is in (llvmpipe would
-// run both sides): the first r + R texels fill the window, the rest of the row sums as it goes,
-// and R − r zeros finish the last outputs past the row's end.
+// The walk's texels pushed into the windows of its rows.
+fn push_rows(w0: ptr<function, Window>, w1: ptr<function, Window>, e: Encoded) {
+    window_push(w0, e.e0);
+    if WALK_ROWS == 2u {
+        window_push(w1, e.e1);
+    }
+}
+
+// The rows' sums stored at i in workgroup memory (row y + 1's at i + outs.x).
+fn store_rows(t: Tile, i: i32, w0: Window, w1: Window, k: PairWeights) {
+    sh_tile[i] = window_sum(w0, k);
+    if WALK_ROWS == 2u {
+        sh_tile[i + t.outs.x] = window_sum(w1, k);
+    }
+}
+
+// Strips along x: invocation li walks encoded rows WALK_ROWS at a time, rows WALK_ROWS·li,
+// WALK_ROWS·(li + LANES), … (enc.y rows: the tile's with its halo) from the halo's left end,
+// and stores each row's outs.x horizontal sums in workgroup memory (row-major, outs.x a row).
+// With R = STRIP_RADIUS, output k's sum is complete when the walk has pushed texel k + r + R:
+// the window's a7 is then texel k + r, its centre. Three loops, so that no step tests which
+// part of the walk it is in (llvmpipe would run both sides): the first r + R texels fill the
+// window, the rest of the row sums as it goes, and R − r zeros finish the last outputs past the
+// row's end.
 fn strip_rows(t: Tile, li: u32, k: PairWeights) {
     let r = t.r.x;
     let rr = i32(STRIP_RADIUS);
-    for (var row = i32(li); row < t.enc.y; row += i32(LANES)) {
+    let rows = i32(WALK_ROWS);
+    var bad = 0u;
+    for (var row = rows * i32(li); row < t.enc.y; row += rows * i32(LANES)) {
         var walk = walk_start(t, t.origin - t.r + vec2<i32>(0, row));
-        var win = empty_window();
+        var win0 = empty_window();
+        var win1 = empty_window();
         var j = 0;
         for (; j < r + rr; j++) {
-            window_push(&win, walk_step(t, &walk));
+            push_rows(&win0, &win1, walk_step(t, &walk));
         }
         let at = row * t.outs.x - r - rr;
         for (; j < t.enc.x; j++) {
-            window_push(&win, walk_step(t, &walk));
-            sh_tile[at + j] = window_sum(win, k);
+            push_rows(&win0, &win1, walk_step(t, &walk));
+            store_rows(t, at + j, win0, win1, k);
         }
+        let zeros = Encoded(Texel(0.0), Texel(0.0));
         for (; j < t.enc.x + rr - r; j++) {
-            window_push(&win, Texel(0.0));
-            sh_tile[at + j] = window_sum(win, k);
+            push_rows(&win0, &win1, zeros);
+            store_rows(t, at + j, win0, win1, k);
         }
+        bad += walk.bad;
+    }
+    if bad > 0u {
+        atomicAdd(&stats[0], bad);
     }
 }
 

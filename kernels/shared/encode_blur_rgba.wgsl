@@ -11,6 +11,9 @@ const TILE: u32 = 16u;
 const SH_TEXELS: u32 = 900u;
 // Outputs an invocation sums in the tile's blur passes, four channels: one output an invocation (shared/encode_blur, `run_sums`).
 const RUN: u32 = 1u;
+// Encoded rows a strip walks at once (shared/encode_blur, `walk_step`): one (the encodings read
+// no neighbours, and a second window of four channels took llvmpipe 9% more instructions).
+const WALK_ROWS: u32 = 1u;
 alias Texel = vec4<f32>;
 
 fn texel_of(v: vec4<f32>) -> Texel {

@@ -20,6 +20,9 @@ const TILE: u32 = 24u;
 const SH_TEXELS: u32 = 1444u;
 // Outputs an invocation sums in the tile's blur passes, two channels: runs of 4 (shared/encode_blur, `run_sums`).
 const RUN: u32 = 4u;
+// Encoded rows a strip walks at once (shared/encode_blur, `walk_step`): two, which share their
+// depths above and below (`vsm_moments` reads them).
+const WALK_ROWS: u32 = 2u;
 alias Texel = vec2<f32>;
 
 fn texel_of(v: vec4<f32>) -> Texel {
