@@ -14,6 +14,9 @@
 //! the cores).
 //! With `--passes`, each pass's share too: the plan cut after each of its steps is timed, and
 //! each pass is the difference to the cut before it.
+//! `--exact` picks the cases named exactly by a NAME (`vsm_blur r4` without `vsm_blur r4 f16
+//! (packed)`); `--no-copy` skips the copies (for `benches/instructions.sh`, which counts the
+//! instructions a software driver runs: with it, every compute kernel run is the case's).
 
 use std::time::Instant;
 
@@ -34,6 +37,8 @@ fn run() -> Result<(), String> {
     let mut repeat = 5u32;
     let mut names = Vec::new();
     let mut passes = false;
+    let mut exact = false;
+    let mut copies = true;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -49,11 +54,13 @@ fn run() -> Result<(), String> {
                 repeat = r.parse().map_err(|e| format!("--repeat `{r}`: {e}"))?;
             }
             "--passes" => passes = true,
+            "--exact" => exact = true,
+            "--no-copy" => copies = false,
             "--min" => MIN.store(true, std::sync::atomic::Ordering::Relaxed),
             "--cpu" => CPU.store(true, std::sync::atomic::Ordering::Relaxed),
             flag if flag.starts_with('-') => {
                 return Err(format!(
-                    "unknown option `{flag}` (options: --sizes, --repeat, --passes, --min, --cpu)"
+                    "unknown option `{flag}` (options: --sizes, --repeat, --passes, --min, --cpu, --exact, --no-copy)"
                 ));
             }
             _ => names.push(a),
@@ -61,7 +68,13 @@ fn run() -> Result<(), String> {
     }
     // The bench's own checks: a case filter that names nothing or holds an empty entry, a size
     // of 0 or past the device, `--repeat 0`, a case past the memory budget.
-    let cases = shadowgraph::bench::select_cases(&names).map_err(|e| e.to_string())?;
+    let mut cases = shadowgraph::bench::select_cases(&names).map_err(|e| e.to_string())?;
+    if exact {
+        cases.retain(|c| names.iter().any(|n| n == c.name));
+        if cases.is_empty() {
+            return Err(format!("--exact: no case is named {}", names.join(" or ")));
+        }
+    }
     let gpu = Gpu::new().map_err(|e| e.to_string())?;
     shadowgraph::bench::check_args(&gpu.device, &sizes, repeat).map_err(|e| e.to_string())?;
     let budget = shadowgraph::limits::memory_budget().map_err(|e| e.to_string())?;
@@ -77,7 +90,7 @@ fn run() -> Result<(), String> {
     let mut exec = Executor::new();
     for &n in &sizes {
         for &case in &cases {
-            let (ms, copy_ms, format) = time_case(&gpu, &mut exec, case, n, repeat)?;
+            let (ms, copy_ms, format) = time_case(&gpu, &mut exec, case, n, repeat, copies)?;
             if passes {
                 for (name, ms) in time_passes(&gpu, &mut exec, case, n, repeat)? {
                     println!("{:>6}    {:<22} {:>10.2}", n, name, ms);
@@ -157,6 +170,7 @@ fn time_case(
     case: &BenchCase,
     n: u32,
     repeat: u32,
+    copy: bool,
 ) -> Result<(f64, f64, wgpu::TextureFormat), String> {
     let built = (case.build)(n);
     let outputs: Vec<&str> = built.outputs.iter().map(String::as_str).collect();
@@ -172,7 +186,11 @@ fn time_case(
         out = Some(o.textures[&built.outputs[0]].clone());
     });
     let out = out.ok_or("no run")?;
-    let copy_ms = time_copy(gpu, &out, repeat)?;
+    let copy_ms = if copy {
+        time_copy(gpu, &out, repeat)?
+    } else {
+        f64::NAN
+    };
     Ok((ms, copy_ms, out.format()))
 }
 
