@@ -109,11 +109,15 @@ struct Tile {
     r: vec2<i32>,      // blur radius along x and y (0 along y for a row)
     enc: vec2<i32>,    // encoded extent: outs + 2r
     size: vec2<i32>,   // the map
+    // The depth's linearization, read from `params` once a workgroup: read at each texel,
+    // llvmpipe loaded it from the uniform buffer at each (4% of the MSM strips' instructions).
+    depth: DepthParams,
 }
 
 fn tile_of(wg: vec2<u32>) -> Tile {
     var t: Tile;
     t.size = vec2<i32>(textureDimensions(src));
+    t.depth = params.depth;
     if params.blur.axis == 2u {
         let r = i32(min(params.blur.radius, TILE_RADIUS));
         t.origin = vec2<i32>(wg * TILE);
@@ -155,7 +159,7 @@ fn raw_depth(t: Tile, p: vec2<i32>) -> f32 {
 // The linear depth at map texel p, clamped to the map, read straight from the texture
 // (`encode_at`).
 fn depth_direct(t: Tile, p: vec2<i32>) -> f32 {
-    return linear_depth(raw_depth(t, p), params.depth);
+    return linear_depth(raw_depth(t, p), t.depth);
 }
 
 // Whether map texel p is an output of the tile inside the map: where its own non-finite depth
@@ -178,7 +182,7 @@ fn encode_at(t: Tile, i: i32) -> Texel {
         atomicAdd(&stats[0], 1u);
     }
     return texel_of(encode(
-        linear_depth(raw, params.depth),
+        linear_depth(raw, t.depth),
         depth_direct(t, p - vec2<i32>(1, 0)),
         depth_direct(t, p + vec2<i32>(1, 0)),
         depth_direct(t, p - vec2<i32>(0, 1)),
@@ -529,7 +533,7 @@ fn walk_step(t: Tile, w: ptr<function, Walk>) -> Encoded {
     let dx = vec2<i32>(1, 0);
     let raw0 = (*w).raw0;
     (*w).bad += bad_at(t, p, raw0);
-    let z0 = linear_depth(raw0, params.depth);
+    let z0 = linear_depth(raw0, t.depth);
     let next0 = raw_depth(t, p + dx);
     let up0 = depth_direct(t, p - vec2<i32>(0, 1));
     var e: Encoded;
@@ -537,13 +541,13 @@ fn walk_step(t: Tile, w: ptr<function, Walk>) -> Encoded {
     if WALK_ROWS == 2u {
         let raw1 = (*w).raw1;
         (*w).bad += bad_at(t, q, raw1);
-        let z1 = linear_depth(raw1, params.depth);
+        let z1 = linear_depth(raw1, t.depth);
         let next1 = raw_depth(t, q + dx);
-        e.e0 = texel_of(encode(z0, (*w).before0, linear_depth(next0, params.depth), up0, z1));
+        e.e0 = texel_of(encode(z0, (*w).before0, linear_depth(next0, t.depth), up0, z1));
         e.e1 = texel_of(encode(
             z1,
             (*w).before1,
-            linear_depth(next1, params.depth),
+            linear_depth(next1, t.depth),
             z0,
             depth_direct(t, q + vec2<i32>(0, 1))
         ));
@@ -553,7 +557,7 @@ fn walk_step(t: Tile, w: ptr<function, Walk>) -> Encoded {
         e.e0 = texel_of(encode(
             z0,
             (*w).before0,
-            linear_depth(next0, params.depth),
+            linear_depth(next0, t.depth),
             up0,
             depth_direct(t, q)
         ));
@@ -641,12 +645,14 @@ fn strip_columns(t: Tile, li: u32, k: PairWeights) {
 }
 
 // The tile in strips (the CPU layout): along x into workgroup memory (outs.x × enc.y sums),
-// one barrier, then along y into `dst`.
+// one barrier, then along y into `dst`. Each pass reads its own weights: llvmpipe keeps what
+// lives across a barrier in its coroutine's frame, and the weights held across it took 10% of
+// the VSM strips' instructions (benches/instructions.sh; benches/RESULTS.md, twenty-first
+// session).
 fn blur_tile_strips(t: Tile, li: u32) {
-    let k = pair_weights(t.r.x);
-    strip_rows(t, li, k);
+    strip_rows(t, li, pair_weights(t.r.x));
     workgroupBarrier();
-    strip_columns(t, li, k);
+    strip_columns(t, li, pair_weights(t.r.y));
 }
 
 // The row's blur along x in runs of 2 (ROW = 2·WG_SIZE): invocation li's outputs x = 2li and
