@@ -50,7 +50,7 @@ count() { # index folder
         SHADOWGRAPH_KERNEL_DIR=$2 valgrind --tool=callgrind --smc-check=all-non-file \
             --callgrind-out-file="$out.cg" ./target/release/examples/kernel_wall --exact \
             --no-copy --repeat 1 --sizes "$size" "$case_name" > "$out.log" 2>&1
-    fi || { echo "$0: $2: kernel_wall failed:" >&2; tail -5 "$out.log" >&2; return 1; }
+    fi || { echo "$0: $2: kernel_wall failed: $(grep -m1 '^error' "$out.log")" >&2; return 1; }
     callgrind_annotate --inclusive=no --threshold=100 "$out.cg" \
         | awk '/\[\?\?\?\]$/ { gsub(",", "", $1); n += $1 } END { print n + 0 }' > "$out.n"
 }
@@ -60,6 +60,9 @@ for i in "${!dirs[@]}"; do
     if (( i % 2 == 1 )); then wait; fi
 done
 wait
+for i in "${!dirs[@]}"; do
+    [ -s "$work/$i.n" ] || exit 1
+done
 
 texels=$(( 3 * size * size ))
 first=$(cat "$work/0.n")

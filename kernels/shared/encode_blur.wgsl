@@ -33,7 +33,11 @@
 // invocations' work CPU_LANES at a time.
 //
 // It holds the kernels' entry point, `main`. The importing kernel declares `const CHANNELS`
-// (2 or 4), `struct Params` (its encoding's fields, then `blur: BlurSpec`), `fn encode(z, left, right, up, down) -> vec4<f32>`, the
+// (2 or 4), `struct Params` (its encoding's fields, then `blur: BlurSpec`), the fields of them
+// its encoding reads, `struct Coding` and `fn coding() -> Coding` (read once a workgroup, into
+// the Tile: read at each texel, llvmpipe loaded them from the uniform buffer at each, 3–4% of
+// the EVSM and MSM strips' instructions), `fn encode(z, left, right, up, down, c: Coding) ->
+// vec4<f32>`, the
 // texel its channels need in workgroup memory: `alias Texel` (vec2<f32> for two channels,
 // vec4<f32> for four), `fn texel_of(v: vec4<f32>) -> Texel` and `fn texel_out(t: Texel) ->
 // vec4<f32>` (two channels in vec2s halve the workgroup memory and its traffic), and the tile
@@ -112,12 +116,14 @@ struct Tile {
     // The depth's linearization, read from `params` once a workgroup: read at each texel,
     // llvmpipe loaded it from the uniform buffer at each (4% of the MSM strips' instructions).
     depth: DepthParams,
+    coding: Coding,    // the importer's encoding parameters (`coding`), likewise
 }
 
 fn tile_of(wg: vec2<u32>) -> Tile {
     var t: Tile;
     t.size = vec2<i32>(textureDimensions(src));
     t.depth = params.depth;
+    t.coding = coding();
     if params.blur.axis == 2u {
         let r = i32(min(params.blur.radius, TILE_RADIUS));
         t.origin = vec2<i32>(wg * TILE);
@@ -186,7 +192,8 @@ fn encode_at(t: Tile, i: i32) -> Texel {
         depth_direct(t, p - vec2<i32>(1, 0)),
         depth_direct(t, p + vec2<i32>(1, 0)),
         depth_direct(t, p - vec2<i32>(0, 1)),
-        depth_direct(t, p + vec2<i32>(0, 1))
+        depth_direct(t, p + vec2<i32>(0, 1)),
+        t.coding
     ));
 }
 
@@ -543,13 +550,21 @@ fn walk_step(t: Tile, w: ptr<function, Walk>) -> Encoded {
         (*w).bad += bad_at(t, q, raw1);
         let z1 = linear_depth(raw1, t.depth);
         let next1 = raw_depth(t, q + dx);
-        e.e0 = texel_of(encode(z0, (*w).before0, linear_depth(next0, t.depth), up0, z1));
+        e.e0 = texel_of(encode(
+            z0,
+            (*w).before0,
+            linear_depth(next0, t.depth),
+            up0,
+            z1,
+            t.coding
+        ));
         e.e1 = texel_of(encode(
             z1,
             (*w).before1,
             linear_depth(next1, t.depth),
             z0,
-            depth_direct(t, q + vec2<i32>(0, 1))
+            depth_direct(t, q + vec2<i32>(0, 1)),
+            t.coding
         ));
         (*w).before1 = z1;
         (*w).raw1 = next1;
@@ -559,7 +574,8 @@ fn walk_step(t: Tile, w: ptr<function, Walk>) -> Encoded {
             (*w).before0,
             linear_depth(next0, t.depth),
             up0,
-            depth_direct(t, q)
+            depth_direct(t, q),
+            t.coding
         ));
     }
     (*w).p = p + dx;

@@ -17,6 +17,16 @@ struct Params {
     blur: BlurSpec,
 }
 
-fn encode(z: f32, left: f32, right: f32, up: f32, down: f32) -> vec4<f32> {
-    return evsm_moments(z, params.exp_pos, params.exp_neg);
+// The parameters the encoding reads (shared/encode_blur's `Coding`).
+struct Coding {
+    exp_pos: f32,
+    exp_neg: f32,
+}
+
+fn coding() -> Coding {
+    return Coding(params.exp_pos, params.exp_neg);
+}
+
+fn encode(z: f32, left: f32, right: f32, up: f32, down: f32, c: Coding) -> vec4<f32> {
+    return evsm_moments(z, c.exp_pos, c.exp_neg);
 }

@@ -17,6 +17,15 @@ struct Params {
     blur: BlurSpec,
 }
 
-fn encode(z: f32, left: f32, right: f32, up: f32, down: f32) -> vec4<f32> {
-    return msm_moments(z, params.quantized == 1u);
+// The parameters the encoding reads (shared/encode_blur's `Coding`).
+struct Coding {
+    quantized: bool,
+}
+
+fn coding() -> Coding {
+    return Coding(params.quantized == 1u);
+}
+
+fn encode(z: f32, left: f32, right: f32, up: f32, down: f32, c: Coding) -> vec4<f32> {
+    return msm_moments(z, c.quantized);
 }

@@ -33,6 +33,15 @@ fn texel_out(t: Texel) -> vec4<f32> {
     return vec4<f32>(t, 0.0, 0.0);
 }
 
-fn encode(z: f32, left: f32, right: f32, up: f32, down: f32) -> vec4<f32> {
+// VSM's encoding reads no parameters (shared/encode_blur's `Coding`).
+struct Coding {
+    none: u32,
+}
+
+fn coding() -> Coding {
+    return Coding(0u);
+}
+
+fn encode(z: f32, left: f32, right: f32, up: f32, down: f32, c: Coding) -> vec4<f32> {
     return vec4<f32>(vsm_moments(z, left, right, up, down), 0.0, 0.0);
 }
