@@ -52,7 +52,7 @@ count() { # index folder
             --no-copy --repeat 1 --sizes "$size" "$case_name" > "$out.log" 2>&1
     fi || { echo "$0: $2: kernel_wall failed: $(grep -m1 '^error' "$out.log")" >&2; return 1; }
     callgrind_annotate --inclusive=no --threshold=100 "$out.cg" \
-        | awk '/\[\?\?\?\]$/ { gsub(",", "", $1); n += $1 } END { print n + 0 }' > "$out.n"
+        | awk '/\[\?\?\?\]$/ { gsub(",", "", $1); n += $1 } END { printf "%.0f\n", n }' > "$out.n"
 }
 
 for i in "${!dirs[@]}"; do
@@ -70,5 +70,5 @@ printf '%-40s %16s %12s %8s\n' "kernels ($case_name, $size², 3 runs)" "instruct
 for i in "${!dirs[@]}"; do
     n=$(cat "$work/$i.n")
     awk -v d="${dirs[$i]}" -v n="$n" -v t="$texels" -v f="$first" \
-        'BEGIN { printf "%-40s %16d %12.1f %8.3f\n", d, n, n / t, n / f }'
+        'BEGIN { printf "%-40s %16.0f %12.1f %8.3f\n", d, n, n / t, n / f }'
 done
