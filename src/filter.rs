@@ -7,8 +7,8 @@ use crate::model::{BlurKernel, Filter};
 mod encode_blur;
 
 pub use self::encode_blur::{
-    ENCODE_BLUR_TILE_RADIUS, EncodeBlur, add_encode_blur, encode_blur_row, encode_blur_row_kernel,
-    encode_blur_tile,
+    ENCODE_BLUR_TILE_RADIUS, EncodeBlur, add_encode_blur, encode_blur_cpu_rows, encode_blur_row,
+    encode_blur_row_kernel, encode_blur_tile,
 };
 
 /// Taps each side the blur kernel's weight table holds.

@@ -711,7 +711,8 @@ fn log_blur_span_matches_the_wgsl() {
 #[test]
 fn encode_blur_dispatch_constants_match_the_wgsl() {
     use shadowgraph::filter::{
-        ENCODE_BLUR_TILE_RADIUS, encode_blur_row, encode_blur_row_kernel, encode_blur_tile,
+        ENCODE_BLUR_TILE_RADIUS, encode_blur_cpu_rows, encode_blur_row, encode_blur_row_kernel,
+        encode_blur_tile,
     };
     use shadowgraph::kernels::KernelId;
     // The row kernels where their rows are full, else the tile kernels' shorter rows.
@@ -743,6 +744,7 @@ fn encode_blur_dispatch_constants_match_the_wgsl() {
         let tile = encode_blur_tile(kernel);
         for (constant, rust) in [
             ("TILE", tile),
+            ("CPU_TILE_ROWS", encode_blur_cpu_rows(kernel)),
             ("ROW", encode_blur_row(kernel)),
             ("TILE_RADIUS", ENCODE_BLUR_TILE_RADIUS),
         ] {

@@ -100,7 +100,12 @@ fn malformed_plans_are_typed_errors() {
     let blocks = plan
         .steps
         .iter()
-        .position(|st| matches!(st.node.dispatch, Dispatch::Blocks { .. }))
+        .position(|st| {
+            matches!(
+                st.node.dispatch,
+                Dispatch::Blocks { .. } | Dispatch::Tiles { .. }
+            )
+        })
         .unwrap();
     type Edit = Box<dyn Fn(&mut Plan)>;
     let edits: Vec<(&str, Edit)> = vec![
@@ -162,6 +167,29 @@ fn malformed_plans_are_typed_errors() {
                     of: "nothing".into(),
                     x: 1,
                     y: 1,
+                }
+            }),
+        ),
+        (
+            "tiles over nothing",
+            Box::new(move |p| {
+                p.steps[blocks].node.dispatch = Dispatch::Tiles {
+                    of: "nothing".into(),
+                    x: 16,
+                    y: 16,
+                    cpu_y: 32,
+                }
+            }),
+        ),
+        (
+            "tiles 0 tall on a CPU driver",
+            Box::new(move |p| {
+                let of = p.resources[0].resource.name.clone();
+                p.steps[blocks].node.dispatch = Dispatch::Tiles {
+                    of,
+                    x: 16,
+                    y: 16,
+                    cpu_y: 0,
                 }
             }),
         ),

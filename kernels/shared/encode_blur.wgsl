@@ -45,7 +45,10 @@
 // workgroup memory: at least the encoded tile at TILE_RADIUS, (TILE + 2·TILE_RADIUS)², and
 // the fallback's encoded row, ROW + 2·MAX_RADIUS; 16 KiB at most): 24 and 1444 with two channels
 // (11.3 KiB), 16 and 900 with four (14.1 KiB); `const RUN`, the outputs an invocation sums in a
-// tile's blur passes: 4 with two channels, 1 with four (see `run_sums`); `const WALK_ROWS`, the
+// tile's blur passes: 4 with two channels, 1 with four (see `run_sums`); `const
+// CPU_TILE_ROWS`, the output rows of a CPU driver's taller tile (`filter::encode_blur_cpu_rows`:
+// 40 with two channels, 32 with four; its horizontal sums, TILE × (CPU_TILE_ROWS +
+// 2·TILE_RADIUS), fit SH_TEXELS); `const WALK_ROWS`, the
 // encoded rows a CPU driver's strip walks at once (`walk_step`): 2 where the encoding reads the
 // depths above and below (VSM), else 1; and the fallback's row,
 // `const ROW` outputs a workgroup in runs of `const ROW_RUN` an invocation (ROW = ROW_RUN ·
@@ -128,6 +131,11 @@ fn tile_of(wg: vec2<u32>) -> Tile {
         let r = i32(min(params.blur.radius, TILE_RADIUS));
         t.origin = vec2<i32>(wg * TILE);
         t.outs = vec2<i32>(i32(TILE));
+        if !GPU_LAYOUT {
+            // The strips' taller tile (`graph::Dispatch::Tiles`): less halo a texel.
+            t.origin.y = i32(wg.y * CPU_TILE_ROWS);
+            t.outs.y = i32(CPU_TILE_ROWS);
+        }
         t.r = vec2<i32>(r);
     } else {
         t.origin = vec2<i32>(i32(wg.x * ROW), i32(wg.y));
@@ -419,8 +427,9 @@ struct Window {
 // workgroup memory.
 const_assert TILE_RADIUS == 7u;
 const_assert TILE * (TILE + 2u * TILE_RADIUS) <= SH_TEXELS;
-// Rows walked in pairs: every tile's encoded rows, TILE + 2r, pair up.
-const_assert WALK_ROWS == 1u || (WALK_ROWS == 2u && TILE % 2u == 0u);
+const_assert TILE * (CPU_TILE_ROWS + 2u * TILE_RADIUS) <= SH_TEXELS;
+// Rows walked in pairs: the strips' encoded rows, CPU_TILE_ROWS + 2r, pair up.
+const_assert WALK_ROWS == 1u || (WALK_ROWS == 2u && CPU_TILE_ROWS % 2u == 0u);
 
 fn empty_window() -> Window {
     let z = Texel(0.0);

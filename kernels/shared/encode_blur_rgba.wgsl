@@ -11,6 +11,9 @@ const TILE: u32 = 16u;
 const SH_TEXELS: u32 = 900u;
 // Outputs an invocation sums in the tile's blur passes, four channels: one output an invocation (shared/encode_blur, `run_sums`).
 const RUN: u32 = 1u;
+// Output rows of a CPU driver's tile (shared/encode_blur, `filter::encode_blur_cpu_rows`):
+// 40 encoded rows at r = 4, five for each of the 8 walks.
+const CPU_TILE_ROWS: u32 = 32u;
 // Encoded rows a strip walks at once (shared/encode_blur, `walk_step`): one (the encodings read
 // no neighbours, and a second window of four channels took llvmpipe 9% more instructions).
 const WALK_ROWS: u32 = 1u;

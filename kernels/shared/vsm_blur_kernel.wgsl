@@ -20,6 +20,9 @@ const TILE: u32 = 24u;
 const SH_TEXELS: u32 = 1444u;
 // Outputs an invocation sums in the tile's blur passes, two channels: runs of 4 (shared/encode_blur, `run_sums`).
 const RUN: u32 = 4u;
+// Output rows of a CPU driver's tile (shared/encode_blur, `filter::encode_blur_cpu_rows`):
+// 48 encoded rows at r = 4, three pairs for each of the 8 walks.
+const CPU_TILE_ROWS: u32 = 40u;
 // Encoded rows a strip walks at once (shared/encode_blur, `walk_step`): two, which share their
 // depths above and below (`vsm_moments` reads them).
 const WALK_ROWS: u32 = 2u;

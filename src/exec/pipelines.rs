@@ -20,6 +20,8 @@ pub struct ComputeKernel {
     pub layouts: Vec<wgpu::BindGroupLayout>,
     /// The pipeline (entry point `main`).
     pub pipeline: wgpu::ComputePipeline,
+    /// The layout it was compiled in.
+    pub layout: KernelLayout,
 }
 
 /// The environment variable that picks [`KernelLayout`] for every device: `gpu` or `cpu`
@@ -211,6 +213,7 @@ impl ComputeKernel {
             reflection: reflection.in_layout(layout == KernelLayout::Gpu),
             layouts,
             pipeline,
+            layout,
         })
     }
 

@@ -23,6 +23,21 @@ pub fn encode_blur_tile(kernel: KernelId) -> u32 {
     }
 }
 
+/// Output rows of a two-axis tile where the kernel compiles in a CPU driver's layout (`const
+/// CPU_TILE_ROWS`, which each fused kernel declares): its [`encode_blur_tile`] columns and
+/// this many rows ([`Dispatch::Tiles`]). There 8 invocations walk the tile in strips, and a
+/// taller tile encodes less halo a texel: VSM's 24 × 40 (its encoded rows, 48 at r = 4, are
+/// three pairs for each of the 8 walks) took 0.91× the instructions of its 24², EVSM's and
+/// MSM's 16 × 32 0.87× of their 16² (`benches/instructions.sh`; benches/RESULTS.md,
+/// twenty-first session). Their horizontal sums, `TILE × (CPU_TILE_ROWS + 2·TILE_RADIUS)`,
+/// fit the workgroup memory the GPU's tile declares.
+pub fn encode_blur_cpu_rows(kernel: KernelId) -> u32 {
+    match kernel {
+        KernelId::VsmBlur | KernelId::VsmBlurRow => 40,
+        _ => 32,
+    }
+}
+
 /// Outputs of a one-row workgroup, the two-pass fallback (`ROW`, which each fused kernel
 /// declares for `kernels/shared/encode_blur.wgsl`). Four channels: 256 one an invocation
 /// (`evsm_blur`, `msm_blur`), or on maps at least 512 wide 512 in runs of 2 (`evsm_blur_row`,
@@ -102,7 +117,14 @@ pub fn add_encode_blur(
     let both = BlurParams::new(BOTH_AXES, radius, sigma, kernel, BlurMode::Linear);
     let out = format!("{}.blur", e.encoded);
     if both.radius <= ENCODE_BLUR_TILE_RADIUS {
-        fused_node(graph, light, e, &out, both, encode_blur_tile(e.kernel));
+        fused_node(
+            graph,
+            light,
+            e,
+            &out,
+            both,
+            Some(encode_blur_tile(e.kernel)),
+        );
         return Some(out);
     }
     let h = format!("{}.blur_h", e.encoded);
@@ -110,7 +132,7 @@ pub fn add_encode_blur(
         kernel: encode_blur_row_kernel(e.kernel, e.width),
         ..*e
     };
-    fused_node(graph, light, &row, &h, BlurParams { axis: 0, ..both }, 0);
+    fused_node(graph, light, &row, &h, BlurParams { axis: 0, ..both }, None);
     let v = BlurParams { axis: 1, ..both };
     Some(add_blur_pass(
         graph,
@@ -121,15 +143,16 @@ pub fn add_encode_blur(
     ))
 }
 
-/// The node `name` of `e`'s fused kernel with `blur`: a workgroup per `tile`² outputs, or per
-/// [`encode_blur_row`] texels of a row when `tile` is 0.
+/// The node `name` of `e`'s fused kernel with `blur`: a workgroup per `tile`² outputs (per
+/// `tile` × [`encode_blur_cpu_rows`] on a CPU driver), or per [`encode_blur_row`] texels of a
+/// row when `tile` is `None`.
 fn fused_node(
     graph: &mut Graph,
     light: usize,
     e: &EncodeBlur,
     name: &str,
     blur: BlurParams,
-    tile: u32,
+    tile: Option<u32>,
 ) {
     let out = graph.resource(
         name.to_string(),
@@ -140,9 +163,18 @@ fn fused_node(
         },
         Some(light),
     );
-    let (x, y) = match tile {
-        0 => (encode_blur_row(e.kernel), 1),
-        t => (t, t),
+    let dispatch = match tile {
+        None => Dispatch::Blocks {
+            of: out.clone(),
+            x: encode_blur_row(e.kernel),
+            y: 1,
+        },
+        Some(t) => Dispatch::Tiles {
+            of: out.clone(),
+            x: t,
+            y: t,
+            cpu_y: encode_blur_cpu_rows(e.kernel),
+        },
     };
     graph.node(Node {
         name: name.to_string(),
@@ -150,7 +182,7 @@ fn fused_node(
         inputs: vec![("src".into(), e.depth.to_string())],
         outputs: vec![("dst".into(), out.clone())],
         params: [e.params, bytemuck::bytes_of(&blur)].concat(),
-        dispatch: Dispatch::Blocks { of: out, x, y },
+        dispatch,
         light: Some(light),
     });
 }

@@ -86,7 +86,10 @@ impl Plan {
         let of = match dispatch {
             Dispatch::Layers { .. } | Dispatch::Interleaved { .. } => None,
             Dispatch::Texels(r) => Some(r),
-            Dispatch::Blocks { of, .. } => Some(of),
+            Dispatch::Tiles { x, y, cpu_y, .. } if *x == 0 || *y == 0 || *cpu_y == 0 => {
+                return bad("dispatches tiles 0 texels wide or tall".into());
+            }
+            Dispatch::Blocks { of, .. } | Dispatch::Tiles { of, .. } => Some(of),
             Dispatch::Lines { per_group: 0, .. } => {
                 return bad("dispatches lines with 0 per workgroup".into());
             }

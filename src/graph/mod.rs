@@ -94,6 +94,22 @@ pub enum Dispatch {
         /// Block height in texels (0: the whole height, one group).
         y: u32,
     },
+    /// [`Dispatch::Blocks`] whose blocks are taller where the kernel compiles in a CPU driver's
+    /// layout ([`crate::exec::KernelLayout::Cpu`]): `x × y` texels a workgroup on a GPU, `x ×
+    /// cpu_y` on a CPU driver, whose fewer invocations walk a taller tile for less of its halo
+    /// (the fused blurs' strips, `CPU_TILE_ROWS` in `kernels/shared/encode_blur.wgsl`).
+    /// [`Dispatch::groups`] gives the GPU's count, which the cost model describes;
+    /// [`Dispatch::groups_in_layout`] either.
+    Tiles {
+        /// The resource whose size counts.
+        of: String,
+        /// Block width in texels.
+        x: u32,
+        /// Block height in texels on a GPU.
+        y: u32,
+        /// Block height in texels on a CPU driver.
+        cpu_y: u32,
+    },
     /// One invocation per column and one per row of this resource:
     /// `[⌈max(width, height) / per_group⌉, 2, 1]`, workgroup row 0 over the columns and row 1
     /// over the rows (work serial along each line, e.g. a summed-area table's carries).
@@ -190,7 +206,7 @@ impl Dispatch {
                 let (w, h) = size(r)?;
                 [w.div_ceil(workgroup[0]), h.div_ceil(workgroup[1]), 1]
             }
-            Self::Blocks { of, x, y } => {
+            Self::Blocks { of, x, y } | Self::Tiles { of, x, y, .. } => {
                 let (w, h) = size(of)?;
                 [block_count(w, *x), block_count(h, *y), 1]
             }
@@ -208,6 +224,24 @@ impl Dispatch {
             }
             Self::Several(_) => return None,
         })
+    }
+
+    /// [`Dispatch::groups`] for a kernel compiled in the GPU's layout (`gpu`) or a CPU
+    /// driver's: the same but for [`Dispatch::Tiles`], whose blocks are `cpu_y` tall on a CPU
+    /// driver.
+    pub fn groups_in_layout(
+        &self,
+        size: impl Fn(&str) -> Option<(u32, u32)>,
+        workgroup: [u32; 3],
+        gpu: bool,
+    ) -> Option<[u32; 3]> {
+        match self {
+            Self::Tiles { of, x, cpu_y, .. } if !gpu => {
+                let (w, h) = size(of)?;
+                Some([block_count(w, *x), block_count(h, *cpu_y), 1])
+            }
+            _ => self.groups(size, workgroup),
+        }
     }
 }
 

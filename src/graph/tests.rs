@@ -298,3 +298,41 @@ fn unaliased_plan_gives_every_resource_its_own_texture() {
     assert_eq!(slots, [0, 1, 2]);
     assert_eq!(p.slots.len(), 3);
 }
+
+/// A `Tiles` dispatch counts `y`-tall blocks in the GPU's layout and `cpu_y`-tall ones in a CPU
+/// driver's; every other dispatch the same in both.
+#[test]
+fn tiles_are_taller_in_a_cpu_drivers_layout() {
+    let size = |r: &str| (r == "map").then_some((100, 90));
+    let tiles = Dispatch::Tiles {
+        of: "map".into(),
+        x: 24,
+        y: 24,
+        cpu_y: 40,
+    };
+    assert_eq!(tiles.groups(size, [8, 1, 1]), Some([5, 4, 1]));
+    assert_eq!(
+        tiles.groups_in_layout(size, [8, 1, 1], true),
+        Some([5, 4, 1])
+    );
+    assert_eq!(
+        tiles.groups_in_layout(size, [8, 1, 1], false),
+        Some([5, 3, 1])
+    );
+    let blocks = Dispatch::Blocks {
+        of: "map".into(),
+        x: 24,
+        y: 24,
+    };
+    assert_eq!(
+        blocks.groups_in_layout(size, [8, 1, 1], false),
+        Some([5, 4, 1])
+    );
+    let other = Dispatch::Tiles {
+        of: "other".into(),
+        x: 24,
+        y: 24,
+        cpu_y: 40,
+    };
+    assert_eq!(other.groups_in_layout(size, [8, 1, 1], false), None);
+}
