@@ -7,7 +7,8 @@
 //
 // `params.blur.axis` picks the shape:
 //   2: a TILE × TILE tile blurred along both axes (radius ≤ TILE_RADIUS; the tile and its halo of
-//      encoded texels fill workgroup memory at TILE_RADIUS with four channels);
+//      encoded texels fill workgroup memory at TILE_RADIUS with four channels), TILE ×
+//      CPU_TILE_ROWS on a CPU driver (`graph::Dispatch::Tiles`);
 //   0: ROW texels of one row blurred along x only (radius ≤ MAX_RADIUS): the fallback for larger
 //      radii, followed by `blur`'s vertical pass.
 // The sums are those of `blur` (the centre, then the symmetric pairs w₀·v₀ + Σ wᵢ·(v₋ᵢ + vᵢ),
