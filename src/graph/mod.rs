@@ -193,12 +193,25 @@ impl Dispatch {
     }
 
     /// Workgroup counts of a dispatch of a kernel whose workgroup is `workgroup`, with
-    /// `size(resource)` the planned `(width, height)` of a resource; `None` when a resource it
-    /// counts is unknown, or for [`Dispatch::Several`] (each of which has its own).
+    /// `size(resource)` the planned `(width, height)` of a resource, in the GPU's kernel
+    /// layout (what the cost model describes: [`Dispatch::groups_in_layout`]); `None` when a
+    /// resource it counts is unknown, or for [`Dispatch::Several`] (each of which has its own).
     pub fn groups(
         &self,
         size: impl Fn(&str) -> Option<(u32, u32)>,
         workgroup: [u32; 3],
+    ) -> Option<[u32; 3]> {
+        self.groups_in_layout(size, workgroup, true)
+    }
+
+    /// [`Dispatch::groups`] for a kernel compiled in the GPU's layout (`gpu`) or a CPU
+    /// driver's: the same but for [`Dispatch::Tiles`] (within [`Dispatch::Layers`] or
+    /// [`Dispatch::Interleaved`] too), whose blocks are `cpu_y` tall on a CPU driver.
+    pub fn groups_in_layout(
+        &self,
+        size: impl Fn(&str) -> Option<(u32, u32)>,
+        workgroup: [u32; 3],
+        gpu: bool,
     ) -> Option<[u32; 3]> {
         Some(match self {
             Self::Groups(g) => *g,
@@ -206,42 +219,32 @@ impl Dispatch {
                 let (w, h) = size(r)?;
                 [w.div_ceil(workgroup[0]), h.div_ceil(workgroup[1]), 1]
             }
-            Self::Blocks { of, x, y } | Self::Tiles { of, x, y, .. } => {
+            Self::Blocks { of, x, y } => {
                 let (w, h) = size(of)?;
                 [block_count(w, *x), block_count(h, *y), 1]
+            }
+            Self::Tiles { of, x, y, cpu_y } => {
+                let (w, h) = size(of)?;
+                [
+                    block_count(w, *x),
+                    block_count(h, if gpu { *y } else { *cpu_y }),
+                    1,
+                ]
             }
             Self::Lines { of, per_group } => {
                 let (w, h) = size(of)?;
                 [block_count(w.max(h), *per_group), 2, 1]
             }
             Self::Layers { base, layers } => {
-                let [x, y, _] = base.groups(size, workgroup)?;
+                let [x, y, _] = base.groups_in_layout(size, workgroup, gpu)?;
                 [x, y, *layers]
             }
             Self::Interleaved { base, layers } => {
-                let [x, y, _] = base.groups(size, workgroup)?;
+                let [x, y, _] = base.groups_in_layout(size, workgroup, gpu)?;
                 [x.checked_mul(*layers)?, y, 1]
             }
             Self::Several(_) => return None,
         })
-    }
-
-    /// [`Dispatch::groups`] for a kernel compiled in the GPU's layout (`gpu`) or a CPU
-    /// driver's: the same but for [`Dispatch::Tiles`], whose blocks are `cpu_y` tall on a CPU
-    /// driver.
-    pub fn groups_in_layout(
-        &self,
-        size: impl Fn(&str) -> Option<(u32, u32)>,
-        workgroup: [u32; 3],
-        gpu: bool,
-    ) -> Option<[u32; 3]> {
-        match self {
-            Self::Tiles { of, x, cpu_y, .. } if !gpu => {
-                let (w, h) = size(of)?;
-                Some([block_count(w, *x), block_count(h, *cpu_y), 1])
-            }
-            _ => self.groups(size, workgroup),
-        }
     }
 }
 

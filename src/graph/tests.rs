@@ -335,4 +335,13 @@ fn tiles_are_taller_in_a_cpu_drivers_layout() {
         cpu_y: 40,
     };
     assert_eq!(other.groups_in_layout(size, [8, 1, 1], false), None);
+    let layered = Dispatch::Layers {
+        base: Box::new(tiles),
+        layers: 3,
+    };
+    assert_eq!(
+        layered.groups_in_layout(size, [8, 1, 1], false),
+        Some([5, 3, 3])
+    );
+    assert_eq!(layered.groups(size, [8, 1, 1]), Some([5, 4, 3]));
 }
