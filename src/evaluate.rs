@@ -210,6 +210,7 @@ pub fn scene_for(path: &Path, opts: &EvaluateOptions) -> Result<Scene> {
 pub fn run(gpu: &Gpu, scene_path: &Path, out: &Path, opts: &EvaluateOptions) -> Result<String> {
     check_options(opts)?;
     let scene = scene_for(scene_path, opts)?;
+    check_sides(gpu.device.limits().max_texture_dimension_2d, &scene, opts)?;
     let configs = sweep(&scene, opts)?;
     output::check_dir(out)?;
     let (report, images) = evaluate(gpu, &scene, &configs, opts)?;
@@ -265,6 +266,37 @@ pub fn check_options(opts: &EvaluateOptions) -> Result<()> {
         )));
     }
     Ok(())
+}
+
+/// The texture sides the options ask for against the device's largest, `max`, each named by
+/// its flag: the image (`--image`) and every light's map at every `--sizes` entry (a point
+/// light's atlas is three faces wide). Past the device, the scene's own check would name the
+/// scene file's key and line, which the user did not write.
+pub fn check_sides(max: u32, scene: &Scene, opts: &EvaluateOptions) -> Result<()> {
+    let image = [
+        (
+            "evaluate --image (width)".to_string(),
+            opts.image.map(|(w, _)| w),
+        ),
+        (
+            "evaluate --image (height)".into(),
+            opts.image.map(|(_, h)| h),
+        ),
+    ];
+    let maps = opts.sizes.iter().flatten().flat_map(|&size| {
+        scene.lights.iter().enumerate().map(move |(i, l)| {
+            let mut l = l.clone();
+            l.shadow_map = size;
+            let (w, h) = l.map_dims();
+            let what = if w == size {
+                format!("evaluate --sizes {size} (light[{i}]'s map side)")
+            } else {
+                format!("evaluate --sizes {size} (light[{i}]'s point-light atlas of three faces: its width)")
+            };
+            (what, Some(w.max(h)))
+        })
+    });
+    crate::limits::flag_sides(max, image.into_iter().chain(maps))
 }
 
 /// Renders every configuration of `configs` on `scene` and measures it (see the module docs).

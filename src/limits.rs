@@ -224,6 +224,27 @@ pub fn kernel_over(name: &str, wgsl: &str, l: &wgpu::Limits) -> Result<Option<Ne
         .find(Need::over))
 }
 
+/// Texture sides given on the command line (`what` names the flag, `--image (width)`) against
+/// the device's largest side `max`: the first past it is an error naming its flag. Checked
+/// before the flag's value reaches a scene, whose own check would name the scene file's key and
+/// line, which the user did not write.
+pub fn flag_sides<S: Into<String>>(
+    max: u32,
+    sides: impl IntoIterator<Item = (S, Option<u32>)>,
+) -> Result<()> {
+    match sides
+        .into_iter()
+        .find_map(|(what, n)| n.filter(|&n| n > max).map(|n| (what, n)))
+    {
+        Some((what, n)) => Err(Error::Limit {
+            what: what.into(),
+            requested: u64::from(n),
+            limit: u64::from(max),
+        }),
+        None => Ok(()),
+    }
+}
+
 /// The first step of `plan` whose kernel or dispatch exceeds `l`, if any, or else the first
 /// texture wider or taller than the device allows (tables interleaved along x are several
 /// times as wide as the map: `Graph::interleaved`).

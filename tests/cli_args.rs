@@ -3,8 +3,8 @@
 //! is wrong; `plan /dev/zero` stops reading; `bench --layouts` takes `gpu` and `cpu` only, each
 //! once. Each is one line and status 1, within seconds (no GPU work starts); so are an `evaluate
 //! --out` folder that cannot be made, a `render` output that is not a PNG, an `--aux` folder
-//! that cannot be made, a `dump --out` that names a file, an empty `bench --only` entry and a
-//! `bench --image` past the device.
+//! that cannot be made, a `dump --out` that names a file, an empty `bench --only` entry, and a
+//! `bench --image`, `evaluate --image` or `evaluate --sizes` past the device.
 
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
@@ -324,8 +324,8 @@ fn dump_refuses_a_file_as_its_folder() {
 /// An empty entry of `bench --only` (`sat,`, `,`) would keep every kernel, since every name
 /// contains it: refused naming the entry, with and without `--lookup`, before any table. An
 /// `--image` past the device's texture side is named as `--image`, not as the bench's own
-/// scene file; a negative `evaluate --moment-bias` gets its range, not clap's "unexpected
-/// argument".
+/// scene file, and so are `evaluate`'s `--image` and `--sizes`; a negative `evaluate
+/// --moment-bias` gets its range, not clap's "unexpected argument".
 #[test]
 fn empty_filters_and_oversized_images_are_named() {
     for (args, needles) in [
@@ -386,10 +386,27 @@ fn empty_filters_and_oversized_images_are_named() {
             &["--moment-bias", "no technique", "msm, msm_soft"][..],
         ),
         (&["--k", "100000000"], &["--k 100000000", "at most 65536"]),
+        // Sides past the device (65 536 is past every device's largest texture side) are named
+        // by their flags, not by the scene file's `output.width` or `light[0].shadow_map`.
+        (
+            &["--image", "100000x48"],
+            &["evaluate --image (width)", "100000"],
+        ),
+        (
+            &["--image", "64x100000"],
+            &["evaluate --image (height)", "100000"],
+        ),
+        (
+            &["--sizes", "512,65536"],
+            &["evaluate --sizes 65536", "light[0]", "65536"],
+        ),
     ] {
         let mut args = vec!["evaluate", &s, "--out", out.to_str().unwrap()];
         args.extend_from_slice(extra);
         refused(&args, needles);
-        assert!(shadowgraph(&args).stdout.is_empty());
+        let o = shadowgraph(&args);
+        assert!(o.stdout.is_empty());
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!err.contains("sphere_on_plane.toml"), "{err}");
     }
 }

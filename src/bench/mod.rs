@@ -1115,20 +1115,14 @@ pub const CPU_CHECKED_MS: f64 = 2.0;
 /// it an error naming the flag (the bench's own scene file would name a key and a line the
 /// user did not write).
 fn check_map(device: &wgpu::Device, map: Option<u32>, image: Option<(u32, u32)>) -> Result<()> {
-    let max = device.limits().max_texture_dimension_2d;
-    let sides = [
-        ("bench --map (shadow-map side)", map),
-        ("bench --image (width)", image.map(|(w, _)| w)),
-        ("bench --image (height)", image.map(|(_, h)| h)),
-    ];
-    match sides.into_iter().find(|(_, n)| n.is_some_and(|n| n > max)) {
-        Some((what, Some(n))) => Err(Error::Limit {
-            what: what.into(),
-            requested: u64::from(n),
-            limit: u64::from(max),
-        }),
-        _ => Ok(()),
-    }
+    crate::limits::flag_sides(
+        device.limits().max_texture_dimension_2d,
+        [
+            ("bench --map (shadow-map side)", map),
+            ("bench --image (width)", image.map(|(w, _)| w)),
+            ("bench --image (height)", image.map(|(_, h)| h)),
+        ],
+    )
 }
 
 /// The kernel benchmark's sizes (at least one, each 1 to the device's largest texture side) and
