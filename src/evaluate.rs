@@ -200,8 +200,23 @@ pub fn scene_for(path: &Path, opts: &EvaluateOptions) -> Result<Scene> {
         }
         scene.width = w;
         scene.height = h;
+        let by = match opts.image {
+            Some(_) => format!("evaluate --image {w}x{h}"),
+            None => format!("evaluate --quick, {w}x{h}"),
+        };
+        scene.locations.set_by("output.width", by.clone());
+        scene.locations.set_by("output.height", by);
     }
     Ok(scene)
+}
+
+/// Records in `scene`'s locations that every light's `key` (`shadow_map`, `shadow`) was set
+/// by `by`, so that a limit or memory error names the sweep's choice rather than the file's
+/// line.
+pub(crate) fn set_lights_by(scene: &mut Scene, key: &str, by: &str) {
+    for i in 0..scene.lights.len() {
+        scene.locations.set_by(format!("light[{i}].{key}"), by);
+    }
 }
 
 /// `shadowgraph evaluate`: runs the sweep on the scene at `scene_path` and writes
@@ -365,6 +380,14 @@ pub fn evaluate(
                 l.shadow.cascades = crate::model::Cascades::SINGLE;
             }
         }
+        // (`linear_maps` below renders this scene's maps too: its errors name the same.)
+        let by = format!("evaluate's configuration `{}`", c.label);
+        set_lights_by(&mut s, "shadow", &by);
+        let size_by = match opts.sizes {
+            Some(_) => format!("evaluate --sizes (configuration `{}`)", c.label),
+            None => by,
+        };
+        set_lights_by(&mut s, "shadow_map", &size_by);
         let linear = match linear.entry(c.shadow_map) {
             std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
             std::collections::hash_map::Entry::Vacant(e) => {

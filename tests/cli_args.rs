@@ -12,8 +12,14 @@ use std::time::{Duration, Instant};
 
 /// Runs the CLI, killing it after 60 s (a refusal must come long before).
 fn shadowgraph(args: &[&str]) -> Output {
+    shadowgraph_env(args, &[])
+}
+
+/// [`shadowgraph`] with `envs` set.
+fn shadowgraph_env(args: &[&str], envs: &[(&str, &str)]) -> Output {
     let mut child = Command::new(env!("CARGO_BIN_EXE_shadowgraph"))
         .args(args)
+        .envs(envs.iter().copied())
         .env("XDG_RUNTIME_DIR", std::env::temp_dir())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -408,5 +414,63 @@ fn empty_filters_and_oversized_images_are_named() {
         assert!(o.stdout.is_empty());
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(!err.contains("sphere_on_plane.toml"), "{err}");
+    }
+}
+
+/// A value a flag or the sweep set, past the memory budget, is named with what set it, not
+/// with the scene file's line (`scenes/bunny.toml:5:1: ... lower output.width` for
+/// `--image 4000x4000`, or a line of the lookup benchmark's bundled scene): one line, status 1,
+/// before any frame.
+#[test]
+fn memory_errors_name_the_flag_that_set_the_value() {
+    let s = scene();
+    let out = std::env::temp_dir().join(format!("shadowgraph-set-by-{}", std::process::id()));
+    let out = out.to_str().unwrap();
+    let evaluate = [
+        "evaluate",
+        &s,
+        "--out",
+        out,
+        "--quick",
+        "--techniques",
+        "hard",
+    ];
+    let lookup = ["bench", "--lookup", "3", "--repeat", "1"];
+    for (base, extra, budget, needles) in [
+        (
+            &evaluate[..],
+            &["--image", "4000x4000"][..],
+            "64MiB",
+            &["(`output.width` from evaluate --image 4000x4000)"][..],
+        ),
+        (
+            &evaluate,
+            &["--sizes", "8192"],
+            "64MiB",
+            &["(`light[0].shadow_map` from evaluate --sizes (configuration `hard 8192`))"],
+        ),
+        (
+            &lookup,
+            &["--image", "2000x2000"],
+            "32MiB",
+            &["scenes/techniques/vsm.toml (`output.width` from bench --lookup --image 2000x2000)"],
+        ),
+        (
+            &lookup,
+            &["--map", "8192"],
+            "64MiB",
+            &["(`light[0].shadow_map` from bench --lookup --map 8192)"],
+        ),
+    ] {
+        let args = [base, extra].concat();
+        let what = args.join(" ");
+        let o = shadowgraph_env(&args, &[("SHADOWGRAPH_MEMORY_BUDGET", budget)]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "`{what}`: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "`{what}`: {err}");
+        for n in needles.iter().chain(&["SHADOWGRAPH_MEMORY_BUDGET"]) {
+            assert!(err.contains(n), "`{what}`: `{n}` missing from {err}");
+        }
+        assert!(!err.contains(".toml:"), "`{what}` names a line: {err}");
     }
 }

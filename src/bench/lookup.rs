@@ -70,17 +70,17 @@ pub fn lookup_cost(
         ));
     }
     super::check_map(&gpu.device, map, image)?;
-    let mut base = crate::scene::Scene::parse(std::path::Path::new("vsm.toml"), LOOKUP_SCENE)?;
-    if let Some((w, h)) = image {
-        (base.width, base.height) = (w, h);
-    }
-    if let Some(n) = map {
-        base.lights[0].shadow_map = n;
-    }
+    let scene = crate::scene::Scene::parse(
+        std::path::Path::new("scenes/techniques/vsm.toml"),
+        LOOKUP_SCENE,
+    )?;
+    let base = super::with_flags(scene, map, image);
     let mut renderer = crate::render::Renderer::new(&gpu.device);
     let mut shade = |technique: Technique| -> Result<(f64, f64)> {
         let mut scene = base.clone();
         scene.lights[0].shadow.technique = technique;
+        let by = format!("bench --lookup's `{}` configuration", technique.name());
+        scene.locations.set_by("light[0].shadow", by);
         // On a GPU, untimed frames until its clocks have risen; then the WARMUP frames below
         // as on any device.
         renderer.warm_up(&gpu.device, &gpu.queue, &scene)?;

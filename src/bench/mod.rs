@@ -1125,6 +1125,30 @@ fn check_map(device: &wgpu::Device, map: Option<u32>, image: Option<(u32, u32)>)
     )
 }
 
+/// `bench --lookup`'s scene with `--image` and `--map` applied, each recorded as set by its flag
+/// (`Locations::set_by`), so that a limit or memory error names the flag rather than a line of
+/// the bundled scene, which the user did not write.
+fn with_flags(
+    mut scene: crate::scene::Scene,
+    map: Option<u32>,
+    image: Option<(u32, u32)>,
+) -> crate::scene::Scene {
+    if let Some((w, h)) = image {
+        (scene.width, scene.height) = (w, h);
+        let by = format!("bench --lookup --image {w}x{h}");
+        scene.locations.set_by("output.width", by.clone());
+        scene.locations.set_by("output.height", by);
+    }
+    if let Some(n) = map {
+        for (i, l) in scene.lights.iter_mut().enumerate() {
+            l.shadow_map = n;
+            let by = format!("bench --lookup --map {n}");
+            scene.locations.set_by(format!("light[{i}].shadow_map"), by);
+        }
+    }
+    scene
+}
+
 /// The kernel benchmark's sizes (at least one, each 1 to the device's largest texture side) and
 /// `repeat` (at least 1), checked before any work; [`run`] and the `kernel_wall` example share
 /// it.

@@ -103,7 +103,7 @@ fn scene_with(shadow: &str) -> Result<Scene> {
         &SOFT_SCENE[..start],
         &SOFT_SCENE[end..]
     );
-    Scene::parse(std::path::Path::new("cssm.toml"), &text)
+    Scene::parse(std::path::Path::new("scenes/techniques/cssm.toml"), &text)
 }
 
 /// The declared shading fetches per pixel of the scene's one light.
@@ -180,14 +180,10 @@ pub fn soft_cost(
         .map(|(_, t)| t)
         .collect();
     let mut scenes = Vec::new();
-    for (_, shadow) in &picked {
-        let mut base = scene_with(shadow)?;
-        if let Some((w, h)) = image {
-            (base.width, base.height) = (w, h);
-        }
-        if let Some(n) = map {
-            base.lights[0].shadow_map = n;
-        }
+    for (name, shadow) in &picked {
+        let mut base = super::with_flags(scene_with(shadow)?, map, image);
+        let by = format!("bench --lookup's `{name}` configuration");
+        base.locations.set_by("light[0].shadow", by);
         for &size in sizes {
             let mut scene = base.clone();
             scene.lights[0].size = size;

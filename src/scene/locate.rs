@@ -28,6 +28,10 @@ pub fn line_col(text: &str, at: usize) -> String {
 pub struct Locations {
     spans: Vec<(String, Range<usize>, Range<usize>)>,
     at: HashMap<String, String>,
+    /// Keys whose value a command line or a sweep set after the file was read, with what set
+    /// them (`evaluate --image 4000x3000`): an error about such a key names that, not the
+    /// file's line, which the user did not write.
+    set_by: Vec<(String, String)>,
 }
 
 impl Locations {
@@ -72,9 +76,22 @@ impl Locations {
         }
     }
 
-    /// `:line:col` of `key`, else of the nearest enclosing key written (`light[0].shadow_map`
-    /// falls back to `light[0]`), else empty.
+    /// Where the value of `key` comes from, to follow the scene file's path in an error: where
+    /// `key` or a key enclosing it was set after reading ([`Locations::set_by`]),
+    /// `` (`output.width` from evaluate --image 4000x3000)``; else `:line:col` of `key`, else
+    /// of the nearest enclosing key written (`light[0].shadow_map` falls back to `light[0]`),
+    /// else empty.
     pub fn get(&self, key: &str) -> String {
+        let mut k = key;
+        loop {
+            if let Some((set, by)) = self.set_by.iter().rev().find(|(set, _)| set == k) {
+                return format!(" (`{set}` from {by})");
+            }
+            match k.rfind(['.', '[']) {
+                Some(i) => k = &k[..i],
+                None => break,
+            }
+        }
         let mut k = key;
         loop {
             if let Some(at) = self.at.get(k) {
@@ -85,6 +102,13 @@ impl Locations {
                 None => return String::new(),
             }
         }
+    }
+
+    /// Records that `key`'s value (and every key under it) was set by `by` after the file was
+    /// read, e.g. `("output.width", "evaluate --image 4000x3000")`: [`Locations::get`] then
+    /// names `by` instead of the file's line. The latest record for a key wins.
+    pub fn set_by(&mut self, key: impl Into<String>, by: impl Into<String>) {
+        self.set_by.push((key.into(), by.into()));
     }
 
     /// The deepest key whose key or value contains `span`.
@@ -224,6 +248,25 @@ mod tests {
         assert_eq!(l.get("nothing.here"), "");
         let at = text.find("\"y\"").unwrap();
         assert_eq!(l.key_at(&(at..at + 3)), Some("light[1].kind"));
+    }
+
+    /// A key set after reading is named with what set it, and so are the keys under it; its
+    /// neighbours keep their lines, and the latest setter wins.
+    #[test]
+    fn keys_set_after_reading_name_their_setter() {
+        let text = "[output]\nwidth = 3\nheight = 2\n[[light]]\nshadow_map = 64\n\
+                    [light.shadow]\ntechnique = \"pcf\"\n";
+        let mut l = Locations::of(text);
+        l.set_by("output.width", "--image 9x9");
+        l.set_by("light[0].shadow", "configuration `a`");
+        l.set_by("light[0].shadow", "configuration `b`");
+        assert_eq!(l.get("output.width"), " (`output.width` from --image 9x9)");
+        assert_eq!(l.get("output.height"), ":3:1");
+        assert_eq!(
+            l.get("light[0].shadow.technique"),
+            " (`light[0].shadow` from configuration `b`)"
+        );
+        assert_eq!(l.get("light[0].shadow_map"), ":5:1");
     }
 
     #[test]
