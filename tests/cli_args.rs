@@ -138,8 +138,8 @@ fn library_entry_points_check_the_same_bounds() {
 /// The lookup benchmark's options apply to `--lookup` only: given without it they are refused
 /// naming `--lookup` (clap's message on one line), as is a `--map` of 32768 (past lavapipe's
 /// texture side, named as `--map`; past the memory budget where a device allows that side) and
-/// an `--only` that names no soft configuration or a light size that is not a positive width,
-/// both before any table is printed.
+/// an `--only` that names no soft configuration or a light size that is not a positive width
+/// in a scene's `light.size` range, both before any table is printed.
 #[test]
 fn lookup_options_need_the_lookup_and_sane_values() {
     for extra in [
@@ -170,6 +170,11 @@ fn lookup_options_need_the_lookup_and_sane_values() {
         (&["--light-sizes", "nan"], &["light size NaN", "positive"]),
         (&["--light-sizes", "0.5,-1"], &["light size -1", "positive"]),
         (&["--light-sizes", "0"], &["light size 0", "positive"]),
+        // Past a scene's `light.size` range (it rendered, a light 10³⁰ wide).
+        (
+            &["--light-sizes", "1e30"],
+            &["light size 1", "up to 1000000"],
+        ),
     ] {
         let mut args = vec!["bench", "--lookup", "3", "--repeat", "1"];
         args.extend_from_slice(extra);

@@ -116,7 +116,7 @@ fn shading_fetches(scene: &Scene) -> Result<f64> {
 }
 
 /// The checks [`soft_cost`] makes of its arguments before any work: light sizes (at least one,
-/// each a positive finite world width), `repeat` ≥ 1, and an `only` that names at least one
+/// each a positive world width in a scene's `light.size` range), `repeat` ≥ 1, and an `only` that names at least one
 /// configuration of [`SOFT_TECHNIQUES`]. The command line makes them before `bench --lookup`'s
 /// first table, so a bad argument is refused at once rather than after it.
 pub fn check_soft_args(sizes: &[f32], repeat: u32, only: &[String]) -> Result<()> {
@@ -125,9 +125,15 @@ pub fn check_soft_args(sizes: &[f32], repeat: u32, only: &[String]) -> Result<()
             "soft benchmark needs light sizes and repeat ≥ 1".into(),
         ));
     }
-    if let Some(s) = sizes.iter().find(|s| !(s.is_finite() && **s > 0.0)) {
+    // A scene's `light.size` range, whose bound keeps products of two lengths finite in f32.
+    let most = crate::scene::LENGTH_RANGE.1;
+    if let Some(s) = sizes
+        .iter()
+        .find(|&&s| !(s.is_finite() && s > 0.0 && f64::from(s) <= most))
+    {
         return Err(Error::Invalid(format!(
-            "soft benchmark light size {s}: sizes are positive world widths"
+            "soft benchmark light size {s}: sizes are positive world widths up to {most} (a \
+             scene's `light.size` range)"
         )));
     }
     super::check_only("bench --lookup --only", only)?;

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use glam::Vec3;
 
-use super::ctx::{Ctx, fmt_num};
+use super::ctx::{Ctx, LENGTH_RANGE, fmt_num};
 use super::format::{LightFile, SceneFile};
 use super::locate::{self, Locations};
 use super::{Camera, Light, LightKind, Scene, Shadow, Technique, object, validate};
@@ -185,7 +185,7 @@ fn light(ctx: &Ctx, i: usize, l: &LightFile) -> Result<Light> {
             ),
         ));
     }
-    let size = ctx.num_or(&key("size"), &l.size, 0.0, 1e6, 0.0)?;
+    let size = ctx.num_or(&key("size"), &l.size, 0.0, LENGTH_RANGE.1, 0.0)?;
     let color = ctx.color_or(&key("color"), &l.color, Vec3::ONE)?;
     let intensity = ctx.num_or(&key("intensity"), &l.intensity, 0.0, 1e6, 1.0)?;
     let shadow_map = ctx.int_or(&key("shadow_map"), &l.shadow_map, 1, MAX_SIDE, 1024)?;
