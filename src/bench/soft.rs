@@ -116,9 +116,10 @@ fn shading_fetches(scene: &Scene) -> Result<f64> {
 }
 
 /// The checks [`soft_cost`] makes of its arguments before any work: light sizes (at least one,
-/// each a positive world width in a scene's `light.size` range), `repeat` ≥ 1, and an `only` that names at least one
-/// configuration of [`SOFT_TECHNIQUES`]. The command line makes them before `bench --lookup`'s
-/// first table, so a bad argument is refused at once rather than after it.
+/// each a positive world width in a scene's `light.size` range), `repeat` ≥ 1, and an `only`
+/// that names at least one configuration of [`SOFT_TECHNIQUES`]. The command line makes them
+/// before `bench --lookup`'s first table, so a bad argument is refused at once rather than
+/// after it.
 pub fn check_soft_args(sizes: &[f32], repeat: u32, only: &[String]) -> Result<()> {
     if sizes.is_empty() || repeat == 0 {
         return Err(Error::Invalid(
