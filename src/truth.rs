@@ -236,7 +236,11 @@ pub fn area_light_truth(
             .resolution
             .unwrap_or_else(|| default_resolution(light, max));
         let samples = emitter::samples(light, &offsets, res, z_min);
-        let counts = accumulate(renderer, device, queue, &geometry, light, &samples, res)?;
+        let dims = samples.first().map_or((res, res), |s| {
+            (s.light.map_size[0] as u32, s.light.map_size[1] as u32)
+        });
+        check_memory(li, dims, (w, h), opts.resolution.is_some())?;
+        let counts = accumulate(renderer, device, queue, &geometry, light, &samples, dims)?;
         for (px, &c) in counts.iter().enumerate() {
             // Background stays 1, as the renderer reports it.
             if frame.position[4 * px + 3] != 0.0 {
@@ -246,6 +250,36 @@ pub fn area_light_truth(
         truth.resolution.push(res);
     }
     Ok(truth)
+}
+
+/// The truth of light `li` against the memory budget (`SHADOWGRAPH_MEMORY_BUDGET`, as every
+/// frame is): its depth map of `dims` texels, which every emitter sample rasterizes in turn,
+/// and the per-pixel counts of the `image` and their read-back. `asked`: the resolution came
+/// from `--truth-resolution` (else the default, which the message names).
+fn check_memory(li: usize, dims: (u32, u32), image: (u32, u32), asked: bool) -> Result<()> {
+    let budget = crate::limits::memory_budget()?;
+    let depth = u64::from(dims.0) * u64::from(dims.1) * 4;
+    let counts = 2 * u64::from(image.0) * u64::from(image.1) * 4;
+    if depth + counts <= budget {
+        return Ok(());
+    }
+    let fix = if asked {
+        "lower --truth-resolution"
+    } else {
+        "set a lower --truth-resolution (the default is twice the light's shadow_map, 2048 to 8192 texels a side)"
+    };
+    let b = crate::graph::print::human_bytes;
+    Err(Error::Invalid(format!(
+        "the truth of light[{li}] needs {} (a {}×{} depth map: {}; the image's counts: {}), more \
+         than the memory budget of {} ({}): {fix} or raise the budget",
+        b(depth + counts),
+        dims.0,
+        dims.1,
+        b(depth),
+        b(counts),
+        b(budget),
+        crate::limits::MEMORY_BUDGET_ENV
+    )))
 }
 
 /// World position and unit normal of G-buffer pixel `px`.
@@ -331,7 +365,7 @@ fn accumulate(
     geo: &Geometry,
     light: &Light,
     samples: &[emitter::EmitterSample],
-    resolution: u32,
+    dims: (u32, u32),
 ) -> Result<Vec<u32>> {
     let kernel = renderer.executor.kernels.get(device, "truth_accumulate")?;
     let (w, h) = geo.size;
@@ -340,9 +374,6 @@ fn accumulate(
         label: Some("shadowgraph.truth.counts"),
         contents: &vec![0u8; bytes as usize],
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-    });
-    let dims = samples.first().map_or((resolution, resolution), |s| {
-        (s.light.map_size[0] as u32, s.light.map_size[1] as u32)
     });
     let depth = texture(
         device,

@@ -424,8 +424,8 @@ fn empty_filters_and_oversized_images_are_named() {
 
 /// A value a flag or the sweep set, past the memory budget, is named with what set it, not
 /// with the scene file's line (`scenes/bunny.toml:5:1: ... lower output.width` for
-/// `--image 4000x4000`, or a line of the lookup benchmark's bundled scene): one line, status 1,
-/// before any frame.
+/// `--image 4000x4000`, or a line of the lookup benchmark's bundled scene), and so is the
+/// truth's resolution: one line, status 1, before any frame is timed.
 #[test]
 fn memory_errors_name_the_flag_that_set_the_value() {
     let s = scene();
@@ -453,6 +453,17 @@ fn memory_errors_name_the_flag_that_set_the_value() {
             &["--sizes", "8192"],
             "64MiB",
             &["(`light[0].shadow_map` from evaluate --sizes (configuration `hard 8192`))"],
+        ),
+        // The truth's depth map, which no frame plan counts (8192² ran under a 64 MiB budget).
+        (
+            &evaluate,
+            &["--truth-resolution", "8192"],
+            "64MiB",
+            &[
+                "the truth of light[0]",
+                "8192×8192 depth map",
+                "lower --truth-resolution",
+            ],
         ),
         (
             &lookup,
