@@ -213,7 +213,7 @@ pub fn scene_for(path: &Path, opts: &EvaluateOptions) -> Result<Scene> {
 /// Records in `scene`'s locations that every light's `key` (`shadow_map`, `shadow`) was set
 /// by `by`, so that a limit or memory error names the sweep's choice rather than the file's
 /// line.
-pub(crate) fn set_lights_by(scene: &mut Scene, key: &str, by: &str) {
+fn set_lights_by(scene: &mut Scene, key: &str, by: &str) {
     for i in 0..scene.lights.len() {
         scene.locations.set_by(format!("light[{i}].{key}"), by);
     }

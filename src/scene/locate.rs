@@ -82,25 +82,13 @@ impl Locations {
     /// of the nearest enclosing key written (`light[0].shadow_map` falls back to `light[0]`),
     /// else empty.
     pub fn get(&self, key: &str) -> String {
-        let mut k = key;
-        loop {
-            if let Some((set, by)) = self.set_by.iter().rev().find(|(set, _)| set == k) {
-                return format!(" (`{set}` from {by})");
-            }
-            match k.rfind(['.', '[']) {
-                Some(i) => k = &k[..i],
-                None => break,
-            }
-        }
-        let mut k = key;
-        loop {
-            if let Some(at) = self.at.get(k) {
-                return at.clone();
-            }
-            match k.rfind(['.', '[']) {
-                Some(i) => k = &k[..i],
-                None => return String::new(),
-            }
+        let set = enclosing(key).find_map(|k| self.set_by.iter().rev().find(|(set, _)| set == k));
+        match set {
+            Some((set, by)) => format!(" (`{set}` from {by})"),
+            None => enclosing(key)
+                .find_map(|k| self.at.get(k))
+                .cloned()
+                .unwrap_or_default(),
         }
     }
 
@@ -120,6 +108,12 @@ impl Locations {
             .max_by_key(|(p, _, _)| p.len())
             .map(|(p, _, _)| p.as_str())
     }
+}
+
+/// `key`, then each key enclosing it, nearest first: `light[0].shadow_map`, `light[0]`,
+/// `light`.
+fn enclosing(key: &str) -> impl Iterator<Item = &str> {
+    std::iter::successors(Some(key), |k| k.rfind(['.', '[']).map(|i| &k[..i]))
 }
 
 /// Start of the `[[…]]` header line at or before `at` (an array-of-tables element's span
