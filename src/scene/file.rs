@@ -31,6 +31,11 @@ pub struct Scene {
     pub warnings: Vec<String>,
     /// Where each key was written, for errors found later (device limits, memory).
     pub locations: Locations,
+    /// Per light, how often its map is redrawn (`update`; a light past the list's end: every
+    /// frame). See [`Scene::update_rate`].
+    pub updates: Vec<super::UpdateRate>,
+    /// The `[animation]`, if any ([`Scene::at_frame`]).
+    pub animation: Option<super::Animation>,
 }
 
 /// Largest scene file read (the bundled ones are 1–3 KiB); reading stops past it.
@@ -84,6 +89,11 @@ impl Scene {
     /// Parses scene text; `path` names the file in errors and anchors relative mesh paths.
     pub fn parse(path: &Path, text: &str) -> Result<Self> {
         parse::parse(path, text.strip_prefix('\u{feff}').unwrap_or(text))
+    }
+
+    /// How often light `i`'s map is redrawn (every frame unless its `update` says otherwise).
+    pub fn update_rate(&self, i: usize) -> super::UpdateRate {
+        self.updates.get(i).copied().unwrap_or_default()
     }
 
     /// All objects' triangles as one vertex list (material = object index).

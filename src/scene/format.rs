@@ -32,6 +32,8 @@ pub struct SceneFile {
     /// `[[object]]`.
     #[serde(default, rename = "object")]
     pub objects: Vec<ObjectFile>,
+    /// `[animation]`.
+    pub animation: Option<AnimationFile>,
 }
 
 /// `[output]`.
@@ -88,6 +90,8 @@ pub struct LightFile {
     pub shadow_map: Option<Spanned<i64>>,
     /// `[light.shadow]`.
     pub shadow: Option<ShadowFile>,
+    /// How often the map is redrawn: frames (1, k) or `"static"`.
+    pub update: Option<Spanned<toml::Value>>,
 }
 
 /// `[light.shadow]`: the technique and its parameters.
@@ -198,4 +202,36 @@ pub struct ObjectFile {
     pub scale: Option<Spanned<Num>>,
     /// Albedo.
     pub color: Option<V3>,
+}
+
+/// `[animation]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AnimationFile {
+    /// Frames F.
+    pub frames: Spanned<i64>,
+    /// `[[animation.track]]`.
+    #[serde(default, rename = "track")]
+    pub tracks: Vec<TrackFile>,
+}
+
+/// `[[animation.track]]`: one animated value.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrackFile {
+    /// What moves: `light[i].position`, `light[i].target`, `camera.position`,
+    /// `camera.target` or `object[i].translate`.
+    pub animate: Spanned<String>,
+    /// Keyframes, in frame order.
+    pub keys: Spanned<Vec<KeyFile>>,
+}
+
+/// A keyframe: `{ frame = 0, value = [x, y, z] }`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KeyFile {
+    /// Its frame.
+    pub frame: Spanned<i64>,
+    /// The value there.
+    pub value: V3,
 }

@@ -3,6 +3,8 @@
 //! `format`) with errors that name the file, the key and the line.
 
 #[cfg(feature = "cli")]
+mod animation;
+#[cfg(feature = "cli")]
 mod ctx;
 #[cfg(feature = "cli")]
 mod file;
@@ -23,6 +25,8 @@ mod object;
 #[cfg(feature = "cli")]
 mod parse;
 #[cfg(feature = "cli")]
+mod update;
+#[cfg(feature = "cli")]
 mod validate;
 
 pub use crate::model::{
@@ -31,6 +35,8 @@ pub use crate::model::{
     Technique, default_moment_bias, default_soft_moment_bias, exponent_limit,
 };
 pub use crate::technique::sat_exponent_limit;
+#[cfg(feature = "cli")]
+pub use animation::{Animated, Animation, MAX_ANIMATION_FRAMES, Track};
 #[cfg(feature = "cli")]
 pub use ctx::{COLOR_LIMIT, COORD_LIMIT, LENGTH_RANGE, ROTATION_LIMIT, fmt_num};
 #[cfg(feature = "cli")]
@@ -41,3 +47,5 @@ pub use locate::Locations;
 pub use mesh::{Mesh, Vertex};
 #[cfg(feature = "cli")]
 pub use object::{MAX_TRIANGLES, WORLD_LIMIT};
+#[cfg(feature = "cli")]
+pub use update::{MAX_UPDATE_PERIOD, UpdateRate};

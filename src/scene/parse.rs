@@ -9,7 +9,9 @@ use glam::Vec3;
 use super::ctx::{Ctx, LENGTH_RANGE, fmt_num};
 use super::format::{LightFile, SceneFile};
 use super::locate::{self, Locations};
-use super::{Camera, Light, LightKind, Scene, Shadow, Technique, object, validate};
+use super::{
+    Camera, Light, LightKind, Scene, Shadow, Technique, animation, object, update, validate,
+};
 use crate::error::Result;
 
 /// Largest output or shadow-map side accepted before the device is even asked.
@@ -59,6 +61,17 @@ pub(super) fn parse(path: &Path, text: &str) -> Result<Scene> {
     if objects.is_empty() {
         return Err(ctx.err(None, "the scene has no `[[object]]`"));
     }
+    let updates = file
+        .lights
+        .iter()
+        .enumerate()
+        .map(|(i, l)| update::update_rate(&ctx, i, &l.update))
+        .collect::<Result<Vec<_>>>()?;
+    let animation = file
+        .animation
+        .as_ref()
+        .map(|a| animation::animation(&ctx, a, &lights, &camera, &file.objects, &objects))
+        .transpose()?;
     Ok(Scene {
         path: path.to_path_buf(),
         width,
@@ -70,6 +83,8 @@ pub(super) fn parse(path: &Path, text: &str) -> Result<Scene> {
         objects,
         warnings: ctx.warnings.into_inner(),
         locations,
+        updates,
+        animation,
     })
 }
 
