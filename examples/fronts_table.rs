@@ -1,4 +1,4 @@
-//! Prints the README's table of Pareto fronts for the reports under a directory
+//! Prints docs/MEASURED.md's table of Pareto fronts for the reports under a directory
 //! (`benches/evaluation` by default): per scene, the techniques on the front of total time
 //! against the penumbra error and against FLIP, fastest first.
 //!

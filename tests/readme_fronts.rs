@@ -1,7 +1,7 @@
-//! The README's table of Pareto fronts is the summary of the committed reports
-//! (`benches/evaluation/<scene>/report.csv`, `evaluate::summary`), so it cannot drift from
-//! them: `SHADOWGRAPH_BLESS=1 cargo test --release --test readme_fronts` rewrites it after the
-//! reports are regenerated.
+//! The table of Pareto fronts in docs/MEASURED.md (which the README's headline figures link
+//! to) is the summary of the committed reports (`benches/evaluation/<scene>/report.csv`,
+//! `evaluate::summary`), so it cannot drift from them: `SHADOWGRAPH_BLESS=1 cargo test
+//! --release --test readme_fronts` rewrites it after the reports are regenerated.
 
 use std::path::Path;
 
@@ -9,7 +9,7 @@ const BEGIN: &str = "<!-- fronts:begin";
 const END: &str = "<!-- fronts:end -->";
 
 #[test]
-fn readme_fronts_table_is_the_committed_reports_summary() {
+fn fronts_table_is_the_committed_reports_summary() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let table = shadowgraph::evaluate::summary::fronts_table_of(&root.join("benches/evaluation"))
         .expect("summary of the committed reports");
@@ -17,23 +17,25 @@ fn readme_fronts_table_is_the_committed_reports_summary() {
         table.lines().count() >= 2 + 9,
         "fewer than nine scenes' reports:\n{table}"
     );
-    let readme_path = root.join("README.md");
-    let readme = std::fs::read_to_string(&readme_path).expect("README.md");
-    let begin = readme
+    let doc_path = root.join("docs/MEASURED.md");
+    let doc = std::fs::read_to_string(&doc_path).expect("docs/MEASURED.md");
+    let begin = doc
         .find(BEGIN)
-        .expect("README has the fronts:begin marker");
-    let body = begin + readme[begin..].find('\n').expect("marker line") + 1;
-    let end = readme.find(END).expect("README has the fronts:end marker");
+        .expect("docs/MEASURED.md has the fronts:begin marker");
+    let body = begin + doc[begin..].find('\n').expect("marker line") + 1;
+    let end = doc
+        .find(END)
+        .expect("docs/MEASURED.md has the fronts:end marker");
     assert!(body <= end, "markers out of order");
     if std::env::var_os("SHADOWGRAPH_BLESS").is_some() {
-        let new = format!("{}{table}{}", &readme[..body], &readme[end..]);
-        std::fs::write(&readme_path, new).expect("rewrite README.md");
+        let new = format!("{}{table}{}", &doc[..body], &doc[end..]);
+        std::fs::write(&doc_path, new).expect("rewrite docs/MEASURED.md");
         return;
     }
     assert!(
-        readme[body..end] == table,
-        "README's fronts table is stale: regenerate it with `SHADOWGRAPH_BLESS=1 cargo test \
-         --release --test readme_fronts`\n--- README\n{}\n--- reports\n{table}",
-        &readme[body..end]
+        doc[body..end] == table,
+        "docs/MEASURED.md's fronts table is stale: regenerate it with `SHADOWGRAPH_BLESS=1 \
+         cargo test --release --test readme_fronts`\n--- docs/MEASURED.md\n{}\n--- reports\n{table}",
+        &doc[body..end]
     );
 }

@@ -1,8 +1,8 @@
-//! The README's summary of the committed evaluations: for each scene's `report.csv` under a
-//! directory (`benches/evaluation/<scene>/`), which techniques lie on the Pareto front of
-//! total time against the penumbra error and against FLIP, fastest first, with the fastest and
-//! the most accurate configuration of each front. `tests/readme_fronts.rs` checks that the
-//! README's table is this text for the committed reports.
+//! The summary of the committed evaluations in docs/MEASURED.md: for each scene's
+//! `report.csv` under a directory (`benches/evaluation/<scene>/`), which techniques lie on the
+//! Pareto front of total time against the penumbra error and against FLIP, fastest first, with
+//! the fastest and the most accurate configuration of each front. `tests/readme_fronts.rs`
+//! checks that docs/MEASURED.md's table is this text for the committed reports.
 
 use std::fmt::Write as _;
 use std::path::Path;

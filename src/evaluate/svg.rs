@@ -87,8 +87,8 @@ pub fn front(rows: &[Row], metric: Metric) -> Vec<usize> {
 }
 
 /// Indices of the points `(time, error)` on their Pareto front, fastest first (points without
-/// a time are left out): what [`front`] computes for a report's rows, and the README's summary
-/// for the committed reports' (`evaluate::summary`).
+/// a time are left out): what [`front`] computes for a report's rows, and docs/MEASURED.md's
+/// summary for the committed reports' (`evaluate::summary`).
 pub fn pareto_front(points: &[(Option<f64>, f64)]) -> Vec<usize> {
     let mut timed: Vec<usize> = (0..points.len())
         .filter(|&i| points[i].0.is_some())
