@@ -1,10 +1,11 @@
 //! Depth biases against the bias-free ray cast: renders a scene once per bias setting of its
 //! first light (constant only, slope-scaled only, normal offset only, the scene's own, and
-//! receiver-plane), then with the second-depth techniques (`midpoint`, `second_depth`: no bias
-//! but the constant one where a texel has no second surface), and counts, over the pixels the f64 ray cast finds relevant, *acne* (the ray
-//! cast sees the light's centre, the render's visibility < ½) and *leak* (the ray cast does not,
-//! the render ≥ ½). `cargo run --release --example bias_modes -- scenes/grazing.toml [MAP]`
-//! (`MAP`: the first light's map side instead of the scene's).
+//! receiver-plane), then with the second-depth techniques (`midpoint`, `second_depth`: no bias;
+//! the far plane where a texel has no second surface), and counts, over the pixels the f64 ray
+//! cast finds relevant, *acne* (the ray cast sees the light's centre, the render's visibility
+//! < ½) and *leak* (the ray cast does not, the render ≥ ½).
+//! `cargo run --release --example bias_modes -- scenes/grazing.toml [MAP]` (`MAP`: the first
+//! light's map side instead of the scene's).
 
 use shadowgraph::gpu::Gpu;
 use shadowgraph::render::{RenderOptions, Renderer};
@@ -14,10 +15,10 @@ use shadowgraph::truth::{emitter, raycast::ray_cast_truth};
 /// (label, bias, slope_bias, normal_bias, receiver_plane cap).
 type Mode = (&'static str, f32, f32, f32, f32);
 
-/// The second-depth techniques, with the constant bias of their fallback texels.
+/// The second-depth techniques (they read no bias: 0).
 const SECOND_DEPTH: &[(&str, &str, f32)] = &[
-    ("midpoint (fallback bias 0.002)", "midpoint", 0.002),
-    ("second_depth (fallback bias 0.002)", "second_depth", 0.002),
+    ("midpoint", "midpoint", 0.0),
+    ("second_depth", "second_depth", 0.0),
 ];
 
 const MODES: &[Mode] = &[

@@ -1,19 +1,25 @@
 // The first and second rasterized depths → the depth a second-depth shadow map compares
 // against: the midpoint (z1 + z2)/2 (Woo 1992, `mode` 0) or the second depth z2 (Wang & Molnar
-// 1994, `mode` 1), both linear. Where no second surface was rasterized (z2 still the cleared
-// far plane: a lone plane, an open mesh's edge, the map's empty texels) the texel falls back to
-// the first depth plus the constant bias, the test a `hard` light makes: the shading then
-// compares with no bias of its own. The peel pass (`shadow_peel`) wrote z2.
+// 1994, `mode` 1), both linear; the shading compares with no bias. The peel pass
+// (`shadow_peel`) wrote z2 and clears to 1.0, the far plane, where no second surface was
+// rasterized (a lone plane such as the ground, an open mesh's rim, the map's empty texels); a
+// non-finite z2 linearizes to 1.0 too. There z2 is the far plane, as Wang & Molnar store it,
+// and both modes store it: nothing lies behind the first surface, so the texel can shadow no
+// receiver, and the one surface along its ray is lit. The midpoint of z1 and nothing is
+// nothing: Woo's formula with the far plane as z2, (z1 + 1)/2, would put a phantom occluder
+// halfway to the far plane, which a first surface near the far plane and steep to the light
+// comes within a texel's depth slope of (acne again), so `midpoint` holds 1.0 too. Cost: one
+// comparison in the select, no memory.
 
 // #import shared/linear_depth
 
 // Keep in sync with `SecondDepthParams` in src/gpu_data.rs.
 struct Params {
     depth: DepthParams,
-    mode: u32,          // 0 midpoint, 1 second depth
-    fallback_bias: f32, // added to z1 where there is no z2, linear depth units
+    mode: u32, // 0 midpoint, 1 second depth
     _pad0: u32,
     _pad1: u32,
+    _pad2: u32,
 }
 
 // Traffic (the cost model, src/graph/cost): both depths in, one texel out.
@@ -36,14 +42,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let first = load_linear_depth(src, id.xy, params.depth);
-    let raw2 = textureLoad(src2, id.xy, 0).r;
     let second = load_linear_depth(src2, id.xy, params.depth);
     if !first.finite || !second.finite {
         atomicAdd(&stats[0], 1u);
     }
-    // The peel pass clears to 1.0 (the far plane): nothing behind the first surface.
-    let missing = !second.finite || raw2 >= 1.0;
-    var z = select(0.5 * (first.z + second.z), second.z, params.mode == 1u);
-    z = select(z, first.z + params.fallback_bias, missing);
+    // No second surface: `second.z` is 1.0, the far plane, stored as it is (see the top).
+    let z = select(0.5 * (first.z + second.z), second.z, params.mode == 1u || second.z >= 1.0);
     textureStore(dst, id.xy, vec4<f32>(z, 0.0, 0.0, 0.0));
 }

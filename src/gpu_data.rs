@@ -247,12 +247,11 @@ pub struct VsmParams {
 pub struct SecondDepthParams {
     /// The depth buffer's linearization (both depths').
     pub depth: LinearizeParams,
-    /// 0: the midpoint of the first and second depths; 1: the second depth.
+    /// 0: the midpoint of the first and second depths; 1: the second depth. Both store the
+    /// far plane (1.0) where no second surface was rasterized.
     pub mode: u32,
-    /// Added to the first depth where no second surface was rasterized, linear depth units.
-    pub fallback_bias: f32,
     /// Padding.
-    pub _pad: [u32; 2],
+    pub _pad: [u32; 3],
 }
 
 /// The peel pass's margin in depth-buffer units (`PEEL_EPSILON` in `kernels/shadow_peel.wgsl`,

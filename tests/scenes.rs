@@ -97,8 +97,9 @@ fn pixel_reference(
             Technique::Pcf { .. } => cpu::vis_pcf::vis_pcf(&map, &lg, t),
             Technique::Pcss { .. } => cpu::vis_pcss::vis_pcss(&map, &lg, t),
             Technique::Smrt { .. } => cpu::vis_smrt::vis_smrt(&map, &lg, t),
-            // The map holds the comparison depth (bias folded in): tests/second_depth.rs
-            // checks it against the ray cast and the kernel's reference.
+            // The map holds the comparison depth (no bias; the far plane where no second
+            // surface exists): tests/second_depth.rs checks it against the ray cast and the
+            // kernel's reference.
             Technique::Midpoint { radius: 0, .. } | Technique::SecondDepth { radius: 0, .. } => {
                 cpu::vis_hard::vis_hard(&map, &lg, t)
             }

@@ -322,8 +322,8 @@ pub enum Technique {
         max_slope: f32,
     },
     /// Midpoint shadow maps (Woo 1992): the shading compares against the midpoint of the first
-    /// and second rasterized depths (a second, peeled raster pass); the first depth plus the
-    /// constant bias where no second surface exists.
+    /// and second rasterized depths (a second, peeled raster pass), with no bias; the far plane
+    /// where no second surface exists.
     Midpoint {
         /// PCF window radius in texels over the comparisons (0: the nearest texel alone).
         radius: u32,
@@ -331,7 +331,7 @@ pub enum Technique {
         kernel: PcfKernel,
     },
     /// Second-depth shadow maps (Wang & Molnar 1994): the shading compares against the second
-    /// rasterized depth; the first depth plus the constant bias where none exists.
+    /// rasterized depth, with no bias; the far plane where none exists.
     SecondDepth {
         /// PCF window radius in texels over the comparisons (0: the nearest texel alone).
         radius: u32,

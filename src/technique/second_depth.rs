@@ -2,10 +2,10 @@
 //! of the first and second surfaces, or of the second surface, seen from the light. A second
 //! raster pass peels the first surface off (`kernels/shadow_peel.wgsl`, imported as
 //! [`second_depth_name`]); the `second_depth` kernel turns both depths into the one map the
-//! shading compares against with `vis_hard` (or `vis_pcf` over a window, `radius` > 0). Where
-//! no second surface exists (a lone plane, the map's empty texels) a texel holds the first depth
-//! plus the constant `bias`, so a caster that is not watertight shades as `hard` with that bias
-//! there; elsewhere no bias is added.
+//! shading compares against with `vis_hard` (or `vis_pcf` over a window, `radius` > 0), with no
+//! bias: the light's constant `bias` is not read. Where no second surface exists (a lone plane
+//! such as the ground, an open mesh's rim, the map's empty texels) a texel holds the far plane
+//! in both modes: nothing lies behind its first surface, which is lit.
 
 use super::params::{choice, int};
 use super::shade::{VisibilityBody, call};
@@ -113,8 +113,7 @@ fn nodes(n: &mut LightNodes, mode: u32) -> ShadeInput {
     let params = SecondDepthParams {
         depth: n.lin,
         mode,
-        fallback_bias: n.light.shadow.bias,
-        _pad: [0; 2],
+        _pad: [0; 3],
     };
     n.graph.node(Node {
         name: format!("light{i}.second_depth"),
@@ -128,8 +127,8 @@ fn nodes(n: &mut LightNodes, mode: u32) -> ShadeInput {
     n.one(out)
 }
 
-/// The constant bias went into the map where it applies (the fallback texels): the shading
-/// adds none. The PCF window as `pcf`'s (`LightGpu::kernel`: 0 box, 1 tent).
+/// The map needs no bias (the far plane where there is no second surface): the shading adds
+/// none. The PCF window as `pcf`'s (`LightGpu::kernel`: 0 box, 1 tent).
 fn gpu(t: &Technique, g: &mut LightGpu) {
     g.bias = 0.0;
     let (radius, kernel) = window(t);
@@ -141,7 +140,7 @@ fn gpu(t: &Technique, g: &mut LightGpu) {
 pub(super) static MIDPOINT: TechniqueDef = TechniqueDef {
     name: "midpoint",
     id: TECHNIQUE_MIDPOINT,
-    doc: "midpoint shadow map (Woo): compares against (z1 + z2)/2 of a second, peeled raster pass; z1 + bias where there is no z2",
+    doc: "midpoint shadow map (Woo): compares against (z1 + z2)/2 of a second, peeled raster pass, no bias; the far plane where there is no z2",
     params: &[PARAMS],
     build: |v| {
         let (radius, kernel) = build_window(v);
@@ -164,7 +163,7 @@ pub(super) static MIDPOINT: TechniqueDef = TechniqueDef {
 pub(super) static SECOND_DEPTH: TechniqueDef = TechniqueDef {
     name: "second_depth",
     id: TECHNIQUE_SECOND_DEPTH,
-    doc: "second-depth shadow map (Wang & Molnar): compares against z2 of a second, peeled raster pass; z1 + bias where there is no z2",
+    doc: "second-depth shadow map (Wang & Molnar): compares against z2 of a second, peeled raster pass, no bias; the far plane where there is no z2",
     params: &[PARAMS],
     build: |v| {
         let (radius, kernel) = build_window(v);
