@@ -2,6 +2,7 @@
 //! the generated shading kernel ([`Renderer`]). Also [`probe`], which evaluates visibility at
 //! given points on given maps (how tests compare the GPU to the f64 references).
 
+mod cache;
 mod cascade;
 mod probe;
 mod renderer;
@@ -126,7 +127,11 @@ pub fn check_render(device: &wgpu::Device, scene: &Scene, opts: &RenderOptions) 
         )));
     }
     let drawn = drawn_lights(scene)?;
-    let sp = plan_lights_for(&drawn.lights, opts)?;
+    let mut sp = plan_lights_for(&drawn.lights, opts)?;
+    if cache::caches(scene) && !opts.dump {
+        // What the renderer runs: cached lights' maps in textures of their own.
+        sp.plan = cache::dedicate_outputs(sp.plan);
+    }
     // A cascaded scene is checked as the lights it draws (its visibility buffer counted for
     // every cascade: an over-estimate).
     let expanded;
@@ -209,6 +214,10 @@ pub struct Frame {
     /// Per frame, wall-clock milliseconds from submitting the frame's commands to their
     /// completion (what the passes' times should add up to, less submission overhead).
     pub wall_ms: Vec<f64>,
+    /// Per frame, the passes it recorded, by name, in order: each redrawn light's raster
+    /// (`light<i>.shadow_raster`, and `light<i>.shadow_peel` where it peels) and plan steps,
+    /// then `gbuffer` and `shade`. A light whose map was kept (its `update` rate) has none.
+    pub recorded: Vec<Vec<String>>,
     /// Steps whose kernels reported replaced texels (non-finite depth), with the count.
     pub sanitized: Vec<(String, u32)>,
     /// Per light, the map its shading reads (level 0): raw depth, linear depth or a filtered

@@ -38,6 +38,8 @@ pub struct Executor {
     pool: TexturePool,
     in_use: Vec<(Slot, wgpu::Texture)>,
     prepared: Option<Prepared>,
+    /// Compute dispatches recorded so far.
+    dispatches: u64,
 }
 
 /// What a plan's run needs besides its passes, made once and reused while the plan and the
@@ -67,6 +69,12 @@ impl Executor {
             record::compile(&mut self.kernels, device, plan, &step.node)?;
         }
         Ok(())
+    }
+
+    /// Compute dispatches this executor has recorded so far, every run together (a run's are
+    /// the difference across it).
+    pub fn dispatch_count(&self) -> u64 {
+        self.dispatches
     }
 
     /// Textures held by the pool (constant across runs of the same plan).
@@ -109,6 +117,44 @@ impl Executor {
         plan: &Plan,
         imports: &HashMap<String, wgpu::Texture>,
         layers: &HashMap<String, u32>,
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<Outputs> {
+        self.record_run(device, encoder, plan, imports, layers, None, timer)
+    }
+
+    /// [`Executor::record`] of only the steps `run` marks (one flag per step of `plan`): the
+    /// others record nothing, and their outputs keep what they last wrote while the plan, its
+    /// imports and its textures stay the same (the returned textures say which) and no
+    /// recorded step writes the same texture. The renderer skips a cached light's steps so.
+    pub fn record_steps(
+        &mut self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        plan: &Plan,
+        imports: &HashMap<String, wgpu::Texture>,
+        run: &[bool],
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<Outputs> {
+        if run.len() != plan.steps.len() {
+            return Err(crate::error::Error::Invalid(format!(
+                "{} step flags for a plan of {} steps",
+                run.len(),
+                plan.steps.len()
+            )));
+        }
+        let layers = HashMap::new();
+        self.record_run(device, encoder, plan, imports, &layers, Some(run), timer)
+    }
+
+    #[expect(clippy::too_many_arguments, reason = "a run's inputs and the steps it records")]
+    fn record_run(
+        &mut self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        plan: &Plan,
+        imports: &HashMap<String, wgpu::Texture>,
+        layers: &HashMap<String, u32>,
+        run: Option<&[bool]>,
         mut timer: Option<&mut GpuTimer>,
     ) -> Result<Outputs> {
         // A plan's fields are public: check what the binding below relies on first.
@@ -121,7 +167,7 @@ impl Executor {
             Some(p) if same_plan => self.rebind_imports(device, p, imports, layers)?,
             _ => self.prepare_run(device, plan, imports, layers)?,
         };
-        record::encode(encoder, &prepared, timer.as_deref_mut());
+        self.dispatches += record::encode(encoder, &prepared, run, timer.as_deref_mut());
         let outputs = prepared.outputs.clone();
         self.prepared = Some(prepared);
         // The last node ends here, not at whatever the caller records next.

@@ -371,14 +371,20 @@ pub(super) fn params_buffer(device: &wgpu::Device, plan: &Plan) -> Result<RunPar
     Ok(RunParams { buffer, at })
 }
 
-/// Records the passes of a prepared plan: one compute pass per node, a span of `timer` each.
+/// Records the passes of a prepared plan: one compute pass per node (each node `run` marks,
+/// all without it), a span of `timer` each. Returns the dispatches recorded.
 pub(super) fn encode(
     encoder: &mut wgpu::CommandEncoder,
     prepared: &Prepared,
+    run: Option<&[bool]>,
     mut timer: Option<&mut GpuTimer>,
-) {
+) -> u64 {
+    let mut dispatches = 0;
     encoder.clear_buffer(&prepared.outputs.stats, 0, None);
-    for (step, bound) in prepared.plan.steps.iter().zip(&prepared.steps) {
+    for (k, (step, bound)) in prepared.plan.steps.iter().zip(&prepared.steps).enumerate() {
+        if run.is_some_and(|r| !r.get(k).copied().unwrap_or(true)) {
+            continue;
+        }
         let node = &step.node;
         if let Some(t) = timer.as_deref_mut() {
             t.begin(encoder, &node.name);
@@ -391,6 +397,8 @@ pub(super) fn encode(
         for (bind_group, g) in &bound.dispatches {
             pass.set_bind_group(0, bind_group, &[]);
             pass.dispatch_workgroups(g[0], g[1], g[2]);
+            dispatches += 1;
         }
     }
+    dispatches
 }

@@ -21,6 +21,7 @@ pub(super) use raster::VIEW_BYTES;
 pub(super) use raster::depth_only_view;
 use raster::{clear_depth, raster_pass};
 
+use super::cache::{LightCache, caches, dedicate_outputs};
 use super::cascade::{DrawnLights, drawn_lights};
 use super::targets::{TargetKey, Targets};
 use super::{Frame, RenderOptions, ScenePlan, check_render, plan_lights_for};
@@ -42,6 +43,8 @@ pub struct Renderer {
     /// The shading pass's bind groups for the last kernel and maps.
     binding: Option<ShadeBinding>,
     timer: Option<GpuTimer>,
+    /// Which lights' maps are kept from earlier frames ([`super::cache`]).
+    cache: LightCache,
 }
 
 /// The shading pass's bind groups, valid for one kernel, one set of map textures and the
@@ -50,6 +53,16 @@ struct ShadeBinding {
     kernel: Arc<ComputeKernel>,
     maps: Vec<wgpu::Texture>,
     groups: [wgpu::BindGroup; 2],
+}
+
+/// What one frame records from: the plan, the kept resources, the drawn lights, the shading
+/// kernel and which lights it redraws.
+struct FrameInputs<'a> {
+    sp: &'a ScenePlan,
+    targets: &'a Targets,
+    lights: &'a [Light],
+    kernel: &'a Arc<ComputeKernel>,
+    redraw: &'a [bool],
 }
 
 /// The shading pass's group-0 inputs and outputs (the sampler is the renderer's).
@@ -74,6 +87,7 @@ impl Renderer {
             targets: None,
             binding: None,
             timer: None,
+            cache: LightCache::default(),
             cmp_sampler: created::sampler(
                 device,
                 &wgpu::SamplerDescriptor {
@@ -189,15 +203,31 @@ impl Renderer {
         check_render(device, scene, &opts)?;
         let drawn = drawn_lights(scene)?;
         let mut sp = plan_lights_for(&drawn.lights, &opts)?;
+        let caching = caches(scene);
         if opts.dump {
             // Everything is read back after the frame: no resource may share a texture.
             sp.plan = sp.plan.unaliased();
+        } else if caching {
+            sp.plan = dedicate_outputs(sp.plan);
         }
         let vertices = scene.vertices();
         let mut targets = self.take_targets(device, scene, &drawn, vertices.len())?;
         targets.upload(queue, scene, &drawn, &vertices);
+        if caching {
+            let depths = (0..drawn.lights.len())
+                .filter_map(|i| targets.imports.get(&technique::depth_name(i)).cloned())
+                .collect();
+            let bytes = bytemuck::cast_slice(&vertices);
+            self.cache
+                .begin(scene, &drawn, &sp.plan, depths, bytes, opts.dump);
+        } else {
+            self.cache.clear();
+        }
         let run = self.frames(device, queue, &sp, &targets, &drawn, opts.repeat.max(1));
-        let read = run.and_then(|(timings, wall_ms, outputs)| {
+        if run.is_err() {
+            self.cache.clear();
+        }
+        let read = run.and_then(|(timings, wall_ms, recorded, outputs)| {
             let (rgba, visibility) = targets.read_back(device, queue)?;
             let sanitized = outputs.read_stats(device)?;
             for (step, n) in &sanitized {
@@ -212,6 +242,7 @@ impl Renderer {
                 normal: Vec::new(),
                 timings,
                 wall_ms,
+                recorded,
                 sanitized,
                 shade_maps: Vec::new(),
                 shade_mips: Vec::new(),
@@ -225,9 +256,12 @@ impl Renderer {
     }
 
     /// Renders `repeat` frames: per frame its pass times (timestamps read a frame later, the
-    /// rest after the last), its wall time from submission to completion, and the last
-    /// frame's plan outputs.
-    #[expect(clippy::type_complexity, reason = "timings, wall times and outputs")]
+    /// rest after the last), its wall time from submission to completion and the passes it
+    /// recorded, and the last frame's plan outputs.
+    #[expect(
+        clippy::type_complexity,
+        reason = "timings, wall times, passes and outputs"
+    )]
     fn frames(
         &mut self,
         device: &wgpu::Device,
@@ -236,7 +270,7 @@ impl Renderer {
         targets: &Targets,
         drawn: &DrawnLights,
         repeat: u32,
-    ) -> Result<(Vec<Vec<(String, f64)>>, Vec<f64>, Outputs)> {
+    ) -> Result<(Vec<Vec<(String, f64)>>, Vec<f64>, Vec<Vec<String>>, Outputs)> {
         let kernel = self.shade_kernel_cascaded(device, &drawn.lights, &drawn.groups)?;
         let peels = targets.lights.iter().filter(|t| t.peel.is_some()).count();
         let spans = (drawn.lights.len() + peels) as u32 + sp.plan.steps.len() as u32 + 2;
@@ -244,21 +278,33 @@ impl Renderer {
             Some(t) if t.span_capacity() >= spans => Some(t),
             _ => GpuTimer::new(device, queue, spans),
         };
-        let (mut timings, mut wall_ms, mut last) = (Vec::new(), Vec::new(), None);
+        let (mut timings, mut wall_ms, mut recorded, mut last) =
+            (Vec::new(), Vec::new(), Vec::new(), None);
         for _ in 0..repeat {
-            if let Some(t) = timer.as_mut() {
-                t.reset();
-            }
-            let mut enc = device.create_command_encoder(&Default::default());
-            let outputs = self.record_frame(
-                device,
-                &mut enc,
-                sp,
-                targets,
-                &drawn.lights,
-                &kernel,
-                timer.as_mut(),
-            )?;
+            let mut redraw = self.cache.next_frame(drawn.lights.len());
+            let (enc, outputs, passes) = loop {
+                if let Some(t) = timer.as_mut() {
+                    t.reset();
+                }
+                let mut enc = device.create_command_encoder(&Default::default());
+                let frame = FrameInputs {
+                    sp,
+                    targets,
+                    lights: &drawn.lights,
+                    kernel: &kernel,
+                    redraw: &redraw,
+                };
+                let (outputs, passes) =
+                    self.record_frame(device, &mut enc, &frame, timer.as_mut())?;
+                // Kept maps are only valid in the textures they were drawn into: a frame whose
+                // plan textures moved (the executor ran another plan meanwhile) redraws all.
+                if self.cache.intact(&outputs) || redraw.iter().all(|&r| r) {
+                    break (enc, outputs, passes);
+                }
+                self.cache.redraw_all();
+                redraw.fill(true);
+            };
+            let mut enc = enc;
             if let Some(t) = timer.as_mut() {
                 t.resolve(&mut enc);
             }
@@ -269,6 +315,7 @@ impl Renderer {
             if let Some(t) = timer.as_mut() {
                 timings.extend(t.collect(device)?);
             }
+            recorded.push(passes);
             last = Some(outputs);
         }
         if let Some(t) = timer.as_mut() {
@@ -276,23 +323,66 @@ impl Renderer {
         }
         self.timer = timer;
         let outputs = last.ok_or_else(|| Error::Invalid("no frame rendered".into()))?;
-        Ok((timings, wall_ms, outputs))
+        Ok((timings, wall_ms, recorded, outputs))
     }
 
-    /// Records one frame: the raster passes (each light's depth, then its peeled second depth
-    /// where its technique reads one), the plan, the G-buffer and the shading pass.
-    #[expect(clippy::too_many_arguments, reason = "one frame's inputs")]
+    /// Records one frame: the raster passes of the lights it redraws (each light's depth, then
+    /// its peeled second depth where its technique reads one), their plan steps, the G-buffer
+    /// and the shading pass. Returns the plan's outputs and the passes recorded, by name.
     fn record_frame(
         &mut self,
         device: &wgpu::Device,
         enc: &mut wgpu::CommandEncoder,
-        sp: &ScenePlan,
-        targets: &Targets,
-        lights: &[Light],
-        kernel: &Arc<ComputeKernel>,
+        frame: &FrameInputs,
         mut timer: Option<&mut GpuTimer>,
-    ) -> Result<Outputs> {
-        for (l, t) in lights.iter().zip(&targets.lights) {
+    ) -> Result<(Outputs, Vec<String>)> {
+        let mut passes = self.record_rasters(device, enc, frame, timer.as_deref_mut())?;
+        let sp = frame.sp;
+        let run: Vec<bool> = sp
+            .plan
+            .steps
+            .iter()
+            .map(|s| {
+                s.node
+                    .light
+                    .is_none_or(|l| frame.redraw.get(l) != Some(&false))
+            })
+            .collect();
+        let outputs = self.executor.record_steps(
+            device,
+            enc,
+            &sp.plan,
+            &frame.targets.imports,
+            &run,
+            timer.as_deref_mut(),
+        )?;
+        let steps = sp.plan.steps.iter().zip(&run).filter(|(_, r)| **r);
+        passes.extend(steps.map(|(s, _)| s.node.name.clone()));
+        self.gbuffer_pass(device, enc, frame.targets, timer.as_deref_mut())?;
+        let maps: Vec<wgpu::Texture> = sp
+            .shade_inputs
+            .iter()
+            .flat_map(|s| &s.maps)
+            .map(|m| outputs.textures[m].clone())
+            .collect();
+        let groups = self.shade_groups(device, frame.kernel, frame.targets, maps)?;
+        record_shade(enc, frame.kernel, groups, frame.targets.key.size, timer);
+        passes.extend(["gbuffer".to_string(), "shade".to_string()]);
+        Ok((outputs, passes))
+    }
+
+    /// Records the raster passes of the lights `frame` redraws; returns their names.
+    fn record_rasters(
+        &mut self,
+        device: &wgpu::Device,
+        enc: &mut wgpu::CommandEncoder,
+        frame: &FrameInputs,
+        mut timer: Option<&mut GpuTimer>,
+    ) -> Result<Vec<String>> {
+        let targets = frame.targets;
+        let mut passes = Vec::new();
+        let lights = frame.lights.iter().zip(&targets.lights).zip(frame.redraw);
+        for ((l, t), _) in lights.filter(|(_, redraw)| **redraw) {
             let (pipeline, _) = self.shadow_pipeline(device, l.shadow.slope_bias)?;
             raster_pass(
                 enc,
@@ -305,6 +395,7 @@ impl Renderer {
                 &t.viewports,
                 timer.as_deref_mut(),
             );
+            passes.push(t.label.clone());
             if let Some(peel) = &t.peel {
                 let (pipeline, _) = self.peel_pipeline(device, l.shadow.slope_bias)?;
                 raster_pass(
@@ -318,25 +409,10 @@ impl Renderer {
                     &t.viewports,
                     timer.as_deref_mut(),
                 );
+                passes.push(peel.label.clone());
             }
         }
-        let outputs = self.executor.record(
-            device,
-            enc,
-            &sp.plan,
-            &targets.imports,
-            timer.as_deref_mut(),
-        )?;
-        self.gbuffer_pass(device, enc, targets, timer.as_deref_mut())?;
-        let maps: Vec<wgpu::Texture> = sp
-            .shade_inputs
-            .iter()
-            .flat_map(|s| &s.maps)
-            .map(|m| outputs.textures[m].clone())
-            .collect();
-        let groups = self.shade_groups(device, kernel, targets, maps)?;
-        record_shade(enc, kernel, groups, targets.key.size, timer);
-        Ok(outputs)
+        Ok(passes)
     }
 
     fn gbuffer_pass(
