@@ -20,9 +20,13 @@
 //! **Pareto fronts** ([`front`]) of total time against each [`Metric`]: the mean error, the
 //! penumbra's mean error and FLIP.
 //!
-//! **Times** are medians over the repeats of the renderer's GPU timestamps; a configuration's
-//! total is its shadow raster, its graph kernels and its shading pass (the camera G-buffer is
-//! the same for every configuration and reported apart). **Memory** is the plan's peak of live
+//! **Times** come from the renderer's GPU timestamps under the time protocol
+//! ([`protocol`]): after every configuration's error is measured, the configurations are timed
+//! interleaved, round-robin over the repeats, with the camera G-buffer (the same work in
+//! every configuration) as the clock check, and a configuration whose check is more than 10%
+//! off the run's median measured again. A configuration's total is its shadow raster, its
+//! graph kernels and its shading pass (the G-buffer is reported apart), median over its frames
+//! with the quartiles and range ([`Spread`]). **Memory** is the plan's peak of live
 //! textures plus the rasterized depth maps.
 
 mod crops;
@@ -31,15 +35,23 @@ mod grid;
 mod html;
 mod measure;
 mod output;
+pub mod protocol;
 mod stats;
 pub mod summary;
 mod svg;
 mod sweep;
+mod timing;
+pub mod verdict;
 
 pub use flip::{Shader, flip_map, flip_stats, to_unorm8};
-pub use output::{WALL_TOLERANCE, untrusted_times, wall_check, wall_ratios};
-pub use stats::{EDGE_BAND, ErrorStats, PENUMBRA_HIGH, PENUMBRA_LOW, Region, Regions};
-pub use svg::{Metric, front, pareto, pareto_front};
+pub use output::{
+    WALL_TOLERANCE, csv, markdown, protocol_text, untrusted_times, wall_check, wall_ratios,
+};
+pub use protocol::{Protocol, Spread};
+pub use stats::{
+    EDGE_BAND, ErrorStats, PENUMBRA_HIGH, PENUMBRA_LOW, Region, Regions, laplacian_rms,
+};
+pub use svg::{Metric, PALETTE, colour as colour_of, front, pareto, pareto_front};
 use sweep::storage_name;
 pub use sweep::{Config, FILTERS, FilterOfWidth, sweep};
 
@@ -57,7 +69,8 @@ pub struct EvaluateOptions {
     /// Technique names to keep (`None`: every registered technique, `technique::names`).
     pub techniques: Option<Vec<String>>,
     /// A tiny sweep (one map size, one width, one storage per technique; K = 16 at 1024²,
-    /// image at most 160 wide, one repeat): seconds on a software GPU.
+    /// image at most 160 wide; the command line's default `--repeat` is then 3): seconds on a
+    /// software GPU.
     pub quick: bool,
     /// Map sizes (default 512, 1024, 2048, 4096; quick: 512).
     pub sizes: Option<Vec<u32>>,
@@ -65,13 +78,20 @@ pub struct EvaluateOptions {
     pub samples: Option<u32>,
     /// Truth resolution (default: [`crate::truth::default_resolution`]; quick: 1024).
     pub truth_resolution: Option<u32>,
-    /// Timed frames per configuration (the median is reported).
+    /// Timed frames per configuration: rounds of the interleaved time protocol (the median
+    /// and spread are reported).
     pub repeat: u32,
-    /// Image size to evaluate at (default: the scene's; quick: scaled to ≤ 160 wide).
+    /// Image size to evaluate at (default: [`GPU_IMAGE`] on a GPU, the scene's own on a CPU
+    /// driver, set by [`run`]; quick: scaled to ≤ 160 wide).
     pub image: Option<(u32, u32)>,
     /// MSM moment biases: each `msm`/`msm_soft` configuration runs once per bias instead of
     /// at its storage's default (`None`: the defaults).
     pub moment_biases: Option<Vec<f32>>,
+    /// The time budget per light of the report's verdict, ms (`None`: 1 ms on a GPU, the
+    /// median configuration's on a CPU driver; [`verdict::budget`]).
+    pub budget_ms: Option<f64>,
+    /// Whether `image` is [`run`]'s default rather than the user's (errors then say so).
+    pub image_default: bool,
 }
 
 impl Default for EvaluateOptions {
@@ -85,9 +105,16 @@ impl Default for EvaluateOptions {
             repeat: 5,
             image: None,
             moment_biases: None,
+            budget_ms: None,
+            image_default: false,
         }
     }
 }
+
+/// The image `run` evaluates at on a GPU unless told otherwise: where games render. A CPU
+/// driver keeps the scene's own size (the bundled scenes' are at most 480×360), which it
+/// renders in seconds rather than minutes.
+pub const GPU_IMAGE: (u32, u32) = (1920, 1080);
 
 /// Measurements of one configuration.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
@@ -96,6 +123,9 @@ pub struct Row {
     pub label: String,
     /// Technique name.
     pub technique: String,
+    /// Its family ([`verdict::Family::name`]): the plots' marker shape.
+    #[serde(default)]
+    pub family: String,
     /// Shadow-map side.
     pub shadow_map: u32,
     /// Storage of the representation (`f32`, `f16`, `unorm16`; empty when none).
@@ -104,7 +134,8 @@ pub struct Row {
     pub filter: String,
     /// Box width in texels, when the configuration filters with a box.
     pub box_width: Option<f64>,
-    /// Median milliseconds per timed pass, in pass order (empty without timestamps).
+    /// Median milliseconds per timed pass over the kept frames, in pass order (empty without
+    /// timestamps).
     pub passes: Vec<(String, f64)>,
     /// Shadow raster, ms.
     pub raster_ms: Option<f64>,
@@ -120,12 +151,32 @@ pub struct Row {
     /// included), median over the timed frames, ms: what the timestamps are checked against.
     #[serde(default)]
     pub wall_ms: Option<f64>,
+    /// The total's spread over the kept frames (median, quartiles, range), ms.
+    #[serde(default)]
+    pub total_spread: Option<Spread>,
+    /// Times the configuration was measured again because its clock check was off.
+    #[serde(default)]
+    pub retries: u32,
+    /// Whether its clock check is still more than 10% off the run's after the retries: its
+    /// times ran at another clock.
+    #[serde(default)]
+    pub clock_off: bool,
+    /// Its G-buffer's median over the run's median G-buffer (1: the same clock).
+    #[serde(default)]
+    pub check_ratio: Option<f64>,
     /// Peak live texture bytes of the plan plus the depth maps.
     pub memory_bytes: u64,
+    /// What `shadowgraph plan` says light 0's map costs.
+    #[serde(default)]
+    pub cost: PlanCost,
     /// Error against the area-light truth.
     pub soft: ErrorStats,
     /// The same over the truth's penumbra (see [`Regions`]).
     pub penumbra: ErrorStats,
+    /// The penumbra's high-frequency error: RMS of the discrete Laplacian of (visibility −
+    /// truth) over the penumbra ([`laplacian_rms`]).
+    #[serde(default)]
+    pub penumbra_hf: f64,
     /// The same over the truth's umbra: light where there should be none.
     pub umbra: ErrorStats,
     /// The same over the truth's lit pixels: shadow where there should be none.
@@ -137,13 +188,43 @@ pub struct Row {
     pub pcf: Option<ErrorStats>,
 }
 
+/// What `shadowgraph plan` computes of a configuration's first drawn light (its cost model,
+/// `docs/COST.md`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PlanCost {
+    /// Bytes read and written per texel of the map by the graph's kernels.
+    pub bytes_per_texel: f64,
+    /// Dispatches of the graph's kernels.
+    pub dispatches: u32,
+    /// Texture fetches per pixel of the visibility function in the shading kernel.
+    pub fetches_per_pixel: f64,
+}
+
 /// The whole evaluation.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Report {
     /// Scene file.
     pub scene: String,
-    /// Device description.
+    /// Device description (name, backend, type, driver).
     pub device: String,
+    /// The source's commit (`git rev-parse` where the binary was built, `unknown` otherwise).
+    #[serde(default)]
+    pub commit: String,
+    /// Date of the run (UTC), `YYYY-MM-DD`.
+    #[serde(default)]
+    pub date: String,
+    /// Timed frames per configuration (rounds of the time protocol).
+    #[serde(default)]
+    pub repeats: u32,
+    /// The run's median G-buffer time, ms: the clock check's reference.
+    #[serde(default)]
+    pub check_median_ms: Option<f64>,
+    /// Lights of the scene (the operating point's).
+    #[serde(default)]
+    pub lights: usize,
+    /// The verdict's time budget per light as given (`--budget`), ms.
+    #[serde(default)]
+    pub budget_ms: Option<f64>,
     /// Whether times come from a CPU driver (lavapipe/llvmpipe), so only ratios mean much.
     pub cpu_driver: bool,
     /// Image size evaluated.
@@ -201,6 +282,9 @@ pub fn scene_for(path: &Path, opts: &EvaluateOptions) -> Result<Scene> {
         scene.width = w;
         scene.height = h;
         let by = match opts.image {
+            Some(GPU_IMAGE) if opts.image_default => {
+                format!("evaluate's image {w}x{h} (the default on a GPU)")
+            }
             Some(_) => format!("evaluate --image {w}x{h}"),
             None => format!("evaluate --quick, {w}x{h}"),
         };
@@ -224,6 +308,12 @@ fn set_lights_by(scene: &mut Scene, key: &str, by: &str) {
 /// `out`. Returns a short summary.
 pub fn run(gpu: &Gpu, scene_path: &Path, out: &Path, opts: &EvaluateOptions) -> Result<String> {
     check_options(opts)?;
+    let mut opts = opts.clone();
+    if opts.image.is_none() && !opts.quick && crate::timer::is_gpu(&gpu.device) {
+        opts.image = Some(GPU_IMAGE);
+        opts.image_default = true;
+    }
+    let opts = &opts;
     let scene = scene_for(scene_path, opts)?;
     check_sides(gpu.device.limits().max_texture_dimension_2d, &scene, opts)?;
     let configs = sweep(&scene, opts)?;
@@ -332,7 +422,7 @@ pub fn evaluate(
             .truth_resolution
             .or(if opts.quick { Some(1024) } else { None }),
     };
-    let bar = progress(configs.len() as u64 + 1);
+    let bar = progress(configs.len() as u64 * (1 + u64::from(opts.repeat)) + 1);
     bar.set_message("area-light truth");
     let truth = area_light_truth(&mut renderer, device, queue, scene, &truth_opts)?;
     bar.inc(1);
@@ -349,6 +439,12 @@ pub fn evaluate(
     let mut report = Report {
         scene: scene.path.display().to_string(),
         device: gpu.describe(),
+        commit: timing::commit(),
+        date: timing::today(),
+        repeats: opts.repeat,
+        check_median_ms: None,
+        lights: scene.lights.len(),
+        budget_ms: opts.budget_ms,
         cpu_driver: info.device_type == wgpu::DeviceType::Cpu,
         image: (scene.width, scene.height),
         truth_samples: t.samples,
@@ -369,6 +465,8 @@ pub fn evaluate(
         shaded: Vec::new(),
     };
     let mut linear = std::collections::HashMap::new();
+    // The scene of every measured configuration, timed after all are measured.
+    let mut timed_scenes = Vec::new();
     for c in configs {
         bar.set_message(c.label.clone());
         let mut s = scene.clone();
@@ -394,8 +492,9 @@ pub fn evaluate(
                 e.insert(measure::linear_maps(&mut renderer, gpu, &s, c.shadow_map)?)
             }
         };
-        match measure::measure(&mut renderer, gpu, &s, c, linear, &reference, opts.repeat) {
+        match measure::measure(&mut renderer, gpu, &s, c, linear, &reference) {
             Ok(m) => {
+                timed_scenes.push(s);
                 let lights = reference.truth.lights;
                 images.visibility.push(light0(&m.frame.visibility, lights));
                 if images.truth_shaded.is_empty() {
@@ -414,8 +513,22 @@ pub fn evaluate(
         }
         bar.inc(1);
     }
+    bar.set_message("timing (interleaved)");
+    let protocol = Protocol::new(opts.repeat);
+    let run = timing::time_scenes(&mut renderer, gpu, &timed_scenes, &protocol, &bar)?;
+    apply_times(&mut report, &run);
     bar.finish_and_clear();
     Ok((report, images))
+}
+
+/// Fills the times of `report`'s rows from the time protocol's `run` (row `i` from
+/// configuration `i`): per pass and part the median over the kept frames, the total's spread,
+/// the clock check's ratio, retries and flag, and the run's check median.
+pub fn apply_times(report: &mut Report, run: &protocol::Run) {
+    for (row, t) in report.rows.iter_mut().zip(&run.timed) {
+        timing::fill(row, t, run.check_median);
+    }
+    report.check_median_ms = run.check_median;
 }
 
 /// A progress bar on stderr; indicatif draws nothing when stderr is not a terminal.

@@ -142,12 +142,18 @@ enum Command {
         /// Shadow-map side of the truth's samples (default max(2048, 2 × the light's map)).
         #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
         truth_resolution: Option<u32>,
-        /// Timed frames per configuration (the median is reported), 1 to 1000.
-        #[arg(long, default_value_t = 5, value_parser = repeat_range())]
-        repeat: u32,
-        /// Evaluate at this image size, WIDTHxHEIGHT (default: the scene's).
+        /// Timed frames per configuration, 1 to 1000: rounds of the interleaved time protocol
+        /// (median and quartiles reported; default 5, quick 3).
+        #[arg(long, value_parser = repeat_range())]
+        repeat: Option<u32>,
+        /// Evaluate at this image size, WIDTHxHEIGHT (default: 1920x1080 on a GPU, the scene's
+        /// own size on a CPU driver; quick: at most 160 wide).
         #[arg(long, value_parser = parse_size)]
         image: Option<(u32, u32)>,
+        /// Time budget per light of the report's verdict, ms (default: 1 on a GPU, the median
+        /// configuration's on a CPU driver).
+        #[arg(long, value_parser = parse_budget)]
+        budget: Option<f64>,
         /// Run every MSM configuration at each of these moment biases (default: the storage's).
         #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
         moment_bias: Option<Vec<f32>>,
@@ -169,6 +175,15 @@ fn parse_inputs(name: &str) -> Result<shadowgraph::bench::Inputs, String> {
 /// `--repeat` of every command: 1 to `render::MAX_REPEAT` frames (each keeps a row of timings).
 fn repeat_range() -> clap::builder::RangedI64ValueParser<u32> {
     clap::value_parser!(u32).range(1..=i64::from(shadowgraph::render::MAX_REPEAT))
+}
+
+/// `evaluate --budget`: a positive, finite number of milliseconds.
+fn parse_budget(s: &str) -> Result<f64, String> {
+    s.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .ok_or_else(|| format!("`{s}`: a budget is a positive number of milliseconds"))
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -266,6 +281,7 @@ fn run(args: Args) -> Result<()> {
             truth_resolution,
             repeat,
             image,
+            budget,
             moment_bias,
         } => {
             let opts = shadowgraph::evaluate::EvaluateOptions {
@@ -274,9 +290,11 @@ fn run(args: Args) -> Result<()> {
                 sizes,
                 samples: k,
                 truth_resolution,
-                repeat: if quick { repeat.min(1) } else { repeat },
+                repeat: repeat.unwrap_or(if quick { 3 } else { 5 }),
                 image,
                 moment_biases: moment_bias,
+                budget_ms: budget,
+                image_default: false,
             };
             let gpu = Gpu::new()?;
             print!("{}", shadowgraph::evaluate::run(&gpu, &scene, &out, &opts)?);

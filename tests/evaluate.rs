@@ -54,7 +54,7 @@ fn assert_finite(v: &serde_json::Value, path: &str) {
                 // Optional fields are null where they do not apply, never where a number is due.
                 if x.is_null() {
                     assert!(
-                        k == "pcf" || k == "box_width",
+                        k == "pcf" || k == "box_width" || k == "budget_ms",
                         "{path}.{k} is null (a non-finite number?)"
                     );
                     continue;
@@ -79,6 +79,8 @@ fn quick_sweep_writes_every_file_consistently() {
         "--quick",
         "--techniques",
         "hard,pcf,pcss,vsm,msm",
+        "--repeat",
+        "2",
         "--out",
         out.to_str().unwrap(),
     ]);
@@ -131,6 +133,9 @@ fn quick_sweep_writes_every_file_consistently() {
             // The CSV prints ms to three decimals: half a unit of the last place, plus the
             // parse's own rounding (11.5575 printed as 11.558 differs by 5e-4 and one ulp).
             ("total_ms", r.total_ms.unwrap(), 5e-4 + 1e-12),
+            ("total_q1_ms", r.total_spread.unwrap().q1, 5e-4 + 1e-12),
+            ("total_q3_ms", r.total_spread.unwrap().q3, 5e-4 + 1e-12),
+            ("penumbra_hf", r.penumbra_hf, 5e-7),
             ("shade_ms", r.shade_ms.unwrap(), 5e-4 + 1e-12),
             ("wall_ms", r.wall_ms.unwrap(), 5e-4 + 1e-12),
         ] {
@@ -160,21 +165,30 @@ fn quick_sweep_writes_every_file_consistently() {
         "{:?}",
         report.region_pixels
     );
-    // Each plot: one point per configuration, a ring per front point, a legend swatch per
-    // technique and for the front; labels on the front's points and on no other.
+    // Each plot: one marker per configuration, with its tooltip and its technique's colour
+    // (no two techniques sharing one); labels on the front's points and on no other.
     let techniques: std::collections::BTreeSet<&str> =
         report.rows.iter().map(|r| r.technique.as_str()).collect();
+    let fills: std::collections::BTreeSet<String> = techniques
+        .iter()
+        .map(|t| format!("{:?}", shadowgraph::evaluate::colour_of(t)))
+        .collect();
+    assert_eq!(fills.len(), techniques.len(), "techniques share a colour");
     for m in Metric::ALL {
         let svg = std::fs::read_to_string(out.join(m.file())).unwrap();
         assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
         let on = front(&report.rows, m);
         assert!(!on.is_empty());
         assert_eq!(
-            svg.matches("<circle").count(),
-            report.rows.len() + on.len() + techniques.len() + 1,
+            svg.matches("<g class=\"pt\">").count(),
+            report.rows.len(),
             "{}",
             m.file()
         );
+        for r in &report.rows {
+            let title = format!("<title>{} (", r.label);
+            assert_eq!(svg.matches(&title).count(), 1, "{}: {}", m.file(), r.label);
+        }
         for (i, r) in report.rows.iter().enumerate() {
             // plotters writes a text element's content on a line of its own.
             let labelled = svg.contains(&format!(">\n{}\n</text>", r.label));
@@ -191,6 +205,51 @@ fn quick_sweep_writes_every_file_consistently() {
     assert_eq!(legend.lines().count(), 2 + 2 * report.rows.len());
     let md = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(md.contains("CPU-driver times") == report.cpu_driver);
+    // The header names the run; every row has its n frames' spread around its median.
+    assert_eq!(report.repeats, 2);
+    assert!(
+        !report.commit.is_empty() && report.date.len() == 10,
+        "{report:?}"
+    );
+    assert!(md.contains(&format!("n = {} timed frames", report.repeats)));
+    assert!(md.contains("Time protocol") && md.contains("Clock check"));
+    for r in &report.rows {
+        let t = r.total_spread.expect("a spread");
+        assert_eq!(t.n, report.repeats as usize, "{}", r.label);
+        assert!(t.min <= t.q1 && t.q1 <= t.median && t.median <= t.q3 && t.q3 <= t.max);
+        assert!(
+            (t.median - r.total_ms.unwrap()).abs() < 1e-12,
+            "{}",
+            r.label
+        );
+        assert!(r.check_ratio.is_some_and(|q| q > 0.0), "{}", r.label);
+        assert!(r.penumbra_hf.is_finite() && r.penumbra_hf >= 0.0);
+        assert!(
+            r.cost.dispatches >= 1 && r.cost.fetches_per_pixel >= 1.0,
+            "{}",
+            r.label
+        );
+    }
+    // The verdict: the cheapest configuration within 10% of the best penumbra error, by a
+    // direct search over the rows.
+    let best = report
+        .rows
+        .iter()
+        .map(|r| r.penumbra.mean_abs)
+        .fold(f64::INFINITY, f64::min);
+    let cheapest = report
+        .rows
+        .iter()
+        .filter(|r| r.penumbra.mean_abs <= 1.1 * best)
+        .min_by(|a, b| a.total_ms.unwrap().total_cmp(&b.total_ms.unwrap()))
+        .unwrap();
+    let line = md
+        .lines()
+        .find(|l| l.starts_with("- Cheapest within 10%"))
+        .expect("a verdict line");
+    assert!(line.contains(&format!("**{}**", cheapest.label)), "{line}");
+    assert!(md.contains("- Most accurate within") && md.contains("- Prefiltering against PCSS"));
+    clock_drop_is_flagged_in_the_report(&report);
     // The timestamps' cross-check against the wall clock, over every configuration.
     let check = format!("in each of the {} configurations", report.rows.len());
     assert!(md.contains(&check), "report.md lacks the wall check");
@@ -219,6 +278,52 @@ fn quick_sweep_writes_every_file_consistently() {
             r.label
         );
     }
+}
+
+/// Synthetic timings with a clock drop fed to the time protocol and written into a copy of a
+/// real report: every pass 2× slow in configuration 1's first attempt (retried once, its times
+/// then the fast clock's) and in all of configuration 0's frames (retried twice and flagged
+/// †); the report says how many were measured again and what spread remains, and the CSV
+/// carries the retries and the flag.
+fn clock_drop_is_flagged_in_the_report(report: &Report) {
+    use shadowgraph::evaluate::protocol::{Protocol, Sample, run};
+    let n = report.rows.len();
+    let mut seen = vec![0u32; n];
+    let timed = run(&Protocol::new(3), n, "gbuffer", |c| {
+        seen[c] += 1;
+        let slow = c == 0 || (c == 1 && seen[c] <= 3);
+        let k = if slow { 2.0 } else { 1.0 };
+        let shade = 1.0 + c as f64;
+        Ok(Sample {
+            passes: vec![
+                ("light0.shadow_raster".into(), 0.5 * k),
+                ("gbuffer".into(), k),
+                ("shade".into(), shade * k),
+            ],
+            wall_ms: k * (1.5 + shade),
+        })
+    })
+    .expect("protocol");
+    let mut r = report.clone();
+    shadowgraph::evaluate::apply_times(&mut r, &timed);
+    assert_eq!((r.rows[0].retries, r.rows[0].clock_off), (2, true));
+    assert_eq!((r.rows[1].retries, r.rows[1].clock_off), (1, false));
+    assert!((r.rows[1].total_ms.unwrap() - 2.5).abs() < 1e-12);
+    assert!((r.rows[0].total_ms.unwrap() - 3.0).abs() < 1e-12);
+    assert!(r.rows[2..].iter().all(|x| x.retries == 0 && !x.clock_off));
+    let md = shadowgraph::evaluate::markdown(&r);
+    let text = shadowgraph::evaluate::protocol_text(&r);
+    assert!(md.contains(&text));
+    assert!(
+        text.contains(&format!("2 of {n} configurations"))
+            && text.contains(&format!("1 remain off (†: {})", r.rows[0].label))
+            && text.contains("span 1.00–2.00×"),
+        "{text}"
+    );
+    assert!(md.contains(&format!("| {} |", r.rows[0].label)) && md.contains(" † |"));
+    let csv = shadowgraph::evaluate::csv(&r);
+    let row0 = csv.lines().nth(1).expect("a row");
+    assert!(row0.contains(",2,true,"), "{row0}");
 }
 
 /// A scene whose light has size 0 (stacked.toml's spot): the area-light truth is the light's

@@ -1,7 +1,9 @@
-//! `report.html`: one self-contained page (every image a `data:` URI, the style and the
-//! table-sorting script inline, a Content-Security-Policy that lets nothing else load): the
-//! three Pareto plots, a sortable table of every configuration, and crops of the truth and of
-//! each front configuration where their penumbrae differ most from it, with error maps.
+//! `report.html`: one self-contained page (every image a `data:` URI, the plots inline SVG so
+//! that their points' `<title>` tooltips show, the style and the table-sorting script inline,
+//! a Content-Security-Policy that lets nothing else load): the run's facts and the verdict at
+//! its operating point, the three Pareto plots, a sortable table of every configuration, and
+//! crops of the truth and of each front configuration (and each family's best off the fronts)
+//! where their penumbrae differ most from it, with error maps and times.
 
 use std::fmt::Write;
 
@@ -9,7 +11,7 @@ use base64::Engine;
 
 use super::crops::{self, Crop};
 use super::flip::{flip_map, magma};
-use super::output::{region_text, wall_check};
+use super::output::{protocol_text, region_text, run_line, wall_check};
 use super::svg::{Metric, colour, front};
 use super::{ErrorStats, Images, Report, Row};
 use crate::error::Result;
@@ -35,7 +37,10 @@ border-radius:5px;margin-right:5px}\
 padding-right:6px;border-right:1px solid #ccc}\
 figure{margin:0;font-size:11.5px;text-align:center}\
 figure img{display:block;image-rendering:pixelated;margin-bottom:2px}\
-figcaption{max-width:180px;overflow-wrap:anywhere}.note{color:#555}";
+figcaption{max-width:180px;overflow-wrap:anywhere}.note{color:#555}\
+.verdict{background:#f3f7ff;border:1px solid #c8d6f0;padding:8px 16px;margin:12px 0}\
+.verdict li{margin:3px 0}.plot svg{max-width:100%;height:auto;border:1px solid #ddd;\
+margin:6px 0}.plot .pt:hover{stroke-width:2}";
 
 /// Sorts a `table.sortable` by the clicked column: numbers by `data-v`, text otherwise.
 const SCRIPT: &str = "document.querySelectorAll('table.sortable th').forEach((th,col)=>{\
@@ -48,7 +53,8 @@ parseFloat(td.dataset.v):td.textContent;};\
 const c=typeof x==='number'?x-y:String(x).localeCompare(String(y));\
 return asc?c:-c;}).forEach(r=>body.appendChild(r));});});";
 
-fn escape(s: &str) -> String {
+/// `s` with HTML's special characters escaped (for text and attribute values).
+pub(super) fn escape(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")
@@ -63,6 +69,19 @@ fn emphasis(s: &str) -> String {
             (1, _) => format!("<i>{part}"),
             (0, 0) => part.to_string(),
             _ => format!("</i>{part}"),
+        })
+        .collect()
+}
+
+/// Markdown's `**bold**` as `<b>bold</b>` on escaped text (the verdict is shared with
+/// report.md).
+fn bold(s: &str) -> String {
+    s.split("**")
+        .enumerate()
+        .map(|(k, part)| match (k % 2, k) {
+            (1, _) => format!("<b>{part}"),
+            (0, 0) => part.to_string(),
+            _ => format!("</b>{part}"),
         })
         .collect()
 }
@@ -97,30 +116,47 @@ pub fn html(report: &Report, images: &Images, plots: &[(Metric, String)]) -> Res
          <title>{t}</title><style>{STYLE}</style></head><body>\n<h1>{t}</h1>\n",
         t = escape(&title)
     );
+    let _ = writeln!(s, "<p>{}</p>", escape(&run_line(report)));
+    let verdicts = super::verdict::verdicts(report);
+    if !verdicts.is_empty() {
+        s.push_str("<div class=\"verdict\"><h2>At this operating point</h2><ul>\n");
+        for v in &verdicts {
+            let _ = writeln!(s, "<li class=\"verdict-line\">{}</li>", bold(&escape(v)));
+        }
+        s.push_str("</ul></div>\n");
+    }
     let _ = writeln!(
         s,
-        "<p>Device: {}. Image {}×{}, {} relevant pixels. Ground truth: the area light sampled \
-         at K = {} points, {:?}² hard shadow maps. {}</p>\n<p class=\"note\">{}</p>",
-        escape(&report.device),
+        "<p>Image {}×{}, {} relevant pixels. Ground truth: the area light sampled \
+         at K = {} points, {:?}² hard shadow maps. {}</p>\n<p class=\"note\">{}</p>\n\
+         <p class=\"note\">{}</p>",
         report.image.0,
         report.image.1,
         report.relevant_pixels,
         report.truth_samples,
         report.truth_resolution,
         if report.cpu_driver {
-            "<b>Times are CPU-driver times</b> (a software Vulkan driver): compare \
-             configurations with each other only."
+            "<b>Times are CPU-driver times</b> (a software Vulkan driver, whose ratios between \
+             passes differ from a GPU's by up to 7×): these fronts test the machinery, not the \
+             answer for a GPU; compare configurations with each other only."
         } else {
             ""
         },
-        emphasis(&escape(&region_text(report)))
+        emphasis(&escape(&region_text(report))),
+        escape(&protocol_text(report))
     );
     s.push_str("<h2>Time against error: the Pareto fronts</h2>\n");
+    s.push_str(
+        "<p class=\"note\">Colour: technique; shape: family (circle: a lookup or fixed kernel, \
+         square: a per-pixel search, triangle: prefiltered, diamond: prefiltered soft); size: \
+         map side; bar: the total time's interquartile range over the timed frames. Hover a \
+         point for its figures.</p>\n",
+    );
     for (m, svg) in plots {
+        let body = svg.find("<svg").map_or(svg.as_str(), |k| &svg[k..]);
         let _ = writeln!(
             s,
-            "<div class=\"plot\"><img src=\"{}\" alt=\"total time vs {}\" width=\"960\"></div>",
-            data_uri("image/svg+xml", svg.as_bytes()),
+            "<div class=\"plot\" role=\"img\" aria-label=\"total time vs {}\">{body}</div>",
             m.name()
         );
     }
@@ -167,7 +203,10 @@ fn table(s: &mut String, report: &Report) {
          umbra and lit regions, and against the box-PCF truth of the configuration's own map \
          (pcf); FLIP is the mean perceptual error of the shaded image. <i>front</i>: on the \
          Pareto front of total time vs the soft mean (M), the penumbra mean (P), FLIP \
-         (F).</p>\n<table class=\"sortable\"><thead><tr>",
+         (F). IQR: the total's first–third quartile over the timed frames; retries: times \
+         measured again for its clock check († still off); B/texel, dispatches, fetches/px: \
+         <code>shadowgraph plan</code>'s cost of light 0; penumbra HF: RMS of the Laplacian \
+         of the penumbra's error.</p>\n<table class=\"sortable\"><thead><tr>",
     );
     for h in [
         "configuration",
@@ -176,12 +215,18 @@ fn table(s: &mut String, report: &Report) {
         "kernels",
         "shade",
         "total",
+        "IQR",
+        "retries",
         "wall",
         "MiB",
+        "B/texel",
+        "dispatches",
+        "fetches/px",
         "soft mean",
         "soft p99",
         "penumbra mean",
         "penumbra p99",
+        "penumbra HF",
         "umbra mean",
         "lit mean",
         "FLIP mean",
@@ -208,14 +253,38 @@ fn table(s: &mut String, report: &Report) {
             escape(&r.label)
         );
         s.push_str(&num(Some(f64::from(r.shadow_map)), 0));
-        for t in [r.raster_ms, r.kernels_ms, r.shade_ms, r.total_ms, r.wall_ms] {
+        for t in [r.raster_ms, r.kernels_ms, r.shade_ms, r.total_ms] {
             s.push_str(&num(t, 2));
         }
+        match r.total_spread {
+            Some(t) => {
+                let _ = write!(
+                    s,
+                    "<td data-v=\"{}\">{:.2}–{:.2}</td>",
+                    t.q3 - t.q1,
+                    t.q1,
+                    t.q3
+                );
+            }
+            None => s.push_str(&num(None, 0)),
+        }
+        let _ = write!(
+            s,
+            "<td data-v=\"{}\">{}{}</td>",
+            r.retries,
+            r.retries,
+            if r.clock_off { " †" } else { "" }
+        );
+        s.push_str(&num(r.wall_ms, 2));
         s.push_str(&num(Some(r.memory_bytes as f64 / 1048576.0), 1));
+        s.push_str(&num(Some(r.cost.bytes_per_texel), 1));
+        s.push_str(&num(Some(f64::from(r.cost.dispatches)), 0));
+        s.push_str(&num(Some(r.cost.fetches_per_pixel), 1));
         s.push_str(&num(Some(r.soft.mean_abs), 4));
         s.push_str(&num(Some(r.soft.p99), 3));
         s.push_str(&num(region_mean(&r.penumbra), 4));
         s.push_str(&num(region_mean(&r.penumbra).map(|_| r.penumbra.p99), 3));
+        s.push_str(&num(region_mean(&r.penumbra).map(|_| r.penumbra_hf), 4));
         s.push_str(&num(region_mean(&r.umbra), 4));
         s.push_str(&num(region_mean(&r.lit), 4));
         s.push_str(&num(Some(r.flip.mean_abs), 4));
@@ -243,9 +312,29 @@ fn front_rows(report: &Report) -> Vec<usize> {
     all
 }
 
+/// The rows the crops show: the fronts' union, then each family's most accurate in the
+/// penumbra where it is on no front, fastest first.
+pub(super) fn crop_rows(report: &Report) -> Vec<usize> {
+    let mut all = front_rows(report);
+    for f in super::verdict::Family::ALL {
+        let best = (0..report.rows.len())
+            .filter(|&i| super::verdict::Family::named(&report.rows[i].family) == f)
+            .min_by(|&a, &b| {
+                let e = |i: usize| report.rows[i].penumbra.mean_abs;
+                e(a).total_cmp(&e(b))
+            });
+        if let Some(i) = best.filter(|i| !all.contains(i)) {
+            all.push(i);
+        }
+    }
+    let t = |i: usize| report.rows[i].total_ms.unwrap_or(f64::INFINITY);
+    all.sort_by(|&a, &b| t(a).total_cmp(&t(b)).then(a.cmp(&b)));
+    all
+}
+
 fn crop_section(s: &mut String, report: &Report, images: &Images) -> Result<()> {
     let (w, h) = (images.width as usize, images.height as usize);
-    let chosen = front_rows(report);
+    let chosen = crop_rows(report);
     let windows = crops::choose(images, &chosen);
     s.push_str("<h2>Where the front's penumbrae differ most</h2>\n");
     if windows.is_empty() || images.truth_shaded.is_empty() {
@@ -257,8 +346,9 @@ fn crop_section(s: &mut String, report: &Report, images: &Images) -> Result<()> 
     let _ = writeln!(
         s,
         "<p class=\"note\">The {} windows of {side}×{side} pixels (outlined) whose penumbra pixels \
-         hold the largest sum of |visibility − truth| over the configurations on a front (light \
-         0). Per configuration: the shaded crop, its signed visibility error (red: brighter than \
+         hold the largest sum of |visibility − truth| over the configurations on a front and \
+         each family's most accurate off the fronts (light 0). Per configuration, with its total \
+         time (median and interquartile range): the shaded crop, its signed visibility error (red: brighter than \
          the truth, blue: darker, full colour at 0.5; grey: not a relevant pixel) and its FLIP \
          map (magma: black 0, yellow 1). The truth's column shows the regions (orange penumbra, \
          navy umbra, pale lit).</p>",
@@ -328,13 +418,30 @@ fn crop_row(
     );
     for (i, err, flip) in maps {
         let r: &Row = &report.rows[*i];
+        let time = r.total_spread.map_or_else(
+            || {
+                r.total_ms
+                    .map_or_else(|| "untimed".into(), |t| format!("{t:.3} ms"))
+            },
+            |t| format!("{} ms", t.text(3)),
+        );
+        let on_front = Metric::ALL
+            .iter()
+            .any(|&m| front(&report.rows, m).contains(i));
         let _ = writeln!(
             s,
-            "<figure>{}{}{}<figcaption>{}<br>penumbra {:.4}, FLIP {:.4}</figcaption></figure>",
+            "<figure>{}{}{}<figcaption class=\"crop-caption\">{}{}<br>{}<br>penumbra {:.4}, FLIP {:.4}\
+             </figcaption></figure>",
             cell(&images.shaded[*i], &r.label)?,
             cell(err, "visibility error")?,
             cell(flip, "FLIP map")?,
             escape(&r.label),
+            if on_front {
+                ""
+            } else {
+                " (its family's best, off the fronts)"
+            },
+            escape(&time),
             r.penumbra.mean_abs,
             r.flip.mean_abs
         );

@@ -4,8 +4,8 @@
 use glam::DVec3;
 
 use super::flip::{Shader, flip_map, flip_stats};
-use super::stats::{ErrorStats, Region, Regions};
-use super::{Config, Row, storage_name};
+use super::stats::{ErrorStats, Region, Regions, laplacian_rms};
+use super::{Config, PlanCost, Row, storage_name};
 use crate::cpu::Map;
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
@@ -69,7 +69,8 @@ pub struct Measured {
     pub truth_shaded: Vec<u8>,
 }
 
-/// Renders one configuration (`repeat` timed frames) and measures it.
+/// Renders one frame of a configuration and measures its errors, memory and plan cost; its
+/// times are filled later by the time protocol (`timing::fill`).
 pub fn measure(
     renderer: &mut Renderer,
     gpu: &Gpu,
@@ -77,21 +78,15 @@ pub fn measure(
     c: &Config,
     linear: &[FloatMap],
     reference: &Reference,
-    repeat: u32,
 ) -> Result<Measured> {
     let truth = &reference.truth;
-    // On a GPU, untimed frames until its clocks have risen (the error measurement of the last
-    // configuration left it idle); on a CPU device none beyond the dropped frame below.
-    renderer.warm_up(&gpu.device, &gpu.queue, scene)?;
     let frame = renderer.render(
         &gpu.device,
         &gpu.queue,
         scene,
         RenderOptions {
             aux: true,
-            // One more frame than timed: the first also pays for first-use work (software
-            // drivers compile shaders at their first dispatch), so its times are dropped.
-            repeat: repeat.max(1) + 1,
+            repeat: 1,
             dump: false,
         },
     )?;
@@ -101,6 +96,15 @@ pub fn measure(
     let stats = |mask: &[bool]| ErrorStats::new(&frame.visibility, &reference.truth64, mask);
     let soft = stats(&truth.mask);
     let [penumbra, umbra, lit] = reference.masks.each_ref().map(|m| stats(m));
+    let (penumbra_hf, _) = laplacian_rms(
+        &frame.visibility,
+        &reference.truth64,
+        &reference.masks[0],
+        &truth.mask,
+        frame.width as usize,
+        frame.height as usize,
+        truth.lights,
+    );
     let shade = |v: &[f32]| reference.shader.image(&frame.position, &frame.normal, v);
     let (shaded, truth_shaded) = (shade(&frame.visibility), shade(&truth.visibility));
     let flip = flip_stats(&flip_map(&truth_shaded, &shaded, frame.width, frame.height));
@@ -108,25 +112,10 @@ pub fn measure(
         Some(w) => Some(pcf_stats(scene, &frame, linear, truth, w)?),
         None => None,
     };
-    let passes = median_passes(frame.timings.get(1..).unwrap_or_default());
-    let mut walls = frame.wall_ms.get(1..).unwrap_or_default().to_vec();
-    walls.sort_by(f64::total_cmp);
-    let wall_ms = walls.get(walls.len() / 2).copied();
-    let sum = |f: &dyn Fn(&str) -> bool| -> Option<f64> {
-        (!passes.is_empty()).then(|| passes.iter().filter(|(l, _)| f(l)).map(|p| p.1).sum())
-    };
-    // The depth passes: each light's map and, for the second-depth techniques, its peel pass.
-    let raster = |l: &str| l.ends_with(".shadow_raster") || l.ends_with(".shadow_peel");
-    let raster_ms = sum(&raster);
-    let gbuffer_ms = sum(&|l| l == "gbuffer");
-    let shade_ms = sum(&|l| l == "shade");
-    let kernels_ms = sum(&|l| !raster(l) && l != "gbuffer" && l != "shade");
-    let total_ms = match (raster_ms, kernels_ms, shade_ms) {
-        (Some(a), Some(b), Some(c)) => Some(a + b + c),
-        _ => None,
-    };
     // The lights the frame drew: a cascaded light's every cascade, each with its own maps.
-    let plan = plan_lights(&crate::render::drawn_lights(scene)?.lights)?;
+    let drawn = crate::render::drawn_lights(scene)?;
+    let plan = plan_lights(&drawn.lights)?;
+    let cost = plan_cost(&plan.plan, &drawn.lights)?;
     // The rasterized maps the plan imports (one depth per drawn light, two where it peels).
     let depth: u64 = plan
         .plan
@@ -142,20 +131,27 @@ pub fn measure(
     let row = Row {
         label: c.label.clone(),
         technique: c.technique.name().to_string(),
+        family: super::verdict::Family::of(&c.technique).name().to_string(),
         shadow_map: c.shadow_map,
         storage,
         filter,
         box_width: c.box_width,
-        passes,
-        raster_ms,
-        kernels_ms,
-        shade_ms,
-        total_ms,
-        gbuffer_ms,
-        wall_ms,
+        passes: Vec::new(),
+        raster_ms: None,
+        kernels_ms: None,
+        shade_ms: None,
+        total_ms: None,
+        gbuffer_ms: None,
+        wall_ms: None,
+        total_spread: None,
+        retries: 0,
+        clock_off: false,
+        check_ratio: None,
         memory_bytes: plan.plan.peak_live_bytes() + depth,
+        cost,
         soft,
         penumbra,
+        penumbra_hf,
         umbra,
         lit,
         flip,
@@ -179,23 +175,18 @@ fn filter_name(f: Filter) -> String {
     .to_string()
 }
 
-/// Median of each pass over the frames (passes in the first frame's order).
-fn median_passes(frames: &[Vec<(String, f64)>]) -> Vec<(String, f64)> {
-    let Some(first) = frames.first() else {
-        return Vec::new();
-    };
-    first
-        .iter()
-        .enumerate()
-        .map(|(i, (label, _))| {
-            let mut v: Vec<f64> = frames
-                .iter()
-                .filter_map(|f| f.get(i).map(|x| x.1))
-                .collect();
-            v.sort_by(f64::total_cmp);
-            (label.clone(), v[v.len() / 2])
-        })
-        .collect()
+/// What `shadowgraph plan` prints for the first drawn light: the graph's bytes per texel and
+/// dispatches, and the shading's fetches per pixel.
+fn plan_cost(plan: &crate::graph::Plan, lights: &[crate::scene::Light]) -> Result<PlanCost> {
+    use crate::graph::cost;
+    let nodes = cost::light_traffic(plan, 0)?;
+    let texels = cost::map_texels(plan, 0).max(1.0);
+    let fetches = crate::cli::shading_fetches(lights)?;
+    Ok(PlanCost {
+        bytes_per_texel: nodes.iter().map(|(_, t)| t.bytes()).sum::<f64>() / texels,
+        dispatches: nodes.iter().map(|(_, t)| t.dispatches).sum(),
+        fetches_per_pixel: fetches.first().copied().unwrap_or(0.0),
+    })
 }
 
 /// Each light's linear depth map at `size`: the shade map of a `hard` render (the plan's

@@ -86,7 +86,7 @@ fn stats_cells(s: Option<&ErrorStats>) -> String {
 /// One line per configuration; per-pass times as `name=ms` pairs separated by `;`.
 pub fn csv(report: &Report) -> String {
     let mut s = format!(
-        "label,technique,shadow_map,storage,filter,box_width,raster_ms,kernels_ms,shade_ms,total_ms,gbuffer_ms,wall_ms,memory_bytes,{},{},{},{},{},{},passes\n",
+        "label,technique,shadow_map,storage,filter,box_width,raster_ms,kernels_ms,shade_ms,total_ms,total_q1_ms,total_q3_ms,total_min_ms,total_max_ms,gbuffer_ms,wall_ms,check_ratio,retries,clock_off,memory_bytes,bytes_per_texel,dispatches,fetches_per_pixel,penumbra_hf,{},{},{},{},{},{},passes\n",
         stats_header("soft"),
         stats_header("penumbra"),
         stats_header("umbra"),
@@ -102,7 +102,7 @@ pub fn csv(report: &Report) -> String {
             .collect();
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{},{:.2},{:.6},{},{},{},{},{},{},{}",
             r.label,
             r.technique,
             r.shadow_map,
@@ -113,9 +113,21 @@ pub fn csv(report: &Report) -> String {
             ms(r.kernels_ms),
             ms(r.shade_ms),
             ms(r.total_ms),
+            ms(r.total_spread.map(|s| s.q1)),
+            ms(r.total_spread.map(|s| s.q3)),
+            ms(r.total_spread.map(|s| s.min)),
+            ms(r.total_spread.map(|s| s.max)),
             ms(r.gbuffer_ms),
             ms(r.wall_ms),
+            r.check_ratio
+                .map_or_else(String::new, |q| format!("{q:.4}")),
+            r.retries,
+            r.clock_off,
             r.memory_bytes,
+            r.cost.bytes_per_texel,
+            r.cost.dispatches,
+            r.cost.fetches_per_pixel,
+            r.penumbra_hf,
             stats_cells(Some(&r.soft)),
             stats_cells(Some(&r.penumbra)),
             stats_cells(Some(&r.umbra)),
@@ -148,6 +160,75 @@ pub fn region_text(report: &Report) -> String {
          mean over the whole image.",
         w = 2 * EDGE_BAND + 1
     )
+}
+
+/// The run's facts: device and driver, commit, date, timed frames per configuration.
+pub fn run_line(report: &Report) -> String {
+    format!(
+        "Device: {}. Commit {}, {} (UTC); n = {} timed frames per configuration.",
+        report.device,
+        if report.commit.is_empty() {
+            "unknown"
+        } else {
+            &report.commit
+        },
+        if report.date.is_empty() {
+            "date unknown"
+        } else {
+            &report.date
+        },
+        report.repeats
+    )
+}
+
+/// How the times were taken (the time protocol), and what its clock check found.
+pub fn protocol_text(report: &Report) -> String {
+    let n = report.rows.len();
+    let mut s = format!(
+        "Time protocol: after every configuration's error was measured, the {n} \
+         configurations were timed interleaved, round-robin over {} rounds (each round starting \
+         one configuration later, one untimed frame before each timed one, and on a GPU {} ms of \
+         untimed frames first so that its clocks have risen).",
+        report.repeats,
+        crate::timer::GPU_WARMUP_MS
+    );
+    let Some(m) = report.check_median_ms else {
+        s.push_str(" No clock check: the device wrote no timestamps.");
+        return s;
+    };
+    let retried = report.rows.iter().filter(|r| r.retries > 0).count();
+    let off: Vec<&str> = report
+        .rows
+        .iter()
+        .filter(|r| r.clock_off)
+        .map(|r| r.label.as_str())
+        .collect();
+    let ratios: Vec<f64> = report.rows.iter().filter_map(|r| r.check_ratio).collect();
+    let (lo, hi) = ratios
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &q| {
+            (a.min(q), b.max(q))
+        });
+    let _ = write!(
+        s,
+        " Clock check: the camera G-buffer, the same work in every configuration, ran {m:.3} ms \
+         (the run's median); {retried} of {n} configurations had their G-buffer more than 10% off \
+         it and were measured again (at most twice, keeping the attempt closest to it); {} \
+         remain off",
+        off.len()
+    );
+    if !off.is_empty() {
+        let _ = write!(s, " (†: {})", off.join(", "));
+    }
+    if lo.is_finite() {
+        let _ = write!(
+            s,
+            "; the configurations' G-buffer medians span {lo:.2}–{hi:.2}× the run's."
+        );
+    } else {
+        s.push('.');
+    }
+    s
 }
 
 /// A mean, or a dash where its region is empty.
@@ -251,13 +332,16 @@ fn fronts_text(report: &Report) -> String {
 pub fn markdown(report: &Report) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# Accuracy vs time: `{}`\n", report.scene);
+    let _ = writeln!(s, "{}\n", run_line(report));
+    for v in super::verdict::verdicts(report) {
+        let _ = writeln!(s, "- {v}");
+    }
     let _ = writeln!(
         s,
-        "Device: {}. Image {}×{}, {} relevant pixels (lit receivers: facing the light, inside its \
+        "\nImage {}×{}, {} relevant pixels (lit receivers: facing the light, inside its \
          frustum and cone). Ground truth: the area light's emitter (a square of side `size` at \
          the light's position, perpendicular to its direction) sampled at K = {} stratified \
          points, one {:?}² hard shadow map each (`shadowgraph::truth`).\n",
-        report.device,
         report.image.0,
         report.image.1,
         report.relevant_pixels,
@@ -267,29 +351,38 @@ pub fn markdown(report: &Report) -> String {
     if report.cpu_driver {
         s.push_str(
             "**Times are CPU-driver times** (a software Vulkan driver runs the kernels on the \
-             CPU): compare configurations with each other, not with a GPU.\n\n",
+             CPU, and its ratios between passes differ from a GPU's by up to 7×): these fronts \
+             test the machinery, not the answer for a GPU; compare configurations with each \
+             other only.\n\n",
         );
     }
+    s.push_str(&protocol_text(report));
+    s.push_str("\n\n");
     s.push_str(
-        "Columns: GPU time per part (median over the repeats, from timestamps): raster = shadow \
+        "Columns: GPU time per part (median over the timed frames, from timestamps): raster = shadow \
          map (and the peel pass of a second-depth technique), kernels = the graph (linearize, encode, filter), shade = the shading pass, total = \
-         their sum (the camera G-buffer is common to all and left out); wall = a whole frame, \
+         their sum (the camera G-buffer is common to all and left out), shown as median (first–third \
+         quartile); † marks a configuration whose clock check stayed off; wall = a whole frame, \
          G-buffer included, from submission to completion (median), which the timestamps are \
          checked against below the table; memory = the plan's peak \
-         live textures plus the depth maps. *soft*: error against the area-light truth (the \
+         live textures plus the depth maps; B/texel, dispatches and fetches/px: what \
+         `shadowgraph plan` counts for light 0 (the graph's bytes read and written per map \
+         texel, its dispatches, the shading's texture fetches per pixel). *soft*: error against the area-light truth (the \
          scene as it should look); *pcf*: error against brute-force box PCF of the \
          configuration's own map with the same box width (what a prefiltered technique \
          approximates), where the configuration filters with a box. Errors are |visibility − \
          truth| over the relevant pixels: mean, RMSE, 99th percentile, max, and the shares of \
          pixels off by more than 0.05 and 0.2; *penumbra*, *umbra*, *lit*: the soft mean over \
-         each region of the truth.\n\n",
+         each region of the truth; *penumbra HF*: the penumbra's high-frequency error, the \
+         RMS of the discrete Laplacian of (visibility − truth) over penumbra pixels (0 for an \
+         error that varies smoothly, large for a staircase, banding or noise).\n\n",
     );
     s.push_str(&region_text(report));
     s.push_str("\n\n");
     s.push_str(
-        "| configuration | raster ms | kernels ms | shade ms | total ms | wall ms | MiB | soft mean | soft rmse | soft p99 | soft max | soft >0.05 | soft >0.2 | penumbra mean | umbra mean | lit mean | FLIP mean | pcf mean | pcf p99 | pcf >0.05 |\n",
+        "| configuration | raster ms | kernels ms | shade ms | total ms (IQR) | wall ms | MiB | B/texel | dispatches | fetches/px | soft mean | soft rmse | soft p99 | soft max | soft >0.05 | soft >0.2 | penumbra mean | penumbra HF | umbra mean | lit mean | FLIP mean | pcf mean | pcf p99 | pcf >0.05 |\n",
     );
-    s.push_str("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+    s.push_str("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
     for r in &report.rows {
         let (pm, pp, po) =
             r.pcf
@@ -303,14 +396,18 @@ pub fn markdown(report: &Report) -> String {
                 });
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.3} | {:.3} | {:.2}% | {:.2}% | {} | {} | {} | {:.4} | {pm} | {pp} | {po} |",
+            "| {} | {} | {} | {} | {}{} | {} | {} | {:.1} | {} | {:.1} | {:.4} | {:.4} | {:.3} | {:.3} | {:.2}% | {:.2}% | {} | {:.4} | {} | {} | {:.4} | {pm} | {pp} | {po} |",
             r.label,
             ms(r.raster_ms),
             ms(r.kernels_ms),
             ms(r.shade_ms),
-            ms(r.total_ms),
+            r.total_spread.map_or_else(|| ms(r.total_ms), |t| t.text(3)),
+            if r.clock_off { " †" } else { "" },
             ms(r.wall_ms),
             mib(r.memory_bytes),
+            r.cost.bytes_per_texel,
+            r.cost.dispatches,
+            r.cost.fetches_per_pixel,
             r.soft.mean_abs,
             r.soft.rmse,
             r.soft.p99,
@@ -318,6 +415,7 @@ pub fn markdown(report: &Report) -> String {
             100.0 * r.soft.over_005,
             100.0 * r.soft.over_02,
             mean_cell(&r.penumbra),
+            r.penumbra_hf,
             mean_cell(&r.umbra),
             mean_cell(&r.lit),
             r.flip.mean_abs,

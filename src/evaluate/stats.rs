@@ -71,6 +71,50 @@ impl ErrorStats {
     }
 }
 
+/// The penumbra's high-frequency error: the root mean square of the discrete Laplacian of
+/// the error e = values − truth, Δe(x, y) = e(x+1, y) + e(x−1, y) + e(x, y+1) + e(x, y−1) −
+/// 4 e(x, y), over the pixels of `penumbra` whose four neighbours are all `relevant` (pixels
+/// are indexed `[(y · width + x) · lights + l]`, each light on its own). An error that
+/// varies smoothly (an offset, a ramp) scores 0 however large it is; a staircase, banding or
+/// noise of the same mean scores by its steps. Returns the value and the pixels it was taken
+/// over (0 and 0 when none qualifies).
+#[expect(
+    clippy::too_many_arguments,
+    reason = "an image, its truth, two masks and its shape"
+)]
+pub fn laplacian_rms(
+    values: &[f32],
+    truth: &[f64],
+    penumbra: &[bool],
+    relevant: &[bool],
+    width: usize,
+    height: usize,
+    lights: usize,
+) -> (f64, usize) {
+    let (mut sum, mut n) = (0.0, 0usize);
+    for l in 0..lights {
+        let at = |x: usize, y: usize| (y * width + x) * lights + l;
+        let e = |i: usize| f64::from(values[i]) - truth[i];
+        for y in 1..height.saturating_sub(1) {
+            for x in 1..width.saturating_sub(1) {
+                let i = at(x, y);
+                let around = [at(x + 1, y), at(x - 1, y), at(x, y + 1), at(x, y - 1)];
+                if !penumbra[i] || !relevant[i] || !around.iter().all(|&j| relevant[j]) {
+                    continue;
+                }
+                let lap: f64 = around.iter().map(|&j| e(j)).sum::<f64>() - 4.0 * e(i);
+                sum += lap * lap;
+                n += 1;
+            }
+        }
+    }
+    if n == 0 {
+        (0.0, 0)
+    } else {
+        ((sum / n as f64).sqrt(), n)
+    }
+}
+
 /// Where a relevant pixel lies in the truth's shadow.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Region {
@@ -157,4 +201,73 @@ fn dilate(m: &[bool], w: usize, h: usize, k: usize) -> Vec<bool> {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The Laplacian's RMS, written out directly in f64 over one light.
+    fn direct(e: &dyn Fn(usize, usize) -> f64, w: usize, h: usize) -> f64 {
+        let (mut sum, mut n) = (0.0, 0.0);
+        for y in 1..h - 1 {
+            for x in 1..w - 1 {
+                let lap = e(x + 1, y) + e(x - 1, y) + e(x, y + 1) + e(x, y - 1) - 4.0 * e(x, y);
+                sum += lap * lap;
+                n += 1.0;
+            }
+        }
+        (sum / n).sqrt()
+    }
+
+    /// A truth ramp t = 0.1 + g·x (64 × 8, every pixel penumbra and relevant) rendered as a
+    /// staircase of 4-texel steps (each step's value the truth at its centre) and as the ramp
+    /// offset by g: both have mean |error| g, but the staircase's error is a sawtooth whose
+    /// Laplacian is ±4g at the two pixels around each step, so its RMS is sqrt(30 · 6 ·
+    /// (4g)² / (62 · 6)) (30 step pixels per interior row) while the offset scores 0. Both
+    /// against the written-out sum (1e-12: the same sums in another order). A second light
+    /// (interleaved) with the roles swapped scores the same, so lights do not mix; a pixel
+    /// that is not relevant, and its four neighbours, are left out.
+    #[test]
+    fn a_staircase_scores_above_a_smooth_error_of_the_same_mean() {
+        let (w, h, g) = (64usize, 8usize, 0.01);
+        let truth_at = |x: usize| 0.1 + g * x as f64;
+        let stair_at = |x: usize| truth_at(4 * (x / 4)) + 1.5 * g;
+        let truth: Vec<f64> = (0..w * h).map(|i| truth_at(i % w)).collect();
+        let stair: Vec<f32> = (0..w * h).map(|i| stair_at(i % w) as f32).collect();
+        let offset: Vec<f32> = (0..w * h).map(|i| (truth_at(i % w) + g) as f32).collect();
+        let all = vec![true; w * h];
+        let mean = |v: &[f32]| ErrorStats::new(v, &truth, &all).mean_abs;
+        assert!((mean(&stair) - g).abs() < 1e-7 && (mean(&offset) - g).abs() < 1e-7);
+        let (hf_stair, n) = laplacian_rms(&stair, &truth, &all, &all, w, h, 1);
+        let (hf_offset, _) = laplacian_rms(&offset, &truth, &all, &all, w, h, 1);
+        assert_eq!(n, 62 * 6);
+        let known = (30.0 * 6.0 * (4.0 * g).powi(2) / (62.0 * 6.0)).sqrt();
+        // f32 storage of the values: their errors are within 1e-8, the Laplacian's 1e-7.
+        assert!((hf_stair - known).abs() < 1e-6, "{hf_stair} vs {known}");
+        assert!(hf_offset < 1e-6, "{hf_offset}");
+        let e = |v: &[f32]| {
+            let v = v.to_vec();
+            let truth = truth.clone();
+            move |x: usize, y: usize| f64::from(v[y * w + x]) - truth[y * w + x]
+        };
+        assert!((hf_stair - direct(&e(&stair), w, h)).abs() < 1e-12);
+        assert!((hf_offset - direct(&e(&offset), w, h)).abs() < 1e-12);
+        // Two lights interleaved: [stair, offset] per pixel.
+        let both: Vec<f32> = (0..w * h).flat_map(|i| [stair[i], offset[i]]).collect();
+        let truth2: Vec<f64> = truth.iter().flat_map(|&t| [t, t]).collect();
+        let only = |l: usize| -> Vec<bool> { (0..2 * w * h).map(|i| i % 2 == l).collect() };
+        let all2 = vec![true; 2 * w * h];
+        let (a, na) = laplacian_rms(&both, &truth2, &only(0), &all2, w, h, 2);
+        assert!((a - hf_stair).abs() < 1e-12 && na == n);
+        let (b, _) = laplacian_rms(&both, &truth2, &only(1), &all2, w, h, 2);
+        assert!((b - hf_offset).abs() < 1e-12);
+        // A pixel whose neighbour is not relevant is left out.
+        let mut relevant = all.clone();
+        relevant[3 * w + 10] = false;
+        assert_eq!(
+            laplacian_rms(&stair, &truth, &all, &relevant, w, h, 1).1,
+            n - 5
+        );
+    }
 }

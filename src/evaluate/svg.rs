@@ -1,6 +1,8 @@
 //! The Pareto plots (`pareto.svg`, `pareto_penumbra.svg`, `pareto_flip.svg`), drawn with
 //! `plotters`: total GPU time (log scale) against one error [`Metric`] (log scale when it spans
-//! a decade or more), one point per configuration coloured by technique with a legend, the
+//! a decade or more), one point per configuration — coloured by technique (each its own
+//! colour, [`PALETTE`]), shaped by family ([`Family`]), sized by map size, with the total's
+//! interquartile range as a horizontal error bar and a `<title>` tooltip — with a legend, the
 //! Pareto front as a staircase, and only the front's points labelled, each label placed where
 //! it overlaps no other label (see [`place_labels`]).
 
@@ -8,6 +10,7 @@ use plotters::coord::Shift;
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::prelude::*;
 
+use super::verdict::Family;
 use super::{Report, Row};
 use crate::error::{Error, Result};
 
@@ -70,12 +73,110 @@ impl Metric {
     }
 }
 
-/// Colour per technique (by name; the registry's `colour`), so families read at a glance.
+/// The plots' colours, one per registered technique in registry order: as many as there are
+/// techniques, so none shares a colour ([`colour`]; a test checks they differ).
+pub const PALETTE: [[u8; 3]; 20] = [
+    [0x44, 0x44, 0x44],
+    [0x1f, 0x77, 0xb4],
+    [0x17, 0xbe, 0xcf],
+    [0x2c, 0xa0, 0x2c],
+    [0xbc, 0xbd, 0x22],
+    [0x8c, 0x56, 0x4b],
+    [0x94, 0x67, 0xbd],
+    [0xd6, 0x27, 0x28],
+    [0xff, 0x7f, 0x0e],
+    [0xe3, 0x77, 0xc2],
+    [0x00, 0x5f, 0x3f],
+    [0x8b, 0x00, 0x00],
+    [0xf0, 0x02, 0x7f],
+    [0x00, 0x00, 0x80],
+    [0xc4, 0x9c, 0x94],
+    [0x98, 0xdf, 0x8a],
+    [0xae, 0xc7, 0xe8],
+    [0xff, 0xbb, 0x78],
+    [0x7f, 0x7f, 0x00],
+    [0x9e, 0xda, 0xe5],
+];
+
+/// Colour per technique: its registry position's [`PALETTE`] entry (grey for a name not
+/// registered; past the palette, a hue of its own by the golden angle).
 pub fn colour(technique: &str) -> RGBColor {
-    crate::technique::by_name(technique).map_or(RGBColor(0x7f, 0x7f, 0x7f), |d| {
-        let [r, g, b] = d.colour;
-        RGBColor(r, g, b)
-    })
+    let Some(i) = crate::technique::REGISTRY
+        .iter()
+        .position(|d| d.name == technique)
+    else {
+        return RGBColor(0x7f, 0x7f, 0x7f);
+    };
+    match PALETTE.get(i) {
+        Some(&[r, g, b]) => RGBColor(r, g, b),
+        None => {
+            let hue = (i as f64 * 137.508).rem_euclid(360.0);
+            let c = HSLColor(hue / 360.0, 0.65, 0.45).to_rgba();
+            RGBColor(c.0, c.1, c.2)
+        }
+    }
+}
+
+/// A marker's radius in pixels for a map of side `map`: 3 at 256², one more per doubling,
+/// within [2.5, 9].
+pub fn marker_radius(map: u32) -> f64 {
+    (3.0 + (f64::from(map.max(1)) / 256.0).log2()).clamp(2.5, 9.0)
+}
+
+/// One point's marker as SVG: the family's shape at (x, y), `r` in radius, filled with
+/// `fill`, inside a group whose `<title>` (the browser's tooltip) is `title`.
+pub fn marker(
+    class: &str,
+    family: Family,
+    (x, y): (i32, i32),
+    r: f64,
+    fill: RGBColor,
+    title: &str,
+) -> String {
+    let (x, y) = (f64::from(x), f64::from(y));
+    let style = format!(
+        "fill=\"rgb({},{},{})\" fill-opacity=\"0.85\" stroke=\"#222\" stroke-width=\"0.6\"",
+        fill.0, fill.1, fill.2
+    );
+    let poly = |pts: &[(f64, f64)]| {
+        let p: Vec<String> = pts
+            .iter()
+            .map(|(a, b)| format!("{:.1},{:.1}", x + a * r, y + b * r))
+            .collect();
+        format!("<polygon points=\"{}\" {style}/>", p.join(" "))
+    };
+    let shape = match family {
+        Family::Lookup => format!("<circle cx=\"{x}\" cy=\"{y}\" r=\"{r:.1}\" {style}/>"),
+        Family::Search => poly(&[(-0.9, -0.9), (0.9, -0.9), (0.9, 0.9), (-0.9, 0.9)]),
+        Family::Prefiltered => poly(&[(0.0, -1.2), (1.1, 0.8), (-1.1, 0.8)]),
+        Family::PrefilteredSoft => poly(&[(0.0, -1.25), (1.25, 0.0), (0.0, 1.25), (-1.25, 0.0)]),
+    };
+    format!(
+        "<g class=\"{class}\"><title>{}</title>{shape}</g>\n",
+        super::html::escape(title)
+    )
+}
+
+/// A point's tooltip: label, family, map, total time with its quartiles, the metric.
+fn tooltip(r: &Row, metric: Metric) -> String {
+    let t = r.total_spread.map_or_else(
+        || format!("{:.3}", r.total_ms.unwrap_or(f64::NAN)),
+        |s| s.text(3),
+    );
+    format!(
+        "{} ({}, {}² map): {t} ms total; {} {:.4}; penumbra HF {:.4}{}",
+        r.label,
+        r.family,
+        r.shadow_map,
+        metric.name(),
+        metric.value(r),
+        r.penumbra_hf,
+        if r.clock_off {
+            "; clock check off: timed at another clock"
+        } else {
+            ""
+        }
+    )
 }
 
 /// Indices of the rows on the Pareto front of (total time, `metric`), fastest first: a row
@@ -128,6 +229,7 @@ pub fn pareto(report: &Report, metric: Metric) -> Result<String> {
         })
         .collect();
     let mut svg = String::new();
+    let mut marks = Vec::new();
     {
         let root = SVGBackend::with_string(&mut svg, (W, H)).into_drawing_area();
         root.fill(&WHITE).map_err(plot_error)?;
@@ -153,7 +255,16 @@ pub fn pareto(report: &Report, metric: Metric) -> Result<String> {
             ))
             .map_err(plot_error)?;
         } else {
-            let (t0, t1) = span(pts.iter().map(|p| p.1));
+            let quartiles = pts.iter().flat_map(|p| {
+                let s = report.rows[p.0].total_spread;
+                [s.map_or(p.1, |s| s.q1), s.map_or(p.1, |s| s.q3)]
+            });
+            let (t0, t1) = span(
+                pts.iter()
+                    .map(|p| p.1)
+                    .chain(quartiles)
+                    .filter(|t| *t > 0.0),
+            );
             let (e0, e1) = span(pts.iter().map(|p| p.2));
             let (t0, t1) = (t0 / 1.3, t1 * 1.3);
             let (bold, light) = log_ticks(t0, t1);
@@ -168,13 +279,17 @@ pub fn pareto(report: &Report, metric: Metric) -> Result<String> {
                     .log_scale()
                     .with_key_points(bold)
                     .with_light_points(light);
-                draw(&root, report, metric, &pts, x, y)?;
+                marks = draw(&root, report, metric, &pts, x, y)?;
             } else {
                 // plotters' own linear ticks are 1-2-5 steps already.
-                draw(&root, report, metric, &pts, x, 0.0..(e1 * 1.1).max(1e-4))?;
+                marks = draw(&root, report, metric, &pts, x, 0.0..(e1 * 1.1).max(1e-4))?;
             }
         }
         root.present().map_err(plot_error)?;
+    }
+    // The markers, with their tooltips, drawn over the chart (plotters writes no <title>).
+    if let Some(end) = svg.rfind("</svg>") {
+        svg.insert_str(end, &marks.concat());
     }
     Ok(svg)
 }
@@ -200,7 +315,8 @@ fn span(v: impl Iterator<Item = f64>) -> (f64, f64) {
     })
 }
 
-/// Draws the chart on `root` with the x and y coordinates given (log or linear).
+/// Draws the chart on `root` with the x and y coordinates given (log or linear); returns the
+/// points' and the legend's markers as SVG, to be drawn over it.
 fn draw<X, Y>(
     root: &DrawingArea<SVGBackend, Shift>,
     report: &Report,
@@ -208,7 +324,7 @@ fn draw<X, Y>(
     pts: &[(usize, f64, f64)],
     x: X,
     y: Y,
-) -> Result<()>
+) -> Result<Vec<String>>
 where
     X: AsRangedCoord<Value = f64>,
     Y: AsRangedCoord<Value = f64>,
@@ -239,10 +355,27 @@ where
     chart
         .draw_series(LineSeries::new(stair, RGBColor(0x99, 0, 0).stroke_width(2)))
         .map_err(plot_error)?;
-    let dots = pts
+    // Each point's interquartile range of its total time, a horizontal bar.
+    let bars = pts.iter().filter_map(|&(i, _, e)| {
+        let s = rows[i].total_spread?;
+        let style = colour(&rows[i].technique).mix(0.7).stroke_width(2);
+        Some(PathElement::new(vec![(s.q1, e), (s.q3, e)], style))
+    });
+    chart.draw_series(bars).map_err(plot_error)?;
+    let mut marks: Vec<String> = pts
         .iter()
-        .map(|&(i, t, e)| Circle::new((t, e), 4, colour(&rows[i].technique).mix(0.85).filled()));
-    chart.draw_series(dots).map_err(plot_error)?;
+        .map(|&(i, t, e)| {
+            let r = &rows[i];
+            marker(
+                "pt",
+                Family::named(&r.family),
+                chart.backend_coord(&(t, e)),
+                marker_radius(r.shadow_map),
+                colour(&r.technique),
+                &tooltip(r, metric),
+            )
+        })
+        .collect();
     let rings = f.iter().filter_map(|&i| {
         let at = (rows[i].total_ms?, metric.value(&rows[i]));
         Some(Circle::new(at, 7, BLACK.stroke_width(2)))
@@ -268,7 +401,8 @@ where
         ys.end - base.1,
     );
     draw_labels(&area, &labelled, &points, bounds)?;
-    draw_legend(&legend, report)
+    marks.extend(draw_legend(&legend, report)?);
+    Ok(marks)
 }
 
 /// The grid, the ticks and the axes' names.
@@ -314,8 +448,10 @@ fn draw_labels(
     Ok(())
 }
 
-/// One technique per line, in the order they first appear.
-fn draw_legend(area: &DrawingArea<SVGBackend, Shift>, report: &Report) -> Result<()> {
+/// One technique per line (its colour), in the order they first appear, then the families
+/// (their shapes), the map sizes (marker sizes) and the front's ring; returns the shapes'
+/// markers as SVG.
+fn draw_legend(area: &DrawingArea<SVGBackend, Shift>, report: &Report) -> Result<Vec<String>> {
     let mut seen: Vec<&str> = Vec::new();
     for r in &report.rows {
         if !seen.contains(&r.technique.as_str()) {
@@ -332,12 +468,69 @@ fn draw_legend(area: &DrawingArea<SVGBackend, Shift>, report: &Report) -> Result
         area.draw(&Text::new(t.to_string(), (28, y - 7), style.clone()))
             .map_err(plot_error)?;
     }
-    let y = 46 + 22 * seen.len() as i32 + 8;
+    let mut y = 46 + 22 * seen.len() as i32 + 8;
     area.draw(&Circle::new((16, y), 7, BLACK.stroke_width(2)))
         .map_err(plot_error)?;
-    area.draw(&Text::new("Pareto front", (28, y - 7), style))
+    area.draw(&Text::new("Pareto front", (28, y - 7), style.clone()))
         .map_err(plot_error)?;
-    Ok(())
+    let base = area.get_base_pixel();
+    let small = ("sans-serif", 13).into_font().color(&BLACK);
+    let mut marks = Vec::new();
+    let mut families: Vec<Family> = Vec::new();
+    for r in &report.rows {
+        let f = Family::named(&r.family);
+        if !families.contains(&f) {
+            families.push(f);
+        }
+    }
+    y += 30;
+    area.draw(&Text::new("family", (10, y - 7), style.clone()))
+        .map_err(plot_error)?;
+    for f in families {
+        y += 20;
+        let grey = RGBColor(0xaa, 0xaa, 0xaa);
+        marks.push(marker(
+            "legend",
+            f,
+            (base.0 + 16, base.1 + y),
+            5.0,
+            grey,
+            f.name(),
+        ));
+        area.draw(&Text::new(f.name(), (28, y - 7), small.clone()))
+            .map_err(plot_error)?;
+    }
+    let mut sizes: Vec<u32> = report.rows.iter().map(|r| r.shadow_map).collect();
+    sizes.sort_unstable();
+    sizes.dedup();
+    y += 30;
+    area.draw(&Text::new("map side", (10, y - 7), style))
+        .map_err(plot_error)?;
+    for m in sizes {
+        y += 20;
+        let grey = RGBColor(0xaa, 0xaa, 0xaa);
+        let r = marker_radius(m);
+        let at = (base.0 + 16, base.1 + y);
+        marks.push(marker(
+            "legend",
+            Family::Lookup,
+            at,
+            r,
+            grey,
+            &format!("{m}²"),
+        ));
+        area.draw(&Text::new(format!("{m}²"), (28, y - 7), small.clone()))
+            .map_err(plot_error)?;
+    }
+    y += 26;
+    area.draw(&PathElement::new(
+        vec![(8, y), (24, y)],
+        RGBColor(0x88, 0x88, 0x88).stroke_width(2),
+    ))
+    .map_err(plot_error)?;
+    area.draw(&Text::new("time IQR", (28, y - 7), small))
+        .map_err(plot_error)?;
+    Ok(marks)
 }
 
 /// A placed label: text at (x, y) (its top-left), and a leader line from the point to it when
@@ -444,6 +637,18 @@ fn tick(v: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every registered technique has a colour of its own (the palette does not wrap).
+    #[test]
+    fn every_technique_has_its_own_colour() {
+        let names: Vec<&str> = crate::technique::REGISTRY.iter().map(|d| d.name).collect();
+        assert!(names.len() <= PALETTE.len(), "extend PALETTE");
+        for (i, a) in names.iter().enumerate() {
+            for b in &names[i + 1..] {
+                assert_ne!(colour(a), colour(b), "{a} and {b}");
+            }
+        }
+    }
 
     /// Eight labels on points crowded into a few pixels, in a plot 600×400: every label inside
     /// the bounds and no two labels' boxes overlapping.
