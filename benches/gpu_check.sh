@@ -1,12 +1,11 @@
 #!/bin/bash
-# The device checks to run first when a GPU is lent: the figures issues 14 (soft shading, the
-# shading pass's floor, table build) and 15 (kernels against a texture copy) are measured by,
-# in one call. From the repository root, after
-# `cargo build --release`:
+# The device checks to run first when a GPU is lent: the soft shading, the shading pass's
+# floor, the table build and the kernels against a texture copy, in one call. From the
+# repository root, after `cargo build --release`:
 #
 #   benches/gpu_check.sh [BINARY] [OUT]     # defaults: target/release/shadowgraph, gpu-out
 #
-# On an H200 (2026-11-27, fourteenth session) the steps took: soft table 66 s, a shading
+# On an H200 (2026-11-27) the steps took: soft table 66 s, a shading
 # variant with `hard` alone about 12 s (with `vssm` too perhaps 20 s), every kernel at 2048²
 # 20 s, 4096²/8192² 123 s, a kernel bench process at two sizes about 8 s of texture copies
 # before its kernels. In order now: soft table, four shading shapes (about 80 s), the blur's
@@ -82,11 +81,11 @@ step() {
 command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version,clocks.sm \
     --format=csv >>"$OUT/env.txt" 2>&1
 step env.txt 30 "$B" info
-# Issue 14: the soft techniques' shading against PCSS 16 + 32 at 1920×1080 with a 2048² map,
+# The soft techniques' shading against PCSS 16 + 32 at 1920×1080 with a 2048² map,
 # each configuration's prefilter, and each frame's passes against its wall time.
-# The SM clock sampled through it (the twelfth session's soft table read its prefilter
-# 2.4× the kernel bench's time for the same chain at a clock of 345-735 MHz; the fourteenth's
-# 1.5× at 1980 MHz: the table's last block, the prefilter pass by pass, says which pass).
+# The SM clock sampled through it (on 2026-11-27 the soft table read its prefilter 2.4× the
+# kernel bench's time for the same chain at a clock of 345-735 MHz, and 1.5× at 1980 MHz:
+# the table's last block, the prefilter pass by pass, says which pass).
 SAMPLER=
 if command -v nvidia-smi >/dev/null; then
     echo "## clocks during the soft table" >>"$OUT/env.txt"
@@ -111,8 +110,8 @@ mkdir -p "$V/shipped" "$V/empty" "$V/no_lookup" "$V/gbuffer_only" "$V/store_only
     "$V/wg16x4" "$V/tx2" "$V/tx4"
 cp "$S" "$V/shipped/shade.wgsl"
 # Nothing a pixel (the same 32 400 workgroups, each invocation testing its bounds and
-# returning): the pass's own cost, its transitions and launch (the twelfth session's `no_srgb`
-# variant, 0.015 ms of the 0.114, is dropped for it).
+# returning): the pass's own cost, its transitions and launch (a `no_srgb` variant, 0.015 ms
+# of the 0.114 on 2026-11-27, is dropped for it).
 {
     sed '/^@compute/,$d' "$S"
     printf '%s\n' "$MAIN"
@@ -132,7 +131,7 @@ sed 's/let v = light_visibility(i, gp.xyz, n, dp.dpdx, dp.dpdy);/let v = 1.0;/' 
     printf '%s\n' "$MAIN"
     printf '    textureStore(out_color, xy, vec4<f32>(0.5, 0.5, 0.5, 1.0));\n}\n'
 } >"$V/store_only/shade.wgsl"
-# Fewer workgroups (fourteenth session: an empty 8 × 8 kernel over 1080p 0.040 ms of `hard`'s
+# Fewer workgroups (2026-11-27: an empty 8 × 8 kernel over 1080p 0.040 ms of `hard`'s
 # 0.066, a constant store 0.058 in 8 × 8 and 0.025 in 16 × 16 workgroups, but the shipped
 # kernel slower in 16 × 16, 0.112 against 0.094): 16 × 4 (64 invocations on rows twice as
 # long), and 2 or 4 pixels an invocation along its row (`TEXELS_X`: the dispatch follows).
@@ -143,9 +142,9 @@ sed 's/^const TEXELS_X: u32 = 1u;$/const TEXELS_X: u32 = 4u;/' "$S" >"$V/tx4/sha
 for v in no_lookup wg16x4 tx2 tx4; do
     edited "$S" "$V/$v/shade.wgsl"
 done
-# `vssm` beside `hard` where the whole pass is kept (issue 14's ratio with each shape).
-# The floor's parts (empty, no_lookup, gbuffer_only, store_only) were timed in the fourteenth
-# session (0.040, 0.055-0.059, 0.060-0.061, 0.057-0.058 ms): set SHADE_PARTS=1 to time them again.
+# `vssm` beside `hard` where the whole pass is kept (the soft target's ratio with each shape).
+# The floor's parts (empty, no_lookup, gbuffer_only, store_only) were timed on 2026-11-27
+# (0.040, 0.055-0.059, 0.060-0.061, 0.057-0.058 ms): set SHADE_PARTS=1 to time them again.
 SHAPES="shipped wg16x4 tx2 tx4"
 [ -n "${SHADE_PARTS:-}" ] && SHAPES="$SHAPES empty no_lookup gbuffer_only store_only"
 for v in $SHAPES; do
@@ -156,12 +155,12 @@ for v in $SHAPES; do
         --image 1920x1080 --map 2048 --only "$only"
 done
 # The separable blur's row pass (H200: 3-5x its column pass over the same texels; both passes
-# took 0.139 ms at 2048² one output an invocation in the sixth session, 0.164 with the runs of
+# took 0.139 ms at 2048² one output an invocation on 2026-11-26, 0.164 with the runs of
 # 8 since, which were chosen on llvmpipe): benches/variants/blur_rows_run1 (one output an
 # invocation, neighbouring invocations on neighbouring texels) and blur_rows_run2 (runs of 2)
 # against the shipped runs of 8, columns as shipped, the same blur bit for bit
 # (tests/kernel_dir.rs), alternated twice. On llvmpipe the row pass is 2.1x (run1) and
-# 1.4-1.6x (run2) slower than shipped (benches/RESULTS.md, fifteenth session).
+# 1.4-1.6x (run2) slower than shipped (benches/RESULTS.md, 2026-11-27).
 # One process a round (`bench --kernel-dirs`: one warm-up, one set of copies, each kernel in
 # each folder adjacent in time), the folders' order reversed in the second.
 R1=benches/variants/blur_rows_run1
@@ -171,14 +170,14 @@ for dirs in "shipped,$R1,$R2" "$R2,$R1,shipped"; do
         --only 'blur rg32f,evsm4+blur' --passes --kernel-dirs "$dirs"
 done
 # VSM's table texels each from five depth loads (benches/variants/sat_vsm_texel) against the
-# shipped 4 x 4 sub-block of depths in private arrays (H200, fourteenth session: VSM's tile
+# shipped 4 x 4 sub-block of depths in private arrays (H200, 2026-11-27: VSM's tile
 # sums 0.110 ms at 2048² against MSM's 0.063; llvmpipe 1.3x slower with the variant), the same
 # tables bit for bit, alternated twice.
 # And the tables' tile passes with 2 x 2 sub-blocks, 256 invocations a tile
 # (benches/variants/sat_sub2: lanes 2 texels apart instead of 4, four times the invocations;
 # fixed-point tables bit for bit the same; llvmpipe 1.15-1.5x slower).
 # And the carries kernel loading one edge texel at a time as its serial sum reaches it
-# (benches/variants/sat_carries_serial, shipped until the nineteenth session; the H200's
+# (benches/variants/sat_carries_serial, shipped until f1ee092; the H200's
 # carries took 0.034 ms at 2048² and 0.082 at 4096², 0.5-0.6 us a tile of a line: a load's
 # latency each), against the shipped loads eight ahead of the sums; the same carries bit for bit.
 TV=benches/variants/sat_vsm_texel
@@ -196,7 +195,7 @@ for dirs in shipped,benches/variants/mip_quads benches/variants/mip_quads,shippe
     step variants.txt 40 "$B" bench --sizes 2048,4096 --repeat 20 --only mips \
         --kernel-dirs "$dirs"
 done
-# Every kernel at 2048² by dispatch (the soft tables' build: issue 14's ≤ 0.2 ms at 2048²,
+# Every kernel at 2048² by dispatch (the soft tables' build, target ≤ 0.2 ms at 2048²,
 # `chain vssm`, `chain msm_soft`), then the chains the targets name at 4096² and 8192².
 step kernels_2048.txt 60 "$B" bench --sizes 2048 --repeat 20 --passes
 step kernels_large.txt 150 "$B" bench --sizes 4096,8192 --repeat 20 --only chain,blur,mips,sat --passes
@@ -221,12 +220,12 @@ edited "$V/fused_no_blur/shared/encode_blur.wgsl" "$V/fused_no_encode/shared/enc
 step variants.txt 40 "$B" bench --sizes 2048 --repeat 20 \
     --only 'vsm_blur r4,msm_blur r4,evsm_blur 4 r4' \
     --kernel-dirs "shipped,$V/fused_no_blur,$V/fused_no_encode"
-# Issue 14's table build at 2048² (≤ 0.2 ms) in the kernels' two layouts (exec::KernelLayout)
-# in one process, every case in both side by side (`bench --layouts`), one round (the
-# fourteenth session's two agreed within 1%): `gpu` (the default on a GPU) loads and encodes pass 3's texels
-# again, `cpu` keeps the first sweep's (fourteenth session: `chain vssm` 0.313 against 0.336
+# The soft table build at 2048² (target ≤ 0.2 ms) in the kernels' two layouts (exec::KernelLayout)
+# in one process, every case in both side by side (`bench --layouts`), one round (two rounds
+# agreed within 1% on 2026-11-27): `gpu` (the default on a GPU) loads and encodes pass 3's texels
+# again, `cpu` keeps the first sweep's (2026-11-27: `chain vssm` 0.313 against 0.336
 # ms). The fused tile blurs too: `gpu` blurs a tile in workgroup memory with 256 invocations,
-# `cpu` walks it in strips with 8 (2-3x faster on llvmpipe, twentieth session). The strips
+# `cpu` walks it in strips with 8 (2-3x faster on llvmpipe, 2026-11-28). The strips
 # ship for GPUs only if faster there in this step at 2048² (then GPU_LAYOUT's branches in
 # shared/encode_blur.wgsl go, and LANES becomes a constant).
 for order in gpu,cpu; do
@@ -237,7 +236,7 @@ done
 # The kernels' workgroup memory left as the device leaves it (shipped: exec::WorkgroupInit::AsLeft,
 # safe because tests/workgroup_memory.rs finds every kernel writing it before reading it)
 # against wgpu's default of zeroing it first (`zeroed`: each workgroup stores its whole declared
-# workgroup memory and waits at a barrier), alternated twice. The fourteenth session found
+# workgroup memory and waits at a barrier), alternated twice. Runs on 2026-11-27 found
 # declared workgroup memory costing the H200 1.1-2x even where no branch used it; this says how
 # much of that was the zeroing. Informational: AsLeft ships (less work); llvmpipe showed no
 # difference beyond its spread.

@@ -14,7 +14,7 @@
 # to the first. Needs valgrind (`apt-get install valgrind`); about a minute a variant, most of
 # it LLVM compiling the kernels under valgrind. An instruction count is no time: memory
 # stalls and the CPU's parallelism are not in it, so confirm a win with `kernel_wall --cpu
-# --min` rounds alternated (benches/RESULTS.md, twenty-first session: −17% instructions and
+# --min` rounds alternated (benches/RESULTS.md, 2026-11-28: −17% instructions and
 # 1.11–1.23× less CPU time for the VSM strips).
 set -euo pipefail
 size=512

@@ -47,8 +47,8 @@ const WG_SIZE: u32 = 8u;
 // Pixels an invocation shades along a row, WG_SIZE apart, so that neighbouring lanes stay on
 // neighbouring pixels (`kernels::TEXELS_X_CONSTANT`: the dispatch covers WG_SIZE · TEXELS_X
 // columns a workgroup). On an H200 a kernel that only tests its bounds costs 0.040 ms over
-// 1080p in 8 × 8 workgroups, most of `hard`'s 0.066 (benches/RESULTS.md, 2026-11-27,
-// fourteenth session): fewer workgroups are the candidate, to be measured there
+// 1080p in 8 × 8 workgroups, most of `hard`'s 0.066 (benches/RESULTS.md,
+// 2026-11-27): fewer workgroups are the candidate, to be measured there
 // (`benches/gpu_check.sh`'s tx2 and tx4 variants).
 const TEXELS_X: u32 = 1u;
 

@@ -63,7 +63,7 @@ fn assert_scene_traffic(name: &str, s: &Scene, rows: &[Row], total: f64, ideal: 
 }
 
 /// `vsm.toml`: a 512² map, f32 moments, a Gaussian blur of radius 3: one dispatch, the
-/// encoding fused into both blur passes (issue 15's target: ≤ 2 dispatches, ≤ 28 B/texel).
+/// encoding fused into both blur passes (the target: ≤ 2 dispatches, ≤ 28 B/texel).
 #[test]
 fn vsm_with_blur_moves_what_the_hand_count_says() {
     assert_traffic(

@@ -320,7 +320,7 @@ fn only_dumps_one_resource() {
 
 /// Tables interleaved in one texture (CSM's four, `techniques/csm_sat.toml`) are dumped one by
 /// one: `--only` the texture writes each of its tables (it wrote nothing, silently, before
-/// 2026-11-27's fifteenth session), and `--only` one table's name, which a full dump writes,
+/// 2026-11-27), and `--only` one table's name, which a full dump writes,
 /// writes that table, the same values as the full dump's.
 #[test]
 fn only_an_interleaved_texture_or_one_of_its_tables() {

@@ -18,8 +18,8 @@
 // Each workgroup counts the non-finite depths of its own outputs, so each is counted once.
 // Each encoding reads its five depths straight from the texture (`depth_direct`), on every
 // device: staging the tile's depth through workgroup memory first made the fused tiles
-// 1.0–1.28× slower on llvmpipe (benches/RESULTS.md, twelfth session) and 1.13–1.20× slower on
-// an H200 (fourteenth session), where the texture cache serves the neighbours' reads.
+// 1.0–1.28× slower on llvmpipe and 1.13–1.20× slower on an H200 (benches/RESULTS.md,
+// 2026-11-27), where the texture cache serves the neighbours' reads.
 //
 // Two layouts (`exec::KernelLayout`, the override GPU_LAYOUT) blur a tile:
 //   a GPU's: WG_SIZE invocations encode the tile with its halo into workgroup memory, one texel
@@ -28,8 +28,8 @@
 //     walks an encoded row along x, loading each depth once and encoding it in registers, and
 //     keeps the horizontal sums; then each walks a column of those sums and stores. On
 //     llvmpipe, which runs every SIMD group of a workgroup through every branch and barrier
-//     under masks, this ran 2–3× faster than the GPU's layout (benches/RESULTS.md, twentieth
-//     session); on a GPU its few invocations a tile would leave most of each SM idle.
+//     under masks, this ran 2–3× faster than the GPU's layout (benches/RESULTS.md,
+//     2026-11-28); on a GPU its few invocations a tile would leave most of each SM idle.
 // The row path is the same in both; a CPU driver's CPU_LANES invocations run its WG_SIZE
 // invocations' work CPU_LANES at a time.
 //
@@ -81,7 +81,7 @@ const WG_SIZE: u32 = 256u;
 override GPU_LAYOUT: bool = false;
 // A CPU driver's workgroup: one of llvmpipe's SIMD groups (8 lanes of AVX2's 256-bit vectors).
 // Strips of 32 and of 8 lanes ran alike on llvmpipe's wall clock and 8 took 1.2–1.6× less CPU
-// time (benches/RESULTS.md, twentieth session): each extra SIMD group is one more coroutine
+// time (benches/RESULTS.md, 2026-11-28): each extra SIMD group is one more coroutine
 // through the barrier.
 const CPU_LANES: u32 = 8u;
 // The invocations of a workgroup: WG_SIZE on a GPU, CPU_LANES on a CPU driver.
@@ -400,7 +400,7 @@ fn blur_tile_single(t: Tile, li: u32) {
 // STRIP_RADIUS is a constant of each pipeline, set from the node's radius
 // (`exec::KernelCache::node_constants`): 4 up to radius 4, else TILE_RADIUS. A window of 9
 // texels in place of 15 took the MSM strips 1.27× less CPU time on llvmpipe, VSM's 1.05–1.1×
-// (benches/RESULTS.md, twentieth session); as a run-time test llvmpipe would run both.
+// (benches/RESULTS.md, 2026-11-28); as a run-time test llvmpipe would run both.
 // #override STRIP_RADIUS: select(TILE_RADIUS, 4, params.blur.radius <= 4)
 override STRIP_RADIUS: u32 = TILE_RADIUS;
 // The window's outer pairs (a0 … a2, a12 … a14): only where STRIP_RADIUS is TILE_RADIUS.
@@ -506,7 +506,7 @@ fn window_sum(w: Window, k: PairWeights) -> Texel {
 // depths before it and the raw depths at it (row y's, then row y + 1's), and the non-finite
 // depths of the tile's own outputs met so far. Counted in a register, added to `stats` once an
 // invocation (`strip_rows`): an atomic in the walk's step, under a mask, took 7% of the strips'
-// instructions on llvmpipe (benches/RESULTS.md, twenty-first session).
+// instructions on llvmpipe (benches/RESULTS.md, 2026-11-28).
 struct Walk {
     p: vec2<i32>,
     before0: f32,
@@ -673,8 +673,7 @@ fn strip_columns(t: Tile, li: u32, k: PairWeights) {
 // The tile in strips (the CPU layout): along x into workgroup memory (outs.x × enc.y sums),
 // one barrier, then along y into `dst`. Each pass reads its own weights: llvmpipe keeps what
 // lives across a barrier in its coroutine's frame, and the weights held across it took 10% of
-// the VSM strips' instructions (benches/instructions.sh; benches/RESULTS.md, twenty-first
-// session).
+// the VSM strips' instructions (benches/instructions.sh; benches/RESULTS.md, 2026-11-28).
 fn blur_tile_strips(t: Tile, li: u32) {
     strip_rows(t, li, pair_weights(t.r.x));
     workgroupBarrier();

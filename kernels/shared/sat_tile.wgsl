@@ -17,8 +17,7 @@
 // `sat_enc` in shared/sat_tile_scan). Either way an invocation reads and writes its own SUB ×
 // SUB sub-block straight from and to the texture: staging the tile through workgroup memory so
 // that neighbouring lanes touch neighbouring texels made the tables 1.3–2.7× slower on an H200
-// and 1.5–2.5× on llvmpipe (benches/RESULTS.md, 2026-11-27, thirteenth and fourteenth
-// sessions). The same sums in the same order either way: tables bit for bit the same
+// and 1.5–2.5× on llvmpipe (benches/RESULTS.md, 2026-11-27). The same sums in the same order either way: tables bit for bit the same
 // (`tests/sat.rs` and `tests/csm_sat.rs` compare both).
 override GPU_LAYOUT: bool = false;
 

@@ -33,10 +33,10 @@ var<workgroup> sh_carry: array<vec4<u32>, 64>; // 2 · TILE = WG_SIZE
 
 // Without GPU_LAYOUT: the sub-block's encoded texels (row-major), kept from the pass's first
 // sweep for its second, which then neither loads nor encodes (MSM's tables 1.1×, CSSM's
-// 1.2× faster on llvmpipe, benches/RESULTS.md, 2026-11-27, thirteenth session). Under it the
+// 1.2× faster on llvmpipe, benches/RESULTS.md, 2026-11-27). Under it the
 // second sweep loads and encodes again, from the texture cache: pass 3 7–13% faster on an
 // H200 than with the kept texels, sixteen four-channel values more an invocation
-// (fourteenth session).
+// (2026-11-27).
 var<private> sat_enc: array<vec4<u32>, 16>; // SUB · SUB
 
 // Row j of the sub-block at `origin`: its encoded texels prefixed along the

@@ -142,7 +142,7 @@ pub const CASES: &[BenchCase] = &[
             )
         },
     },
-    // Depth → blurred moments: the encoding fused into the blur (issue 15), and the chain it
+    // Depth → blurred moments: the encoding fused into the blur (76856d8), and the chain it
     // replaced (encode, blur_h, blur_v: the `(old)` rows) timed beside it.
     BenchCase {
         name: "vsm_blur r4",
@@ -211,7 +211,7 @@ pub const CASES: &[BenchCase] = &[
         build: |n| stage_graph(light_graph(n, csm()), "light0.depth", "light0.csm0"),
     },
     // Depth → encoded maps, whatever the dispatches (linearize fused into the encodings, CSM
-    // maps four a dispatch since issue 15): timed against the chains of earlier builds.
+    // maps four a dispatch since 2026-11-23): timed against the chains of earlier builds.
     BenchCase {
         name: "chain vsm (depth → moments)",
         build: |n| chain_graph(n, vsm(), &["light0.vsm"]),
@@ -229,7 +229,7 @@ pub const CASES: &[BenchCase] = &[
     },
     // CSSM's prefilter: the layered tables (basis computed in their tile passes) against the
     // chain before them, until the comparison is recorded.
-    // The soft techniques' whole prefilter at their defaults: issue 14's table build.
+    // The soft techniques' whole prefilter at their defaults: the soft table build.
     BenchCase {
         name: "chain vssm (depth → table)",
         build: |n| chain_graph(n, named("vssm", &[]), &["light0.vsm.sat"]),

@@ -355,7 +355,7 @@ fn prefilter_by_pass(rows: &[SoftRow]) -> String {
 
 /// The lookups' own cost: at each light size, (technique − `hard`) / (PCSS 16+32 − `hard`),
 /// the shading pass less what one fetch a pixel costs, against PCSS's taps measured the same
-/// way (the measure issue 14 filed CSSM's cost in). Empty without `hard` and the yardstick.
+/// way (the measure of CSSM's cost in docs/TECHNIQUES.md). Empty without `hard` and the yardstick.
 /// On an H200 `hard` itself was 0.29–0.32× PCSS, half of it a floor that a kernel storing a
 /// constant colour a pixel still read (benches/RESULTS.md, 2026-11-27).
 fn above_hard(name: usize, rows: &[SoftRow]) -> String {

@@ -45,7 +45,7 @@ pub use crate::kernels::GPU_LAYOUT_CONSTANT;
 /// neighbouring texels (the blur's row pass, the fused blurs, the tables' tile passes) were
 /// slower on the H200 than each invocation reading its own run or block straight, 1.1–2.7×,
 /// and their workgroup memory, declared in both variants, slowed the straight one too
-/// (`benches/RESULTS.md`, 2026-11-27, fourteenth session): they are gone.
+/// (`benches/RESULTS.md`, 2026-11-27): they are gone.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum KernelLayout {
     /// A GPU's (`GPU_LAYOUT = true`): recompute from the texture cache.
@@ -94,7 +94,7 @@ impl KernelLayout {
 /// [`WorkgroupInit::AsLeft`]: `tests/workgroup_memory.rs` fills that memory with NaN bit
 /// patterns before each kernel's body runs, and every map of every plan that runs the kernels
 /// stays the same bit for bit. (On the H200 a kernel's declared workgroup memory cost time even
-/// where the branch using it never ran: `benches/RESULTS.md`, 2026-11-27, fourteenth session;
+/// where the branch using it never ran: `benches/RESULTS.md`, 2026-11-27;
 /// `shadowgraph bench --kernel-dirs shipped,zeroed` times both.)
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum WorkgroupInit {

@@ -29,7 +29,7 @@ pub fn encode_blur_tile(kernel: KernelId) -> u32 {
 /// taller tile encodes less halo a texel: VSM's 24 × 40 (its encoded rows, 48 at r = 4, are
 /// three pairs for each of the 8 walks) took 0.91× the instructions of its 24², EVSM's and
 /// MSM's 16 × 32 0.87× of their 16² (`benches/instructions.sh`; benches/RESULTS.md,
-/// twenty-first session). Their horizontal sums, `TILE × (CPU_TILE_ROWS + 2·TILE_RADIUS)`,
+/// 2026-11-28). Their horizontal sums, `TILE × (CPU_TILE_ROWS + 2·TILE_RADIUS)`,
 /// fit the workgroup memory the GPU's tile declares.
 pub fn encode_blur_cpu_rows(kernel: KernelId) -> u32 {
     match kernel {

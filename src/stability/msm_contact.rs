@@ -40,7 +40,8 @@ use crate::scene::{
 const MAP: u32 = 32;
 const SOFT_MAP: u32 = 256;
 const SOFT_MAX_SEARCH: f32 = 0.4;
-/// Occluder depths: near both ends, the middle, and the 0.90475309.
+/// Occluder depths: near both ends, the middle, and 0.90475309 (`cpu::vis_msm`'s near-singular
+/// case).
 const DEPTHS: [f32; 6] = [0.05, 0.3, 0.5, 0.7, 0.904_753_1, 0.99];
 /// Receivers `10^(−5 + k/4)` behind the occluder, k = 0..=16.
 const STEPS: i32 = 16;

@@ -84,7 +84,7 @@ fn blur_run(b: BlurLine, o: i32, vertical: bool) {
     // Offsets 1 .. r − 1 slide the windows after their sums; offset r, which needs no next
     // taps, is summed after the loop. With the slide behind `if i < r` inside the loop,
     // llvmpipe ran it as masked selects of all 16 windows at every offset: peeled, 1.2–1.3×
-    // faster at r = 32 (benches/RESULTS.md, 2026-11-27, tenth session); a GPU branches on the
+    // faster at r = 32 (benches/RESULTS.md, 2026-11-27); a GPU branches on the
     // uniform test either way.
     for (var i = 1; i < b.r; i++) {
         let w = weight(i, b.r);
