@@ -114,6 +114,21 @@ struct Readback {
     frame: u64,
 }
 
+impl Readback {
+    /// Drops the frame the buffer holds, unread, and makes it free for the next copy. Only a
+    /// buffer whose mapping was requested (pending: cancelled) or done is unmapped: one whose
+    /// copy was only recorded, or whose mapping failed, is not mapped, and unmapping it is a
+    /// validation error. The state is a new one, so that the callback of a cancelled or stale
+    /// mapping, whenever it runs, finds nothing to change.
+    fn take_back(&mut self) {
+        let state = self.state.load(Ordering::Acquire);
+        if state == slot::MAPPING || state == slot::MAPPED {
+            self.buffer.unmap();
+        }
+        self.state = Arc::new(AtomicU8::new(slot::IDLE));
+    }
+}
+
 /// Timestamps at pass boundaries, resolved into a ring of readback buffers and read back a
 /// frame or more later without waiting ([`GpuTimer::collect`]), or waited for when asked
 /// ([`GpuTimer::read`], [`GpuTimer::finish`]).
@@ -258,7 +273,8 @@ impl GpuTimer {
 
     /// Ends the open span and records the query resolve and its copy into the next readback
     /// buffer of the ring; call after the last timed pass, before submitting. A buffer still
-    /// holding an unread frame is taken back (that frame's times are dropped).
+    /// holding an unread frame is taken back, whatever became of it (its copy recorded, its
+    /// mapping requested or done): that frame's times are dropped.
     pub fn resolve(&mut self, encoder: &mut wgpu::CommandEncoder) {
         self.end(encoder);
         let n = 2 * self.marks;
@@ -268,10 +284,7 @@ impl GpuTimer {
         let frame = self.frames;
         self.frames += 1;
         let slot = &mut self.ring[(frame % RING as u64) as usize];
-        if slot.state.load(Ordering::Acquire) != slot::IDLE {
-            slot.buffer.unmap();
-            slot.state.store(slot::IDLE, Ordering::Release);
-        }
+        slot.take_back();
         encoder.resolve_query_set(&self.query_set, 0..n, &self.resolve, 0);
         encoder.copy_buffer_to_buffer(&self.resolve, 0, &slot.buffer, 0, u64::from(n) * 8);
         slot.spans = std::mem::take(&mut self.spans);
@@ -294,7 +307,7 @@ impl GpuTimer {
                 } else {
                     slot::FAILED
                 };
-                // Only a mapping still awaited completes (a reused slot was set back to IDLE).
+                // Only a mapping still awaited completes (a reused slot has a new state).
                 let _ =
                     state.compare_exchange(slot::MAPPING, to, Ordering::AcqRel, Ordering::Acquire);
             });
