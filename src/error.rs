@@ -52,10 +52,10 @@ pub enum Error {
     },
     /// The kernel graph is malformed.
     #[error("graph: {0}")]
-    Graph(#[from] GraphError),
+    Graph(GraphError),
     /// The executor cannot run a plan over the textures it was given.
     #[error("executor: {0}")]
-    Exec(#[from] ExecError),
+    Exec(ExecError),
     /// A scene file could not be read or is invalid.
     #[error("{path}{location}: {message}")]
     Scene {
@@ -98,7 +98,7 @@ pub enum Error {
     },
     /// What a host handed the plug-in stage is unusable (see [`crate::prefilter`]).
     #[error("plug-in stage: {0}")]
-    Stage(#[from] StageError),
+    Stage(StageError),
     /// The scene needs a device feature the adapter does not offer.
     #[error("{what} needs the device feature {feature}, which this adapter does not offer")]
     MissingFeature {
@@ -126,6 +126,26 @@ pub enum Error {
         /// Encoder message.
         message: String,
     },
+}
+
+// The wrapped errors are part of the message and not also a `source()`: a chain printed cause
+// by cause (anyhow's `{:#}`) would print them twice.
+impl From<GraphError> for Error {
+    fn from(e: GraphError) -> Self {
+        Self::Graph(e)
+    }
+}
+
+impl From<ExecError> for Error {
+    fn from(e: ExecError) -> Self {
+        Self::Exec(e)
+    }
+}
+
+impl From<StageError> for Error {
+    fn from(e: StageError) -> Self {
+        Self::Stage(e)
+    }
 }
 
 /// Why the executor (`exec`) cannot record a plan, beyond the plan's own shape
@@ -273,6 +293,15 @@ pub enum StageError {
         layers: u32,
         /// Its sample count.
         samples: u32,
+    },
+    /// A depth texture of several array layers was passed whole, which names no layer.
+    #[error(
+        "depth texture has {layers} array layers and was passed whole: name the light's layer \
+         with `DepthLayer::new(&texture, layer)`"
+    )]
+    DepthArray {
+        /// The texture's layers.
+        layers: u32,
     },
     /// The layer asked for is past the depth texture's layers.
     #[error("depth layer {layer} asked for, but the depth texture has {layers} layer(s)")]

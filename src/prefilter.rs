@@ -25,6 +25,7 @@
 
 pub mod cascades;
 mod config;
+mod depth;
 mod limits;
 pub mod wgsl;
 
@@ -37,6 +38,7 @@ pub use crate::error::StageError;
 /// [`LightParams::light_gpu`] returns), where a host looks for it.
 pub use crate::gpu_data::LightGpu;
 pub use config::{LightParams, PrefilterConfig};
+pub use depth::{DEPTH_FORMATS, DepthLayer};
 
 use crate::error::{Error, Result};
 use crate::exec::{Executor, KernelCache};
@@ -44,15 +46,6 @@ use crate::graph::{Graph, Plan, plan};
 use crate::scene::Light;
 use crate::technique;
 use crate::timer::{GpuTimer, TIMER_FEATURES};
-
-/// Depth formats the `linearize` kernel reads (as unfilterable float, depth aspect only).
-pub const DEPTH_FORMATS: [wgpu::TextureFormat; 5] = [
-    wgpu::TextureFormat::Depth32Float,
-    wgpu::TextureFormat::Depth32FloatStencil8,
-    wgpu::TextureFormat::Depth24Plus,
-    wgpu::TextureFormat::Depth24PlusStencil8,
-    wgpu::TextureFormat::Depth16Unorm,
-];
 
 /// One map the visibility function reads.
 #[derive(Clone, Debug)]
@@ -125,30 +118,6 @@ impl PlanKey {
     }
 }
 
-/// The depth a light's maps are filtered from: a whole 2-D depth texture, or one layer of a
-/// 2-D array texture (a host's layered shadow maps: one layer per light or cascade), read in
-/// place through a view of that layer. `&wgpu::Texture` converts to layer 0.
-#[derive(Clone, Copy, Debug)]
-pub struct DepthLayer<'a> {
-    /// The depth texture (`D2`, one or more array layers).
-    pub texture: &'a wgpu::Texture,
-    /// The array layer to read.
-    pub layer: u32,
-}
-
-impl<'a> DepthLayer<'a> {
-    /// Layer `layer` of `texture`.
-    pub fn new(texture: &'a wgpu::Texture, layer: u32) -> Self {
-        Self { texture, layer }
-    }
-}
-
-impl<'a> From<&'a wgpu::Texture> for DepthLayer<'a> {
-    fn from(texture: &'a wgpu::Texture) -> Self {
-        Self { texture, layer: 0 }
-    }
-}
-
 /// The sampler a host binds after the maps where [`Prefilter::needs_filtering_sampler`]
 /// (defined beside the tables it reads, [`crate::sat::SAT_SAMPLER_DESCRIPTOR`]).
 pub use crate::sat::SAT_SAMPLER_DESCRIPTOR;
@@ -167,6 +136,8 @@ pub struct Prefilter {
     /// 0 is made by [`Prefilter::new`]).
     lights: Vec<Option<LightSlot>>,
     timer: Option<GpuTimer>,
+    /// Compute dispatches recorded so far, every light slot together.
+    dispatches: u64,
 }
 
 /// What one light of a stage keeps between frames.
@@ -204,6 +175,7 @@ impl Prefilter {
                 maps: Vec::new(),
             })],
             timer: None,
+            dispatches: 0,
         })
     }
 
@@ -225,8 +197,9 @@ impl Prefilter {
     /// its own textures, so its maps stay valid until the next record of the same slot (or a
     /// new map size). Nothing is submitted.
     ///
-    /// `depth` is a texture (`&wgpu::Texture`: layer 0) or [`DepthLayer`]: one layer of a 2-D
-    /// array, read through a view of it (no copy). It must be square, single-sampled, in one of
+    /// `depth` is a texture of one layer (`&wgpu::Texture`) or [`DepthLayer`]: one layer of a
+    /// 2-D array, read through a view of it (no copy); an array passed whole is refused
+    /// ([`StageError::DepthArray`]). It must be square, single-sampled, in one of
     /// [`DEPTH_FORMATS`], with `TEXTURE_BINDING`. A size other than the slot's last one replans
     /// and reallocates its pooled textures; pipelines are kept. With timing enabled, slot 0's
     /// kernels are timed.
@@ -257,7 +230,7 @@ impl Prefilter {
             }
             .into());
         }
-        let size = check_depth(depth, light)?;
+        let size = depth::check_depth(depth, light)?;
         let key = PlanKey::new(light, size);
         self.replan(device, slot, key, light)?;
         let config = &self.config;
@@ -265,10 +238,10 @@ impl Prefilter {
             .as_mut()
             .ok_or_else(|| Error::Invalid(format!("light slot {slot} was not planned")))?;
         let name = technique::depth_name(0);
-        let imports = HashMap::from([(name.clone(), depth.texture.clone())]);
+        let imports = HashMap::from([(name.clone(), depth.texture().clone())]);
         let mut layers = HashMap::new();
-        if depth.texture.depth_or_array_layers() > 1 {
-            layers.insert(name, depth.layer);
+        if depth.texture().depth_or_array_layers() > 1 {
+            layers.insert(name, depth.layer());
         }
         let mut timer = self.timer.as_mut().filter(|_| slot == 0);
         if let Some(t) = timer.as_mut() {
@@ -276,6 +249,7 @@ impl Prefilter {
         }
         // The slot's executor records with the stage's pipelines, then gives them back.
         one.executor.kernels = std::mem::take(&mut self.kernels);
+        let before = one.executor.dispatch_count();
         let recorded = one.executor.record_layers(
             device,
             encoder,
@@ -285,6 +259,7 @@ impl Prefilter {
             timer.as_deref_mut(),
         );
         self.kernels = std::mem::take(&mut one.executor.kernels);
+        self.dispatches += one.executor.dispatch_count() - before;
         let outputs = recorded?;
         if let Some(t) = timer {
             t.resolve(encoder);
@@ -389,7 +364,8 @@ impl Prefilter {
     /// `@group(group) @binding(first_binding + k)` (then a comparison sampler where
     /// [`Prefilter::needs_comparison_sampler`], a filtering one where
     /// [`Prefilter::needs_filtering_sampler`]) and
-    /// `fn shadowgraph_visibility(l: Light, p: vec3<f32>, n: vec3<f32>) -> f32`.
+    /// `fn shadowgraph_visibility(l: sg_Light, p: vec3<f32>, n: vec3<f32>) -> f32` (upload
+    /// [`PrefilterOutput::light`] as the `sg_Light`).
     pub fn wgsl(&self, group: u32, first_binding: u32) -> Result<String> {
         wgsl::host_block(&self.config.technique, group, first_binding)
     }
@@ -584,6 +560,13 @@ impl Prefilter {
             .sum()
     }
 
+    /// Compute dispatches the stage has recorded since it was made, every light slot
+    /// together: a frame's are the difference across it. Only [`Prefilter::record_light`]
+    /// dispatches, so a static light the host does not record again costs none.
+    pub fn dispatch_count(&self) -> u64 {
+        self.dispatches
+    }
+
     /// Pipelines created so far (shared by every light slot).
     pub fn pipeline_count(&self) -> usize {
         self.kernels.len()
@@ -682,61 +665,6 @@ struct MapInput {
     wgsl_type: &'static str,
     /// Its format in the graph.
     format: wgpu::TextureFormat,
-}
-
-/// The side of `depth`, or what makes it unusable.
-/// The map size of `depth` for `light`: its side (square), or a point light's face side (an
-/// atlas of three faces by two).
-fn check_depth(depth: DepthLayer<'_>, light: &LightParams) -> Result<u32, StageError> {
-    let DepthLayer {
-        texture: depth,
-        layer,
-    } = depth;
-    if !DEPTH_FORMATS.contains(&depth.format()) {
-        let accepted: Vec<String> = DEPTH_FORMATS.iter().map(|f| format!("{f:?}")).collect();
-        return Err(StageError::DepthFormat {
-            format: depth.format(),
-            accepted: accepted.join(", "),
-        });
-    }
-    if !depth.usage().contains(wgpu::TextureUsages::TEXTURE_BINDING) {
-        return Err(StageError::DepthUsage {
-            usage: depth.usage(),
-        });
-    }
-    let (dimension, layers, samples) = (
-        depth.dimension(),
-        depth.depth_or_array_layers(),
-        depth.sample_count(),
-    );
-    if dimension != wgpu::TextureDimension::D2 || samples != 1 {
-        return Err(StageError::DepthLayout {
-            dimension,
-            layers,
-            samples,
-        });
-    }
-    if layer >= layers {
-        return Err(StageError::DepthLayer { layer, layers });
-    }
-    let (w, h) = (depth.width(), depth.height());
-    if light.point {
-        let face = h / 2;
-        if face == 0 || w != 3 * face || h != 2 * face {
-            return Err(StageError::DepthNotAtlas {
-                width: w,
-                height: h,
-            });
-        }
-        return Ok(face);
-    }
-    if w != h {
-        return Err(StageError::DepthNotSquare {
-            width: w,
-            height: h,
-        });
-    }
-    Ok(w)
 }
 
 fn depth_aspect_view(t: &wgpu::Texture) -> wgpu::TextureView {

@@ -126,6 +126,22 @@ fn unusable_depth_textures_are_named() {
         ),
         "{e}"
     );
+    // Passed whole, an array names no layer: refused, not read from layer 0 (a second light's
+    // maps would be filtered from the first's depth), in one line naming `DepthLayer`.
+    let e = record_err(&g, &layered, &light());
+    assert!(matches!(e, StageError::DepthArray { layers: 2 }), "{e}");
+    let line = Error::from(e).to_string();
+    assert!(
+        line.contains("2 array layers") && line.contains("DepthLayer::new") && !line.contains('\n'),
+        "{line}"
+    );
+    // One layer named, the same array is read.
+    let mut stage = Prefilter::new(&g.device, &PrefilterConfig::vsm(64)).expect("stage");
+    let mut enc = g.device.create_command_encoder(&Default::default());
+    let first = shadowgraph::prefilter::DepthLayer::new(&layered, 1);
+    stage
+        .record(&g.device, &mut enc, first, &light())
+        .expect("a named layer of the array");
 
     let msaa = texture(
         &g,
@@ -558,4 +574,37 @@ fn float_tables_without_float32_filterable_are_a_missing_feature() {
     }
     let fixed = PrefilterConfig::vssm(64, 0.5).with_soft(shadowgraph::sat::SatVariant::Fixed, 0.2);
     Prefilter::new(&plain, &fixed).expect("fixed-point tables on a plain device");
+}
+
+/// A wrapped error prints its cause once, also where causes are printed one by one (anyhow's
+/// `{:#}`, what the examples and a host's `main` print): the variant's message holds the
+/// cause, so it is not also its `source()`.
+#[test]
+fn wrapped_errors_print_their_cause_once() {
+    let g = common::gpu();
+    let cleared = texture(
+        &g,
+        wgpu::TextureFormat::Depth32Float,
+        (64, 32, 1),
+        1,
+        READABLE,
+    );
+    let stage = Error::from(record_err(&g, &cleared, &light()));
+    let graph = Error::from(
+        shadowgraph::graph::plan(&shadowgraph::graph::Graph::default(), &["light0.vsm"])
+            .expect_err("an undeclared output"),
+    );
+    let exec = Error::from(shadowgraph::exec::ExecError::MissingImport(
+        "light0.depth".into(),
+    ));
+    for (e, cause) in [
+        (stage, "is 64x32"),
+        (graph, "`light0.vsm`"),
+        (exec, "`light0.depth`"),
+    ] {
+        let line = e.to_string();
+        let chain = format!("{:#}", anyhow::Error::from(e));
+        assert_eq!(chain, line, "the chain adds to the message");
+        assert_eq!(chain.matches(cause).count(), 1, "{chain}");
+    }
 }
