@@ -416,3 +416,109 @@ fn the_cascaded_shading_calls_each_cascade_once() {
         1
     );
 }
+
+/// A scene file with a directional light in three cascades, the camera at `eye` looking at
+/// `target`, and a plane `scale` times 18 units wide and a unit box at `at`.
+fn far_scene(eye: [f64; 3], target: [f64; 3], scale: f64, at: [f64; 3]) -> String {
+    format!(
+        "[output]\nwidth = 64\nheight = 48\n\n[camera]\nposition = {eye:?}\ntarget = {target:?}\n\
+         fov_y_degrees = 45.0\n\n[[light]]\nkind = \"directional\"\nposition = [-3.0, 6.0, 2.0]\n\
+         target = [0.0, 0.0, 0.0]\nextent = 4.0\n\n[light.shadow]\ntechnique = \"hard\"\n\
+         cascades = 3\n\n[[object]]\nshape = \"plane\"\nsize = 18.0\nscale = {scale:?}\n\
+         translate = {at:?}\n\n\
+         [[object]]\nshape = \"box\"\nsize = 1.0\ntranslate = {at:?}\n"
+    )
+}
+
+/// The cascades of a scene file cover the view distances of its geometry, computed here in f64
+/// from the loaded vertices, whatever the camera's distance: a camera ~13,000 units from a
+/// small scene (its depth range a two-thousandth of its distance, which the fit once refused as
+/// "no geometry in front"), one at z = 10⁶ before geometry reaching past the 10⁷ cascades
+/// cover (once refused naming an internal `cascade near/far`: now cut at 10⁷), and one looking
+/// away from everything (the cascades shade nothing, as one map would not). Geometry whose
+/// nearest point lies past 10⁷ is refused naming the light's `cascades` key and its line.
+#[test]
+fn cascades_cover_the_scene_files_view_range() {
+    use shadowgraph::scene::Scene;
+    let path = std::path::Path::new("far.toml");
+    let cases = [
+        ([0.0, 3.0, 13000.0], [0.0; 3], 0.5, [0.0; 3], true),
+        ([0.0, 0.0, 1e6], [0.0; 3], 1e6, [0.0, 0.0, -1e6], true),
+        ([0.0, 3.0, 20.0], [0.0, 3.0, 40.0], 1.0, [0.0; 3], false),
+    ];
+    for (eye, target, scale, at, in_front) in cases {
+        let text = far_scene(eye, target, scale, at);
+        let scene = Scene::parse(path, &text).expect("the scene loads");
+        let drawn = shadowgraph::render::drawn_lights(&scene)
+            .unwrap_or_else(|e| panic!("camera at {eye:?}: {e}"));
+        assert_eq!(drawn.groups.len(), 1);
+        let g = drawn.gpu[0];
+        let eye = DVec3::from_array(eye);
+        let forward = (DVec3::from_array(target) - eye).normalize();
+        let d: Vec<f64> = scene
+            .objects
+            .iter()
+            .flat_map(|o| &o.mesh.positions)
+            .map(|p| (p.as_dvec3() - eye).dot(forward))
+            .collect();
+        let lo = d.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = d.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let near = f64::from(g.cascade_near);
+        let far = f64::from(g.cascade_far[0][2]);
+        let last = f64::from(g.cascade_far[0][1]);
+        assert!(near < last && last < far, "splits {near} {last} {far}");
+        if in_front {
+            // f32 rounding of distances near 10⁶: relative 1e-6.
+            let tol = 1e-6 * hi.abs().max(1.0);
+            assert!(
+                (near - lo.max(0.05)).abs() <= tol,
+                "near {near}, geometry from {lo}"
+            );
+            assert!(
+                (far - hi.min(1e7)).abs() <= tol || far >= hi,
+                "far {far}, geometry to {hi}"
+            );
+        } else {
+            assert!(hi < 0.05, "the camera was to look away ({hi})");
+            assert_eq!(near, 0.05f32 as f64);
+        }
+    }
+    // Only a mesh's vertices reach past 10⁷ from a camera within 10⁶ (a built-in shape holds its
+    // centre, within 10⁶): a triangle 1.05·10⁷ ahead.
+    let dir = std::env::temp_dir().join(format!("shadowgraph-far-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    std::fs::write(
+        dir.join("far.obj"),
+        "v 0 0 -9.5e6\nv 1 0 -9.5e6\nv 0 1 -9.5e6\nf 1 2 3\n",
+    )
+    .expect("mesh");
+    let text = far_scene([0.0, 0.0, 1e6], [0.0; 3], 1.0, [0.0; 3]);
+    let at = text.find("[[object]]").expect("objects");
+    let text = format!(
+        "{}[[object]]\nshape = \"mesh\"\npath = \"far.obj\"\n",
+        &text[..at]
+    );
+    let path = dir.join("far.toml");
+    let scene = Scene::parse(&path, &text).expect("the scene loads");
+    std::fs::remove_dir_all(&dir).ok();
+    let line = text[..text.find("cascades = 3").expect("key")]
+        .matches('\n')
+        .count()
+        + 1;
+    match shadowgraph::render::drawn_lights(&scene) {
+        Err(shadowgraph::Error::Scene {
+            location, message, ..
+        }) => {
+            assert!(
+                location.starts_with(&format!(":{line}:")),
+                "{location}: {message}"
+            );
+            assert!(
+                message.contains("light[0].shadow.cascades") && message.contains("camera.position"),
+                "{message}"
+            );
+            assert!(!message.contains('\n'));
+        }
+        other => panic!("expected a scene error at line {line}, got {other:?}"),
+    }
+}

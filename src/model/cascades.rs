@@ -11,6 +11,10 @@ use crate::error::StageError;
 /// Cascades one light may have.
 pub const MAX_CASCADES: u32 = 8;
 
+/// The farthest view distance cascades split (a light's planes' range, `LightParams::validate`):
+/// the slices' spheres stay far from f32's limits.
+pub const MAX_VIEW_DISTANCE: f32 = 1e7;
+
 /// How a directional light's shadow is split into cascades (`[light.shadow]` keys `cascades`,
 /// `cascade_lambda`, `cascade_blend`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -169,7 +173,12 @@ pub fn split_distances(
     }
     // A light's planes' range (`LightParams::validate`): the slices' spheres stay far from
     // f32's limits.
-    if !(near.is_finite() && far.is_finite() && near >= 1e-6 && far > near && far <= 1e7) {
+    if !(near.is_finite()
+        && far.is_finite()
+        && near >= 1e-6
+        && far > near
+        && far <= MAX_VIEW_DISTANCE)
+    {
         return Err(bad(
             "cascade near/far",
             format!("need 1e-6 ≤ near < far ≤ 1e7; got near {near}, far {far}"),

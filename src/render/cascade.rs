@@ -27,6 +27,14 @@ use crate::technique::{CascadeGroup, LightGpu};
 /// The camera's near plane (`model::Camera::view_proj`): the closest a cascade range starts.
 const CAMERA_NEAR: f32 = 0.05;
 
+/// The shallowest view-distance range the cascades split, as a fraction of its near distance:
+/// far enough from f32's resolution (2⁻²³) that every split is distinct.
+pub const MIN_RANGE: f64 = 1.0 / 1024.0;
+
+/// The farthest view distance cascades cover (`model::cascades::split_distances`' limit):
+/// geometry beyond it reads the last cascade.
+pub const MAX_VIEW_DISTANCE: f32 = crate::model::cascades::MAX_VIEW_DISTANCE;
+
 /// The lights a frame draws: the scene's, a cascaded one as its cascade 0, then the further
 /// cascades of each cascaded light.
 #[derive(Clone, Debug)]
@@ -54,23 +62,50 @@ impl DrawnLights {
 }
 
 /// The view-distance range the cascades of `scene` cover: from the nearest point of the
-/// scene's geometry in front of the camera (at least the camera's near plane) to the farthest.
+/// scene's geometry in front of the camera (at least the camera's near plane) to the farthest,
+/// at least [`MIN_RANGE`] of the near distance deep (a scene thin along the view, or far from
+/// the camera, still splits) and at most [`MAX_VIEW_DISTANCE`]. With no geometry in front the
+/// cascades shade nothing, and cover the first [`MIN_RANGE`] past the near plane. An error
+/// (the scene's nearest geometry beyond [`MAX_VIEW_DISTANCE`]) names the first cascaded
+/// light's `cascades` key with its line.
 pub fn view_range(scene: &Scene) -> Result<(f32, f32)> {
-    let eye = scene.camera.position;
-    let forward = (scene.camera.target - eye).normalize();
-    let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+    let eye = scene.camera.position.as_dvec3();
+    let forward = (scene.camera.target.as_dvec3() - eye).normalize();
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for p in scene.objects.iter().flat_map(|o| &o.mesh.positions) {
-        let d = (*p - eye).dot(forward);
+        let d = (p.as_dvec3() - eye).dot(forward);
         lo = lo.min(d);
         hi = hi.max(d);
     }
-    let near = lo.max(CAMERA_NEAR);
-    if hi.is_nan() || hi <= near * 1.001 {
-        return Err(Error::Invalid(
-            "cascades: no geometry lies in front of the camera".into(),
-        ));
+    let camera_near = f64::from(CAMERA_NEAR);
+    let near = if hi > camera_near {
+        lo.max(camera_near)
+    } else {
+        camera_near
+    };
+    let limit = f64::from(MAX_VIEW_DISTANCE);
+    if near * (1.0 + MIN_RANGE) > limit {
+        let why = format!(
+            "the scene's nearest geometry lies {} units from `camera.position`{}, past the {} that cascades cover; move the camera closer or use one map (`cascades = 1`)",
+            crate::scene::fmt_num(near),
+            scene.locations.get("camera.position"),
+            crate::scene::fmt_num(limit)
+        );
+        let light = scene
+            .lights
+            .iter()
+            .position(|l| l.shadow.cascades.count > 1);
+        return Err(match light {
+            Some(i) => cascade_error(scene, i, why),
+            None => Error::Scene {
+                path: scene.path.clone(),
+                location: scene.locations.get("camera.position"),
+                message: format!("cascades: {why}"),
+            },
+        });
     }
-    Ok((near, hi))
+    let far = hi.max(near * (1.0 + MIN_RANGE)).min(limit);
+    Ok((near as f32, far as f32))
 }
 
 /// The camera of `scene` as the cascades see it.
@@ -98,11 +133,14 @@ pub fn drawn_lights(scene: &Scene) -> Result<DrawnLights> {
             continue;
         }
         crate::technique::params::cascade_support(&light.shadow.technique).map_err(|why| {
-            Error::Invalid(format!(
-                "light[{i}]: {} cascades of technique \"{}\": {why}",
-                c.count,
-                light.shadow.technique.name()
-            ))
+            cascade_error(
+                scene,
+                i,
+                format!(
+                    "does not apply to technique \"{}\": {why}",
+                    light.shadow.technique.name()
+                ),
+            )
         })?;
         let camera = cascade_camera(scene)?;
         let guard = guard(light);
@@ -114,7 +152,7 @@ pub fn drawn_lights(scene: &Scene) -> Result<DrawnLights> {
             light.shadow_map,
             guard,
         )
-        .map_err(|e| Error::Invalid(format!("light[{i}]: {e}")))?;
+        .map_err(|e| cascade_error(scene, i, e.to_string()))?;
         let group = CascadeGroup {
             light: i,
             first: lights.len(),
@@ -142,6 +180,19 @@ pub fn drawn_lights(scene: &Scene) -> Result<DrawnLights> {
         groups,
         visible,
     })
+}
+
+/// An error of light `i`'s cascades, naming its `cascades` key with the file and line.
+fn cascade_error(scene: &Scene, i: usize, why: String) -> Error {
+    let key = format!("light[{i}].shadow.cascades");
+    Error::Scene {
+        path: scene.path.clone(),
+        location: scene.locations.get(&key),
+        message: match scene.lights.get(i) {
+            Some(l) => format!("`{key}` = {}: {why}", l.shadow.cascades.count),
+            None => format!("`{key}`: {why}"),
+        },
+    }
 }
 
 /// Cascade 0's description with the cascade fields the pick reads.

@@ -132,6 +132,76 @@ fn header_before(text: &str, at: usize) -> usize {
     }
 }
 
+/// The dotted path (`light[1].shadow.radius`, `output` for a table) of the key written at
+/// `span` of `text`, read from the text itself: the TOML reader refuses a duplicated key or
+/// table before it builds the tree [`Locations`] walks, and says only "duplicate key".
+pub fn written_key(text: &str, span: &Range<usize>) -> Option<String> {
+    let start = span.start.min(text.len());
+    let line_start = text.get(..start)?.rfind('\n').map_or(0, |i| i + 1);
+    let line = text[line_start..].lines().next().unwrap_or("").trim_start();
+    // The table the key is in: the nearest header above it, with the index of every array of
+    // tables (`[[light]]`) on its path counted from the headers before it.
+    let mut arrays: HashMap<String, usize> = HashMap::new();
+    let mut table = String::new();
+    for l in text[..line_start].lines().map(str::trim_start) {
+        if let Some(name) = header_name(l) {
+            if l.starts_with("[[") {
+                *arrays.entry(name.clone()).or_default() += 1;
+            }
+            table = resolve(&name, &arrays);
+        }
+    }
+    if let Some(name) = header_name(line) {
+        // A table written twice (or over an array of tables): its parent with indices.
+        return Some(match name.rsplit_once('.') {
+            Some((parent, last)) => format!("{}.{last}", resolve(parent, &arrays)),
+            None => name,
+        });
+    }
+    let key = line.split('=').next()?;
+    let key: Vec<&str> = key
+        .split('.')
+        .map(|k| k.trim().trim_matches(['"', '\'']))
+        .collect();
+    let key = key.join(".");
+    match (key.is_empty(), table.is_empty()) {
+        (true, _) => None,
+        (false, true) => Some(key),
+        (false, false) => Some(format!("{table}.{key}")),
+    }
+}
+
+/// `light.shadow` of a header line `[light.shadow]` or `[[light]]` (comments after it dropped).
+fn header_name(line: &str) -> Option<String> {
+    let inner = line.strip_prefix('[')?;
+    let inner = inner.strip_prefix('[').unwrap_or(inner);
+    let name = &inner[..inner.find(']')?];
+    let parts: Vec<&str> = name
+        .split('.')
+        .map(|k| k.trim().trim_matches(['"', '\'']))
+        .collect();
+    Some(parts.join("."))
+}
+
+/// A header's dotted name with the current element of each array of tables on its path:
+/// `light.shadow` after two `[[light]]` is `light[1].shadow`.
+fn resolve(name: &str, arrays: &HashMap<String, usize>) -> String {
+    let mut out = String::new();
+    let mut prefix = String::new();
+    for part in name.split('.') {
+        if !prefix.is_empty() {
+            prefix.push('.');
+            out.push('.');
+        }
+        prefix.push_str(part);
+        out.push_str(part);
+        if let Some(n) = arrays.get(&prefix) {
+            out.push_str(&format!("[{}]", n.saturating_sub(1)));
+        }
+    }
+    out
+}
+
 /// The TOML reader's message made one line that names `key`, in the scene's own words:
 /// serde's `invalid type: string "x", expected i64` becomes
 /// `expected an integer, found a string "x"`; numbers print with [`fmt_num`].

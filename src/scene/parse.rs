@@ -7,7 +7,7 @@ use std::path::Path;
 use glam::Vec3;
 
 use super::ctx::{Ctx, LENGTH_RANGE, fmt_num};
-use super::format::{LightFile, SceneFile};
+use super::format::{LightFile, SceneFile, ShadowFile};
 use super::locate::{self, Locations};
 use super::{
     Camera, Light, LightKind, Scene, Shadow, Technique, animation, object, update, validate,
@@ -30,6 +30,13 @@ pub(super) fn parse(path: &Path, text: &str) -> Result<Scene> {
             e.message().starts_with("missing field") && e.span().is_none_or(|s| s.is_empty());
         let span = e.span().filter(|_| !whole);
         let key = span.as_ref().and_then(|s| locations.key_at(s));
+        if e.message().trim() == "duplicate key" {
+            // Refused before any tree is built: the key is read from the text at its span.
+            let written = span.as_ref().and_then(|s| locate::written_key(text, s));
+            if let Some(k) = written {
+                return ctx.err(span, format!("duplicate key `{k}`: written twice"));
+            }
+        }
         ctx.err(span, locate::rewrite(e.message(), key))
     })?;
     let width = ctx.int("output.width", &file.output.width, 1, MAX_SIDE)?;
@@ -204,6 +211,9 @@ fn light(ctx: &Ctx, i: usize, l: &LightFile) -> Result<Light> {
     let color = ctx.color_or(&key("color"), &l.color, Vec3::ONE)?;
     let intensity = ctx.num_or(&key("intensity"), &l.intensity, 0.0, 1e6, 1.0)?;
     let shadow_map = ctx.int_or(&key("shadow_map"), &l.shadow_map, 1, MAX_SIDE, 1024)?;
+    if let Some(s) = &l.shadow {
+        directional_keys(ctx, i, s, kind)?;
+    }
     let shadow = match &l.shadow {
         Some(s) => validate::shadow(ctx, i, s)?,
         None => Shadow {
@@ -217,21 +227,6 @@ fn light(ctx: &Ctx, i: usize, l: &LightFile) -> Result<Light> {
     };
     if kind == LightKind::Point {
         point_support(ctx, i, l, &shadow, shadow_map)?;
-    }
-    if shadow.cascades.count > 1 && matches!(kind, LightKind::Spot { .. }) {
-        let span = l
-            .shadow
-            .as_ref()
-            .and_then(|s| s.cascades.as_ref())
-            .map(|v| v.span());
-        return Err(ctx.err(
-            span,
-            format!(
-                "`{}` = {} needs a directional light: cascades split a sun's view range, a spot light has one frustum",
-                key("shadow.cascades"),
-                shadow.cascades.count
-            ),
-        ));
     }
     if crate::technique::of(&shadow.technique).area_light && size <= 0.0 {
         let span = l.size.as_ref().map(|s| s.span()).or(Some(l.kind.span()));
@@ -307,23 +302,34 @@ fn cascade_band(ctx: &Ctx, i: usize, l: &LightFile, light: &Light) -> Result<()>
     ))
 }
 
-/// What a point light's six faces refuse: cascades and techniques whose reach no guard band
-/// bounds
-/// (`model::point::reach`), each naming its key and line.
+/// The cascade keys (`params::CASCADES`) apply to directional lights only: on a spot or a
+/// point light any of them, even `cascades = 1`, is refused as `extent` is, naming its line.
+fn directional_keys(ctx: &Ctx, i: usize, s: &ShadowFile, kind: LightKind) -> Result<()> {
+    let why = match kind {
+        LightKind::Directional { .. } => return Ok(()),
+        LightKind::Spot { .. } => "cascades split a sun's view range, a spot light has one frustum",
+        LightKind::Point => {
+            "cascades split a sun's view range, a point light's six faces cover every direction"
+        }
+    };
+    let keys = crate::technique::params::CASCADES.iter().map(|p| p.key);
+    match keys
+        .filter_map(|k| validate::written(s, k).map(|span| (k, span)))
+        .next()
+    {
+        Some((k, span)) => Err(ctx.err(
+            Some(span),
+            format!("`light[{i}].shadow.{k}` applies to directional lights only: {why}"),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// What a point light's six faces refuse: techniques whose reach no guard band bounds
+/// (`model::point::reach`), naming the technique's line.
 fn point_support(ctx: &Ctx, i: usize, l: &LightFile, shadow: &Shadow, face: u32) -> Result<()> {
     let key = |k: &str| format!("light[{i}].{k}");
     let file = l.shadow.as_ref();
-    if shadow.cascades.count > 1 {
-        let span = file.and_then(|s| s.cascades.as_ref()).map(|v| v.span());
-        return Err(ctx.err(
-            span,
-            format!(
-                "`{}` = {} needs a directional light: a point light's six faces cover every direction",
-                key("shadow.cascades"),
-                shadow.cascades.count
-            ),
-        ));
-    }
     let reach = crate::model::point::reach(&shadow.technique, face);
     if let Err(why) = reach.and_then(|r| crate::model::point::PointLayout::new(face, r)) {
         let span = file

@@ -117,6 +117,11 @@ fn raw<'a>(s: &'a ShadowFile, key: &str) -> Option<Raw<'a>> {
     }
 }
 
+/// Where `key` of the table is written, if it is.
+pub(super) fn written(s: &ShadowFile, key: &str) -> Option<std::ops::Range<usize>> {
+    raw(s, key).map(|r| r.span())
+}
+
 /// Light `i`'s table as the checker's source: values in f64 checked then rounded to f32
 /// (`Ctx`), errors naming `light[i].shadow.<key>` and its line.
 struct Table<'a> {

@@ -21,7 +21,7 @@ pub fn parameters_markdown() -> String {
     table(&mut s, &[params::COMMON]);
     s.push_str(
         "\n## Directional cascades\n\nKeys of every technique's table on a directional light; \
-         more than one cascade is refused for a spot light and for `smrt`; PCSS and the soft \
+         refused on a spot or a point light, more than one cascade for `smrt`; PCSS and the soft \
          techniques give each cascade a guard band of their reach — see \
          [Cascades](SCENES.md#cascades).\n\n",
     );

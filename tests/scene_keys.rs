@@ -1,0 +1,146 @@
+//! Scene keys refused where they do not apply or when written twice, each with one line naming
+//! the file, the line and the key. No GPU needed.
+
+use std::path::Path;
+
+use shadowgraph::Error;
+use shadowgraph::scene::Scene;
+
+/// Two lights (a spot, then the light `LIGHT` puts in) over a plane.
+const BASE: &str = r#"[output]
+width = 64
+height = 48
+
+[camera]
+position = [0.0, 3.0, 6.0]
+target = [0.0, 0.0, 0.0]
+fov_y_degrees = 45.0
+
+[[light]]
+kind = "spot"
+position = [-3.0, 6.0, 2.0]
+target = [0.0, 0.0, 0.0]
+fov_degrees = 50.0
+
+[light.shadow]
+technique = "pcf"
+radius = 2
+
+LIGHT
+
+[[object]]
+shape = "plane"
+size = [8.0, 8.0]
+"#;
+
+/// `BASE` with its second light.
+fn scene(light: &str) -> String {
+    BASE.replace("LIGHT", light)
+}
+
+/// Parses `text` expecting a one-line `Error::Scene` at the line of the `nth` occurrence of
+/// `at`, naming each of `needles`.
+#[track_caller]
+fn expect(text: &str, at: &str, nth: usize, needles: &[&str]) {
+    let offset = text
+        .match_indices(at)
+        .nth(nth)
+        .expect("the marker occurs")
+        .0;
+    let line = text[..offset].matches('\n').count() + 1;
+    let err = match Scene::parse(Path::new("keys.toml"), text) {
+        Ok(_) => panic!("expected an error at line {line}, but the scene parsed:\n{text}"),
+        Err(e) => e,
+    };
+    let shown = err.to_string();
+    assert!(
+        matches!(err, Error::Scene { .. }),
+        "expected Error::Scene: {err:?}"
+    );
+    assert!(
+        shown.starts_with(&format!("keys.toml:{line}:")),
+        "`{shown}` is not at line {line}"
+    );
+    assert!(!shown.contains('\n'), "more than one line: {shown}");
+    for n in needles {
+        assert!(shown.contains(n), "`{shown}` does not mention `{n}`");
+    }
+}
+
+/// The cascade keys apply to directional lights only (docs/SCENES.md, PARAMETERS.md): on a
+/// spot or a point light each of them, `cascades = 1` too, is refused naming its key and line,
+/// as `extent` is; on a directional light they load.
+#[test]
+fn cascade_keys_apply_to_directional_lights_only() {
+    let spot = "[[light]]\nkind = \"spot\"\nposition = [3.0, 6.0, 2.0]\n\
+                target = [0.0, 0.0, 0.0]\nfov_degrees = 40.0\n\n[light.shadow]\n\
+                technique = \"hard\"\n";
+    let point = "[[light]]\nkind = \"point\"\nposition = [3.0, 6.0, 2.0]\n\n[light.shadow]\n\
+                 technique = \"hard\"\n";
+    let sun = "[[light]]\nkind = \"directional\"\nposition = [3.0, 6.0, 2.0]\n\
+               target = [0.0, 0.0, 0.0]\nextent = 5.0\n\n[light.shadow]\ntechnique = \"hard\"\n";
+    for key in [
+        "cascades = 1",
+        "cascades = 3",
+        "cascade_lambda = 0.5",
+        "cascade_blend = 0.2",
+    ] {
+        let name = key.split(' ').next().expect("a key");
+        let named = format!("light[1].shadow.{name}");
+        for (light, kind) in [(spot, "spot"), (point, "point")] {
+            let text = scene(&format!("{light}{key}\n"));
+            expect(&text, key, 0, &[&named, "directional lights only", kind]);
+        }
+        let text = scene(&format!("{sun}{key}\n"));
+        Scene::parse(Path::new("keys.toml"), &text).expect("a directional light takes it");
+    }
+}
+
+/// A key or a table written twice names its dotted path (arrays of tables by index), at the
+/// line of the second.
+#[test]
+fn duplicated_keys_and_tables_are_named() {
+    let sun = "[[light]]\nkind = \"directional\"\nposition = [3.0, 6.0, 2.0]\n\
+               target = [0.0, 0.0, 0.0]\nextent = 5.0\n\n[light.shadow]\ntechnique = \"hard\"\n";
+    let cases: [(String, &str, usize, &str); 6] = [
+        (
+            scene("").replace("height = 48", "height = 48\nwidth = 32"),
+            "width",
+            1,
+            "`output.width`",
+        ),
+        (
+            scene(&format!("{sun}bias = 0.1\nbias = 0.2\n")),
+            "bias",
+            1,
+            "`light[1].shadow.bias`",
+        ),
+        (
+            scene(&format!("{sun}\n[light.shadow]\n")),
+            "[light.shadow]",
+            2,
+            "`light[1].shadow`",
+        ),
+        (
+            scene("").replace("[[object]]", "[output]\nwidth = 3\n\n[[object]]"),
+            "[output]",
+            1,
+            "`output`",
+        ),
+        (
+            scene("[light]\nkind = \"spot\"\n"),
+            "[light]\n",
+            0,
+            "`light`",
+        ),
+        (
+            scene("").replace("radius = 2", "radius = 2\n\"radius\" = 3"),
+            "\"radius\"",
+            0,
+            "`light[0].shadow.radius`",
+        ),
+    ];
+    for (text, at, nth, named) in &cases {
+        expect(text, at, *nth, &["duplicate key", named]);
+    }
+}
