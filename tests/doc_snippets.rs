@@ -162,6 +162,27 @@ drop(maps_layout);
 Ok((shader, out, stage.warnings().len() + f16.warnings().len()))
 }
 
+/// docs/PLUGIN.md's device setup: the features the stage can use that the adapter offers, the
+/// adapter's limits, timing where the device has timestamps.
+#[rustfmt::skip]
+fn plugin_device(g: &Gpu) -> anyhow::Result<(wgpu::Features, bool)> {
+use shadowgraph::prefilter::{Prefilter, PrefilterConfig};
+let adapter = &g.adapter;
+let wanted = shadowgraph::timer::TIMER_FEATURES
+    | wgpu::Features::FLOAT32_FILTERABLE
+    | wgpu::Features::TEXTURE_FORMAT_16BIT_NORM;
+let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+    required_features: adapter.features() & wanted,
+    required_limits: adapter.limits(),
+    ..Default::default()
+}))?;
+let mut stage = Prefilter::new(&device, &PrefilterConfig::vsm(1024))?;
+if device.features().contains(shadowgraph::timer::TIMER_FEATURES) {
+    stage.enable_timing(&device, &queue)?;
+}
+Ok((device.features(), stage.timings(&device)?.is_empty()))
+}
+
 // snippets:end
 
 /// This file's lines between the markers, trimmed, comments cut.
@@ -274,6 +295,10 @@ fn the_snippets_run() {
     let (shader, out, _) = plugin_stage(&g).expect("PLUGIN stage");
     shadowgraph::kernels::reflect("plugin host", &shader).expect("PLUGIN host shader validates");
     assert_eq!(out.maps[0].texture.width(), 1024);
+
+    let (features, _) = plugin_device(&g).expect("PLUGIN device");
+    let offered = g.adapter.features() & shadowgraph::timer::TIMER_FEATURES;
+    assert_eq!(features & shadowgraph::timer::TIMER_FEATURES, offered);
 
     let (nodes, pixels) = plugin_library().expect("PLUGIN library");
     assert!(nodes > 0 && pixels > 0, "{nodes} nodes, {pixels} pixels");

@@ -118,7 +118,8 @@ fn fresh(
 /// the static light in the first frame and again only when it changes. Each frame's
 /// dispatches are the stage's count across it: the moving light's alone while the static
 /// light is unchanged, both when it changed; its maps, kept from the frame it was recorded
-/// while the moving light's layer is redrawn and refiltered, are a fresh filter's.
+/// while the moving light's layer is redrawn and refiltered (and the static light's layer
+/// drawn over by the host), are a fresh filter's.
 #[test]
 fn a_static_light_is_filtered_once_and_kept() {
     let g = common::gpu();
@@ -146,6 +147,10 @@ fn a_static_light_is_filtered_once_and_kept() {
             }
             let moving = orbiting(2.0 + 0.1 * frame as f32);
             draw_layer(&g, &vertices, &moving, &array, 1);
+            if !changed {
+                // The host draws something else into the static light's layer meanwhile.
+                draw_layer(&g, &vertices, &moving, &array, 0);
+            }
             let before = stage.dispatch_count();
             let mut enc = g.device.create_command_encoder(&Default::default());
             if changed {
