@@ -376,9 +376,11 @@ fn distance_to_pcss(g: &Gpu, renderer: &mut Renderer, scene: &Scene) -> Distance
 fn soft_scenes_approach_pcss() {
     // Not an accuracy claim (PCSS is itself an estimate; ground truth is area-light
     // sampling): a guard that each soft technique's whole chain still makes soft shadows where
-    // PCSS does. On each bundled soft scene: mean |v − v_pcss| ≤ 0.05, and at least half as
-    // many penumbra pixels (visibility in (0.02, 0.98)) as PCSS leaves (hard shadows leave
-    // almost none).
+    // PCSS does. On each bundled soft scene: mean |v − v_pcss| ≤ 0.05, and at least a third
+    // as many penumbra pixels (visibility in (0.02, 0.98)) as PCSS leaves (hard shadows leave
+    // almost none). A third, not more: PCSS widens the sphere's penumbra on vssm.toml well
+    // past the area-light truth's (`shadowgraph evaluate`, 512² map, K = 64: penumbra error
+    // PCSS 16 + 32 0.087, vssm 0.057), and vssm's blocker search in cells follows the truth.
     let g = common::gpu();
     let mut renderer = Renderer::new(&g.device);
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/techniques");
@@ -392,7 +394,7 @@ fn soft_scenes_approach_pcss() {
             d.mean, d.pixels, d.penumbra, d.hard, d.hard_penumbra, d.partial, d.pcss_partial
         );
         eprintln!("{line}");
-        if d.mean > 0.05 || 2 * d.partial < d.pcss_partial {
+        if d.mean > 0.05 || 3 * d.partial < d.pcss_partial {
             failures.push(line);
         }
     }

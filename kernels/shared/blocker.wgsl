@@ -66,6 +66,28 @@ fn soft_filter_trips(look: SoftLookup) -> u32 {
     return select(0u, 1u, look.blockers);
 }
 
+// The blocker estimates of a search square's cells combined: the share is the cells' shares
+// weighted by their areas, z_avg the cells' z_avg weighted by their blockers (area · share).
+struct BlockerSum {
+    z: f32,      // Σ area · share · z_avg
+    share: f32,  // Σ area · share
+    area: f32,   // Σ area
+}
+
+// An empty cell (area 0: its moments are the table's offset, any estimate of them) adds
+// nothing, selected rather than multiplied so that no value of its estimate can reach the sum.
+fn blocker_add(acc: BlockerSum, b: vec2<f32>, area: f32) -> BlockerSum {
+    let blockers = area * max(b.y, 0.0);
+    let add = select(vec3<f32>(0.0), vec3<f32>(blockers * b.x, blockers, area), area > 0.0);
+    return BlockerSum(acc.z + add.x, acc.share + add.y, acc.area + add.z);
+}
+
+// (z_avg, share) of the cells summed in `acc`, receiver depth d.
+fn blocker_total(acc: BlockerSum, d: f32) -> vec2<f32> {
+    let share = acc.share / max(acc.area, 1.0);
+    return blocker_result(acc.z / max(acc.share, 1e-30), share, d);
+}
+
 // (z_avg, share) from a blocker depth estimate `z` and share: z clamped to [0, d] (blockers
 // are in front of the receiver d).
 fn blocker_result(z: f32, share: f32, d: f32) -> vec2<f32> {

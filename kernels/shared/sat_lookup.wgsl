@@ -42,18 +42,20 @@ fn sat_nearest(r: vec4<f32>) -> vec4<f32> {
     return vec4<f32>(lo, max(round(r.zw), lo + 1.0));
 }
 
-// The mean over `sat_rect(l, uv, width)` with its edges rounded to the nearest texel edges
-// (`sat_nearest`, then `sat_box_*`): the soft techniques' filter in four loads. Their box
-// changes width and centre per pixel; moving its edges by at most half a texel moved the mean
-// error against the area-light truth by under 1% (5% in one of 27 configurations) on
-// sphere_on_plane, pole and stacked, where the exact integral (`sat_sample_*`) reads 16.
-// #fetches sat_filter_fixed: 4
+// The soft techniques' filter from a fixed-point table: the exact mean over
+// `sat_rect(l, uv, width)` (`sat_sample_fixed`, 16 loads). Their box changes width and centre
+// per pixel, so edges rounded to the nearest texel edges (4 loads) move it by up to half a
+// texel at the map's texel pitch: a mean error that cannot be seen in the mean against the
+// area-light truth, and a staircase of the texel grid across every penumbra that can (the
+// mean |Laplacian| of the penumbra several times the exact square's).
+// #fetches sat_filter_fixed: sat_sample_fixed
 fn sat_filter_fixed(map: texture_2d<u32>, l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
-    return sat_box_fixed(map, sat_nearest(sat_rect(l, uv, width)), l.sat_offset, l.sat_scale);
+    return sat_sample_fixed(map, l, uv, width);
 }
 
-// `sat_filter_fixed`'s integer window over tables of `size`, for several tables of one size
-// read over one square (`sat_layer_window` each): CSSM's five.
+// CSSM's filter window over tables of `size`: the square `sat_rect(l, uv, width)` with its
+// edges rounded to the nearest texel edges (`sat_nearest`), one integer window that several
+// tables of one size are read over (`sat_layer_window` each, 4 loads a table: CSSM's five).
 fn sat_filter_window(l: Light, uv: vec2<f32>, width: f32, size: vec2<u32>) -> vec4<i32> {
     return sat_box(sat_nearest(sat_rect(l, uv, width)), size);
 }
@@ -73,6 +75,92 @@ fn sat_filter_float(map: texture_2d<f32>, smp: sampler, l: Light, uv: vec2<f32>,
 // #fetches sat_search_fixed: 4
 fn sat_search_fixed(map: texture_2d<u32>, l: Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
     return sat_box_fixed(map, sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
+}
+
+// The blocker search in cells (Yang et al. 2010, "Variance Soft Shadow Mapping", §4.3: a
+// kernel that is not planar is subdivided): the search square snapped outward to texel edges,
+// as `sat_search_*` reads it, cut at texel edges into SEARCH_CELLS × SEARCH_CELLS cells, each
+// cell's mean from the table. One estimate over a wide square fails where the receiver's own
+// texels fill it: a plane seen by a spot light stores a linear depth whose mean over a square
+// lies behind its centre (1/z, not z, is affine across the map), and a few blockers in front
+// cannot pull the mean in front of the receiver, so the estimate reads no blockers and a long
+// shadow's far end is cut off along an arc. A cell holds a quarter of the plane's spread in depth
+// and its blockers at up to four times their share. Cell edges are X0 + ⌊k·(X1 − X0)/SEARCH_CELLS⌋: a square
+// narrower than SEARCH_CELLS texels has empty cells (area 0), which weigh nothing. The
+// (SEARCH_CELLS + 1)² corners are loaded once each, a row at a time.
+const SEARCH_CELLS: u32 = 2u;
+const SEARCH_CELL_COUNT: u32 = 4u;
+const SEARCH_CORNERS: u32 = 3u;
+
+struct SearchCells {
+    m: array<vec4<f32>, SEARCH_CELL_COUNT>,  // each cell's mean, row by row
+    area: array<f32, SEARCH_CELL_COUNT>,     // each cell's texels (0: an empty cell)
+}
+
+// Edge k (0 ..= SEARCH_CELLS) of the cells of the integer span [lo, hi).
+fn search_edge(lo: i32, hi: i32, k: u32) -> i32 {
+    return lo + (i32(k) * (hi - lo)) / i32(SEARCH_CELLS);
+}
+
+// The cells' integer window: `sat_box` of the search square.
+fn search_window(l: Light, uv: vec2<f32>, width: f32, size: vec2<u32>) -> vec4<i32> {
+    return sat_box(sat_rect(l, uv, width), size);
+}
+
+// The texels of cell (i, j) of window b, i and j ≥ 1 naming the cell's far edges.
+fn search_cell_area(b: vec4<i32>, i: u32, j: u32) -> f32 {
+    let w = search_edge(b.x, b.z, i) - search_edge(b.x, b.z, i - 1u);
+    let h = search_edge(b.y, b.w, j) - search_edge(b.y, b.w, j - 1u);
+    return f32(w * h);
+}
+
+// The cells of the search square from a fixed-point table (rgba32uint).
+// #fetches sat_search_cells_fixed: 9
+fn sat_search_cells_fixed(map: texture_2d<u32>, l: Light, uv: vec2<f32>, width: f32) -> SearchCells {
+    let layer = sat_alone();
+    let b = search_window(l, uv, width, sat_layer_size(map, layer));
+    var cells: SearchCells;
+    var prev: array<vec4<u32>, SEARCH_CORNERS>;
+    for (var j = 0u; j <= SEARCH_CELLS; j++) {
+        let y = search_edge(b.y, b.w, j);
+        var row: array<vec4<u32>, SEARCH_CORNERS>;
+        for (var i = 0u; i <= SEARCH_CELLS; i++) {
+            row[i] = sat_layer_node(map, layer, search_edge(b.x, b.z, i), y);
+        }
+        for (var i = 1u; i <= SEARCH_CELLS && j > 0u; i++) {
+            let window = (row[i] - row[i - 1u]) - (prev[i] - prev[i - 1u]);
+            let area = search_cell_area(b, i, j);
+            let k = (j - 1u) * SEARCH_CELLS + i - 1u;
+            cells.m[k] = vec4<f32>(bitcast<vec4<i32>>(window)) / (l.sat_scale * max(area, 1.0)) + l.sat_offset;
+            cells.area[k] = area;
+        }
+        prev = row;
+    }
+    return cells;
+}
+
+// The cells of the search square from an f32 table (rgba32float).
+// #fetches sat_search_cells_float: 9
+fn sat_search_cells_float(map: texture_2d<f32>, l: Light, uv: vec2<f32>, width: f32) -> SearchCells {
+    let b = search_window(l, uv, width, textureDimensions(map));
+    var cells: SearchCells;
+    var prev: array<vec4<f32>, SEARCH_CORNERS>;
+    for (var j = 0u; j <= SEARCH_CELLS; j++) {
+        let y = search_edge(b.y, b.w, j);
+        var row: array<vec4<f32>, SEARCH_CORNERS>;
+        for (var i = 0u; i <= SEARCH_CELLS; i++) {
+            row[i] = sat_node_f32(map, search_edge(b.x, b.z, i), y);
+        }
+        for (var i = 1u; i <= SEARCH_CELLS && j > 0u; i++) {
+            let window = (row[i] - row[i - 1u]) - (prev[i] - prev[i - 1u]);
+            let area = search_cell_area(b, i, j);
+            let k = (j - 1u) * SEARCH_CELLS + i - 1u;
+            cells.m[k] = window / (l.sat_scale * max(area, 1.0)) + l.sat_offset;
+            cells.area[k] = area;
+        }
+        prev = row;
+    }
+    return cells;
 }
 
 // `sat_search_fixed` of the table `layer` of `map`.

@@ -3,10 +3,11 @@
 // blocker share and depth from the Hamburger reconstruction (blocker_msm), the PCSS penumbra
 // width follows, and MSM's visibility (vis_msm_of: Hamburger or Hausdorff, bleed reduction) is
 // read from the moments over that width. The search reads the
-// square snapped outward to texel edges (`sat_search_*`: 4 loads; the square grows by less
-// than a texel per side, an estimate either way), the filter the square with its edges rounded
-// to the nearest texel edges (`sat_filter_*`: 4 loads), in a loop of `soft_filter_trips` trips: a receiver whose search square holds no blockers
-// (share below BLOCKER_MIN_SHARE) is lit after the search.
+// square snapped outward to texel edges in 2 × 2 cells (`sat_search_cells_*`: 9 loads; the
+// cells' estimates combined, so that the receiver's own texels filling a wide square cannot
+// hide its blockers), the filter the exact square (`sat_filter_*`), in a loop of
+// `soft_filter_trips` trips: a receiver whose search square holds no blockers (share below
+// BLOCKER_MIN_SHARE) is lit after the search.
 // `vis_msm_soft_fixed` reads a fixed-point table (rgba32uint), `vis_msm_soft_float` an f32 one.
 // #import shared/light
 // #import shared/sat_lookup
@@ -17,10 +18,19 @@ fn msm_soft_blocker(m: vec4<f32>, l: Light, s: LightSample) -> vec2<f32> {
     return blocker_msm(msm_biased(m, l), s.depth - l.bias);
 }
 
-// #fetches vis_msm_soft_fixed: sat_search_fixed + sat_filter_fixed
+// The blocker estimate of the search square's cells (`sat_search_cells_*`), combined.
+fn msm_soft_search(cells: SearchCells, l: Light, s: LightSample) -> vec2<f32> {
+    var acc = BlockerSum(0.0, 0.0, 0.0);
+    for (var k = 0u; k < SEARCH_CELL_COUNT; k++) {
+        acc = blocker_add(acc, msm_soft_blocker(cells.m[k], l, s), cells.area[k]);
+    }
+    return blocker_total(acc, s.depth - l.bias);
+}
+
+// #fetches vis_msm_soft_fixed: sat_search_cells_fixed + sat_filter_fixed
 fn vis_msm_soft_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32 {
-    let search = sat_search_fixed(map, l, s.uv, blocker_search_width(l, s));
-    let look = soft_blockers(msm_soft_blocker(search, l, s), l, s);
+    let search = sat_search_cells_fixed(map, l, s.uv, blocker_search_width(l, s));
+    let look = soft_blockers(msm_soft_search(search, l, s), l, s);
     var m = vec4<f32>(0.0);
     for (var k = 0u; k < soft_filter_trips(look); k++) {
         m = sat_filter_fixed(map, l, s.uv, look.width);
@@ -31,10 +41,10 @@ fn vis_msm_soft_fixed(map: texture_2d<u32>, l: Light, s: LightSample) -> f32 {
     return vis_msm_of(m, l, s);
 }
 
-// #fetches vis_msm_soft_float: sat_search_float + sat_filter_float
+// #fetches vis_msm_soft_float: sat_search_cells_float + sat_filter_float
 fn vis_msm_soft_float(map: texture_2d<f32>, smp: sampler, l: Light, s: LightSample) -> f32 {
-    let search = sat_search_float(map, l, s.uv, blocker_search_width(l, s));
-    let look = soft_blockers(msm_soft_blocker(search, l, s), l, s);
+    let search = sat_search_cells_float(map, l, s.uv, blocker_search_width(l, s));
+    let look = soft_blockers(msm_soft_search(search, l, s), l, s);
     var m = vec4<f32>(0.0);
     for (var k = 0u; k < soft_filter_trips(look); k++) {
         m = sat_filter_float(map, smp, l, s.uv, look.width);

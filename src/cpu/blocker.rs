@@ -36,6 +36,25 @@ impl Blocker {
     }
 }
 
+/// `SEARCH_CELLS` of `kernels/shared/sat_lookup.wgsl`: the blocker search reads its square
+/// in `SEARCH_CELLS × SEARCH_CELLS` cells, each estimated on its own ([`combine`]).
+pub const SEARCH_CELLS: u32 = 2;
+
+/// `blocker_total` after `blocker_add` of each cell's estimate and area (texels): the share
+/// weighted by area, the depth by blockers (area · share); a cell of area 0 weighs nothing.
+pub fn combine(cells: impl IntoIterator<Item = (Blocker, f64)>, d: f64) -> Blocker {
+    let (mut z, mut share, mut area) = (0.0, 0.0, 0.0);
+    for (b, a) in cells {
+        if a > 0.0 {
+            let blockers = a * b.share.max(0.0);
+            z += blockers * b.depth;
+            share += blockers;
+            area += a;
+        }
+    }
+    Blocker::new(z / share.max(1e-30), share / area.max(1.0), d)
+}
+
 /// `blocker_width`: at least 1 texel, at most `l.max_width`.
 fn width(texels: f64, l: &LightGpu) -> f64 {
     let w = if texels > 1.0 { texels } else { 1.0 };
@@ -122,4 +141,39 @@ pub fn csm_z(below: f64, zsum: f64, d: f64) -> Blocker {
 /// point light's atlas).
 fn face_texels(l: &LightGpu) -> f64 {
     f64::from(l.map_size[0]) * f64::from(l.face_uv[0])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn search_cells_match_the_kernel() {
+        let wgsl = include_str!("../../kernels/shared/sat_lookup.wgsl");
+        let n = SEARCH_CELLS;
+        for line in [
+            format!("const SEARCH_CELLS: u32 = {n}u;"),
+            format!("const SEARCH_CELL_COUNT: u32 = {}u;", n * n),
+            format!("const SEARCH_CORNERS: u32 = {}u;", n + 1),
+        ] {
+            assert!(wgsl.contains(&line), "sat_lookup.wgsl lacks `{line}`");
+        }
+    }
+
+    #[test]
+    fn cells_combine_by_area_and_blockers() {
+        // Two cells of 6 and 2 texels: blockers at 0.2 over half of the first, at 0.4 over all
+        // of the second; an empty cell whatever its estimate. Share (3 + 2)/8, depth
+        // (3·0.2 + 2·0.4)/5 = 0.28.
+        let b = |depth, share| Blocker { depth, share };
+        let got = combine(
+            [(b(0.2, 0.5), 6.0), (b(0.4, 1.0), 2.0), (b(0.9, 1.0), 0.0)],
+            0.8,
+        );
+        assert!((got.share - 5.0 / 8.0).abs() < 1e-12, "{got:?}");
+        assert!((got.depth - 0.28).abs() < 1e-12, "{got:?}");
+        // No blockers anywhere: share 0, depth clamped into [0, d].
+        let none = combine([(b(0.5, 0.0), 4.0)], 0.8);
+        assert_eq!((none.share, none.depth), (0.0, 0.0));
+    }
 }

@@ -326,7 +326,7 @@ impl Integral {
     }
 
     /// The mean over the square of [`Self::square_mean`] as the soft techniques' filter reads
-    /// it: from a table read with loads, [`Self::nearest_square_mean`]; from one read with
+    /// it (CSSM's): from a table read with loads, [`Self::nearest_square_mean`]; from one read with
     /// filtered fetches ([`Self::filtered`]), the square itself on the 2⁻⁸-texel grid
     /// ([`grid_rect`], `sat_filter_float`).
     pub fn filter_square_mean(&self, map_size: [f32; 2], uv: [f64; 2], width: f64) -> Vec<f64> {
@@ -334,6 +334,22 @@ impl Integral {
             self.grid_square_mean(map_size, uv, width)
         } else {
             self.nearest_square_mean(map_size, uv, width)
+        }
+    }
+
+    /// The mean over the square of [`Self::square_mean`] as `vssm` and `msm_soft` read it
+    /// (`sat_filter_*`): exact from a table read with loads, on the 2⁻⁸-texel grid
+    /// ([`Self::grid_square_mean`]) from one read with filtered fetches.
+    pub fn exact_filter_square_mean(
+        &self,
+        map_size: [f32; 2],
+        uv: [f64; 2],
+        width: f64,
+    ) -> Vec<f64> {
+        if self.filtered {
+            self.grid_square_mean(map_size, uv, width)
+        } else {
+            self.square_mean(map_size, uv, width)
         }
     }
 
@@ -350,11 +366,49 @@ impl Integral {
     /// The mean over the square of [`Self::square_mean`] snapped outward to texel edges after
     /// [`clamp_rect`]: `[⌊x0⌋, ⌈x1⌉) × [⌊y0⌋, ⌈y1⌉)` (`sat_search_*`, the blocker search).
     pub fn snapped_square_mean(&self, map_size: [f32; 2], uv: [f64; 2], width: f64) -> Vec<f64> {
+        self.rect_mean(self.snapped_square(map_size, uv, width))
+    }
+
+    /// The square of [`Self::snapped_square_mean`], `[X0, Y0, X1, Y1]` in whole texels.
+    fn snapped_square(&self, map_size: [f32; 2], uv: [f64; 2], width: f64) -> [f32; 4] {
         let (cx, cy) = (uv[0] as f32 * map_size[0], uv[1] as f32 * map_size[1]);
         let h = 0.5 * width as f32;
         let r = clamp_rect([cx - h, cy - h, cx + h, cy + h], self.width, self.height);
-        let snapped = [r[0].floor(), r[1].floor(), r[2].ceil(), r[3].ceil()];
-        self.rect_mean(snapped)
+        [r[0].floor(), r[1].floor(), r[2].ceil(), r[3].ceil()]
+    }
+
+    /// The square of [`Self::snapped_square_mean`] cut at texel edges into `n × n` cells, edge
+    /// `k` of the span `[lo, hi)` at `lo + ⌊k·(hi − lo)/n⌋` (`sat_search_cells_*`): each
+    /// cell's mean and area in texels, row by row. An empty cell (a square narrower than `n`
+    /// texels) has area 0 and no mean (an empty vector).
+    pub fn search_cells(
+        &self,
+        map_size: [f32; 2],
+        uv: [f64; 2],
+        width: f64,
+        n: u32,
+    ) -> Vec<(Vec<f64>, f64)> {
+        let [x0, y0, x1, y1] = self.snapped_square(map_size, uv, width).map(|e| e as i64);
+        let edge = |lo: i64, hi: i64, k: u32| lo + i64::from(k) * (hi - lo) / i64::from(n);
+        let mut cells = Vec::with_capacity((n * n) as usize);
+        for j in 1..=n {
+            for i in 1..=n {
+                let r = [
+                    edge(x0, x1, i - 1),
+                    edge(y0, y1, j - 1),
+                    edge(x0, x1, i),
+                    edge(y0, y1, j),
+                ];
+                let area = ((r[2] - r[0]) * (r[3] - r[1])) as f64;
+                let mean = if area > 0.0 {
+                    self.rect_mean(r.map(|e| e as f32))
+                } else {
+                    Vec::new()
+                };
+                cells.push((mean, area));
+            }
+        }
+        cells
     }
 }
 

@@ -7,22 +7,34 @@ use super::light::LightSample;
 use super::sat::Integral;
 use crate::gpu_data::LightGpu;
 
-/// The mean (possibly quantized) moments over the blocker-search square snapped outward to
-/// texel edges.
-pub fn search(moments: &Integral, l: &LightGpu, s: &LightSample) -> Vec<f64> {
-    moments.snapped_square_mean(l.map_size, s.uv, blocker::search_width(l, s))
+/// The blocker search's cells (`sat_search_cells_*`): each cell's mean moments and area.
+pub fn search(moments: &Integral, l: &LightGpu, s: &LightSample) -> Vec<(Vec<f64>, f64)> {
+    moments.search_cells(
+        l.map_size,
+        s.uv,
+        blocker::search_width(l, s),
+        blocker::SEARCH_CELLS,
+    )
 }
 
-/// `msm_soft_blocker`.
-pub fn blocker_of(m: &[f64], l: &LightGpu, s: &LightSample) -> Blocker {
+/// `msm_soft_blocker` of one cell's mean moments `m`.
+pub fn cell_blocker(m: &[f64], l: &LightGpu, s: &LightSample) -> Blocker {
     blocker::msm(&super::vis_msm::biased(m, l), s.depth - f64::from(l.bias))
 }
 
+/// `msm_soft_search`: the cells' estimates combined ([`blocker::combine`]).
+pub fn blocker_of(cells: &[(Vec<f64>, f64)], l: &LightGpu, s: &LightSample) -> Blocker {
+    let each = cells
+        .iter()
+        .filter(|(_, area)| *area > 0.0)
+        .map(|(m, area)| (cell_blocker(m, l, s), *area));
+    blocker::combine(each, s.depth - f64::from(l.bias))
+}
+
 /// The mean moments over the penumbra width of `b`, the square as the table is read
-/// ([`Integral::filter_square_mean`]: rounded to texel edges, or on the 2⁻⁸ grid of filtered
-/// fetches).
+/// ([`Integral::exact_filter_square_mean`]: exact, or on the 2⁻⁸ grid of filtered fetches).
 pub fn filtered(moments: &Integral, l: &LightGpu, s: &LightSample, b: Blocker) -> Vec<f64> {
-    moments.filter_square_mean(l.map_size, s.uv, blocker::filter_width(l, s, b.depth))
+    moments.exact_filter_square_mean(l.map_size, s.uv, blocker::filter_width(l, s, b.depth))
 }
 
 /// The visibility for blocker estimate `b` (`msm_soft_resolve` after the second lookup).

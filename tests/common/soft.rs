@@ -83,6 +83,64 @@ impl TableError {
             40.0 * ULP * a + strips
         })
     }
+
+    /// [`Self::mean`] of one cell of the blocker search, an integer window of `area` texels
+    /// (no weights; its side at most √area + 1: the cells of a snapped square differ by a
+    /// texel at most).
+    pub fn cell(&self, area: f64) -> [f64; 4] {
+        let n = self.size as f64;
+        let side = area.sqrt() + 1.0;
+        self.amp.map(|a| {
+            let strips = if self.float {
+                3.0 * ULP * (n + 2.0) * (side.ceil() + 2.0) * a / area.max(1.0)
+            } else {
+                0.0
+            };
+            40.0 * ULP * a + strips
+        })
+    }
+}
+
+/// The blocker search's cells as one vector for [`Chain`]: each cell's first `ch` values (as
+/// `f` makes them from its mean; zeros for an empty cell), then its area.
+pub fn flat_cells(
+    cells: &[(Vec<f64>, f64)],
+    ch: usize,
+    f: impl Fn(&[f64]) -> Vec<f64>,
+) -> Vec<f64> {
+    let mut v = Vec::with_capacity(cells.len() * (ch + 1));
+    for (m, area) in cells {
+        if *area > 0.0 {
+            v.extend_from_slice(&f(m)[..ch]);
+        } else {
+            v.extend(std::iter::repeat_n(0.0, ch));
+        }
+        v.push(*area);
+    }
+    v
+}
+
+/// [`flat_cells`] back into cells of `ch` values and an area.
+pub fn unflat_cells(v: &[f64], ch: usize) -> Vec<(Vec<f64>, f64)> {
+    v.chunks(ch + 1)
+        .map(|c| (c[..ch].to_vec(), c[ch]))
+        .collect()
+}
+
+/// The errors of [`flat_cells`]' entries: `e(m, area)` for each non-empty cell's values, 0
+/// for the areas (exact) and empty cells.
+fn cell_errors(v: &[f64], ch: usize, e: impl Fn(&[f64], f64) -> [f64; 4]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(v.len());
+    for c in v.chunks(ch + 1) {
+        let area = c[ch];
+        if area > 0.0 {
+            out.extend_from_slice(&e(&c[..ch], area)[..ch]);
+        } else {
+            out.extend(std::iter::repeat_n(0.0, ch));
+        }
+        out.push(0.0);
+    }
+    out
 }
 
 /// The f32 error of the receiver's UV (the projection of the normal-offset point: a few
@@ -121,8 +179,16 @@ fn combinations(n: usize, mut f: impl FnMut(&[f64])) {
 pub struct Chain<'a> {
     /// Search-step inputs at the UV moved by the argument.
     pub search: &'a dyn Fn([f64; 2]) -> Vec<f64>,
-    /// Their absolute errors.
+    /// Their absolute errors, or with `cells` a function of the moved inputs giving them.
     pub e_search: Vec<f64>,
+    /// The search's inputs are this many cells of equal length ([`flat_cells`]) whose errors
+    /// are independent: each cell is perturbed on its own and the changes of the estimate are
+    /// summed (first order), instead of every sign combination of every input at once
+    /// (2^(4·4) for MSM's four cells). 1: the inputs are perturbed together.
+    pub cells: usize,
+    /// With `cells` > 1, the errors of the search's inputs at the moved UV (their areas change
+    /// with it).
+    pub cell_errors: Option<&'a dyn Fn(&[f64]) -> Vec<f64>>,
     /// Blocker estimate of (inputs, depth offset).
     pub blocker: &'a dyn Fn(&[f64], f64) -> Blocker,
     /// Visibility for blockers at this depth (exact lookups at its filter width).
@@ -138,9 +204,10 @@ pub struct Chain<'a> {
     /// The filter square's edges before rounding for blockers at this depth
     /// (`cpu::sat::square`).
     pub filter_box: &'a dyn Fn(f64) -> [f32; 4],
-    /// The filter reads an f32 table with filtered fetches: its square's edges snap to the
-    /// 2⁻⁸ grid, where an edge landing one step off moves the means by no more than
-    /// [`grid_flips`] adds to `e_last` (no point is set aside for its edges).
+    /// The filter's square is exact (`vssm`, `msm_soft`) or read with filtered fetches of an
+    /// f32 table, whose edges snap to the 2⁻⁸ grid, where an edge landing one step off moves
+    /// the means by no more than [`grid_flips`] adds to `e_last`: no point is set aside for
+    /// its edges. Else (CSSM's fixed-point tables) its edges are rounded to texel edges.
     pub grid: bool,
 }
 
@@ -180,6 +247,17 @@ impl Chain<'_> {
     pub fn tolerance(&self, v0: f64) -> Option<f64> {
         let search0 = (self.search)([0.0; 2]);
         let b0 = (self.blocker)(&search0, 0.0);
+        let (flips, dz) = if self.cells > 1 {
+            self.cell_search_range(b0)
+        } else {
+            self.search_range(b0)
+        };
+        self.finish_tolerance(v0, b0, flips, dz)
+    }
+
+    /// Whether a perturbation of the search's inputs flips the blocker threshold, and the
+    /// largest change of the blocker depth, every input perturbed together.
+    fn search_range(&self, b0: Blocker) -> (bool, f64) {
         let mut flips = false;
         let mut dz: f64 = 0.0;
         for moved in UV_MOVES {
@@ -194,6 +272,51 @@ impl Chain<'_> {
                 dz = dz.max((b.depth - b0.depth).abs());
             });
         }
+        (flips, dz)
+    }
+
+    /// [`Self::search_range`] for inputs in cells: at each moved UV, each cell perturbed on
+    /// its own (every sign combination of its values and the depth), the changes of the
+    /// share and of the depth summed over the cells.
+    fn cell_search_range(&self, b0: Blocker) -> (bool, f64) {
+        let mut flips = false;
+        let mut dz: f64 = 0.0;
+        for moved in UV_MOVES {
+            let search = (self.search)(moved);
+            let e = self
+                .cell_errors
+                .map_or_else(|| self.e_search.clone(), |f| f(&search));
+            let bm = (self.blocker)(&search, 0.0);
+            let stride = search.len() / self.cells;
+            let (mut d_share, mut d_depth) = (0.0f64, 0.0f64);
+            for k in 0..self.cells {
+                let idx: Vec<usize> = (k * stride..(k + 1) * stride)
+                    .filter(|&i| e[i] > 0.0)
+                    .collect();
+                let (mut cs, mut cz) = (0.0f64, 0.0f64);
+                combinations(idx.len() + 1, |sg| {
+                    let mut m = search.clone();
+                    for (j, &i) in idx.iter().enumerate() {
+                        m[i] += sg[j] * e[i];
+                    }
+                    let b = (self.blocker)(&m, sg[idx.len()] * self.e_depth);
+                    cs = cs.max((b.share - bm.share).abs());
+                    cz = cz.max((b.depth - bm.depth).abs());
+                });
+                d_share += cs;
+                d_depth += cz;
+            }
+            let lo = bm.share - d_share;
+            let hi = bm.share + d_share;
+            let min = cpu::blocker::MIN_SHARE;
+            flips |= bm.found() != b0.found() || if b0.found() { lo < min } else { hi >= min };
+            dz = dz.max((bm.depth - b0.depth).abs() + d_depth);
+        }
+        (flips, dz)
+    }
+
+    /// The tolerance from the search's range: `None` where it flips the threshold.
+    fn finish_tolerance(&self, v0: f64, b0: Blocker, flips: bool, dz: f64) -> Option<f64> {
         if flips {
             return None;
         }
@@ -251,20 +374,23 @@ pub fn vssm_tolerance(
 ) -> Option<f64> {
     use cpu::vis_vssm as v;
     let b0 = v::blocker_of(&v::search(t, l, s), l, s);
-    let es = err.mean(l, s, cpu::blocker::search_width(l, s));
     let width = cpu::blocker::filter_width(l, s, b0.depth);
     let el = grid_flips(t, l, s, width, err.mean(l, s, width));
+    let search = |du| flat_cells(&v::search(t, l, &shifted(s, du)), 2, <[f64]>::to_vec);
+    let errors = |m: &[f64]| cell_errors(m, 2, |_, area| err.cell(area));
     Chain {
-        search: &|du| v::search(t, l, &shifted(s, du))[..2].to_vec(),
-        e_search: es[..2].to_vec(),
-        blocker: &|m, dd| v::blocker_of(m, l, &moved(s, dd)),
+        search: &search,
+        e_search: errors(&search([0.0; 2])),
+        cells: cpu::blocker::SEARCH_CELLS.pow(2) as usize,
+        cell_errors: Some(&errors),
+        blocker: &|m, dd| v::blocker_of(&unflat_cells(m, 2), l, &moved(s, dd)),
         finish: &|z| v::finish(t, l, s, Blocker { depth: z, ..b0 }),
         last: &|du| v::filtered(t, l, &shifted(s, du), b0)[..2].to_vec(),
         e_last: el[..2].to_vec(),
         visibility: &|m, dd| cpu::vis_vsm::vis_vsm_of(m, l, &moved(s, dd)),
         e_depth: depth_error(l, s),
         filter_box: &|z| filter_box(l, s, z),
-        grid: t.is_filtered(),
+        grid: true,
     }
     .tolerance(v0)
 }
@@ -274,7 +400,11 @@ pub fn vssm_tolerance(
 /// stable in the moments: the GPU's answer is exact for moments that close, as in
 /// `msm_tolerance`). Perturbed moments are then projected and biased, as the kernel does.
 fn msm_moment_error(l: &LightGpu, m: &[f64], e: [f64; 4]) -> [f64; 4] {
-    let b = cpu::vis_msm::dequantized(m, l);
+    msm_dequantized_error(l, &cpu::vis_msm::dequantized(m, l), e)
+}
+
+/// [`msm_moment_error`] of moments already dequantized, `b`.
+fn msm_dequantized_error(l: &LightGpu, b: &[f64], e: [f64; 4]) -> [f64; 4] {
     let carried: [f64; 4] = if l.msm_flags & MSM_QUANTIZED != 0 {
         let zero = cpu::msm::dequantize([0.0; 4]);
         let mut out = [0.0; 4];
@@ -307,28 +437,36 @@ pub fn msm_soft_tolerance(
     v0: f64,
 ) -> Option<f64> {
     use cpu::vis_msm_soft as v;
-    let search0 = v::search(t, l, s);
-    let b0 = v::blocker_of(&search0, l, s);
-    let es = msm_moment_error(
-        l,
-        &search0,
-        err.mean(l, s, cpu::blocker::search_width(l, s)),
-    );
+    let b0 = v::blocker_of(&v::search(t, l, s), l, s);
+    let dequantized = |m: &[f64]| cpu::vis_msm::dequantized(m, l).to_vec();
+    let search = |du| flat_cells(&v::search(t, l, &shifted(s, du)), 4, dequantized);
+    let errors =
+        |m: &[f64]| cell_errors(m, 4, |b, area| msm_dequantized_error(l, b, err.cell(area)));
+    let d = s.depth - f64::from(l.bias);
+    let cell_blockers = |m: &[f64], dd: f64| {
+        let each = unflat_cells(m, 4)
+            .into_iter()
+            .filter(|(_, area)| *area > 0.0)
+            .map(|(b, area)| (cpu::blocker::msm(&msm_bias(l, &b), d + dd), area))
+            .collect::<Vec<_>>();
+        cpu::blocker::combine(each, d + dd)
+    };
     let width = cpu::blocker::filter_width(l, s, b0.depth);
     let last0 = v::filtered(t, l, s, b0);
     let el = msm_moment_error(l, &last0, grid_flips(t, l, s, width, err.mean(l, s, width)));
-    let d = s.depth - f64::from(l.bias);
     Chain {
-        search: &|du| cpu::vis_msm::dequantized(&v::search(t, l, &shifted(s, du)), l).to_vec(),
-        e_search: es.to_vec(),
-        blocker: &|b, dd| cpu::blocker::msm(&msm_bias(l, b), d + dd),
+        search: &search,
+        e_search: errors(&search([0.0; 2])),
+        cells: cpu::blocker::SEARCH_CELLS.pow(2) as usize,
+        cell_errors: Some(&errors),
+        blocker: &cell_blockers,
         finish: &|z| v::finish(t, l, s, Blocker { depth: z, ..b0 }),
         last: &|du| cpu::vis_msm::dequantized(&v::filtered(t, l, &shifted(s, du), b0), l).to_vec(),
         e_last: el.to_vec(),
         visibility: &|b, dd| cpu::vis_msm::visibility(&msm_bias(l, b), d + dd, l),
         e_depth: depth_error(l, s),
         filter_box: &|z| filter_box(l, s, z),
-        grid: t.is_filtered(),
+        grid: true,
     }
     .tolerance(v0)
 }
@@ -417,6 +555,8 @@ pub fn cssm_tolerance(
     Chain {
         search: &|du| v::search(maps, l, &shifted(s, du)),
         e_search,
+        cells: 1,
+        cell_errors: None,
         blocker: &|m, dd| v::blocker_of(kind, m, l, &moved(s, dd)),
         finish: &|z| v::finish(maps, l, s, Blocker { depth: z, ..b0 }),
         last: &last,
