@@ -40,6 +40,7 @@ mod stats;
 pub mod summary;
 mod svg;
 mod sweep;
+pub mod temporal;
 mod timing;
 pub mod verdict;
 

@@ -192,6 +192,22 @@ impl Renderer {
         Ok(())
     }
 
+    /// Renders frame `frame` of `scene`'s animation ([`Scene::at_frame`]; frame 0 of a scene
+    /// without one is the scene). Frames rendered in turn by one renderer are an animation as a
+    /// game draws it: a light whose map is kept (its `update` rate) is redrawn on the frame
+    /// the animation moves it or its casters.
+    pub fn render_frame(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+        frame: u32,
+        opts: RenderOptions,
+    ) -> Result<Frame> {
+        let at = scene.at_frame(frame)?;
+        self.render(device, queue, &at, opts)
+    }
+
     /// Renders `scene` on `device`/`queue` and reads the frame back.
     pub fn render(
         &mut self,
