@@ -1,22 +1,25 @@
 #!/bin/bash
-# The device checks to run first when a GPU is lent: the soft shading, the shading pass's
-# floor, the table build and the kernels against a texture copy, in one call. From the
-# repository root, after `cargo build --release`:
+# The device checks to run first when a GPU is lent: the evaluation's fronts at 1920×1080
+# under its time protocol, the soft shading, the shading pass's floor, the table build and the
+# kernels against a texture copy, in one call. From the repository root, after
+# `cargo build --release`:
 #
 #   benches/gpu_check.sh [BINARY] [OUT]     # defaults: target/release/shadowgraph, gpu-out
 #
 # On an H200 (2026-11-27) the steps took: soft table 66 s, a shading
 # variant with `hard` alone about 12 s (with `vssm` too perhaps 20 s), every kernel at 2048²
 # 20 s, 4096²/8192² 123 s, a kernel bench process at two sizes about 8 s of texture copies
-# before its kernels. In order now: soft table, four shading shapes (about 80 s), the blur's
+# before its kernels. In order now: `evaluate` at 1920×1080 on three scenes (one map size,
+# 2048², each scene time-boxed at 120 s: at most 360 s, the first refresh of the GPU fronts
+# since the H100's were found to be a clock artifact; docs/EVALUATION.md), soft table, four shading shapes (about 80 s), the blur's
 # row variants (two processes, `bench --kernel-dirs`, perhaps 35 s), the tables' two variants
 # (two, 30 s), the mip variant (two, 20 s), every kernel at 2048², 4096²/8192², the fused ablation
 # (one, 10 s), one round of the layouts (tables and fused blurs, perhaps 70 s), the workgroup
 # memory zeroed or not (two, perhaps 30 s),
-# the bunny frame, six cascaded frames (perhaps 20 s): about 480 s, with BASE about 60 s more. Give the call 520 s (the machine's start, about 50 s, counts too); a step cut off by
+# the bunny frame, six cascaded frames (perhaps 20 s): about 480 s after the evaluation's at most 360 s, with BASE about 60 s more. Give the call the 600 s a command may run (the machine's start, about 50 s, counts too); a step cut off by
 # the call's end loses only the steps after it.
 # The steps run most wanted first, each under its own time box, and append to at most seven
-# files in OUT (the device tool brings back eight), so a call stopped by its time box still
+# files in OUT (env, steps, evaluate, soft, shade, variants, kernels_large) (the device tool brings back eight), so a call stopped by its time box still
 # returns what ran. A second binary to compare against goes in as BASE=path/to/other/shadowgraph:
 # its 2048² blur and table rows are then timed alternately with BINARY's (compare timings
 # only within one call). Record the results in benches/RESULTS.md (device, date, commit, command, table).
@@ -81,6 +84,18 @@ step() {
 command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version,clocks.sm \
     --format=csv >>"$OUT/env.txt" 2>&1
 step env.txt 30 "$B" info
+# The evaluation's fronts on a GPU, first: three scenes at 1920×1080 with 2048² maps under the
+# time protocol (interleaved rounds, the G-buffer as the clock check, n = 5). Each report's
+# Markdown and CSV are appended to evaluate.txt between `#### <scene>/<file>` lines, so that
+# one file comes back; the reports' folders stay on the machine.
+EV=$(mktemp -d)
+for scene in sphere_on_plane bunny colonnade; do
+    step evaluate.txt 120 "$B" evaluate "scenes/$scene.toml" --image 1920x1080 --sizes 2048 \
+        --repeat 5 --out "$EV/$scene"
+    for f in report.md report.csv; do
+        [ -f "$EV/$scene/$f" ] && { echo "#### $scene/$f"; cat "$EV/$scene/$f"; } >>"$OUT/evaluate.txt"
+    done
+done
 # The soft techniques' shading against PCSS 16 + 32 at 1920×1080 with a 2048² map,
 # each configuration's prefilter, and each frame's passes against its wall time.
 # The SM clock sampled through it (on 2026-11-27 the soft table read its prefilter 2.4× the

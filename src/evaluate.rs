@@ -93,6 +93,8 @@ pub struct EvaluateOptions {
     pub budget_ms: Option<f64>,
     /// Whether `image` is [`run`]'s default rather than the user's (errors then say so).
     pub image_default: bool,
+    /// How often every light's map is redrawn (`--update`; `None`: each light's own `update`).
+    pub update: Option<crate::scene::UpdateRate>,
 }
 
 impl Default for EvaluateOptions {
@@ -108,6 +110,7 @@ impl Default for EvaluateOptions {
             moment_biases: None,
             budget_ms: None,
             image_default: false,
+            update: None,
         }
     }
 }
@@ -223,6 +226,10 @@ pub struct Report {
     /// Lights of the scene (the operating point's).
     #[serde(default)]
     pub lights: usize,
+    /// How often the lights' maps are redrawn, per light as the scene file writes it (`1`,
+    /// `k`, `"static"`).
+    #[serde(default)]
+    pub updates: Vec<String>,
     /// The verdict's time budget per light as given (`--budget`), ms.
     #[serde(default)]
     pub budget_ms: Option<f64>,
@@ -445,6 +452,9 @@ pub fn evaluate(
         repeats: opts.repeat,
         check_median_ms: None,
         lights: scene.lights.len(),
+        updates: (0..scene.lights.len())
+            .map(|i| opts.update.unwrap_or(scene.update_rate(i)).name())
+            .collect(),
         budget_ms: opts.budget_ms,
         cpu_driver: info.device_type == wgpu::DeviceType::Cpu,
         image: (scene.width, scene.height),
@@ -471,6 +481,9 @@ pub fn evaluate(
     for c in configs {
         bar.set_message(c.label.clone());
         let mut s = scene.clone();
+        if let Some(u) = opts.update {
+            s.updates = vec![u; s.lights.len()];
+        }
         for l in &mut s.lights {
             l.shadow.technique = c.technique;
             l.shadow_map = c.shadow_map;

@@ -152,8 +152,12 @@ enum Command {
         image: Option<(u32, u32)>,
         /// Time budget per light of the report's verdict, ms (default: 1 on a GPU, the median
         /// configuration's on a CPU driver).
-        #[arg(long, value_parser = parse_budget)]
+        #[arg(long, value_parser = parse_budget, allow_negative_numbers = true)]
         budget: Option<f64>,
+        /// How often every light's map is redrawn: `every` (each frame), a period K in frames,
+        /// or `static` (default: each light's `update`). Frames are timed over a whole period.
+        #[arg(long, value_parser = parse_update, allow_negative_numbers = true)]
+        update: Option<shadowgraph::scene::UpdateRate>,
         /// Run every MSM configuration at each of these moment biases (default: the storage's).
         #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
         moment_bias: Option<Vec<f32>>,
@@ -184,6 +188,23 @@ fn parse_budget(s: &str) -> Result<f64, String> {
         .ok()
         .filter(|v| v.is_finite() && *v > 0.0)
         .ok_or_else(|| format!("`{s}`: a budget is a positive number of milliseconds"))
+}
+
+/// `evaluate --update`: `every`, a period of at least 1 frame (1 is every frame) up to
+/// `scene::MAX_UPDATE_PERIOD`, or `static`.
+fn parse_update(s: &str) -> Result<shadowgraph::scene::UpdateRate, String> {
+    use shadowgraph::scene::{MAX_UPDATE_PERIOD, UpdateRate};
+    match s.trim() {
+        "every" => Ok(UpdateRate::EveryFrame),
+        "static" => Ok(UpdateRate::Static),
+        k => match k.parse::<i64>() {
+            Ok(1) => Ok(UpdateRate::EveryFrame),
+            Ok(k) if (2..=MAX_UPDATE_PERIOD).contains(&k) => Ok(UpdateRate::Every(k as u32)),
+            _ => Err(format!(
+                "`{s}`: expected `every`, `static` or a period of 1 to {MAX_UPDATE_PERIOD} frames"
+            )),
+        },
+    }
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -282,6 +303,7 @@ fn run(args: Args) -> Result<()> {
             repeat,
             image,
             budget,
+            update,
             moment_bias,
         } => {
             let opts = shadowgraph::evaluate::EvaluateOptions {
@@ -295,6 +317,7 @@ fn run(args: Args) -> Result<()> {
                 moment_biases: moment_bias,
                 budget_ms: budget,
                 image_default: false,
+                update,
             };
             let gpu = Gpu::new()?;
             print!("{}", shadowgraph::evaluate::run(&gpu, &scene, &out, &opts)?);

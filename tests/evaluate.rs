@@ -316,7 +316,7 @@ fn clock_drop_is_flagged_in_the_report(report: &Report) {
     assert!(md.contains(&text));
     assert!(
         text.contains(&format!("2 of {n} configurations"))
-            && text.contains(&format!("1 remain off (†: {})", r.rows[0].label))
+            && text.contains(&format!("still off after that: 1 (†: {})", r.rows[0].label))
             && text.contains("span 1.00–2.00×"),
         "{text}"
     );
@@ -324,6 +324,58 @@ fn clock_drop_is_flagged_in_the_report(report: &Report) {
     let csv = shadowgraph::evaluate::csv(&r);
     let row0 = csv.lines().nth(1).expect("a row");
     assert!(row0.contains(",2,true,"), "{row0}");
+}
+
+/// `--update` through the library: with every light static, each timed frame reuses the map
+/// the visit's settling frame drew, so no configuration is charged a raster or a kernel (0 ms,
+/// exactly: the passes are not recorded) while every frame redraws them (both > 0); the errors
+/// are the same still frame's in both runs (equal exactly), and the report names the rate.
+#[test]
+fn a_static_light_is_timed_without_its_map() {
+    use shadowgraph::scene::UpdateRate;
+    let g = common::gpu();
+    let run = |update| {
+        let opts = EvaluateOptions {
+            image: Some((96, 72)),
+            samples: Some(4),
+            truth_resolution: Some(512),
+            techniques: Some(vec!["hard".into(), "vsm".into()]),
+            sizes: Some(vec![256]),
+            quick: true,
+            repeat: 2,
+            update: Some(update),
+            ..Default::default()
+        };
+        let scene = scene_for(&scene_path("sphere_on_plane.toml"), &opts).expect("scene");
+        let configs = shadowgraph::evaluate::sweep(&scene, &opts).expect("sweep");
+        evaluate(&g, &scene, &configs, &opts).expect("evaluate").0
+    };
+    let moving = run(UpdateRate::EveryFrame);
+    let still = run(UpdateRate::Static);
+    assert_eq!(still.updates, ["\"static\""]);
+    assert_eq!(moving.updates, ["1"]);
+    assert!(moving.rows.len() >= 2);
+    for (m, s) in moving.rows.iter().zip(&still.rows) {
+        assert_eq!(m.label, s.label);
+        assert_eq!(m.soft, s.soft, "{}", m.label);
+        assert!(
+            m.raster_ms.unwrap() > 0.0 && m.kernels_ms.unwrap() > 0.0,
+            "{}",
+            m.label
+        );
+        assert_eq!(
+            (s.raster_ms, s.kernels_ms),
+            (Some(0.0), Some(0.0)),
+            "{}",
+            s.label
+        );
+        assert_eq!(s.total_ms, s.shade_ms, "{}", s.label);
+    }
+    let md = shadowgraph::evaluate::markdown(&still);
+    assert!(
+        md.contains("static lights: maps drawn once and kept"),
+        "{md}"
+    );
 }
 
 /// A scene whose light has size 0 (stacked.toml's spot): the area-light truth is the light's
@@ -617,6 +669,30 @@ fn bad_input_is_a_clear_error() {
         "{err}"
     );
     assert!(!err.contains("panicked"), "{err}");
+    for (flag, value) in [
+        ("--update", "0"),
+        ("--update", "sometimes"),
+        ("--update", "-3"),
+        ("--budget", "0"),
+        ("--budget", "-1"),
+        ("--budget", "NaN"),
+    ] {
+        let o = shadowgraph(&[
+            "evaluate",
+            scene_path("sphere_on_plane.toml").to_str().unwrap(),
+            "--quick",
+            flag,
+            value,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{flag} {value}: {err}");
+        assert!(
+            err.trim().lines().count() == 1 && err.contains(flag) && !err.contains("panicked"),
+            "{flag} {value}: {err}"
+        );
+    }
     let o = shadowgraph(&[
         "evaluate",
         "no/such/scene.toml",

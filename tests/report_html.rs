@@ -3,8 +3,12 @@
 //! over its DevTools protocol on a pipe (`--remote-debugging-pipe`: fds 3 and 4, messages ended
 //! by NUL; no port, no extra crate). Asserted: the page loads with no console error, no
 //! uncaught exception and no error log entry; it requests nothing but itself and `data:` URIs;
-//! every image decodes with a non-zero natural width; the table sorts when a heading is
-//! clicked; a screenshot is not blank. A missing Chromium fails the test, loudly.
+//! every image decodes with a non-zero natural width; the three plots are inline SVG with one
+//! marker per configuration, each with a `<title>` tooltip; the verdict lines are at the top
+//! (before the plots), name configurations of the table, and the cheapest within 10% of the
+//! best penumbra error is the one a direct search of the table finds; every crop caption gives
+//! a time; the table sorts when a heading is clicked; a screenshot is not blank. A missing
+//! Chromium fails the test, loudly.
 
 use std::io::{BufRead, BufReader, Write};
 use std::os::fd::AsRawFd;
@@ -279,9 +283,8 @@ fn report_html_loads_in_headless_chromium() {
         "[...document.images].map(i => [i.complete, i.naturalWidth, i.naturalHeight, i.alt])",
     );
     let images = images.as_array().expect("an array of images");
-    // Three plots, the overview pair, and per crop the truth's two images and three per
-    // front configuration.
-    assert!(images.len() >= 3 + 2 + 5, "{} images", images.len());
+    // The overview pair, and per crop the truth's two images and three per configuration.
+    assert!(images.len() >= 2 + 5, "{} images", images.len());
     assert_eq!(images.len(), html.matches("<img ").count());
     for (k, i) in images.iter().enumerate() {
         assert!(
@@ -289,6 +292,85 @@ fn report_html_loads_in_headless_chromium() {
             "image {k} did not load: {i}"
         );
         assert_eq!(decoded[k], true, "image {k} does not decode: {i}");
+    }
+    // The plots: inline SVG, a marker with a tooltip per configuration in each.
+    let rows = b.eval("document.querySelector('table.sortable').tBodies[0].rows.length");
+    let rows = rows.as_u64().expect("row count") as usize;
+    let plots = b.eval(
+        "[...document.querySelectorAll('.plot svg')].map(s => \
+         [s.querySelectorAll('g.pt').length, s.querySelectorAll('g.pt > title').length, \
+          s.getBoundingClientRect().width])",
+    );
+    let plots = plots.as_array().expect("plots");
+    assert_eq!(plots.len(), 3, "{plots:?}");
+    for p in plots {
+        assert!(
+            p[0].as_u64() == Some(rows as u64)
+                && p[1].as_u64() == Some(rows as u64)
+                && p[2].as_f64() > Some(100.0),
+            "{p} for {rows} rows"
+        );
+    }
+    // The verdict: at the top, each configuration it names (in bold) a row of the table, and
+    // its cheapest configuration within 10% of the best penumbra error the table's.
+    let verdict = b.eval(
+        "(() => { const lines = [...document.querySelectorAll('li.verdict-line')];\
+         const plot = document.querySelector('.plot');\
+         const before = lines.length > 0 && (lines[lines.length - 1]\
+           .compareDocumentPosition(plot) & Node.DOCUMENT_POSITION_FOLLOWING) !== 0;\
+         return [before, lines.map(l => [l.textContent, [...l.querySelectorAll('b')]\
+           .map(b => b.textContent)])]; })()",
+    );
+    assert_eq!(
+        verdict[0], true,
+        "the verdict is not above the plots: {verdict}"
+    );
+    let lines = verdict[1].as_array().expect("verdict lines");
+    assert!(lines.len() >= 4, "{lines:?}");
+    let table = b.eval(
+        "(() => { const t = document.querySelector('table.sortable');\
+         const h = [...t.tHead.rows[0].cells].map(c => c.textContent);\
+         const tc = h.indexOf('total'), pc = h.indexOf('penumbra mean');\
+         return [...t.tBodies[0].rows].map(r => [r.cells[0].textContent,\
+           parseFloat(r.cells[tc].dataset.v), parseFloat(r.cells[pc].dataset.v)]); })()",
+    );
+    let table: Vec<(String, f64, f64)> = table
+        .as_array()
+        .expect("table")
+        .iter()
+        .map(|r| {
+            let num = |v: &Value| v.as_f64().expect("a number");
+            (
+                r[0].as_str().expect("label").to_string(),
+                num(&r[1]),
+                num(&r[2]),
+            )
+        })
+        .collect();
+    for l in lines {
+        for named in l[1].as_array().expect("bold names") {
+            let named = named.as_str().expect("a name");
+            assert!(table.iter().any(|r| r.0 == named), "{named} is not a row");
+        }
+    }
+    let best = table.iter().map(|r| r.2).fold(f64::INFINITY, f64::min);
+    let cheapest = table
+        .iter()
+        .filter(|r| r.2 <= 1.1 * best)
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .expect("a row");
+    let line = lines
+        .iter()
+        .find(|l| l[0].as_str().is_some_and(|t| t.starts_with("Cheapest")))
+        .expect("the cheapest line");
+    assert_eq!(line[1][0].as_str(), Some(cheapest.0.as_str()), "{line}");
+    // Every crop caption gives its configuration's time.
+    let captions =
+        b.eval("[...document.querySelectorAll('figcaption.crop-caption')].map(c => c.textContent)");
+    let captions = captions.as_array().expect("captions");
+    assert!(!captions.is_empty());
+    for c in captions {
+        assert!(c.as_str().is_some_and(|t| t.contains(" ms")), "{c}");
     }
     // The table sorts: ascending, then descending, by total time.
     let sorted = |b: &mut Browser| -> Vec<f64> {

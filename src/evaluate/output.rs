@@ -213,8 +213,8 @@ pub fn protocol_text(report: &Report) -> String {
         s,
         " Clock check: the camera G-buffer, the same work in every configuration, ran {m:.3} ms \
          (the run's median); {retried} of {n} configurations had their G-buffer more than 10% off \
-         it and were measured again (at most twice, keeping the attempt closest to it); {} \
-         remain off",
+         it and were measured again (at most twice, keeping the attempt closest to it); still \
+         off after that: {}",
         off.len()
     );
     if !off.is_empty() {

@@ -7,7 +7,7 @@ use super::protocol::{self, Protocol, Run, Sample, Spread, Timed};
 use crate::error::Result;
 use crate::gpu::Gpu;
 use crate::render::{RenderOptions, Renderer};
-use crate::scene::Scene;
+use crate::scene::{Scene, UpdateRate};
 
 /// The pass that is the same work in every configuration: the clock check.
 pub const CHECK_PASS: &str = "gbuffer";
@@ -17,9 +17,41 @@ pub const CHECK_PASS: &str = "gbuffer";
 /// memory touched for the first time).
 pub const SETTLE_FRAMES: u32 = 1;
 
+/// Frames a visit times for `scene`: the longest period of its lights' update rates (`update =
+/// k`: k frames, one of which redraws the map), else one (a light redrawn every frame, or a
+/// static light, whose timed frame reuses the map the settling frame drew).
+pub fn frames_per_visit(scene: &Scene) -> u32 {
+    (0..scene.lights.len())
+        .map(|i| match scene.update_rate(i) {
+            UpdateRate::Every(k) => k.max(1),
+            UpdateRate::EveryFrame | UpdateRate::Static => 1,
+        })
+        .max()
+        .unwrap_or(1)
+}
+
+/// The mean of `frames`' passes per frame: a pass recorded in only some frames (a cached
+/// light's raster and prefilter) counts 0 in the others. Passes in the order they first
+/// appear.
+pub fn per_frame(frames: &[Vec<(String, f64)>]) -> Vec<(String, f64)> {
+    let mut out: Vec<(String, f64)> = Vec::new();
+    for f in frames {
+        for (label, ms) in f {
+            match out.iter_mut().find(|(l, _)| l == label) {
+                Some(p) => p.1 += ms,
+                None => out.push((label.clone(), *ms)),
+            }
+        }
+    }
+    let n = frames.len().max(1) as f64;
+    out.iter_mut().for_each(|p| p.1 /= n);
+    out
+}
+
 /// Times `scenes` (one per configuration) under `protocol`: on a GPU, untimed frames first
-/// until its clocks have risen (and again before each retry round), then the interleaved
-/// rounds, each visit [`SETTLE_FRAMES`] untimed frames and one timed.
+/// until its clocks have risen, then the interleaved rounds, each visit [`SETTLE_FRAMES`]
+/// untimed frames and [`frames_per_visit`] timed ones, whose mean per frame is the sample
+/// (so a light redrawn every k frames is charged a k-th of its redraw).
 pub fn time_scenes(
     renderer: &mut Renderer,
     gpu: &Gpu,
@@ -31,18 +63,20 @@ pub fn time_scenes(
     if let Some(first) = scenes.first() {
         renderer.warm_up(device, queue, first)?;
     }
-    let opts = RenderOptions {
-        aux: false,
-        repeat: SETTLE_FRAMES + 1,
-        dump: false,
-    };
     protocol::run(protocol, scenes.len(), CHECK_PASS, |c| {
         bar.inc(1);
+        let timed = frames_per_visit(&scenes[c]);
+        let opts = RenderOptions {
+            aux: false,
+            repeat: SETTLE_FRAMES + timed,
+            dump: false,
+        };
         let frame = renderer.render(device, queue, &scenes[c], opts)?;
-        let last = SETTLE_FRAMES as usize;
+        let first = SETTLE_FRAMES as usize;
+        let walls = frame.wall_ms.get(first..).unwrap_or_default();
         Ok(Sample {
-            passes: frame.timings.get(last).cloned().unwrap_or_default(),
-            wall_ms: frame.wall_ms.get(last).copied().unwrap_or(0.0),
+            passes: per_frame(frame.timings.get(first..).unwrap_or_default()),
+            wall_ms: walls.iter().sum::<f64>() / walls.len().max(1) as f64,
         })
     })
 }
@@ -154,6 +188,28 @@ fn civil_from_days(days: i64) -> (i64, u32, u32) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A pass present in one frame of four counts a quarter of its time per frame.
+    #[test]
+    fn passes_per_frame() {
+        let f = |v: &[(&str, f64)]| v.iter().map(|(l, t)| (l.to_string(), *t)).collect();
+        let frames: Vec<Vec<(String, f64)>> = vec![
+            f(&[("gbuffer", 1.0), ("shade", 2.0)]),
+            f(&[("gbuffer", 1.0), ("shade", 2.0)]),
+            f(&[("gbuffer", 1.0), ("shade", 2.0)]),
+            f(&[
+                ("light0.shadow_raster", 4.0),
+                ("gbuffer", 1.0),
+                ("shade", 2.0),
+            ]),
+        ];
+        let want: Vec<(String, f64)> = f(&[
+            ("gbuffer", 1.0),
+            ("shade", 2.0),
+            ("light0.shadow_raster", 1.0),
+        ]);
+        assert_eq!(per_frame(&frames), want);
+    }
 
     /// Known dates: the epoch, a leap day, the turn of 2000 and of 2100.
     #[test]

@@ -72,13 +72,29 @@ impl Family {
 
 /// The operating point in words: image, lights, how often the maps change.
 pub fn operating_point(report: &Report) -> String {
+    let mut rates = report.updates.clone();
+    rates.dedup();
+    let how = match rates.as_slice() {
+        [] => "every map redrawn and refiltered every frame".to_string(),
+        [one] => rate_words(one),
+        _ => format!("maps redrawn at update = {}", report.updates.join(", ")),
+    };
     format!(
-        "{}×{}, {} light{}, every map redrawn and refiltered every frame",
+        "{}×{}, {} light{}, {how}",
         report.image.0,
         report.image.1,
         report.lights.max(1),
         if report.lights == 1 { "" } else { "s" }
     )
+}
+
+/// An update rate as the scene file writes it (`1`, `k`, `"static"`) in words.
+fn rate_words(rate: &str) -> String {
+    match rate {
+        "1" => "every map redrawn and refiltered every frame".into(),
+        "\"static\"" => "static lights: maps drawn once and kept".into(),
+        k => format!("maps redrawn and refiltered every {k} frames"),
+    }
 }
 
 /// The budget per light the verdict uses, and how it was chosen: the report's, else 1 ms on
