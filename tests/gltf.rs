@@ -460,6 +460,37 @@ fn cases() -> Vec<Case> {
             edit: |d, _| d["buffers"][0]["uri"] = json!("q%zz.bin"),
             expect: &["%"],
         },
+        // Indices past 2³² once wrapped modulo 2³² to another element (view 1: the normals).
+        Case {
+            name: "wide bufferView",
+            edit: |d, _| d["accessors"][0]["bufferView"] = json!(4_294_967_297u64),
+            expect: &["`accessors[0].bufferView` = 4294967297", "not an index"],
+        },
+        Case {
+            name: "wide scene node",
+            edit: |d, _| d["scenes"][0]["nodes"][0] = json!(1u64 << 32),
+            expect: &["`scenes[0].nodes[0]` = 4294967296"],
+        },
+        Case {
+            name: "wide node mesh",
+            edit: |d, _| d["nodes"][0]["mesh"] = json!(1u64 << 32),
+            expect: &["`nodes[0].mesh`"],
+        },
+        Case {
+            name: "wide indices",
+            edit: |d, _| prim(d)["indices"] = json!((1u64 << 32) + 2),
+            expect: &["`meshes[0].primitives[0].indices`"],
+        },
+        Case {
+            name: "wide buffer",
+            edit: |d, _| d["bufferViews"][1]["buffer"] = json!(u64::MAX),
+            expect: &["`bufferViews[1].buffer`", "18446744073709551615"],
+        },
+        Case {
+            name: "wide attribute",
+            edit: |d, _| prim(d)["attributes"]["NORMAL"] = json!((1u64 << 32) + 1),
+            expect: &["`meshes[0].primitives[0].attributes.NORMAL`"],
+        },
     ]
 }
 
@@ -564,4 +595,19 @@ fn damaged_containers_and_odd_paths_are_one_line_errors() {
     assert!(e.contains("is a directory"), "{e}");
     let e = load_gltf(&d.join("absent.glb")).expect_err("missing");
     assert!(e.contains("not found") && e.contains("absent.glb"), "{e}");
+}
+
+/// A GLB's JSON chunk is checked as a `.gltf` file is: an index past 2³² (which the reader once
+/// wrapped to view 1, the normals, read as positions) is refused naming its JSON path.
+#[test]
+fn wide_indices_in_a_glb_are_refused() {
+    let mut doc = quad_doc("quad.bin");
+    doc["accessors"][0]["bufferView"] = json!(4_294_967_297u64);
+    let path = dir("wideglb").join("wide.glb");
+    std::fs::write(&path, glb(&doc, &quad_bytes([0.0, 1.0, 0.0]))).unwrap();
+    let e = load_gltf(&path).map(|_| ()).expect_err("a wide index");
+    assert!(
+        e.contains("wide.glb") && e.contains("`accessors[0].bufferView` = 4294967297"),
+        "{e}"
+    );
 }

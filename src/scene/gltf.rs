@@ -5,7 +5,8 @@
 //! document's arrays exists. What it leaves to the reader is checked here before any accessor
 //! is read, so that a malformed file is a one-line error naming it: buffers are read by this
 //! module (capped at [`MAX_MESH_BYTES`], no images, `data:` URIs decoded) and must hold their
-//! `byteLength`; every accessor read must have the element type its role needs, lie inside its
+//! `byteLength`; every index into the document's arrays must fit in 32 bits (the crate wraps
+//! wider ones); every accessor read must have the element type its role needs, lie inside its
 //! buffer view, and that view inside its buffer; indices must refer to the primitive's
 //! vertices; positions must be finite; the node hierarchy must be a tree. Normals that are zero
 //! or not finite are repaired (and counted), missing ones computed, as for OBJ files.
@@ -49,6 +50,7 @@ pub fn load_gltf(path: &Path) -> Result<LoadedMesh, String> {
 /// `POSITION` before it checks that index, and panics on a dangling one.
 fn parse(bytes: &[u8]) -> Result<gltf::Gltf, String> {
     let raw = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| brief(&e))?;
+    check_index_widths(bytes)?;
     let json = raw.document.into_json();
     let positions = gltf::json::validation::Checked::Valid(gltf::Semantic::Positions);
     for (m, mesh) in json.meshes.iter().enumerate() {
@@ -71,6 +73,94 @@ fn parse(bytes: &[u8]) -> Result<gltf::Gltf, String> {
         document,
         blob: raw.blob,
     })
+}
+
+/// Where the glTF 2.0 schema puts an index into one of the document's arrays (`[]` an array's
+/// element, `*` any key of a map): gltf-json reads each as `u64 as u32`, so an index of 2³² or
+/// more would silently name another element (`bufferView = 4294967297` is view 1).
+const INDEX_PATHS: &[&str] = &[
+    "scene",
+    "scenes[].nodes[]",
+    "nodes[].children[]",
+    "nodes[].mesh",
+    "nodes[].camera",
+    "nodes[].skin",
+    "meshes[].primitives[].attributes.*",
+    "meshes[].primitives[].indices",
+    "meshes[].primitives[].material",
+    "meshes[].primitives[].targets[].*",
+    "accessors[].bufferView",
+    "accessors[].sparse.indices.bufferView",
+    "accessors[].sparse.values.bufferView",
+    "bufferViews[].buffer",
+    "images[].bufferView",
+    "textures[].source",
+    "textures[].sampler",
+    "materials[].pbrMetallicRoughness.baseColorTexture.index",
+    "materials[].pbrMetallicRoughness.metallicRoughnessTexture.index",
+    "materials[].normalTexture.index",
+    "materials[].occlusionTexture.index",
+    "materials[].emissiveTexture.index",
+    "skins[].joints[]",
+    "skins[].skeleton",
+    "skins[].inverseBindMatrices",
+    "animations[].channels[].sampler",
+    "animations[].channels[].target.node",
+    "animations[].samplers[].input",
+    "animations[].samplers[].output",
+];
+
+/// Every index of the document's JSON (a GLB's JSON chunk) fits in 32 bits; an error names the
+/// first that does not by its JSON path. Runs after the crate parsed the file, so the JSON and
+/// the container are known to be well formed.
+fn check_index_widths(bytes: &[u8]) -> Result<(), String> {
+    let json = if bytes.starts_with(b"glTF") {
+        let glb = gltf::binary::Glb::from_slice(bytes).map_err(|e| brief(&e))?;
+        serde_json::from_slice::<serde_json::Value>(&glb.json)
+    } else {
+        serde_json::from_slice::<serde_json::Value>(bytes)
+    };
+    let json = json.map_err(|e| format!("not valid glTF JSON: {e}").replace(['\n', '\r'], " "))?;
+    first_wide_index(&json, "", "").map_or(Ok(()), |(path, n)| {
+        Err(format!(
+            "invalid glTF: `{path}` = {n} is not an index (the largest is {})",
+            u32::MAX
+        ))
+    })
+}
+
+/// The first value at one of [`INDEX_PATHS`] under `v` (at schema path `schema` and JSON path
+/// `path`) that is an integer past `u32::MAX`.
+fn first_wide_index(v: &serde_json::Value, schema: &str, path: &str) -> Option<(String, u64)> {
+    let join = |a: &str, b: &str| {
+        if a.is_empty() {
+            b.to_string()
+        } else {
+            format!("{a}.{b}")
+        }
+    };
+    match v {
+        serde_json::Value::Object(map) => map.iter().find_map(|(k, child)| {
+            // A map of indices (`attributes`, a morph target) is `*` whatever its keys.
+            let any = join(schema, "*");
+            let s = if INDEX_PATHS.iter().any(|p| p.starts_with(&any)) {
+                any
+            } else {
+                join(schema, k)
+            };
+            first_wide_index(child, &s, &join(path, k))
+        }),
+        serde_json::Value::Array(items) => items.iter().enumerate().find_map(|(i, child)| {
+            first_wide_index(child, &format!("{schema}[]"), &format!("{path}[{i}]"))
+        }),
+        serde_json::Value::Number(n) => match n.as_u64() {
+            Some(n) if n > u64::from(u32::MAX) && INDEX_PATHS.contains(&schema) => {
+                Some((path.to_string(), n))
+            }
+            _ => None,
+        },
+        _ => None,
+    }
 }
 
 /// A GLB's declared length must cover its 12-byte header (the `gltf` crate subtracts before it
