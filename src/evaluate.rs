@@ -190,6 +190,10 @@ pub struct Row {
     pub flip: ErrorStats,
     /// Error against the box-PCF truth of the configuration's own map, where it applies.
     pub pcf: Option<ErrorStats>,
+    /// The flicker it adds over the scene's animation, which the truth does not have
+    /// ([`temporal::temporal_error`]); `None` for a scene without an `[animation]`.
+    #[serde(default)]
+    pub temporal: Option<temporal::TemporalError>,
 }
 
 /// What `shadowgraph plan` computes of a configuration's first drawn light (its cost model,
@@ -442,6 +446,13 @@ pub fn evaluate(
         )));
     }
     let reference = measure::Reference::new(scene, truth);
+    // An animated scene's truth of every frame, for the temporal error.
+    let truths = if scene.frames() > 1 {
+        bar.set_message("area-light truth of every animation frame");
+        temporal::animation_truths(&mut renderer, device, queue, scene, &truth_opts)?
+    } else {
+        Vec::new()
+    };
     let info = gpu.adapter.get_info();
     let t = &reference.truth;
     let mut report = Report {
@@ -507,7 +518,11 @@ pub fn evaluate(
             }
         };
         match measure::measure(&mut renderer, gpu, &s, c, linear, &reference) {
-            Ok(m) => {
+            Ok(mut m) => {
+                if !truths.is_empty() {
+                    let v = temporal::animation_visibility(&mut renderer, device, queue, &s)?;
+                    m.row.temporal = Some(temporal::animation_temporal_error(&truths, &v)?);
+                }
                 timed_scenes.push(s);
                 let lights = reference.truth.lights;
                 images.visibility.push(light0(&m.frame.visibility, lights));

@@ -54,7 +54,7 @@ fn assert_finite(v: &serde_json::Value, path: &str) {
                 // Optional fields are null where they do not apply, never where a number is due.
                 if x.is_null() {
                     assert!(
-                        k == "pcf" || k == "box_width" || k == "budget_ms",
+                        k == "pcf" || k == "box_width" || k == "budget_ms" || k == "temporal",
                         "{path}.{k} is null (a non-finite number?)"
                     );
                     continue;
@@ -376,6 +376,70 @@ fn a_static_light_is_timed_without_its_map() {
         md.contains("static lights: maps drawn once and kept"),
         "{md}"
     );
+}
+
+/// An animated scene (`colonnade_sun`, 8 frames of a sweeping sun): each row's temporal error
+/// equals the temporal module's, recomputed from an independent renderer's frames and truths
+/// (1e-12: the same sums); `hard` flickers more than a 5-texel VSM blur (its edge steps from
+/// texel to texel as the sun moves by a fraction of one); the report has the temporal front and
+/// its plot.
+#[test]
+fn an_animated_scene_has_a_temporal_error() {
+    use shadowgraph::evaluate::temporal;
+    let g = common::gpu();
+    let opts = EvaluateOptions {
+        image: Some((80, 60)),
+        samples: Some(4),
+        truth_resolution: Some(512),
+        techniques: Some(vec!["hard".into(), "vsm".into()]),
+        quick: true,
+        repeat: 1,
+        ..Default::default()
+    };
+    let scene = scene_for(&scene_path("colonnade_sun.toml"), &opts).expect("scene");
+    assert!(scene.frames() > 2);
+    let configs: Vec<Config> = shadowgraph::evaluate::sweep(&scene, &opts)
+        .expect("sweep")
+        .into_iter()
+        .filter(|c| c.label == "hard 512" || c.label == "vsm f32 blur5 512")
+        .collect();
+    assert_eq!(configs.len(), 2);
+    let (report, _) = evaluate(&g, &scene, &configs, &opts).expect("evaluate");
+    let truth_opts = TruthOptions {
+        emitter: Emitter::Stratified { k: 4, seed: 1 },
+        resolution: Some(512),
+    };
+    let mut renderer = Renderer::new(&g.device);
+    let truths =
+        temporal::animation_truths(&mut renderer, &g.device, &g.queue, &scene, &truth_opts)
+            .expect("truths");
+    for (c, r) in configs.iter().zip(&report.rows) {
+        let mut s = scene.clone();
+        for l in &mut s.lights {
+            l.shadow.technique = c.technique;
+            l.shadow_map = c.shadow_map;
+        }
+        let v =
+            temporal::animation_visibility(&mut Renderer::new(&g.device), &g.device, &g.queue, &s)
+                .expect("frames");
+        let want = temporal::animation_temporal_error(&truths, &v).expect("temporal");
+        let got = r.temporal.expect("a temporal error");
+        assert_eq!(
+            (got.pairs, got.pixels),
+            (want.pairs, want.pixels),
+            "{}",
+            r.label
+        );
+        assert!((got.mean_abs - want.mean_abs).abs() < 1e-12, "{}", r.label);
+        assert!(got.pixels > 0 && got.mean_abs > 0.0, "{}", r.label);
+    }
+    let t = |i: usize| report.rows[i].temporal.unwrap().mean_abs;
+    assert!(t(0) > t(1), "hard {} vs vsm {}", t(0), t(1));
+    let md = shadowgraph::evaluate::markdown(&report);
+    assert!(md.contains("front of total time vs temporal mean"), "{md}");
+    assert_eq!(Metric::of(&report).last(), Some(&Metric::Temporal));
+    let svg = shadowgraph::evaluate::pareto(&report, Metric::Temporal).expect("plot");
+    assert_eq!(svg.matches("<g class=\"pt\">").count(), 2);
 }
 
 /// A scene whose light has size 0 (stacked.toml's spot): the area-light truth is the light's

@@ -183,13 +183,14 @@ fn region_mean(e: &ErrorStats) -> Option<f64> {
 
 /// Which fronts a row is on, as `mean, penumbra, FLIP` initials.
 fn fronts_of(report: &Report, i: usize) -> String {
-    Metric::ALL
+    Metric::of(report)
         .iter()
         .filter(|&&m| front(&report.rows, m).contains(&i))
         .map(|m| match m {
             Metric::Mean => "M",
             Metric::Penumbra => "P",
             Metric::Flip => "F",
+            Metric::Temporal => "T",
         })
         .collect::<Vec<_>>()
         .join(" ")
@@ -230,6 +231,7 @@ fn table(s: &mut String, report: &Report) {
         "umbra mean",
         "lit mean",
         "FLIP mean",
+        "temporal mean",
         "pcf mean",
         "front",
     ] {
@@ -288,6 +290,7 @@ fn table(s: &mut String, report: &Report) {
         s.push_str(&num(region_mean(&r.umbra), 4));
         s.push_str(&num(region_mean(&r.lit), 4));
         s.push_str(&num(Some(r.flip.mean_abs), 4));
+        s.push_str(&num(r.temporal.map(|t| t.mean_abs), 4));
         s.push_str(&num(r.pcf.map(|p| p.mean_abs), 4));
         let _ = writeln!(s, "<td>{fronts}</td></tr>");
     }
@@ -300,7 +303,7 @@ fn table(s: &mut String, report: &Report) {
 
 /// The union of the fronts, fastest first.
 fn front_rows(report: &Report) -> Vec<usize> {
-    let mut all: Vec<usize> = Metric::ALL
+    let mut all: Vec<usize> = Metric::of(report)
         .iter()
         .flat_map(|&m| front(&report.rows, m))
         .collect();
@@ -425,7 +428,7 @@ fn crop_row(
             },
             |t| format!("{} ms", t.text(3)),
         );
-        let on_front = Metric::ALL
+        let on_front = Metric::of(report)
             .iter()
             .any(|&m| front(&report.rows, m).contains(i));
         let _ = writeln!(

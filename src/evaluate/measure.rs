@@ -156,6 +156,7 @@ pub fn measure(
         lit,
         flip,
         pcf,
+        temporal: None,
     };
     Ok(Measured {
         row,

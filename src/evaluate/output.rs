@@ -39,7 +39,7 @@ pub fn write_all(dir: &Path, report: &Report, images: &Images) -> Result<Vec<Pat
         .map_err(|e| Error::Invalid(format!("report.json: {e}")))?;
     put("report.json", json.as_bytes())?;
     let mut plots = Vec::new();
-    for m in Metric::ALL {
+    for m in Metric::of(report) {
         let svg = super::svg::pareto(report, m)?;
         put(m.file(), svg.as_bytes())?;
         plots.push((m, svg));
@@ -86,7 +86,7 @@ fn stats_cells(s: Option<&ErrorStats>) -> String {
 /// One line per configuration; per-pass times as `name=ms` pairs separated by `;`.
 pub fn csv(report: &Report) -> String {
     let mut s = format!(
-        "label,technique,shadow_map,storage,filter,box_width,raster_ms,kernels_ms,shade_ms,total_ms,total_q1_ms,total_q3_ms,total_min_ms,total_max_ms,gbuffer_ms,wall_ms,check_ratio,retries,clock_off,memory_bytes,bytes_per_texel,dispatches,fetches_per_pixel,penumbra_hf,{},{},{},{},{},{},passes\n",
+        "label,technique,shadow_map,storage,filter,box_width,raster_ms,kernels_ms,shade_ms,total_ms,total_q1_ms,total_q3_ms,total_min_ms,total_max_ms,gbuffer_ms,wall_ms,check_ratio,retries,clock_off,memory_bytes,bytes_per_texel,dispatches,fetches_per_pixel,penumbra_hf,temporal_mean_abs,temporal_max,{},{},{},{},{},{},passes\n",
         stats_header("soft"),
         stats_header("penumbra"),
         stats_header("umbra"),
@@ -102,7 +102,7 @@ pub fn csv(report: &Report) -> String {
             .collect();
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{},{:.2},{:.6},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.2},{},{:.2},{:.6},{},{},{},{},{},{},{},{},{}",
             r.label,
             r.technique,
             r.shadow_map,
@@ -128,6 +128,10 @@ pub fn csv(report: &Report) -> String {
             r.cost.dispatches,
             r.cost.fetches_per_pixel,
             r.penumbra_hf,
+            r.temporal
+                .map_or_else(String::new, |t| format!("{:.6}", t.mean_abs)),
+            r.temporal
+                .map_or_else(String::new, |t| format!("{:.6}", t.max)),
             stats_cells(Some(&r.soft)),
             stats_cells(Some(&r.penumbra)),
             stats_cells(Some(&r.umbra)),
@@ -302,7 +306,7 @@ pub fn wall_check(report: &Report) -> String {
 /// The Pareto fronts, one list per metric.
 fn fronts_text(report: &Report) -> String {
     let mut s = String::new();
-    for m in Metric::ALL {
+    for m in Metric::of(report) {
         let f = front(&report.rows, m);
         if f.is_empty() {
             continue;
@@ -373,16 +377,18 @@ pub fn markdown(report: &Report) -> String {
          approximates), where the configuration filters with a box. Errors are |visibility − \
          truth| over the relevant pixels: mean, RMSE, 99th percentile, max, and the shares of \
          pixels off by more than 0.05 and 0.2; *penumbra*, *umbra*, *lit*: the soft mean over \
-         each region of the truth; *penumbra HF*: the penumbra's high-frequency error, the \
+         each region of the truth; *temporal* (animated scenes): the mean |Δ visibility − Δ \
+         truth| between consecutive frames over the truth's penumbra, the flicker the truth \
+         does not have; *penumbra HF*: the penumbra's high-frequency error, the \
          RMS of the discrete Laplacian of (visibility − truth) over penumbra pixels (0 for an \
          error that varies smoothly, large for a staircase, banding or noise).\n\n",
     );
     s.push_str(&region_text(report));
     s.push_str("\n\n");
     s.push_str(
-        "| configuration | raster ms | kernels ms | shade ms | total ms (IQR) | wall ms | MiB | B/texel | dispatches | fetches/px | soft mean | soft rmse | soft p99 | soft max | soft >0.05 | soft >0.2 | penumbra mean | penumbra HF | umbra mean | lit mean | FLIP mean | pcf mean | pcf p99 | pcf >0.05 |\n",
+        "| configuration | raster ms | kernels ms | shade ms | total ms (IQR) | wall ms | MiB | B/texel | dispatches | fetches/px | soft mean | soft rmse | soft p99 | soft max | soft >0.05 | soft >0.2 | penumbra mean | penumbra HF | umbra mean | lit mean | FLIP mean | temporal mean | pcf mean | pcf p99 | pcf >0.05 |\n",
     );
-    s.push_str("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+    s.push_str("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
     for r in &report.rows {
         let (pm, pp, po) =
             r.pcf
@@ -396,7 +402,7 @@ pub fn markdown(report: &Report) -> String {
                 });
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {}{} | {} | {} | {:.1} | {} | {:.1} | {:.4} | {:.4} | {:.3} | {:.3} | {:.2}% | {:.2}% | {} | {:.4} | {} | {} | {:.4} | {pm} | {pp} | {po} |",
+            "| {} | {} | {} | {} | {}{} | {} | {} | {:.1} | {} | {:.1} | {:.4} | {:.4} | {:.3} | {:.3} | {:.2}% | {:.2}% | {} | {:.4} | {} | {} | {:.4} | {} | {pm} | {pp} | {po} |",
             r.label,
             ms(r.raster_ms),
             ms(r.kernels_ms),
@@ -419,6 +425,8 @@ pub fn markdown(report: &Report) -> String {
             mean_cell(&r.umbra),
             mean_cell(&r.lit),
             r.flip.mean_abs,
+            r.temporal
+                .map_or_else(|| "—".into(), |t| format!("{:.4}", t.mean_abs)),
         );
     }
     s.push_str(&wall_check(report));

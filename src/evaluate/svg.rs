@@ -30,11 +30,23 @@ pub enum Metric {
     Penumbra,
     /// Mean FLIP of the shaded image against the truth-shaded image.
     Flip,
+    /// Mean temporal error over the scene's animation (NaN for a row without one).
+    Temporal,
 }
 
 impl Metric {
     /// Every metric, in report order.
     pub const ALL: [Metric; 3] = [Metric::Mean, Metric::Penumbra, Metric::Flip];
+
+    /// The metrics of `report`: [`Metric::ALL`], and [`Metric::Temporal`] when its scene
+    /// animates.
+    pub fn of(report: &Report) -> Vec<Metric> {
+        let mut v = Self::ALL.to_vec();
+        if report.rows.iter().any(|r| r.temporal.is_some()) {
+            v.push(Metric::Temporal);
+        }
+        v
+    }
 
     /// The row's value of this metric.
     pub fn value(self, r: &Row) -> f64 {
@@ -42,6 +54,7 @@ impl Metric {
             Metric::Mean => r.soft.mean_abs,
             Metric::Penumbra => r.penumbra.mean_abs,
             Metric::Flip => r.flip.mean_abs,
+            Metric::Temporal => r.temporal.map_or(f64::NAN, |t| t.mean_abs),
         }
     }
 
@@ -51,6 +64,7 @@ impl Metric {
             Metric::Mean => "soft mean",
             Metric::Penumbra => "penumbra mean",
             Metric::Flip => "FLIP mean",
+            Metric::Temporal => "temporal mean",
         }
     }
 
@@ -60,6 +74,7 @@ impl Metric {
             Metric::Mean => "mean |visibility − truth| (relevant pixels)",
             Metric::Penumbra => "mean |visibility − truth| over the penumbra",
             Metric::Flip => "mean FLIP, shaded vs truth-shaded image",
+            Metric::Temporal => "mean |Δ visibility − Δ truth| between frames (penumbra)",
         }
     }
 
@@ -69,6 +84,7 @@ impl Metric {
             Metric::Mean => "pareto.svg",
             Metric::Penumbra => "pareto_penumbra.svg",
             Metric::Flip => "pareto_flip.svg",
+            Metric::Temporal => "pareto_temporal.svg",
         }
     }
 }
