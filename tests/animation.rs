@@ -241,3 +241,34 @@ fn hard_shadows_flicker_under_sub_texel_steps_and_a_wide_blur_does_not() {
         soft.mean_abs
     );
 }
+
+#[test]
+fn the_bundled_animated_scenes_move_what_they_say() {
+    let g = common::gpu();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    // (scene, its frames, per frame whether light 0's map is redrawn)
+    let cases: [(&str, u32, &[bool]); 2] = [
+        ("colonnade_sun.toml", 8, &[true; 8]),
+        (
+            "moving_object.toml",
+            9,
+            &[true, true, true, true, true, true, true, false, false],
+        ),
+    ];
+    for (name, frames, redrawn) in cases {
+        let mut s = Scene::load(root.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(s.frames(), frames, "{name}");
+        // What is redrawn does not depend on the image size.
+        (s.width, s.height) = (32, 24);
+        let mut r = Renderer::new(&g.device);
+        let got: Vec<bool> = (0..frames)
+            .map(|f| {
+                let frame = r
+                    .render_frame(&g.device, &g.queue, &s, f, RenderOptions::default())
+                    .unwrap_or_else(|e| panic!("{name} frame {f}: {e}"));
+                frame.recorded[0].contains(&"light0.shadow_raster".to_string())
+            })
+            .collect();
+        assert_eq!(got, redrawn, "{name}");
+    }
+}
