@@ -78,10 +78,6 @@ impl ErrorStats {
 /// varies smoothly (an offset, a ramp) scores 0 however large it is; a staircase, banding or
 /// noise of the same mean scores by its steps. Returns the value and the pixels it was taken
 /// over (0 and 0 when none qualifies).
-#[expect(
-    clippy::too_many_arguments,
-    reason = "an image, its truth, two masks and its shape"
-)]
 pub fn laplacian_rms(
     values: &[f32],
     truth: &[f64],
