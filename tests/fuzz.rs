@@ -40,3 +40,58 @@ fn three_thousand_mutated_scenes() {
     assert!(s.gltf_accepted >= 2 && s.gltf_refused >= 60, "{s:?}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The fuzzer's keys and words are the library's (`scene::keys`), and they cover the registry:
+/// every key of the biases', the cascades' and each technique's table is a `[light.shadow]` key
+/// the fuzzer writes, every technique's name and every option of a choice is a word it writes.
+/// A list written by hand that drifts from the registry fails here (as the fuzzer's own once
+/// lacked `resolve`, `bias_mode`, the cascade keys, `smrt`, `midpoint` and `second_depth`).
+#[test]
+fn the_fuzzer_knows_every_key_and_technique() {
+    use shadowgraph::model::ParamKind;
+    use shadowgraph::technique::{REGISTRY, params};
+    let keys = fuzz_support::mutate::keys();
+    let words = fuzz_support::mutate::words();
+    let shadow = &keys
+        .iter()
+        .find(|(table, _)| *table == "shadow")
+        .expect("a [light.shadow] table")
+        .1;
+    assert!(shadow.contains(&"technique"));
+    let tables = [params::COMMON, params::CASCADES]
+        .into_iter()
+        .chain(REGISTRY.iter().flat_map(|d| d.params.iter().copied()));
+    for spec in tables.flat_map(|t| t.iter()) {
+        assert!(
+            shadow.contains(&spec.key),
+            "the fuzzer lacks `{}`",
+            spec.key
+        );
+        if let ParamKind::Choice(options) = spec.kind {
+            for o in options {
+                assert!(words.contains(o), "the fuzzer lacks `{}` = {o:?}", spec.key);
+            }
+        }
+    }
+    for d in REGISTRY {
+        assert!(
+            words.contains(&d.name),
+            "the fuzzer lacks technique {:?}",
+            d.name
+        );
+        assert!(fuzz_support::mutate::techniques().contains(&d.name));
+    }
+    for kind in ["directional", "spot", "point"] {
+        assert!(
+            words.contains(&kind),
+            "the fuzzer lacks light kind {kind:?}"
+        );
+    }
+    for table in ["", "output", "camera", "light", "object"] {
+        let known = keys.iter().find(|(t, _)| *t == table).map(|(_, k)| k.len());
+        assert!(
+            known.is_some_and(|n| n >= 3),
+            "table {table:?}: {known:?} keys"
+        );
+    }
+}

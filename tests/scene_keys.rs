@@ -144,3 +144,44 @@ fn duplicated_keys_and_tables_are_named() {
         expect(text, at, *nth, &["duplicate key", named]);
     }
 }
+
+/// The reader knows every key of the registry's tables (`format::ShadowFile` and `validate`'s
+/// lookup are written by hand): each technique refuses, naming it, every other technique's key
+/// it does not take, and no key of its own is unknown to the reader.
+#[test]
+fn every_registry_key_reaches_the_checker() {
+    use shadowgraph::model::{ParamKind, keys};
+    use shadowgraph::technique::REGISTRY;
+    let all: Vec<_> = REGISTRY
+        .iter()
+        .flat_map(|d| d.params.iter().flat_map(|t| t.iter()))
+        .collect();
+    for def in REGISTRY {
+        let own = keys(def.params);
+        for spec in &all {
+            let value = match spec.kind {
+                ParamKind::Int { lo, .. } => lo.to_string(),
+                ParamKind::Float { lo, .. } => format!("{lo:?}"),
+                ParamKind::Choice(options) => format!("{:?}", options[0]),
+            };
+            let sun = format!(
+                "[[light]]\nkind = \"directional\"\nposition = [3.0, 6.0, 2.0]\n\
+                 target = [0.0, 0.0, 0.0]\nextent = 5.0\nsize = 0.5\n\n[light.shadow]\n\
+                 technique = \"{}\"\n{} = {value}\n",
+                def.name, spec.key
+            );
+            let text = scene(&sun);
+            let got = Scene::parse(Path::new("keys.toml"), &text);
+            let key = format!("light[1].shadow.{}", spec.key);
+            if own.contains(&spec.key) {
+                if let Err(e) = got {
+                    assert!(!e.to_string().contains("unknown"), "{}: {e}", def.name);
+                }
+            } else {
+                let at = format!("{} = ", spec.key);
+                let last = text.matches(&at).count() - 1;
+                expect(&text, &at, last, &[&key, "does not apply", def.name]);
+            }
+        }
+    }
+}

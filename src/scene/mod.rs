@@ -13,6 +13,8 @@ pub mod format;
 #[cfg(feature = "cli")]
 pub mod gltf;
 #[cfg(feature = "cli")]
+pub mod keys;
+#[cfg(feature = "cli")]
 pub mod locate;
 #[cfg(feature = "cli")]
 pub mod mesh;

@@ -22,7 +22,7 @@ pub const MAX_TRIANGLES: usize = 1 << 22;
 
 /// The shape-specific keys each shape takes (`translate`, `rotate_degrees`, `scale` and
 /// `color` apply to every shape).
-const SHAPE_KEYS: &[(&str, &[&str])] = &[
+pub(super) const SHAPE_KEYS: &[(&str, &[&str])] = &[
     ("plane", &["size"]),
     ("box", &["size"]),
     ("sphere", &["radius"]),

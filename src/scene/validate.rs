@@ -31,43 +31,6 @@ impl Raw<'_> {
     }
 }
 
-/// Every technique key of the table, in the order a key that does not apply is reported.
-const KEYS: &[&str] = &[
-    "radius",
-    "kernel",
-    "blocker_samples",
-    "filter_samples",
-    "max_search",
-    "format",
-    "filter",
-    "filter_radius",
-    "filter_sigma",
-    "filter_kernel",
-    "bleed_reduction",
-    "min_variance",
-    "exponent",
-    "exponent_pos",
-    "exponent_neg",
-    "filter_width",
-    "sat_sums",
-    "max_anisotropy",
-    "reconstruction",
-    "moment_bias",
-    "terms",
-    "attenuation",
-    "offset",
-    "scale",
-    "sharpen",
-    "sharpen_falloff",
-    "blocker_search",
-    "resolve",
-    "bias_mode",
-    "receiver_plane_cap",
-    "rays",
-    "steps",
-    "max_slope",
-];
-
 /// The value of `key` as written, if it is.
 fn raw<'a>(s: &'a ShadowFile, key: &str) -> Option<Raw<'a>> {
     let n = |v: &'a Option<Spanned<f64>>| v.as_ref().map(Raw::Num);
@@ -205,9 +168,12 @@ pub(super) fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
         ));
     };
     let allowed = crate::model::keys(def.params);
-    if let Some(k) = KEYS
-        .iter()
-        .find(|k| !allowed.contains(k) && raw(s, k).is_some())
+    // Every technique's keys (the registry's tables, in its order): the first written that
+    // this technique does not take is reported.
+    let keys = REGISTRY.iter().flat_map(|d| crate::model::keys(d.params));
+    if let Some(k) = keys
+        .filter(|k| !allowed.contains(k))
+        .find(|k| raw(s, k).is_some())
     {
         return Err(table.not_applicable(k, &format!("does not apply to technique \"{name}\"")));
     }

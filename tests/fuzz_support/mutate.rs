@@ -1,6 +1,8 @@
 //! TOML-aware mutations of scene files and line-aware mutations of OBJ meshes (glTF files:
 //! `mutate_gltf`).
 
+use std::sync::OnceLock;
+
 use rand::Rng;
 use rand::rngs::SmallRng;
 use rand::seq::IndexedRandom;
@@ -77,117 +79,33 @@ const INTEGERS: &[i64] = &[
     i64::MIN,
 ];
 
-/// Every key a scene file knows, by table (`""` is the top level).
-pub const KEYS: &[(&str, &[&str])] = &[
-    ("", &["ambient", "output", "camera", "light", "object"]),
-    ("output", &["width", "height", "background"]),
-    ("camera", &["position", "target", "up", "fov_y_degrees"]),
-    (
-        "light",
-        &[
-            "kind",
-            "position",
-            "target",
-            "fov_degrees",
-            "extent",
-            "near",
-            "far",
-            "size",
-            "color",
-            "intensity",
-            "shadow_map",
-            "shadow",
-        ],
-    ),
-    (
-        "shadow",
-        &[
-            "technique",
-            "bias",
-            "slope_bias",
-            "normal_bias",
-            "radius",
-            "kernel",
-            "blocker_samples",
-            "filter_samples",
-            "max_search",
-            "format",
-            "filter",
-            "filter_radius",
-            "filter_sigma",
-            "filter_kernel",
-            "bleed_reduction",
-            "min_variance",
-            "exponent",
-            "exponent_pos",
-            "exponent_neg",
-            "filter_width",
-            "sat_sums",
-            "max_anisotropy",
-            "reconstruction",
-            "moment_bias",
-            "terms",
-            "attenuation",
-            "offset",
-            "scale",
-            "sharpen",
-            "sharpen_falloff",
-            "blocker_search",
-        ],
-    ),
-    (
-        "object",
-        &[
-            "shape",
-            "size",
-            "radius",
-            "height",
-            "path",
-            "translate",
-            "rotate_degrees",
-            "scale",
-            "color",
-        ],
-    ),
-];
+/// Every key a scene file knows, by table (`""` is the top level, `shadow` is
+/// `[light.shadow]`): the library's own list (`scene::keys`, read from the reader's structs and
+/// the technique registry), so a new key is fuzzed as soon as it exists.
+pub fn keys() -> &'static [(&'static str, Vec<&'static str>)] {
+    static KEYS: OnceLock<Vec<(&'static str, Vec<&'static str>)>> = OnceLock::new();
+    KEYS.get_or_init(shadowgraph::scene::keys::tables)
+}
 
-/// Words the string keys take, and some they do not.
-const WORDS: &[&str] = &[
-    "hard",
-    "pcf",
-    "pcss",
-    "vsm",
-    "evsm2",
-    "evsm4",
-    "esm",
-    "msm",
-    "csm",
-    "cssm",
-    "vssm",
-    "msm_soft",
-    "directional",
-    "spot",
-    "point",
-    "plane",
-    "box",
-    "sphere",
-    "cylinder",
-    "mesh",
-    "box",
-    "tent",
-    "hardware",
-    "f32",
-    "f16",
-    "unorm16",
-    "none",
-    "blur",
-    "mips",
-    "sat",
-    "gaussian",
-    "fixed",
-    "float",
-    "hamburger",
-    "hausdorff",
+/// The techniques' names (the registry's).
+pub fn techniques() -> &'static [&'static str] {
+    static NAMES: OnceLock<Vec<&'static str>> = OnceLock::new();
+    NAMES.get_or_init(shadowgraph::technique::names)
+}
+
+/// Words the string keys take (the library's: techniques, every choice's options, light kinds,
+/// shapes), and some they do not (`JUNK`).
+pub fn words() -> &'static [&'static str] {
+    static WORDS: OnceLock<Vec<&'static str>> = OnceLock::new();
+    WORDS.get_or_init(|| {
+        let mut w = shadowgraph::scene::keys::words();
+        w.extend(JUNK);
+        w
+    })
+}
+
+/// Strings no key takes, or that break a line, a path or a file name.
+const JUNK: &[&str] = &[
     "",
     " ",
     "PCF",
@@ -246,7 +164,7 @@ pub fn nearby(v: &Value, rng: &mut SmallRng) -> Value {
 pub fn any_value(rng: &mut SmallRng, depth: u32) -> Value {
     match rng.random_range(0..12) {
         0..=3 => number(rng),
-        4..=5 => Value::String(WORDS.choose(rng).unwrap_or(&"").to_string()),
+        4..=5 => Value::String(words().choose(rng).unwrap_or(&"").to_string()),
         6 => Value::Boolean(rng.random_bool(0.5)),
         7..=9 if depth < 2 => {
             let n = rng.random_range(0..5);
@@ -368,7 +286,9 @@ fn edit_in_value(v: &mut Value, steps: &[&str], rng: &mut SmallRng) {
 }
 
 fn random_key(rng: &mut SmallRng) -> String {
-    let (_, keys) = KEYS.choose(rng).unwrap_or(&KEYS[0]);
+    let Some((_, keys)) = keys().choose(rng) else {
+        return "x".into();
+    };
     let k = keys.choose(rng).unwrap_or(&"x").to_string();
     if rng.random_bool(0.1) {
         format!("{k}_")
@@ -426,7 +346,7 @@ pub fn mutate(root: &mut Table, rng: &mut SmallRng) {
             }
         }
         11 => {
-            let word = *WORDS.choose(rng).unwrap_or(&"hard");
+            let word = *words().choose(rng).unwrap_or(&"hard");
             let (which, key) = *[
                 ("shadow", "technique"),
                 ("light", "kind"),
@@ -464,7 +384,7 @@ pub fn mutate(root: &mut Table, rng: &mut SmallRng) {
                 let mut s = Table::new();
                 s.insert(
                     "technique".into(),
-                    Value::String(WORDS[rng.random_range(0..12)].into()),
+                    Value::String(techniques().choose(rng).unwrap_or(&"hard").to_string()),
                 );
                 s.insert(random_key(rng), number(rng));
                 t.insert("shadow".into(), Value::Table(s));
