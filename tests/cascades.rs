@@ -432,11 +432,10 @@ fn far_scene(eye: [f64; 3], target: [f64; 3], scale: f64, at: [f64; 3]) -> Strin
 
 /// The cascades of a scene file cover the view distances of its geometry, computed here in f64
 /// from the loaded vertices, whatever the camera's distance: a camera ~13,000 units from a
-/// small scene (its depth range a two-thousandth of its distance, which the fit once refused as
-/// "no geometry in front"), one at z = 10⁶ before geometry reaching past the 10⁷ cascades
-/// cover (once refused naming an internal `cascade near/far`: now cut at 10⁷), and one looking
-/// away from everything (the cascades shade nothing, as one map would not). Geometry whose
-/// nearest point lies past 10⁷ is refused naming the light's `cascades` key and its line.
+/// small scene (its depth range a two-thousandth of its distance), one at z = 10⁶ before
+/// geometry reaching past the 10⁷ cascades cover (the range cut there), and one looking away
+/// from everything (the cascades shade nothing, as one map would not). Geometry whose nearest
+/// point lies past 10⁷ is refused naming the light's `cascades` key and its line.
 #[test]
 fn cascades_cover_the_scene_files_view_range() {
     use shadowgraph::scene::Scene;

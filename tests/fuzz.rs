@@ -44,8 +44,7 @@ fn three_thousand_mutated_scenes() {
 /// The fuzzer's keys and words are the library's (`scene::keys`), and they cover the registry:
 /// every key of the biases', the cascades' and each technique's table is a `[light.shadow]` key
 /// the fuzzer writes, every technique's name and every option of a choice is a word it writes.
-/// A list written by hand that drifts from the registry fails here (as the fuzzer's own once
-/// lacked `resolve`, `bias_mode`, the cascade keys, `smrt`, `midpoint` and `second_depth`).
+/// A list written by hand that drifts from the registry fails here.
 #[test]
 fn the_fuzzer_knows_every_key_and_technique() {
     use shadowgraph::model::ParamKind;

@@ -460,7 +460,7 @@ fn cases() -> Vec<Case> {
             edit: |d, _| d["buffers"][0]["uri"] = json!("q%zz.bin"),
             expect: &["%"],
         },
-        // Indices past 2³² once wrapped modulo 2³² to another element (view 1: the normals).
+        // Indices past 2³², which the gltf crate wraps modulo 2³² (4294967297: view 1, the normals).
         Case {
             name: "wide bufferView",
             edit: |d, _| d["accessors"][0]["bufferView"] = json!(4_294_967_297u64),
@@ -597,8 +597,8 @@ fn damaged_containers_and_odd_paths_are_one_line_errors() {
     assert!(e.contains("not found") && e.contains("absent.glb"), "{e}");
 }
 
-/// A GLB's JSON chunk is checked as a `.gltf` file is: an index past 2³² (which the reader once
-/// wrapped to view 1, the normals, read as positions) is refused naming its JSON path.
+/// A GLB's JSON chunk is checked as a `.gltf` file is: an index past 2³² (which the gltf crate
+/// wraps to view 1, the normals, read as positions) is refused naming its JSON path.
 #[test]
 fn wide_indices_in_a_glb_are_refused() {
     let mut doc = quad_doc("quad.bin");
