@@ -124,7 +124,7 @@ keys = [{ frame = 0, value = [0.0, 1.0, 0.0] }, { frame = 8, value = [2.0, 1.0, 
         }
         assert_eq!(at.objects[0].mesh.positions, s.objects[0].mesh.positions);
     }
-    let e = s.at_frame(9).err().expect("frame 9 of 9").to_string();
+    let e = s.at_frame(9).expect_err("frame 9 of 9").to_string();
     assert!(e.contains("frame 9") && e.contains("anim.toml:"), "{e}");
 }
 
