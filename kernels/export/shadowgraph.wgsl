@@ -56,39 +56,41 @@
 //
 // Names defined here, each with the `sg_` prefix (a host's own names need only avoid
 // `sg_` and `shadowgraph_`):
-//   sg_BLOCKER_MIN_SHARE sg_CSM_PI sg_CSSM_BLOCKER_FLOOR sg_CSSM_FULL_CONTRAST
+//   sg_BLOCKER_MIN_SHARE sg_BlockerSum sg_CSM_PI sg_CSSM_BLOCKER_FLOOR sg_CSSM_FULL_CONTRAST
 //   sg_CSSM_MIN_CONTRAST sg_CascadePick sg_CsmTerms sg_GOLDEN_ANGLE sg_Light sg_LightSample
 //   sg_MSM_B0 sg_MSM_B0_COV sg_MSM_B0_SCHUR sg_MSM_ROOT_LIMIT sg_MipTaps sg_MsmMoments
-//   sg_SAT_GRID sg_SAT_MIN_EXTENT sg_SatLayer sg_SatNodes sg_SoftLookup sg_TECHNIQUE_CSM
-//   sg_TECHNIQUE_CSSM sg_TECHNIQUE_ESM sg_TECHNIQUE_EVSM sg_TECHNIQUE_HARD sg_TECHNIQUE_MIDPOINT
-//   sg_TECHNIQUE_MSM sg_TECHNIQUE_MSM_SOFT sg_TECHNIQUE_PCF sg_TECHNIQUE_PCSS
-//   sg_TECHNIQUE_SECOND_DEPTH sg_TECHNIQUE_SMRT sg_TECHNIQUE_VSM sg_TECHNIQUE_VSSM
-//   sg_bilinear_level sg_bilinear_level_packed sg_bilinear_log_level sg_blocker_csm_z
-//   sg_blocker_filter_width sg_blocker_msm sg_blocker_result sg_blocker_search_width
-//   sg_blocker_vsm sg_blocker_width sg_cascade_far_of sg_cascade_pick sg_chebyshev_upper
-//   sg_csm_chunk sg_csm_chunk_of sg_csm_resolve sg_csm_sin_cos sg_csm_terms_advance
-//   sg_csm_terms_chunk sg_csm_terms_start sg_csm_weight sg_csm_z_chunk_of sg_cssm_blocker
-//   sg_cssm_blocker_moments sg_cssm_filter_blockers sg_cssm_resolve sg_cssm_sharpen
-//   sg_cssm_two_series sg_level_size sg_level_size_of sg_light_depth_slope
-//   sg_light_depth_slope_view sg_light_faces sg_light_footprint sg_light_linear_to_ndc
-//   sg_light_linear_to_z sg_light_map_width sg_light_plane_slope sg_light_receiver_offset
-//   sg_light_sample sg_light_tap_offset sg_light_texel sg_light_to_light sg_linstep
-//   sg_load_depth sg_map_sample sg_mip_tap_uv sg_mip_taps sg_msm_biased sg_msm_dequantize
-//   sg_msm_expect sg_msm_intensity sg_msm_moments sg_msm_quantize sg_msm_roots
-//   sg_msm_soft_blocker sg_pack_f16x2 sg_pcss_search_radius sg_point_coords sg_point_face
-//   sg_point_sample sg_sample_bilinear sg_sample_bilinear_log sg_sample_map sg_sample_map_log
-//   sg_sample_map_packed sg_sat_alone sg_sat_box sg_sat_box_fixed sg_sat_box_float sg_sat_clamp
-//   sg_sat_corner_linear sg_sat_filter_fixed sg_sat_filter_float sg_sat_filter_window
-//   sg_sat_grid sg_sat_layer_box sg_sat_layer_mean sg_sat_layer_node sg_sat_layer_size
-//   sg_sat_layer_window sg_sat_mean_fixed sg_sat_mean_float sg_sat_mean_linear sg_sat_nearest
-//   sg_sat_node_f32 sg_sat_nodes sg_sat_rect sg_sat_sample_fixed sg_sat_sample_float
-//   sg_sat_sample_layer sg_sat_search_fixed sg_sat_search_float sg_sat_search_layer
-//   sg_sat_span_weights sg_smrt_emitter_point sg_smrt_ray sg_soft_blockers sg_soft_filter_trips
-//   sg_texel_of sg_trilinear sg_trilinear_log sg_trilinear_packed sg_unpack_f16x2 sg_vis_esm
-//   sg_vis_esm_of_log sg_vis_esm_of_sat sg_vis_evsm sg_vis_evsm_of sg_vis_hard sg_vis_msm
-//   sg_vis_msm_of sg_vis_msm_soft_fixed sg_vis_msm_soft_float sg_vis_pcf sg_vis_pcf_hardware
-//   sg_vis_pcss sg_vis_smrt sg_vis_vsm sg_vis_vsm_of sg_vis_vssm_fixed sg_vis_vssm_float
-//   sg_vogel_disc sg_vssm_blocker
+//   sg_SAT_GRID sg_SAT_MIN_EXTENT sg_SatLayer sg_SatNodes sg_SearchCells sg_SoftLookup
+//   sg_TECHNIQUE_CSM sg_TECHNIQUE_CSSM sg_TECHNIQUE_ESM sg_TECHNIQUE_EVSM sg_TECHNIQUE_HARD
+//   sg_TECHNIQUE_MIDPOINT sg_TECHNIQUE_MSM sg_TECHNIQUE_MSM_SOFT sg_TECHNIQUE_PCF
+//   sg_TECHNIQUE_PCSS sg_TECHNIQUE_SECOND_DEPTH sg_TECHNIQUE_SMRT sg_TECHNIQUE_VSM
+//   sg_TECHNIQUE_VSSM sg_bilinear_level sg_bilinear_level_packed sg_bilinear_log_level
+//   sg_blocker_add sg_blocker_csm_z sg_blocker_filter_width sg_blocker_msm sg_blocker_result
+//   sg_blocker_search_width sg_blocker_total sg_blocker_vsm sg_blocker_width sg_cascade_far_of
+//   sg_cascade_pick sg_chebyshev_upper sg_csm_chunk sg_csm_chunk_of sg_csm_resolve
+//   sg_csm_sin_cos sg_csm_terms_advance sg_csm_terms_chunk sg_csm_terms_start sg_csm_weight
+//   sg_csm_z_chunk_of sg_cssm_blocker sg_cssm_blocker_moments sg_cssm_filter_blockers
+//   sg_cssm_resolve sg_cssm_sharpen sg_cssm_two_series sg_level_size sg_level_size_of
+//   sg_light_depth_slope sg_light_depth_slope_view sg_light_faces sg_light_footprint
+//   sg_light_linear_to_ndc sg_light_linear_to_z sg_light_map_width sg_light_plane_slope
+//   sg_light_receiver_offset sg_light_sample sg_light_tap_offset sg_light_texel
+//   sg_light_to_light sg_linstep sg_load_depth sg_map_sample sg_mip_tap_uv sg_mip_taps
+//   sg_msm_biased sg_msm_dequantize sg_msm_expect sg_msm_intensity sg_msm_moments
+//   sg_msm_quantize sg_msm_roots sg_msm_soft_blocker sg_msm_soft_search sg_pack_f16x2
+//   sg_pcss_search_radius sg_point_coords sg_point_face sg_point_sample sg_sample_bilinear
+//   sg_sample_bilinear_log sg_sample_map sg_sample_map_log sg_sample_map_packed sg_sat_alone
+//   sg_sat_box sg_sat_box_fixed sg_sat_box_float sg_sat_clamp sg_sat_corner_linear
+//   sg_sat_filter_fixed sg_sat_filter_float sg_sat_filter_window sg_sat_grid sg_sat_layer_box
+//   sg_sat_layer_mean sg_sat_layer_node sg_sat_layer_size sg_sat_layer_window sg_sat_mean_fixed
+//   sg_sat_mean_float sg_sat_mean_linear sg_sat_nearest sg_sat_node_f32 sg_sat_nodes sg_sat_rect
+//   sg_sat_sample_fixed sg_sat_sample_float sg_sat_sample_layer sg_sat_search_cells_fixed
+//   sg_sat_search_cells_float sg_sat_search_fixed sg_sat_search_float sg_sat_search_layer
+//   sg_sat_span_weights sg_search_areas sg_search_middle sg_search_window sg_smrt_emitter_point
+//   sg_smrt_ray sg_soft_blockers sg_soft_filter_trips sg_texel_of sg_trilinear sg_trilinear_log
+//   sg_trilinear_packed sg_unpack_f16x2 sg_vis_esm sg_vis_esm_of_log sg_vis_esm_of_sat
+//   sg_vis_evsm sg_vis_evsm_of sg_vis_hard sg_vis_msm sg_vis_msm_of sg_vis_msm_soft_fixed
+//   sg_vis_msm_soft_float sg_vis_pcf sg_vis_pcf_hardware sg_vis_pcss sg_vis_smrt sg_vis_vsm
+//   sg_vis_vsm_of sg_vis_vssm_fixed sg_vis_vssm_float sg_vogel_disc sg_vssm_blocker
+//   sg_vssm_search
 
 // Shared light description and light-space helpers (import-only module).
 //
@@ -1078,18 +1080,20 @@ fn sg_sat_nearest(r: vec4<f32>) -> vec4<f32> {
     return vec4<f32>(lo, max(round(r.zw), lo + 1.0));
 }
 
-// The mean over `sat_rect(l, uv, width)` with its edges rounded to the nearest texel edges
-// (`sat_nearest`, then `sat_box_*`): the soft techniques' filter in four loads. Their box
-// changes width and centre per pixel; moving its edges by at most half a texel moved the mean
-// error against the area-light truth by under 1% (5% in one of 27 configurations) on
-// sphere_on_plane, pole and stacked, where the exact integral (`sat_sample_*`) reads 16.
-// #fetches sg_sat_filter_fixed: 4
+// The soft techniques' filter from a fixed-point table: the exact mean over
+// `sat_rect(l, uv, width)` (`sat_sample_fixed`, 16 loads). Their box changes width and centre
+// per pixel, so edges rounded to the nearest texel edges (4 loads) move it by up to half a
+// texel at the map's texel pitch: a mean error that cannot be seen in the mean against the
+// area-light truth, and a staircase of the texel grid across every penumbra that can (the
+// mean |Laplacian| of the penumbra several times the exact square's).
+// #fetches sg_sat_filter_fixed: sg_sat_sample_fixed
 fn sg_sat_filter_fixed(map: texture_2d<u32>, l: sg_Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
-    return sg_sat_box_fixed(map, sg_sat_nearest(sg_sat_rect(l, uv, width)), l.sat_offset, l.sat_scale);
+    return sg_sat_sample_fixed(map, l, uv, width);
 }
 
-// `sat_filter_fixed`'s integer window over tables of `size`, for several tables of one size
-// read over one square (`sat_layer_window` each): CSSM's five.
+// CSSM's filter window over tables of `size`: the square `sat_rect(l, uv, width)` with its
+// edges rounded to the nearest texel edges (`sat_nearest`), one integer window that several
+// tables of one size are read over (`sat_layer_window` each, 4 loads a table: CSSM's five).
 fn sg_sat_filter_window(l: sg_Light, uv: vec2<f32>, width: f32, size: vec2<u32>) -> vec4<i32> {
     return sg_sat_box(sg_sat_nearest(sg_sat_rect(l, uv, width)), size);
 }
@@ -1109,6 +1113,95 @@ fn sg_sat_filter_float(map: texture_2d<f32>, smp: sampler, l: sg_Light, uv: vec2
 // #fetches sg_sat_search_fixed: 4
 fn sg_sat_search_fixed(map: texture_2d<u32>, l: sg_Light, uv: vec2<f32>, width: f32) -> vec4<f32> {
     return sg_sat_box_fixed(map, sg_sat_rect(l, uv, width), l.sat_offset, l.sat_scale);
+}
+
+// The blocker search in cells (Yang et al. 2010, "Variance Soft Shadow Mapping", §4.3: a
+// kernel that is not planar is subdivided): the search square snapped outward to texel edges,
+// as `sat_search_*` reads it, cut at texel edges into 2 × 2 cells, each cell's mean from the
+// table. One estimate over a wide square fails where the receiver's own texels fill it: a plane
+// seen by a spot light stores a linear depth whose mean over a square lies behind its centre
+// (1/z, not z, is affine across the map), and a few blockers in front cannot pull the mean in
+// front of the receiver, so the estimate reads no blockers and a long shadow's far end is cut
+// off along an arc. A cell holds a quarter of the plane's spread in depth and its blockers at
+// up to four times their share. The cells meet at X0 + ⌊(X1 − X0)/2⌋ (and the same along y):
+// a square one texel wide has an empty column of cells (area 0), which weighs nothing. Each of
+// the 3 × 3 corners is loaded once; no arrays and no loops (private arrays indexed in a loop
+// live in memory on a GPU and on llvmpipe alike).
+struct sg_SearchCells {
+    m00: vec4<f32>,    // each cell's mean: (left, top), (right, top), (left, bottom), (right, bottom)
+    m10: vec4<f32>,
+    m01: vec4<f32>,
+    m11: vec4<f32>,
+    area: vec4<f32>,   // the four cells' texels in that order (0: an empty cell)
+}
+
+// The cells' integer window (`sat_box` of the search square, x0, y0, x1, y1) and where they
+// meet (the x and y of the middle edges).
+fn sg_search_window(l: sg_Light, uv: vec2<f32>, width: f32, size: vec2<u32>) -> vec4<i32> {
+    return sg_sat_box(sg_sat_rect(l, uv, width), size);
+}
+
+fn sg_search_middle(b: vec4<i32>) -> vec2<i32> {
+    return b.xy + (b.zw - b.xy) / 2;
+}
+
+// The four cells' texels.
+fn sg_search_areas(b: vec4<i32>, mid: vec2<i32>) -> vec4<f32> {
+    let w = vec2<f32>(vec2<i32>(mid.x - b.x, b.z - mid.x));
+    let h = vec2<f32>(vec2<i32>(mid.y - b.y, b.w - mid.y));
+    return vec4<f32>(w.x * h.x, w.y * h.x, w.x * h.y, w.y * h.y);
+}
+
+// The cells of the search square from a fixed-point table (rgba32uint): nine corners, four
+// wrapping integer windows.
+// #fetches sg_sat_search_cells_fixed: 9
+fn sg_sat_search_cells_fixed(map: texture_2d<u32>, l: sg_Light, uv: vec2<f32>, width: f32) -> sg_SearchCells {
+    let layer = sg_sat_alone();
+    let b = sg_search_window(l, uv, width, sg_sat_layer_size(map, layer));
+    let mid = sg_search_middle(b);
+    let f00 = sg_sat_layer_node(map, layer, b.x, b.y);
+    let f10 = sg_sat_layer_node(map, layer, mid.x, b.y);
+    let f20 = sg_sat_layer_node(map, layer, b.z, b.y);
+    let f01 = sg_sat_layer_node(map, layer, b.x, mid.y);
+    let f11 = sg_sat_layer_node(map, layer, mid.x, mid.y);
+    let f21 = sg_sat_layer_node(map, layer, b.z, mid.y);
+    let f02 = sg_sat_layer_node(map, layer, b.x, b.w);
+    let f12 = sg_sat_layer_node(map, layer, mid.x, b.w);
+    let f22 = sg_sat_layer_node(map, layer, b.z, b.w);
+    let area = sg_search_areas(b, mid);
+    let a = max(area, vec4<f32>(1.0));
+    var c: sg_SearchCells;
+    c.m00 = vec4<f32>(bitcast<vec4<i32>>((f11 - f01) - (f10 - f00))) / (l.sat_scale * a.x) + l.sat_offset;
+    c.m10 = vec4<f32>(bitcast<vec4<i32>>((f21 - f11) - (f20 - f10))) / (l.sat_scale * a.y) + l.sat_offset;
+    c.m01 = vec4<f32>(bitcast<vec4<i32>>((f12 - f02) - (f11 - f01))) / (l.sat_scale * a.z) + l.sat_offset;
+    c.m11 = vec4<f32>(bitcast<vec4<i32>>((f22 - f12) - (f21 - f11))) / (l.sat_scale * a.w) + l.sat_offset;
+    c.area = area;
+    return c;
+}
+
+// The cells of the search square from an f32 table (rgba32float).
+// #fetches sg_sat_search_cells_float: 9
+fn sg_sat_search_cells_float(map: texture_2d<f32>, l: sg_Light, uv: vec2<f32>, width: f32) -> sg_SearchCells {
+    let b = sg_search_window(l, uv, width, textureDimensions(map));
+    let mid = sg_search_middle(b);
+    let f00 = sg_sat_node_f32(map, b.x, b.y);
+    let f10 = sg_sat_node_f32(map, mid.x, b.y);
+    let f20 = sg_sat_node_f32(map, b.z, b.y);
+    let f01 = sg_sat_node_f32(map, b.x, mid.y);
+    let f11 = sg_sat_node_f32(map, mid.x, mid.y);
+    let f21 = sg_sat_node_f32(map, b.z, mid.y);
+    let f02 = sg_sat_node_f32(map, b.x, b.w);
+    let f12 = sg_sat_node_f32(map, mid.x, b.w);
+    let f22 = sg_sat_node_f32(map, b.z, b.w);
+    let area = sg_search_areas(b, mid);
+    let a = max(area, vec4<f32>(1.0));
+    var c: sg_SearchCells;
+    c.m00 = ((f11 - f01) - (f10 - f00)) / (l.sat_scale * a.x) + l.sat_offset;
+    c.m10 = ((f21 - f11) - (f20 - f10)) / (l.sat_scale * a.y) + l.sat_offset;
+    c.m01 = ((f12 - f02) - (f11 - f01)) / (l.sat_scale * a.z) + l.sat_offset;
+    c.m11 = ((f22 - f12) - (f21 - f11)) / (l.sat_scale * a.w) + l.sat_offset;
+    c.area = area;
+    return c;
 }
 
 // `sat_search_fixed` of the table `layer` of `map`.
@@ -1384,6 +1477,28 @@ fn sg_soft_filter_trips(look: sg_SoftLookup) -> u32 {
     return select(0u, 1u, look.blockers);
 }
 
+// The blocker estimates of a search square's cells combined: the share is the cells' shares
+// weighted by their areas, z_avg the cells' z_avg weighted by their blockers (area · share).
+struct sg_BlockerSum {
+    z: f32,      // Σ area · share · z_avg
+    share: f32,  // Σ area · share
+    area: f32,   // Σ area
+}
+
+// An empty cell (area 0: its moments are the table's offset, any estimate of them) adds
+// nothing, selected rather than multiplied so that no value of its estimate can reach the sum.
+fn sg_blocker_add(acc: sg_BlockerSum, b: vec2<f32>, area: f32) -> sg_BlockerSum {
+    let blockers = area * max(b.y, 0.0);
+    let add = select(vec3<f32>(0.0), vec3<f32>(blockers * b.x, blockers, area), area > 0.0);
+    return sg_BlockerSum(acc.z + add.x, acc.share + add.y, acc.area + add.z);
+}
+
+// (z_avg, share) of the cells summed in `acc`, receiver depth d.
+fn sg_blocker_total(acc: sg_BlockerSum, d: f32) -> vec2<f32> {
+    let share = acc.share / max(acc.area, 1.0);
+    return sg_blocker_result(acc.z / max(acc.share, 1e-30), share, d);
+}
+
 // (z_avg, share) from a blocker depth estimate `z` and share: z clamped to [0, d] (blockers
 // are in front of the receiver d).
 fn sg_blocker_result(z: f32, share: f32, d: f32) -> vec2<f32> {
@@ -1627,20 +1742,30 @@ fn sg_vis_hard(map: texture_2d<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
 // blocker share and depth from the Hamburger reconstruction (blocker_msm), the PCSS penumbra
 // width follows, and MSM's visibility (vis_msm_of: Hamburger or Hausdorff, bleed reduction) is
 // read from the moments over that width. The search reads the
-// square snapped outward to texel edges (`sat_search_*`: 4 loads; the square grows by less
-// than a texel per side, an estimate either way), the filter the square with its edges rounded
-// to the nearest texel edges (`sat_filter_*`: 4 loads), in a loop of `soft_filter_trips` trips: a receiver whose search square holds no blockers
-// (share below BLOCKER_MIN_SHARE) is lit after the search.
+// square snapped outward to texel edges in 2 × 2 cells (`sat_search_cells_*`: 9 loads; the
+// cells' estimates combined, so that the receiver's own texels filling a wide square cannot
+// hide its blockers), the filter the exact square (`sat_filter_*`), in a loop of
+// `soft_filter_trips` trips: a receiver whose search square holds no blockers (share below
+// BLOCKER_MIN_SHARE) is lit after the search.
 // `vis_msm_soft_fixed` reads a fixed-point table (rgba32uint), `vis_msm_soft_float` an f32 one.
 
 fn sg_msm_soft_blocker(m: vec4<f32>, l: sg_Light, s: sg_LightSample) -> vec2<f32> {
     return sg_blocker_msm(sg_msm_biased(m, l), s.depth - l.bias);
 }
 
-// #fetches sg_vis_msm_soft_fixed: sg_sat_search_fixed + sg_sat_filter_fixed
+// The blocker estimate of the search square's cells (`sat_search_cells_*`), combined.
+fn sg_msm_soft_search(c: sg_SearchCells, l: sg_Light, s: sg_LightSample) -> vec2<f32> {
+    var acc = sg_blocker_add(sg_BlockerSum(0.0, 0.0, 0.0), sg_msm_soft_blocker(c.m00, l, s), c.area.x);
+    acc = sg_blocker_add(acc, sg_msm_soft_blocker(c.m10, l, s), c.area.y);
+    acc = sg_blocker_add(acc, sg_msm_soft_blocker(c.m01, l, s), c.area.z);
+    acc = sg_blocker_add(acc, sg_msm_soft_blocker(c.m11, l, s), c.area.w);
+    return sg_blocker_total(acc, s.depth - l.bias);
+}
+
+// #fetches sg_vis_msm_soft_fixed: sg_sat_search_cells_fixed + sg_sat_filter_fixed
 fn sg_vis_msm_soft_fixed(map: texture_2d<u32>, l: sg_Light, s: sg_LightSample) -> f32 {
-    let search = sg_sat_search_fixed(map, l, s.uv, sg_blocker_search_width(l, s));
-    let look = sg_soft_blockers(sg_msm_soft_blocker(search, l, s), l, s);
+    let search = sg_sat_search_cells_fixed(map, l, s.uv, sg_blocker_search_width(l, s));
+    let look = sg_soft_blockers(sg_msm_soft_search(search, l, s), l, s);
     var m = vec4<f32>(0.0);
     for (var k = 0u; k < sg_soft_filter_trips(look); k++) {
         m = sg_sat_filter_fixed(map, l, s.uv, look.width);
@@ -1651,10 +1776,10 @@ fn sg_vis_msm_soft_fixed(map: texture_2d<u32>, l: sg_Light, s: sg_LightSample) -
     return sg_vis_msm_of(m, l, s);
 }
 
-// #fetches sg_vis_msm_soft_float: sg_sat_search_float + sg_sat_filter_float
+// #fetches sg_vis_msm_soft_float: sg_sat_search_cells_float + sg_sat_filter_float
 fn sg_vis_msm_soft_float(map: texture_2d<f32>, smp: sampler, l: sg_Light, s: sg_LightSample) -> f32 {
-    let search = sg_sat_search_float(map, l, s.uv, sg_blocker_search_width(l, s));
-    let look = sg_soft_blockers(sg_msm_soft_blocker(search, l, s), l, s);
+    let search = sg_sat_search_cells_float(map, l, s.uv, sg_blocker_search_width(l, s));
+    let look = sg_soft_blockers(sg_msm_soft_search(search, l, s), l, s);
     var m = vec4<f32>(0.0);
     for (var k = 0u; k < sg_soft_filter_trips(look); k++) {
         m = sg_sat_filter_float(map, smp, l, s.uv, look.width);
@@ -1863,20 +1988,30 @@ fn sg_vis_vsm_of(m: vec4<f32>, l: sg_Light, s: sg_LightSample) -> f32 {
 // the moments over the blocker-search square give the blocker share and depth (blocker_vsm),
 // the PCSS penumbra width follows, and the VSM bound (vis_vsm_of: variance floor, bleed
 // reduction) is read from the moments over that width. The search reads the
-// square snapped outward to texel edges (`sat_search_*`: 4 loads; the square grows by less
-// than a texel per side, an estimate either way), the filter the square with its edges rounded
-// to the nearest texel edges (`sat_filter_*`: 4 loads), in a loop of `soft_filter_trips` trips: a receiver whose search square holds no blockers
-// (share below BLOCKER_MIN_SHARE) is lit after the search.
+// square snapped outward to texel edges in 2 × 2 cells (`sat_search_cells_*`: 9 loads; the
+// cells' estimates combined, so that the receiver's own texels filling a wide square cannot
+// hide its blockers), the filter the exact square (`sat_filter_*`), in a loop of
+// `soft_filter_trips` trips: a receiver whose search square holds no blockers (share below
+// BLOCKER_MIN_SHARE) is lit after the search.
 // `vis_vssm_fixed` reads a fixed-point table (rgba32uint), `vis_vssm_float` an f32 one.
 
 fn sg_vssm_blocker(m: vec4<f32>, l: sg_Light, s: sg_LightSample) -> vec2<f32> {
     return sg_blocker_vsm(m, s.depth - l.bias, l.min_variance);
 }
 
-// #fetches sg_vis_vssm_fixed: sg_sat_search_fixed + sg_sat_filter_fixed
+// The blocker estimate of the search square's cells (`sat_search_cells_*`), combined.
+fn sg_vssm_search(c: sg_SearchCells, l: sg_Light, s: sg_LightSample) -> vec2<f32> {
+    var acc = sg_blocker_add(sg_BlockerSum(0.0, 0.0, 0.0), sg_vssm_blocker(c.m00, l, s), c.area.x);
+    acc = sg_blocker_add(acc, sg_vssm_blocker(c.m10, l, s), c.area.y);
+    acc = sg_blocker_add(acc, sg_vssm_blocker(c.m01, l, s), c.area.z);
+    acc = sg_blocker_add(acc, sg_vssm_blocker(c.m11, l, s), c.area.w);
+    return sg_blocker_total(acc, s.depth - l.bias);
+}
+
+// #fetches sg_vis_vssm_fixed: sg_sat_search_cells_fixed + sg_sat_filter_fixed
 fn sg_vis_vssm_fixed(map: texture_2d<u32>, l: sg_Light, s: sg_LightSample) -> f32 {
-    let search = sg_sat_search_fixed(map, l, s.uv, sg_blocker_search_width(l, s));
-    let look = sg_soft_blockers(sg_vssm_blocker(search, l, s), l, s);
+    let search = sg_sat_search_cells_fixed(map, l, s.uv, sg_blocker_search_width(l, s));
+    let look = sg_soft_blockers(sg_vssm_search(search, l, s), l, s);
     var m = vec4<f32>(0.0);
     for (var k = 0u; k < sg_soft_filter_trips(look); k++) {
         m = sg_sat_filter_fixed(map, l, s.uv, look.width);
@@ -1887,10 +2022,10 @@ fn sg_vis_vssm_fixed(map: texture_2d<u32>, l: sg_Light, s: sg_LightSample) -> f3
     return sg_vis_vsm_of(m, l, s);
 }
 
-// #fetches sg_vis_vssm_float: sg_sat_search_float + sg_sat_filter_float
+// #fetches sg_vis_vssm_float: sg_sat_search_cells_float + sg_sat_filter_float
 fn sg_vis_vssm_float(map: texture_2d<f32>, smp: sampler, l: sg_Light, s: sg_LightSample) -> f32 {
-    let search = sg_sat_search_float(map, l, s.uv, sg_blocker_search_width(l, s));
-    let look = sg_soft_blockers(sg_vssm_blocker(search, l, s), l, s);
+    let search = sg_sat_search_cells_float(map, l, s.uv, sg_blocker_search_width(l, s));
+    let look = sg_soft_blockers(sg_vssm_search(search, l, s), l, s);
     var m = vec4<f32>(0.0);
     for (var k = 0u; k < sg_soft_filter_trips(look); k++) {
         m = sg_sat_filter_float(map, smp, l, s.uv, look.width);

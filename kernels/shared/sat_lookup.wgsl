@@ -79,88 +79,91 @@ fn sat_search_fixed(map: texture_2d<u32>, l: Light, uv: vec2<f32>, width: f32) -
 
 // The blocker search in cells (Yang et al. 2010, "Variance Soft Shadow Mapping", §4.3: a
 // kernel that is not planar is subdivided): the search square snapped outward to texel edges,
-// as `sat_search_*` reads it, cut at texel edges into SEARCH_CELLS × SEARCH_CELLS cells, each
-// cell's mean from the table. One estimate over a wide square fails where the receiver's own
-// texels fill it: a plane seen by a spot light stores a linear depth whose mean over a square
-// lies behind its centre (1/z, not z, is affine across the map), and a few blockers in front
-// cannot pull the mean in front of the receiver, so the estimate reads no blockers and a long
-// shadow's far end is cut off along an arc. A cell holds a quarter of the plane's spread in depth
-// and its blockers at up to four times their share. Cell edges are X0 + ⌊k·(X1 − X0)/SEARCH_CELLS⌋: a square
-// narrower than SEARCH_CELLS texels has empty cells (area 0), which weigh nothing. The
-// (SEARCH_CELLS + 1)² corners are loaded once each, a row at a time.
-const SEARCH_CELLS: u32 = 2u;
-const SEARCH_CELL_COUNT: u32 = 4u;
-const SEARCH_CORNERS: u32 = 3u;
-
+// as `sat_search_*` reads it, cut at texel edges into 2 × 2 cells, each cell's mean from the
+// table. One estimate over a wide square fails where the receiver's own texels fill it: a plane
+// seen by a spot light stores a linear depth whose mean over a square lies behind its centre
+// (1/z, not z, is affine across the map), and a few blockers in front cannot pull the mean in
+// front of the receiver, so the estimate reads no blockers and a long shadow's far end is cut
+// off along an arc. A cell holds a quarter of the plane's spread in depth and its blockers at
+// up to four times their share. The cells meet at X0 + ⌊(X1 − X0)/2⌋ (and the same along y):
+// a square one texel wide has an empty column of cells (area 0), which weighs nothing. Each of
+// the 3 × 3 corners is loaded once; no arrays and no loops (private arrays indexed in a loop
+// live in memory on a GPU and on llvmpipe alike).
 struct SearchCells {
-    m: array<vec4<f32>, SEARCH_CELL_COUNT>,  // each cell's mean, row by row
-    area: array<f32, SEARCH_CELL_COUNT>,     // each cell's texels (0: an empty cell)
+    m00: vec4<f32>,    // each cell's mean: (left, top), (right, top), (left, bottom), (right, bottom)
+    m10: vec4<f32>,
+    m01: vec4<f32>,
+    m11: vec4<f32>,
+    area: vec4<f32>,   // the four cells' texels in that order (0: an empty cell)
 }
 
-// Edge k (0 ..= SEARCH_CELLS) of the cells of the integer span [lo, hi).
-fn search_edge(lo: i32, hi: i32, k: u32) -> i32 {
-    return lo + (i32(k) * (hi - lo)) / i32(SEARCH_CELLS);
-}
-
-// The cells' integer window: `sat_box` of the search square.
+// The cells' integer window (`sat_box` of the search square, x0, y0, x1, y1) and where they
+// meet (the x and y of the middle edges).
 fn search_window(l: Light, uv: vec2<f32>, width: f32, size: vec2<u32>) -> vec4<i32> {
     return sat_box(sat_rect(l, uv, width), size);
 }
 
-// The texels of cell (i, j) of window b, i and j ≥ 1 naming the cell's far edges.
-fn search_cell_area(b: vec4<i32>, i: u32, j: u32) -> f32 {
-    let w = search_edge(b.x, b.z, i) - search_edge(b.x, b.z, i - 1u);
-    let h = search_edge(b.y, b.w, j) - search_edge(b.y, b.w, j - 1u);
-    return f32(w * h);
+fn search_middle(b: vec4<i32>) -> vec2<i32> {
+    return b.xy + (b.zw - b.xy) / 2;
 }
 
-// The cells of the search square from a fixed-point table (rgba32uint).
+// The four cells' texels.
+fn search_areas(b: vec4<i32>, mid: vec2<i32>) -> vec4<f32> {
+    let w = vec2<f32>(vec2<i32>(mid.x - b.x, b.z - mid.x));
+    let h = vec2<f32>(vec2<i32>(mid.y - b.y, b.w - mid.y));
+    return vec4<f32>(w.x * h.x, w.y * h.x, w.x * h.y, w.y * h.y);
+}
+
+// The cells of the search square from a fixed-point table (rgba32uint): nine corners, four
+// wrapping integer windows.
 // #fetches sat_search_cells_fixed: 9
 fn sat_search_cells_fixed(map: texture_2d<u32>, l: Light, uv: vec2<f32>, width: f32) -> SearchCells {
     let layer = sat_alone();
     let b = search_window(l, uv, width, sat_layer_size(map, layer));
-    var cells: SearchCells;
-    var prev: array<vec4<u32>, SEARCH_CORNERS>;
-    for (var j = 0u; j <= SEARCH_CELLS; j++) {
-        let y = search_edge(b.y, b.w, j);
-        var row: array<vec4<u32>, SEARCH_CORNERS>;
-        for (var i = 0u; i <= SEARCH_CELLS; i++) {
-            row[i] = sat_layer_node(map, layer, search_edge(b.x, b.z, i), y);
-        }
-        for (var i = 1u; i <= SEARCH_CELLS && j > 0u; i++) {
-            let window = (row[i] - row[i - 1u]) - (prev[i] - prev[i - 1u]);
-            let area = search_cell_area(b, i, j);
-            let k = (j - 1u) * SEARCH_CELLS + i - 1u;
-            cells.m[k] = vec4<f32>(bitcast<vec4<i32>>(window)) / (l.sat_scale * max(area, 1.0)) + l.sat_offset;
-            cells.area[k] = area;
-        }
-        prev = row;
-    }
-    return cells;
+    let mid = search_middle(b);
+    let f00 = sat_layer_node(map, layer, b.x, b.y);
+    let f10 = sat_layer_node(map, layer, mid.x, b.y);
+    let f20 = sat_layer_node(map, layer, b.z, b.y);
+    let f01 = sat_layer_node(map, layer, b.x, mid.y);
+    let f11 = sat_layer_node(map, layer, mid.x, mid.y);
+    let f21 = sat_layer_node(map, layer, b.z, mid.y);
+    let f02 = sat_layer_node(map, layer, b.x, b.w);
+    let f12 = sat_layer_node(map, layer, mid.x, b.w);
+    let f22 = sat_layer_node(map, layer, b.z, b.w);
+    let area = search_areas(b, mid);
+    let a = max(area, vec4<f32>(1.0));
+    var c: SearchCells;
+    c.m00 = vec4<f32>(bitcast<vec4<i32>>((f11 - f01) - (f10 - f00))) / (l.sat_scale * a.x) + l.sat_offset;
+    c.m10 = vec4<f32>(bitcast<vec4<i32>>((f21 - f11) - (f20 - f10))) / (l.sat_scale * a.y) + l.sat_offset;
+    c.m01 = vec4<f32>(bitcast<vec4<i32>>((f12 - f02) - (f11 - f01))) / (l.sat_scale * a.z) + l.sat_offset;
+    c.m11 = vec4<f32>(bitcast<vec4<i32>>((f22 - f12) - (f21 - f11))) / (l.sat_scale * a.w) + l.sat_offset;
+    c.area = area;
+    return c;
 }
 
 // The cells of the search square from an f32 table (rgba32float).
 // #fetches sat_search_cells_float: 9
 fn sat_search_cells_float(map: texture_2d<f32>, l: Light, uv: vec2<f32>, width: f32) -> SearchCells {
     let b = search_window(l, uv, width, textureDimensions(map));
-    var cells: SearchCells;
-    var prev: array<vec4<f32>, SEARCH_CORNERS>;
-    for (var j = 0u; j <= SEARCH_CELLS; j++) {
-        let y = search_edge(b.y, b.w, j);
-        var row: array<vec4<f32>, SEARCH_CORNERS>;
-        for (var i = 0u; i <= SEARCH_CELLS; i++) {
-            row[i] = sat_node_f32(map, search_edge(b.x, b.z, i), y);
-        }
-        for (var i = 1u; i <= SEARCH_CELLS && j > 0u; i++) {
-            let window = (row[i] - row[i - 1u]) - (prev[i] - prev[i - 1u]);
-            let area = search_cell_area(b, i, j);
-            let k = (j - 1u) * SEARCH_CELLS + i - 1u;
-            cells.m[k] = window / (l.sat_scale * max(area, 1.0)) + l.sat_offset;
-            cells.area[k] = area;
-        }
-        prev = row;
-    }
-    return cells;
+    let mid = search_middle(b);
+    let f00 = sat_node_f32(map, b.x, b.y);
+    let f10 = sat_node_f32(map, mid.x, b.y);
+    let f20 = sat_node_f32(map, b.z, b.y);
+    let f01 = sat_node_f32(map, b.x, mid.y);
+    let f11 = sat_node_f32(map, mid.x, mid.y);
+    let f21 = sat_node_f32(map, b.z, mid.y);
+    let f02 = sat_node_f32(map, b.x, b.w);
+    let f12 = sat_node_f32(map, mid.x, b.w);
+    let f22 = sat_node_f32(map, b.z, b.w);
+    let area = search_areas(b, mid);
+    let a = max(area, vec4<f32>(1.0));
+    var c: SearchCells;
+    c.m00 = ((f11 - f01) - (f10 - f00)) / (l.sat_scale * a.x) + l.sat_offset;
+    c.m10 = ((f21 - f11) - (f20 - f10)) / (l.sat_scale * a.y) + l.sat_offset;
+    c.m01 = ((f12 - f02) - (f11 - f01)) / (l.sat_scale * a.z) + l.sat_offset;
+    c.m11 = ((f22 - f12) - (f21 - f11)) / (l.sat_scale * a.w) + l.sat_offset;
+    c.area = area;
+    return c;
 }
 
 // `sat_search_fixed` of the table `layer` of `map`.

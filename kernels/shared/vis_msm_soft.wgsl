@@ -19,11 +19,11 @@ fn msm_soft_blocker(m: vec4<f32>, l: Light, s: LightSample) -> vec2<f32> {
 }
 
 // The blocker estimate of the search square's cells (`sat_search_cells_*`), combined.
-fn msm_soft_search(cells: SearchCells, l: Light, s: LightSample) -> vec2<f32> {
-    var acc = BlockerSum(0.0, 0.0, 0.0);
-    for (var k = 0u; k < SEARCH_CELL_COUNT; k++) {
-        acc = blocker_add(acc, msm_soft_blocker(cells.m[k], l, s), cells.area[k]);
-    }
+fn msm_soft_search(c: SearchCells, l: Light, s: LightSample) -> vec2<f32> {
+    var acc = blocker_add(BlockerSum(0.0, 0.0, 0.0), msm_soft_blocker(c.m00, l, s), c.area.x);
+    acc = blocker_add(acc, msm_soft_blocker(c.m10, l, s), c.area.y);
+    acc = blocker_add(acc, msm_soft_blocker(c.m01, l, s), c.area.z);
+    acc = blocker_add(acc, msm_soft_blocker(c.m11, l, s), c.area.w);
     return blocker_total(acc, s.depth - l.bias);
 }
 

@@ -188,7 +188,7 @@ pub struct Chain<'a> {
     pub cells: usize,
     /// With `cells` > 1, the errors of the search's inputs at the moved UV (their areas change
     /// with it).
-    pub cell_errors: Option<&'a dyn Fn(&[f64]) -> Vec<f64>>,
+    pub cell_errors: Option<&'a CellErrors<'a>>,
     /// Blocker estimate of (inputs, depth offset).
     pub blocker: &'a dyn Fn(&[f64], f64) -> Blocker,
     /// Visibility for blockers at this depth (exact lookups at its filter width).
@@ -210,6 +210,9 @@ pub struct Chain<'a> {
     /// its edges. Else (CSSM's fixed-point tables) its edges are rounded to texel edges.
     pub grid: bool,
 }
+
+/// The errors of a search's cells' values at a moved UV ([`Chain::cell_errors`]).
+pub type CellErrors<'a> = dyn Fn(&[f64]) -> Vec<f64> + 'a;
 
 /// `e` (a mean's error per channel, of the filter's square at `width`) plus, for a table read
 /// with filtered fetches, the change of the means when the GPU's square lands its edges one
