@@ -185,3 +185,35 @@ fn every_registry_key_reaches_the_checker() {
         }
     }
 }
+
+/// Every key of the biases' and the cascades' tables reaches the light it is written in: a
+/// value other than its default (the middle of its range) changes the loaded light, for every
+/// key of those tables as the registry lists them.
+#[test]
+fn every_common_and_cascade_key_changes_the_light() {
+    use shadowgraph::model::ParamKind;
+    use shadowgraph::technique::params::{CASCADES, COMMON};
+    let sun = "[[light]]\nkind = \"directional\"\nposition = [3.0, 6.0, 2.0]\n\
+               target = [0.0, 0.0, 0.0]\nextent = 5.0\n\n[light.shadow]\ntechnique = \"pcf\"\n";
+    let load = |extra: &str| {
+        let text = scene(&format!("{sun}{extra}"));
+        let s =
+            Scene::parse(Path::new("keys.toml"), &text).unwrap_or_else(|e| panic!("{extra}: {e}"));
+        format!("{:?}", s.lights[1])
+    };
+    let plain = load("");
+    for spec in COMMON.iter().chain(CASCADES) {
+        let value = match spec.kind {
+            ParamKind::Int { lo, hi } => format!("{}", (lo + hi) / 2),
+            ParamKind::Float { lo, hi } => format!("{:?}", 0.5 * (lo + hi) + 0.0123),
+            ParamKind::Choice(options) => format!("{:?}", options[options.len() - 1]),
+        };
+        let set = format!("{} = {value}\n", spec.key);
+        assert_ne!(
+            load(&set),
+            plain,
+            "`{}` left the light as it was",
+            spec.key.trim()
+        );
+    }
+}
