@@ -35,6 +35,7 @@ mod grid;
 mod html;
 mod measure;
 mod output;
+mod points;
 pub mod protocol;
 mod stats;
 pub mod summary;
@@ -95,6 +96,10 @@ pub struct EvaluateOptions {
     pub image_default: bool,
     /// How often every light's map is redrawn (`--update`; `None`: each light's own `update`).
     pub update: Option<crate::scene::UpdateRate>,
+    /// Further operating points for [`run`]: the same configurations timed again with every
+    /// light at each of these rates, each report in `DIR/update-<rate>/` (`--update a,b,…`
+    /// past its first; `--quick` without `--update`: static).
+    pub more_updates: Vec<crate::scene::UpdateRate>,
 }
 
 impl Default for EvaluateOptions {
@@ -111,6 +116,7 @@ impl Default for EvaluateOptions {
             budget_ms: None,
             image_default: false,
             update: None,
+            more_updates: Vec::new(),
         }
     }
 }
@@ -330,8 +336,12 @@ pub fn run(gpu: &Gpu, scene_path: &Path, out: &Path, opts: &EvaluateOptions) -> 
     check_sides(gpu.device.limits().max_texture_dimension_2d, &scene, opts)?;
     let configs = sweep(&scene, opts)?;
     output::check_dir(out)?;
-    let (report, images) = evaluate(gpu, &scene, &configs, opts)?;
-    let files = output::write_all(out, &report, &images)?;
+    let (report, images, mut kept) = evaluate_kept(gpu, &scene, &configs, opts)?;
+    let others = points::more(gpu, &mut kept, &report, opts)?;
+    let mut files = output::write_all(out, &report, &images, &others)?;
+    for (dir, r) in &others {
+        files.extend(output::write_all(&out.join(dir), r, &images, &[])?);
+    }
     let mut s = format!(
         "evaluated {} configuration(s) of {} at {}x{} against a K = {} area-light truth ({} relevant pixels)\n",
         report.rows.len(),
@@ -423,6 +433,23 @@ pub fn evaluate(
     configs: &[Config],
     opts: &EvaluateOptions,
 ) -> Result<(Report, Images)> {
+    evaluate_kept(gpu, scene, configs, opts).map(|(r, i, _)| (r, i))
+}
+
+/// What [`evaluate_kept`] keeps to time the configurations again: its renderer and the scene
+/// of every measured configuration (row order).
+pub(crate) struct Kept {
+    renderer: Renderer,
+    scenes: Vec<Scene>,
+}
+
+/// [`evaluate`], keeping what timing the rows again needs.
+fn evaluate_kept(
+    gpu: &Gpu,
+    scene: &Scene,
+    configs: &[Config],
+    opts: &EvaluateOptions,
+) -> Result<(Report, Images, Kept)> {
     let (device, queue) = (&gpu.device, &gpu.queue);
     let mut renderer = Renderer::new(device);
     let truth_opts = TruthOptions {
@@ -547,7 +574,11 @@ pub fn evaluate(
     let run = timing::time_scenes(&mut renderer, gpu, &timed_scenes, &protocol, &bar)?;
     apply_times(&mut report, &run);
     bar.finish_and_clear();
-    Ok((report, images))
+    let kept = Kept {
+        renderer,
+        scenes: timed_scenes,
+    };
+    Ok((report, images, kept))
 }
 
 /// Fills the times of `report`'s rows from the time protocol's `run` (row `i` from

@@ -155,9 +155,11 @@ enum Command {
         #[arg(long, value_parser = parse_budget, allow_negative_numbers = true)]
         budget: Option<f64>,
         /// How often every light's map is redrawn: `every` (each frame), a period K in frames,
-        /// or `static` (default: each light's `update`). Frames are timed over a whole period.
-        #[arg(long, value_parser = parse_update, allow_negative_numbers = true)]
-        update: Option<shadowgraph::scene::UpdateRate>,
+        /// or `static` (default: each light's `update`; quick: that, then static). Frames are
+        /// timed over a whole period. A list times each rate past the first again, its report
+        /// in DIR/update-<rate>/.
+        #[arg(long, value_parser = parse_update, allow_negative_numbers = true, value_delimiter = ',')]
+        update: Option<Vec<shadowgraph::scene::UpdateRate>>,
         /// Run every MSM configuration at each of these moment biases (default: the storage's).
         #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
         moment_bias: Option<Vec<f32>>,
@@ -317,7 +319,14 @@ fn run(args: Args) -> Result<()> {
                 moment_biases: moment_bias,
                 budget_ms: budget,
                 image_default: false,
-                update,
+                update: update.as_ref().and_then(|u| u.first().copied()),
+                // Past the first rate, each a further operating point; --quick alone times a
+                // static light too.
+                more_updates: match &update {
+                    Some(u) => u.iter().skip(1).copied().collect(),
+                    None if quick => vec![shadowgraph::scene::UpdateRate::Static],
+                    None => Vec::new(),
+                },
             };
             let gpu = Gpu::new()?;
             print!("{}", shadowgraph::evaluate::run(&gpu, &scene, &out, &opts)?);

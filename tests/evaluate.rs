@@ -250,6 +250,29 @@ fn quick_sweep_writes_every_file_consistently() {
     assert!(line.contains(&format!("**{}**", cheapest.label)), "{line}");
     assert!(md.contains("- Most accurate within") && md.contains("- Prefiltering against PCSS"));
     clock_drop_is_flagged_in_the_report(&report);
+    // --quick also times every light static: its report in update-static/, the same errors,
+    // no raster or kernel time, summarized under the first report's verdict.
+    let text = std::fs::read_to_string(out.join("update-static/report.json")).expect("static");
+    let still: Report = serde_json::from_str(&text).expect("a Report");
+    assert_eq!(still.updates, ["\"static\""]);
+    assert_eq!(still.rows.len(), report.rows.len());
+    for (m, s) in report.rows.iter().zip(&still.rows) {
+        assert_eq!(
+            (&m.label, m.soft, m.penumbra_hf),
+            (&s.label, s.soft, s.penumbra_hf)
+        );
+        assert_eq!(
+            (s.raster_ms, s.kernels_ms),
+            (Some(0.0), Some(0.0)),
+            "{}",
+            s.label
+        );
+    }
+    assert!(
+        md.contains("### `update-static/`: 160×120, 1 light, static lights"),
+        "{md}"
+    );
+    assert!(out.join("update-static/report.html").is_file());
     // The timestamps' cross-check against the wall clock, over every configuration.
     let check = format!("in each of the {} configurations", report.rows.len());
     assert!(md.contains(&check), "report.md lacks the wall check");

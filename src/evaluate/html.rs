@@ -105,7 +105,12 @@ fn img(rgb: &[u8], w: usize, h: usize, scale: usize, alt: &str) -> Result<String
 }
 
 /// The page. `plots` are the SVG texts of the Pareto plots.
-pub fn html(report: &Report, images: &Images, plots: &[(Metric, String)]) -> Result<String> {
+pub fn html(
+    report: &Report,
+    images: &Images,
+    plots: &[(Metric, String)],
+    others: &[(String, Report)],
+) -> Result<String> {
     let mut s = String::new();
     let title = format!("Accuracy vs time: {}", report.scene);
     let _ = write!(
@@ -123,7 +128,20 @@ pub fn html(report: &Report, images: &Images, plots: &[(Metric, String)]) -> Res
         for v in &verdicts {
             let _ = writeln!(s, "<li class=\"verdict-line\">{}</li>", bold(&escape(v)));
         }
-        s.push_str("</ul></div>\n");
+        s.push_str("</ul>\n");
+        for (dir, r) in others {
+            let _ = writeln!(
+                s,
+                "<h3>Timed again at <a href=\"{d}/report.html\">{d}/</a>: {}</h3><ul>",
+                escape(&super::verdict::operating_point(r)),
+                d = escape(dir)
+            );
+            for v in super::verdict::verdicts(r).iter().skip(1) {
+                let _ = writeln!(s, "<li class=\"verdict-other\">{}</li>", bold(&escape(v)));
+            }
+            s.push_str("</ul>\n");
+        }
+        s.push_str("</div>\n");
     }
     let _ = writeln!(
         s,

@@ -21,8 +21,15 @@ pub fn check_dir(dir: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Writes every output file into `dir`; returns their paths.
-pub fn write_all(dir: &Path, report: &Report, images: &Images) -> Result<Vec<PathBuf>> {
+/// Writes every output file into `dir`; returns their paths. `others` are the further
+/// operating points' reports with their folders under `dir`, summarized in this one's
+/// report.md and report.html.
+pub fn write_all(
+    dir: &Path,
+    report: &Report,
+    images: &Images,
+    others: &[(String, Report)],
+) -> Result<Vec<PathBuf>> {
     let mut written = Vec::new();
     let mut put = |name: &str, bytes: &[u8]| -> Result<()> {
         let path = out_path(dir, name)?;
@@ -33,7 +40,9 @@ pub fn write_all(dir: &Path, report: &Report, images: &Images) -> Result<Vec<Pat
         written.push(path);
         Ok(())
     };
-    put("report.md", markdown(report).as_bytes())?;
+    let mut md = markdown(report);
+    md.push_str(&others_text(others));
+    put("report.md", md.as_bytes())?;
     put("report.csv", csv(report).as_bytes())?;
     let json = serde_json::to_string_pretty(report)
         .map_err(|e| Error::Invalid(format!("report.json: {e}")))?;
@@ -49,7 +58,7 @@ pub fn write_all(dir: &Path, report: &Report, images: &Images) -> Result<Vec<Pat
     put("grid.txt", legend.as_bytes())?;
     put(
         "report.html",
-        super::html::html(report, images, &plots)?.as_bytes(),
+        super::html::html(report, images, &plots, others)?.as_bytes(),
     )?;
     Ok(written)
 }
@@ -164,6 +173,30 @@ pub fn region_text(report: &Report) -> String {
          mean over the whole image.",
         w = 2 * EDGE_BAND + 1
     )
+}
+
+/// The further operating points (Markdown): per folder, its operating point and verdict.
+pub fn others_text(others: &[(String, Report)]) -> String {
+    let mut s = String::new();
+    if others.is_empty() {
+        return s;
+    }
+    s.push_str(
+        "\n## Other operating points\n\nThe same configurations and errors, timed again under \
+         the same protocol with every light at another update rate; each is a report of its own \
+         in its folder.\n",
+    );
+    for (dir, r) in others {
+        let _ = writeln!(
+            s,
+            "\n### `{dir}/`: {}\n",
+            super::verdict::operating_point(r)
+        );
+        for v in super::verdict::verdicts(r).iter().skip(1) {
+            let _ = writeln!(s, "- {v}");
+        }
+    }
+    s
 }
 
 /// The run's facts: device and driver, commit, date, timed frames per configuration.
