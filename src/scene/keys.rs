@@ -9,7 +9,10 @@ use std::fmt;
 use serde::Deserialize;
 use serde::de::{self, Deserializer, Visitor};
 
-use super::format::{CameraFile, LightFile, ObjectFile, OutputFile, SceneFile, ShadowFile};
+use super::format::{
+    AnimationFile, CameraFile, KeyFile, LightFile, ObjectFile, OutputFile, SceneFile, ShadowFile,
+    TrackFile,
+};
 use crate::model::{ParamKind, ParamSpec};
 use crate::technique::{REGISTRY, params};
 
@@ -17,7 +20,8 @@ use crate::technique::{REGISTRY, params};
 pub const LIGHT_KINDS: [&str; 3] = ["directional", "spot", "point"];
 
 /// Every key of each table, by the name this module calls the table: `""` is the top level,
-/// `shadow` is `[light.shadow]`. A table's keys are its struct's fields as the reader sees them
+/// `shadow` is `[light.shadow]`, `track` `[[animation.track]]` and `key` one of its `keys`. A
+/// table's keys are its struct's fields as the reader sees them
 /// (renames included); `shadow`'s are `technique` and every key of the registry's tables.
 pub fn tables() -> Vec<(&'static str, Vec<&'static str>)> {
     vec![
@@ -27,6 +31,9 @@ pub fn tables() -> Vec<(&'static str, Vec<&'static str>)> {
         ("light", fields::<LightFile>().to_vec()),
         ("shadow", shadow_keys()),
         ("object", fields::<ObjectFile>().to_vec()),
+        ("animation", fields::<AnimationFile>().to_vec()),
+        ("track", fields::<TrackFile>().to_vec()),
+        ("key", fields::<KeyFile>().to_vec()),
     ]
 }
 
