@@ -436,11 +436,12 @@ pub fn evaluate(
     evaluate_kept(gpu, scene, configs, opts).map(|(r, i, _)| (r, i))
 }
 
-/// What [`evaluate_kept`] keeps to time the configurations again: its renderer and the scene
-/// of every measured configuration (row order).
+/// What [`evaluate_kept`] keeps to time the configurations again: its renderer, the scene and
+/// every measured configuration's lights (row order).
 pub(crate) struct Kept {
     renderer: Renderer,
-    scenes: Vec<Scene>,
+    scene: Scene,
+    variants: Vec<timing::Variant>,
 }
 
 /// [`evaluate`], keeping what timing the rows again needs.
@@ -515,7 +516,7 @@ fn evaluate_kept(
     };
     let mut linear = std::collections::HashMap::new();
     // The scene of every measured configuration, timed after all are measured.
-    let mut timed_scenes = Vec::new();
+    let mut variants = Vec::new();
     for c in configs {
         bar.set_message(c.label.clone());
         let mut s = scene.clone();
@@ -550,7 +551,7 @@ fn evaluate_kept(
                     let v = temporal::animation_visibility(&mut renderer, device, queue, &s)?;
                     m.row.temporal = Some(temporal::animation_temporal_error(&truths, &v)?);
                 }
-                timed_scenes.push(s);
+                variants.push(timing::Variant::of(&s));
                 let lights = reference.truth.lights;
                 images.visibility.push(light0(&m.frame.visibility, lights));
                 if images.truth_shaded.is_empty() {
@@ -571,12 +572,13 @@ fn evaluate_kept(
     }
     bar.set_message("timing (interleaved)");
     let protocol = Protocol::new(opts.repeat);
-    let run = timing::time_scenes(&mut renderer, gpu, &timed_scenes, &protocol, &bar)?;
+    let run = timing::time_variants(&mut renderer, gpu, scene, &variants, &protocol, &bar)?;
     apply_times(&mut report, &run);
     bar.finish_and_clear();
     let kept = Kept {
         renderer,
-        scenes: timed_scenes,
+        scene: scene.clone(),
+        variants,
     };
     Ok((report, images, kept))
 }

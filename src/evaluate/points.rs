@@ -32,19 +32,26 @@ pub fn more(
         if names == report.updates || out.iter().any(|(d, _)| *d == dir(rate)) {
             continue;
         }
-        let scenes: Vec<_> = kept
-            .scenes
+        let variants: Vec<_> = kept
+            .variants
             .iter()
-            .map(|s| {
-                let mut s = s.clone();
-                s.updates = vec![rate; s.lights.len()];
-                s
+            .map(|v| {
+                let mut v = v.clone();
+                v.updates = vec![rate; v.lights.len()];
+                v
             })
             .collect();
-        let bar = indicatif::ProgressBar::new((scenes.len() as u64) * u64::from(opts.repeat));
+        let bar = indicatif::ProgressBar::new((variants.len() as u64) * u64::from(opts.repeat));
         bar.set_message(format!("timing at update = {}", rate.name()));
         let protocol = Protocol::new(opts.repeat);
-        let run = timing::time_scenes(&mut kept.renderer, gpu, &scenes, &protocol, &bar)?;
+        let run = timing::time_variants(
+            &mut kept.renderer,
+            gpu,
+            &kept.scene,
+            &variants,
+            &protocol,
+            &bar,
+        )?;
         bar.finish_and_clear();
         let mut r = report.clone();
         r.updates = names;

@@ -7,7 +7,7 @@ use super::protocol::{self, Protocol, Run, Sample, Spread, Timed};
 use crate::error::Result;
 use crate::gpu::Gpu;
 use crate::render::{RenderOptions, Renderer};
-use crate::scene::{Scene, UpdateRate};
+use crate::scene::{Light, Scene, UpdateRate};
 
 /// The pass that is the same work in every configuration: the clock check.
 pub const CHECK_PASS: &str = "gbuffer";
@@ -48,30 +48,59 @@ pub fn per_frame(frames: &[Vec<(String, f64)>]) -> Vec<(String, f64)> {
     out
 }
 
-/// Times `scenes` (one per configuration) under `protocol`: on a GPU, untimed frames first
+/// What sets one configuration's scene apart from the evaluated scene: its lights (technique,
+/// map size, cascades) and their update rates. The timing swaps them into one scene instead of
+/// keeping a copy of the scene (its meshes) per configuration.
+#[derive(Clone, Debug)]
+pub struct Variant {
+    /// The lights, as the configuration was measured with them.
+    pub lights: Vec<Light>,
+    /// Their update rates.
+    pub updates: Vec<UpdateRate>,
+}
+
+impl Variant {
+    /// The variant of `scene`.
+    pub fn of(scene: &Scene) -> Self {
+        Self {
+            lights: scene.lights.clone(),
+            updates: scene.updates.clone(),
+        }
+    }
+}
+
+/// Times the configurations `variants` of `base` under `protocol`: on a GPU, untimed frames first
 /// until its clocks have risen, then the interleaved rounds, each visit [`SETTLE_FRAMES`]
 /// untimed frames and [`frames_per_visit`] timed ones, whose mean per frame is the sample
 /// (so a light redrawn every k frames is charged a k-th of its redraw).
-pub fn time_scenes(
+pub fn time_variants(
     renderer: &mut Renderer,
     gpu: &Gpu,
-    scenes: &[Scene],
+    base: &Scene,
+    variants: &[Variant],
     protocol: &Protocol,
     bar: &indicatif::ProgressBar,
 ) -> Result<Run> {
     let (device, queue) = (&gpu.device, &gpu.queue);
-    if let Some(first) = scenes.first() {
-        renderer.warm_up(device, queue, first)?;
+    let mut scene = base.clone();
+    let set = |scene: &mut Scene, v: &Variant| {
+        scene.lights.clone_from(&v.lights);
+        scene.updates.clone_from(&v.updates);
+    };
+    if let Some(first) = variants.first() {
+        set(&mut scene, first);
+        renderer.warm_up(device, queue, &scene)?;
     }
-    protocol::run(protocol, scenes.len(), CHECK_PASS, |c| {
+    protocol::run(protocol, variants.len(), CHECK_PASS, |c| {
         bar.inc(1);
-        let timed = frames_per_visit(&scenes[c]);
+        set(&mut scene, &variants[c]);
+        let timed = frames_per_visit(&scene);
         let opts = RenderOptions {
             aux: false,
             repeat: SETTLE_FRAMES + timed,
             dump: false,
         };
-        let frame = renderer.render(device, queue, &scenes[c], opts)?;
+        let frame = renderer.render(device, queue, &scene, opts)?;
         let first = SETTLE_FRAMES as usize;
         let walls = frame.wall_ms.get(first..).unwrap_or_default();
         Ok(Sample {
