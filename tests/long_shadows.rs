@@ -149,3 +149,40 @@ fn soft_penumbrae_have_no_texel_staircase() {
         );
     }
 }
+
+#[test]
+fn a_search_cut_by_its_cap_is_named_with_the_cap_that_covers_it() {
+    // The bundled scene's search fits its cap; at a tenth of it the search of the farthest
+    // receivers is cut for the nearest blockers, and the warning names the file, the light,
+    // the key and the cap that covers them, which then warns no more.
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/long_shadows.toml");
+    let text = std::fs::read_to_string(&path).expect("scene file");
+    let bundled = shadowgraph::scene::Scene::parse(&path, &text).expect("scene");
+    assert!(bundled.warnings.is_empty(), "{:?}", bundled.warnings);
+    let capped = text.replace(
+        "technique = \"vssm\"",
+        "technique = \"vssm\"\nmax_search = 0.002",
+    );
+    let scene = shadowgraph::scene::Scene::parse(&path, &capped).expect("scene");
+    let [w] = &scene.warnings[..] else {
+        panic!("one warning: {:?}", scene.warnings)
+    };
+    assert!(
+        w.starts_with(&format!("{}:", path.display()))
+            && w.contains("light[0] `vssm`")
+            && w.contains("`max_search` = 0.002")
+            && !w.contains('\n'),
+        "{w}"
+    );
+    let cover = w
+        .split("`max_search` = ")
+        .nth(2)
+        .and_then(|s| s.split(' ').next())
+        .expect("the cap that covers it");
+    let covered = text.replace(
+        "technique = \"vssm\"",
+        &format!("technique = \"vssm\"\nmax_search = {cover}"),
+    );
+    let scene = shadowgraph::scene::Scene::parse(&path, &covered).expect("scene");
+    assert!(scene.warnings.is_empty(), "{cover}: {:?}", scene.warnings);
+}

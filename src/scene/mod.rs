@@ -27,6 +27,8 @@ mod object;
 #[cfg(feature = "cli")]
 mod parse;
 #[cfg(feature = "cli")]
+mod search_cap;
+#[cfg(feature = "cli")]
 mod update;
 #[cfg(feature = "cli")]
 mod validate;

@@ -9,6 +9,7 @@ use glam::Vec3;
 use super::ctx::{Ctx, LENGTH_RANGE, fmt_num};
 use super::format::{LightFile, SceneFile, ShadowFile};
 use super::locate::{self, Locations};
+use super::search_cap;
 use super::{
     Camera, Light, LightKind, Scene, Shadow, Technique, animation, object, update, validate,
 };
@@ -67,6 +68,9 @@ pub(super) fn parse(path: &Path, text: &str) -> Result<Scene> {
     }
     if objects.is_empty() {
         return Err(ctx.err(None, "the scene has no `[[object]]`"));
+    }
+    for (i, (file, light)) in file.lights.iter().zip(&lights).enumerate() {
+        search_cap::check(&ctx, i, file, light, &objects);
     }
     let updates = file
         .lights
