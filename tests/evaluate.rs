@@ -250,6 +250,7 @@ fn quick_sweep_writes_every_file_consistently() {
     assert!(line.contains(&format!("**{}**", cheapest.label)), "{line}");
     assert!(md.contains("- Most accurate within") && md.contains("- Prefiltering against PCSS"));
     clock_drop_is_flagged_in_the_report(&report);
+    verdict_of_known_rows(&report);
     // --quick also times every light static: its report in update-static/, the same errors,
     // no raster or kernel time, summarized under the first report's verdict.
     let text = std::fs::read_to_string(out.join("update-static/report.json")).expect("static");
@@ -301,6 +302,59 @@ fn quick_sweep_writes_every_file_consistently() {
             r.label
         );
     }
+}
+
+/// The verdict on a copy of a real report whose times and penumbra errors are set by hand
+/// (hard and PCF 0.5 at 0.5 ms, PCSS 0.05 at 10 ms, VSM's blur 0.054 at 5 ms and its mips 0.04 at
+/// 20 ms, every other row 0.3 at 1 ms; a budget of 6 ms per light): the cheapest within 10%
+/// of the best (0.04) is VSM's mips, the most accurate within 6 ms VSM's blur, which is within
+/// 10% of PCSS's best at half its time; with every prefiltered row at 0.2, none comes within
+/// 10% and the closest is named with its 4× error.
+fn verdict_of_known_rows(report: &Report) {
+    use shadowgraph::evaluate::verdict::verdicts;
+    let mut r = report.clone();
+    r.budget_ms = Some(6.0);
+    let set = |r: &mut Report, label: &str, e: f64, t: f64| {
+        let row = r.rows.iter_mut().find(|x| x.label == label).expect(label);
+        row.penumbra.mean_abs = e;
+        row.total_ms = Some(t);
+    };
+    for i in 0..r.rows.len() {
+        let label = r.rows[i].label.clone();
+        set(&mut r, &label, 0.3, 1.0);
+    }
+    set(&mut r, "hard 512", 0.5, 0.5);
+    set(&mut r, "pcf box5 512", 0.5, 0.5);
+    set(&mut r, "pcss 16+32 512", 0.05, 10.0);
+    set(&mut r, "vsm f32 blur5 512", 0.054, 5.0);
+    set(&mut r, "vsm f32 mips5 512", 0.04, 20.0);
+    let v = verdicts(&r);
+    assert!(
+        v[1].contains("(0.0400, vsm f32 mips5 512): **vsm f32 mips5 512**"),
+        "{v:?}"
+    );
+    assert!(
+        v[2].starts_with("Most accurate within 6.000 ms per light (given): **vsm f32 blur5 512**"),
+        "{v:?}"
+    );
+    assert!(
+        v[3].contains("**vsm f32 blur5 512** (5.000 ms, penumbra error 0.0540) is within 10% of")
+            && v[3].ends_with("at 0.50× its time."),
+        "{v:?}"
+    );
+    for row in r
+        .rows
+        .iter_mut()
+        .filter(|x| x.family.starts_with("prefiltered"))
+    {
+        row.penumbra.mean_abs = 0.2;
+    }
+    let v = verdicts(&r);
+    assert!(
+        v[3].contains("no prefiltered configuration comes within 10%")
+            && v[3].contains("4.00× its error"),
+        "{v:?}"
+    );
 }
 
 /// Synthetic timings with a clock drop fed to the time protocol and written into a copy of a

@@ -189,8 +189,13 @@ fn against_pcss(report: &Report) -> Option<String> {
     Some(
         match fastest(pre().filter(|r| r.penumbra.mean_abs <= limit)) {
             Some(r) => format!(
-                "Prefiltering against PCSS: {} is within 10% of PCSS's best, {}, at {:.2}× its time.",
+                "Prefiltering against PCSS: {} {} PCSS's best, {}, at {:.2}× its time.",
                 describe(r),
+                if r.penumbra.mean_abs <= pcss.penumbra.mean_abs {
+                    "is at least as accurate as"
+                } else {
+                    "is within 10% of"
+                },
                 describe(pcss),
                 ratio(r)
             ),
