@@ -152,7 +152,7 @@ fn soft_penumbrae_have_no_texel_staircase() {
 
 #[test]
 fn a_search_cut_by_its_cap_is_named_with_the_cap_that_covers_it() {
-    // The bundled scene's search fits its cap; at a tenth of it the search of the farthest
+    // The bundled scene's search fits its cap; at 0.002 the search of the farthest
     // receivers is cut for the nearest blockers, and the warning names the file, the light,
     // the key and the cap that covers them, which then warns no more.
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/long_shadows.toml");
