@@ -77,7 +77,7 @@ fn drawn_labels(scene: &Scene, drawn: &DrawnLights) -> Vec<String> {
                 None => light.label(),
                 Some(g) => {
                     let (near, far) = ranges(i).get(c).copied().unwrap_or((0.0, 0.0));
-                    let guard = crate::model::cascades::guard(&scene.lights[i]);
+                    let guard = crate::technique::cascade_guard(&scene.lights[i]);
                     let band = if guard == crate::model::cascades::SliceGuard::NONE {
                         String::new()
                     } else {

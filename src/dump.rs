@@ -16,6 +16,7 @@ use crate::gpu::Gpu;
 use crate::io::{deinterleave, write_exr, write_png};
 use crate::render::{DumpedResource, FloatMap, RenderOptions, Renderer, plan_lights_for};
 use crate::scene::Scene;
+use crate::technique::{ChannelNaming, MapChannels, map_kinds};
 
 /// Statistics of one channel: range and mean over the finite values, and the non-finite count.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
@@ -57,78 +58,19 @@ pub fn channel_stats(values: &[f32]) -> ChannelStats {
     s
 }
 
-/// How a kind of resource names its channels.
-#[derive(Clone, Copy, Debug)]
-pub enum ChannelNaming {
-    /// Fixed names, in texel order. A texture with more channels than names stores padding
-    /// (e.g. CSM's last pair of terms in `Rgba16Float`): the extra channels are not dumped.
-    /// Packed f16 pairs (`graph::PACKED_F16X2`, one `r32uint` word a texel) are unpacked on
-    /// readback and dumped as their two float channels.
-    Fixed(&'static [&'static str]),
-    /// Fourier coefficients split into chunks `<kind><k>` (`csm0`, `csm1`, …): channel pairs
-    /// `sin_j`, `cos_j` with `j = k·(channels / 2) + pair + 1` (1-based, as the terms of a
-    /// Fourier series).
-    Fourier,
-}
-
-/// One row of [`CHANNEL_TABLE`]: a resource kind and how its channels are named.
-#[derive(Clone, Copy, Debug)]
-pub struct KindChannels {
-    /// The kind: what follows `light{i}.` up to the next `.` (e.g. `vsm` for
-    /// `light0.vsm.blur_h`). For [`ChannelNaming::Fourier`], the kind without its chunk index.
-    pub kind: &'static str,
-    /// How its channels are named.
-    pub naming: ChannelNaming,
-}
-
-/// Channel names per resource kind. Kinds not listed get generic names `c0`, `c1`, ….
-pub const CHANNEL_TABLE: &[KindChannels] = &[
+/// Channel names of the kinds every light has; each technique's maps name theirs in its
+/// registry entry ([`crate::technique::TechniqueDef::maps`]). Kinds named in neither get generic
+/// names `c0`, `c1`, ….
+const LIGHT_MAPS: &[MapChannels] = &[
     // Rasterized depth (Depth32Float, the imported map).
-    KindChannels {
+    MapChannels {
         kind: "depth",
         naming: ChannelNaming::Fixed(&["depth"]),
     },
     // Linear depth (R32Float).
-    KindChannels {
+    MapChannels {
         kind: "linear",
         naming: ChannelNaming::Fixed(&["z"]),
-    },
-    // Variance shadow map moments (z, z²) and their blurs; f16 storage pads to four channels.
-    KindChannels {
-        kind: "vsm",
-        naming: ChannelNaming::Fixed(&["z", "z2"]),
-    },
-    // Exponential VSM (`light{i}.evsm`): (pos, pos², neg, neg²) of the warped depth; EVSM2 in
-    // Rg32Float keeps the first two.
-    KindChannels {
-        kind: "evsm",
-        naming: ChannelNaming::Fixed(&["pos", "pos2", "neg", "neg2"]),
-    },
-    // Future: EVSM2/EVSM4 should they become resource kinds of their own.
-    KindChannels {
-        kind: "evsm2",
-        naming: ChannelNaming::Fixed(&["pos", "pos2"]),
-    },
-    KindChannels {
-        kind: "evsm4",
-        naming: ChannelNaming::Fixed(&["pos", "pos2", "neg", "neg2"]),
-    },
-    // Exponential shadow map (`light{i}.esm`), stored in log form c·z = log(exp(c·z)) so that
-    // blurring (log-sum-exp) never overflows.
-    KindChannels {
-        kind: "esm",
-        naming: ChannelNaming::Fixed(&["log_exp"]),
-    },
-    // Moment shadow maps: the four power moments b1..b4 (f32), or their optimized
-    // quantization (16-bit storage), named alike.
-    KindChannels {
-        kind: "msm",
-        naming: ChannelNaming::Fixed(&["b1", "b2", "b3", "b4"]),
-    },
-    // Convolution shadow maps: the Fourier basis in chunks `csm0`, `csm1`, … of two terms.
-    KindChannels {
-        kind: "csm",
-        naming: ChannelNaming::Fourier,
     },
 ];
 
@@ -143,22 +85,26 @@ pub fn resource_kind(resource: &str) -> Option<&str> {
     rest.split('.').next().filter(|k| !k.is_empty())
 }
 
-/// Looks `kind` up in [`CHANNEL_TABLE`]: an exact match, else a [`ChannelNaming::Fourier`]
-/// row whose kind is `kind` without its trailing chunk index. Returns the row and the index.
-fn lookup(kind: &str) -> Option<(&'static KindChannels, usize)> {
-    if let Some(row) = CHANNEL_TABLE.iter().find(|r| r.kind == kind) {
+/// Every kind with named channels: the light's own, then each technique's.
+fn kinds() -> impl Iterator<Item = &'static MapChannels> {
+    LIGHT_MAPS.iter().chain(map_kinds())
+}
+
+/// Looks `kind` up in [`kinds`]: an exact match, else a [`ChannelNaming::Fourier`] row whose
+/// kind is `kind` without its trailing chunk index. Returns the row and the index.
+fn lookup(kind: &str) -> Option<(&'static MapChannels, usize)> {
+    if let Some(row) = kinds().find(|r| r.kind == kind) {
         return Some((row, 0));
     }
     let base = kind.trim_end_matches(|c: char| c.is_ascii_digit());
     let chunk = kind[base.len()..].parse().ok()?;
-    CHANNEL_TABLE
-        .iter()
+    kinds()
         .find(|r| r.kind == base && matches!(r.naming, ChannelNaming::Fourier))
         .map(|r| (r, chunk))
 }
 
-/// The names of the channels of `resource` worth dumping, from its kind (see
-/// [`CHANNEL_TABLE`]); their count may be below `channels` (padding is dropped). Unknown kinds
+/// The names of the channels of `resource` worth dumping, from its kind (the light's maps and
+/// each technique's entry, [`crate::technique::TechniqueDef::maps`]); their count may be below `channels` (padding is dropped). Unknown kinds
 /// get `c0`, `c1`, … (`depth` for depth formats).
 pub fn channel_names(resource: &str, format: wgpu::TextureFormat, channels: usize) -> Vec<String> {
     let generic = || -> Vec<String> {

@@ -349,7 +349,7 @@ impl Prefilter {
 
     /// The face layout of the stage's technique on `face`-texel faces, or why there is none.
     fn point_layout(&self, face: u32) -> Result<crate::model::point::PointLayout> {
-        crate::model::point::reach(&self.config.technique, face)
+        crate::technique::reach(&self.config.technique, face)
             .and_then(|r| crate::model::point::PointLayout::new(face, r))
             .map_err(|message| {
                 StageError::Config {

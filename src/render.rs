@@ -43,7 +43,7 @@ impl FrameGpu {
     }
 }
 
-/// A point light whose technique its faces cannot bound (`model::point::reach`), or whose
+/// A point light whose technique its faces cannot bound (`technique::reach`), or whose
 /// guard band leaves less than half a face, is refused: scene files are checked when they
 /// load, this catches a light built or changed in code.
 pub(crate) fn check_point(i: usize, light: &Light) -> Result<()> {

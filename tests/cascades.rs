@@ -345,7 +345,7 @@ fn soft_cascades_keep_one_reach_inside_their_maps() {
                     rng.random_range(-0.4..0.1),
                     rng.random_range(-1.0..1.0),
                 );
-            let guard = shadowgraph::model::cascades::guard(&scene.lights[0]);
+            let guard = shadowgraph::technique::cascade_guard(&scene.lights[0]);
             let reach = f64::from(guard.world);
             assert!(
                 (reach - 2.8).abs() < 1e-5,

@@ -10,6 +10,7 @@ use rand::{Rng, SeedableRng};
 use shadowgraph::model::point::{self, PointLayout};
 use shadowgraph::render::{RenderOptions, Renderer};
 use shadowgraph::scene::{Filter, PcfKernel, Scene, Technique};
+use shadowgraph::technique::reach;
 use shadowgraph::truth::emitter;
 use shadowgraph::truth::raycast::ray_cast_truth;
 
@@ -71,16 +72,16 @@ fn each_direction_lands_in_its_faces_core() {
 #[test]
 fn guard_bands_follow_each_techniques_reach() {
     let pcf = |radius, kernel| Technique::Pcf { radius, kernel };
-    assert_eq!(point::reach(&Technique::Hard, 512), Ok(1.0));
-    assert_eq!(point::reach(&pcf(3, PcfKernel::Tent), 512), Ok(4.0));
-    assert_eq!(point::reach(&pcf(3, PcfKernel::Hardware), 512), Ok(1.0));
+    assert_eq!(reach(&Technique::Hard, 512), Ok(1.0));
+    assert_eq!(reach(&pcf(3, PcfKernel::Tent), 512), Ok(4.0));
+    assert_eq!(reach(&pcf(3, PcfKernel::Hardware), 512), Ok(1.0));
     let pcss = Technique::Pcss {
         blocker_samples: 16,
         filter_samples: 32,
         max_search: 0.02,
     };
     // 0.02 of a 512-texel face: 10.24 texels of search (and, on a point light, of filter).
-    assert!((point::reach(&pcss, 512).unwrap() - 11.24).abs() < 1e-4);
+    assert!((reach(&pcss, 512).unwrap() - 11.24).abs() < 1e-4);
     assert_eq!(PointLayout::new(512, 11.24).unwrap().guard, 13);
     // A mip chain read at width 8 (level 3) needs faces that are a multiple of 8.
     let esm = |width| Technique::Esm {
@@ -90,8 +91,8 @@ fn guard_bands_follow_each_techniques_reach() {
         },
         exponent: 40.0,
     };
-    assert_eq!(point::reach(&esm(8.0), 512), Ok(16.0));
-    assert!(point::reach(&esm(8.0), 300).is_err());
+    assert_eq!(reach(&esm(8.0), 512), Ok(16.0));
+    assert!(reach(&esm(8.0), 300).is_err());
     // A guard band past a quarter of the face is refused.
     assert!(PointLayout::new(64, 16.0).is_err());
     assert!(PointLayout::new(64, 15.0).is_ok());

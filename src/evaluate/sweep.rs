@@ -106,14 +106,14 @@ pub fn sweep(scene: &Scene, opts: &EvaluateOptions) -> Result<Vec<Config>> {
             .find(|t| t.name() == def.name);
         swept(def, own, &knobs, &mut out)?;
     }
-    // A point light's faces bound only some techniques' reach (`model::point::reach`).
+    // A point light's faces bound only some techniques' reach (`technique::reach`).
     out.retain(|c| {
         scene
             .lights
             .iter()
             .filter(|l| l.kind == crate::model::LightKind::Point)
             .all(|_| {
-                crate::model::point::reach(&c.technique, c.shadow_map)
+                crate::technique::reach(&c.technique, c.shadow_map)
                     .and_then(|r| crate::model::point::PointLayout::new(c.shadow_map, r))
                     .is_ok()
             })

@@ -92,35 +92,6 @@ impl SliceGuard {
     }
 }
 
-/// The guard band of a cascaded directional `light`'s maps. PCSS and the soft techniques:
-/// their reach `R` in world units — the cap on search and filter radius that `max_search`
-/// sets on the light's one map (`max_search · 2·extent`), or the widest radius they can
-/// read, `0.5 · size · (far − near) / near` (the penumbra of a blocker at the near plane over
-/// a receiver at the far one; every search radius is smaller), whichever is less — plus the
-/// texels their lookups read past a radius ([`super::point::texels_past_radius`], as a point
-/// light's faces), one for the snapped centre (half a texel each
-/// way) and the normal offset (`normal_bias` texels). The other techniques keep the slice's
-/// bounding sphere (their filters read a few texels around receivers that lie inside it).
-pub fn guard(light: &super::Light) -> SliceGuard {
-    let t = &light.shadow.technique;
-    let (Some(max_search), Some(taps), super::LightKind::Directional { extent }) = (
-        t.max_search(),
-        super::point::texels_past_radius(t),
-        light.kind,
-    ) else {
-        return SliceGuard::NONE;
-    };
-    let widest = if light.near > 0.0 {
-        0.5 * light.size * (light.far - light.near) / light.near
-    } else {
-        f32::INFINITY
-    };
-    SliceGuard {
-        world: (max_search * 2.0 * extent).min(widest),
-        texels: taps + 1.0 + light.shadow.normal_bias.max(0.0),
-    }
-}
-
 /// `light` moved across its direction so that its axis passes through `slice`'s centre, with
 /// the slice's (guarded) radius as its half-width and, for PCSS and the soft techniques, the
 /// guard's world reach as `max_search` in its own map's UV.

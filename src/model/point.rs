@@ -20,7 +20,7 @@
 
 use glam::{DVec3, Mat4, Vec3};
 
-use super::{Filter, PcfKernel, Technique};
+use super::Filter;
 
 /// Faces of a point light's map.
 pub const FACES: u32 = 6;
@@ -111,55 +111,11 @@ impl PointLayout {
     }
 }
 
-/// The texels PCSS's and the soft techniques' lookups read past their radius (capped at
-/// `max_search`): PCSS's taps take the nearest texel (1); a table's window rounds its edges
-/// to texels and snaps the blocker window outward (2). `None` for the other techniques.
-/// Shared by a point light's faces ([`reach`]) and a cascade's guard band
-/// ([`super::cascades::guard`]).
-pub fn texels_past_radius(technique: &Technique) -> Option<f32> {
-    match technique {
-        Technique::Pcss { .. } => Some(1.0),
-        Technique::Cssm { .. } | Technique::Vssm { .. } | Technique::MsmSoft { .. } => Some(2.0),
-        _ => None,
-    }
-}
-
-/// How far around a receiver's texel `technique`'s lookup reads a point light's map, in
-/// face texels, counting what its prefilter folded into the texels it reads (`face`: the face's
-/// side); an error says why a technique cannot be bounded to one face.
-pub fn reach(technique: &Technique, face: u32) -> Result<f32, String> {
-    let soft = |max_search: f32| (2.0 * max_search * face as f32).clamp(1.0, face as f32) * 0.5;
-    match *technique {
-        Technique::Hard => Ok(1.0),
-        Technique::Pcf { radius, kernel } => Ok(match kernel {
-            PcfKernel::Hardware => 1.0,
-            PcfKernel::Box | PcfKernel::Tent => radius as f32 + 1.0,
-        }),
-        // The search radius and (on a point light) the filter radius are capped at max_search,
-        // and so is a soft technique's window (at most max_width texels); see
-        // texels_past_radius for what each reads beyond.
-        Technique::Pcss { .. } | Technique::Cssm { .. } | Technique::Vssm { .. } | Technique::MsmSoft { .. } => {
-            let past = texels_past_radius(technique).unwrap_or(0.0);
-            Ok(soft(technique.max_search().unwrap_or(0.0)) + past)
-        }
-        Technique::Vsm { prefilter, .. }
-        | Technique::Evsm { prefilter, .. }
-        | Technique::Msm { prefilter, .. }
-        | Technique::Csm { prefilter, .. } => filter_reach(prefilter.filter, face),
-        Technique::Esm { filter, .. } => filter_reach(filter, face),
-        Technique::Smrt { .. } => Err(
-            "point lights do not support \"smrt\": its rays march across the map toward the emitter's far side, which a face's guard band does not bound".into(),
-        ),
-        Technique::Midpoint { .. } | Technique::SecondDepth { .. } => Err(format!(
-            "point lights do not support \"{}\": the peeled second-depth pass draws one map, not six faces",
-            technique.name()
-        )),
-    }
-}
-
-/// [`reach`] of a prefilter: the bilinear tap, plus the blur's radius, the table's half box,
-/// or the mip level's texel span.
-fn filter_reach(filter: Filter, face: u32) -> Result<f32, String> {
+/// How far around a receiver's texel a prefilter's lookup reads a point light's map, in face
+/// texels (`face`: the face's side): the bilinear tap, plus the blur's radius, the table's half
+/// box, or the mip level's texel span; an error where it cannot be bounded to one face. A
+/// technique's whole reach is its registry entry's (`technique::reach`).
+pub fn filter_reach(filter: Filter, face: u32) -> Result<f32, String> {
     match filter {
         Filter::None => Ok(1.0),
         Filter::Blur { radius, .. } => Ok(radius.ceil() + 1.0),

@@ -27,7 +27,7 @@ use glam::{Mat4, Vec3, Vec4Swizzles};
 use super::{LightGpu, LightParams, PrefilterConfig};
 use crate::error::StageError;
 pub use crate::model::cascades::{CascadeCamera, MAX_CASCADES, split_distances};
-use crate::model::cascades::{SliceGuard, cascade_light, fit_slices, guard, light_rotation};
+use crate::model::cascades::{SliceGuard, cascade_light, fit_slices, light_rotation};
 
 /// How the cascades are laid out.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -132,7 +132,7 @@ pub fn fit_light_cascades(
     }
     let (config, _) = config.validated()?;
     let base = light.scene_light(&config, config.size);
-    let band = guard(&base);
+    let band = crate::technique::cascade_guard(&base);
     let c = config.cascades;
     let slices = fit_slices(
         camera,

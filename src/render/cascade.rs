@@ -17,9 +17,7 @@
 use glam::{Mat4, Vec3};
 
 use crate::error::{Error, Result};
-use crate::model::cascades::{
-    CascadeCamera, CascadeSlice, SliceGuard, cascade_light, fit_slices, guard,
-};
+use crate::model::cascades::{CascadeCamera, CascadeSlice, SliceGuard, cascade_light, fit_slices};
 use crate::model::{Cascades, Light, LightKind};
 use crate::scene::Scene;
 use crate::technique::{CascadeGroup, LightGpu};
@@ -143,7 +141,7 @@ pub fn drawn_lights(scene: &Scene) -> Result<DrawnLights> {
             )
         })?;
         let camera = cascade_camera(scene)?;
-        let guard = guard(light);
+        let guard = crate::technique::cascade_guard(light);
         let slices = fit_slices(
             &camera,
             light.direction(),

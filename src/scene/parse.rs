@@ -279,11 +279,11 @@ fn light(ctx: &Ctx, i: usize, l: &LightFile) -> Result<Light> {
     Ok(light)
 }
 
-/// A cascaded light's guard band (`model::cascades::guard`: PCSS and the soft techniques) must
+/// A cascaded light's guard band (`technique::cascade_guard`: PCSS and the soft techniques) must
 /// leave at least half of each cascade's map, as a point light's faces must; named with the
 /// line of `normal_bias` (most of a wide band's texels) or of the technique.
 fn cascade_band(ctx: &Ctx, i: usize, l: &LightFile, light: &Light) -> Result<()> {
-    let guard = crate::model::cascades::guard(light);
+    let guard = crate::technique::cascade_guard(light);
     let map = light.shadow_map as f32;
     if 4.0 * guard.texels <= map {
         return Ok(());
@@ -330,11 +330,11 @@ fn directional_keys(ctx: &Ctx, i: usize, s: &ShadowFile, kind: LightKind) -> Res
 }
 
 /// What a point light's six faces refuse: techniques whose reach no guard band bounds
-/// (`model::point::reach`), naming the technique's line.
+/// (`technique::reach`), naming the technique's line.
 fn point_support(ctx: &Ctx, i: usize, l: &LightFile, shadow: &Shadow, face: u32) -> Result<()> {
     let key = |k: &str| format!("light[{i}].{k}");
     let file = l.shadow.as_ref();
-    let reach = crate::model::point::reach(&shadow.technique, face);
+    let reach = crate::technique::reach(&shadow.technique, face);
     if let Err(why) = reach.and_then(|r| crate::model::point::PointLayout::new(face, r)) {
         let span = file
             .map(|s| s.technique.span())

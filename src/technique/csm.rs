@@ -1,6 +1,7 @@
 //! `csm`: convolution shadow maps (Annen et al. 2007), Fourier basis sin(c_k z), cos(c_k z),
 //! k = 1..M, in ⌈M/2⌉ four-channel maps.
 
+use super::encoding::{CSM_MAPS, Encoding};
 use super::params::{CSM, FILTER, FLOAT_FORMAT, prefilter, prefilter_values};
 use super::sweep_plan::{SweepPlan, SweptStorages, SweptTerms};
 use super::{TechniqueDef, no_clamp};
@@ -212,6 +213,14 @@ pub(super) fn csm_nodes(
     out
 }
 
+/// CSM's basis of `terms` terms.
+fn csm_encoding(t: &Technique) -> Option<Encoding> {
+    match *t {
+        Technique::Csm { terms, .. } => Some(Encoding::Csm { terms }),
+        _ => None,
+    }
+}
+
 /// `csm`.
 pub(super) static DEF: TechniqueDef = TechniqueDef {
     name: "csm",
@@ -242,6 +251,11 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     value_range: |_| ([-1.0; 4], [1.0; 4]),
     clamp: no_clamp,
     area_light: false,
+    reach: super::reach::filtered,
+    texels_past_radius: None,
+    cascades: Ok(()),
+    encoding: csm_encoding,
+    maps: &[CSM_MAPS],
     example: "scenes/techniques/csm.toml",
     colour: [0xff, 0x7f, 0x0e],
     // The knobs at M = 8 (4 when quick); the other M with the first filter.

@@ -7,6 +7,8 @@
 
 use super::csm::{basis_sequence, series_values};
 use super::csm_sat::TableRef;
+use super::encoding::CSM_MAPS;
+use super::no_encoding;
 use super::params::{CSM, FLOAT_FORMAT, SOFT, choice, float, soft, soft_values};
 use super::sweep_plan::{SweepPlan, SweepVariant};
 use super::{TechniqueDef, no_clamp};
@@ -307,6 +309,11 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     value_range: |_| ([-1.0; 4], [1.0; 4]),
     clamp: no_clamp,
     area_light: true,
+    reach: super::reach::searched,
+    texels_past_radius: Some(2.0),
+    cascades: Ok(()),
+    encoding: no_encoding,
+    maps: &[CSM_MAPS],
     example: "scenes/techniques/cssm.toml",
     colour: [0xe3, 0x77, 0xc2],
     sweep: SweepPlan::Variants {

@@ -3,6 +3,7 @@
 
 use super::TechniqueDef;
 use super::csm_sat::{Moments, moment_table_nodes};
+use super::encoding::{ChannelNaming, Encoding, MapChannels};
 use super::no_variant;
 use super::params::{
     Clamp, ClampReason, FILTER, clamp, filter, filter_values, float, sat_exponent_limit,
@@ -64,6 +65,21 @@ fn nodes(n: &mut super::LightNodes) -> ShadeInput {
     )
 }
 
+/// ESM's `c·z`.
+fn esm_encoding(t: &Technique) -> Option<Encoding> {
+    match *t {
+        Technique::Esm { exponent, .. } => Some(Encoding::Esm { exponent }),
+        _ => None,
+    }
+}
+
+/// ESM's map (`light{i}.esm`), stored in log form `c·z = log(exp(c·z))` so that blurring
+/// (log-sum-exp) never overflows.
+const ESM_MAPS: MapChannels = MapChannels {
+    kind: "esm",
+    naming: ChannelNaming::Fixed(&["log_exp"]),
+};
+
 /// `esm`.
 pub(super) static DEF: TechniqueDef = TechniqueDef {
     name: "esm",
@@ -90,6 +106,11 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     value_range: |_| ([-1.0, 0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]),
     clamp: clamp_exponent,
     area_light: false,
+    reach: super::reach::filtered,
+    texels_past_radius: None,
+    cascades: Ok(()),
+    encoding: esm_encoding,
+    maps: &[ESM_MAPS],
     example: "scenes/techniques/esm.toml",
     colour: [0x94, 0x67, 0xbd],
     sweep: SweepPlan::Prefiltered {

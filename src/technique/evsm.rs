@@ -3,6 +3,7 @@
 
 use super::TechniqueDef;
 use super::csm_sat::{Moments, moment_table_nodes};
+use super::encoding::{ChannelNaming, Encoding, MapChannels};
 use super::no_variant;
 use super::nodes::moments_format;
 use super::params::{
@@ -171,6 +172,35 @@ fn value_range(t: &Technique) -> ([f32; 4], [f32; 4]) {
     (hi.map(|v| -v), hi)
 }
 
+/// EVSM's exponents.
+fn evsm_encoding(t: &Technique) -> Option<Encoding> {
+    match *t {
+        Technique::Evsm {
+            exp_pos, exp_neg, ..
+        } => Some(Encoding::Evsm { exp_pos, exp_neg }),
+        _ => None,
+    }
+}
+
+/// EVSM's map (`light{i}.evsm`): (pos, pos², neg, neg²) of the warped depth; EVSM2's two
+/// channels keep the first two.
+const EVSM_MAPS: MapChannels = MapChannels {
+    kind: "evsm",
+    naming: ChannelNaming::Fixed(&["pos", "pos2", "neg", "neg2"]),
+};
+
+/// EVSM2's channels under its own name, should it become a resource kind of its own.
+const EVSM2_MAPS: MapChannels = MapChannels {
+    kind: "evsm2",
+    naming: ChannelNaming::Fixed(&["pos", "pos2"]),
+};
+
+/// EVSM4's channels under its own name, likewise.
+const EVSM4_MAPS: MapChannels = MapChannels {
+    kind: "evsm4",
+    naming: ChannelNaming::Fixed(&["pos", "pos2", "neg", "neg2"]),
+};
+
 /// `evsm2`.
 pub(super) static EVSM2: TechniqueDef = TechniqueDef {
     name: "evsm2",
@@ -188,6 +218,11 @@ pub(super) static EVSM2: TechniqueDef = TechniqueDef {
     value_range,
     clamp: clamp_exponents,
     area_light: false,
+    reach: super::reach::filtered,
+    texels_past_radius: None,
+    cascades: Ok(()),
+    encoding: evsm_encoding,
+    maps: &[EVSM_MAPS, EVSM2_MAPS],
     example: "scenes/techniques/evsm2.toml",
     colour: [0xbc, 0xbd, 0x22],
     sweep: SweepPlan::Prefiltered {
@@ -213,6 +248,11 @@ pub(super) static EVSM4: TechniqueDef = TechniqueDef {
     value_range,
     clamp: clamp_exponents,
     area_light: false,
+    reach: super::reach::filtered,
+    texels_past_radius: None,
+    cascades: Ok(()),
+    encoding: evsm_encoding,
+    maps: &[EVSM_MAPS, EVSM4_MAPS],
     example: "scenes/techniques/evsm4.toml",
     colour: [0x8c, 0x56, 0x4b],
     sweep: SweepPlan::Prefiltered {

@@ -1,5 +1,6 @@
 //! `hard`: one comparison at the nearest texel.
 
+use super::no_encoding;
 use super::shade::call;
 use super::sweep_plan::SweepPlan;
 use super::{TechniqueDef, no_clamp};
@@ -25,6 +26,11 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     value_range: unit_range,
     clamp: no_clamp,
     area_light: false,
+    reach: super::reach::one_texel,
+    texels_past_radius: None,
+    cascades: Ok(()),
+    encoding: no_encoding,
+    maps: &[],
     example: "scenes/grazing.toml",
     colour: [0x44, 0x44, 0x44],
     sweep: SweepPlan::Defaults,

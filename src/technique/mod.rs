@@ -9,6 +9,7 @@ mod cascade_shade;
 mod csm;
 mod csm_sat;
 mod cssm;
+mod encoding;
 mod esm;
 mod evsm;
 mod given;
@@ -20,6 +21,7 @@ mod nodes;
 pub mod params;
 mod pcf;
 mod pcss;
+mod reach;
 mod reference;
 mod second_depth;
 mod shade;
@@ -41,6 +43,8 @@ pub use csm_sat::{
     CsmBasis, CsmSatParams, INTERLEAVED_MAX_WIDTH, MomentTable, Moments, add_csm_tables,
     add_moment_table, basis_interleave, basis_table,
 };
+use encoding::no_encoding;
+pub use encoding::{ChannelNaming, Encoding, MapChannels, encoding, map_kinds};
 use light_gpu::unit_range;
 pub use light_gpu::{sat_coding, sat_variant, soft_lookup_area, soft_max_width, soft_width_cap};
 pub use msm::msm_quantized;
@@ -50,6 +54,7 @@ pub use nodes::{
     map_tables, map_type, maps_packed, moments_format,
 };
 pub use params::{Clamp, ClampReason, sat_exponent_limit};
+pub use reach::{cascade_guard, reach, texels_past_radius};
 pub use reference::parameters_markdown;
 pub use second_depth::{peels, second_depth_name};
 pub use shade::{
@@ -95,6 +100,22 @@ pub struct TechniqueDef {
     pub value_range: fn(&Technique) -> ([f32; 4], [f32; 4]),
     /// Whether it needs an area light (`size` > 0): PCSS and the soft techniques.
     pub area_light: bool,
+    /// How far around a receiver's texel its lookup reads a point light's face, in face texels
+    /// (`face`: the face's side), counting what its prefilter folded into the texels it reads:
+    /// the faces' guard band rests on it ([`reach()`]). An error says why a face cannot bound it.
+    pub reach: fn(&Technique, u32) -> Result<f32, String>,
+    /// The texels its lookup reads past its search radius (capped at `max_search`): PCSS's taps
+    /// take the nearest texel (1), a table's window rounds its edges to texels and snaps the
+    /// blocker window outward (2); `None` without a search. A point light's reach and a
+    /// cascade's guard band ([`cascade_guard`]) add it.
+    pub texels_past_radius: Option<f32>,
+    /// Whether it works in cascades (`cascades` > 1): `Err` says why not.
+    pub cascades: Result<(), &'static str>,
+    /// The encoding its maps store (the prefiltered techniques), with the parameters its f64
+    /// reference takes; `None` for techniques that read the depth or build a table from it.
+    pub encoding: fn(&Technique) -> Option<Encoding>,
+    /// The channel names of the maps it adds, by resource kind (`shadowgraph dump`).
+    pub maps: &'static [MapChannels],
     /// A scene that shows it.
     pub example: &'static str,
     /// Its colour in the evaluation's plots (sRGB), so families read at a glance.

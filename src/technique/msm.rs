@@ -2,6 +2,7 @@
 //! optimized 16-bit quantization; Hamburger or Hausdorff reconstruction.
 
 use super::csm_sat::{Moments, moment_table_nodes};
+use super::encoding::{Encoding, MSM_MAPS};
 use super::light_gpu::quantized_msm_range;
 use super::nodes::{LightNodes, moments_format};
 use super::params::{FILTER, MSM, MSM_FORMAT, prefilter, prefilter_values, storage};
@@ -155,6 +156,15 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     value_range,
     clamp: no_clamp,
     area_light: false,
+    reach: super::reach::filtered,
+    texels_past_radius: None,
+    cascades: Ok(()),
+    encoding: |t| {
+        Some(Encoding::Msm {
+            quantized: msm_quantized(t),
+        })
+    },
+    maps: &[MSM_MAPS],
     example: "scenes/techniques/msm.toml",
     colour: [0xd6, 0x27, 0x28],
     sweep: SweepPlan::Prefiltered {

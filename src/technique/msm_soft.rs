@@ -1,8 +1,10 @@
 //! `msm_soft`: moment soft shadow maps (after Peters et al. 2016): the blocker depth from the
 //! four moments over the search square, then MSM at the penumbra width.
 
+use super::encoding::MSM_MAPS;
 use super::msm::{moment_bias, msm_values};
 use super::msm::{moments, msm_gpu, value_range};
+use super::no_encoding;
 use super::no_variant;
 use super::params::{MSM, MSM_FORMAT, SOFT, soft, soft_values, storage};
 use super::shade::soft_call;
@@ -50,6 +52,11 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     value_range,
     clamp: no_clamp,
     area_light: true,
+    reach: super::reach::searched,
+    texels_past_radius: Some(2.0),
+    cascades: Ok(()),
+    encoding: no_encoding,
+    maps: &[MSM_MAPS],
     example: "scenes/techniques/msm_soft.toml",
     colour: [0x8b, 0x00, 0x00],
     sweep: SweepPlan::Variants {

@@ -580,19 +580,12 @@ pub fn cascades(v: &ParamValues) -> crate::model::Cascades {
     c
 }
 
-/// Whether a technique works in cascades: `Err` says why not. PCSS and the soft techniques
+/// Whether a technique works in cascades: `Err` says why not (its entry's
+/// [`super::TechniqueDef::cascades`]). PCSS and the soft techniques
 /// size search and penumbra in world units from the light's depths, which every cascade keeps,
-/// and each cascade's map carries a guard band of their reach (`model::cascades::guard`); the
+/// and each cascade's map carries a guard band of their reach (`technique::cascade_guard`); the
 /// second-depth techniques peel each cascade's depth as a light's (every cascade is a drawn
 /// light); SMRT's rays march across the map toward the emitter's far side, which no band bounds.
 pub fn cascade_support(t: &crate::model::Technique) -> Result<(), &'static str> {
-    use crate::model::Technique as T;
-    match t {
-        T::Smrt { .. } => Err(
-            "its rays march across the map toward the emitter's far side, which a cascade's guard band does not bound; use pcss, vssm, msm_soft or cssm",
-        ),
-        T::Hard | T::Pcf { .. } | T::Vsm { .. } | T::Evsm { .. } | T::Esm { .. } => Ok(()),
-        T::Msm { .. } | T::Csm { .. } | T::Midpoint { .. } | T::SecondDepth { .. } => Ok(()),
-        T::Pcss { .. } | T::Cssm { .. } | T::Vssm { .. } | T::MsmSoft { .. } => Ok(()),
-    }
+    super::of(t).cascades
 }

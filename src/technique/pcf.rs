@@ -4,7 +4,7 @@ use super::params::{choice, int};
 use super::shade::{ShadeInput, VisibilityBody, call, first};
 use super::sweep_plan::SweepPlan;
 use super::unit_range;
-use super::{TechniqueDef, no_clamp};
+use super::{TechniqueDef, no_clamp, no_encoding};
 use crate::gpu_data::LightGpu;
 use crate::gpu_data::TECHNIQUE_PCF;
 use crate::model::Light;
@@ -106,6 +106,19 @@ fn visibility(light: &Light, maps: &[String]) -> VisibilityBody {
     call("shared/vis_pcf", "vis_pcf", maps)
 }
 
+/// PCF's reach: the window's radius and the bilinear tap (the hardware kernel's 2 × 2 taps: one
+/// texel).
+fn pcf_reach(t: &Technique, _: u32) -> Result<f32, String> {
+    Ok(match *t {
+        Technique::Pcf {
+            kernel: PcfKernel::Hardware,
+            ..
+        } => 1.0,
+        Technique::Pcf { radius, .. } => radius as f32 + 1.0,
+        _ => 1.0,
+    })
+}
+
 /// `pcf`.
 pub(super) static DEF: TechniqueDef = TechniqueDef {
     name: "pcf",
@@ -134,6 +147,11 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     value_range: unit_range,
     clamp: no_clamp,
     area_light: false,
+    reach: pcf_reach,
+    texels_past_radius: None,
+    cascades: Ok(()),
+    encoding: no_encoding,
+    maps: &[],
     example: "scenes/bunny.toml",
     colour: [0x1f, 0x77, 0xb4],
     sweep: SweepPlan::Radii {

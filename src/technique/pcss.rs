@@ -1,5 +1,6 @@
 //! `pcss`: percentage-closer soft shadows (Fernando 2005).
 
+use super::no_encoding;
 use super::params::{float, int};
 use super::shade::call;
 use super::sweep_plan::SweepPlan;
@@ -68,6 +69,11 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     value_range: unit_range,
     clamp: no_clamp,
     area_light: true,
+    reach: super::reach::searched,
+    texels_past_radius: Some(1.0),
+    cascades: Ok(()),
+    encoding: no_encoding,
+    maps: &[],
     example: "scenes/colonnade.toml",
     colour: [0x17, 0xbe, 0xcf],
     // PCSS as engines ship it, at several tap counts (blocker search + filter).

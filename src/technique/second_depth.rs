@@ -7,6 +7,7 @@
 //! such as the ground, an open mesh's rim, the map's empty texels) a texel holds the far plane
 //! in both modes: nothing lies behind its first surface, which is lit.
 
+use super::no_encoding;
 use super::params::{choice, int};
 use super::shade::{VisibilityBody, call};
 use super::sweep_plan::SweepPlan;
@@ -136,6 +137,14 @@ fn gpu(t: &Technique, g: &mut LightGpu) {
     g.kernel = u32::from(kernel == PcfKernel::Tent);
 }
 
+/// The peeled techniques cannot draw a point light's six faces.
+fn peel_reach(t: &Technique, _: u32) -> Result<f32, String> {
+    Err(format!(
+        "point lights do not support \"{}\": the peeled second-depth pass draws one map, not six faces",
+        t.name()
+    ))
+}
+
 /// `midpoint`.
 pub(super) static MIDPOINT: TechniqueDef = TechniqueDef {
     name: "midpoint",
@@ -154,6 +163,11 @@ pub(super) static MIDPOINT: TechniqueDef = TechniqueDef {
     value_range: unit_range,
     clamp: no_clamp,
     area_light: false,
+    reach: peel_reach,
+    texels_past_radius: None,
+    cascades: Ok(()),
+    encoding: no_encoding,
+    maps: &[],
     example: "scenes/techniques/midpoint.toml",
     colour: [0x8c, 0x56, 0x4b],
     sweep: SweepPlan::Defaults,
@@ -177,6 +191,11 @@ pub(super) static SECOND_DEPTH: TechniqueDef = TechniqueDef {
     value_range: unit_range,
     clamp: no_clamp,
     area_light: false,
+    reach: peel_reach,
+    texels_past_radius: None,
+    cascades: Ok(()),
+    encoding: no_encoding,
+    maps: &[],
     example: "scenes/techniques/second_depth.toml",
     colour: [0xc4, 0x9c, 0x94],
     sweep: SweepPlan::Defaults,

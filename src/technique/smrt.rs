@@ -2,6 +2,7 @@
 //! EEVEE-Next: rays toward fixed stratified points on the emitter, each marched through the one
 //! linear depth map (`kernels/shared/vis_smrt.wgsl`).
 
+use super::no_encoding;
 use super::params::{float, int};
 use super::shade::call;
 use super::sweep_plan::{SweepPlan, SweepVariant};
@@ -55,6 +56,11 @@ const fn counts(
     }
 }
 
+/// SMRT cannot be bounded to a point light's face.
+fn smrt_reach(_: &Technique, _: u32) -> Result<f32, String> {
+    Err("point lights do not support \"smrt\": its rays march across the map toward the emitter's far side, which a face's guard band does not bound".into())
+}
+
 /// `smrt`.
 pub(super) static DEF: TechniqueDef = TechniqueDef {
     name: "smrt",
@@ -88,6 +94,13 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     value_range: unit_range,
     clamp: no_clamp,
     area_light: true,
+    reach: smrt_reach,
+    texels_past_radius: None,
+    cascades: Err(
+        "its rays march across the map toward the emitter's far side, which a cascade's guard band does not bound; use pcss, vssm, msm_soft or cssm",
+    ),
+    encoding: no_encoding,
+    maps: &[],
     example: "scenes/techniques/smrt.toml",
     colour: [0xbc, 0xbd, 0x22],
     // UE5's default first (at every map size), then fewer and more rays and steps.

@@ -1,6 +1,7 @@
 //! `vsm`: variance shadow maps (Donnelly & Lauritzen 2006), moments (z, z²), filtered.
 
 use super::csm_sat::{Moments, moment_table_nodes};
+use super::encoding::{Encoding, VSM_MAPS};
 use super::nodes::{LightNodes, moments_format};
 use super::params::{FILTER, FLOAT_FORMAT, float, prefilter, prefilter_values};
 use super::shade::{ShadeInput, prefiltered};
@@ -107,6 +108,11 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     value_range: unit_range,
     clamp: no_clamp,
     area_light: false,
+    reach: super::reach::filtered,
+    texels_past_radius: None,
+    cascades: Ok(()),
+    encoding: |_| Some(Encoding::Vsm),
+    maps: &[VSM_MAPS],
     example: "scenes/techniques/vsm.toml",
     colour: [0x2c, 0xa0, 0x2c],
     sweep: SweepPlan::Prefiltered {

@@ -1,5 +1,7 @@
 //! `vssm`: variance soft shadow maps (Yang et al. 2010) through a summed-area table.
 
+use super::encoding::VSM_MAPS;
+use super::no_encoding;
 use super::params::{FLOAT_FORMAT, SOFT, soft, soft_values};
 use super::shade::soft_call;
 use super::sweep_plan::{SweepPlan, SweepVariant};
@@ -55,6 +57,11 @@ pub(super) static DEF: TechniqueDef = TechniqueDef {
     value_range: unit_range,
     clamp: no_clamp,
     area_light: true,
+    reach: super::reach::searched,
+    texels_past_radius: Some(2.0),
+    cascades: Ok(()),
+    encoding: no_encoding,
+    maps: &[VSM_MAPS],
     example: "scenes/techniques/vssm.toml",
     colour: [0x00, 0x5f, 0x3f],
     sweep: SweepPlan::Variants {
