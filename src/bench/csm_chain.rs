@@ -4,7 +4,8 @@
 //! `csm` storing the nine basis maps four a dispatch, then three table passes per map. The old
 //! chain stays a bench case until the comparison is recorded.
 
-use super::{BenchGraph, bench_light, named, shading_chain};
+use super::cases::named;
+use super::graphs::{BenchGraph, bench_light, shading_chain};
 use crate::gpu_data::{CSM_OUTPUTS, CsmParams, LinearizeParams};
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
 use crate::kernels::KernelId;
