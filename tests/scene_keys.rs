@@ -217,3 +217,21 @@ fn every_common_and_cascade_key_changes_the_light() {
         );
     }
 }
+
+/// A light's `update` of the wrong kind shows its value on one short line: numbers as the
+/// other errors print them (`1e300`, not 301 digits), long arrays cut, a table as `{…}`.
+#[test]
+fn a_bad_update_rate_prints_its_value_briefly() {
+    let spot = "[[light]]\nkind = \"spot\"\nposition = [3.0, 6.0, 2.0]\n\
+                target = [0.0, 0.0, 0.0]\nfov_degrees = 40.0\n";
+    for (value, shown) in [
+        ("[1e300, \"x\"]", "[1e300, \"x\"]"),
+        ("[1, 2, 3, 4, 5e-300]", "[1, 2, 3, 4, …]"),
+        ("{ a = 1e300 }", "{…}"),
+        ("2.5", "2.5"),
+    ] {
+        let text = scene(&format!("{spot}update = {value}\n"));
+        let at = format!("update = {value}");
+        expect(&text, &at, 0, &[&format!("`light[1].update` = {shown}:")]);
+    }
+}

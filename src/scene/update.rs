@@ -73,11 +73,24 @@ pub(super) fn update_rate(
     })
 }
 
-/// A TOML value as the error shows it, on one line.
+/// A TOML value as the error shows it, on one line: numbers as [`super::ctx::fmt_num`] prints
+/// them (never the 300 digits of `1e300`), strings cut at 40 characters, the first four
+/// elements of an array, a table as `{…}`.
 fn shown(v: &toml::Value) -> String {
     match v {
         toml::Value::Float(x) => super::ctx::fmt_num(*x),
+        toml::Value::String(s) if s.chars().count() > 40 => {
+            format!("{:?}…", s.chars().take(40).collect::<String>())
+        }
         toml::Value::String(s) => format!("{s:?}"),
-        other => other.to_string().replace('\n', " "),
+        toml::Value::Array(items) => {
+            let mut parts: Vec<String> = items.iter().take(4).map(shown).collect();
+            if items.len() > 4 {
+                parts.push("…".into());
+            }
+            format!("[{}]", parts.join(", "))
+        }
+        toml::Value::Table(_) => "{…}".into(),
+        other => other.to_string().replace(['\n', '\r'], " "),
     }
 }
