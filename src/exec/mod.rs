@@ -146,7 +146,10 @@ impl Executor {
         self.record_run(device, encoder, plan, imports, &layers, Some(run), timer)
     }
 
-    #[expect(clippy::too_many_arguments, reason = "a run's inputs and the steps it records")]
+    #[expect(
+        clippy::too_many_arguments,
+        reason = "a run's inputs and the steps it records"
+    )]
     fn record_run(
         &mut self,
         device: &wgpu::Device,
