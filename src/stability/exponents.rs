@@ -28,6 +28,7 @@ use crate::graph::Graph;
 use crate::model::ParamValue;
 use crate::sat::{SatCoding, SatVariant, add_sat, float_sum_depth};
 use crate::scene::{BlurKernel, Filter, Scene, Storage, Technique, exponent_limit};
+use crate::technique::{Encoding, encoding};
 
 const MAP: u32 = 64;
 
@@ -389,14 +390,12 @@ pub(crate) fn scene_sat_rows(gpu: &Gpu) -> Result<Vec<Row>> {
             1,
             &linear.data,
         );
-        let (want, exponent) = match technique {
-            Technique::Evsm {
-                exp_pos, exp_neg, ..
-            } => (
+        let (want, exponent) = match encoding(&technique) {
+            Some(Encoding::Evsm { exp_pos, exp_neg }) => (
                 cpu::evsm::evsm(&lin, exp_pos.into(), exp_neg.into()),
                 exp_pos.max(exp_neg),
             ),
-            Technique::Esm { exponent, .. } => {
+            Some(Encoding::Esm { exponent }) => {
                 (cpu::esm::esm_linear(&lin, exponent.into()), exponent)
             }
             _ => return Err(Error::Invalid("case 4 runs exponential techniques".into())),
@@ -469,9 +468,8 @@ fn validator_rows() -> [Row; 2] {
         let limit = f64::from(exponent_limit(storage));
         match Scene::parse(path, &scene_text(shadow)) {
             Ok(scene) => {
-                if let Technique::Evsm {
-                    exp_pos, exp_neg, ..
-                } = scene.lights[0].shadow.technique
+                if let Some(Encoding::Evsm { exp_pos, exp_neg }) =
+                    encoding(&scene.lights[0].shadow.technique)
                 {
                     clamped.compare(f64::from(exp_pos), limit, 0.0, || "exponent_pos".into());
                     if keys == 2 {

@@ -103,8 +103,8 @@ fn receivers(l: &crate::scene::Light, z: f64) -> Vec<(Vec3, Vec3)> {
 /// One technique at one storage: every depth's map, every receiver.
 fn check(gpu: &Gpu, storage: Storage, soft: bool) -> Result<(Check, f32)> {
     let t = technique(storage, soft);
-    let alpha = match t {
-        Technique::Msm { moment_bias, .. } | Technique::MsmSoft { moment_bias, .. } => moment_bias,
+    let alpha = match crate::technique::value(&t, "moment_bias") {
+        Some(crate::model::ParamValue::Float(alpha)) => alpha,
         _ => 0.0,
     };
     let size = if soft { SOFT_MAP } else { MAP };

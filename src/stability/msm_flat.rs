@@ -110,7 +110,7 @@ fn check_map(
     (name, raw, uvs): &SweptMap,
     c: &mut Checks,
 ) -> Result<()> {
-    let Technique::Msm { prefilter, .. } = l.shadow.technique else {
+    let Some(prefilter) = l.shadow.technique.prefilter() else {
         return Ok(());
     };
     let (ran, maps) = run_light(gpu, exec, l, raw)?;

@@ -46,11 +46,8 @@ pub(crate) struct MsmMaps {
 
 /// `technique` with its moment bias set to `alpha`.
 fn with_alpha(technique: Technique, alpha: f32) -> Technique {
-    let mut t = technique;
-    if let Technique::Msm { moment_bias, .. } | Technique::MsmSoft { moment_bias, .. } = &mut t {
-        *moment_bias = alpha;
-    }
-    t
+    let alpha = [("moment_bias", crate::model::ParamValue::Float(alpha))];
+    crate::technique::with_values(&technique, &alpha).unwrap_or(technique)
 }
 
 impl MsmMaps {
@@ -60,8 +57,9 @@ impl MsmMaps {
         let (ran, maps) = run_light(gpu, exec, light, raw)?;
         let linear = ran.texels(gpu, &linear_name(0), 0)?;
         let raw_moments = cpu::msm::msm(&linear, false);
-        let (stored, exact) = match light.shadow.technique {
-            Technique::Msm { prefilter, .. } => {
+        let t = light.shadow.technique;
+        let (stored, exact) = match (t.name(), t.prefilter()) {
+            ("msm", Some(prefilter)) => {
                 let exact = match prefilter.filter {
                     Filter::Blur {
                         radius,
@@ -80,7 +78,7 @@ impl MsmMaps {
                     Exact::Levels(vec![exact]),
                 )
             }
-            Technique::MsmSoft { .. } => {
+            ("msm_soft", _) => {
                 let coding = sat_coding(light)?
                     .ok_or_else(|| Error::Invalid("soft MSM without a table".into()))?;
                 let texture = &ran.outputs.textures[&maps[0]];

@@ -18,7 +18,7 @@ use crate::exec::Executor;
 use crate::gpu::Gpu;
 use crate::render::Renderer;
 use crate::scene::{BlurKernel, Filter, LightKind, Prefilter, Storage, Technique, exponent_limit};
-use crate::technique::{LightGpu, linear_name};
+use crate::technique::{Encoding, LightGpu, encoding, linear_name};
 
 /// Map side: small, a constant map has nothing to resolve.
 const MAP: u32 = 32;
@@ -177,8 +177,8 @@ pub(crate) fn planar_case(gpu: &Gpu) -> Result<Vec<Row>> {
     let mut rows = Vec::new();
     for storage in [Storage::F32, Storage::F16] {
         for (name, technique) in techniques(storage) {
-            let label = match technique {
-                Technique::Evsm { exp_pos, .. } => format!("{name} c={exp_pos}"),
+            let label = match encoding(&technique) {
+                Some(Encoding::Evsm { exp_pos, .. }) => format!("{name} c={exp_pos}"),
                 _ => name.to_string(),
             };
             rows.extend(check_technique(gpu, &mut rng, &label, technique, storage)?);

@@ -22,7 +22,7 @@ use crate::error::Result;
 use crate::exec::Executor;
 use crate::gpu::Gpu;
 use crate::scene::{Filter, Light, LightKind, Storage, Technique};
-use crate::technique::{linear_name, msm_quantized};
+use crate::technique::{Encoding, encoding, linear_name};
 
 /// `(atol, rtol)`.
 type Tol = (f64, f64);
@@ -60,31 +60,28 @@ fn model(t: &Technique) -> Option<Model> {
         mixed_sign,
         log,
     };
-    Some(match *t {
-        Technique::Vsm { .. } => m(Box::new(cpu::vsm::vsm), (1e-6, 1e-6), false, None),
-        Technique::Evsm {
-            exp_pos, exp_neg, ..
-        } => {
+    // The encoding the technique's entry declares, with its f64 reference and error model.
+    Some(match encoding(t)? {
+        Encoding::Vsm => m(Box::new(cpu::vsm::vsm), (1e-6, 1e-6), false, None),
+        Encoding::Evsm { exp_pos, exp_neg } => {
             let c = f64::from(exp_pos.max(exp_neg));
             let f = move |z: &Texels| cpu::evsm::evsm(z, exp_pos.into(), exp_neg.into());
             let rtol = 2.0 * (3.0 + 2.0 * c) * ulp + 4.0 * U;
             m(Box::new(f), (0.0, rtol), false, None)
         }
-        Technique::Esm { exponent, .. } => {
+        Encoding::Esm { exponent } => {
             let f = move |z: &Texels| cpu::esm::esm(z, exponent.into());
             m(Box::new(f), (0.0, 2.0 * U), false, Some(exponent.into()))
         }
-        Technique::Msm { .. } => {
-            let q = msm_quantized(t);
+        Encoding::Msm { quantized: q } => {
             let f = move |z: &Texels| cpu::msm::msm(z, q);
             let tol = if q { (3e-5, 0.0) } else { (1e-7, 4.0 * U) };
             m(Box::new(f), tol, false, None)
         }
-        Technique::Csm { terms, .. } => {
+        Encoding::Csm { terms } => {
             let f = move |z: &Texels| cpu::csm::csm(z, terms);
             m(Box::new(f), (2f64.powi(-11), 0.0), true, None)
         }
-        _ => return None,
     })
 }
 

@@ -206,6 +206,11 @@ pub fn with_values(
     build_with(def, &v)
 }
 
+/// The value of key `key` of `t` (its entry's `values`); `None` where the key does not apply.
+pub fn value(t: &Technique, key: &str) -> Option<crate::model::ParamValue> {
+    (of(t).values)(t).get(key)
+}
+
 /// Whether option `name` of key `key` is one `def` accepts.
 pub fn accepts(def: &TechniqueDef, key: &str, name: &str) -> bool {
     def.params.iter().flat_map(|t| t.iter()).any(|s| {
@@ -238,6 +243,32 @@ mod tests {
             let values = (def.values)(&t);
             let again = crate::model::check(def.params, &params::Given(&values)).expect(def.name);
             assert_eq!((def.build)(&again), t, "{}", def.name);
+        }
+    }
+
+    /// Setting a number through the entry (`with_values`, as the stability suite sets MSM's
+    /// moment bias) changes that key and no other, on every technique's defaults and on MSM
+    /// with a blur at f16.
+    #[test]
+    fn with_values_changes_only_its_key() {
+        use crate::model::ParamValue::Float;
+        let msm_f16 = with_values(
+            &default_of(&msm::DEF),
+            &[("format", crate::model::ParamValue::Choice("f16"))],
+        );
+        let cases = REGISTRY.iter().map(|d| default_of(d)).chain(msm_f16);
+        for t in cases {
+            let before = (of(&t).values)(&t);
+            for &(key, value) in &before.0 {
+                let Float(x) = value else { continue };
+                let y = 0.5 * x + 0.25;
+                let changed = with_values(&t, &[(key, Float(y))]).expect(key);
+                let after = (of(&changed).values)(&changed);
+                for &(k, v) in &before.0 {
+                    let want = if k == key { Float(y) } else { v };
+                    assert_eq!(after.get(k), Some(want), "{} {key}: {k}", t.name());
+                }
+            }
         }
     }
 }
