@@ -75,6 +75,23 @@ impl PrefilterConfig {
         }
     }
 
+    /// The technique named `name` in scene files (any of `technique::names()`, e.g. `"vsm"`,
+    /// `"msm_soft"`) with every key at a scene's default, on `size`² maps; the `with_*` methods
+    /// change its values, checked by [`PrefilterConfig::validated`]. An unknown name is a
+    /// [`StageError::Config`] of `technique` listing the registered ones.
+    pub fn named(name: &str, size: u32) -> Result<Self, StageError> {
+        let def = technique::by_name(name).ok_or_else(|| {
+            config_err(
+                "technique",
+                format!(
+                    "unknown technique \"{name}\" (expected one of: {})",
+                    technique::names().join(", ")
+                ),
+            )
+        })?;
+        Ok(Self::new(technique::default_of(def), size))
+    }
+
     /// VSM with a scene's defaults: f32 moments, Gaussian blur of radius 2, bleed reduction
     /// 0.2, variance floor 1e-5.
     pub fn vsm(size: u32) -> Self {
