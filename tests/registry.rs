@@ -248,3 +248,31 @@ fn rust_files(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
         }
     }
 }
+
+/// `PrefilterConfig::named` builds every registered technique at a scene's defaults (its
+/// entry's `default_of`, and the named constructors' techniques), and an unknown name is a
+/// config error naming the key and listing the registered names.
+#[test]
+fn configs_are_built_by_name() {
+    use shadowgraph::prefilter::PrefilterConfig;
+    use shadowgraph::technique::default_of;
+    for def in REGISTRY {
+        let config = PrefilterConfig::named(def.name, 256).expect(def.name);
+        assert_eq!(config.technique, default_of(def), "{}", def.name);
+        assert_eq!(config.size, 256);
+    }
+    let same = |a: PrefilterConfig, name: &str| {
+        let b = PrefilterConfig::named(name, 128).expect(name);
+        assert_eq!(a.technique, b.technique, "{name}");
+    };
+    same(PrefilterConfig::vsm(128), "vsm");
+    same(PrefilterConfig::evsm4(128), "evsm4");
+    same(PrefilterConfig::msm_soft(128, 0.5), "msm_soft");
+    let err = PrefilterConfig::named("vsn", 128)
+        .expect_err("unknown name")
+        .to_string();
+    assert!(
+        err.contains("technique") && err.contains("\"vsn\"") && err.contains("msm_soft"),
+        "{err}"
+    );
+}
