@@ -1,0 +1,246 @@
+//! Reflection: a kernel's bindings, workgroup sizes (in each layout) and texels per invocation,
+//! read back from naga's IR so that Rust never restates them by hand.
+
+use super::KERNEL_DIR_ENV;
+use super::binding_type::{binding_type, sampled_images};
+use super::source::replacements;
+use super::validate::validate_with_info;
+use crate::error::{Error, Result};
+
+/// A binding of a kernel, read from naga's IR.
+#[derive(Clone, Debug)]
+pub struct Binding {
+    /// The WGSL variable name (the slot name a graph node binds by).
+    pub name: String,
+    /// `@group`.
+    pub group: u32,
+    /// `@binding`.
+    pub binding: u32,
+    /// The wgpu binding type derived from the WGSL type.
+    pub ty: wgpu::BindingType,
+}
+
+/// What reflection tells about a kernel.
+#[derive(Clone, Debug)]
+pub struct Reflection {
+    /// All resource bindings, sorted by (group, binding).
+    pub bindings: Vec<Binding>,
+    /// `@workgroup_size` of the compute entry point `main`, if there is one, as a GPU compiles
+    /// it: where the size is an `override` of the layout ([`GPU_LAYOUT_CONSTANT`] true), that
+    /// layout's. A [`crate::exec::ComputeKernel`]'s reflection holds its own layout's.
+    pub workgroup_size: Option<[u32; 3]>,
+    /// The same as a CPU driver compiles it ([`GPU_LAYOUT_CONSTANT`] false): where the kernel's
+    /// size does not depend on the layout, [`Reflection::workgroup_size`].
+    pub cpu_workgroup_size: Option<[u32; 3]>,
+    /// Texels an invocation of `main` covers along x ([`TEXELS_X_CONSTANT`]; 1 where the
+    /// kernel declares none): a workgroup covers `workgroup_size[0] · texels_x` columns.
+    pub texels_x: u32,
+    /// Shader stages of the entry points.
+    pub stages: wgpu::ShaderStages,
+}
+
+/// The constant (`const TEXELS_X: u32`) by which a compute kernel says that each invocation of
+/// `main` covers that many texels along x, `@workgroup_size`'s x apart (`kernels/shade.wgsl`:
+/// pixels a lane shades). The dispatch ([`Reflection::groups_for`]) follows it.
+pub const TEXELS_X_CONSTANT: &str = "TEXELS_X";
+
+/// The most texels along x a kernel may give an invocation ([`TEXELS_X_CONSTANT`]).
+pub const MAX_TEXELS_X: u32 = 64;
+
+/// The pipeline constant a kernel declares (`override GPU_LAYOUT: bool`) where it has two
+/// layouts, one for GPUs and one for CPU drivers (`crate::exec::KernelLayout`). Its workgroup
+/// size may depend on it (`kernels/shared/encode_blur.wgsl`: `@workgroup_size(LANES)`).
+pub const GPU_LAYOUT_CONSTANT: &str = "GPU_LAYOUT";
+
+impl Reflection {
+    /// This reflection as the kernel compiles in one layout (`gpu`: [`GPU_LAYOUT_CONSTANT`]
+    /// true): its workgroup size that layout's.
+    pub fn in_layout(mut self, gpu: bool) -> Self {
+        if !gpu {
+            self.workgroup_size = self.cpu_workgroup_size;
+        }
+        self
+    }
+
+    /// The largest workgroup of either layout, dimension by dimension (what the device's limits
+    /// must allow).
+    pub fn largest_workgroup(&self) -> Option<[u32; 3]> {
+        match (self.workgroup_size, self.cpu_workgroup_size) {
+            (Some(a), Some(b)) => Some([a[0].max(b[0]), a[1].max(b[1]), a[2].max(b[2])]),
+            (a, b) => a.or(b),
+        }
+    }
+
+    /// Workgroups of `main` covering a `w × h` texel grid: `workgroup_size[0] · texels_x`
+    /// columns and `workgroup_size[1]` rows a workgroup.
+    pub fn groups_for(&self, w: u32, h: u32) -> [u32; 3] {
+        let wg = self.workgroup_size.unwrap_or([1, 1, 1]);
+        [w.div_ceil(wg[0] * self.texels_x), h.div_ceil(wg[1]), 1]
+    }
+
+    /// The binding named `name`.
+    pub fn binding(&self, name: &str) -> Option<&Binding> {
+        self.bindings.iter().find(|b| b.name == name)
+    }
+
+    /// Number of bind groups used (highest group + 1).
+    pub fn group_count(&self) -> u32 {
+        self.bindings.iter().map(|b| b.group + 1).max().unwrap_or(0)
+    }
+
+    /// Bind group layout entries of `group`.
+    pub fn layout_entries(&self, group: u32) -> Vec<wgpu::BindGroupLayoutEntry> {
+        self.bindings
+            .iter()
+            .filter(|b| b.group == group)
+            .map(|b| wgpu::BindGroupLayoutEntry {
+                binding: b.binding,
+                visibility: self.stages,
+                ty: b.ty,
+                count: None,
+            })
+            .collect()
+    }
+}
+
+/// Validates `wgsl` and reads its bindings and workgroup size.
+pub fn reflect(kernel: &str, wgsl: &str) -> Result<(naga::Module, Reflection)> {
+    let replaced = replacements().is_ok_and(|r| !r.is_empty());
+    let origin = format!("kernels replaced by {KERNEL_DIR_ENV}");
+    let (module, info) = validate_with_info(kernel, wgsl, replaced.then_some(origin.as_str()))?;
+    reflect_module(kernel, module, &info)
+}
+
+/// [`reflect`] of a kernel replaced from `origin` (a folder of variants): a validation error
+/// is one line tagged `[origin]`.
+pub fn reflect_replaced(
+    kernel: &str,
+    wgsl: &str,
+    origin: &str,
+) -> Result<(naga::Module, Reflection)> {
+    let (module, info) = validate_with_info(kernel, wgsl, Some(origin))?;
+    reflect_module(kernel, module, &info)
+}
+
+fn reflect_module(
+    kernel: &str,
+    module: naga::Module,
+    info: &naga::valid::ModuleInfo,
+) -> Result<(naga::Module, Reflection)> {
+    let sampled = sampled_images(&module);
+    let mut bindings = Vec::new();
+    for (h, g) in module.global_variables.iter() {
+        let Some(rb) = &g.binding else { continue };
+        let name = g.name.clone().unwrap_or_default();
+        let ty = binding_type(&module, g, sampled.contains(&h)).map_err(|m| Error::Kernel {
+            kernel: kernel.to_string(),
+            message: format!("binding `{name}`: {m}"),
+        })?;
+        bindings.push(Binding {
+            name,
+            group: rb.group,
+            binding: rb.binding,
+            ty,
+        });
+    }
+    bindings.sort_by_key(|b| (b.group, b.binding));
+    let mut stages = wgpu::ShaderStages::NONE;
+    let mut workgroup_size = None;
+    let mut cpu_workgroup_size = None;
+    for ep in &module.entry_points {
+        match ep.stage {
+            naga::ShaderStage::Compute => {
+                stages |= wgpu::ShaderStages::COMPUTE;
+                if ep.name == "main" {
+                    let sizes = if ep.workgroup_size_overrides.is_some() {
+                        [true, false].map(|gpu| layout_workgroup_size(kernel, &module, info, gpu))
+                    } else {
+                        [Ok(ep.workgroup_size), Ok(ep.workgroup_size)]
+                    };
+                    let [gpu, cpu] = sizes;
+                    workgroup_size = Some(gpu?);
+                    cpu_workgroup_size = Some(cpu?);
+                }
+            }
+            naga::ShaderStage::Vertex => stages |= wgpu::ShaderStages::VERTEX,
+            naga::ShaderStage::Fragment => stages |= wgpu::ShaderStages::FRAGMENT,
+            _ => {}
+        }
+    }
+    let texels_x = texels_x(kernel, &module)?;
+    Ok((
+        module,
+        Reflection {
+            bindings,
+            workgroup_size,
+            cpu_workgroup_size,
+            texels_x,
+            stages,
+        },
+    ))
+}
+
+/// `main`'s workgroup size where it is an `override` expression: as the layout `gpu` compiles
+/// it ([`GPU_LAYOUT_CONSTANT`] set where the kernel declares it, every other override its
+/// default), naga's own evaluation of the pipeline constants.
+fn layout_workgroup_size(
+    kernel: &str,
+    module: &naga::Module,
+    info: &naga::valid::ModuleInfo,
+    gpu: bool,
+) -> Result<[u32; 3]> {
+    let mut constants = naga::back::PipelineConstants::default();
+    if module
+        .overrides
+        .iter()
+        .any(|(_, o)| o.name.as_deref() == Some(GPU_LAYOUT_CONSTANT))
+    {
+        constants.insert(GPU_LAYOUT_CONSTANT.to_string(), f64::from(u8::from(gpu)));
+    }
+    let stage = (naga::ShaderStage::Compute, "main");
+    let (resolved, _) =
+        naga::back::pipeline_constants::process_overrides(module, info, Some(stage), &constants)
+            .map_err(|e| Error::Kernel {
+                kernel: kernel.to_string(),
+                message: format!("its workgroup size's overrides: {e}"),
+            })?;
+    let ep = resolved
+        .entry_points
+        .iter()
+        .find(|e| e.name == "main")
+        .expect("process_overrides keeps the entry point it was given");
+    Ok(ep.workgroup_size)
+}
+
+/// `kernel`'s [`TEXELS_X_CONSTANT`]: 1 if it declares none, else a u32 in 1..=[`MAX_TEXELS_X`].
+fn texels_x(kernel: &str, module: &naga::Module) -> Result<u32> {
+    let Some((_, c)) = module
+        .constants
+        .iter()
+        .find(|(_, c)| c.name.as_deref() == Some(TEXELS_X_CONSTANT))
+    else {
+        return Ok(1);
+    };
+    match module.global_expressions[c.init] {
+        naga::Expression::Literal(naga::Literal::U32(n)) if (1..=MAX_TEXELS_X).contains(&n) => {
+            Ok(n)
+        }
+        _ => Err(Error::Kernel {
+            kernel: kernel.to_string(),
+            message: format!(
+                "`const {TEXELS_X_CONSTANT}` must be a u32 literal in 1..={MAX_TEXELS_X}"
+            ),
+        }),
+    }
+}
+
+/// Size in bytes of the WGSL struct `name` as naga lays it out (for the Rust mirrors' tests).
+pub fn struct_size(module: &naga::Module, name: &str) -> Option<u32> {
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(module.to_ctx()).ok()?;
+    module
+        .types
+        .iter()
+        .find(|(_, t)| t.name.as_deref() == Some(name))
+        .map(|(h, _)| layouter[h].size)
+}
