@@ -30,6 +30,9 @@
 //! textures plus the rasterized depth maps.
 
 mod crops;
+pub mod crossover;
+mod crossover_run;
+mod crossover_svg;
 mod flip;
 mod grid;
 mod html;
@@ -201,6 +204,10 @@ pub struct Report {
     pub skipped: Vec<(String, String)>,
     /// One row per configuration, in sweep order.
     pub rows: Vec<Row>,
+    /// Each front's technique against PCSS as the image grows ([`crossover`]; `None` in a
+    /// further operating point's report, whose first report has it).
+    #[serde(default)]
+    pub crossover: Option<crossover::Crossover>,
 }
 
 /// Light 0's images for the grid: the truth, its mask and every configuration's visibility.
@@ -248,8 +255,9 @@ pub fn run(gpu: &Gpu, scene_path: &Path, out: &Path, opts: &EvaluateOptions) -> 
     check_sides(gpu.device.limits().max_texture_dimension_2d, &scene, opts)?;
     let configs = sweep(&scene, opts)?;
     output::check_dir(out)?;
-    let (report, images, mut kept) = evaluate_kept(gpu, &scene, &configs, opts)?;
+    let (mut report, images, mut kept) = evaluate_kept(gpu, &scene, &configs, opts)?;
     let others = points::more(gpu, &mut kept, &report, opts)?;
+    report.crossover = Some(crossover_run::measure(gpu, &mut kept, &report, opts)?);
     let mut files = output::write_all(out, &report, &images, &others)?;
     for (dir, r) in &others {
         files.extend(output::write_all(&out.join(dir), r, &images, &[])?);
@@ -270,6 +278,17 @@ pub fn run(gpu: &Gpu, scene_path: &Path, out: &Path, opts: &EvaluateOptions) -> 
         s.push_str(&format!(
             "times not trusted: {label}'s passes sum to {q:.2}x its wall time (rerun on an idle machine)\n"
         ));
+    }
+    match &report.crossover {
+        Some(c) if c.note.is_none() => {
+            s.push_str(&crossover_run::check_line(c));
+            s.push('\n');
+        }
+        Some(c) => s.push_str(&format!(
+            "no crossover: {}\n",
+            c.note.as_deref().unwrap_or_default()
+        )),
+        None => {}
     }
     for f in files {
         s.push_str(&format!("wrote {}\n", f.display()));
@@ -354,6 +373,7 @@ fn evaluate_kept(
         region_pixels: reference.region_pixels(),
         skipped: Vec::new(),
         rows: Vec::new(),
+        crossover: None,
     };
     let mut images = Images {
         width: t.width,

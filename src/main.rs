@@ -163,6 +163,11 @@ enum Command {
         /// Run every MSM configuration at each of these moment biases (default: the storage's).
         #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
         moment_bias: Option<Vec<f32>>,
+        /// Image sizes of the crossover against PCSS, WxH,WxH,…: the shading is fitted at all
+        /// but the last, the last checks the fit (default 320x240,640x480,960x540 on a CPU
+        /// driver, 1280x720,3840x2160,1920x1080 on a GPU; quick: 80x60,160x120,120x90).
+        #[arg(long, value_parser = parse_size, value_delimiter = ',')]
+        crossover_sizes: Option<Vec<(u32, u32)>>,
     },
     /// Run the numerical-stability suite: each hard input through the real kernels against its
     /// f64 reference and stated bound; exits non-zero when a check fails.
@@ -307,6 +312,7 @@ fn run(args: Args) -> Result<()> {
             budget,
             update,
             moment_bias,
+            crossover_sizes,
         } => {
             let opts = shadowgraph::evaluate::EvaluateOptions {
                 techniques,
@@ -327,6 +333,7 @@ fn run(args: Args) -> Result<()> {
                     None if quick => vec![shadowgraph::scene::UpdateRate::Static],
                     None => Vec::new(),
                 },
+                crossover_sizes,
             };
             let gpu = Gpu::new()?;
             print!("{}", shadowgraph::evaluate::run(&gpu, &scene, &out, &opts)?);

@@ -178,6 +178,7 @@ pub fn html(
             m.name()
         );
     }
+    s.push_str(&super::crossover_run::html(report)?);
     table(&mut s, report);
     crop_section(&mut s, report, images)?;
     for (label, why) in &report.skipped {

@@ -41,6 +41,10 @@ pub struct EvaluateOptions {
     /// light at each of these rates, each report in `DIR/update-<rate>/` (`--update a,b,…`
     /// past its first; `--quick` without `--update`: static).
     pub more_updates: Vec<crate::scene::UpdateRate>,
+    /// The crossover's image sizes (`--crossover-sizes`): all but the last are fitted, the
+    /// last checks the fit (`None`: the defaults of
+    /// [`crossover_run::sizes`](super::crossover_run::sizes)).
+    pub crossover_sizes: Option<Vec<(u32, u32)>>,
 }
 
 impl Default for EvaluateOptions {
@@ -58,6 +62,7 @@ impl Default for EvaluateOptions {
             image_default: false,
             update: None,
             more_updates: Vec::new(),
+            crossover_sizes: None,
         }
     }
 }
@@ -124,6 +129,37 @@ pub fn check_options(opts: &EvaluateOptions) -> Result<()> {
             "--k {k}: the truth takes at most {most} emitter samples (a shadow map each)"
         )));
     }
+    check_crossover_sizes(opts.crossover_sizes.as_deref())
+}
+
+/// `--crossover-sizes`: at least three sizes, none empty, and the ones fitted (all but the
+/// last) of at least two pixel counts.
+fn check_crossover_sizes(sizes: Option<&[(u32, u32)]>) -> Result<()> {
+    let Some(sizes) = sizes else {
+        return Ok(());
+    };
+    if let Some((w, h)) = sizes.iter().find(|(w, h)| *w == 0 || *h == 0) {
+        return Err(Error::Invalid(format!(
+            "--crossover-sizes: {w}x{h} is empty"
+        )));
+    }
+    if sizes.len() < 3 {
+        return Err(Error::Invalid(format!(
+            "--crossover-sizes: give at least three sizes (two or more to fit, the last to check the fit), got {}",
+            sizes.len()
+        )));
+    }
+    let mut fitted: Vec<u64> = sizes[..sizes.len() - 1]
+        .iter()
+        .map(|&(w, h)| u64::from(w) * u64::from(h))
+        .collect();
+    fitted.sort_unstable();
+    fitted.dedup();
+    if fitted.len() < 2 {
+        return Err(Error::Invalid(
+            "--crossover-sizes: the sizes fitted (all but the last) need at least two different pixel counts".into(),
+        ));
+    }
     Ok(())
 }
 
@@ -142,6 +178,18 @@ pub fn check_sides(max: u32, scene: &Scene, opts: &EvaluateOptions) -> Result<()
             opts.image.map(|(_, h)| h),
         ),
     ];
+    let crossover = opts.crossover_sizes.iter().flatten().flat_map(|&(w, h)| {
+        [
+            (
+                format!("evaluate --crossover-sizes {w}x{h} (width)"),
+                Some(w),
+            ),
+            (
+                format!("evaluate --crossover-sizes {w}x{h} (height)"),
+                Some(h),
+            ),
+        ]
+    });
     let maps = opts.sizes.iter().flatten().flat_map(|&size| {
         scene.lights.iter().enumerate().map(move |(i, l)| {
             let mut l = l.clone();
@@ -155,5 +203,5 @@ pub fn check_sides(max: u32, scene: &Scene, opts: &EvaluateOptions) -> Result<()
             (what, Some(w.max(h)))
         })
     });
-    crate::limits::flag_sides(max, image.into_iter().chain(maps))
+    crate::limits::flag_sides(max, image.into_iter().chain(crossover).chain(maps))
 }

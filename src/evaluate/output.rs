@@ -53,6 +53,12 @@ pub fn write_all(
         put(m.file(), svg.as_bytes())?;
         plots.push((m, svg));
     }
+    if let Some(c) = report.crossover.as_ref().filter(|c| c.note.is_none()) {
+        put(
+            "crossover.svg",
+            super::crossover_svg::crossover_svg(c, &crossover_title(report))?.as_bytes(),
+        )?;
+    }
     let (png, legend) = super::grid::grid(report, images)?;
     put("grid.png", &png)?;
     put("grid.txt", legend.as_bytes())?;
@@ -61,6 +67,19 @@ pub fn write_all(
         super::html::html(report, images, &plots, others)?.as_bytes(),
     )?;
     Ok(written)
+}
+
+/// The crossover plot's title.
+pub(super) fn crossover_title(report: &Report) -> String {
+    format!(
+        "{}: cost per frame against image size{}",
+        report.scene,
+        if report.cpu_driver {
+            " (CPU-driver times)"
+        } else {
+            ""
+        }
+    )
 }
 
 fn ms(v: Option<f64>) -> String {
@@ -464,6 +483,9 @@ pub fn markdown(report: &Report) -> String {
     }
     s.push_str(&wall_check(report));
     s.push_str(&fronts_text(report));
+    if let Some(c) = &report.crossover {
+        s.push_str(&super::crossover_run::markdown(c, report.cpu_driver));
+    }
     for (label, why) in &report.skipped {
         let _ = writeln!(s, "\nSkipped {label}: {why}");
     }
