@@ -1,0 +1,85 @@
+//! The layout a kernel compiles in where it has two ([`KernelLayout`]: a GPU's and a CPU
+//! driver's), and how its workgroup memory starts ([`WorkgroupInit`]).
+
+use crate::error::{Error, Result};
+
+/// The environment variable that picks [`KernelLayout`] for every device: `gpu` or `cpu`
+/// (unset: by the device's type). A/B of the two layouts on one machine.
+pub const KERNEL_LAYOUT_ENV: &str = "SHADOWGRAPH_KERNEL_LAYOUT";
+
+pub use crate::kernels::GPU_LAYOUT_CONSTANT;
+
+/// Which of its two variants a kernel that has two compiles (`override GPU_LAYOUT: bool`): today
+/// the summed-area tables' pass 3 (`kernels/shared/sat_tile*.wgsl`), whose second sweep over an
+/// invocation's sub-block loads and encodes its texels again on a GPU (from its texture cache:
+/// 7–13% faster on an H200 than keeping them) and reads the first sweep's encoded texels kept in
+/// private memory on a CPU driver (1.1–1.2× faster on llvmpipe); both give the same tables bit
+/// for bit (`tests/sat.rs`, `tests/csm_sat.rs`). And the encodings fused into the blur
+/// (`kernels/shared/encode_blur.wgsl`): a tile blurred in workgroup memory by 256 invocations on
+/// a GPU, walked in strips by 8 on a CPU driver (2–3× less CPU time on llvmpipe), the workgroup
+/// size itself an override (`kernels::Reflection::cpu_workgroup_size`); both within
+/// `tests/fused.rs`'s tolerances of the f64 reference.
+///
+/// Variants that staged texels through workgroup memory so that a SIMD group's lanes touch
+/// neighbouring texels (the blur's row pass, the fused blurs, the tables' tile passes) were
+/// slower on the H200 than each invocation reading its own run or block straight, 1.1–2.7×,
+/// and their workgroup memory, declared in both variants, slowed the straight one too
+/// (`benches/RESULTS.md`, 2026-11-27): they are gone.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum KernelLayout {
+    /// A GPU's (`GPU_LAYOUT = true`): recompute from the texture cache.
+    Gpu,
+    /// A CPU driver's (`GPU_LAYOUT = false`): keep in private memory.
+    Cpu,
+}
+
+impl KernelLayout {
+    /// [`KERNEL_LAYOUT_ENV`] if set, else [`KernelLayout::Cpu`] on a CPU driver
+    /// ([`wgpu::DeviceType::Cpu`]) and [`KernelLayout::Gpu`] on anything else.
+    pub fn for_device(device: &wgpu::Device) -> Result<Self> {
+        match std::env::var(KERNEL_LAYOUT_ENV) {
+            Ok(v) => {
+                Self::parse(&v).map_err(|e| Error::Invalid(format!("{KERNEL_LAYOUT_ENV}: {e}")))
+            }
+            Err(_) if crate::timer::is_gpu(device) => Ok(Self::Gpu),
+            Err(_) => Ok(Self::Cpu),
+        }
+    }
+
+    /// `gpu` or `cpu`, as [`KERNEL_LAYOUT_ENV`] and `shadowgraph bench --layouts` spell it;
+    /// else what is wrong with `name`.
+    pub fn parse(name: &str) -> std::result::Result<Self, String> {
+        match name {
+            "gpu" => Ok(Self::Gpu),
+            "cpu" => Ok(Self::Cpu),
+            _ => Err(format!("`{name}`: expected `gpu` or `cpu`")),
+        }
+    }
+
+    /// The name [`KernelLayout::parse`] reads.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Gpu => "gpu",
+            Self::Cpu => "cpu",
+        }
+    }
+}
+
+/// How a kernel's workgroup memory starts. WebGPU guarantees zeros, and wgpu keeps the
+/// guarantee by default: each workgroup first stores its whole declared workgroup memory and
+/// waits at a barrier (the driver's zeroing, or code naga writes where the driver has none),
+/// whichever of its entries the kernel reads. Every kernel in `kernels/` writes each entry of
+/// its workgroup memory before it reads it, so [`KernelCache`](super::KernelCache) compiles them
+/// [`WorkgroupInit::AsLeft`]: `tests/workgroup_memory.rs` fills that memory with NaN bit
+/// patterns before each kernel's body runs, and every map of every plan that runs the kernels
+/// stays the same bit for bit. (On the H200 a kernel's declared workgroup memory cost time even
+/// where the branch using it never ran: `benches/RESULTS.md`, 2026-11-27;
+/// `shadowgraph bench --kernel-dirs shipped,zeroed` times both.)
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum WorkgroupInit {
+    /// Zeroed before the kernel's body runs (wgpu's default).
+    #[default]
+    Zeroed,
+    /// Left as the device leaves it: for kernels that write before they read.
+    AsLeft,
+}
