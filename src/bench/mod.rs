@@ -11,7 +11,7 @@
 //! [`crate::exec::Executor::record`] under a [`crate::exec::GpuTimer`], and keeps the median over the timed
 //! runs (after [`WARMUP`] untimed ones) of the summed node times.
 //!
-//! The entry is [`run`]; [`measure`] ([`measure_variants`]) takes the rows, [`format_table`]
+//! The entry is [`run`]; [`measure()`] ([`measure_variants`]) takes the rows, [`format_table`]
 //! prints them. The case list is `cases.rs`, the graphs the cases run `graphs.rs`, the
 //! yardsticks `copy.rs`, the timing `harness.rs`, the checks of the arguments and of memory
 //! `args.rs` and `memory.rs`, the kernel variants compared side by side `variant.rs`; the
@@ -89,7 +89,7 @@ fn texels(n: u32) -> u64 {
     u64::from(n) * u64::from(n)
 }
 
-/// Runs [`measure`] on `gpu` and formats the report: each kernel in each of `layouts` in turn
+/// Runs [`measure()`] on `gpu` and formats the report: each kernel in each of `layouts` in turn
 /// (`--layouts`), or in each folder of `kernel_dirs` (`--kernel-dirs`, [`KernelVariant::folder`];
 /// [`SHIPPED`] the embedded kernels), or the device's kernels alone. Layouts and folders are
 /// not combined.
