@@ -164,7 +164,7 @@ enum Command {
         #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
         moment_bias: Option<Vec<f32>>,
         /// Image sizes of the crossover against PCSS, WxH,WxH,…: the shading is fitted at all
-        /// but the last, the last checks the fit (default 320x240,640x480,960x540 on a CPU
+        /// but the last, the last checks the fit (default 480x360,1280x720,960x540 on a CPU
         /// driver, 1280x720,3840x2160,1920x1080 on a GPU; quick: 80x60,160x120,120x90).
         #[arg(long, value_parser = parse_size, value_delimiter = ',')]
         crossover_sizes: Option<Vec<(u32, u32)>>,

@@ -311,6 +311,27 @@ fn report_html_loads_in_headless_chromium() {
             "{p} for {rows} rows"
         );
     }
+    // The crossover against PCSS: its plot drawn (two lines per compared configuration, each
+    // with a tooltip, laid out wider than 100 px) and a table row per technique compared, as
+    // report.json has them.
+    let json: Value = serde_json::from_str(
+        &std::fs::read_to_string(out.join("report.json")).expect("report.json"),
+    )
+    .expect("report.json parses");
+    let cross = &json["crossover"];
+    let costs = cross["costs"].as_array().map_or(0, Vec::len);
+    let pairs = cross["pairs"].as_array().map_or(0, Vec::len);
+    assert!(costs >= 2 && pairs >= 1, "no crossover: {cross}");
+    let drawn = b.eval(
+        "(() => { const s = document.querySelector('.crossover-plot svg');\
+         return s ? [s.querySelectorAll('path.xo-line').length,\
+           s.querySelectorAll('path.xo-line > title').length, s.getBoundingClientRect().width,\
+           document.querySelectorAll('table.crossover tbody tr').length] : null; })()",
+    );
+    assert_eq!(drawn[0].as_u64(), Some(2 * costs as u64), "{drawn}");
+    assert_eq!(drawn[1].as_u64(), Some(2 * costs as u64), "{drawn}");
+    assert!(drawn[2].as_f64() > Some(100.0), "{drawn}");
+    assert_eq!(drawn[3].as_u64(), Some(pairs as u64), "{drawn}");
     // The verdict: at the top, each configuration it names (in bold) a row of the table, and
     // its cheapest configuration within 10% of the best penumbra error the table's.
     let verdict = b.eval(

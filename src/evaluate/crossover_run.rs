@@ -8,16 +8,18 @@ use super::crossover::{
     self, CheckError, Checked, Cost, Crossover, Match, Pair, RANGE_MPX, crossing, fit,
     relative_error,
 };
-use super::protocol::{self, Protocol};
+use super::protocol::{self, Protocol, Timed};
 use super::svg::{Metric, front};
 use super::{EvaluateOptions, Kept, Report, Row, timing};
 use crate::error::Result;
 use crate::gpu::Gpu;
 use crate::scene::UpdateRate;
 
-/// The sizes on a CPU driver unless `--crossover-sizes` says otherwise: fitted at 320×240 and
-/// 640×480, checked at 960×540 (a software driver shades 0.5 Mpx in a fraction of a second).
-pub const CPU_SIZES: [(u32, u32); 3] = [(320, 240), (640, 480), (960, 540)];
+/// The sizes on a CPU driver unless `--crossover-sizes` says otherwise: fitted at 480×360 and
+/// 1280×720, checked at 960×540 (a software driver shades 0.9 Mpx in a fraction of a second).
+/// Fitted at 320×240 and 640×480 instead, lavapipe's slopes moved by up to 35% between runs
+/// (its fixed costs weigh on images that small) and the check at 960×540 missed by up to 33%.
+pub const CPU_SIZES: [(u32, u32); 3] = [(480, 360), (1280, 720), (960, 540)];
 
 /// On a GPU: fitted at 1280×720 and 3840×2160, checked at 1920×1080.
 pub const GPU_SIZES: [(u32, u32); 3] = [(1280, 720), (3840, 2160), (1920, 1080)];
@@ -77,10 +79,8 @@ pub fn measure(
     let (fit_sizes, check) = sizes.split_at(sizes.len().saturating_sub(1));
     let check = check.first().copied().unwrap_or((1, 1));
     let repeats = opts.repeat.min(MAX_REPEATS);
-    let mut at_size: Vec<Vec<Row>> = Vec::new();
-    for &size in fit_sizes.iter().chain([&check]) {
-        at_size.push(time_at(gpu, kept, report, &measured, size, repeats)?);
-    }
+    let all: Vec<(u32, u32)> = fit_sizes.iter().copied().chain([check]).collect();
+    let at_size = time_sizes(gpu, kept, report, &measured, &all, repeats)?;
     let costs: Vec<Cost> = measured
         .iter()
         .enumerate()
@@ -160,17 +160,68 @@ fn cost(
     }
 }
 
-/// `report`'s rows `measured`, timed at image `size` with every light redrawn every frame
-/// (raster, prefilter and shading in each timed frame), `repeats` interleaved rounds: each a
-/// copy of its row with its times.
-fn time_at(
+/// `report`'s rows `measured` timed at every image size of `sizes` with every light redrawn
+/// every frame (raster, prefilter and shading in each timed frame): `repeats` rounds, each
+/// visiting every size in turn and at each size every configuration once under the time
+/// protocol (its clock check within the size), so that a change of the machine's load falls
+/// on every size alike. Per size, a copy of each row with its times.
+fn time_sizes(
     gpu: &Gpu,
     kept: &mut Kept,
     report: &Report,
     measured: &[usize],
-    (w, h): (u32, u32),
+    sizes: &[(u32, u32)],
     repeats: u32,
-) -> Result<Vec<Row>> {
+) -> Result<Vec<Vec<Row>>> {
+    let mut timed = vec![vec![Timed::default(); measured.len()]; sizes.len()];
+    let mut checks: Vec<Vec<f64>> = vec![Vec::new(); sizes.len()];
+    let bar =
+        indicatif::ProgressBar::new((sizes.len() * measured.len()) as u64 * u64::from(repeats));
+    bar.set_message("crossover: timing at each image size");
+    for _ in 0..repeats {
+        for (s, &size) in sizes.iter().enumerate() {
+            let run = time_round(gpu, kept, measured, size, &bar)?;
+            checks[s].extend(run.check_median);
+            for (all, t) in timed[s].iter_mut().zip(run.timed) {
+                all.samples.extend(t.samples);
+                all.retries += t.retries;
+                all.off |= t.off;
+            }
+        }
+    }
+    bar.finish_and_clear();
+    Ok(timed
+        .iter_mut()
+        .zip(&checks)
+        .map(|(per_config, runs)| {
+            let run_check = protocol::median(runs);
+            measured
+                .iter()
+                .zip(per_config.iter_mut())
+                .map(|(&i, t)| {
+                    let c: Vec<f64> = t
+                        .samples
+                        .iter()
+                        .filter_map(|x| x.pass(timing::CHECK_PASS))
+                        .collect();
+                    t.check_ms = protocol::median(&c);
+                    let mut r = report.rows[i].clone();
+                    timing::fill(&mut r, t, run_check);
+                    r
+                })
+                .collect()
+        })
+        .collect())
+}
+
+/// One round of `report`'s rows `measured` at image `(w, h)`, every light redrawn every frame.
+fn time_round(
+    gpu: &Gpu,
+    kept: &mut Kept,
+    measured: &[usize],
+    (w, h): (u32, u32),
+    bar: &indicatif::ProgressBar,
+) -> Result<protocol::Run> {
     let mut scene = kept.scene.clone();
     scene.width = w;
     scene.height = h;
@@ -185,20 +236,8 @@ fn time_at(
             v
         })
         .collect();
-    let bar = indicatif::ProgressBar::new(variants.len() as u64 * u64::from(repeats));
-    bar.set_message(format!("crossover: timing at {w}x{h}"));
-    let protocol = Protocol::new(repeats);
-    let run = timing::time_variants(&mut kept.renderer, gpu, &scene, &variants, &protocol, &bar)?;
-    bar.finish_and_clear();
-    Ok(measured
-        .iter()
-        .zip(&run.timed)
-        .map(|(&i, t)| {
-            let mut r = report.rows[i].clone();
-            timing::fill(&mut r, t, run.check_median);
-            r
-        })
-        .collect())
+    let protocol = Protocol::new(1);
+    timing::time_variants(&mut kept.renderer, gpu, &scene, &variants, &protocol, bar)
 }
 
 fn size_list(sizes: &[(u32, u32)]) -> String {
@@ -236,13 +275,15 @@ pub fn method_text(c: &Crossover) -> String {
         "Each technique's configuration on a front (its most accurate in the penumbra) against \
          PCSS of comparable penumbra error: the cheapest PCSS configuration at most 10% less \
          accurate, else the most accurate PCSS (marked *). Built from measurements: these \
-         configurations timed again with every light redrawn every frame, {} interleaved \
-         rounds at each of {} under the time protocol; the shading pass fitted as a + b·Mpx \
-         (least squares), raster + prefilter taken as its median over those frames (it depends \
-         on the map, not the image). A moving light costs raster + prefilter + shading per \
-         frame, a static one the shading. Drawn over {}–{:.1} Mpx (3840×2160).",
+         configurations timed again with every light redrawn every frame, in {} rounds, each \
+         visiting every image size in turn and at each every configuration once under the \
+         time protocol; the shading pass fitted as a + b·Mpx (least squares) at {}, raster + \
+         prefilter taken as its median over those frames (it depends on the map, not the \
+         image), and both checked at {} (not fitted). A moving light costs raster + prefilter \
+         + shading per frame, a static one the shading. Drawn over {}–{:.1} Mpx (3840×2160).",
         c.repeats,
         size_list(&c.fit_sizes),
+        size_list(&[c.check_size]),
         RANGE_MPX.0,
         RANGE_MPX.1
     )
