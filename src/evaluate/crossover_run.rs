@@ -86,21 +86,7 @@ pub fn measure(
         .enumerate()
         .map(|(k, &i)| cost(&rows[i], i, fit_sizes, check, &at_size, k))
         .collect();
-    let at = |row: usize| measured.iter().position(|&m| m == row).unwrap_or(0);
-    let pairs: Vec<Pair> = pairs
-        .iter()
-        .map(|&(t, p, matched)| {
-            let (t, p) = (at(t), at(p));
-            let cross = |moving| crossing(costs[t].line(moving), costs[p].line(moving), RANGE_MPX);
-            Pair {
-                config: t,
-                pcss: p,
-                matched,
-                moving: cross(true),
-                still: cross(false),
-            }
-        })
-        .collect();
+    let pairs = with_crossings(&pairs, &measured, &costs);
     let errors = |f: &dyn Fn(&Checked) -> f64| {
         let e: Vec<f64> = costs.iter().map(|c| f(&c.check)).collect();
         CheckError::of(&e).unwrap_or_default()
@@ -115,6 +101,30 @@ pub fn measure(
         costs,
         pairs,
     })
+}
+
+/// Each `(technique row, PCSS row, match)` of `pairs` with its indices among `measured` (the
+/// rows of `costs`) and where the technique is cheaper, moving and static.
+fn with_crossings(
+    pairs: &[(usize, usize, Match)],
+    measured: &[usize],
+    costs: &[Cost],
+) -> Vec<Pair> {
+    let at = |row: usize| measured.iter().position(|&m| m == row).unwrap_or(0);
+    pairs
+        .iter()
+        .map(|&(t, p, matched)| {
+            let (t, p) = (at(t), at(p));
+            let cross = |moving| crossing(costs[t].line(moving), costs[p].line(moving), RANGE_MPX);
+            Pair {
+                config: t,
+                pcss: p,
+                matched,
+                moving: cross(true),
+                still: cross(false),
+            }
+        })
+        .collect()
 }
 
 /// Row `row`'s cost from its times at every size (`at_size[s][k]`, the check size last).

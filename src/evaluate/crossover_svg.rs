@@ -7,7 +7,7 @@ use std::fmt::Write;
 
 use plotters::prelude::*;
 
-use super::crossover::{Crossover, RANGE_MPX};
+use super::crossover::{Cost, Crossover, RANGE_MPX};
 use super::html::escape;
 use super::marks::colour;
 use super::svg::plot_error;
@@ -106,77 +106,9 @@ pub fn crossover_svg(c: &Crossover, title: &str) -> Result<String> {
         let px = |x: f64, y: f64| chart.backend_coord(&(x, y));
         let fill = colours(c);
         for (k, cost) in c.costs.iter().enumerate() {
-            let RGBColor(r, g, b) = fill[k];
-            for moving in [true, false] {
-                let line = cost.line(moving);
-                let (a, z) = (px(lo, line.at(lo)), px(hi, line.at(hi)));
-                let _ = writeln!(
-                    over,
-                    "<path class=\"xo-line {}\" d=\"M{} {} L{} {}\" stroke=\"rgb({r},{g},{b})\" \
-                     stroke-width=\"2\" fill=\"none\"{}><title>{}</title></path>",
-                    if moving { "moving" } else { "static" },
-                    a.0,
-                    a.1,
-                    z.0,
-                    z.1,
-                    if moving {
-                        ""
-                    } else {
-                        " stroke-dasharray=\"7 5\""
-                    },
-                    escape(&format!(
-                        "{}, {} light: {:.3} + {:.3}·Mpx ms",
-                        cost.label,
-                        if moving { "moving" } else { "static" },
-                        line.a,
-                        line.b
-                    ))
-                );
-            }
-            let mut dot = |x: f64, y: f64, hollow: bool, what: &str| {
-                let (u, v) = px(x, y);
-                let paint = if hollow {
-                    format!("fill=\"white\" stroke=\"rgb({r},{g},{b})\" stroke-width=\"1.5\"")
-                } else {
-                    format!("fill=\"rgb({r},{g},{b})\"")
-                };
-                let _ = writeln!(
-                    over,
-                    "<g class=\"xo-measured\"><title>{}</title><circle cx=\"{u}\" cy=\"{v}\" r=\"3.5\" {paint}/></g>",
-                    escape(&format!("{}: {what} {y:.3} ms at {x:.3} Mpx", cost.label))
-                );
-            };
-            for &(x, y) in &cost.shade_points {
-                dot(x, y, false, "shading measured (fitted)");
-            }
-            let ch = cost.check;
-            dot(ch.mpx, ch.static_measured, true, "shading measured (check)");
-            dot(
-                ch.mpx,
-                ch.moving_measured,
-                true,
-                "moving frame measured (check)",
-            );
+            over.push_str(&lines_of(cost, fill[k], &px));
         }
-        for p in &c.pairs {
-            let (t, q) = (&c.costs[p.config], &c.costs[p.pcss]);
-            for (moving, cross) in [(true, p.moving), (false, p.still)] {
-                let Some(x) = cross.mpx() else { continue };
-                let (u, v) = px(x, t.line(moving).at(x));
-                let _ = writeln!(
-                    over,
-                    "<g class=\"xo-cross\"><title>{}</title><circle cx=\"{u}\" cy=\"{v}\" r=\"7\" \
-                     fill=\"none\" stroke=\"black\" stroke-width=\"2\"/></g>",
-                    escape(&format!(
-                        "{} against {}, {} light: cheaper {}",
-                        t.label,
-                        q.label,
-                        if moving { "moving" } else { "static" },
-                        cross.text()
-                    ))
-                );
-            }
-        }
+        over.push_str(&rings_of(c, &px));
         legend_of(&legend, c, &fill)?;
         root.present().map_err(plot_error)?;
     }
@@ -184,6 +116,92 @@ pub fn crossover_svg(c: &Crossover, title: &str) -> Result<String> {
         svg.insert_str(end, &over);
     }
     Ok(svg)
+}
+
+/// Pixel coordinates of a point of the chart (megapixels, ms).
+type Px<'a> = dyn Fn(f64, f64) -> (i32, i32) + 'a;
+
+/// A configuration's two lines (moving solid, static dashed) and its measured points, as SVG.
+fn lines_of(cost: &Cost, colour: RGBColor, px: &Px) -> String {
+    let (lo, hi) = RANGE_MPX;
+    let mut over = String::new();
+    let RGBColor(r, g, b) = colour;
+    for moving in [true, false] {
+        let line = cost.line(moving);
+        let (a, z) = (px(lo, line.at(lo)), px(hi, line.at(hi)));
+        let _ = writeln!(
+            over,
+            "<path class=\"xo-line {}\" d=\"M{} {} L{} {}\" stroke=\"rgb({r},{g},{b})\" \
+             stroke-width=\"2\" fill=\"none\"{}><title>{}</title></path>",
+            if moving { "moving" } else { "static" },
+            a.0,
+            a.1,
+            z.0,
+            z.1,
+            if moving {
+                ""
+            } else {
+                " stroke-dasharray=\"7 5\""
+            },
+            escape(&format!(
+                "{}, {} light: {:.3} + {:.3}·Mpx ms",
+                cost.label,
+                if moving { "moving" } else { "static" },
+                line.a,
+                line.b
+            ))
+        );
+    }
+    let mut dot = |x: f64, y: f64, hollow: bool, what: &str| {
+        let (u, v) = px(x, y);
+        let paint = if hollow {
+            format!("fill=\"white\" stroke=\"rgb({r},{g},{b})\" stroke-width=\"1.5\"")
+        } else {
+            format!("fill=\"rgb({r},{g},{b})\"")
+        };
+        let _ = writeln!(
+            over,
+            "<g class=\"xo-measured\"><title>{}</title><circle cx=\"{u}\" cy=\"{v}\" r=\"3.5\" {paint}/></g>",
+            escape(&format!("{}: {what} {y:.3} ms at {x:.3} Mpx", cost.label))
+        );
+    };
+    for &(x, y) in &cost.shade_points {
+        dot(x, y, false, "shading measured (fitted)");
+    }
+    let ch = cost.check;
+    dot(ch.mpx, ch.static_measured, true, "shading measured (check)");
+    dot(
+        ch.mpx,
+        ch.moving_measured,
+        true,
+        "moving frame measured (check)",
+    );
+    over
+}
+
+/// A ring at each crossing of a technique with its PCSS, as SVG.
+fn rings_of(c: &Crossover, px: &Px) -> String {
+    let mut over = String::new();
+    for p in &c.pairs {
+        let (t, q) = (&c.costs[p.config], &c.costs[p.pcss]);
+        for (moving, cross) in [(true, p.moving), (false, p.still)] {
+            let Some(x) = cross.mpx() else { continue };
+            let (u, v) = px(x, t.line(moving).at(x));
+            let _ = writeln!(
+                over,
+                "<g class=\"xo-cross\"><title>{}</title><circle cx=\"{u}\" cy=\"{v}\" r=\"7\" \
+                 fill=\"none\" stroke=\"black\" stroke-width=\"2\"/></g>",
+                escape(&format!(
+                    "{} against {}, {} light: cheaper {}",
+                    t.label,
+                    q.label,
+                    if moving { "moving" } else { "static" },
+                    cross.text()
+                ))
+            );
+        }
+    }
+    over
 }
 
 /// The legend: each line's label in its colour, then the styles.
