@@ -1046,7 +1046,11 @@ mod cascades {
             ref_v.push(v);
             tol.push(t);
         }
-        let what = format!("light {li} in {} cascades", group.count);
+        let what = format!(
+            "light {li} ({}) in {} cascades",
+            technique.name(),
+            group.count
+        );
         assert!(
             gpu_v.len() * 10 >= covered * 9,
             "{what}: only {} of {covered} pixels robust",

@@ -280,7 +280,9 @@ impl Chain<'_> {
 
     /// [`Self::search_range`] for inputs in cells: at each moved UV, each cell perturbed on
     /// its own (every sign combination of its values and the depth), the changes of the
-    /// share and of the depth summed over the cells.
+    /// depth summed over the cells (first order), and every cell perturbed at once with the
+    /// same signs per channel (errors that move together); a perturbation flips the threshold
+    /// where it changes whether the estimate finds blockers.
     fn cell_search_range(&self, b0: Blocker) -> (bool, f64) {
         let mut flips = false;
         let mut dz: f64 = 0.0;
@@ -290,29 +292,33 @@ impl Chain<'_> {
                 .cell_errors
                 .map_or_else(|| self.e_search.clone(), |f| f(&search));
             let bm = (self.blocker)(&search, 0.0);
+            flips |= bm.found() != b0.found();
             let stride = search.len() / self.cells;
-            let (mut d_share, mut d_depth) = (0.0f64, 0.0f64);
+            let mut d_depth = 0.0f64;
             for k in 0..self.cells {
                 let idx: Vec<usize> = (k * stride..(k + 1) * stride)
                     .filter(|&i| e[i] > 0.0)
                     .collect();
-                let (mut cs, mut cz) = (0.0f64, 0.0f64);
+                let mut cz = 0.0f64;
                 combinations(idx.len() + 1, |sg| {
                     let mut m = search.clone();
                     for (j, &i) in idx.iter().enumerate() {
                         m[i] += sg[j] * e[i];
                     }
                     let b = (self.blocker)(&m, sg[idx.len()] * self.e_depth);
-                    cs = cs.max((b.share - bm.share).abs());
+                    flips |= b.found() != b0.found();
                     cz = cz.max((b.depth - bm.depth).abs());
                 });
-                d_share += cs;
                 d_depth += cz;
             }
-            let lo = bm.share - d_share;
-            let hi = bm.share + d_share;
-            let min = cpu::blocker::MIN_SHARE;
-            flips |= bm.found() != b0.found() || if b0.found() { lo < min } else { hi >= min };
+            combinations(stride, |sg| {
+                let m: Vec<f64> = (0..search.len())
+                    .map(|i| search[i] + sg[i % stride] * e[i])
+                    .collect();
+                let b = (self.blocker)(&m, sg[stride - 1] * self.e_depth);
+                flips |= b.found() != b0.found();
+                d_depth = d_depth.max((b.depth - bm.depth).abs());
+            });
             dz = dz.max((bm.depth - b0.depth).abs() + d_depth);
         }
         (flips, dz)
