@@ -26,6 +26,7 @@
 pub mod cascades;
 mod config;
 mod depth;
+mod light_params;
 mod limits;
 mod planning;
 pub mod wgsl;
@@ -38,8 +39,9 @@ pub use crate::error::StageError;
 /// The light's GPU description the exported WGSL's `Light` mirrors (what
 /// [`LightParams::light_gpu`] returns), where a host looks for it.
 pub use crate::gpu_data::LightGpu;
-pub use config::{LightParams, PrefilterConfig};
+pub use config::PrefilterConfig;
 pub use depth::{DEPTH_FORMATS, DepthLayer};
+pub use light_params::LightParams;
 
 use crate::error::{Error, Result};
 use crate::exec::{Executor, KernelCache};
