@@ -9,7 +9,9 @@ mod specialize;
 use std::collections::HashMap;
 use std::sync::Arc;
 
-pub use self::layout::{GPU_LAYOUT_CONSTANT, KERNEL_LAYOUT_ENV, KernelLayout, WorkgroupInit};
+pub use self::layout::{
+    GPU_LAYOUT_CONSTANT, KERNEL_LAYOUT_ENV, KernelLayout, REDESIGN_CONSTANT, WorkgroupInit,
+};
 use self::specialize::{apply, changes};
 pub use self::specialize::{specialized_source, wgsl_storage_format};
 use super::node_constants::NodeOverrides;
@@ -72,15 +74,19 @@ impl ComputeKernel {
         overrides: &[(String, f64)],
     ) -> Result<Self> {
         let (module, reflection) = kernels::reflect(name, wgsl)?;
-        let two_layouts = module
-            .overrides
-            .iter()
-            .any(|(_, o)| o.name.as_deref() == Some(GPU_LAYOUT_CONSTANT));
-        let gpu = f64::from(u8::from(layout == KernelLayout::Gpu));
         let mut constants: Vec<(&str, f64)> =
             overrides.iter().map(|(n, v)| (n.as_str(), *v)).collect();
-        if two_layouts {
-            constants.push((GPU_LAYOUT_CONSTANT, gpu));
+        for (name, value) in [
+            (GPU_LAYOUT_CONSTANT, layout.is_gpu()),
+            (REDESIGN_CONSTANT, layout == KernelLayout::Redesign),
+        ] {
+            if module
+                .overrides
+                .iter()
+                .any(|(_, o)| o.name.as_deref() == Some(name))
+            {
+                constants.push((name, f64::from(u8::from(value))));
+            }
         }
         let constants: &[(&str, f64)] = &constants;
         let label = format!("shadowgraph.{name}");
@@ -137,7 +143,10 @@ impl ComputeKernel {
         )?;
         Ok(Self {
             name: name.to_string(),
-            reflection: reflection.in_layout(layout == KernelLayout::Gpu),
+            reflection: match layout {
+                KernelLayout::Redesign => reflection.in_redesign(),
+                _ => reflection.in_layout(layout.is_gpu()),
+            },
             layouts,
             pipeline,
             layout,

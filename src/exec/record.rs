@@ -6,7 +6,7 @@
 use std::ops::Range;
 use std::sync::Arc;
 
-use super::pipelines::{ComputeKernel, KernelCache, KernelLayout, no_layout};
+use super::pipelines::{ComputeKernel, KernelCache, no_layout};
 use super::pool::{Outputs, STATS_STRIDE};
 use super::{ExecError, Prepared};
 use crate::created;
@@ -202,7 +202,7 @@ pub(super) fn bind_step(
             Some(g) => g,
             None => node
                 .dispatch
-                .groups_in_layout(size, wg, kernel.layout == KernelLayout::Gpu)
+                .groups_in_layout(size, wg, kernel.layout.is_gpu())
                 .ok_or_else(|| ExecError::DispatchOver {
                     node: node.name.clone(),
                 })?,

@@ -32,6 +32,10 @@ pub struct Reflection {
     /// The same as a CPU driver compiles it ([`GPU_LAYOUT_CONSTANT`] false): where the kernel's
     /// size does not depend on the layout, [`Reflection::workgroup_size`].
     pub cpu_workgroup_size: Option<[u32; 3]>,
+    /// The same as the redesign layout compiles it ([`GPU_LAYOUT_CONSTANT`] and
+    /// [`REDESIGN_CONSTANT`] true): where the kernel's size does not depend on `REDESIGN`,
+    /// [`Reflection::workgroup_size`].
+    pub redesign_workgroup_size: Option<[u32; 3]>,
     /// Texels an invocation of `main` covers along x ([`TEXELS_X_CONSTANT`]; 1 where the
     /// kernel declares none): a workgroup covers `workgroup_size[0] · texels_x` columns.
     pub texels_x: u32,
@@ -52,6 +56,12 @@ pub const MAX_TEXELS_X: u32 = 64;
 /// size may depend on it (`kernels/shared/encode_blur.wgsl`: `@workgroup_size(LANES)`).
 pub const GPU_LAYOUT_CONSTANT: &str = "GPU_LAYOUT";
 
+/// The pipeline constant a kernel declares (`override REDESIGN: bool`) where it has a variant not
+/// yet decided on a GPU (`crate::exec::KernelLayout::Redesign` sets it, with
+/// [`GPU_LAYOUT_CONSTANT`]; every other layout leaves it false). Its workgroup size may depend on
+/// it.
+pub const REDESIGN_CONSTANT: &str = "REDESIGN";
+
 impl Reflection {
     /// This reflection as the kernel compiles in one layout (`gpu`: [`GPU_LAYOUT_CONSTANT`]
     /// true): its workgroup size that layout's.
@@ -62,11 +72,20 @@ impl Reflection {
         self
     }
 
+    /// This reflection as the redesign layout compiles it: its workgroup size that layout's.
+    pub fn in_redesign(mut self) -> Self {
+        self.workgroup_size = self.redesign_workgroup_size;
+        self
+    }
+
     /// The largest workgroup of either layout, dimension by dimension (what the device's limits
     /// must allow).
     pub fn largest_workgroup(&self) -> Option<[u32; 3]> {
         match (self.workgroup_size, self.cpu_workgroup_size) {
-            (Some(a), Some(b)) => Some([a[0].max(b[0]), a[1].max(b[1]), a[2].max(b[2])]),
+            (Some(a), Some(b)) => {
+                let c = self.redesign_workgroup_size.unwrap_or(a);
+                Some([0, 1, 2].map(|i| a[i].max(b[i]).max(c[i])))
+            }
             (a, b) => a.or(b),
         }
     }
@@ -147,19 +166,23 @@ fn reflect_module(
     let mut stages = wgpu::ShaderStages::NONE;
     let mut workgroup_size = None;
     let mut cpu_workgroup_size = None;
+    let mut redesign_workgroup_size = None;
     for ep in &module.entry_points {
         match ep.stage {
             naga::ShaderStage::Compute => {
                 stages |= wgpu::ShaderStages::COMPUTE;
                 if ep.name == "main" {
                     let sizes = if ep.workgroup_size_overrides.is_some() {
-                        [true, false].map(|gpu| layout_workgroup_size(kernel, &module, info, gpu))
+                        [(true, false), (false, false), (true, true)].map(|(gpu, redesign)| {
+                            layout_workgroup_size(kernel, &module, info, gpu, redesign)
+                        })
                     } else {
-                        [Ok(ep.workgroup_size), Ok(ep.workgroup_size)]
+                        [(); 3].map(|()| Ok(ep.workgroup_size))
                     };
-                    let [gpu, cpu] = sizes;
+                    let [gpu, cpu, redesign] = sizes;
                     workgroup_size = Some(gpu?);
                     cpu_workgroup_size = Some(cpu?);
+                    redesign_workgroup_size = Some(redesign?);
                 }
             }
             naga::ShaderStage::Vertex => stages |= wgpu::ShaderStages::VERTEX,
@@ -174,28 +197,33 @@ fn reflect_module(
             bindings,
             workgroup_size,
             cpu_workgroup_size,
+            redesign_workgroup_size,
             texels_x,
             stages,
         },
     ))
 }
 
-/// `main`'s workgroup size where it is an `override` expression: as the layout `gpu` compiles
-/// it ([`GPU_LAYOUT_CONSTANT`] set where the kernel declares it, every other override its
-/// default), naga's own evaluation of the pipeline constants.
+/// `main`'s workgroup size where it is an `override` expression: as the layout `gpu` (and
+/// `redesign`) compiles it ([`GPU_LAYOUT_CONSTANT`] and [`REDESIGN_CONSTANT`] set where the
+/// kernel declares them, every other override its default), naga's own evaluation of the
+/// pipeline constants.
 fn layout_workgroup_size(
     kernel: &str,
     module: &naga::Module,
     info: &naga::valid::ModuleInfo,
     gpu: bool,
+    redesign: bool,
 ) -> Result<[u32; 3]> {
     let mut constants = naga::back::PipelineConstants::default();
-    if module
-        .overrides
-        .iter()
-        .any(|(_, o)| o.name.as_deref() == Some(GPU_LAYOUT_CONSTANT))
-    {
-        constants.insert(GPU_LAYOUT_CONSTANT.to_string(), f64::from(u8::from(gpu)));
+    for (name, value) in [(GPU_LAYOUT_CONSTANT, gpu), (REDESIGN_CONSTANT, redesign)] {
+        if module
+            .overrides
+            .iter()
+            .any(|(_, o)| o.name.as_deref() == Some(name))
+        {
+            constants.insert(name.to_string(), f64::from(u8::from(value)));
+        }
     }
     let stage = (naga::ShaderStage::Compute, "main");
     let (resolved, _) =

@@ -7,7 +7,7 @@ use crate::error::{Error, Result};
 /// (unset: by the device's type). A/B of the two layouts on one machine.
 pub const KERNEL_LAYOUT_ENV: &str = "SHADOWGRAPH_KERNEL_LAYOUT";
 
-pub use crate::kernels::GPU_LAYOUT_CONSTANT;
+pub use crate::kernels::{GPU_LAYOUT_CONSTANT, REDESIGN_CONSTANT};
 
 /// Which of its two variants a kernel that has two compiles (`override GPU_LAYOUT: bool`): today
 /// the summed-area tables' pass 3 (`kernels/shared/sat_tile*.wgsl`), whose second sweep over an
@@ -31,6 +31,13 @@ pub enum KernelLayout {
     Gpu,
     /// A CPU driver's (`GPU_LAYOUT = false`): keep in private memory.
     Cpu,
+    /// A GPU's with every redesign not yet decided on a GPU (`GPU_LAYOUT = true`,
+    /// `REDESIGN = true`; graph-level redesigns ask [`KernelLayout::is_redesign`]): never a
+    /// device's default, chosen by [`KERNEL_LAYOUT_ENV`]` = redesign` or `shadowgraph bench
+    /// --layouts gpu,redesign`, which times it against [`KernelLayout::Gpu`] kernel by kernel.
+    /// Every redesign is tested in it on lavapipe against the same references as the shipped
+    /// kernels; one that wins on a GPU moves into [`KernelLayout::Gpu`].
+    Redesign,
 }
 
 impl KernelLayout {
@@ -46,14 +53,26 @@ impl KernelLayout {
         }
     }
 
-    /// `gpu` or `cpu`, as [`KERNEL_LAYOUT_ENV`] and `shadowgraph bench --layouts` spell it;
-    /// else what is wrong with `name`.
+    /// `gpu`, `cpu` or `redesign`, as [`KERNEL_LAYOUT_ENV`] and `shadowgraph bench --layouts`
+    /// spell it; else what is wrong with `name`.
     pub fn parse(name: &str) -> std::result::Result<Self, String> {
         match name {
             "gpu" => Ok(Self::Gpu),
             "cpu" => Ok(Self::Cpu),
-            _ => Err(format!("`{name}`: expected `gpu` or `cpu`")),
+            "redesign" => Ok(Self::Redesign),
+            _ => Err(format!("`{name}`: expected `gpu`, `cpu` or `redesign`")),
         }
+    }
+
+    /// Whether kernels compile their GPU variant (`GPU_LAYOUT = true`): [`KernelLayout::Gpu`]
+    /// and [`KernelLayout::Redesign`].
+    pub fn is_gpu(self) -> bool {
+        !matches!(self, Self::Cpu)
+    }
+
+    /// Whether the undecided redesigns run ([`KernelLayout::Redesign`]).
+    pub fn is_redesign(self) -> bool {
+        matches!(self, Self::Redesign)
     }
 
     /// The name [`KernelLayout::parse`] reads.
@@ -61,6 +80,7 @@ impl KernelLayout {
         match self {
             Self::Gpu => "gpu",
             Self::Cpu => "cpu",
+            Self::Redesign => "redesign",
         }
     }
 }
