@@ -29,6 +29,7 @@
 //! with the quartiles and range ([`Spread`]). **Memory** is the plan's peak of live
 //! textures plus the rasterized depth maps.
 
+pub mod agreement;
 mod crops;
 pub mod crossover;
 mod crossover_run;
@@ -73,7 +74,7 @@ use crate::truth::{Emitter, TruthOptions, area_light_truth};
 
 /// Measurements of one configuration.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
-pub struct Row {
+pub struct Measurement {
     /// [`Config::label`].
     pub label: String,
     /// Technique name.
@@ -203,7 +204,7 @@ pub struct Report {
     /// Configurations skipped, with the reason.
     pub skipped: Vec<(String, String)>,
     /// One row per configuration, in sweep order.
-    pub rows: Vec<Row>,
+    pub rows: Vec<Measurement>,
     /// Each front's technique against PCSS as the image grows ([`crossover`]; `None` in a
     /// further operating point's report, whose first report has it).
     #[serde(default)]
