@@ -1,18 +1,18 @@
 //! The frame: per light a depth-only raster pass, the planned kernels, the camera G-buffer and
-//! the generated shading kernel ([`Renderer`]). Also [`probe`], which evaluates visibility at
-//! given points on given maps (how tests compare the GPU to the f64 references).
+//! the generated shading kernel ([`Renderer`]). Also [`visibility_at`], which evaluates
+//! visibility at given points on given maps (how tests compare the GPU to the f64 references).
 
 mod cache;
 mod cascade;
-mod probe;
 mod renderer;
 mod targets;
+mod visibility_at;
 
 use bytemuck::Zeroable;
 
 pub use self::cascade::{DrawnLights, cascade_camera, drawn_lights, view_range};
-pub use self::probe::{ProbeMap, probe};
 pub use self::renderer::{Renderer, ShadowRaster};
+pub use self::visibility_at::{MapData, visibility_at};
 use crate::error::{Error, Result};
 use crate::exec::Outputs;
 use crate::gpu::read_texture;

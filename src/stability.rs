@@ -13,7 +13,7 @@
 //! | 7 | near/far 1e-4 and 0.999, spot and directional | linear depth within 5 f32 roundings of the f64 linearization; the depth buffer's own step reported against the bias |
 //! | 8 | MSM (f32, f16, unorm16; soft MSM f32, f16) with the receiver 10⁻⁵–10⁻¹ behind a flat occluder, at the default moment biases | within 0.01 (f32), 0.03 (unorm16), 0.05 (soft MSM's tables) or 0.25 (f16) of exact MSM on the occluder's point mass with the same bias: the requirement the defaults were chosen to meet |
 //!
-//! Each case returns [`Row`]s; [`run`] runs them all, [`StabilityReport::table`] formats them.
+//! Each case returns [`StabilityRow`]s; [`run`] runs them all, [`StabilityReport::table`] formats them.
 
 mod check;
 mod csm_ringing;
@@ -62,7 +62,7 @@ impl std::fmt::Display for Verdict {
 
 /// One line of the report: a quantity measured on the GPU against its f64 reference.
 #[derive(Clone, Debug)]
-pub struct Row {
+pub struct StabilityRow {
     /// Case number (1–8, see the module documentation).
     pub case: u8,
     /// What is measured (e.g. `window means`).
@@ -96,7 +96,7 @@ pub struct StabilityOptions {
 #[derive(Clone, Debug, Default)]
 pub struct StabilityReport {
     /// All rows, case by case.
-    pub rows: Vec<Row>,
+    pub rows: Vec<StabilityRow>,
     /// `(case, seconds)`.
     pub seconds: Vec<(u8, f64)>,
     /// The device it ran on.
@@ -109,7 +109,7 @@ pub fn sat_size(opts: &StabilityOptions) -> u32 {
 }
 
 /// The cases in order: number, name, function.
-type CaseFn = fn(&Gpu, &StabilityOptions) -> Result<Vec<Row>>;
+type CaseFn = fn(&Gpu, &StabilityOptions) -> Result<Vec<StabilityRow>>;
 const CASES: [(u8, &str, CaseFn); 8] = [
     (1, "summed-area tables", |g, o| {
         sat_windows::sat_case(g, sat_size(o), SatTables::All)
@@ -132,42 +132,42 @@ const CASES: [(u8, &str, CaseFn); 8] = [
 ];
 
 /// Case 1: SAT window sums at `size`² (see the module documentation) for `tables`.
-pub fn sat_case(gpu: &Gpu, size: u32, tables: SatTables) -> Result<Vec<Row>> {
+pub fn sat_case(gpu: &Gpu, size: u32, tables: SatTables) -> Result<Vec<StabilityRow>> {
     sat_windows::sat_case(gpu, size, tables)
 }
 
 /// Case 2: VSM/EVSM over a zero-variance planar occluder.
-pub fn planar_case(gpu: &Gpu) -> Result<Vec<Row>> {
+pub fn planar_case(gpu: &Gpu) -> Result<Vec<StabilityRow>> {
     planar::planar_case(gpu)
 }
 
 /// Case 3: MSM with all-equal moments and depths exactly 0 and 1.
-pub fn msm_case(gpu: &Gpu) -> Result<Vec<Row>> {
+pub fn msm_case(gpu: &Gpu) -> Result<Vec<StabilityRow>> {
     msm_flat::msm_case(gpu)
 }
 
 /// Case 4: EVSM and ESM exponents at and past the storage limits, through every filter.
-pub fn exponent_case(gpu: &Gpu) -> Result<Vec<Row>> {
+pub fn exponent_case(gpu: &Gpu) -> Result<Vec<StabilityRow>> {
     exponents::exponent_case(gpu)
 }
 
 /// Case 5: CSM (M = 16) at blocker depths and at 0 and 1, and its ringing.
-pub fn csm_case(gpu: &Gpu) -> Result<Vec<Row>> {
+pub fn csm_case(gpu: &Gpu) -> Result<Vec<StabilityRow>> {
     csm_ringing::csm_case(gpu)
 }
 
 /// Case 6: NaN and ±Inf in the depth buffer.
-pub fn non_finite_case(gpu: &Gpu) -> Result<Vec<Row>> {
+pub fn non_finite_case(gpu: &Gpu) -> Result<Vec<StabilityRow>> {
     non_finite::non_finite_case(gpu)
 }
 
 /// Case 7: linear depth of very deep and very shallow frusta.
-pub fn frusta_case(gpu: &Gpu) -> Result<Vec<Row>> {
+pub fn frusta_case(gpu: &Gpu) -> Result<Vec<StabilityRow>> {
     frusta::frusta_case(gpu)
 }
 
 /// Case 8: MSM with the receiver just behind a flat occluder, at the default moment biases.
-pub fn msm_contact_case(gpu: &Gpu) -> Result<Vec<Row>> {
+pub fn msm_contact_case(gpu: &Gpu) -> Result<Vec<StabilityRow>> {
     msm_contact::msm_contact_case(gpu)
 }
 
@@ -192,7 +192,7 @@ pub fn run(
 
 impl StabilityReport {
     /// Rows that failed.
-    pub fn failures(&self) -> Vec<&Row> {
+    pub fn failures(&self) -> Vec<&StabilityRow> {
         self.rows
             .iter()
             .filter(|r| r.verdict == Verdict::Fail)

@@ -250,7 +250,7 @@ fn creation_goes_through_the_counter() {
         "render.rs",
         "render/renderer.rs",
         "render/targets.rs",
-        "render/probe.rs",
+        "render/visibility_at.rs",
         "exec/mod.rs",
         "exec/pipelines.rs",
         "exec/pool.rs",

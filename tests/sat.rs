@@ -18,7 +18,7 @@ use shadowgraph::gpu::{Gpu, read_texture, submit_and_wait, write_texture};
 use shadowgraph::graph::{Graph, plan, texel_bytes};
 use shadowgraph::kernels;
 use shadowgraph::sat::five_pass::{SAT_BLOCK, SAT_CARRY_LINES, add_sat_five_pass};
-use shadowgraph::sat::probe::{Lookup, probe_means};
+use shadowgraph::sat::lookups::{Lookup, lookup_means};
 use shadowgraph::sat::{
     SAT_LINES_PER_GROUP, SAT_TILE, SatCoding, SatParams, SatVariant, add_sat, float_sum_depth,
     format_channels, lookup_area,
@@ -520,7 +520,7 @@ fn probe(g: &Gpu, table: &wgpu::Texture, coding: &SatCoding, rects: &[[f32; 4]])
         SatVariant::Fixed => Lookup::Fixed,
         SatVariant::Float => Lookup::Float,
     };
-    probe_means(g, table, lookup, coding, rects).expect("probe")
+    lookup_means(g, table, lookup, coding, rects).expect("probe")
 }
 
 /// Random rectangles up to `max` texels a side, some reversed, partly or wholly outside the

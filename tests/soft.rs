@@ -17,7 +17,7 @@ use rand::Rng;
 use shadowgraph::cpu::sat::Integral;
 use shadowgraph::cpu::{self, Texels};
 use shadowgraph::gpu::Gpu;
-use shadowgraph::render::{ProbeMap, Renderer, probe};
+use shadowgraph::render::{MapData, Renderer, visibility_at};
 use shadowgraph::sat::SatVariant;
 use shadowgraph::scene::{CssmSearch, Light, Scene, Storage, Technique};
 use shadowgraph::technique::{LightGpu, sat_coding};
@@ -87,17 +87,17 @@ fn check_soft(
             .iter()
             .map(|t| Integral::new(&t.decoded).filtered(float))
             .collect();
-        let maps: Vec<ProbeMap> = tabs
+        let maps: Vec<MapData> = tabs
             .iter()
             .flat_map(|t| {
                 t.words
                     .iter()
-                    .map(|w| ProbeMap::new(MAP as u32, t.format, w))
+                    .map(|w| MapData::new(MAP as u32, t.format, w))
             })
             .collect();
         let points: Vec<(Vec3, Vec3)> = (0..3000).map(|_| point(&l, &mut rng)).collect();
         let mut renderer = Renderer::new(&g.device);
-        let vis = probe(
+        let vis = visibility_at(
             &mut renderer,
             &g.device,
             &g.queue,
@@ -105,7 +105,7 @@ fn check_soft(
             &maps,
             &points,
         )
-        .expect("probe");
+        .expect("visibility_at");
         let (mut gpu_v, mut ref_v, mut tol) = (Vec::new(), Vec::new(), Vec::new());
         for (i, (p, n)) in points.iter().enumerate() {
             let s = cpu::light::sample(&lg, p.as_dvec3(), n.as_dvec3());

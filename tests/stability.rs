@@ -11,10 +11,13 @@
 mod common;
 
 use shadowgraph::gpu::Gpu;
-use shadowgraph::stability::{self, Row, SatTables, StabilityReport, Verdict};
+use shadowgraph::stability::{self, SatTables, StabilityReport, StabilityRow, Verdict};
 
 /// Runs one case, prints its table and asserts every verdict; returns the rows.
-fn run_case(case: u8, f: impl FnOnce(&Gpu) -> shadowgraph::Result<Vec<Row>>) -> Vec<Row> {
+fn run_case(
+    case: u8,
+    f: impl FnOnce(&Gpu) -> shadowgraph::Result<Vec<StabilityRow>>,
+) -> Vec<StabilityRow> {
     let g = common::gpu();
     let start = std::time::Instant::now();
     let rows = f(&g).unwrap_or_else(|e| panic!("case {case}: {e}"));
@@ -60,7 +63,12 @@ fn run_case(case: u8, f: impl FnOnce(&Gpu) -> shadowgraph::Result<Vec<Row>>) -> 
     rows
 }
 
-fn find<'a>(rows: &'a [Row], what: &str, technique: &str, storage: &str) -> &'a Row {
+fn find<'a>(
+    rows: &'a [StabilityRow],
+    what: &str,
+    technique: &str,
+    storage: &str,
+) -> &'a StabilityRow {
     rows.iter()
         .find(|r| {
             r.what.contains(what) && r.technique.contains(technique) && r.storage.contains(storage)

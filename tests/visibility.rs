@@ -11,7 +11,7 @@ mod common;
 use glam::{DVec3, Vec3};
 use rand::Rng;
 use shadowgraph::cpu::{self, Map};
-use shadowgraph::render::{ProbeMap, Renderer, probe};
+use shadowgraph::render::{MapData, Renderer, visibility_at};
 use shadowgraph::scene::{Light, LightKind, PcfKernel, Shadow, Technique};
 use shadowgraph::technique::LightGpu;
 
@@ -107,15 +107,15 @@ fn check_light(l: Light, seed: u64, on_map: bool) {
         })
         .collect();
     let mut renderer = Renderer::new(&g.device);
-    let vis = probe(
+    let vis = visibility_at(
         &mut renderer,
         &g.device,
         &g.queue,
         std::slice::from_ref(&l),
-        &[ProbeMap::linear(MAP as u32, &map)],
+        &[MapData::linear(MAP as u32, &map)],
         &points,
     )
-    .expect("probe");
+    .expect("visibility_at");
     let lg = LightGpu::new(&l);
     let cmap = Map {
         size: MAP,
@@ -413,9 +413,9 @@ fn check_prefiltered(
             }
             uploads.push((format, data));
         }
-        let maps: Vec<ProbeMap> = uploads
+        let maps: Vec<MapData> = uploads
             .iter()
-            .map(|(format, data)| ProbeMap {
+            .map(|(format, data)| MapData {
                 size: MAP as u32,
                 format: *format,
                 mips: levels.len() as u32,
@@ -424,7 +424,7 @@ fn check_prefiltered(
             .collect();
         let points: Vec<(Vec3, Vec3)> = (0..6000).map(|_| point(&l, &mut rng)).collect();
         let mut renderer = Renderer::new(&g.device);
-        let vis = probe(
+        let vis = visibility_at(
             &mut renderer,
             &g.device,
             &g.queue,
@@ -432,7 +432,7 @@ fn check_prefiltered(
             &maps,
             &points,
         )
-        .expect("probe");
+        .expect("visibility_at");
         let lg = LightGpu::new(&l);
         let (mut reference, mut tol) = (Vec::new(), Vec::new());
         for (p, n) in &points {

@@ -13,7 +13,7 @@
 //! the measurement is [`run`](super::crossover_run), the plot
 //! [`crossover_svg`](super::crossover_svg).
 
-use super::Row;
+use super::Measurement;
 
 /// The image sizes the crossover is drawn over, megapixels: 0.25 Mpx to 3840×2160.
 pub const RANGE_MPX: (f64, f64) = (0.25, 3840.0 * 2160.0 / 1e6);
@@ -165,7 +165,7 @@ pub fn comparable_pcss(error: f64, pcss: &[(usize, f64, f64)]) -> Option<(usize,
 /// The rows the crossover compares: per technique other than PCSS, its most accurate
 /// configuration in the penumbra among those on a front (`on_front`), each with the PCSS row
 /// it is compared with. Rows without a total time take no part.
-pub fn pairs(rows: &[Row], on_front: &[usize]) -> Vec<(usize, usize, Match)> {
+pub fn pairs(rows: &[Measurement], on_front: &[usize]) -> Vec<(usize, usize, Match)> {
     let timed = |i: &usize| rows[*i].total_ms.is_some_and(f64::is_finite);
     let pcss: Vec<(usize, f64, f64)> = (0..rows.len())
         .filter(|i| rows[*i].technique == "pcss" && timed(i))

@@ -10,7 +10,7 @@ use super::crossover::{
 };
 use super::protocol::{self, Protocol, Timed};
 use super::svg::{Metric, front};
-use super::{EvaluateOptions, Kept, Report, Row, timing};
+use super::{EvaluateOptions, Kept, Measurement, Report, timing};
 use crate::error::Result;
 use crate::gpu::Gpu;
 use crate::scene::UpdateRate;
@@ -129,15 +129,15 @@ fn with_crossings(
 
 /// Row `row`'s cost from its times at every size (`at_size[s][k]`, the check size last).
 fn cost(
-    row: &Row,
+    row: &Measurement,
     index: usize,
     fit_sizes: &[(u32, u32)],
     check: (u32, u32),
-    at_size: &[Vec<Row>],
+    at_size: &[Vec<Measurement>],
     k: usize,
 ) -> Cost {
-    let shade = |r: &Row| r.shade_ms.unwrap_or(f64::NAN);
-    let prefilter = |r: &Row| r.raster_ms.unwrap_or(0.0) + r.kernels_ms.unwrap_or(0.0);
+    let shade = |r: &Measurement| r.shade_ms.unwrap_or(f64::NAN);
+    let prefilter = |r: &Measurement| r.raster_ms.unwrap_or(0.0) + r.kernels_ms.unwrap_or(0.0);
     let fitted = &at_size[..fit_sizes.len()];
     let shade_points: Vec<(f64, f64)> = fit_sizes
         .iter()
@@ -182,7 +182,7 @@ fn time_sizes(
     measured: &[usize],
     sizes: &[(u32, u32)],
     repeats: u32,
-) -> Result<Vec<Vec<Row>>> {
+) -> Result<Vec<Vec<Measurement>>> {
     let mut timed = vec![vec![Timed::default(); measured.len()]; sizes.len()];
     let mut checks: Vec<Vec<f64>> = vec![Vec::new(); sizes.len()];
     let bar =

@@ -13,7 +13,7 @@ use super::crops::{self, Crop};
 use super::flip::{flip_map, magma};
 use super::output::{protocol_text, region_text, run_line, wall_check};
 use super::svg::{Metric, colour, front};
-use super::{ErrorStats, Images, Report, Row};
+use super::{ErrorStats, Images, Measurement, Report};
 use crate::error::Result;
 
 /// Crops are shown about this many CSS pixels wide (an integer zoom: square pixels).
@@ -439,7 +439,7 @@ fn crop_row(
         report.truth_samples
     );
     for (i, err, flip) in maps {
-        let r: &Row = &report.rows[*i];
+        let r: &Measurement = &report.rows[*i];
         let time = r.total_spread.map_or_else(
             || {
                 r.total_ms

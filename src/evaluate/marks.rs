@@ -6,7 +6,7 @@ use plotters::prelude::*;
 
 use super::svg::{Metric, plot_error};
 use super::verdict::Family;
-use super::{Report, Row};
+use super::{Measurement, Report};
 use crate::error::Result;
 
 /// The plots' colours, one per registered technique in registry order: as many as there are
@@ -94,7 +94,7 @@ pub fn marker(
 }
 
 /// A point's tooltip: label, family, map, total time with its quartiles, the metric.
-pub(super) fn tooltip(r: &Row, metric: Metric) -> String {
+pub(super) fn tooltip(r: &Measurement, metric: Metric) -> String {
     let t = r.total_spread.map_or_else(
         || format!("{:.3}", r.total_ms.unwrap_or(f64::NAN)),
         |s| s.text(3),

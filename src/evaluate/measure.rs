@@ -5,7 +5,7 @@ use glam::DVec3;
 
 use super::flip::{Shader, flip_map, flip_stats};
 use super::stats::{ErrorStats, Region, Regions, laplacian_rms};
-use super::{Config, PlanCost, Row, storage_name};
+use super::{Config, Measurement, PlanCost, storage_name};
 use crate::cpu::Map;
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
@@ -60,7 +60,7 @@ impl Reference {
 /// One configuration measured: its row, its frame and both shaded images.
 pub struct Measured {
     /// The report's row.
-    pub row: Row,
+    pub row: Measurement,
     /// The last rendered frame.
     pub frame: Frame,
     /// The frame's G-buffer shaded with the frame's visibility (RGB8).
@@ -128,7 +128,7 @@ pub fn measure(
         (Some(storage), Some(filter)) => (storage_name(storage).to_string(), filter_name(filter)),
         _ => (String::new(), String::new()),
     };
-    let row = Row {
+    let row = Measurement {
         label: c.label.clone(),
         technique: c.technique.name().to_string(),
         family: super::verdict::Family::of(&c.technique).name().to_string(),

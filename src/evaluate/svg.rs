@@ -13,7 +13,7 @@ use plotters::prelude::*;
 pub use super::marks::{PALETTE, colour, marker, marker_radius};
 use super::marks::{draw_legend, tooltip};
 use super::verdict::Family;
-use super::{Report, Row};
+use super::{Measurement, Report};
 use crate::error::{Error, Result};
 
 const W: u32 = 960;
@@ -51,7 +51,7 @@ impl Metric {
     }
 
     /// The row's value of this metric.
-    pub fn value(self, r: &Row) -> f64 {
+    pub fn value(self, r: &Measurement) -> f64 {
         match self {
             Metric::Mean => r.soft.mean_abs,
             Metric::Penumbra => r.penumbra.mean_abs,
@@ -93,7 +93,7 @@ impl Metric {
 
 /// Indices of the rows on the Pareto front of (total time, `metric`), fastest first: a row
 /// is on it when no row is at most as slow and at most as wrong, and better in one.
-pub fn front(rows: &[Row], metric: Metric) -> Vec<usize> {
+pub fn front(rows: &[Measurement], metric: Metric) -> Vec<usize> {
     let points: Vec<(Option<f64>, f64)> =
         rows.iter().map(|r| (r.total_ms, metric.value(r))).collect();
     pareto_front(&points)

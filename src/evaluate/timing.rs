@@ -2,7 +2,7 @@
 //! [`protocol`](super::protocol) on the GPU, its rows' times filled from the kept frames, and
 //! the run's facts (commit, date) for the report's header.
 
-use super::Row;
+use super::Measurement;
 use super::protocol::{self, Protocol, Run, Sample, Spread, Timed};
 use crate::error::Result;
 use crate::gpu::Gpu;
@@ -119,7 +119,7 @@ fn is_raster(label: &str) -> bool {
 /// Fills `row`'s times from its configuration's `timed` frames: per pass the median, the
 /// parts (raster, kernels, shading) and total as medians of each frame's sums, the total's
 /// spread, the check pass, the wall time, the retries and the flag.
-pub fn fill(row: &mut Row, timed: &Timed, run_check: Option<f64>) {
+pub fn fill(row: &mut Measurement, timed: &Timed, run_check: Option<f64>) {
     let frames = &timed.samples;
     let sum = |s: &Sample, f: &dyn Fn(&str) -> bool| -> f64 {
         s.passes.iter().filter(|(l, _)| f(l)).map(|p| p.1).sum()

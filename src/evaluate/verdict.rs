@@ -3,7 +3,7 @@
 //! accurate within a stated time budget per light, and prefiltering against PCSS there. And
 //! the families the plots draw with one marker shape each.
 
-use super::{Report, Row};
+use super::{Measurement, Report};
 
 /// How much worse than the best penumbra error a configuration may be and still count as
 /// "as accurate" (10%).
@@ -46,7 +46,7 @@ impl Family {
         }
     }
 
-    /// The name a row keeps ([`Row::family`]).
+    /// The name a row keeps ([`Measurement::family`]).
     pub fn name(self) -> &'static str {
         match self {
             Family::Lookup => "lookup",
@@ -111,12 +111,12 @@ pub fn budget(report: &Report) -> Option<(f64, &'static str)> {
     super::protocol::median(&per_light).map(|m| (m, "the median configuration's time"))
 }
 
-fn per_light(report: &Report, r: &Row) -> f64 {
+fn per_light(report: &Report, r: &Measurement) -> f64 {
     r.total_ms.unwrap_or(f64::INFINITY) / report.lights.max(1) as f64
 }
 
 /// Rows with a total time and a penumbra.
-fn timed(report: &Report) -> impl Iterator<Item = &Row> {
+fn timed(report: &Report) -> impl Iterator<Item = &Measurement> {
     report
         .rows
         .iter()
@@ -124,19 +124,19 @@ fn timed(report: &Report) -> impl Iterator<Item = &Row> {
 }
 
 /// The fastest of `rows` (`None` when empty).
-fn fastest<'a>(rows: impl Iterator<Item = &'a Row>) -> Option<&'a Row> {
+fn fastest<'a>(rows: impl Iterator<Item = &'a Measurement>) -> Option<&'a Measurement> {
     rows.min_by(|a, b| {
-        let t = |r: &Row| r.total_ms.unwrap_or(f64::INFINITY);
+        let t = |r: &Measurement| r.total_ms.unwrap_or(f64::INFINITY);
         t(a).total_cmp(&t(b))
     })
 }
 
 /// The most accurate in the penumbra of `rows`.
-fn most_accurate<'a>(rows: impl Iterator<Item = &'a Row>) -> Option<&'a Row> {
+fn most_accurate<'a>(rows: impl Iterator<Item = &'a Measurement>) -> Option<&'a Measurement> {
     rows.min_by(|a, b| a.penumbra.mean_abs.total_cmp(&b.penumbra.mean_abs))
 }
 
-fn describe(r: &Row) -> String {
+fn describe(r: &Measurement) -> String {
     format!(
         "**{}** ({:.3} ms, penumbra error {:.4})",
         r.label,
@@ -183,8 +183,8 @@ pub fn verdicts(report: &Report) -> Vec<String> {
 fn against_pcss(report: &Report) -> Option<String> {
     let pcss = most_accurate(timed(report).filter(|r| r.technique == "pcss"))?;
     let pre = || timed(report).filter(|r| Family::named(&r.family).prefilters());
-    let t = |r: &Row| r.total_ms.unwrap_or(f64::NAN);
-    let ratio = |r: &Row| t(r) / t(pcss);
+    let t = |r: &Measurement| r.total_ms.unwrap_or(f64::NAN);
+    let ratio = |r: &Measurement| t(r) / t(pcss);
     let limit = NEAR_BEST * pcss.penumbra.mean_abs;
     Some(
         match fastest(pre().filter(|r| r.penumbra.mean_abs <= limit)) {

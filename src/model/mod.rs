@@ -15,7 +15,8 @@ pub use defaults::{
     default_soft_moment_bias, exponent_limit,
 };
 pub use params::{
-    Needs, ParamDefault, ParamKind, ParamSource, ParamSpec, ParamValue, ParamValues, check, keys,
+    Needs, ParamDefault, ParamKind, ParamSource, ParamSpec, ParamValue, ParamValues, check_params,
+    keys,
 };
 
 use glam::{Mat4, Vec3};

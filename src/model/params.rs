@@ -1,7 +1,7 @@
 //! Parameter specifications: what a technique's keys accept (range or options), their
 //! defaults and when they apply, as plain data. The technique registry writes each table once
 //! (`crate::technique`); the scene parser and the plug-in's config check values against it
-//! through one checker (`technique::check`), each wording its own errors.
+//! through one checker (`technique::check_and_build` over `model::check_params`), each wording its own errors.
 
 /// The values a key accepts.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -149,7 +149,10 @@ pub trait ParamSource {
 /// with its value or its default. A key given where a condition ([`Needs`]) excludes it is an
 /// error; a key of several specs takes the first whose conditions hold. Keys the tables do not
 /// name are the front end's to refuse (it knows their spelling and position).
-pub fn check<S: ParamSource>(tables: &[&[ParamSpec]], source: &S) -> Result<ParamValues, S::Error> {
+pub fn check_params<S: ParamSource>(
+    tables: &[&[ParamSpec]],
+    source: &S,
+) -> Result<ParamValues, S::Error> {
     let specs: Vec<&ParamSpec> = tables.iter().flat_map(|t| t.iter()).collect();
     let mut values = ParamValues::default();
     let mut done: Vec<&str> = Vec::new();

@@ -331,7 +331,7 @@ impl PrefilterConfig {
             ("bias", ParamValue::Float(self.bias)),
             ("normal_bias", ParamValue::Float(self.normal_bias)),
         ]);
-        crate::model::check(&[COMMON], &Given(&common)).map_err(given_err)?;
+        crate::model::check_params(&[COMMON], &Given(&common)).map_err(given_err)?;
         if self.receiver_plane != 0.0 {
             if !crate::model::keys(def.params).contains(&"bias_mode") {
                 return Err(config_err(
@@ -343,7 +343,7 @@ impl PrefilterConfig {
             let mut values = (def.values)(&self.technique);
             values.set("bias_mode", ParamValue::Choice("receiver_plane"));
             values.set("receiver_plane_cap", ParamValue::Float(self.receiver_plane));
-            crate::model::check(def.params, &Given(&values)).map_err(given_err)?;
+            crate::model::check_params(def.params, &Given(&values)).map_err(given_err)?;
         }
         let c = self.cascades;
         let cascades = ParamValues(vec![
@@ -351,7 +351,7 @@ impl PrefilterConfig {
             ("cascade_lambda", ParamValue::Float(c.lambda)),
             ("cascade_blend", ParamValue::Float(c.blend)),
         ]);
-        crate::model::check(&[CASCADES], &Given(&cascades)).map_err(given_err)?;
+        crate::model::check_params(&[CASCADES], &Given(&cascades)).map_err(given_err)?;
         if c.count > 1 {
             technique::params::cascade_support(&self.technique).map_err(|why| {
                 config_err(
@@ -384,7 +384,7 @@ fn checked(
     light_size: f32,
 ) -> Result<(Technique, Vec<String>), StageError> {
     let values = (def.values)(&t);
-    crate::model::check(def.params, &Given(&values)).map_err(given_err)?;
+    crate::model::check_params(def.params, &Given(&values)).map_err(given_err)?;
     if technique::peels(&t) {
         return Err(config_err(
             "technique",

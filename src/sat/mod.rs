@@ -40,7 +40,7 @@
 
 pub mod five_pass;
 pub mod layers;
-pub mod probe;
+pub mod lookups;
 
 use crate::error::{Error, Result};
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
@@ -62,8 +62,8 @@ pub use crate::model::SatVariant;
 /// The sampler of f32 summed-area tables read with bilinear-filtered fetches (linear
 /// filtering, clamped to the edge, level 0; `kernels/shared/sat.wgsl`, `sat_mean_linear`): a
 /// plug-in host binds it after the maps where `Prefilter::needs_filtering_sampler` says so (the
-/// plug-in re-exports it as `prefilter::SAT_SAMPLER_DESCRIPTOR`); the renderer and the probe
-/// ([`probe`]) bind the same one.
+/// plug-in re-exports it as `prefilter::SAT_SAMPLER_DESCRIPTOR`); the renderer and
+/// [`lookups::lookup_means`] bind the same one.
 pub const SAT_SAMPLER_DESCRIPTOR: wgpu::SamplerDescriptor<'static> = wgpu::SamplerDescriptor {
     label: Some("shadowgraph.sat_sampler"),
     address_mode_u: wgpu::AddressMode::ClampToEdge,

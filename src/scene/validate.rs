@@ -177,7 +177,7 @@ pub(super) fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
     {
         return Err(table.not_applicable(k, &format!("does not apply to technique \"{name}\"")));
     }
-    let (technique, clamps) = technique::check(def, &table)?;
+    let (technique, clamps) = technique::check_and_build(def, &table)?;
     for c in clamps {
         // A table's limit is the scene's choice of width: its clamp is reported only when the
         // exponent was written; a storage's limit always.
@@ -190,9 +190,9 @@ pub(super) fn shadow(ctx: &Ctx, i: usize, s: &ShadowFile) -> Result<Shadow> {
     // The technique's own values again, for the keys its `Technique` does not hold (the
     // receiver-plane bias, which is the light's `Shadow`).
     let receiver_plane =
-        technique::params::receiver_plane(&crate::model::check(def.params, &table)?);
-    let common = crate::model::check(&[COMMON], &table)?;
-    let cascades = technique::params::cascades(&crate::model::check(&[CASCADES], &table)?);
+        technique::params::receiver_plane(&crate::model::check_params(def.params, &table)?);
+    let common = crate::model::check_params(&[COMMON], &table)?;
+    let cascades = technique::params::cascades(&crate::model::check_params(&[CASCADES], &table)?);
     if cascades.count > 1 {
         if let Err(why) = technique::params::cascade_support(&technique) {
             return Err(table.not_applicable(

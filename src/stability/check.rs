@@ -3,12 +3,12 @@
 //! non-finite GPU values and the count of values outside their bounds. Also the suite's
 //! deterministic random numbers.
 
-use super::{Row, Verdict};
+use super::{StabilityRow, Verdict};
 
 /// f32's unit roundoff (round to nearest).
 pub(crate) use crate::tolerance::U;
 
-/// Accumulates comparisons for one [`Row`].
+/// Accumulates comparisons for one [`StabilityRow`].
 #[derive(Debug, Default)]
 pub(crate) struct Check {
     /// Values compared.
@@ -109,7 +109,7 @@ impl Check {
 
     /// The row: `pass` when every value is finite and within its bound and nothing else went
     /// wrong; a check that compared nothing fails (it could not have failed otherwise).
-    pub(crate) fn row(self, case: u8, what: &str, technique: &str, storage: &str) -> Row {
+    pub(crate) fn row(self, case: u8, what: &str, technique: &str, storage: &str) -> StabilityRow {
         let (error, bound, _, at) = self.worst.unwrap_or((0.0, 0.0, 0.0, String::new()));
         let mut note = if at.is_empty() {
             format!("{} values", self.values)
@@ -134,7 +134,7 @@ impl Check {
             verdict = Verdict::Fail;
             note = format!("{}; {note}", self.problems.join("; "));
         }
-        Row {
+        StabilityRow {
             case,
             what: what.into(),
             technique: technique.into(),
@@ -157,8 +157,8 @@ impl Check {
         bound: f64,
         nonfinite: u64,
         note: String,
-    ) -> Row {
-        Row {
+    ) -> StabilityRow {
+        StabilityRow {
             case,
             what: what.into(),
             technique: technique.into(),

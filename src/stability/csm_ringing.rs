@@ -16,7 +16,7 @@ use std::f64::consts::PI;
 
 use glam::Vec3;
 
-use super::Row;
+use super::StabilityRow;
 use super::check::{Check, Rng};
 use super::harness::{DIRECTIONAL, light, receiver, run_light, sample, shade};
 use super::planar::storage_name;
@@ -96,7 +96,7 @@ fn step_exact(l: &LightGpu) -> f64 {
 
 /// The unclamped f64 series against the step on a fine grid of t: the bound `s·E(t)` away
 /// from the jumps, and the series' own overshoot (Gibbs) past [0, 1] near them.
-fn series_rows(l: &LightGpu) -> [Row; 2] {
+fn series_rows(l: &LightGpu) -> [StabilityRow; 2] {
     let w = tolerance::csm_weights(l);
     let s = f64::from(l.csm_scale);
     let tv = total_variation(l);
@@ -160,7 +160,7 @@ struct Checks {
 
 /// One storage: the GPU's clamped output against the f64 series on the same maps and against
 /// the step over flat blockers.
-fn check_storage(gpu: &Gpu, rng: &mut Rng, storage: Storage) -> Result<[Row; 4]> {
+fn check_storage(gpu: &Gpu, rng: &mut Rng, storage: Storage) -> Result<[StabilityRow; 4]> {
     let l = light(DIRECTIONAL, technique(storage), MAP, BIAS);
     let lg = LightGpu::new(&l);
     let n = MAP as usize;
@@ -339,7 +339,7 @@ fn concat(levels: &[Vec<Texels>]) -> Result<Texels> {
 }
 
 /// Case 5.
-pub(crate) fn csm_case(gpu: &Gpu) -> Result<Vec<Row>> {
+pub(crate) fn csm_case(gpu: &Gpu) -> Result<Vec<StabilityRow>> {
     let mut rng = Rng::new(0xC5);
     let mut rows = Vec::new();
     for storage in [Storage::F32, Storage::F16] {

@@ -16,7 +16,7 @@
 use std::collections::HashMap;
 use std::path::Path;
 
-use super::Row;
+use super::StabilityRow;
 use super::check::{Check, Rng, U};
 use super::harness::{DIRECTIONAL, Poison, light, mips, registered, run_graph};
 use super::stages::{Stages, run_stages};
@@ -112,7 +112,7 @@ fn configuration(
     name: &str,
     storage: &str,
     technique: impl Fn(Filter) -> Technique,
-) -> Result<Vec<Row>> {
+) -> Result<Vec<StabilityRow>> {
     let mut rows = Vec::new();
     let mut sat = Vec::new();
     for (i, filter) in filters().into_iter().enumerate() {
@@ -167,7 +167,7 @@ fn sat_rows(
     texels: &Texels,
     name: &str,
     storage: &str,
-) -> Result<Vec<Row>> {
+) -> Result<Vec<StabilityRow>> {
     let (lo, hi) = range(texels);
     let area = (texels.width * texels.height) as u64;
     let chosen = sat_coding_for(lo, hi, area, area)?;
@@ -296,7 +296,13 @@ pub(crate) fn sat_check(
 /// Encodes with an exponent the validator would clamp: the Inf count and the largest relative
 /// error against the f64 encoding (a driver that converts to f16 toward zero saturates at
 /// 65504 instead of overflowing, so the values are wrong without being infinite).
-fn unclamped(gpu: &Gpu, exec: &mut Executor, raw: &[f32], storage: Storage, c: f32) -> Result<Row> {
+fn unclamped(
+    gpu: &Gpu,
+    exec: &mut Executor,
+    raw: &[f32],
+    storage: Storage,
+    c: f32,
+) -> Result<StabilityRow> {
     let l = light(DIRECTIONAL, evsm4(storage, Filter::None, c), MAP, 0.002);
     let s = run_stages(gpu, exec, &l, raw)?
         .ok_or_else(|| Error::Invalid("evsm has a prefiltered map".into()))?;
@@ -341,7 +347,7 @@ fn unclamped(gpu: &Gpu, exec: &mut Executor, raw: &[f32], storage: Storage, c: f
 /// integrate) equals the f64 encoding of the GPU's linear map within ½/scale per channel (plus
 /// SPIR-V's `exp` to (3 + 2|x|) ULP and 2⁻¹⁰ relative for f16 storage); visibility is finite
 /// and in [0, 1].
-pub(crate) fn scene_sat_rows(gpu: &Gpu) -> Result<Vec<Row>> {
+pub(crate) fn scene_sat_rows(gpu: &Gpu) -> Result<Vec<StabilityRow>> {
     let path = Path::new("stability.toml");
     let mut rows = Vec::new();
     for (name, shadow, storage) in [
@@ -450,7 +456,7 @@ fn scene_text(shadow: &str) -> String {
 
 /// The validator: exponents past the storage limit are clamped to it with a warning naming
 /// the key; exponents past the accepted range are errors naming the key.
-fn validator_rows() -> [Row; 2] {
+fn validator_rows() -> [StabilityRow; 2] {
     let path = Path::new("stability.toml");
     let mut clamped = Check::new();
     for (shadow, storage, keys) in [
@@ -519,7 +525,7 @@ fn validator_rows() -> [Row; 2] {
 }
 
 /// Case 4.
-pub(crate) fn exponent_case(gpu: &Gpu) -> Result<Vec<Row>> {
+pub(crate) fn exponent_case(gpu: &Gpu) -> Result<Vec<StabilityRow>> {
     let mut rng = Rng::new(0xE4);
     let raw = depth_map(&mut rng);
     let mut exec = Executor::new();

@@ -13,7 +13,7 @@
 
 use std::path::Path;
 
-use super::Row;
+use super::StabilityRow;
 use super::check::{Check, Rng, U};
 use super::harness::{light, run_light};
 use crate::cpu::{self, linearize::linearize_texel};
@@ -130,7 +130,7 @@ fn rasterized(
 }
 
 /// Case 7.
-pub(crate) fn frusta_case(gpu: &Gpu) -> Result<Vec<Row>> {
+pub(crate) fn frusta_case(gpu: &Gpu) -> Result<Vec<StabilityRow>> {
     let mut rng = Rng::new(0xF7);
     let mut exec = Executor::new();
     let mut rows = Vec::new();

@@ -12,7 +12,7 @@ use crate::exec::{Executor, Outputs};
 use crate::gpu::{Gpu, read_buffer, read_resource_texture, submit_and_wait, write_texture_level};
 use crate::graph::{Graph, Plan, plan, texel_bytes};
 use crate::model::{ParamValue, ParamValues};
-use crate::render::{ProbeMap, Renderer, probe};
+use crate::render::{MapData, Renderer, visibility_at};
 use crate::scene::{Light, LightKind, Shadow, Technique};
 use crate::technique::{self, LightGpu, params};
 
@@ -345,7 +345,7 @@ pub(crate) fn run_light(
 }
 
 /// Visibility of `l` at `points` with the real shading kernel on `maps` (every level of each
-/// map the light binds, as read back: the probe uploads them as 32-bit floats). Reuse one
+/// map the light binds, as read back: `visibility_at` uploads them as 32-bit floats). Reuse one
 /// `renderer` per technique: it keeps the compiled shading kernel.
 pub(crate) fn shade(
     gpu: &Gpu,
@@ -370,22 +370,22 @@ pub(crate) fn shade(
             (format, v)
         })
         .collect();
-    let probe_maps: Vec<ProbeMap> = maps
+    let map_data: Vec<MapData> = maps
         .iter()
         .zip(&data)
-        .map(|(levels, (format, v))| ProbeMap {
+        .map(|(levels, (format, v))| MapData {
             size: levels[0].width as u32,
             format: *format,
             mips: levels.len() as u32,
             data: v,
         })
         .collect();
-    probe(
+    visibility_at(
         renderer,
         &gpu.device,
         &gpu.queue,
         std::slice::from_ref(l),
-        &probe_maps,
+        &map_data,
         points,
     )
 }

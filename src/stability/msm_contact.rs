@@ -19,7 +19,7 @@
 
 use glam::Vec3;
 
-use super::Row;
+use super::StabilityRow;
 use super::check::Check;
 use super::harness::{DIRECTIONAL, light, receiver};
 use super::msm_maps::{MsmMaps, leak_depth};
@@ -129,7 +129,7 @@ fn check(gpu: &Gpu, storage: Storage, soft: bool) -> Result<(Check, f32)> {
 
 /// Case 8: `msm` (Hamburger) at f32, f16 and unorm16 (when the device has 16-bit normalized
 /// textures) and `msm_soft` at f32 and f16, each at its default moment bias.
-pub(crate) fn msm_contact_case(gpu: &Gpu) -> Result<Vec<Row>> {
+pub(crate) fn msm_contact_case(gpu: &Gpu) -> Result<Vec<StabilityRow>> {
     let unorm16 = gpu
         .device
         .features()

@@ -13,7 +13,7 @@
 
 use glam::Vec3;
 
-use super::Row;
+use super::StabilityRow;
 use super::check::Check;
 use super::harness::{DIRECTIONAL, light, receiver, run_light, sample, shade};
 use super::planar::storage_name;
@@ -164,7 +164,7 @@ fn check_map(
 
 /// Case 3: Hamburger at f32, f16 and unorm16 (when the device has 16-bit normalized
 /// textures), Hausdorff at f32.
-pub(crate) fn msm_case(gpu: &Gpu) -> Result<Vec<Row>> {
+pub(crate) fn msm_case(gpu: &Gpu) -> Result<Vec<StabilityRow>> {
     let unorm16 = gpu
         .device
         .features()

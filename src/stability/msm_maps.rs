@@ -12,7 +12,7 @@ use crate::cpu::{self, Texels};
 use crate::error::{Error, Result};
 use crate::exec::Executor;
 use crate::gpu::{Gpu, read_texture};
-use crate::render::{ProbeMap, Renderer, probe};
+use crate::render::{MapData, Renderer, visibility_at};
 use crate::scene::{Filter, Light, Technique};
 use crate::technique::{LightGpu, MSM_QUANTIZED, linear_name, sat_coding};
 
@@ -133,16 +133,16 @@ impl MsmMaps {
                     .iter()
                     .flat_map(|t| t.data.iter().map(|&x| x as f32))
                     .collect();
-                ProbeMap {
+                MapData {
                     size,
                     format: wgpu::TextureFormat::Rgba32Float,
                     mips: levels.len() as u32,
                     data: &data,
                 }
             }
-            Stored::Table { words, format, .. } => ProbeMap::new(size, *format, words),
+            Stored::Table { words, format, .. } => MapData::new(size, *format, words),
         };
-        probe(
+        visibility_at(
             renderer,
             &gpu.device,
             &gpu.queue,

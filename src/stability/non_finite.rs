@@ -9,7 +9,7 @@
 //! The buffer is 61² (not a multiple of any workgroup): blocky random depths with non-finite
 //! values at the four corners, along the edges, in a 3×3 cluster and at 2% of random texels.
 
-use super::Row;
+use super::StabilityRow;
 use super::check::{Check, Rng};
 use super::exponents::{range, sat_check, sat_coding_for};
 use super::harness::{DIRECTIONAL, SPOT, light, mips, registered};
@@ -116,7 +116,7 @@ fn configurations() -> Vec<(String, &'static str, LightKind, Technique)> {
 }
 
 /// Case 6.
-pub(crate) fn non_finite_case(gpu: &Gpu) -> Result<Vec<Row>> {
+pub(crate) fn non_finite_case(gpu: &Gpu) -> Result<Vec<StabilityRow>> {
     let mut rng = Rng::new(0x6A6);
     let (raw, injected) = depth_buffer(&mut rng);
     let mut exec = Executor::new();
@@ -170,7 +170,12 @@ pub(crate) fn non_finite_case(gpu: &Gpu) -> Result<Vec<Row>> {
 }
 
 /// A summed-area table over sanitized data: finite, windows within the coding's model.
-fn sat_row(gpu: &Gpu, texture: &wgpu::Texture, texels: &Texels, what: &str) -> Result<Row> {
+fn sat_row(
+    gpu: &Gpu,
+    texture: &wgpu::Texture,
+    texels: &Texels,
+    what: &str,
+) -> Result<StabilityRow> {
     let (lo, hi) = range(texels);
     let area = (texels.width * texels.height) as u64;
     let coding = sat_coding_for(lo, hi, area, area)?;

@@ -9,7 +9,7 @@
 //! with the f64 function on the same filtered texels, within the first-order propagation of
 //! the f32 roundings through the Chebyshev bound (`tolerance::vsm`, `tolerance::evsm`).
 
-use super::Row;
+use super::StabilityRow;
 use super::check::{Check, Rng};
 use super::harness::{DIRECTIONAL, SPOT, light, receiver, run_light, sample, shade};
 use crate::cpu;
@@ -93,7 +93,7 @@ fn check_technique(
     name: &str,
     technique: Technique,
     storage: Storage,
-) -> Result<[Row; 2]> {
+) -> Result<[StabilityRow; 2]> {
     let mut exec = Executor::new();
     let mut renderer = Renderer::new(&gpu.device);
     let (mut front, mut behind) = (Check::new(), Check::new());
@@ -172,7 +172,7 @@ pub(crate) fn storage_name(storage: Storage) -> &'static str {
 }
 
 /// Case 2: every variance technique at f32 and f16.
-pub(crate) fn planar_case(gpu: &Gpu) -> Result<Vec<Row>> {
+pub(crate) fn planar_case(gpu: &Gpu) -> Result<Vec<StabilityRow>> {
     let mut rng = Rng::new(0x91A7);
     let mut rows = Vec::new();
     for storage in [Storage::F32, Storage::F16] {

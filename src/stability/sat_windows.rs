@@ -15,7 +15,7 @@
 
 use std::collections::HashMap;
 
-use super::Row;
+use super::StabilityRow;
 use super::check::{Check, Rng, U};
 use super::harness::{Poison, read_texels, run_graph, upload};
 use crate::cpu::sat::encode_fixed;
@@ -23,7 +23,7 @@ use crate::error::{Error, Result};
 use crate::exec::Executor;
 use crate::gpu::Gpu;
 use crate::graph::Graph;
-use crate::sat::probe::{Lookup, probe_means};
+use crate::sat::lookups::{Lookup, lookup_means};
 use crate::sat::{SatCoding, SatVariant, add_sat, float_sum_depth, lookup_area};
 
 /// Units of the maps' values: every texel is an integer multiple of 2⁻²⁴.
@@ -204,7 +204,7 @@ fn gpu_table(
     let table = &ran.outputs.textures[&out];
     let texels = read_texels(gpu, table, coords)?;
     let filtered = if coding.variant == SatVariant::Float {
-        probe_means(gpu, table, Lookup::Linear, coding, rects)?
+        lookup_means(gpu, table, Lookup::Linear, coding, rects)?
             .iter()
             .map(|m| m[0])
             .collect()
@@ -256,7 +256,7 @@ fn check_fixed(
     wins: &[[usize; 4]],
     got: &HashMap<(u32, u32), [u32; 4]>,
     label: &str,
-) -> [Row; 2] {
+) -> [StabilityRow; 2] {
     let n = map.n;
     // The exact prefix of the codes in i64 (|sum| < 2²⁶·2³¹); the table holds it mod 2³².
     let mut codes: Vec<i64> = map
@@ -327,7 +327,7 @@ fn check_float(
     wins: &[[usize; 4]],
     got: &Read,
     rects: &[[f32; 4]],
-) -> [Row; 2] {
+) -> [StabilityRow; 2] {
     let filtered = check_filtered(map, coding, rects, &got.filtered);
     let got = &got.texels;
     let n = map.n;
@@ -371,7 +371,7 @@ fn check_float(
 
 /// The filtered lookups' means (`sat_mean_linear`, four filtered fetches) against the exact
 /// means of `rects` (see [`check_float`] for the bound).
-fn check_filtered(map: &Map, coding: &SatCoding, rects: &[[f32; 4]], got: &[f32]) -> Row {
+fn check_filtered(map: &Map, coding: &SatCoding, rects: &[[f32; 4]], got: &[f32]) -> StabilityRow {
     let n = map.n;
     let offset = f64::from(coding.offset[0]);
     let max_x = map.spread(offset);
@@ -428,7 +428,7 @@ pub enum SatTables {
 }
 
 /// Case 1 at `size`²: a constant 0.999 map and a random map, the tables `tables` names.
-pub(crate) fn sat_case(gpu: &Gpu, size: u32, tables: SatTables) -> Result<Vec<Row>> {
+pub(crate) fn sat_case(gpu: &Gpu, size: u32, tables: SatTables) -> Result<Vec<StabilityRow>> {
     let n = size as usize;
     if n < 8 || size > gpu.device.limits().max_texture_dimension_2d {
         return Err(Error::Invalid(format!(

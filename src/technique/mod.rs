@@ -6,23 +6,23 @@
 //! `nodes.rs`, `light_gpu.rs` and `shade.rs`.
 
 mod cascade_shade;
+mod code_values;
 mod csm;
 mod csm_sat;
 mod cssm;
 mod encoding;
 mod esm;
 mod evsm;
-mod given;
 mod hard;
 mod light_gpu;
 mod msm;
 mod msm_soft;
 mod nodes;
+mod parameters_doc;
 pub mod params;
 mod pcf;
 mod pcss;
 mod reach;
-mod reference;
 mod second_depth;
 mod shade;
 mod smrt;
@@ -53,9 +53,9 @@ pub use nodes::{
     PACKED_MAP_TYPE, add_light_nodes, depth_name, float_moments_format, linear_name, map_channels,
     map_tables, map_type, maps_packed, moments_format,
 };
+pub use parameters_doc::parameters_markdown;
 pub use params::{Clamp, ClampReason, sat_exponent_limit};
 pub use reach::{cascade_guard, reach, texels_past_radius};
-pub use reference::parameters_markdown;
 pub use second_depth::{peels, second_depth_name};
 pub use shade::{
     SAT_SAMPLER, ShadeInput, VisibilityBody, shade_key, shading_block, shading_block_cascaded,
@@ -159,11 +159,11 @@ pub fn of(t: &Technique) -> &'static TechniqueDef {
 }
 
 /// Checks `source` against technique `def`'s tables and builds it, with the clamps applied.
-pub fn check<S: ParamSource>(
+pub fn check_and_build<S: ParamSource>(
     def: &TechniqueDef,
     source: &S,
 ) -> Result<(Technique, Vec<Clamp>), S::Error> {
-    let values = crate::model::check(def.params, source)?;
+    let values = crate::model::check_params(def.params, source)?;
     let mut t = (def.build)(&values);
     let mut clamps = Vec::new();
     (def.clamp)(&mut t, &mut clamps);
@@ -172,7 +172,7 @@ pub fn check<S: ParamSource>(
 
 /// `def` with every key at its default.
 pub fn default_of(def: &TechniqueDef) -> Technique {
-    let values = crate::model::check(def.params, &params::Given(&ParamValues::default()));
+    let values = crate::model::check_params(def.params, &params::Given(&ParamValues::default()));
     (def.build)(&values.unwrap_or_default())
 }
 
@@ -180,7 +180,7 @@ pub fn default_of(def: &TechniqueDef) -> Technique {
 /// whose values a later check reports (`None` when a value is of another kind than its key's or
 /// a key is set where it does not apply).
 pub fn build_with(def: &TechniqueDef, values: &ParamValues) -> Option<Technique> {
-    let values = crate::model::check(def.params, &params::Loose(values)).ok()?;
+    let values = crate::model::check_params(def.params, &params::Loose(values)).ok()?;
     Some((def.build)(&values))
 }
 
@@ -241,7 +241,8 @@ mod tests {
             let t = default_of(def);
             assert_eq!(t.name(), def.name);
             let values = (def.values)(&t);
-            let again = crate::model::check(def.params, &params::Given(&values)).expect(def.name);
+            let again =
+                crate::model::check_params(def.params, &params::Given(&values)).expect(def.name);
             assert_eq!((def.build)(&again), t, "{}", def.name);
         }
     }

@@ -9,7 +9,7 @@ use crate::model::{
 };
 use crate::sat::{SatVariant, lookup_area};
 
-pub use super::given::{Given, GivenError, Loose};
+pub use super::code_values::{Given, GivenError, Loose};
 
 /// A number spec without conditions.
 pub(super) const fn float(

@@ -1,6 +1,6 @@
-//! The shading side's table lookups run by a probe kernel, one rectangle per invocation, so a
-//! test or the numerical-stability suite can hold each lookup against an exact reference
-//! without a scene around it.
+//! The shading side's table lookups run by a kernel of their own ([`lookup_means`]), one
+//! rectangle per invocation, so a test or the numerical-stability suite can hold each lookup
+//! against an exact reference without a scene around it.
 
 use wgpu::util::DeviceExt;
 
@@ -9,7 +9,7 @@ use crate::error::Result;
 use crate::exec::ComputeKernel;
 use crate::gpu::{Gpu, submit_and_read};
 
-/// Which of `shared/sat`'s lookups the probe runs.
+/// Which of `shared/sat`'s lookups the kernel runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Lookup {
     /// `sat_mean_fixed`: the exact integral from a fixed-point (u32) table, sixteen loads.
@@ -31,7 +31,7 @@ impl Lookup {
         }
     }
 
-    /// The probe kernel's source (before `// #import` resolution).
+    /// The kernel's source (before `// #import` resolution).
     fn source(self) -> String {
         let (f, ty, smp) = self.parts();
         let sampler = if smp.is_empty() {
@@ -60,7 +60,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
 /// The means over `rects` (x0, y0, x1, y1 in texels) that `lookup` reads from `table`, a table
 /// coded by `coding`, one dispatch, read back. Compiles its kernel each call: for tests and the
 /// stability suite, not for a frame.
-pub fn probe_means(
+pub fn lookup_means(
     gpu: &Gpu,
     table: &wgpu::Texture,
     lookup: Lookup,
@@ -68,7 +68,7 @@ pub fn probe_means(
     rects: &[[f32; 4]],
 ) -> Result<Vec<[f32; 4]>> {
     let d = &gpu.device;
-    let name = "sat_probe";
+    let name = "sat_lookup";
     let wgsl = crate::kernels::resolve_source(name, &lookup.source())?;
     let kernel = ComputeKernel::new(d, name, &wgsl)?;
     let init = |label, contents: &[u8], usage| {
@@ -79,19 +79,19 @@ pub fn probe_means(
         })
     };
     let rects_buf = init(
-        "sat_probe.rects",
+        "sat_lookup.rects",
         bytemuck::cast_slice(rects),
         wgpu::BufferUsages::STORAGE,
     );
     let coding_buf = init(
-        "sat_probe.coding",
+        "sat_lookup.coding",
         bytemuck::cast_slice(&[coding.offset, coding.scale]),
         wgpu::BufferUsages::UNIFORM,
     );
     // A zero-sized storage binding is invalid: one unused rectangle's room at least.
     let bytes = (rects.len().max(1) * 16) as u64;
     let means = d.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("sat_probe.means"),
+        label: Some("sat_lookup.means"),
         size: bytes,
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         mapped_at_creation: false,

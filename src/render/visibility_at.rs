@@ -1,4 +1,4 @@
-//! [`probe`]: the real shading kernel evaluated at given points on given maps.
+//! [`visibility_at`]: the real shading kernel evaluated at given points on given maps.
 
 use bytemuck::Zeroable;
 use glam::Vec3;
@@ -13,10 +13,10 @@ use crate::technique;
 use super::FrameGpu;
 use super::renderer::{Renderer, ShadeInputs, record_shade};
 
-/// A map handed to [`probe`]: what the light's technique reads (linear depth as R32Float,
+/// A map handed to [`visibility_at`]: what the light's technique reads (linear depth as R32Float,
 /// moments as Rg32Float, …), never the raw depth of hardware PCF. Two moments of a light that
-/// stores them in f16 are given as Rg32Float too; the probe packs them as the stage does.
-pub struct ProbeMap<'a> {
+/// stores them in f16 are given as Rg32Float too; `visibility_at` packs them as the stage does.
+pub struct MapData<'a> {
     /// Side length of level 0.
     pub size: u32,
     /// Texel format of `data`: a 32-bit float format, or `Rgba32Uint` for a fixed-point
@@ -28,7 +28,7 @@ pub struct ProbeMap<'a> {
     pub data: &'a [f32],
 }
 
-impl<'a> ProbeMap<'a> {
+impl<'a> MapData<'a> {
     /// A linear depth map.
     pub fn linear(size: u32, data: &'a [f32]) -> Self {
         Self::new(size, wgpu::TextureFormat::R32Float, data)
@@ -48,14 +48,14 @@ impl<'a> ProbeMap<'a> {
 /// Evaluates each light's visibility at `points` (position, unit normal) on the given maps
 /// with the real shading kernel. `maps` lists every light's maps in binding order (one per
 /// light; CSM: one per two terms), summed-area tables that the light's shading reads
-/// interleaved in one texture (`technique::map_tables`) one by one: the probe interleaves
+/// interleaved in one texture (`technique::map_tables`) one by one: `visibility_at` interleaves
 /// them. Returns `vis[point * lights + light]`.
-pub fn probe(
+pub fn visibility_at(
     renderer: &mut Renderer,
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     lights: &[Light],
-    maps: &[ProbeMap],
+    maps: &[MapData],
     points: &[(Vec3, Vec3)],
 ) -> Result<Vec<f32>> {
     // Per binding, the tables it holds (1 for a map).
@@ -66,7 +66,7 @@ pub fn probe(
     let needed: usize = held.iter().sum();
     if maps.len() != needed || points.is_empty() {
         return Err(Error::Invalid(format!(
-            "probe needs {needed} map(s) for these lights and at least one point"
+            "visibility_at needs {needed} map(s) for these lights and at least one point"
         )));
     }
     let w = (points.len() as u32).min(256);
@@ -87,8 +87,8 @@ pub fn probe(
             usage,
         )
     };
-    let gpos = points_texture("shadowgraph.probe.position");
-    let gnorm = points_texture("shadowgraph.probe.normal");
+    let gpos = points_texture("shadowgraph.visibility_at.position");
+    let gnorm = points_texture("shadowgraph.visibility_at.normal");
     write_texture(queue, &gpos, bytemuck::cast_slice(&pos));
     write_texture(queue, &gnorm, bytemuck::cast_slice(&nor));
     // A light whose shading reads packed f16 moments (`technique::maps_packed`) gets its
@@ -111,8 +111,8 @@ pub fn probe(
         // Several tables of one binding: one texture n times as wide.
         let interleaved = interleave(tables)?;
         let m = match &interleaved {
-            Some(i) => ProbeMap::new(i.size, i.format, &i.data),
-            None => ProbeMap { ..tables[0] },
+            Some(i) => MapData::new(i.size, i.format, &i.data),
+            None => MapData { ..tables[0] },
         };
         let channels = crate::gpu::float_channels(m.format).unwrap_or(0);
         let packed = packed && channels == 2;
@@ -121,7 +121,7 @@ pub fn probe(
         let is_f32 = crate::graph::texel_bytes(m.format) == 4 * channels as u64;
         if !is_f32 || channels == 0 || m.mips == 0 || m.data.len() != texels * channels * n {
             return Err(Error::Invalid(format!(
-                "a {0}x{0} {1:?} probe map of {3} level(s) needs {2} f32 values",
+                "a {0}x{0} {1:?} map of {3} level(s) needs {2} f32 values",
                 m.size,
                 m.format,
                 texels * channels.max(1),
@@ -131,7 +131,7 @@ pub fn probe(
         let t = created::texture(
             device,
             &wgpu::TextureDescriptor {
-                label: Some("shadowgraph.probe.map"),
+                label: Some("shadowgraph.visibility_at.map"),
                 size: wgpu::Extent3d {
                     width: m.size * n as u32,
                     height: m.size,
@@ -186,7 +186,7 @@ pub fn probe(
     );
     let mut enc = device.create_command_encoder(&Default::default());
     enc.copy_buffer_to_buffer(&visibility, 0, &readback, 0, visibility.size());
-    submit_and_wait(device, queue, enc, "probe readback")?;
+    submit_and_wait(device, queue, enc, "visibility_at readback")?;
     let mut vis: Vec<f32> = bytemuck::cast_slice(&read_buffer(device, &readback)?).to_vec();
     vis.truncate(points.len() * lights.len());
     Ok(vis)
@@ -204,11 +204,11 @@ struct Interleaved {
 }
 
 /// `tables` interleaved; `None` for a binding of one table or map.
-fn interleave(tables: &[ProbeMap<'_>]) -> Result<Option<Interleaved>> {
+fn interleave(tables: &[MapData<'_>]) -> Result<Option<Interleaved>> {
     let [first, _, ..] = tables else {
         return Ok(None);
     };
-    let channels = |m: &ProbeMap| crate::gpu::float_channels(m.format).unwrap_or(0);
+    let channels = |m: &MapData| crate::gpu::float_channels(m.format).unwrap_or(0);
     let texels = (first.size * first.size) as usize;
     if tables.iter().any(|m| {
         m.size != first.size
@@ -217,7 +217,7 @@ fn interleave(tables: &[ProbeMap<'_>]) -> Result<Option<Interleaved>> {
             || m.data.len() != texels * channels(m)
     }) {
         return Err(Error::Invalid(format!(
-            "{} probe tables of one binding need one level each of {1}x{1} texels",
+            "{} tables of one binding need one level each of {1}x{1} texels",
             tables.len(),
             first.size
         )));
@@ -249,8 +249,8 @@ pub(super) struct ShadePoints<'a> {
 }
 
 impl Renderer {
-    /// Runs the shading kernel for `lights` once over positions and normals in `at` (the
-    /// probe: no camera, the frame's own buffers), returning its visibility buffer.
+    /// Runs the shading kernel for `lights` once over positions and normals in `at` (for
+    /// `visibility_at`: no camera, the frame's own buffers), returning its visibility buffer.
     pub(super) fn shade_points(
         &mut self,
         device: &wgpu::Device,
@@ -313,7 +313,7 @@ impl Renderer {
         let groups = self.shade_bind_groups(device, &kernel, &inputs, at.maps)?;
         let mut enc = device.create_command_encoder(&Default::default());
         record_shade(&mut enc, &kernel, &groups, (w, h), None);
-        submit_and_wait(device, queue, enc, "probe")?;
+        submit_and_wait(device, queue, enc, "visibility_at")?;
         Ok(visibility)
     }
 }
