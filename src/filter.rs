@@ -182,20 +182,31 @@ fn add_blur_pass(
         inputs: vec![("src".into(), src.to_string())],
         outputs: vec![("dst".into(), out.clone())],
         params: bytemuck::bytes_of(&params).to_vec(),
-        // Rows: a workgroup per BLUR_GROUP · PER texels of a row; columns: a workgroup per
-        // BLUR_GROUP columns × the kernel's rows per column invocation.
-        dispatch: Dispatch::Blocks {
-            of: out.clone(),
-            x: if axis == 0 {
-                BLUR_GROUP * BLUR_PER_INVOCATION
-            } else {
-                BLUR_GROUP
-            },
-            y: if axis == 0 { 1 } else { col_per },
-        },
+        dispatch: blur_dispatch(&out, axis, col_per),
         light: Some(light),
     });
     out
+}
+
+/// The workgroups of a `blur` or `blur_log` pass along `axis` writing `out`, whose column
+/// invocations write `col_per` rows each. Columns: a workgroup per [`BLUR_GROUP`] columns ×
+/// `col_per` rows. Rows: a workgroup per [`BLUR_GROUP`] · [`BLUR_PER_INVOCATION`] texels of
+/// a row; in [`crate::exec::KernelLayout::Redesign`] the columns' blocks turned sideways,
+/// `col_per` columns × [`BLUR_GROUP`] rows, an invocation a row (`REDESIGN` in
+/// `kernels/shared/blur_pass.wgsl`).
+fn blur_dispatch(out: &str, axis: u32, col_per: u32) -> Dispatch {
+    let blocks = |x, y| Dispatch::Blocks {
+        of: out.to_string(),
+        x,
+        y,
+    };
+    if axis != 0 {
+        return blocks(BLUR_GROUP, col_per);
+    }
+    Dispatch::Redesigned {
+        shipped: Box::new(blocks(BLUR_GROUP * BLUR_PER_INVOCATION, 1)),
+        redesign: Box::new(blocks(col_per, BLUR_GROUP)),
+    }
 }
 
 /// Parameters of `kernels/mips.wgsl` (mirrors its `Params`): one per dispatch of a mip chain

@@ -318,9 +318,10 @@ fn steps_over(plan: &Plan, l: &wgpu::Limits) -> Result<Option<StepOver>> {
     Ok(None)
 }
 
-/// Workgroup counts of a node's dispatch (as the executor computes them, the larger of the
-/// two kernel layouts' along each axis where they differ, [`Dispatch::Tiles`]; for several
-/// dispatches the largest along each axis, e.g. a mip chain's first).
+/// Workgroup counts of a node's dispatch (as the executor computes them, the largest of the
+/// kernel layouts' along each axis where they differ, [`Dispatch::Tiles`] and
+/// [`Dispatch::Redesigned`]; for several dispatches the largest along each axis, e.g. a mip
+/// chain's first).
 pub fn dispatch_groups(plan: &Plan, node: &Node, wg: [u32; 3]) -> [u32; 3] {
     let size = |r: &str| plan.resource(r).map(|p| (p.width, p.height));
     let wg = wg.map(|w| w.max(1));
@@ -329,13 +330,15 @@ pub fn dispatch_groups(plan: &Plan, node: &Node, wg: [u32; 3]) -> [u32; 3] {
             .iter()
             .fold([1, 1, 1], |m, d| [0, 1, 2].map(|a| m[a].max(d.groups[a])));
     }
-    let layout = |gpu| {
+    let layout = |(gpu, redesign)| {
         node.dispatch
-            .groups_in_layout(size, wg, gpu)
+            .groups_in(size, wg, gpu, redesign)
             .unwrap_or([1, 1, 1])
     };
-    let (gpu, cpu) = (layout(true), layout(false));
-    [0, 1, 2].map(|a| gpu[a].max(cpu[a]))
+    [(true, false), (false, false), (true, true)]
+        .map(layout)
+        .into_iter()
+        .fold([1, 1, 1], |m, g| [0, 1, 2].map(|a| m[a].max(g[a])))
 }
 
 /// Checks that the device offers the features the lights' techniques need (unorm16 moment

@@ -8,6 +8,13 @@
 // workgroup's loads lie side by side and its halo of 2r rows is shared by `col_per` outputs. Edges
 // clamp (replicate the border texel), so the map edge keeps its shadow instead of fading
 // toward zero.
+// REDESIGN (`exec::KernelLayout::Redesign`, not yet decided on a GPU): rows as the columns
+// turned sideways: workgroup (x, y) covers rows y·WG_SIZE + li, `col_per` texels each from
+// x·col_per, so that a SIMD group's lanes load neighbouring rows at one x (a column of a GPU's
+// block-linear tiles, which the row pass's lanes PER texels apart touched a sector each) and
+// an invocation slides its windows along its row for as many outputs as a column invocation.
+// The same sums in the same order per output (runs of the importing kernel's length from a
+// multiple of it): the same blur bit for bit (tests/blur_rows.rs).
 // Storage: rg32float by default; the executor re-declares `dst` for the bound format.
 
 // Keep in sync with `BlurParams` in src/filter.rs.
@@ -27,6 +34,8 @@ struct Params {
 const PER: u32 = 8u;
 const WG_SIZE: u32 = 64u;
 const MAX_RADIUS: u32 = 32u;
+// The rows' redesign (above); the Rust side dispatches its blocks (`filter::blur_dispatch`).
+override REDESIGN: bool = false;
 
 // The texels an invocation writes along line `line` of a map `along` texels long and `across`
 // lines wide: `count` of them from `first`, in runs of consecutive texels `step` apart (the
@@ -39,7 +48,8 @@ struct BlurLine {
     along: i32,
     across: u32,
     r: i32,
-    // Outputs the invocation writes: PER along a row, `col_per` down a column.
+    // Outputs the invocation writes: PER along a row, `col_per` down a column (and along a
+    // row in the REDESIGN).
     count: i32,
 }
 
@@ -48,18 +58,25 @@ struct BlurLine {
 // that neighbouring invocations' runs lie side by side (run = PER: the PER consecutive texels
 // from li·PER, for a kernel that slides one window along them). Columns: workgroup (x, y)
 // covers columns x·WG_SIZE + li, rows [y·col_per, (y + 1)·col_per), runs one after another:
-// neighbouring invocations are neighbouring columns either way.
+// neighbouring invocations are neighbouring columns either way. REDESIGN rows: the columns'
+// blocks transposed, workgroup (x, y) on rows y·WG_SIZE + li from x·col_per.
 fn blur_line(wg: vec2<u32>, li: u32, run: u32, col_per: u32) -> BlurLine {
     let size = textureDimensions(src);
     var b: BlurLine;
     b.r = i32(min(params.radius, MAX_RADIUS));
-    b.count = i32(select(PER, col_per, params.axis == 1u));
+    b.count = i32(select(PER, col_per, params.axis == 1u || REDESIGN));
     if params.axis == 1u {
         b.first = i32(wg.y * col_per);
         b.step = i32(run);
         b.line = wg.x * WG_SIZE + li;
         b.along = i32(size.y);
         b.across = size.x;
+    } else if REDESIGN {
+        b.first = i32(wg.x * col_per);
+        b.step = i32(run);
+        b.line = wg.y * WG_SIZE + li;
+        b.along = i32(size.x);
+        b.across = size.y;
     } else {
         b.first = i32(wg.x * WG_SIZE * PER + li * run);
         b.step = i32(WG_SIZE * run);

@@ -202,7 +202,12 @@ pub(super) fn bind_step(
             Some(g) => g,
             None => node
                 .dispatch
-                .groups_in_layout(size, wg, kernel.layout.is_gpu())
+                .groups_in(
+                    size,
+                    footprint,
+                    kernel.layout.is_gpu(),
+                    kernel.layout.is_redesign(),
+                )
                 .ok_or_else(|| ExecError::DispatchOver {
                     node: node.name.clone(),
                 })?,

@@ -74,6 +74,22 @@ impl Plan {
         if let Some((_, r)) = n.inputs.iter().chain(&n.outputs).find(|(_, r)| !known(r)) {
             return bad(format!("uses `{r}`, which is not in the plan"));
         }
+        if let Dispatch::Redesigned { shipped, redesign } = &n.dispatch {
+            // Each as the node's dispatch.
+            for d in [shipped, redesign] {
+                if matches!(**d, Dispatch::Several(_) | Dispatch::Redesigned { .. }) {
+                    return bad(
+                        "has several dispatches, or a redesign in a redesign, in one layout".into(),
+                    );
+                }
+                let one = Node {
+                    dispatch: (**d).clone(),
+                    ..n.clone()
+                };
+                self.check_step(i, &one, known)?;
+            }
+            return Ok(());
+        }
         let mut dispatch = &n.dispatch;
         while let Dispatch::Layers { base, layers } | Dispatch::Interleaved { base, layers } =
             dispatch
@@ -85,6 +101,9 @@ impl Plan {
         }
         let of = match dispatch {
             Dispatch::Layers { .. } | Dispatch::Interleaved { .. } => None,
+            Dispatch::Redesigned { .. } => {
+                return bad("dispatches layers of a dispatch with a redesign".into());
+            }
             Dispatch::Texels(r) => Some(r),
             Dispatch::Tiles { x, y, cpu_y, .. } if *x == 0 || *y == 0 || *cpu_y == 0 => {
                 return bad("dispatches tiles 0 texels wide or tall".into());

@@ -138,6 +138,17 @@ pub enum Dispatch {
         /// Workgroups side by side along x.
         layers: u32,
     },
+    /// `shipped` where the kernel compiles in a shipped layout (a GPU's or a CPU driver's) and
+    /// `redesign` in [`crate::exec::KernelLayout::Redesign`], whose variant of the kernel
+    /// (`override REDESIGN`) covers other blocks a workgroup: e.g. the separable blur's row pass
+    /// with its invocations on neighbouring rows ([`crate::filter`]). [`Dispatch::groups`] and
+    /// the cost model read `shipped`; [`Dispatch::groups_in`] either.
+    Redesigned {
+        /// The dispatch in the shipped layouts (not [`Dispatch::Several`]).
+        shipped: Box<Dispatch>,
+        /// The dispatch in the redesign layout (not [`Dispatch::Several`]).
+        redesign: Box<Dispatch>,
+    },
     /// Several dispatches in the node's one compute pass, each with its own parameters, its
     /// bindings of single mip levels and its workgroups: e.g. a mip chain, a few levels per
     /// dispatch, each reading the last level written ([`crate::filter`] builds them). Planner,
@@ -213,6 +224,19 @@ impl Dispatch {
         workgroup: [u32; 3],
         gpu: bool,
     ) -> Option<[u32; 3]> {
+        self.groups_in(size, workgroup, gpu, false)
+    }
+
+    /// [`Dispatch::groups_in_layout`] in the redesign layout too (`redesign`, with `gpu`
+    /// true: [`crate::exec::KernelLayout::Redesign`]), where [`Dispatch::Redesigned`] takes
+    /// its `redesign` dispatch.
+    pub fn groups_in(
+        &self,
+        size: impl Fn(&str) -> Option<(u32, u32)>,
+        workgroup: [u32; 3],
+        gpu: bool,
+        redesign: bool,
+    ) -> Option<[u32; 3]> {
         Some(match self {
             Self::Groups(g) => *g,
             Self::Texels(r) => {
@@ -236,12 +260,19 @@ impl Dispatch {
                 [block_count(w.max(h), *per_group), 2, 1]
             }
             Self::Layers { base, layers } => {
-                let [x, y, _] = base.groups_in_layout(size, workgroup, gpu)?;
+                let [x, y, _] = base.groups_in(size, workgroup, gpu, redesign)?;
                 [x, y, *layers]
             }
             Self::Interleaved { base, layers } => {
-                let [x, y, _] = base.groups_in_layout(size, workgroup, gpu)?;
+                let [x, y, _] = base.groups_in(size, workgroup, gpu, redesign)?;
                 [x.checked_mul(*layers)?, y, 1]
+            }
+            Self::Redesigned {
+                shipped,
+                redesign: r,
+            } => {
+                let d = if redesign { r } else { shipped };
+                return d.groups_in(size, workgroup, gpu, redesign);
             }
             Self::Several(_) => return None,
         })
