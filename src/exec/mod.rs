@@ -25,7 +25,8 @@ use crate::graph::{Plan, Slot};
 pub use crate::timer::GpuTimer;
 pub use pipelines::{
     ComputeKernel, GPU_LAYOUT_CONSTANT, KERNEL_LAYOUT_ENV, KernelCache, KernelLayout,
-    REDESIGN_CONSTANT, WorkgroupInit, specialized_source, wgsl_storage_format,
+    REDESIGN_CONSTANT, REDESIGNED_KERNELS, WorkgroupInit, specialized_source,
+    wgsl_storage_format,
 };
 pub use pool::{Outputs, TexturePool};
 

@@ -10,7 +10,8 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 pub use self::layout::{
-    GPU_LAYOUT_CONSTANT, KERNEL_LAYOUT_ENV, KernelLayout, REDESIGN_CONSTANT, WorkgroupInit,
+    GPU_LAYOUT_CONSTANT, KERNEL_LAYOUT_ENV, KernelLayout, REDESIGN_CONSTANT, REDESIGNED_KERNELS,
+    WorkgroupInit,
 };
 use self::specialize::{apply, changes};
 pub use self::specialize::{specialized_source, wgsl_storage_format};
@@ -211,16 +212,21 @@ impl KernelCache {
         wgsl: &str,
         overrides: &[(String, f64)],
     ) -> Result<ComputeKernel> {
-        let layout = match self.layout {
-            Some(layout) => layout,
-            None => KernelLayout::for_device(device)?,
-        };
+        let layout = self.layout_for(device)?;
         let init = if self.zeroed {
             WorkgroupInit::Zeroed
         } else {
             WorkgroupInit::AsLeft
         };
         ComputeKernel::with_constants(device, name, wgsl, layout, init, overrides)
+    }
+
+    /// The layout kernels compile in on `device`.
+    fn layout_for(&self, device: &wgpu::Device) -> Result<KernelLayout> {
+        match self.layout {
+            Some(layout) => Ok(layout),
+            None => KernelLayout::for_device(device),
+        }
     }
 
     /// The pipeline constants a node of kernel `name` named `node` with parameters `params`
@@ -284,13 +290,16 @@ impl KernelCache {
         if let Some(k) = self.kernels.get(&key) {
             return Ok(k.clone());
         }
-        let wgsl = apply(name, &changes, self.replaced.as_deref())?;
-        let k = Arc::new(self.compile_with(device, name, &wgsl, overrides)?);
+        // The file `base` compiled (a redesign's own in `KernelLayout::Redesign`).
+        let wgsl = apply(&base.name, &changes, self.replaced.as_deref())?;
+        let k = Arc::new(self.compile_with(device, &base.name, &wgsl, overrides)?);
         self.kernels.insert(key, k.clone());
         Ok(k)
     }
 
-    /// The pipeline of `name` with a `// #generated` block, keyed by the block's text.
+    /// The pipeline of `name` with a `// #generated` block, keyed by the block's text; in
+    /// [`KernelLayout::Redesign`] compiled from the redesign's file where it has its own
+    /// ([`KernelLayout::kernel_source`]).
     pub fn get_generated(
         &mut self,
         device: &wgpu::Device,
@@ -301,8 +310,10 @@ impl KernelCache {
         if let Some(k) = self.kernels.get(&key) {
             return Ok(k.clone());
         }
-        let wgsl = kernels::resolve_in(name, generated, self.replaced.as_deref())?;
-        let k = Arc::new(self.compile(device, name, &wgsl)?);
+        let layout = self.layout_for(device)?;
+        let source = layout.kernel_source(name);
+        let wgsl = kernels::resolve_in(source, generated, self.replaced.as_deref())?;
+        let k = Arc::new(self.compile(device, source, &wgsl)?);
         self.kernels.insert(key, k.clone());
         Ok(k)
     }

@@ -9,6 +9,15 @@ pub const KERNEL_LAYOUT_ENV: &str = "SHADOWGRAPH_KERNEL_LAYOUT";
 
 pub use crate::kernels::{GPU_LAYOUT_CONSTANT, REDESIGN_CONSTANT};
 
+/// Kernels whose redesign is a file of its own, `(shipped, redesign)`: in
+/// [`KernelLayout::Redesign`] the executor compiles the redesign's file for every node of the
+/// shipped kernel (the same bindings and dispatches; [`KernelLayout::kernel_source`]). A
+/// separate file rather than a branch on `REDESIGN`: a kernel's declared workgroup memory costs
+/// on a GPU even where the branch using it never runs (`benches/RESULTS.md`, 2026-11-27).
+/// The mip chain after AMD FidelityFX SPD: `kernels/shared/mips_spd.wgsl`.
+pub const REDESIGNED_KERNELS: &[(&str, &str)] =
+    &[("mips", "mips_spd"), ("mips_log", "mips_spd_log")];
+
 /// Which of its two variants a kernel that has two compiles (`override GPU_LAYOUT: bool`): today
 /// the summed-area tables' pass 3 (`kernels/shared/sat_tile*.wgsl`), whose second sweep over an
 /// invocation's sub-block loads and encodes its texels again on a GPU (from its texture cache:
@@ -73,6 +82,18 @@ impl KernelLayout {
     /// Whether the undecided redesigns run ([`KernelLayout::Redesign`]).
     pub fn is_redesign(self) -> bool {
         matches!(self, Self::Redesign)
+    }
+
+    /// The kernel file compiled for kernel `name` in this layout: in [`KernelLayout::Redesign`]
+    /// a redesign with a file of its own ([`REDESIGNED_KERNELS`]), else `name` itself.
+    pub fn kernel_source(self, name: &str) -> &str {
+        match self {
+            Self::Redesign => REDESIGNED_KERNELS
+                .iter()
+                .find(|(shipped, _)| *shipped == name)
+                .map_or(name, |(_, redesign)| redesign),
+            Self::Gpu | Self::Cpu => name,
+        }
     }
 
     /// The name [`KernelLayout::parse`] reads.
