@@ -6,7 +6,8 @@
 
 use std::process::ExitCode;
 
-use shadowgraph::{bench, gpu::Gpu};
+use shadowgraph::low_level::bench;
+use shadowgraph::low_level::gpu::Gpu;
 
 const DEFAULT_SIZES: &[u32] = &[512, 1024, 2048];
 const DEFAULT_REPEAT: u32 = 10;

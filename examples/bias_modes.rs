@@ -7,10 +7,11 @@
 //! `cargo run --release --example bias_modes -- scenes/grazing.toml [MAP]` (`MAP`: the first
 //! light's map side instead of the scene's).
 
-use shadowgraph::gpu::Gpu;
-use shadowgraph::render::{RenderOptions, Renderer};
-use shadowgraph::scene::Scene;
-use shadowgraph::truth::{emitter, raycast::ray_cast_truth};
+use shadowgraph::low_level::gpu::Gpu;
+use shadowgraph::low_level::render::{RenderOptions, Renderer};
+use shadowgraph::low_level::scene::Scene;
+use shadowgraph::low_level::truth::emitter;
+use shadowgraph::low_level::truth::raycast::ray_cast_truth;
 
 /// (label, bias, slope_bias, normal_bias, receiver_plane cap).
 type Mode = (&'static str, f32, f32, f32, f32);
@@ -83,7 +84,7 @@ fn run() -> anyhow::Result<()> {
         .chain([&scene_own])
         .map(|&(label, bias, slope, normal, cap)| (label, hard, (bias, slope, normal, cap)));
     let second = SECOND_DEPTH.iter().filter_map(|&(label, name, bias)| {
-        let t = shadowgraph::technique::named(name, &[])?;
+        let t = shadowgraph::low_level::technique::named(name, &[])?;
         Some((label, t, (bias, 0.0, 0.0, 0.0)))
     });
     for (label, technique, (bias, slope, normal, cap)) in rows.chain(second) {

@@ -18,7 +18,7 @@ fn run() -> anyhow::Result<()> {
         .unwrap_or_else(|| "benches/evaluation".into());
     print!(
         "{}",
-        shadowgraph::evaluate::summary::fronts_table_of(std::path::Path::new(&dir))?
+        shadowgraph::low_level::evaluate::summary::fronts_table_of(std::path::Path::new(&dir))?
     );
     Ok(())
 }

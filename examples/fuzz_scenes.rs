@@ -50,7 +50,7 @@ fn main() {
     };
     // Quiet the panic hook's output for caught panics: they are counted and saved instead.
     std::panic::set_hook(Box::new(|_| {}));
-    let gpu = (args.render_every > 0).then(|| match shadowgraph::gpu::Gpu::new() {
+    let gpu = (args.render_every > 0).then(|| match shadowgraph::low_level::gpu::Gpu::new() {
         Ok(g) => g,
         Err(e) => {
             eprintln!("error: {e} (pass --render-every 0 to fuzz without rendering)");

@@ -25,11 +25,11 @@ use common::{
     target, uniform_entry,
 };
 use glam::{Mat4, Vec3};
-use shadowgraph::prefilter::cascades::{CascadeCamera, pick_fields};
-use shadowgraph::prefilter::{
+use shadowgraph::cascades::{CascadeCamera, pick_fields};
+use shadowgraph::{
     DepthLayer, LightParams, Prefilter, PrefilterConfig, PrefilterOutput, StageError,
+    TIMER_FEATURES,
 };
-use shadowgraph::timer::TIMER_FEATURES;
 use wgpu::util::DeviceExt;
 
 const IMAGE: (u32, u32) = (640, 480);
@@ -298,10 +298,10 @@ fn host_wgsl(
     device: &wgpu::Device,
     spot_stage: &Prefilter,
     sun_stage: &Prefilter,
-    sun: shadowgraph::scene::Technique,
+    sun: shadowgraph::Technique,
 ) -> anyhow::Result<(String, wgpu::BindGroupLayout)> {
     let techniques = [spot_stage.config().technique, sun];
-    let mut wgsl = shadowgraph::prefilter::wgsl::functions_for(&techniques)?;
+    let mut wgsl = shadowgraph::wgsl::functions_for(&techniques)?;
     let mut maps_entries = Vec::new();
     for (k, name) in MAPS.iter().enumerate() {
         let stage = if k < 2 { spot_stage } else { sun_stage };

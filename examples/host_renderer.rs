@@ -13,8 +13,7 @@ use common::{
     target, uniform_entry,
 };
 use glam::{Mat4, Vec3};
-use shadowgraph::prefilter::{LightParams, Prefilter, PrefilterConfig};
-use shadowgraph::timer::TIMER_FEATURES;
+use shadowgraph::{LightParams, Prefilter, PrefilterConfig, TIMER_FEATURES};
 use wgpu::util::DeviceExt;
 
 const PANEL: (u32, u32) = (384, 288);

@@ -1,12 +1,12 @@
 //! The moment-bias sweep behind MSM's default biases (docs/STABILITY.md, "MSM moment bias"): every MSM
 //! technique and storage through the real kernels at each bias, against MSM in exact
-//! arithmetic on exact moments (`shadowgraph::stability::msm_bias_sweep`). Prints a Markdown
+//! arithmetic on exact moments (`shadowgraph::low_level::stability::msm_bias_sweep`). Prints a Markdown
 //! table. About 6 s on a software GPU (lavapipe, 2 cores).
 //!
 //!     cargo run --release --example msm_bias_sweep [-- ALPHA,ALPHA,…]
 
-use shadowgraph::gpu::Gpu;
-use shadowgraph::stability::{BiasSweep, bias_table, msm_bias_sweep};
+use shadowgraph::low_level::gpu::Gpu;
+use shadowgraph::low_level::stability::{BiasSweep, bias_table, msm_bias_sweep};
 
 /// Errors as one line, causes joined (`{:#}`), status 1.
 fn main() {

@@ -9,8 +9,8 @@ use crate::graph::cost::fetches::Fetches;
 use crate::io::{deinterleave, write_exr, write_png};
 use crate::kernels;
 use crate::render::{DrawnLights, Frame, RenderOptions, Renderer, drawn_lights, plan_lights};
-use crate::scene::{Light, Scene};
 use crate::technique;
+use crate::{model::Light, scene::Scene};
 
 /// `shadowgraph plan`: the plan as text (or Graphviz with `dot`), with each light's traffic
 /// per texel and its visibility function's fetches per pixel (no GPU needed).

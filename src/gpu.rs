@@ -27,7 +27,8 @@ const WANTED_FEATURES: wgpu::Features = crate::timer::TIMER_FEATURES
     .union(wgpu::Features::FLOAT32_FILTERABLE)
     .union(wgpu::Features::SHADER_F64)
     .union(wgpu::Features::SHADER_INT64)
-    .union(wgpu::Features::TEXTURE_FORMAT_16BIT_NORM);
+    .union(wgpu::Features::TEXTURE_FORMAT_16BIT_NORM)
+    .union(wgpu::Features::SUBGROUP);
 
 impl Gpu {
     /// Picks an adapter and creates a device with the adapter's own limits.
@@ -114,6 +115,7 @@ impl Gpu {
             ("FLOAT32_FILTERABLE", wgpu::Features::FLOAT32_FILTERABLE),
             ("SHADER_F64", wgpu::Features::SHADER_F64),
             ("SHADER_INT64", wgpu::Features::SHADER_INT64),
+            ("SUBGROUP", wgpu::Features::SUBGROUP),
         ] {
             line(&format!("feature {name}"), yes_no(f.contains(feat)));
         }

@@ -5,7 +5,8 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 
-use shadowgraph::{cli, gpu::Gpu};
+use shadowgraph::low_level::cli;
+use shadowgraph::low_level::gpu::Gpu;
 
 #[derive(Parser)]
 #[command(
@@ -100,7 +101,7 @@ enum Command {
         /// `constant` (a GPU that stores textures compressed moves smooth and constant data
         /// faster; the texture copies read the same kind).
         #[arg(long, default_value = "random", value_parser = parse_inputs, conflicts_with = "lookup")]
-        inputs: shadowgraph::bench::Inputs,
+        inputs: shadowgraph::low_level::bench::Inputs,
         /// Also print each dispatch's median time under a kernel of several.
         #[arg(long, conflicts_with = "lookup")]
         passes: bool,
@@ -108,8 +109,8 @@ enum Command {
         /// two, today the summed-area tables' pass 3 and the fused tile blurs; see
         /// SHADOWGRAPH_KERNEL_LAYOUT), rows
         /// named `<kernel> [gpu]`, … (default: the device's variant alone).
-        #[arg(long, value_delimiter = ',', value_parser = shadowgraph::exec::KernelLayout::parse, conflicts_with = "lookup")]
-        layouts: Vec<shadowgraph::exec::KernelLayout>,
+        #[arg(long, value_delimiter = ',', value_parser = shadowgraph::low_level::exec::KernelLayout::parse, conflicts_with = "lookup")]
+        layouts: Vec<shadowgraph::low_level::exec::KernelLayout>,
         /// Time each kernel compiled from each of these folders of `.wgsl` replacements in
         /// turn (as SHADOWGRAPH_KERNEL_DIR reads one; `shipped`: the embedded kernels;
         /// `zeroed`: the embedded kernels with their workgroup memory zeroed first, wgpu's
@@ -159,7 +160,7 @@ enum Command {
         /// timed over a whole period. A list times each rate past the first again, its report
         /// in DIR/update-<rate>/.
         #[arg(long, value_parser = parse_update, allow_negative_numbers = true, value_delimiter = ',')]
-        update: Option<Vec<shadowgraph::scene::UpdateRate>>,
+        update: Option<Vec<shadowgraph::low_level::scene::UpdateRate>>,
         /// Run every MSM configuration at each of these moment biases (default: the storage's).
         #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
         moment_bias: Option<Vec<f32>>,
@@ -179,13 +180,13 @@ enum Command {
 }
 
 /// `bench --inputs`: one of `Inputs::NAMES`.
-fn parse_inputs(name: &str) -> Result<shadowgraph::bench::Inputs, String> {
-    shadowgraph::bench::Inputs::parse(name).map_err(|e| e.to_string())
+fn parse_inputs(name: &str) -> Result<shadowgraph::low_level::bench::Inputs, String> {
+    shadowgraph::low_level::bench::Inputs::parse(name).map_err(|e| e.to_string())
 }
 
 /// `--repeat` of every command: 1 to `render::MAX_REPEAT` frames (each keeps a row of timings).
 fn repeat_range() -> clap::builder::RangedI64ValueParser<u32> {
-    clap::value_parser!(u32).range(1..=i64::from(shadowgraph::render::MAX_REPEAT))
+    clap::value_parser!(u32).range(1..=i64::from(shadowgraph::low_level::render::MAX_REPEAT))
 }
 
 /// `evaluate --budget`: a positive, finite number of milliseconds.
@@ -199,8 +200,8 @@ fn parse_budget(s: &str) -> Result<f64, String> {
 
 /// `evaluate --update`: `every`, a period of at least 1 frame (1 is every frame) up to
 /// `scene::MAX_UPDATE_PERIOD`, or `static`.
-fn parse_update(s: &str) -> Result<shadowgraph::scene::UpdateRate, String> {
-    use shadowgraph::scene::{MAX_UPDATE_PERIOD, UpdateRate};
+fn parse_update(s: &str) -> Result<shadowgraph::low_level::scene::UpdateRate, String> {
+    use shadowgraph::low_level::scene::{MAX_UPDATE_PERIOD, UpdateRate};
     match s.trim() {
         "every" => Ok(UpdateRate::EveryFrame),
         "static" => Ok(UpdateRate::Static),
@@ -295,7 +296,7 @@ fn run(args: Args) -> Result<()> {
             let gpu = Gpu::new()?;
             print!(
                 "{}",
-                shadowgraph::dump::dump(&gpu, &scene, &out, only.as_deref())?
+                shadowgraph::low_level::dump::dump(&gpu, &scene, &out, only.as_deref())?
             );
         }
         Command::Info => print!("{}", Gpu::new()?.info_report()),
@@ -314,7 +315,7 @@ fn run(args: Args) -> Result<()> {
             moment_bias,
             crossover_sizes,
         } => {
-            let opts = shadowgraph::evaluate::EvaluateOptions {
+            let opts = shadowgraph::low_level::evaluate::EvaluateOptions {
                 techniques,
                 quick,
                 sizes,
@@ -330,13 +331,13 @@ fn run(args: Args) -> Result<()> {
                 // static light too.
                 more_updates: match &update {
                     Some(u) => u.iter().skip(1).copied().collect(),
-                    None if quick => vec![shadowgraph::scene::UpdateRate::Static],
+                    None if quick => vec![shadowgraph::low_level::scene::UpdateRate::Static],
                     None => Vec::new(),
                 },
                 crossover_sizes,
             };
             let gpu = Gpu::new()?;
-            print!("{}", shadowgraph::evaluate::run(&gpu, &scene, &out, &opts)?);
+            print!("{}", shadowgraph::low_level::evaluate::run(&gpu, &scene, &out, &opts)?);
         }
         Command::Bench {
             sizes,
@@ -359,24 +360,24 @@ fn run(args: Args) -> Result<()> {
                         "--sizes is the kernel bench's; `--lookup` renders its map at `--map`"
                     );
                 }
-                shadowgraph::bench::check_soft_args(&light_sizes, repeat, &only)?;
+                shadowgraph::low_level::bench::check_soft_args(&light_sizes, repeat, &only)?;
             }
             let sizes = sizes.unwrap_or_else(|| vec![512, 1024, 2048, 4096]);
             let gpu = Gpu::new()?;
             match lookup {
                 Some(widths) => {
-                    let rows = shadowgraph::bench::lookup_cost(&gpu, &widths, repeat, image, map)?;
+                    let rows = shadowgraph::low_level::bench::lookup_cost(&gpu, &widths, repeat, image, map)?;
                     let cpu = gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu;
                     print!(
                         "{}",
-                        shadowgraph::bench::format_lookup_table(
+                        shadowgraph::low_level::bench::format_lookup_table(
                             &gpu.describe(),
                             cpu,
                             repeat,
                             &rows
                         )
                     );
-                    let soft = shadowgraph::bench::soft_cost(
+                    let soft = shadowgraph::low_level::bench::soft_cost(
                         &gpu,
                         &light_sizes,
                         repeat,
@@ -386,7 +387,7 @@ fn run(args: Args) -> Result<()> {
                     )?;
                     print!(
                         "\n{}",
-                        shadowgraph::bench::format_soft_table(
+                        shadowgraph::low_level::bench::format_soft_table(
                             &gpu.describe(),
                             cpu,
                             repeat,
@@ -398,7 +399,7 @@ fn run(args: Args) -> Result<()> {
                 None => {
                     print!(
                         "{}",
-                        shadowgraph::bench::run(
+                        shadowgraph::low_level::bench::run(
                             &gpu,
                             &sizes,
                             repeat,
@@ -414,8 +415,8 @@ fn run(args: Args) -> Result<()> {
         }
         Command::Stability { large } => {
             let gpu = Gpu::new()?;
-            let opts = shadowgraph::stability::StabilityOptions { large };
-            let report = shadowgraph::stability::run(&gpu, &opts, &mut |case, name| {
+            let opts = shadowgraph::low_level::stability::StabilityOptions { large };
+            let report = shadowgraph::low_level::stability::run(&gpu, &opts, &mut |case, name| {
                 eprintln!("stability: case {case}/7, {name}");
             })?;
             print!("{}", report.table());

@@ -10,6 +10,7 @@ const QUANTIZE: [[f64; 4]; 4] = [
     [9.7924062118, -33.7652110555, 47.9456096605, -23.9728048165],
 ];
 /// Its inverse, by columns likewise.
+#[cfg(feature = "cli")]
 const DEQUANTIZE: [[f64; 4]; 4] = [
     [0.2227744146, 0.0771972861, 0.7926986636, 0.0319417555],
     [0.1549679261, 0.1394629426, 0.7963415838, -0.1722823173],
@@ -29,7 +30,8 @@ pub fn quantize(b: [f64; 4]) -> [f64; 4] {
     q
 }
 
-/// The moments of quantized `q`.
+/// The moments of quantized `q` (the CPU reference's).
+#[cfg(feature = "cli")]
 pub fn dequantize(mut q: [f64; 4]) -> [f64; 4] {
     q[0] -= QUANTIZE_OFFSET;
     row_times(q, &DEQUANTIZE)

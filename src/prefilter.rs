@@ -38,7 +38,7 @@ use glam::{Mat4, Vec3};
 pub use crate::error::StageError;
 /// The light's GPU description the exported WGSL's `Light` mirrors (what
 /// [`LightParams::light_gpu`] returns), where a host looks for it.
-pub use crate::gpu_data::LightGpu;
+pub use crate::wgsl_mirrors::LightGpu;
 pub use config::PrefilterConfig;
 pub use depth::{DEPTH_FORMATS, DepthLayer};
 pub use light_params::LightParams;

@@ -18,11 +18,11 @@ use crate::exec::Outputs;
 use crate::gpu::read_texture;
 use crate::graph::{Graph, Plan, plan};
 pub use crate::limits::check_features;
-use crate::scene::{Light, Scene};
 use crate::technique;
+use crate::{model::Light, scene::Scene};
 
-pub use crate::gpu_data::FrameGpu;
 pub use crate::model::CameraRays;
+pub use crate::wgsl_mirrors::FrameGpu;
 
 impl FrameGpu {
     /// Frame constants for `scene` rendered at `width × height`, with the camera's rays.

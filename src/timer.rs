@@ -38,8 +38,8 @@
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU8, Ordering};
 
-use crate::created;
 use crate::error::{Error, Result};
+use crate::gpu_objects;
 
 /// Least wall time of untimed work before a GPU is timed, ms. A GPU left idle (while the
 /// host fills the next case's textures, or measures the last frame's error) drops its clocks,
@@ -164,7 +164,7 @@ impl GpuTimer {
         let bytes = u64::from(capacity) * 2 * 8;
         let ring = (0..RING)
             .map(|_| Readback {
-                buffer: created::buffer(
+                buffer: gpu_objects::buffer(
                     device,
                     &wgpu::BufferDescriptor {
                         label: Some("shadowgraph.timer.readback"),
@@ -179,7 +179,7 @@ impl GpuTimer {
             })
             .collect();
         Some(Self {
-            query_set: created::query_set(
+            query_set: gpu_objects::query_set(
                 device,
                 &wgpu::QuerySetDescriptor {
                     label: Some("shadowgraph.timer"),
@@ -187,7 +187,7 @@ impl GpuTimer {
                     count: capacity * 2,
                 },
             ),
-            resolve: created::buffer(
+            resolve: gpu_objects::buffer(
                 device,
                 &wgpu::BufferDescriptor {
                     label: Some("shadowgraph.timer.resolve"),
@@ -204,7 +204,7 @@ impl GpuTimer {
             open: None,
             period_ns: f64::from(queue.get_timestamp_period()),
             wait_marks: (device.adapter_info().device_type == wgpu::DeviceType::Cpu).then(|| {
-                created::buffer(
+                gpu_objects::buffer(
                     device,
                     &wgpu::BufferDescriptor {
                         label: Some("shadowgraph.timer.wait"),

@@ -13,7 +13,7 @@ use std::f64::consts::PI;
 use crate::cpu::Texels;
 use crate::cpu::light::LightSample;
 use crate::cpu::vis_msm::{bias_for, branch_spread, dequantized, intensity};
-use crate::gpu_data::{LightGpu, MSM_HAUSDORFF, MSM_QUANTIZED};
+use crate::wgsl_mirrors::{LightGpu, MSM_HAUSDORFF, MSM_QUANTIZED};
 
 /// The unit roundoff of f32, 2⁻²⁴.
 pub const U: f64 = 1.0 / (1u64 << 24) as f64;
@@ -110,7 +110,7 @@ pub fn evsm(maps: &[Texels], l: &LightGpu, s: &LightSample) -> f64 {
 /// the log-space bilinear ((3 + 2|x|) ULP each) and the final exp, all relative to `v`.
 pub fn esm(
     logs: &[crate::cpu::Texels],
-    l: &crate::gpu_data::LightGpu,
+    l: &crate::wgsl_mirrors::LightGpu,
     s: &crate::cpu::light::LightSample,
     v: f64,
 ) -> f64 {
@@ -141,7 +141,7 @@ pub fn esm(
 /// receiver depth's f32 rounding scaled by c (as in [`esm`]).
 pub fn esm_sat(
     moments: &[crate::cpu::Texels],
-    l: &crate::gpu_data::LightGpu,
+    l: &crate::wgsl_mirrors::LightGpu,
     s: &crate::cpu::light::LightSample,
     v: f64,
 ) -> f64 {

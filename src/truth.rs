@@ -35,8 +35,11 @@ use wgpu::util::DeviceExt;
 use crate::error::{Error, Result};
 use crate::gpu::{read_buffer, submit_and_wait, write_texture};
 use crate::render::{RenderOptions, Renderer, ShadowRaster};
-use crate::scene::{Light, LightKind, Scene, Technique};
 use crate::technique::LightGpu;
+use crate::{
+    model::{Light, LightKind, Technique},
+    scene::Scene,
+};
 
 /// Samples recorded per submission (bounds the per-sample buffers alive at once).
 const BATCH: usize = 16;

@@ -9,12 +9,12 @@ mod common;
 use std::path::Path;
 
 use glam::Vec3;
-use shadowgraph::evaluate::temporal::{
+use shadowgraph::low_level::evaluate::temporal::{
     TemporalError, animation_temporal_error, animation_truths, animation_visibility,
 };
-use shadowgraph::render::{RenderOptions, Renderer};
-use shadowgraph::scene::Scene;
-use shadowgraph::truth::{Emitter, TruthOptions};
+use shadowgraph::low_level::render::{RenderOptions, Renderer};
+use shadowgraph::low_level::scene::Scene;
+use shadowgraph::low_level::truth::{Emitter, TruthOptions};
 
 /// A directional light over a sphere floating above a plane, 48×36 pixels; `shadow` is its
 /// `[light.shadow]` body, `light` extra light keys, `animation` the `[animation]` text.
@@ -207,7 +207,7 @@ keys = [{ frame = 0, value = [0.0, 8.0, 2.0] }, { frame = 2, value = [0.5, 8.0, 
 }
 
 /// The temporal error of `shadow` over `animation`, against a 16-sample truth at 512².
-fn temporal(g: &shadowgraph::gpu::Gpu, shadow: &str, animation: &str) -> TemporalError {
+fn temporal(g: &shadowgraph::low_level::gpu::Gpu, shadow: &str, animation: &str) -> TemporalError {
     let s = parse(&text(shadow, "", animation)).expect("scene");
     let mut r = Renderer::new(&g.device);
     let opts = TruthOptions {

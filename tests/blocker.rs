@@ -9,12 +9,11 @@ mod common;
 use common::soft::TableError;
 use common::soft_maps::{DIR, MAP, cssm, msm_soft, rounded, tables, trig_error, vssm};
 use rand::Rng;
-use shadowgraph::cpu::sat::Integral;
-use shadowgraph::cpu::{self, Texels};
-use shadowgraph::gpu::Gpu;
-use shadowgraph::sat::SatVariant;
-use shadowgraph::scene::{CssmSearch, Storage};
-use shadowgraph::technique::{LightGpu, sat_coding};
+use shadowgraph::low_level::cpu::sat::Integral;
+use shadowgraph::low_level::cpu::{self, Texels};
+use shadowgraph::low_level::gpu::Gpu;
+use shadowgraph::low_level::technique::sat_coding;
+use shadowgraph::{CssmSearch, LightGpu, SatVariant, Storage};
 
 /// Runs the `csm` kernel's CSM-Z maps (one map a dispatch) for every chunk of `terms` terms at `storage` over `input`
 /// (`w`×`h`), outputs poisoned with NaN first; returns each chunk's texels (its format's
@@ -26,8 +25,8 @@ fn csm_z_on_gpu(
     terms: u32,
     storage: Storage,
 ) -> Vec<(usize, Vec<f32>)> {
-    use shadowgraph::graph::{Dispatch, Graph, Node, SizeRule, plan};
-    use shadowgraph::technique::{
+    use shadowgraph::low_level::graph::{Dispatch, Graph, Node, SizeRule, plan};
+    use shadowgraph::low_level::technique::{
         CsmParams, LinearizeParams, csm_maps, csm_z_channels, csm_z_maps, moments_format,
     };
     let mut graph = Graph::default();
@@ -47,7 +46,7 @@ fn csm_z_on_gpu(
         );
         graph.node(Node {
             name: out.clone(),
-            kernel: shadowgraph::kernels::KernelId::Csm,
+            kernel: shadowgraph::low_level::kernels::KernelId::Csm,
             inputs: vec![("src".into(), "in".into())],
             outputs: vec![("dst0".into(), out.clone())],
             // Orthographic depth in [0, 1] is read as linear depth unchanged.
@@ -75,13 +74,13 @@ fn csm_z_on_gpu(
         bytemuck::cast_slice(input),
     );
     let imports = std::collections::HashMap::from([("in".to_string(), texture)]);
-    let mut exec = shadowgraph::exec::Executor::new();
-    let record = |exec: &mut shadowgraph::exec::Executor| {
+    let mut exec = shadowgraph::low_level::exec::Executor::new();
+    let record = |exec: &mut shadowgraph::low_level::exec::Executor| {
         let mut enc = g.device.create_command_encoder(&Default::default());
         let out = exec
             .record(&g.device, &mut enc, &p, &imports, None)
             .expect("record");
-        shadowgraph::gpu::submit_and_wait(&g.device, &g.queue, enc, "csm_z").expect("submit");
+        shadowgraph::low_level::gpu::submit_and_wait(&g.device, &g.queue, enc, "csm_z").expect("submit");
         out
     };
     let first = record(&mut exec);
@@ -92,17 +91,17 @@ fn csm_z_on_gpu(
         let bytes: Vec<u8> = match t.format() {
             wgpu::TextureFormat::Rgba16Float => 0x7e00u16.to_le_bytes().repeat(4 * texels),
             f => {
-                let n = shadowgraph::graph::texel_bytes(f) as usize / 4;
+                let n = shadowgraph::low_level::graph::texel_bytes(f) as usize / 4;
                 f32::NAN.to_le_bytes().repeat(n * texels)
             }
         };
-        shadowgraph::gpu::write_texture(&g.queue, t, &bytes);
+        shadowgraph::low_level::gpu::write_texture(&g.queue, t, &bytes);
     }
     let out = record(&mut exec);
     outputs
         .iter()
         .map(|name| {
-            shadowgraph::gpu::read_float_texture(&g.device, &g.queue, &out.textures[name], 0)
+            shadowgraph::low_level::gpu::read_float_texture(&g.device, &g.queue, &out.textures[name], 0)
                 .expect("readback")
         })
         .collect()
@@ -190,9 +189,9 @@ fn blocker_harness(
          s.view_z = 1.0;\n    s.inside = true;\n    var r = vec4<f32>(0.0);\n    {body}\n    \
          if id.x < arrayLength(&queries) {{\n        results[i] = r;\n    }}\n}}\n"
     ));
-    let wgsl = shadowgraph::kernels::resolve_source("test.blocker", &text).expect("resolve");
+    let wgsl = shadowgraph::low_level::kernels::resolve_source("test.blocker", &text).expect("resolve");
     let d = &g.device;
-    let kernel = shadowgraph::exec::ComputeKernel::new(d, "blocker_harness", &wgsl)
+    let kernel = shadowgraph::low_level::exec::ComputeKernel::new(d, "blocker_harness", &wgsl)
         .expect("harness compiles");
     let buffer = |bytes: &[u8], usage| {
         d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -260,8 +259,8 @@ fn blocker_harness(
         pass.dispatch_workgroups((queries.len() as u32).div_ceil(64), 1, 1);
     }
     enc.copy_buffer_to_buffer(&results, 0, &readback, 0, results.size());
-    shadowgraph::gpu::submit_and_wait(d, &g.queue, enc, "blocker harness").expect("submit");
-    let raw = shadowgraph::gpu::read_buffer(d, &readback).expect("readback");
+    shadowgraph::low_level::gpu::submit_and_wait(d, &g.queue, enc, "blocker harness").expect("submit");
+    let raw = shadowgraph::low_level::gpu::read_buffer(d, &readback).expect("readback");
     bytemuck::cast_slice(&raw).to_vec()
 }
 
@@ -376,7 +375,7 @@ fn blocker_estimates_match_reference() {
     let l = common::soft_maps::light(DIR, msm_soft(Storage::F32, false));
     let lg = LightGpu::new(&l);
     let coding = sat_coding(&l).expect("coding").expect("table");
-    let quantized = shadowgraph::technique::msm_quantized(&l.shadow.technique);
+    let quantized = shadowgraph::low_level::technique::msm_quantized(&l.shadow.technique);
     let t = tables(&rounded(cpu::msm::msm(&lin, quantized)), &coding);
     let (integral, err) = (
         Integral::new(&t.decoded),

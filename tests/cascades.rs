@@ -7,8 +7,8 @@ mod common;
 
 use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
 use rand::Rng;
-use shadowgraph::prefilter::StageError;
-use shadowgraph::prefilter::cascades::{
+use shadowgraph::StageError;
+use shadowgraph::cascades::{
     CascadeCamera, CascadeLayout, fit_cascades, split_distances, view_distance,
 };
 
@@ -164,7 +164,7 @@ fn cascades_do_not_shimmer() {
     let probe = DVec3::new(3.3, 0.0, -7.1);
     let base = camera(Vec3::new(2.0, 6.0, 12.0), Vec3::new(0.0, 0.0, -5.0));
     let first = fit_cascades(&base, sun(), &LAYOUT).expect("fit");
-    let frac = |c: &shadowgraph::prefilter::cascades::Cascade| {
+    let frac = |c: &shadowgraph::cascades::Cascade| {
         let q = light_ndc(c.light.view, c.light.projection, probe);
         let texels = (q.truncate() * 0.5 + 0.5) * f64::from(LAYOUT.map_size);
         texels - texels.floor()
@@ -219,28 +219,28 @@ fn cascades_do_not_shimmer() {
 /// the fitting.
 #[test]
 fn the_stages_cascade_config_matches_the_renderers_pick() {
-    use shadowgraph::prefilter::{Prefilter, PrefilterConfig};
+    use shadowgraph::{Prefilter, PrefilterConfig};
     let g = common::gpu();
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/city_street.toml");
-    let scene = shadowgraph::scene::Scene::load(&path).expect("city_street loads");
+    let scene = shadowgraph::low_level::scene::Scene::load(&path).expect("city_street loads");
     let light = &scene.lights[0];
     let config = PrefilterConfig::from_light(light);
     assert_eq!(config.cascades, light.shadow.cascades);
     let stage = Prefilter::new(&g.device, &config).expect("stage");
-    let camera = shadowgraph::render::cascade_camera(&scene).expect("camera");
+    let camera = shadowgraph::low_level::render::cascade_camera(&scene).expect("camera");
     let cascades = stage
         .fit_cascades(&camera, light.direction(), 10.0)
         .expect("fit");
     assert_eq!(cascades.len(), 4);
     let mut first = cascades[0].light.light_gpu(&config, config.size);
-    shadowgraph::prefilter::cascades::pick_fields(
+    shadowgraph::cascades::pick_fields(
         &mut first,
         &camera,
         &cascades,
         config.cascades.blend,
     )
     .expect("pick fields");
-    let drawn = shadowgraph::render::drawn_lights(&scene).expect("drawn lights");
+    let drawn = shadowgraph::low_level::render::drawn_lights(&scene).expect("drawn lights");
     let r = drawn.gpu[0];
     let close = |a: f32, b: f32| (a - b).abs() <= 1e-6 * a.abs().max(1.0);
     assert_eq!(first.cascade_count, r.cascade_count);
@@ -291,8 +291,8 @@ fn the_stages_cascade_config_matches_the_renderers_pick() {
         }
         other => panic!("vssm through fit_cascades: {other:?}"),
     }
-    let sun = shadowgraph::prefilter::LightParams::from_light(light);
-    let spot = shadowgraph::prefilter::LightParams::perspective(sun.view, 1.0, sun.near, sun.far);
+    let sun = shadowgraph::LightParams::from_light(light);
+    let spot = shadowgraph::LightParams::perspective(sun.view, 1.0, sun.near, sun.far);
     match soft_stage.fit_light_cascades(&camera, &spot) {
         Err(shadowgraph::Error::Stage(StageError::LightParams { field, .. })) => {
             assert_eq!(field, "projection")
@@ -326,13 +326,13 @@ fn the_stages_cascade_config_matches_the_renderers_pick() {
 #[test]
 fn soft_cascades_keep_one_reach_inside_their_maps() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/city_street.toml");
-    let base = shadowgraph::scene::Scene::load(&path).expect("city_street loads");
+    let base = shadowgraph::low_level::scene::Scene::load(&path).expect("city_street loads");
     let mut rng = common::rng(11);
     for name in ["pcss", "vssm", "msm_soft", "cssm"] {
         for _ in 0..8 {
             let mut scene = base.clone();
             let light = &mut scene.lights[0];
-            light.shadow.technique = shadowgraph::technique::named(name, &[]).expect("registered");
+            light.shadow.technique = shadowgraph::low_level::technique::named(name, &[]).expect("registered");
             let eye = Vec3::new(
                 rng.random_range(-20.0..20.0),
                 rng.random_range(1.0..6.0),
@@ -345,15 +345,15 @@ fn soft_cascades_keep_one_reach_inside_their_maps() {
                     rng.random_range(-0.4..0.1),
                     rng.random_range(-1.0..1.0),
                 );
-            let guard = shadowgraph::technique::cascade_guard(&scene.lights[0]);
+            let guard = shadowgraph::low_level::technique::cascade_guard(&scene.lights[0]);
             let reach = f64::from(guard.world);
             assert!(
                 (reach - 2.8).abs() < 1e-5,
                 "{name}: reach {reach} (size·(far − near)/(2·near) = 2.8)"
             );
-            let drawn = shadowgraph::render::drawn_lights(&scene).expect("drawn lights");
+            let drawn = shadowgraph::low_level::render::drawn_lights(&scene).expect("drawn lights");
             let group = drawn.groups[0];
-            let camera = shadowgraph::render::cascade_camera(&scene).expect("camera");
+            let camera = shadowgraph::low_level::render::cascade_camera(&scene).expect("camera");
             let c = scene.lights[0].shadow.cascades;
             let fars = split_distances(camera.near, camera.far, c.count, c.lambda).expect("split");
             let mut near = f64::from(camera.near);
@@ -391,9 +391,9 @@ fn soft_cascades_keep_one_reach_inside_their_maps() {
 #[test]
 fn the_cascaded_shading_calls_each_cascade_once() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/city_street.toml");
-    let scene = shadowgraph::scene::Scene::load(&path).expect("city_street loads");
-    let drawn = shadowgraph::render::drawn_lights(&scene).expect("drawn lights");
-    let block = shadowgraph::technique::shading_block_cascaded(&drawn.lights, &drawn.groups);
+    let scene = shadowgraph::low_level::scene::Scene::load(&path).expect("city_street loads");
+    let drawn = shadowgraph::low_level::render::drawn_lights(&scene).expect("drawn lights");
+    let block = shadowgraph::low_level::technique::shading_block_cascaded(&drawn.lights, &drawn.groups);
     let group = drawn.groups[0];
     assert_eq!(group.count, 4);
     for c in 0..group.count {
@@ -438,7 +438,7 @@ fn far_scene(eye: [f64; 3], target: [f64; 3], scale: f64, at: [f64; 3]) -> Strin
 /// point lies past 10⁷ is refused naming the light's `cascades` key and its line.
 #[test]
 fn cascades_cover_the_scene_files_view_range() {
-    use shadowgraph::scene::Scene;
+    use shadowgraph::low_level::scene::Scene;
     let path = std::path::Path::new("far.toml");
     let cases = [
         ([0.0, 3.0, 13000.0], [0.0; 3], 0.5, [0.0; 3], true),
@@ -448,7 +448,7 @@ fn cascades_cover_the_scene_files_view_range() {
     for (eye, target, scale, at, in_front) in cases {
         let text = far_scene(eye, target, scale, at);
         let scene = Scene::parse(path, &text).expect("the scene loads");
-        let drawn = shadowgraph::render::drawn_lights(&scene)
+        let drawn = shadowgraph::low_level::render::drawn_lights(&scene)
             .unwrap_or_else(|e| panic!("camera at {eye:?}: {e}"));
         assert_eq!(drawn.groups.len(), 1);
         let g = drawn.gpu[0];
@@ -504,7 +504,7 @@ fn cascades_cover_the_scene_files_view_range() {
         .matches('\n')
         .count()
         + 1;
-    match shadowgraph::render::drawn_lights(&scene) {
+    match shadowgraph::low_level::render::drawn_lights(&scene) {
         Err(shadowgraph::Error::Scene {
             location, message, ..
         }) => {

@@ -21,7 +21,7 @@ fn render_writes_png_and_aux_exrs() {
     let g = common::gpu();
     let dir = temp_dir("aux");
     let png = dir.join("out.png");
-    let report = shadowgraph::cli::render(&g, &scene("two_lights.toml"), &png, Some(&dir), true, 2)
+    let report = shadowgraph::low_level::cli::render(&g, &scene("two_lights.toml"), &png, Some(&dir), true, 2)
         .expect("render");
     assert!(report.contains("wrote"), "{report}");
     assert!(
@@ -63,7 +63,7 @@ fn render_writes_png_and_aux_exrs() {
 
 #[test]
 fn plan_text_and_dot() {
-    let text = shadowgraph::cli::plan(&scene("bunny.toml"), false).expect("plan");
+    let text = shadowgraph::low_level::cli::plan(&scene("bunny.toml"), false).expect("plan");
     for needle in [
         "light 0",
         "light0.linearize",
@@ -73,13 +73,13 @@ fn plan_text_and_dot() {
     ] {
         assert!(text.contains(needle), "`{needle}` missing:\n{text}");
     }
-    let dot = shadowgraph::cli::plan(&scene("bunny.toml"), true).expect("dot");
+    let dot = shadowgraph::low_level::cli::plan(&scene("bunny.toml"), true).expect("dot");
     assert!(dot.starts_with("digraph") && dot.contains("light0.linearize"));
 }
 
 #[test]
 fn bad_scene_path_is_an_error_naming_the_file() {
-    let e = shadowgraph::cli::plan(Path::new("no/such/scene.toml"), false)
+    let e = shadowgraph::low_level::cli::plan(Path::new("no/such/scene.toml"), false)
         .unwrap_err()
         .to_string();
     assert!(e.contains("no/such/scene.toml"), "{e}");
@@ -94,10 +94,10 @@ fn bad_scene_path_is_an_error_naming_the_file() {
 #[test]
 fn soft_benchmark_reports_every_configuration() {
     let g = common::gpu();
-    let rows = shadowgraph::bench::soft_cost(&g, &[0.5, 1.0], 1, Some((48, 36)), Some(128), &[])
+    let rows = shadowgraph::low_level::bench::soft_cost(&g, &[0.5, 1.0], 1, Some((48, 36)), Some(128), &[])
         .expect("soft bench");
     let names: Vec<&str> = rows.iter().map(|r| r.technique.as_str()).collect();
-    let want: Vec<&str> = shadowgraph::bench::SOFT_TECHNIQUES
+    let want: Vec<&str> = shadowgraph::low_level::bench::SOFT_TECHNIQUES
         .iter()
         .map(|(n, _)| *n)
         .collect();
@@ -139,7 +139,7 @@ fn soft_benchmark_reports_every_configuration() {
             tables(soft)
         );
     }
-    let table = shadowgraph::bench::format_soft_table("test", true, 1, &[0.5, 1.0], &rows);
+    let table = shadowgraph::low_level::bench::format_soft_table("test", true, 1, &[0.5, 1.0], &rows);
     assert!(table.contains("(48×36, 128² spot map)"), "{table}");
     assert!(
         table.contains("prefilter ms") && table.contains("wall ms"),
@@ -147,11 +147,11 @@ fn soft_benchmark_reports_every_configuration() {
     );
     // `--only` keeps the named configurations, `hard` and the yardstick, whose ratios stay 1.
     let only = ["cssm".to_string()];
-    let some = shadowgraph::bench::soft_cost(&g, &[0.5], 1, Some((48, 36)), Some(128), &only)
+    let some = shadowgraph::low_level::bench::soft_cost(&g, &[0.5], 1, Some((48, 36)), Some(128), &only)
         .expect("soft bench, only cssm");
     let names: Vec<&str> = some.iter().map(|r| r.technique.as_str()).collect();
     assert_eq!(names, ["hard", "pcss 16+32", "cssm M=8", "cssm M=8 csm_z"]);
-    let table = shadowgraph::bench::format_soft_table("test", true, 1, &[0.5], &some);
+    let table = shadowgraph::low_level::bench::format_soft_table("test", true, 1, &[0.5], &some);
     let pcss = table.lines().find(|l| l.starts_with("pcss 16+32")).unwrap();
     assert!(pcss.contains("( 1.00)"), "{table}");
     assert!(table.contains("above hard"), "{table}");
@@ -163,14 +163,14 @@ fn soft_benchmark_reports_every_configuration() {
 #[test]
 fn lookup_benchmark_reports_every_width() {
     let g = common::gpu();
-    let rows = shadowgraph::bench::lookup_cost(&g, &[3, 9], 1, None, None).expect("lookup bench");
+    let rows = shadowgraph::low_level::bench::lookup_cost(&g, &[3, 9], 1, None, None).expect("lookup bench");
     assert_eq!(rows.iter().map(|r| r.width).collect::<Vec<_>>(), vec![3, 9]);
     for r in &rows {
         for v in [r.pcf_ms, r.sat_fixed_ms, r.sat_float_ms] {
             assert!(v.is_finite() && v > 0.0, "{r:?}");
         }
     }
-    let table = shadowgraph::bench::format_lookup_table("test", true, 1, &rows);
+    let table = shadowgraph::low_level::bench::format_lookup_table("test", true, 1, &rows);
     assert!(
         table.contains("   3²") && table.contains("   9²"),
         "{table}"
@@ -178,12 +178,12 @@ fn lookup_benchmark_reports_every_width() {
     assert!(rows.iter().all(|r| r.image == (400, 300)), "{rows:?}");
     // `--image` shades at the size asked for, and the table says so.
     let small =
-        shadowgraph::bench::lookup_cost(&g, &[3], 1, Some((64, 48)), Some(256)).expect("at 64x48");
+        shadowgraph::low_level::bench::lookup_cost(&g, &[3], 1, Some((64, 48)), Some(256)).expect("at 64x48");
     assert_eq!((small[0].image, small[0].map), ((64, 48), 256));
-    let table = shadowgraph::bench::format_lookup_table("test", true, 1, &small);
+    let table = shadowgraph::low_level::bench::format_lookup_table("test", true, 1, &small);
     assert!(table.contains("(64×48, 256² map)"), "{table}");
     for bad in [4, 0, 67] {
-        let e = shadowgraph::bench::lookup_cost(&g, &[bad], 1, None, None).expect_err("bad width");
+        let e = shadowgraph::low_level::bench::lookup_cost(&g, &[bad], 1, None, None).expect_err("bad width");
         assert!(e.to_string().contains(&format!("width {bad}")), "{e}");
     }
 }

@@ -111,28 +111,28 @@ fn plan_of_an_endless_file_stops() {
 /// `MAX_REPEAT`, an evaluation of `repeat` 0 or `truth_resolution` 0.
 #[test]
 fn library_entry_points_check_the_same_bounds() {
-    let mut opts = shadowgraph::evaluate::EvaluateOptions {
+    let mut opts = shadowgraph::low_level::evaluate::EvaluateOptions {
         repeat: 0,
         ..Default::default()
     };
-    let shown = shadowgraph::evaluate::check_options(&opts)
+    let shown = shadowgraph::low_level::evaluate::check_options(&opts)
         .unwrap_err()
         .to_string();
     assert!(shown.contains("--repeat 0"), "{shown}");
     opts.repeat = 1;
     opts.truth_resolution = Some(0);
-    let shown = shadowgraph::evaluate::check_options(&opts)
+    let shown = shadowgraph::low_level::evaluate::check_options(&opts)
         .unwrap_err()
         .to_string();
     assert!(shown.contains("--truth-resolution 0"), "{shown}");
     opts.truth_resolution = None;
-    opts.samples = Some(shadowgraph::truth::MAX_EMITTER_SAMPLES as u32 + 1);
-    let shown = shadowgraph::evaluate::check_options(&opts)
+    opts.samples = Some(shadowgraph::low_level::truth::MAX_EMITTER_SAMPLES as u32 + 1);
+    let shown = shadowgraph::low_level::evaluate::check_options(&opts)
         .unwrap_err()
         .to_string();
     assert!(shown.contains("--k 65537"), "{shown}");
     opts.samples = None;
-    shadowgraph::evaluate::check_options(&opts).expect("defaults are valid");
+    shadowgraph::low_level::evaluate::check_options(&opts).expect("defaults are valid");
 }
 
 /// The lookup benchmark's options apply to `--lookup` only: given without it they are refused

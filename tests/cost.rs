@@ -8,10 +8,11 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use shadowgraph::graph::cost::{self, fetches::Fetches};
-use shadowgraph::render::{RenderOptions, Renderer, plan_lights};
-use shadowgraph::scene::Scene;
-use shadowgraph::{kernels, technique};
+use shadowgraph::low_level::graph::cost;
+use shadowgraph::low_level::graph::cost::fetches::Fetches;
+use shadowgraph::low_level::render::{RenderOptions, Renderer, plan_lights};
+use shadowgraph::low_level::scene::Scene;
+use shadowgraph::low_level::{kernels, technique};
 
 fn scene_path(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -147,7 +148,7 @@ fn vsm_f16_writes_four_bytes_a_texel() {
         .expect("plan")
         .plan;
     let blurred = plan.resource("light0.vsm.blur").expect("planned");
-    assert_eq!(blurred.resource.format, shadowgraph::graph::PACKED_F16X2);
+    assert_eq!(blurred.resource.format, shadowgraph::PACKED_F16X2);
     assert_eq!(blurred.bytes, 512 * 512 * 4);
 }
 
@@ -172,7 +173,7 @@ fn vsm_f16_mips_move_half_the_bytes() {
     );
 }
 
-/// Side of the SAT's tiles (`shadowgraph::sat::SAT_TILE`).
+/// Side of the SAT's tiles (`shadowgraph::low_level::sat::SAT_TILE`).
 const SAT_TILE: f64 = 32.0;
 
 /// A summed-area table at 512² of a representation of `src` bytes per texel into a table of
@@ -286,7 +287,7 @@ fn shading_fetches_match_the_hand_counts() {
         ("techniques/vsm_mips_aniso.toml", 64.0),
     ] {
         let s = scene(name);
-        let got = shadowgraph::cli::shading_fetches(&s.lights).expect("fetches");
+        let got = shadowgraph::low_level::cli::shading_fetches(&s.lights).expect("fetches");
         assert_eq!(got, [fetches], "{name}");
     }
     let path = scene_path("techniques/cssm.toml");
@@ -295,21 +296,21 @@ fn shading_fetches_match_the_hand_counts() {
         "technique = \"cssm\"\nblocker_search = \"csm_z\"",
     );
     let s = Scene::parse(&path, &text).expect("parse");
-    let got = shadowgraph::cli::shading_fetches(&s.lights).expect("fetches");
+    let got = shadowgraph::low_level::cli::shading_fetches(&s.lights).expect("fetches");
     assert_eq!(got, [52.0], "cssm.toml, csm_z");
     let text = std::fs::read_to_string(&path).expect("cssm.toml").replace(
         "technique = \"cssm\"",
         "technique = \"cssm\"\nresolve = \"two_depth_search\"",
     );
     let s = Scene::parse(&path, &text).expect("parse");
-    let got = shadowgraph::cli::shading_fetches(&s.lights).expect("fetches");
+    let got = shadowgraph::low_level::cli::shading_fetches(&s.lights).expect("fetches");
     assert_eq!(got, [20.0], "cssm.toml, two_depth_search");
 }
 
 /// `plan` prints each node's traffic, the closing total and the shading fetches.
 #[test]
 fn plan_prints_traffic_and_fetches() {
-    let text = shadowgraph::cli::plan(&scene_path("techniques/vsm.toml"), false).expect("plan");
+    let text = shadowgraph::low_level::cli::plan(&scene_path("techniques/vsm.toml"), false).expect("plan");
     for needle in [
         "traffic per texel of the 512² map:",
         "reads    7.56 B, writes    8.00 B",
@@ -318,7 +319,7 @@ fn plan_prints_traffic_and_fetches() {
     ] {
         assert!(text.contains(needle), "`{needle}` missing:\n{text}");
     }
-    let text = shadowgraph::cli::plan(&scene_path("techniques/vsm_f16.toml"), false).expect("plan");
+    let text = shadowgraph::low_level::cli::plan(&scene_path("techniques/vsm_f16.toml"), false).expect("plan");
     for needle in [
         "light0.vsm.blur          R32Uint f16x2    512x512      1.0 MiB",
         "reads    7.56 B, writes    4.00 B",
@@ -351,7 +352,7 @@ fn a_point_lights_atlas_is_planned_like_one_map() {
         .plan;
     assert_eq!(cost::map_dims(&plan, 0), (1536, 1024));
     let text =
-        shadowgraph::cli::plan(&scene_path("techniques/point_vsm.toml"), false).expect("plan");
+        shadowgraph::low_level::cli::plan(&scene_path("techniques/point_vsm.toml"), false).expect("plan");
     for needle in [
         "light 0: point, vsm shadows, six 512² faces, guard band 5 texels (90° cores of 502²)",
         "light0.depth             Depth32Float    1536x1024",
@@ -411,7 +412,7 @@ fn test_lights() -> Vec<Vec<u8>> {
     ]
     .iter()
     .flat_map(|n| scene(n).lights)
-    .map(|l| bytemuck::bytes_of(&technique::LightGpu::new(&l)).to_vec())
+    .map(|l| bytemuck::bytes_of(&shadowgraph::LightGpu::new(&l)).to_vec())
     .collect()
 }
 
@@ -420,7 +421,7 @@ fn test_lights() -> Vec<Vec<u8>> {
 /// not loop equals the sum of its own loads and its callees' declarations.
 #[test]
 fn every_fetching_function_declares_its_fetches() {
-    let library = shadowgraph::prefilter::wgsl::library().expect("library");
+    let library = shadowgraph::wgsl::library().expect("library");
     let mut consistent = 0;
     for light in test_lights() {
         let mut f = Fetches::new("library", &library, &light).expect("declarations");
@@ -565,7 +566,7 @@ fn counted_fetches_match_the_declarations() {
     let mut checked = 0;
     for name in &names {
         let mut s = scene(name);
-        if shadowgraph::render::check_features(&g.device, &s.lights).is_err() {
+        if shadowgraph::low_level::render::check_features(&g.device, &s.lights).is_err() {
             continue;
         }
         (s.width, s.height) = (96, 72);
@@ -577,7 +578,7 @@ fn counted_fetches_match_the_declarations() {
         let frame = renderer
             .render(&g.device, &g.queue, &s, RenderOptions::default())
             .expect("render");
-        let declared = shadowgraph::cli::shading_fetches(&s.lights).expect("declared");
+        let declared = shadowgraph::low_level::cli::shading_fetches(&s.lights).expect("declared");
         let lights = s.lights.len();
         for (l, &d) in declared.iter().enumerate() {
             let counts: Vec<f32> = frame

@@ -17,19 +17,19 @@ mod common;
 use std::collections::HashMap;
 
 use rand::Rng;
-use shadowgraph::cpu::{self, Texels, sat as reference};
-use shadowgraph::exec::{Executor, KernelLayout};
-use shadowgraph::gpu::{Gpu, read_texture, submit_and_wait, write_texture};
-use shadowgraph::graph::{Graph, layer_of, plan, texel_bytes};
-use shadowgraph::sat::layers::LAYERED_SAT_OUTPUTS;
-use shadowgraph::sat::{
-    SAT_TILE, SatCoding, SatVariant, decode_table, float_sum_depth, lookup_area,
+use shadowgraph::low_level::cpu::{self, Texels, sat as reference};
+use shadowgraph::low_level::exec::{Executor, KernelLayout};
+use shadowgraph::low_level::gpu::{Gpu, read_texture, submit_and_wait, write_texture};
+use shadowgraph::low_level::graph::{Graph, layer_of, plan, texel_bytes};
+use shadowgraph::low_level::sat::layers::LAYERED_SAT_OUTPUTS;
+use shadowgraph::low_level::sat::{
+    SAT_TILE, SatCoding, decode_table, float_sum_depth, lookup_area,
 };
-use shadowgraph::scene::{CssmSearch, Storage};
-use shadowgraph::technique::{
+use shadowgraph::low_level::technique::{
     CsmBasis, LinearizeParams, MomentTable, Moments, add_csm_tables, add_moment_table,
     basis_interleave, basis_sequence, csm_maps, csm_z_maps,
 };
+use shadowgraph::{CssmSearch, SatVariant, Storage};
 
 /// f32's unit roundoff.
 const U: f64 = 1.0 / (1u64 << 24) as f64;
@@ -321,6 +321,22 @@ fn check(g: &Gpu, seed: u64, case: &Case) {
     };
     let interleave = basis_interleave(case.w as u32, layers, case.variant);
     let (tables, steps, stats) = run(g, case, &raw, coding, interleave);
+    // The redesign layout (on a device with subgroups the tile passes by subgroup scans,
+    // shared/sat_strip): the same dispatches and counts, fixed-point tables bit for bit, f32
+    // tables checked below against the same reference and tolerance.
+    let redesign = run_in(g, case, &raw, coding, interleave, KernelLayout::Redesign);
+    assert_eq!(redesign.1, steps, "{what}: the redesign's dispatches");
+    assert_eq!(redesign.2, stats, "{what}: the redesign's non-finite count");
+    if case.variant == SatVariant::Fixed {
+        for (m, (a, b)) in tables.iter().zip(&redesign.0).enumerate() {
+            if let Some(i) = (0..a.len()).find(|&i| a[i] != b[i]) {
+                panic!(
+                    "{what} table {m}: redesign word {i} is {:#x}, shipped {:#x}",
+                    b[i], a[i]
+                );
+            }
+        }
+    }
     if interleave > 1 {
         // A texture a table, and two a texture (the last holding the rest: with nine tables
         // five textures, two pass-3 dispatches), hold the same words (each its own channels;
@@ -421,6 +437,8 @@ fn check(g: &Gpu, seed: u64, case: &Case) {
             common::assert_within(&format!("{what} table {m}"), &decoded, &v.data, &tol);
         } else {
             check_float(&format!("{what} table {m}"), words, v, &coding, &tol);
+            let what = format!("{what} table {m}, redesign");
+            check_float(&what, &redesign.0[m], v, &coding, &tol);
         }
     }
 }
@@ -690,10 +708,11 @@ fn storage_rounding_matches_f64() {
                         out[2u * i + 1u] = round_unorm16(xs[i]);\n\
                     }\n\
                 }\n";
-    let wgsl = shadowgraph::kernels::resolve_source("test.storage_round", text).expect("resolve");
+    let wgsl = shadowgraph::low_level::kernels::resolve_source("test.storage_round", text)
+        .expect("resolve");
     let d = &g.device;
-    let kernel =
-        shadowgraph::exec::ComputeKernel::new(d, "storage_round", &wgsl).expect("harness compiles");
+    let kernel = shadowgraph::low_level::exec::ComputeKernel::new(d, "storage_round", &wgsl)
+        .expect("harness compiles");
     let input = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("test.storage_round.in"),
         contents: bytemuck::cast_slice(&xs),
@@ -727,7 +746,7 @@ fn storage_rounding_matches_f64() {
         pass.set_bind_group(0, &bg, &[]);
         pass.dispatch_workgroups(((xs.len() / 4) as u32).div_ceil(64), 1, 1);
     }
-    let raw = shadowgraph::gpu::submit_and_read(d, &g.queue, enc, &out, "storage_round")
+    let raw = shadowgraph::low_level::gpu::submit_and_read(d, &g.queue, enc, &out, "storage_round")
         .expect("readback");
     let got: &[f32] = bytemuck::cast_slice(&raw);
     let (mut f16_bad, mut unorm_bad) = (Vec::new(), Vec::new());

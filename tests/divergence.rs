@@ -24,7 +24,7 @@ fn value(level: u32, x: u32, y: u32) -> f32 {
 }
 
 /// Runs `body` per query (`q`: x = active/count, y, z = texel, w = level), `r` the result.
-fn run(g: &shadowgraph::gpu::Gpu, body: &str, sampler: bool, queries: &[[u32; 4]]) -> Vec<f32> {
+fn run(g: &shadowgraph::low_level::gpu::Gpu, body: &str, sampler: bool, queries: &[[u32; 4]]) -> Vec<f32> {
     let d = &g.device;
     let wgsl = format!(
         "@group(0) @binding(0) var map: texture_2d<f32>;\n\
@@ -40,7 +40,7 @@ fn run(g: &shadowgraph::gpu::Gpu, body: &str, sampler: bool, queries: &[[u32; 4]
             ""
         }
     );
-    let kernel = shadowgraph::exec::ComputeKernel::new(d, "divergence", &wgsl).expect("compile");
+    let kernel = shadowgraph::low_level::exec::ComputeKernel::new(d, "divergence", &wgsl).expect("compile");
     let t = d.create_texture(&wgpu::TextureDescriptor {
         label: None,
         size: wgpu::Extent3d {
@@ -58,7 +58,7 @@ fn run(g: &shadowgraph::gpu::Gpu, body: &str, sampler: bool, queries: &[[u32; 4]
     for level in 0..LEVELS {
         let n = SIZE >> level;
         let data: Vec<f32> = (0..n * n).map(|i| value(level, i % n, i / n)).collect();
-        shadowgraph::gpu::write_texture_level(&g.queue, &t, level, bytemuck::cast_slice(&data));
+        shadowgraph::low_level::gpu::write_texture_level(&g.queue, &t, level, bytemuck::cast_slice(&data));
     }
     let view = t.create_view(&Default::default());
     let qbuf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -106,7 +106,7 @@ fn run(g: &shadowgraph::gpu::Gpu, body: &str, sampler: bool, queries: &[[u32; 4]
         pass.dispatch_workgroups(queries.len() as u32 / 64, 1, 1);
     }
     let raw =
-        shadowgraph::gpu::submit_and_read(d, &g.queue, enc, &out, "divergence").expect("read");
+        shadowgraph::low_level::gpu::submit_and_read(d, &g.queue, enc, &out, "divergence").expect("read");
     bytemuck::cast_slice(&raw).to_vec()
 }
 

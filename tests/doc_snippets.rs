@@ -12,9 +12,9 @@ mod common;
 use std::path::Path;
 
 use glam::{Mat4, Vec3};
-use shadowgraph::gpu::{Gpu, submit_and_wait};
-use shadowgraph::prefilter::cascades::CascadeCamera;
-use shadowgraph::prefilter::{DepthLayer, PrefilterOutput};
+use shadowgraph::cascades::CascadeCamera;
+use shadowgraph::low_level::gpu::{Gpu, submit_and_wait};
+use shadowgraph::{DepthLayer, PrefilterOutput};
 
 /// The markdown files whose ```` ```rust ```` blocks are usage snippets (EVALUATION.md's is a
 /// list of signatures).
@@ -83,7 +83,7 @@ fn view() -> Mat4 {
 /// README.md's plug-in stage: the stage, its WGSL in the host's shader, one frame recorded.
 #[rustfmt::skip]
 fn readme_stage(g: &Gpu) -> anyhow::Result<(String, PrefilterOutput, Vec<u8>)> {
-use shadowgraph::prefilter::{LightParams, Prefilter, PrefilterConfig};
+use shadowgraph::{LightParams, Prefilter, PrefilterConfig};
 let (device, view) = (g.device.clone(), view());
 let shadow = depth_texture(g, (1024, 1024), 1, 0.5);
 let mut encoder = device.create_command_encoder(&Default::default());
@@ -99,7 +99,7 @@ Ok((shader, out, light))
 /// in cascades (and in soft cascades).
 #[rustfmt::skip]
 fn readme_comments(g: &Gpu) -> anyhow::Result<(Vec<PrefilterOutput>, String, usize, usize)> {
-use shadowgraph::prefilter::{LightParams, Prefilter, PrefilterConfig};
+use shadowgraph::{LightParams, Prefilter, PrefilterConfig};
 let (device, n, first_binding) = (g.device.clone(), 128, 2);
 let shadow_array = depth_texture(g, (n, n), 2, 0.5);
 let mut stage = Prefilter::new(&device, &PrefilterConfig::vsm(n))?;
@@ -131,7 +131,9 @@ Ok((outs, block, faces, cascades.min(soft.len())))
 /// docs/PLUGIN.md's library API: a scene loaded, planned and rendered.
 #[rustfmt::skip]
 fn plugin_library() -> anyhow::Result<(usize, usize)> {
-use shadowgraph::{gpu::Gpu, render::{Renderer, RenderOptions, plan_lights}, scene::Scene};
+use shadowgraph::low_level::gpu::Gpu;
+use shadowgraph::low_level::render::{RenderOptions, Renderer, plan_lights};
+use shadowgraph::low_level::scene::Scene;
 let gpu = Gpu::new()?;
 let scene = Scene::load("scenes/bunny.toml")?;
 let plan = plan_lights(&scene.lights)?;
@@ -144,8 +146,7 @@ Ok((plan.plan.steps.len(), frame.rgba.len() / 4))
 /// docs/PLUGIN.md's plug-in stage: configured, laid out, its WGSL, one frame recorded.
 #[rustfmt::skip]
 fn plugin_stage(g: &Gpu) -> anyhow::Result<(String, PrefilterOutput, usize)> {
-use shadowgraph::prefilter::{LightParams, Prefilter, PrefilterConfig};
-use shadowgraph::scene::Storage;
+use shadowgraph::{LightParams, Prefilter, PrefilterConfig, Storage};
 let (device, view) = (g.device.clone(), view());
 let shadow = depth_texture(g, (1024, 1024), 1, 0.5);
 let mut encoder = device.create_command_encoder(&Default::default());
@@ -166,9 +167,9 @@ Ok((shader, out, stage.warnings().len() + f16.warnings().len()))
 /// adapter's limits, timing where the device has timestamps.
 #[rustfmt::skip]
 fn plugin_device(g: &Gpu) -> anyhow::Result<(wgpu::Features, bool)> {
-use shadowgraph::prefilter::{Prefilter, PrefilterConfig};
+use shadowgraph::{Prefilter, PrefilterConfig};
 let adapter = &g.adapter;
-let wanted = shadowgraph::timer::TIMER_FEATURES
+let wanted = shadowgraph::TIMER_FEATURES
     | wgpu::Features::FLOAT32_FILTERABLE
     | wgpu::Features::TEXTURE_FORMAT_16BIT_NORM;
 let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
@@ -177,7 +178,7 @@ let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDes
     ..Default::default()
 }))?;
 let mut stage = Prefilter::new(&device, &PrefilterConfig::vsm(1024))?;
-if device.features().contains(shadowgraph::timer::TIMER_FEATURES) {
+if device.features().contains(shadowgraph::TIMER_FEATURES) {
     stage.enable_timing(&device, &queue)?;
 }
 Ok((device.features(), stage.timings(&device)?.is_empty()))
@@ -282,7 +283,7 @@ fn every_snippet_line_is_compiled_here() {
 fn the_snippets_run() {
     let g = common::gpu();
     let (shader, out, light) = readme_stage(&g).expect("README stage");
-    shadowgraph::kernels::reflect("readme host", &shader).expect("README host shader validates");
+    shadowgraph::low_level::kernels::reflect("readme host", &shader).expect("README host shader validates");
     assert_eq!(out.maps[0].texture.width(), 1024);
     assert_eq!(light.len(), std::mem::size_of_val(&out.light));
 
@@ -293,12 +294,12 @@ fn the_snippets_run() {
     assert_eq!((faces, cascades), (6, 4));
 
     let (shader, out, _) = plugin_stage(&g).expect("PLUGIN stage");
-    shadowgraph::kernels::reflect("plugin host", &shader).expect("PLUGIN host shader validates");
+    shadowgraph::low_level::kernels::reflect("plugin host", &shader).expect("PLUGIN host shader validates");
     assert_eq!(out.maps[0].texture.width(), 1024);
 
     let (features, _) = plugin_device(&g).expect("PLUGIN device");
-    let offered = g.adapter.features() & shadowgraph::timer::TIMER_FEATURES;
-    assert_eq!(features & shadowgraph::timer::TIMER_FEATURES, offered);
+    let offered = g.adapter.features() & shadowgraph::TIMER_FEATURES;
+    assert_eq!(features & shadowgraph::TIMER_FEATURES, offered);
 
     let (nodes, pixels) = plugin_library().expect("PLUGIN library");
     assert!(nodes > 0 && pixels > 0, "{nodes} nodes, {pixels} pixels");

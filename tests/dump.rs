@@ -6,10 +6,12 @@ mod common;
 use std::collections::{BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 
-use shadowgraph::dump::{self, ChannelStats, channel_names, channel_stats, variance_view};
-use shadowgraph::gpu::float_channels;
-use shadowgraph::render::plan_lights;
-use shadowgraph::scene::Scene;
+use shadowgraph::low_level::dump::{
+    self, ChannelStats, channel_names, channel_stats, variance_view,
+};
+use shadowgraph::low_level::gpu::float_channels;
+use shadowgraph::low_level::render::plan_lights;
+use shadowgraph::low_level::scene::Scene;
 
 fn scene(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -9,13 +9,14 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use rand::Rng;
-use shadowgraph::evaluate::{
+use shadowgraph::low_level::evaluate::{
     Config, ErrorStats, EvaluateOptions, FILTERS, Metric, Report, evaluate, front, scene_for,
     untrusted_times, wall_check,
 };
-use shadowgraph::render::{RenderOptions, Renderer};
-use shadowgraph::scene::{Filter, PcfKernel, Scene, Technique};
-use shadowgraph::truth::{Emitter, TruthOptions, area_light_truth};
+use shadowgraph::low_level::render::{RenderOptions, Renderer};
+use shadowgraph::low_level::scene::Scene;
+use shadowgraph::low_level::truth::{Emitter, TruthOptions, area_light_truth};
+use shadowgraph::{Filter, PcfKernel, Technique};
 
 fn scene_path(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -171,7 +172,7 @@ fn quick_sweep_writes_every_file_consistently() {
         report.rows.iter().map(|r| r.technique.as_str()).collect();
     let fills: std::collections::BTreeSet<String> = techniques
         .iter()
-        .map(|t| format!("{:?}", shadowgraph::evaluate::colour_of(t)))
+        .map(|t| format!("{:?}", shadowgraph::low_level::evaluate::colour_of(t)))
         .collect();
     assert_eq!(fills.len(), techniques.len(), "techniques share a colour");
     for m in Metric::ALL {
@@ -311,7 +312,7 @@ fn quick_sweep_writes_every_file_consistently() {
 /// 10% of PCSS's best at half its time; with every prefiltered row at 0.2, none comes within
 /// 10% and the closest is named with its 4× error.
 fn verdict_of_known_rows(report: &Report) {
-    use shadowgraph::evaluate::verdict::verdicts;
+    use shadowgraph::low_level::evaluate::verdict::verdicts;
     let mut r = report.clone();
     r.budget_ms = Some(6.0);
     let set = |r: &mut Report, label: &str, e: f64, t: f64| {
@@ -363,7 +364,7 @@ fn verdict_of_known_rows(report: &Report) {
 /// †); the report says how many were measured again and what spread remains, and the CSV
 /// carries the retries and the flag.
 fn clock_drop_is_flagged_in_the_report(report: &Report) {
-    use shadowgraph::evaluate::protocol::{Protocol, Sample, run};
+    use shadowgraph::low_level::evaluate::protocol::{Protocol, Sample, run};
     let n = report.rows.len();
     let mut seen = vec![0u32; n];
     let timed = run(&Protocol::new(3), n, "gbuffer", |c| {
@@ -382,14 +383,14 @@ fn clock_drop_is_flagged_in_the_report(report: &Report) {
     })
     .expect("protocol");
     let mut r = report.clone();
-    shadowgraph::evaluate::apply_times(&mut r, &timed);
+    shadowgraph::low_level::evaluate::apply_times(&mut r, &timed);
     assert_eq!((r.rows[0].retries, r.rows[0].clock_off), (2, true));
     assert_eq!((r.rows[1].retries, r.rows[1].clock_off), (1, false));
     assert!((r.rows[1].total_ms.unwrap() - 2.5).abs() < 1e-12);
     assert!((r.rows[0].total_ms.unwrap() - 3.0).abs() < 1e-12);
     assert!(r.rows[2..].iter().all(|x| x.retries == 0 && !x.clock_off));
-    let md = shadowgraph::evaluate::markdown(&r);
-    let text = shadowgraph::evaluate::protocol_text(&r);
+    let md = shadowgraph::low_level::evaluate::markdown(&r);
+    let text = shadowgraph::low_level::evaluate::protocol_text(&r);
     assert!(md.contains(&text));
     assert!(
         text.contains(&format!("2 of {n} configurations"))
@@ -398,7 +399,7 @@ fn clock_drop_is_flagged_in_the_report(report: &Report) {
         "{text}"
     );
     assert!(md.contains(&format!("| {} |", r.rows[0].label)) && md.contains(" † |"));
-    let csv = shadowgraph::evaluate::csv(&r);
+    let csv = shadowgraph::low_level::evaluate::csv(&r);
     let row0 = csv.lines().nth(1).expect("a row");
     assert!(row0.contains(",2,true,"), "{row0}");
 }
@@ -426,7 +427,7 @@ fn errors_are_plausible_and_recomputable() {
     scene.lights[0].size = 0.0;
     let wide = FILTERS[0].1(17.0);
     assert!(matches!(wide, Filter::Blur { .. }));
-    let vsm = match shadowgraph::prefilter::PrefilterConfig::vsm(1024)
+    let vsm = match shadowgraph::PrefilterConfig::vsm(1024)
         .with_filter(wide)
         .validated()
     {
@@ -559,7 +560,7 @@ fn region_and_flip_errors_match_direct_computation() {
     };
     let scene: Scene = scene_for(&scene_path("sphere_on_plane.toml"), &opts).expect("scene");
     assert_eq!(scene.lights.len(), 1, "the images hold light 0 only");
-    let vsm = match shadowgraph::prefilter::PrefilterConfig::vsm(512)
+    let vsm = match shadowgraph::PrefilterConfig::vsm(512)
         .with_filter(FILTERS[0].1(5.0))
         .validated()
     {
@@ -763,7 +764,7 @@ fn bad_input_is_a_clear_error() {
 /// (`cargo test --release --test evaluate soft -- --nocapture`).
 #[test]
 fn soft_techniques_approach_the_area_light_truth() {
-    use shadowgraph::prefilter::PrefilterConfig;
+    use shadowgraph::PrefilterConfig;
     let g = common::gpu();
     let opts = EvaluateOptions {
         image: Some((160, 120)),
@@ -868,7 +869,7 @@ fn memory_counts_every_cascade_and_a_point_lights_atlas() {
     let mut street: Scene = scene_for(&scene_path("city_street.toml"), &opts).expect("scene");
     assert_eq!(street.lights[0].shadow.cascades.count, 4);
     let four = memory(&street, 256);
-    street.lights[0].shadow.cascades = shadowgraph::model::Cascades::SINGLE;
+    street.lights[0].shadow.cascades = shadowgraph::Cascades::SINGLE;
     let one = memory(&street, 256);
     // Each cascade: a Depth32Float map and its R32Float linear map, 4 bytes a texel each.
     let per_cascade = 2 * 256 * 256 * 4;

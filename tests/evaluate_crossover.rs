@@ -7,8 +7,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use shadowgraph::evaluate::crossover::{Crossing, Match, RANGE_MPX};
-use shadowgraph::evaluate::{Metric, Report, front};
+use shadowgraph::low_level::evaluate::crossover::{Crossing, Match, RANGE_MPX};
+use shadowgraph::low_level::evaluate::{Metric, Report, front};
 
 fn scene_path(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -202,7 +202,7 @@ fn quick_evaluation_writes_the_crossover() {
     for p in &c.pairs {
         let (t, q) = (&c.costs[p.config], &c.costs[p.pcss]);
         for (moving, got) in [(true, p.moving), (false, p.still)] {
-            let pre = |k: &shadowgraph::evaluate::crossover::Cost| {
+            let pre = |k: &shadowgraph::low_level::evaluate::crossover::Cost| {
                 if moving { k.prefilter_ms } else { 0.0 }
             };
             let da = t.shade.a + pre(t) - q.shade.a - pre(q);

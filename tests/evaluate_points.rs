@@ -6,9 +6,9 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use shadowgraph::evaluate::{Config, EvaluateOptions, Metric, evaluate, scene_for};
-use shadowgraph::render::Renderer;
-use shadowgraph::truth::{Emitter, TruthOptions};
+use shadowgraph::low_level::evaluate::{Config, EvaluateOptions, Metric, evaluate, scene_for};
+use shadowgraph::low_level::render::Renderer;
+use shadowgraph::low_level::truth::{Emitter, TruthOptions};
 
 fn scene_path(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -22,7 +22,7 @@ fn scene_path(name: &str) -> PathBuf {
 /// are the same still frame's in both runs (equal exactly), and the report names the rate.
 #[test]
 fn a_static_light_is_timed_without_its_map() {
-    use shadowgraph::scene::UpdateRate;
+    use shadowgraph::low_level::scene::UpdateRate;
     let g = common::gpu();
     let run = |update| {
         let opts = EvaluateOptions {
@@ -37,7 +37,7 @@ fn a_static_light_is_timed_without_its_map() {
             ..Default::default()
         };
         let scene = scene_for(&scene_path("sphere_on_plane.toml"), &opts).expect("scene");
-        let configs = shadowgraph::evaluate::sweep(&scene, &opts).expect("sweep");
+        let configs = shadowgraph::low_level::evaluate::sweep(&scene, &opts).expect("sweep");
         evaluate(&g, &scene, &configs, &opts).expect("evaluate").0
     };
     let moving = run(UpdateRate::EveryFrame);
@@ -61,7 +61,7 @@ fn a_static_light_is_timed_without_its_map() {
         );
         assert_eq!(s.total_ms, s.shade_ms, "{}", s.label);
     }
-    let md = shadowgraph::evaluate::markdown(&still);
+    let md = shadowgraph::low_level::evaluate::markdown(&still);
     assert!(
         md.contains("static lights: maps drawn once and kept"),
         "{md}"
@@ -75,7 +75,7 @@ fn a_static_light_is_timed_without_its_map() {
 /// its plot.
 #[test]
 fn an_animated_scene_has_a_temporal_error() {
-    use shadowgraph::evaluate::temporal;
+    use shadowgraph::low_level::evaluate::temporal;
     let g = common::gpu();
     let opts = EvaluateOptions {
         image: Some((80, 60)),
@@ -88,7 +88,7 @@ fn an_animated_scene_has_a_temporal_error() {
     };
     let scene = scene_for(&scene_path("colonnade_sun.toml"), &opts).expect("scene");
     assert!(scene.frames() > 2);
-    let configs: Vec<Config> = shadowgraph::evaluate::sweep(&scene, &opts)
+    let configs: Vec<Config> = shadowgraph::low_level::evaluate::sweep(&scene, &opts)
         .expect("sweep")
         .into_iter()
         .filter(|c| c.label == "hard 512" || c.label == "vsm f32 blur5 512")
@@ -125,9 +125,9 @@ fn an_animated_scene_has_a_temporal_error() {
     }
     let t = |i: usize| report.rows[i].temporal.unwrap().mean_abs;
     assert!(t(0) > t(1), "hard {} vs vsm {}", t(0), t(1));
-    let md = shadowgraph::evaluate::markdown(&report);
+    let md = shadowgraph::low_level::evaluate::markdown(&report);
     assert!(md.contains("front of total time vs temporal mean"), "{md}");
     assert_eq!(Metric::of(&report).last(), Some(&Metric::Temporal));
-    let svg = shadowgraph::evaluate::pareto(&report, Metric::Temporal).expect("plot");
+    let svg = shadowgraph::low_level::evaluate::pareto(&report, Metric::Temporal).expect("plot");
     assert_eq!(svg.matches("<g class=\"pt\">").count(), 2);
 }

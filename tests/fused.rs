@@ -12,12 +12,13 @@ mod common;
 use std::collections::HashMap;
 
 use rand::Rng;
-use shadowgraph::cpu::{self, Texels};
-use shadowgraph::exec::{Executor, KernelLayout};
-use shadowgraph::gpu::{read_resource_texture, submit_and_wait, write_texture};
-use shadowgraph::graph::{Graph, plan, texel_bytes};
-use shadowgraph::scene::{Light, Scene};
-use shadowgraph::technique;
+use shadowgraph::Light;
+use shadowgraph::low_level::cpu::{self, Texels};
+use shadowgraph::low_level::exec::{Executor, KernelLayout};
+use shadowgraph::low_level::gpu::{read_resource_texture, submit_and_wait, write_texture};
+use shadowgraph::low_level::graph::{Graph, plan, texel_bytes};
+use shadowgraph::low_level::scene::Scene;
+use shadowgraph::low_level::technique;
 
 /// Not a multiple of the 16 × 16 tiles, and wider than one 256-texel row workgroup, so every
 /// kind of edge of the fused blurs' workgroups is crossed.
@@ -311,7 +312,7 @@ impl BlurCase {
 
 /// VSM and EVSM2 in f32 and f16 (packed two to an r32uint word), EVSM4 and MSM in f32.
 fn blur_cases() -> [BlurCase; 6] {
-    use shadowgraph::scene::BlurKernel;
+    use shadowgraph::BlurKernel;
     let vsm = BlurCase {
         shadow: "technique = \"vsm\"\nformat = \"f32\"",
         encoded: "light0.vsm",
@@ -470,7 +471,7 @@ fn row_kernels_span_row_workgroups() {
 /// kernel's tile node. No GPU: the values the executor would compile the node with.
 #[test]
 fn strip_windows_follow_each_nodes_radius() {
-    let mut cache = shadowgraph::exec::KernelCache::default();
+    let mut cache = shadowgraph::low_level::exec::KernelCache::default();
     for (shadow, map) in [
         ("technique = \"vsm\"\nformat = \"f32\"", "light0.vsm.blur"),
         (

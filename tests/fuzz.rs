@@ -49,8 +49,8 @@ fn three_thousand_mutated_scenes() {
 /// A list written by hand that drifts from the registry fails here.
 #[test]
 fn the_fuzzer_knows_every_key_and_technique() {
-    use shadowgraph::model::ParamKind;
-    use shadowgraph::technique::{REGISTRY, params};
+    use shadowgraph::low_level::model::ParamKind;
+    use shadowgraph::low_level::technique::{REGISTRY, params};
     let keys = fuzz_support::mutate::keys();
     let words = fuzz_support::mutate::words();
     let shadow = &keys

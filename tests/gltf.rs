@@ -11,8 +11,8 @@ use std::path::{Path, PathBuf};
 use base64::Engine;
 use glam::Vec3;
 use serde_json::{Value, json};
-use shadowgraph::scene::Scene;
-use shadowgraph::scene::gltf::load_gltf;
+use shadowgraph::low_level::scene::Scene;
+use shadowgraph::low_level::scene::gltf::load_gltf;
 
 /// A folder of its own per test.
 fn dir(tag: &str) -> PathBuf {

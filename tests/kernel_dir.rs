@@ -8,8 +8,8 @@ use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use shadowgraph::exec::KERNEL_LAYOUT_ENV;
-use shadowgraph::kernels::{self, KERNEL_DIR_ENV};
+use shadowgraph::low_level::exec::KERNEL_LAYOUT_ENV;
+use shadowgraph::low_level::kernels::{self, KERNEL_DIR_ENV};
 
 fn temp_dir(tag: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("shadowgraph-kdir-{tag}-{}", std::process::id()));

@@ -3,12 +3,12 @@
 
 use std::collections::BTreeSet;
 
-use shadowgraph::kernels::{self, KernelId, SOURCES, struct_size};
-use shadowgraph::sat::SatVariant;
-use shadowgraph::scene::{
-    BlurKernel, Filter, Light, LightKind, PcfKernel, Prefilter, Shadow, Soft, Storage, Technique,
+use shadowgraph::low_level::kernels::{self, KernelId, SOURCES, struct_size};
+use shadowgraph::low_level::technique::{LinearizeParams, shading_block};
+use shadowgraph::{
+    BlurKernel, Filter, Light, LightGpu, LightKind, PcfKernel, SatVariant, Shadow, Soft, Storage,
+    StorageFilter, Technique,
 };
-use shadowgraph::technique::{LightGpu, LinearizeParams, shading_block};
 
 fn light(technique: Technique) -> Light {
     Light {
@@ -26,7 +26,7 @@ fn light(technique: Technique) -> Light {
             slope_bias: 1.0,
             normal_bias: 1.0,
             receiver_plane: 0.0,
-            cascades: shadowgraph::model::Cascades::SINGLE,
+            cascades: shadowgraph::Cascades::SINGLE,
         },
     }
 }
@@ -52,7 +52,7 @@ fn all_techniques() -> Vec<Technique> {
             max_search: 0.1,
         },
         Technique::Vsm {
-            prefilter: Prefilter {
+            prefilter: StorageFilter {
                 storage: Storage::F16,
                 filter: Filter::Blur {
                     radius: 2.0,
@@ -64,7 +64,7 @@ fn all_techniques() -> Vec<Technique> {
             min_variance: 1e-5,
         },
         Technique::Evsm {
-            prefilter: Prefilter {
+            prefilter: StorageFilter {
                 storage: Storage::F32,
                 filter: Filter::None,
             },
@@ -82,7 +82,7 @@ fn all_techniques() -> Vec<Technique> {
             exponent: 80.0,
         },
         Technique::Msm {
-            prefilter: Prefilter {
+            prefilter: StorageFilter {
                 storage: Storage::Unorm16,
                 filter: Filter::Mips {
                     width: 2.0,
@@ -94,7 +94,7 @@ fn all_techniques() -> Vec<Technique> {
             bleed: 0.0,
         },
         Technique::Csm {
-            prefilter: Prefilter {
+            prefilter: StorageFilter {
                 storage: Storage::F16,
                 filter: Filter::None,
             },
@@ -111,8 +111,8 @@ fn all_techniques() -> Vec<Technique> {
             scale: 2.0,
             sharpen: 2.0,
             sharpen_falloff: 50.0,
-            search: shadowgraph::scene::CssmSearch::Moments,
-            resolve: shadowgraph::scene::CssmResolve::TwoDepthSearch,
+            search: shadowgraph::CssmSearch::Moments,
+            resolve: shadowgraph::CssmResolve::TwoDepthSearch,
         },
         Technique::Cssm {
             soft: soft(Storage::F16, SatVariant::Float),
@@ -122,8 +122,8 @@ fn all_techniques() -> Vec<Technique> {
             scale: 2.0,
             sharpen: 0.0,
             sharpen_falloff: 0.0,
-            search: shadowgraph::scene::CssmSearch::CsmZ,
-            resolve: shadowgraph::scene::CssmResolve::Sharpen,
+            search: shadowgraph::CssmSearch::CsmZ,
+            resolve: shadowgraph::CssmResolve::Sharpen,
         },
         Technique::Vssm {
             soft: soft(Storage::F32, SatVariant::Fixed),
@@ -371,11 +371,11 @@ fn rust_mirrors_match_naga_layouts() {
     );
     assert_eq!(
         struct_size(&m, "Frame"),
-        Some(size_of::<shadowgraph::render::FrameGpu>() as u32),
+        Some(size_of::<shadowgraph::low_level::render::FrameGpu>() as u32),
         "FrameGpu vs struct Frame"
     );
-    use shadowgraph::filter::BlurParams;
-    use shadowgraph::technique::{
+    use shadowgraph::low_level::filter::BlurParams;
+    use shadowgraph::low_level::technique::{
         CsmParams, CsmSatParams, ExpParams, MsmParams, SecondDepthParams, VsmParams,
     };
     for (kernel, rust) in [
@@ -529,7 +529,7 @@ fn storage_format_variants_validate() {
 /// tables' tile passes, each re-declared and rewritten as the executor does.
 #[test]
 fn packed_f16_variants_validate() {
-    let packed = shadowgraph::graph::texture_format(shadowgraph::graph::PACKED_F16X2);
+    let packed = shadowgraph::low_level::graph::texture_format(shadowgraph::PACKED_F16X2);
     let mut failures = Vec::new();
     let mut rewritten = 0;
     for kernel in [
@@ -557,7 +557,7 @@ fn packed_f16_variants_validate() {
         if kernel.starts_with("sat") {
             bound.retain(|(b, _)| b == "src");
         }
-        match shadowgraph::exec::specialized_source(kernel, &bound) {
+        match shadowgraph::low_level::exec::specialized_source(kernel, &bound) {
             Ok(wgsl) => {
                 rewritten += usize::from(wgsl.contains("pack_f16x2("));
                 if let Err(e) = kernels::reflect(kernel, &wgsl) {
@@ -592,7 +592,7 @@ fn compute_kernels_fit_webgpu_default_limits() {
             continue;
         }
         checked += 1;
-        let needs = shadowgraph::limits::kernel_needs(&module, &refl, &defaults).expect("needs");
+        let needs = shadowgraph::low_level::limits::kernel_needs(&module, &refl, &defaults).expect("needs");
         for n in needs.iter().filter(|n| n.over()) {
             let known = matches!(id.name(), "mips" | "mips_log")
                 && matches!(
@@ -633,7 +633,7 @@ fn wgsl_const(module: &naga::Module, name: &str) -> Option<u32> {
 /// column invocation of `blur` writes `BLUR_COL_PER` rows, one of `blur_log` `PER`.
 #[test]
 fn blur_dispatch_constants_match_the_wgsl() {
-    use shadowgraph::filter::{BLUR_COL_PER, BLUR_GROUP, BLUR_PER_INVOCATION};
+    use shadowgraph::low_level::filter::{BLUR_COL_PER, BLUR_GROUP, BLUR_PER_INVOCATION};
     for (kernel, col_per) in [
         ("blur", BLUR_COL_PER),
         ("blur_log", BLUR_PER_INVOCATION),
@@ -674,7 +674,7 @@ fn peel_epsilon_matches_the_wgsl() {
         naga::Expression::Literal(naga::Literal::F32(v)) => v,
         ref e => panic!("PEEL_EPSILON is {e:?}, not an f32 literal"),
     };
-    assert_eq!(value, shadowgraph::technique::PEEL_EPSILON);
+    assert_eq!(value, shadowgraph::low_level::technique::PEEL_EPSILON);
 }
 
 /// `blur_log`'s span, past which only `blur_log_wide` is exact, is the planner's
@@ -695,7 +695,7 @@ fn log_blur_span_matches_the_wgsl() {
         };
         assert!(
             matches!(literal("SPAN"), naga::Expression::Literal(naga::Literal::F32(v))
-                if v == shadowgraph::filter::LOG_BLUR_SPAN),
+                if v == shadowgraph::low_level::filter::LOG_BLUR_SPAN),
             "{kernel}: SPAN"
         );
         assert!(
@@ -703,18 +703,18 @@ fn log_blur_span_matches_the_wgsl() {
             "{kernel}: WIDE"
         );
     }
-    use shadowgraph::filter::BlurMode;
+    use shadowgraph::low_level::filter::BlurMode;
     assert_eq!(BlurMode::log_sum_exp(80.0), BlurMode::LogSumExp);
     assert_eq!(BlurMode::log_sum_exp(80.5), BlurMode::LogSumExpWide);
 }
 
 #[test]
 fn encode_blur_dispatch_constants_match_the_wgsl() {
-    use shadowgraph::filter::{
+    use shadowgraph::low_level::filter::{
         ENCODE_BLUR_TILE_RADIUS, encode_blur_cpu_rows, encode_blur_row, encode_blur_row_kernel,
         encode_blur_tile,
     };
-    use shadowgraph::kernels::KernelId;
+    use shadowgraph::low_level::kernels::KernelId;
     // The row kernels where their rows are full, else the tile kernels' shorter rows.
     for (kernel, width, row) in [
         (KernelId::VsmBlur, 1023, KernelId::VsmBlur),

@@ -16,14 +16,14 @@ const LAYERS: &[(&str, u32)] = &[
     ("model", 1),
     ("msm_quantize", 1),
     // 2: the GPU mirrors of WGSL structs.
-    ("gpu_data", 2),
+    ("wgsl_mirrors", 2),
     // 3: kernels, the graph, the device, the executor and the kernel-level building blocks;
-    // the CPU references beside them (they read `model` and `gpu_data`, never `technique`).
+    // the CPU references beside them (they read `model` and `wgsl_mirrors`, never `technique`).
     ("kernels", 3),
     ("graph", 3),
     ("gpu", 3),
     ("timer", 3),
-    ("created", 3),
+    ("gpu_objects", 3),
     ("exec", 3),
     ("filter", 3),
     ("sat", 3),
@@ -47,6 +47,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("cli", 5),
     ("main", 5),
     ("lib", 5),
+    ("low_level", 5),
 ];
 
 /// Edges that climb today, each in a file another branch owns, with the change that removes
@@ -261,10 +262,10 @@ fn no_module_imports_from_a_higher_layer() {
 #[test]
 fn the_path_reader_sees_groups_and_skips_comments() {
     let code = code_only(
-        "use crate::{model::Light, technique::{self, x}};\n// crate::render\nlet s = \"crate::dump\";\nfoo::crate::bar; crate::gpu_data::LightGpu",
+        "use crate::{model::Light, technique::{self, x}};\n// crate::render\nlet s = \"crate::dump\";\nfoo::crate::bar; crate::wgsl_mirrors::LightGpu",
     );
     let paths: Vec<String> = crate_paths(&code).iter().map(|p| p.join("::")).collect();
-    assert_eq!(paths, ["model::Light", "technique", "gpu_data::LightGpu"]);
+    assert_eq!(paths, ["model::Light", "technique", "wgsl_mirrors::LightGpu"]);
     assert_eq!(layer_of("limits/scene.rs"), 5);
     assert_eq!(layer_of("limits.rs"), 3);
     assert_eq!(layer_of("scene/validate.rs"), 5);

@@ -7,8 +7,8 @@ mod common;
 use std::path::Path;
 
 use shadowgraph::Error;
-use shadowgraph::render::{RenderOptions, Renderer, plan_lights};
-use shadowgraph::scene::Scene;
+use shadowgraph::low_level::render::{RenderOptions, Renderer, plan_lights};
+use shadowgraph::low_level::scene::Scene;
 
 const HEADER: &str = "[output]\nwidth = WIDTH\nheight = HEIGHT\n\n[camera]\n\
 position = [0.0, 3.0, 6.0]\ntarget = [0.0, 0.0, 0.0]\nfov_y_degrees = 45.0\n";
@@ -48,7 +48,7 @@ fn nth_line(text: &str, prefix: &str, n: usize) -> usize {
 /// `limits.toml:<line>:` and holding every needle; returns the message.
 #[track_caller]
 fn refused(
-    g: &shadowgraph::gpu::Gpu,
+    g: &shadowgraph::low_level::gpu::Gpu,
     s: &Scene,
     opts: RenderOptions,
     line: usize,
@@ -72,15 +72,15 @@ fn refused(
         (0, 0),
         "pipelines or textures were created before the refusal: {shown}"
     );
-    shadowgraph::gpu::take_uncaptured(&g.device).expect("no uncaptured wgpu error");
+    shadowgraph::low_level::gpu::take_uncaptured(&g.device).expect("no uncaptured wgpu error");
 }
 
 /// A device with WebGPU's default sampled-texture and storage-binding limits (16 and
 /// 128 MiB), whatever the adapter offers: a datacenter GPU allows 524288 sampled textures
 /// and 2 GiB bindings, so the refusals below would need scenes no test can build.
-fn webgpu_limits() -> shadowgraph::gpu::Gpu {
+fn webgpu_limits() -> shadowgraph::low_level::gpu::Gpu {
     let webgpu = wgpu::Limits::default();
-    shadowgraph::gpu::Gpu::with_limits(|l| {
+    shadowgraph::low_level::gpu::Gpu::with_limits(|l| {
         l.max_sampled_textures_per_shader_stage = webgpu.max_sampled_textures_per_shader_stage;
         l.max_storage_buffer_binding_size = webgpu.max_storage_buffer_binding_size;
     })
@@ -151,10 +151,10 @@ fn large_outputs_exceed_the_storage_buffer_binding() {
 #[test]
 fn large_maps_exceed_the_memory_budget() {
     let g = common::gpu();
-    if std::env::var_os(shadowgraph::limits::MEMORY_BUDGET_ENV).is_some() {
+    if std::env::var_os(shadowgraph::low_level::limits::MEMORY_BUDGET_ENV).is_some() {
         panic!(
             "unset {} to run this test",
-            shadowgraph::limits::MEMORY_BUDGET_ENV
+            shadowgraph::low_level::limits::MEMORY_BUDGET_ENV
         );
     }
     let max = g.device.limits().max_texture_dimension_2d.min(16384);
@@ -192,10 +192,10 @@ fn large_maps_exceed_the_memory_budget() {
 #[test]
 fn cascades_past_the_memory_budget_name_their_light() {
     let g = common::gpu();
-    if std::env::var_os(shadowgraph::limits::MEMORY_BUDGET_ENV).is_some() {
+    if std::env::var_os(shadowgraph::low_level::limits::MEMORY_BUDGET_ENV).is_some() {
         panic!(
             "unset {} to run this test",
-            shadowgraph::limits::MEMORY_BUDGET_ENV
+            shadowgraph::low_level::limits::MEMORY_BUDGET_ENV
         );
     }
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/city_street.toml");
@@ -227,7 +227,7 @@ fn cascades_past_the_memory_budget_name_their_light() {
 fn memory_estimate_is_the_sum_of_its_parts() {
     let (_, s) = scene(64, 48, &[light(512, "technique = \"pcf\"")]);
     let sp = plan_lights(&s.lights).unwrap();
-    let m = shadowgraph::limits::render_memory(&s, &sp.plan, &RenderOptions::default());
+    let m = shadowgraph::low_level::limits::render_memory(&s, &sp.plan, &RenderOptions::default());
     let vertices: u64 = s.objects.iter().map(|o| o.mesh.indices.len() as u64).sum();
     let pixels = 64 * 48;
     let frame = pixels * (16 + 16 + 4 + 4 + 4) + 28 * vertices + 2 * pixels * (4 + 4);
@@ -252,7 +252,7 @@ fn a_point_lights_atlas_is_checked_whole() {
         max_texture_dimension_2d: 2048,
         ..wgpu::Limits::default()
     };
-    let shown = shadowgraph::limits::check_scene(
+    let shown = shadowgraph::low_level::limits::check_scene(
         &s,
         &sp,
         &limits,
@@ -271,7 +271,7 @@ fn a_point_lights_atlas_is_checked_whole() {
             && shown.contains("max_texture_dimension_2d"),
         "{shown}"
     );
-    let m = shadowgraph::limits::render_memory(&s, &sp.plan, &RenderOptions::default());
+    let m = shadowgraph::low_level::limits::render_memory(&s, &sp.plan, &RenderOptions::default());
     // The atlas's depth and its linear map (PCF reads the linear depth).
     assert_eq!(m.lights, vec![2 * 3072 * 2048 * 4]);
 }
@@ -291,7 +291,7 @@ fn interleaved_tables_past_the_largest_side_name_the_map_size() {
             max_texture_dimension_2d: max,
             ..wgpu::Limits::default()
         };
-        shadowgraph::limits::check_scene(
+        shadowgraph::low_level::limits::check_scene(
             &s,
             &sp,
             &limits,
@@ -326,7 +326,7 @@ fn memory_estimate_counts_the_second_depth() {
             &[light(512, &format!("technique = \"{technique}\""))],
         );
         let sp = plan_lights(&s.lights).unwrap();
-        let m = shadowgraph::limits::render_memory(&s, &sp.plan, &RenderOptions::default());
+        let m = shadowgraph::low_level::limits::render_memory(&s, &sp.plan, &RenderOptions::default());
         assert_eq!(m.lights, vec![3 * 512 * 512 * 4], "{technique}");
     }
 }
@@ -346,7 +346,7 @@ fn lowered_limits_and_budgets_name_the_key() {
     let sp = plan_lights(&s.lights).unwrap();
     let full = wgpu::Limits::default();
     let check = |l: &wgpu::Limits, f: wgpu::Features, budget: u64| {
-        shadowgraph::limits::check_scene(&s, &sp, l, f, &RenderOptions::default(), budget, &[])
+        shadowgraph::low_level::limits::check_scene(&s, &sp, l, f, &RenderOptions::default(), budget, &[])
             .map_err(|e| e.to_string())
     };
     check(&full, wgpu::Features::empty(), 1 << 30).expect("fits");
@@ -385,7 +385,7 @@ fn lowered_limits_and_budgets_name_the_key() {
         &[light(256, "technique = \"msm\"\nformat = \"unorm16\"")],
     );
     let sp = plan_lights(&s.lights).unwrap();
-    let shown = shadowgraph::limits::check_scene(
+    let shown = shadowgraph::low_level::limits::check_scene(
         &s,
         &sp,
         &full,
@@ -412,7 +412,7 @@ fn lowered_limits_and_budgets_name_the_key() {
     );
     let sp = plan_lights(&s.lights).unwrap();
     let check_with = |features| {
-        shadowgraph::limits::check_scene(
+        shadowgraph::low_level::limits::check_scene(
             &s,
             &sp,
             &full,
@@ -453,7 +453,7 @@ fn uncaptured_errors_fail_the_next_submit() {
         view_formats: &[],
     });
     let enc = g.device.create_command_encoder(&Default::default());
-    match shadowgraph::gpu::submit_and_wait(&g.device, &g.queue, enc, "test") {
+    match shadowgraph::low_level::gpu::submit_and_wait(&g.device, &g.queue, enc, "test") {
         Err(e @ Error::Gpu { .. }) => {
             let shown = e.to_string();
             assert!(!shown.contains('\n') && shown.contains("zero"), "{shown}");
@@ -463,5 +463,5 @@ fn uncaptured_errors_fail_the_next_submit() {
     }
     // Reported once: the next submit is clean.
     let enc = g.device.create_command_encoder(&Default::default());
-    shadowgraph::gpu::submit_and_wait(&g.device, &g.queue, enc, "test").expect("clean");
+    shadowgraph::low_level::gpu::submit_and_wait(&g.device, &g.queue, enc, "test").expect("clean");
 }

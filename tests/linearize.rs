@@ -6,11 +6,11 @@ mod common;
 use std::collections::HashMap;
 
 use rand::Rng;
-use shadowgraph::cpu::linearize::linearize;
-use shadowgraph::exec::Executor;
-use shadowgraph::gpu::{read_texture, submit_and_wait, write_texture};
-use shadowgraph::graph::{Dispatch, Graph, Node, SizeRule, plan};
-use shadowgraph::technique::LinearizeParams;
+use shadowgraph::low_level::cpu::linearize::linearize;
+use shadowgraph::low_level::exec::Executor;
+use shadowgraph::low_level::gpu::{read_texture, submit_and_wait, write_texture};
+use shadowgraph::low_level::graph::{Dispatch, Graph, Node, SizeRule, plan};
+use shadowgraph::low_level::technique::LinearizeParams;
 
 struct Run {
     out: Vec<f32>,
@@ -18,7 +18,7 @@ struct Run {
 }
 
 fn run_linearize(
-    g: &shadowgraph::gpu::Gpu,
+    g: &shadowgraph::low_level::gpu::Gpu,
     raw: &[f32],
     w: u32,
     h: u32,
@@ -38,7 +38,7 @@ fn run_linearize(
     );
     graph.node(Node {
         name: "linearize".into(),
-        kernel: shadowgraph::kernels::KernelId::Linearize,
+        kernel: shadowgraph::low_level::kernels::KernelId::Linearize,
         inputs: vec![("src".into(), input)],
         outputs: vec![("dst".into(), out.clone())],
         params: bytemuck::bytes_of(&p).to_vec(),

@@ -10,10 +10,8 @@ mod common;
 
 use std::path::PathBuf;
 
-use shadowgraph::evaluate::{Config, EvaluateOptions, Report, evaluate, scene_for};
-use shadowgraph::prefilter::PrefilterConfig;
-use shadowgraph::sat::SatVariant;
-use shadowgraph::scene::Technique;
+use shadowgraph::low_level::evaluate::{Config, EvaluateOptions, Report, evaluate, scene_for};
+use shadowgraph::{PrefilterConfig, SatVariant, Technique};
 
 fn soft(c: PrefilterConfig) -> Technique {
     match c.validated() {
@@ -157,13 +155,13 @@ fn a_search_cut_by_its_cap_is_named_with_the_cap_that_covers_it() {
     // the key and the cap that covers them, which then warns no more.
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/long_shadows.toml");
     let text = std::fs::read_to_string(&path).expect("scene file");
-    let bundled = shadowgraph::scene::Scene::parse(&path, &text).expect("scene");
+    let bundled = shadowgraph::low_level::scene::Scene::parse(&path, &text).expect("scene");
     assert!(bundled.warnings.is_empty(), "{:?}", bundled.warnings);
     let capped = text.replace(
         "technique = \"vssm\"",
         "technique = \"vssm\"\nmax_search = 0.002",
     );
-    let scene = shadowgraph::scene::Scene::parse(&path, &capped).expect("scene");
+    let scene = shadowgraph::low_level::scene::Scene::parse(&path, &capped).expect("scene");
     let [w] = &scene.warnings[..] else {
         panic!("one warning: {:?}", scene.warnings)
     };
@@ -183,6 +181,6 @@ fn a_search_cut_by_its_cap_is_named_with_the_cap_that_covers_it() {
         "technique = \"vssm\"",
         &format!("technique = \"vssm\"\nmax_search = {cover}"),
     );
-    let scene = shadowgraph::scene::Scene::parse(&path, &covered).expect("scene");
+    let scene = shadowgraph::low_level::scene::Scene::parse(&path, &covered).expect("scene");
     assert!(scene.warnings.is_empty(), "{cover}: {:?}", scene.warnings);
 }

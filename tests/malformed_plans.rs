@@ -9,12 +9,13 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
 
 use rand::Rng;
-use shadowgraph::exec::Executor;
-use shadowgraph::graph::{Dispatch, GraphError, Plan};
-use shadowgraph::kernels::KernelId;
-use shadowgraph::render::plan_lights;
-use shadowgraph::scene::Scene;
-use shadowgraph::{Error, technique};
+use shadowgraph::low_level::exec::Executor;
+use shadowgraph::low_level::graph::{Dispatch, Plan};
+use shadowgraph::low_level::kernels::KernelId;
+use shadowgraph::low_level::render::plan_lights;
+use shadowgraph::low_level::scene::Scene;
+use shadowgraph::low_level::technique;
+use shadowgraph::{Error, GraphError};
 
 /// A plan with a blur, a mip chain and a summed-area table: every dispatch kind.
 fn valid() -> (Plan, Scene) {
@@ -64,7 +65,7 @@ fn depth_imports(device: &wgpu::Device, s: &Scene) -> HashMap<String, wgpu::Text
 
 /// Records `plan`; a panic is reported as `Err("panic: …")`.
 fn record(
-    g: &shadowgraph::gpu::Gpu,
+    g: &shadowgraph::low_level::gpu::Gpu,
     ex: &mut Executor,
     plan: &Plan,
     imports: &HashMap<String, wgpu::Texture>,
@@ -281,7 +282,7 @@ fn randomly_edited_plans_never_panic() {
             Ok(Err(e)) => assert!(!e.to_string().contains('\n'), "case {case}: {e}"),
         }
         // Whatever was recorded and not submitted is dropped; errors from it are the device's.
-        let _ = shadowgraph::gpu::take_uncaptured(&g.device);
+        let _ = shadowgraph::low_level::gpu::take_uncaptured(&g.device);
     }
     assert!(recorded < 300, "no edit was refused");
 }

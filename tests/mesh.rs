@@ -6,8 +6,8 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use shadowgraph::render::{RenderOptions, Renderer};
-use shadowgraph::scene::Scene;
+use shadowgraph::low_level::render::{RenderOptions, Renderer};
+use shadowgraph::low_level::scene::Scene;
 
 /// A folder of its own per test, holding the scene and its mesh.
 fn dir(tag: &str) -> PathBuf {
@@ -237,7 +237,7 @@ fn repaired_meshes_render_finite_normals() {
     check_frame(&g, &mut renderer, &s, "thin sphere");
 }
 
-fn check_frame(g: &shadowgraph::gpu::Gpu, r: &mut Renderer, s: &Scene, what: &str) {
+fn check_frame(g: &shadowgraph::low_level::gpu::Gpu, r: &mut Renderer, s: &Scene, what: &str) {
     let opts = RenderOptions {
         aux: true,
         repeat: 1,

@@ -5,7 +5,7 @@
 fn no_matching_adapter_names_the_software_driver() {
     // SAFETY: this binary has exactly one test, so no other thread reads the environment.
     unsafe { std::env::set_var("WGPU_ADAPTER_NAME", "no adapter is called this") };
-    match shadowgraph::gpu::Gpu::new() {
+    match shadowgraph::low_level::gpu::Gpu::new() {
         Ok(g) => panic!("matched adapter {}", g.describe()),
         Err(e) => {
             let m = e.to_string();

@@ -9,12 +9,14 @@ use common::host::{host_depth, host_depth_views};
 
 use std::path::{Path, PathBuf};
 
-use shadowgraph::exec::ComputeKernel;
-use shadowgraph::gpu::{Gpu, read_float_texture, read_resource_texture, submit_and_wait};
-use shadowgraph::prefilter::{LightParams, Prefilter, PrefilterConfig, StageError};
-use shadowgraph::render::{Frame, RenderOptions, Renderer};
-use shadowgraph::scene::Scene;
-use shadowgraph::technique::depth_name;
+use shadowgraph::low_level::exec::ComputeKernel;
+use shadowgraph::low_level::gpu::{
+    Gpu, read_float_texture, read_resource_texture, submit_and_wait,
+};
+use shadowgraph::low_level::render::{Frame, RenderOptions, Renderer};
+use shadowgraph::low_level::scene::Scene;
+use shadowgraph::low_level::technique::depth_name;
+use shadowgraph::{LightParams, Prefilter, PrefilterConfig, StageError};
 use wgpu::util::DeviceExt;
 
 /// Records the stage over `depth` in an encoder of the host's, submits, reads map `k` back.
@@ -59,9 +61,9 @@ fn stage_maps_as_frame(
     stage: &mut Prefilter,
     depth: &wgpu::Texture,
     params: &LightParams,
-    light: &shadowgraph::scene::Light,
+    light: &shadowgraph::Light,
 ) -> Vec<(usize, Vec<f32>)> {
-    let Some(coding) = shadowgraph::technique::sat_coding(light).expect("coding") else {
+    let Some(coding) = shadowgraph::low_level::technique::sat_coding(light).expect("coding") else {
         return run_stage_channels(g, stage, depth, params);
     };
     let mut enc = g.device.create_command_encoder(&Default::default());
@@ -71,9 +73,9 @@ fn stage_maps_as_frame(
     submit_and_wait(&g.device, &g.queue, enc, "stage").expect("submit");
     out.maps
         .iter()
-        .zip(shadowgraph::technique::map_tables(light))
+        .zip(shadowgraph::low_level::technique::map_tables(light))
         .map(|(m, n)| {
-            let map = shadowgraph::render::read_sat_map(
+            let map = shadowgraph::low_level::render::read_sat_map(
                 &g.device, &g.queue, "stage", &m.texture, &coding, &n,
             )
             .expect("readback");
@@ -85,7 +87,7 @@ fn stage_maps_as_frame(
 /// Per pixel of `frame`, the surface's world-space differentials along x and y (two vec4s),
 /// as the renderer computes them for its footprints.
 fn differentials(frame: &Frame, scene: &Scene) -> Vec<f32> {
-    let rays = shadowgraph::render::CameraRays::new(&scene.camera, frame.width, frame.height);
+    let rays = shadowgraph::low_level::render::CameraRays::new(&scene.camera, frame.width, frame.height);
     let eye = scene.camera.position.as_dvec3();
     let mut diffs = Vec::with_capacity(8 * (frame.width * frame.height) as usize);
     for y in 0..frame.height {
@@ -98,7 +100,7 @@ fn differentials(frame: &Frame, scene: &Scene) -> Vec<f32> {
             } else {
                 glam::DVec3::Y
             };
-            let (dx, dy) = shadowgraph::cpu::shade::pixel_differentials(eye, &rays, x, y, p, n);
+            let (dx, dy) = shadowgraph::low_level::cpu::shade::pixel_differentials(eye, &rays, x, y, p, n);
             for v in [dx, dy] {
                 diffs.extend([v.x as f32, v.y as f32, v.z as f32, 0.0]);
             }
@@ -210,7 +212,7 @@ fn host_visibility(
             resource: wgpu::BindingResource::Sampler(&sampler),
         });
     }
-    let sat_sampler = d.create_sampler(&shadowgraph::prefilter::SAT_SAMPLER_DESCRIPTOR);
+    let sat_sampler = d.create_sampler(&shadowgraph::SAT_SAMPLER_DESCRIPTOR);
     if stage.needs_filtering_sampler().expect("block") {
         entries.push(wgpu::BindGroupEntry {
             binding: entries.len() as u32,
@@ -252,7 +254,7 @@ fn run_probe(
     });
     enc.copy_buffer_to_buffer(vis, 0, &readback, 0, vis.size());
     submit_and_wait(d, &g.queue, enc, "host probe").expect("submit");
-    let raw = shadowgraph::gpu::read_buffer(d, &readback).expect("readback");
+    let raw = shadowgraph::low_level::gpu::read_buffer(d, &readback).expect("readback");
     bytemuck::cast_slice(&raw).to_vec()
 }
 
@@ -287,8 +289,8 @@ fn host_cascaded_visibility(
     g: &Gpu,
     stage: &mut Prefilter,
     depths: &[wgpu::Texture],
-    cascades: &[shadowgraph::prefilter::cascades::Cascade],
-    camera: &shadowgraph::prefilter::cascades::CascadeCamera,
+    cascades: &[shadowgraph::cascades::Cascade],
+    camera: &shadowgraph::cascades::CascadeCamera,
     frame: &Frame,
     scene: &Scene,
 ) -> Vec<f32> {
@@ -312,7 +314,7 @@ fn host_cascaded_visibility(
         })
         .collect();
     let blend = stage.config().cascades.blend;
-    shadowgraph::prefilter::cascades::pick_fields(&mut outs[0].light, camera, cascades, blend)
+    shadowgraph::cascades::pick_fields(&mut outs[0].light, camera, cascades, blend)
         .expect("pick fields");
     let lights: Vec<u8> = outs
         .iter()
@@ -361,7 +363,7 @@ fn host_cascaded_visibility(
         compare: Some(wgpu::CompareFunction::LessEqual),
         ..Default::default()
     });
-    let sat_sampler = d.create_sampler(&shadowgraph::prefilter::SAT_SAMPLER_DESCRIPTOR);
+    let sat_sampler = d.create_sampler(&shadowgraph::SAT_SAMPLER_DESCRIPTOR);
     let per_light = stage
         .layout_entries(0, wgpu::ShaderStages::COMPUTE)
         .expect("entries")
@@ -506,7 +508,7 @@ fn stage_outputs_equal_the_renderers() {
 
             // The second-depth techniques read a peeled second depth the stage takes no
             // input for: refused by name (tests/plugin_errors.rs).
-            if shadowgraph::technique::peels(&light.shadow.technique) {
+            if shadowgraph::low_level::technique::peels(&light.shadow.technique) {
                 continue;
             }
             let mut stage =
@@ -631,7 +633,7 @@ fn kernels_are_timed_when_the_device_can() {
     let mut stage = Prefilter::new(&g.device, &PrefilterConfig::vsm(128)).expect("stage");
     match stage.enable_timing(&g.device, &g.queue) {
         Err(shadowgraph::Error::Stage(StageError::MissingFeature { feature, .. })) => {
-            let missing = shadowgraph::timer::TIMER_FEATURES.difference(g.device.features());
+            let missing = shadowgraph::TIMER_FEATURES.difference(g.device.features());
             assert!(!missing.is_empty());
             assert_eq!(feature, missing);
             return;
@@ -658,12 +660,12 @@ fn kernels_are_timed_when_the_device_can() {
 fn soft_inputs(
     g: &Gpu,
     frame: &Frame,
-    light: &shadowgraph::scene::Light,
+    light: &shadowgraph::Light,
     li: usize,
 ) -> Option<common::soft::SoftInputs> {
     light.shadow.technique.soft()?;
     let sm = &frame.shade_maps[li];
-    let level0 = shadowgraph::cpu::Texels::from_f32(
+    let level0 = shadowgraph::low_level::cpu::Texels::from_f32(
         sm.width as usize,
         sm.height as usize,
         sm.channels,
@@ -676,14 +678,14 @@ fn soft_inputs(
 /// tolerance of the f64 reference, `None` where it jumps or the blocker threshold could flip.
 fn soft_allowance(
     soft: &common::soft::SoftInputs,
-    light: &shadowgraph::scene::Light,
+    light: &shadowgraph::Light,
     frame: &Frame,
     px: usize,
 ) -> Option<f64> {
-    let lg = shadowgraph::technique::LightGpu::new(light);
+    let lg = shadowgraph::LightGpu::new(light);
     let p = &frame.position[4 * px..4 * px + 3];
     let n = &frame.normal[4 * px..4 * px + 3];
-    let s = shadowgraph::cpu::light::sample(
+    let s = shadowgraph::low_level::cpu::light::sample(
         &lg,
         glam::DVec3::new(p[0].into(), p[1].into(), p[2].into()),
         glam::DVec3::new(n[0].into(), n[1].into(), n[2].into()).normalize(),
@@ -706,16 +708,16 @@ fn soft_allowance(
 /// footprint, the footprint variant's for all.
 #[test]
 fn stage_cascades_equal_the_renderers() {
-    use shadowgraph::cpu::cascade::pick;
-    use shadowgraph::prefilter::cascades::pick_fields;
-    use shadowgraph::render::{cascade_camera, drawn_lights};
-    use shadowgraph::scene::{Filter, Technique};
+    use shadowgraph::cascades::pick_fields;
+    use shadowgraph::low_level::cpu::cascade::pick;
+    use shadowgraph::low_level::render::{cascade_camera, drawn_lights};
+    use shadowgraph::{Filter, Technique};
     let g = common::gpu();
     let mut renderer = Renderer::new(&g.device);
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/city_street.toml");
     let mut scene = Scene::load(&path).expect("city_street loads");
     let vertices = scene.vertices();
-    let registered = |name| shadowgraph::technique::named(name, &[]).expect("registered");
+    let registered = |name| shadowgraph::low_level::technique::named(name, &[]).expect("registered");
     let anisotropic = Technique::Esm {
         filter: Filter::Mips {
             width: 2.0,

@@ -3,9 +3,8 @@
 
 mod common;
 
-use shadowgraph::Error;
-use shadowgraph::gpu::Gpu;
-use shadowgraph::prefilter::{LightParams, Prefilter, PrefilterConfig, StageError};
+use shadowgraph::low_level::gpu::Gpu;
+use shadowgraph::{Error, LightParams, Prefilter, PrefilterConfig, StageError};
 
 fn texture(
     g: &Gpu,
@@ -49,7 +48,7 @@ fn light() -> LightParams {
 /// `record` over `depth`, expecting a stage error.
 fn record_err<'a>(
     g: &Gpu,
-    depth: impl Into<shadowgraph::prefilter::DepthLayer<'a>>,
+    depth: impl Into<shadowgraph::DepthLayer<'a>>,
     light: &LightParams,
 ) -> StageError {
     let mut stage = Prefilter::new(&g.device, &PrefilterConfig::vsm(64)).expect("stage");
@@ -114,7 +113,7 @@ fn unusable_depth_textures_are_named() {
     );
     // A layer of an array is read in place (tests/plugin_lights.rs); one past its layers is
     // named.
-    let past = shadowgraph::prefilter::DepthLayer::new(&layered, 2);
+    let past = shadowgraph::DepthLayer::new(&layered, 2);
     let e = record_err(&g, past, &light());
     assert!(
         matches!(
@@ -138,7 +137,7 @@ fn unusable_depth_textures_are_named() {
     // One layer named, the same array is read.
     let mut stage = Prefilter::new(&g.device, &PrefilterConfig::vsm(64)).expect("stage");
     let mut enc = g.device.create_command_encoder(&Default::default());
-    let first = shadowgraph::prefilter::DepthLayer::new(&layered, 1);
+    let first = shadowgraph::DepthLayer::new(&layered, 1);
     stage
         .record(&g.device, &mut enc, first, &light())
         .expect("a named layer of the array");
@@ -164,7 +163,7 @@ fn unusable_depth_textures_are_named() {
 fn every_accepted_depth_format_runs() {
     let g = common::gpu();
     let mut stage = Prefilter::new(&g.device, &PrefilterConfig::vsm(32)).expect("stage");
-    for format in shadowgraph::prefilter::DEPTH_FORMATS {
+    for format in shadowgraph::DEPTH_FORMATS {
         if !format
             .required_features()
             .iter()
@@ -196,10 +195,10 @@ fn every_accepted_depth_format_runs() {
         let out = stage
             .record(&g.device, &mut enc, &depth, &light())
             .unwrap_or_else(|e| panic!("{format:?}: {e}"));
-        shadowgraph::gpu::submit_and_wait(&g.device, &g.queue, enc, "stage")
+        shadowgraph::low_level::gpu::submit_and_wait(&g.device, &g.queue, enc, "stage")
             .unwrap_or_else(|e| panic!("{format:?}: {e}"));
         let (_, moments) =
-            shadowgraph::gpu::read_float_texture(&g.device, &g.queue, &out.maps[0].texture, 0)
+            shadowgraph::low_level::gpu::read_float_texture(&g.device, &g.queue, &out.maps[0].texture, 0)
                 .expect("readback");
         assert!(
             moments.chunks(2).all(|m| m == [1.0, 1.0]),
@@ -325,7 +324,7 @@ fn invalid_configs_are_named_by_new() {
         Ok(_) => panic!("radius 40 accepted"),
     }
     config = PrefilterConfig::evsm2(64);
-    if let shadowgraph::scene::Technique::Evsm { exp_pos, .. } = &mut config.technique {
+    if let shadowgraph::Technique::Evsm { exp_pos, .. } = &mut config.technique {
         *exp_pos = 80.0;
     }
     let stage = Prefilter::new(&g.device, &config).expect("clamped, not rejected");
@@ -342,7 +341,7 @@ fn invalid_configs_are_named_by_new() {
 fn second_depth_techniques_are_refused_by_the_stage() {
     let g = common::gpu();
     for name in ["midpoint", "second_depth"] {
-        let t = shadowgraph::technique::named(name, &[]).expect(name);
+        let t = shadowgraph::low_level::technique::named(name, &[]).expect(name);
         let config = PrefilterConfig::new(t, 64);
         match Prefilter::new(&g.device, &config) {
             Err(Error::Stage(StageError::Config { field, message })) => {
@@ -387,7 +386,7 @@ fn point_light_mistakes_are_named() {
     let views = stage.point_views(&point, 64).expect("views");
     assert_eq!(views.len(), 6);
     assert_eq!(views[5].viewport, [128, 64, 64, 64]);
-    let smrt = shadowgraph::technique::named("smrt", &[]).expect("smrt");
+    let smrt = shadowgraph::low_level::technique::named("smrt", &[]).expect("smrt");
     let config = PrefilterConfig::new(smrt, 64).with_light_size(0.2);
     let stage = Prefilter::new(&g.device, &config).expect("stage");
     match stage.point_views(&point, 64) {
@@ -457,9 +456,9 @@ fn sizes_and_kernels_past_the_device_limits_are_named() {
             ..g.adapter.limits()
         },
     );
-    let table = PrefilterConfig::vsm(64).with_filter(shadowgraph::scene::Filter::Sat {
+    let table = PrefilterConfig::vsm(64).with_filter(shadowgraph::Filter::Sat {
         width: 3.0,
-        variant: shadowgraph::sat::SatVariant::Fixed,
+        variant: shadowgraph::SatVariant::Fixed,
     });
     let e = limit_error(&little_memory, &table);
     assert!(
@@ -508,7 +507,7 @@ fn timing_without_timestamps_is_a_missing_feature() {
             feature,
             needed_for,
         })) => {
-            assert_eq!(feature, shadowgraph::timer::TIMER_FEATURES);
+            assert_eq!(feature, shadowgraph::TIMER_FEATURES);
             assert!(needed_for.contains("timing"));
         }
         Err(e) => panic!("{e}"),
@@ -537,7 +536,7 @@ fn timing_without_timestamps_is_a_missing_feature() {
 fn unorm16_msm_without_the_16_bit_norm_feature_is_a_missing_feature() {
     let g = common::gpu();
     let (plain, _) = device_with(&g, g.adapter.limits());
-    let config = PrefilterConfig::msm(64).with_storage(shadowgraph::scene::Storage::Unorm16);
+    let config = PrefilterConfig::msm(64).with_storage(shadowgraph::Storage::Unorm16);
     match Prefilter::new(&plain, &config) {
         Err(e @ Error::MissingFeature { .. }) => {
             let m = e.to_string();
@@ -550,7 +549,7 @@ fn unorm16_msm_without_the_16_bit_norm_feature_is_a_missing_feature() {
         Ok(_) => panic!("unorm16 MSM accepted without TEXTURE_FORMAT_16BIT_NORM"),
     }
     // f16 quantized moments need no feature.
-    let f16 = PrefilterConfig::msm(64).with_storage(shadowgraph::scene::Storage::F16);
+    let f16 = PrefilterConfig::msm(64).with_storage(shadowgraph::Storage::F16);
     Prefilter::new(&plain, &f16).expect("f16 MSM on a plain device");
 }
 
@@ -560,7 +559,7 @@ fn unorm16_msm_without_the_16_bit_norm_feature_is_a_missing_feature() {
 fn float_tables_without_float32_filterable_are_a_missing_feature() {
     let g = common::gpu();
     let (plain, _) = device_with(&g, g.adapter.limits());
-    let config = PrefilterConfig::vssm(64, 0.5).with_soft(shadowgraph::sat::SatVariant::Float, 0.2);
+    let config = PrefilterConfig::vssm(64, 0.5).with_soft(shadowgraph::SatVariant::Float, 0.2);
     match Prefilter::new(&plain, &config) {
         Err(e @ Error::MissingFeature { .. }) => {
             let m = e.to_string();
@@ -572,7 +571,7 @@ fn float_tables_without_float32_filterable_are_a_missing_feature() {
         Err(e) => panic!("expected a missing feature, got {e}"),
         Ok(_) => panic!("f32 tables accepted without FLOAT32_FILTERABLE"),
     }
-    let fixed = PrefilterConfig::vssm(64, 0.5).with_soft(shadowgraph::sat::SatVariant::Fixed, 0.2);
+    let fixed = PrefilterConfig::vssm(64, 0.5).with_soft(shadowgraph::SatVariant::Fixed, 0.2);
     Prefilter::new(&plain, &fixed).expect("fixed-point tables on a plain device");
 }
 
@@ -591,10 +590,10 @@ fn wrapped_errors_print_their_cause_once() {
     );
     let stage = Error::from(record_err(&g, &cleared, &light()));
     let graph = Error::from(
-        shadowgraph::graph::plan(&shadowgraph::graph::Graph::default(), &["light0.vsm"])
+        shadowgraph::low_level::graph::plan(&shadowgraph::low_level::graph::Graph::default(), &["light0.vsm"])
             .expect_err("an undeclared output"),
     );
-    let exec = Error::from(shadowgraph::exec::ExecError::MissingImport(
+    let exec = Error::from(shadowgraph::ExecError::MissingImport(
         "light0.depth".into(),
     ));
     for (e, cause) in [

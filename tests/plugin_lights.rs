@@ -16,13 +16,13 @@ use std::path::Path;
 use common::host::host_depth;
 use glam::{Mat4, Vec3};
 use rand::Rng;
-use shadowgraph::exec::ComputeKernel;
-use shadowgraph::gpu::{Gpu, read_buffer, read_float_texture, submit_and_wait};
-use shadowgraph::prefilter::{
+use shadowgraph::low_level::exec::ComputeKernel;
+use shadowgraph::low_level::gpu::{Gpu, read_buffer, read_float_texture, submit_and_wait};
+use shadowgraph::low_level::scene::Scene;
+use shadowgraph::{
     DepthLayer, LightParams, MAX_LIGHTS, Prefilter, PrefilterConfig, PrefilterOutput, StageError,
-    wgsl,
+    Technique, wgsl,
 };
-use shadowgraph::scene::{Scene, Technique};
 use wgpu::util::DeviceExt;
 
 const SIZE: u32 = 128;
@@ -440,10 +440,10 @@ fn several_lights_compose_in_one_module() {
 #[test]
 fn the_memory_budget_counts_every_light() {
     let g = common::gpu();
-    if std::env::var_os(shadowgraph::limits::MEMORY_BUDGET_ENV).is_some() {
+    if std::env::var_os(shadowgraph::low_level::limits::MEMORY_BUDGET_ENV).is_some() {
         panic!(
             "unset {} to run this test",
-            shadowgraph::limits::MEMORY_BUDGET_ENV
+            shadowgraph::low_level::limits::MEMORY_BUDGET_ENV
         );
     }
     let big = 4096;

@@ -4,12 +4,12 @@
 
 use std::path::Path;
 
-use shadowgraph::kernels;
-use shadowgraph::prefilter::{PrefilterConfig, StageError, wgsl};
-use shadowgraph::scene::{
-    BlurKernel, CssmResolve, CssmSearch, Filter, PcfKernel, Prefilter, Scene, Storage, Technique,
+use shadowgraph::low_level::kernels;
+use shadowgraph::low_level::scene::Scene;
+use shadowgraph::{
+    BlurKernel, CssmResolve, CssmSearch, Filter, LightGpu, PcfKernel, PrefilterConfig, StageError,
+    Storage, StorageFilter, Technique, wgsl,
 };
-use shadowgraph::technique::LightGpu;
 
 fn every_technique() -> Vec<Technique> {
     let blur = Filter::Blur {
@@ -44,7 +44,7 @@ fn every_technique() -> Vec<Technique> {
         PrefilterConfig::esm(64).with_filter(Filter::None).technique,
         PrefilterConfig::cssm(64, 5, 0.5).technique,
         PrefilterConfig::vssm(64, 0.5)
-            .with_soft(shadowgraph::sat::SatVariant::Float, 0.2)
+            .with_soft(shadowgraph::SatVariant::Float, 0.2)
             .technique,
         PrefilterConfig::msm_soft(64, 0.5)
             .with_storage(Storage::Unorm16)
@@ -292,7 +292,7 @@ fn constructors_have_the_scene_defaults() {
 fn vsm(bleed: f32, min_variance: f32) -> PrefilterConfig {
     let mut c = PrefilterConfig::vsm(64);
     c.technique = Technique::Vsm {
-        prefilter: Prefilter {
+        prefilter: StorageFilter {
             storage: Storage::F32,
             filter: Filter::Blur {
                 radius: 2.0,
@@ -448,7 +448,7 @@ fn configs_follow_the_scene_rules() {
             PrefilterConfig::msm_soft(64, 0.5)
                 .with_moment_bias(1e-5)
                 .with_storage(Storage::F16)
-                .with_soft(shadowgraph::sat::SatVariant::Float, 0.3),
+                .with_soft(shadowgraph::SatVariant::Float, 0.3),
         ),
         // MSM's bias follows the storage's default unless set, and is checked as the key is.
         (
@@ -491,7 +491,7 @@ fn configs_follow_the_scene_rules() {
             "vssm",
             "max_search = 2.0",
             0.5,
-            PrefilterConfig::vssm(64, 0.5).with_soft(shadowgraph::sat::SatVariant::Fixed, 2.0),
+            PrefilterConfig::vssm(64, 0.5).with_soft(shadowgraph::SatVariant::Fixed, 2.0),
         ),
     ];
     for (technique, keys, light_size, mut config) in cases {
@@ -581,7 +581,7 @@ fn settings_that_do_not_apply_are_named() {
         .validated()
         .expect("hard takes the receiver-plane bias");
     let e = PrefilterConfig::vsm(64)
-        .with_soft(shadowgraph::sat::SatVariant::Float, 0.1)
+        .with_soft(shadowgraph::SatVariant::Float, 0.1)
         .validated()
         .unwrap_err();
     assert!(e.to_string().contains("sat_sums"), "{e}");
@@ -593,7 +593,7 @@ fn settings_that_do_not_apply_are_named() {
     // A scene's prefilter field set by hand is still checked.
     let mut c = PrefilterConfig::vsm(64);
     c.technique = Technique::Vsm {
-        prefilter: Prefilter {
+        prefilter: StorageFilter {
             storage: Storage::F32,
             filter: Filter::Blur {
                 radius: 2.0,

@@ -7,12 +7,13 @@ use std::path::Path;
 
 use glam::{DMat4, DVec3, Vec3};
 use rand::{Rng, SeedableRng};
-use shadowgraph::model::point::{self, PointLayout};
-use shadowgraph::render::{RenderOptions, Renderer};
-use shadowgraph::scene::{Filter, PcfKernel, Scene, Technique};
-use shadowgraph::technique::reach;
-use shadowgraph::truth::emitter;
-use shadowgraph::truth::raycast::ray_cast_truth;
+use shadowgraph::low_level::model::point::{self, PointLayout};
+use shadowgraph::low_level::render::{RenderOptions, Renderer};
+use shadowgraph::low_level::scene::Scene;
+use shadowgraph::low_level::technique::reach;
+use shadowgraph::low_level::truth::emitter;
+use shadowgraph::low_level::truth::raycast::ray_cast_truth;
+use shadowgraph::{Filter, PcfKernel, Technique};
 
 /// Every direction lands in exactly the face `face_of` names, inside that face's 90° core
 /// (|x/z|, |y/z| ≤ 1 in its view, the matrices the raster pass draws with), and the core
@@ -199,8 +200,8 @@ fn shadows_across_face_edges_match_the_ray_cast() {
 }
 
 fn vsm_blur(radius: f32) -> Technique {
-    use shadowgraph::model::ParamValue;
-    shadowgraph::technique::named(
+    use shadowgraph::low_level::model::ParamValue;
+    shadowgraph::low_level::technique::named(
         "vsm",
         &[
             ("filter_radius", ParamValue::Float(radius)),

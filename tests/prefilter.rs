@@ -6,11 +6,11 @@ mod common;
 use std::collections::HashMap;
 
 use rand::Rng;
-use shadowgraph::cpu::{self, Texels};
-use shadowgraph::exec::Executor;
-use shadowgraph::gpu::{Gpu, read_resource_texture, submit_and_wait, write_texture};
-use shadowgraph::graph::{Graph, SizeRule, plan};
-use shadowgraph::scene::{BlurKernel, Filter};
+use shadowgraph::low_level::cpu::{self, Texels};
+use shadowgraph::low_level::exec::Executor;
+use shadowgraph::low_level::gpu::{Gpu, read_resource_texture, submit_and_wait, write_texture};
+use shadowgraph::low_level::graph::{Graph, SizeRule, plan};
+use shadowgraph::{BlurKernel, Filter};
 
 fn upload(g: &Gpu, w: u32, h: u32, format: wgpu::TextureFormat, data: &[f32]) -> wgpu::Texture {
     let data = bytemuck::cast_slice(data);
@@ -36,7 +36,7 @@ fn run_levels(g: &Gpu, graph: &Graph, output: &str, input: wgpu::Texture) -> Vec
     let out_tex = &first.textures[output];
     let (w, h) = (out_tex.width(), out_tex.height());
     let format = plan.resource(output).expect("planned").resource.format;
-    if shadowgraph::graph::is_packed(format) && out_tex.mip_level_count() == 1 {
+    if shadowgraph::low_level::graph::is_packed(format) && out_tex.mip_level_count() == 1 {
         // Two NaN halves a word.
         write_texture(&g.queue, out_tex, &vec![0xFF; (w * h) as usize * 4]);
     }
@@ -46,7 +46,7 @@ fn run_levels(g: &Gpu, graph: &Graph, output: &str, input: wgpu::Texture) -> Vec
         4
     };
     let f32_texels =
-        shadowgraph::graph::texel_bytes(out_tex.format()) == 4 * poison_channels as u64;
+        shadowgraph::low_level::graph::texel_bytes(out_tex.format()) == 4 * poison_channels as u64;
     if f32_texels && out_tex.mip_level_count() == 1 {
         write_texture(
             &g.queue,
@@ -91,8 +91,8 @@ fn vsm_graph(
     format: wgpu::TextureFormat,
     filter: Option<Filter>,
 ) -> (Graph, String) {
-    let params = shadowgraph::technique::VsmParams {
-        depth: shadowgraph::technique::LinearizeParams::ORTHOGRAPHIC,
+    let params = shadowgraph::low_level::technique::VsmParams {
+        depth: shadowgraph::low_level::technique::LinearizeParams::ORTHOGRAPHIC,
     };
     encode_graph(
         "vsm",
@@ -101,7 +101,7 @@ fn vsm_graph(
         h,
         format,
         filter,
-        shadowgraph::filter::BlurMode::Linear,
+        shadowgraph::low_level::filter::BlurMode::Linear,
     )
 }
 
@@ -115,7 +115,7 @@ fn encode_graph(
     h: u32,
     format: wgpu::TextureFormat,
     filter: Option<Filter>,
-    mode: shadowgraph::filter::BlurMode,
+    mode: shadowgraph::low_level::filter::BlurMode,
 ) -> (Graph, String) {
     let mut g = Graph::default();
     g.import("in", wgpu::TextureFormat::R32Float, w, h, Some(0));
@@ -129,9 +129,9 @@ fn encode_graph(
         },
         Some(0),
     );
-    g.node(shadowgraph::graph::Node {
+    g.node(shadowgraph::low_level::graph::Node {
         name: "light0.vsm".into(),
-        kernel: shadowgraph::kernels::KernelId::from_name(kernel).expect("a kernel"),
+        kernel: shadowgraph::low_level::kernels::KernelId::from_name(kernel).expect("a kernel"),
         inputs: vec![("src".into(), "in".into())],
         // `csm` names its outputs dst0 … dst3.
         outputs: vec![(
@@ -139,11 +139,11 @@ fn encode_graph(
             "light0.vsm".into(),
         )],
         params,
-        dispatch: shadowgraph::graph::Dispatch::Texels("light0.vsm".into()),
+        dispatch: shadowgraph::low_level::graph::Dispatch::Texels("light0.vsm".into()),
         light: Some(0),
     });
     let out = match filter {
-        Some(f) => shadowgraph::filter::add_filter(&mut g, 0, "light0.vsm", &f, mode),
+        Some(f) => shadowgraph::low_level::filter::add_filter(&mut g, 0, "light0.vsm", &f, mode),
         None => "light0.vsm".to_string(),
     };
     (g, out)
@@ -220,7 +220,7 @@ fn blur_matches_reference_for_each_kernel_and_storage() {
             // The same f16 values packed two to an r32uint word (what `format = "f16"` VSM
             // stores): the same three roundings.
             (
-                shadowgraph::graph::PACKED_F16X2,
+                shadowgraph::PACKED_F16X2,
                 1e-4,
                 3.0 * (2.0f64).powi(-10),
             ),
@@ -264,8 +264,8 @@ fn vsm_light_plans_one_fused_encode_and_blur_only() {
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/techniques/vsm.toml"),
     )
     .unwrap();
-    let scene = shadowgraph::scene::Scene::parse(std::path::Path::new("vsm.toml"), &text).unwrap();
-    let sp = shadowgraph::render::plan_lights(&scene.lights).unwrap();
+    let scene = shadowgraph::low_level::scene::Scene::parse(std::path::Path::new("vsm.toml"), &text).unwrap();
+    let sp = shadowgraph::low_level::render::plan_lights(&scene.lights).unwrap();
     let kernels: Vec<&str> = sp
         .plan
         .steps
@@ -281,8 +281,8 @@ fn vsm_light_plans_one_fused_encode_and_blur_only() {
 
 #[test]
 fn evsm_and_esm_encodings_match_reference() {
-    use shadowgraph::filter::BlurMode;
-    use shadowgraph::technique::ExpParams;
+    use shadowgraph::low_level::filter::BlurMode;
+    use shadowgraph::low_level::technique::ExpParams;
     let g = common::gpu();
     let mut rng = common::rng(42);
     let (w, h) = (333u32, 45u32);
@@ -390,8 +390,8 @@ fn channels_of(t: &Texels, n: usize) -> Vec<f32> {
 
 #[test]
 fn msm_encoding_matches_reference_for_each_storage() {
-    use shadowgraph::filter::BlurMode;
-    use shadowgraph::technique::{LinearizeParams, MsmParams};
+    use shadowgraph::low_level::filter::BlurMode;
+    use shadowgraph::low_level::technique::{LinearizeParams, MsmParams};
     let g = common::gpu();
     let mut rng = common::rng(43);
     let (w, h) = (1000u32, 37u32);
@@ -476,8 +476,8 @@ fn msm_encoding_matches_reference_for_each_storage() {
 
 #[test]
 fn csm_basis_matches_reference() {
-    use shadowgraph::filter::BlurMode;
-    use shadowgraph::technique::CsmParams;
+    use shadowgraph::low_level::filter::BlurMode;
+    use shadowgraph::low_level::technique::CsmParams;
     let g = common::gpu();
     let mut rng = common::rng(44);
     let (w, h) = (257u32, 31u32);
@@ -493,7 +493,7 @@ fn csm_basis_matches_reference() {
         // One map a dispatch here (`tests/fused.rs` writes several): map m holds terms
         // 2m + 1 and 2m + 2.
         let params = bytemuck::bytes_of(&CsmParams {
-            depth: shadowgraph::technique::LinearizeParams::ORTHOGRAPHIC,
+            depth: shadowgraph::low_level::technique::LinearizeParams::ORTHOGRAPHIC,
             first_map: (first_term - 1) / 2,
             maps: 1,
             terms,
@@ -532,8 +532,8 @@ fn csm_basis_matches_reference() {
     // With `moments` (CSSM's moment search) the map after the basis is MSM's quantized moments:
     // the quantization matrix's f32 products (entries up to 82: 6·82·2⁻²⁴).
     let params = bytemuck::bytes_of(&CsmParams {
-        depth: shadowgraph::technique::LinearizeParams::ORTHOGRAPHIC,
-        first_map: shadowgraph::technique::csm_maps(terms),
+        depth: shadowgraph::low_level::technique::LinearizeParams::ORTHOGRAPHIC,
+        first_map: shadowgraph::low_level::technique::csm_maps(terms),
         maps: 1,
         terms,
         moments: 1,
@@ -559,7 +559,7 @@ fn csm_basis_matches_reference() {
 
 #[test]
 fn mip_chain_matches_reference_and_ends_at_the_mean() {
-    use shadowgraph::filter::BlurMode;
+    use shadowgraph::low_level::filter::BlurMode;
     let g = common::gpu();
     let mut rng = common::rng(45);
     for (w, h, mode) in [
@@ -584,7 +584,7 @@ fn mip_chain_matches_reference_and_ends_at_the_mean() {
         };
         let mut graph = Graph::default();
         graph.import("in", wgpu::TextureFormat::R32Float, w, h, Some(0));
-        let out = shadowgraph::filter::add_filter(
+        let out = shadowgraph::low_level::filter::add_filter(
             &mut graph,
             0,
             "in",
@@ -641,8 +641,8 @@ fn mip_chain_matches_reference_and_ends_at_the_mean() {
 
 #[test]
 fn mip_chain_of_16_bit_maps_matches_reference() {
-    use shadowgraph::filter::BlurMode;
-    use shadowgraph::technique::{LinearizeParams, MsmParams};
+    use shadowgraph::low_level::filter::BlurMode;
+    use shadowgraph::low_level::technique::{LinearizeParams, MsmParams};
     let g = common::gpu();
     let mut rng = common::rng(46);
     let (w, h) = (200u32, 75u32);
@@ -701,7 +701,7 @@ fn mip_chain_of_packed_f16_moments_matches_reference() {
             width: 1.0,
             max_anisotropy: 0,
         };
-        let (graph, out) = vsm_graph(w, h, shadowgraph::graph::PACKED_F16X2, Some(filter));
+        let (graph, out) = vsm_graph(w, h, shadowgraph::PACKED_F16X2, Some(filter));
         let gpu = run_levels(
             &g,
             &graph,
@@ -737,7 +737,7 @@ fn mip_chain_of_packed_f16_moments_matches_reference() {
 
 #[test]
 fn plans_hold_exactly_what_each_light_needs() {
-    use shadowgraph::scene::{Light, LightKind, PcfKernel, Prefilter, Shadow, Storage, Technique};
+    use shadowgraph::{Light, LightKind, PcfKernel, Shadow, Storage, StorageFilter, Technique};
     let light = |technique| Light {
         kind: LightKind::Directional { extent: 5.0 },
         position: glam::Vec3::new(0.0, 10.0, 0.1),
@@ -753,7 +753,7 @@ fn plans_hold_exactly_what_each_light_needs() {
             slope_bias: 1.0,
             normal_bias: 1.0,
             receiver_plane: 0.0,
-            cascades: shadowgraph::model::Cascades::SINGLE,
+            cascades: shadowgraph::Cascades::SINGLE,
         },
     };
     let blur = Filter::Blur {
@@ -766,7 +766,7 @@ fn plans_hold_exactly_what_each_light_needs() {
         kernel: PcfKernel::Tent,
     };
     let vsm = Technique::Vsm {
-        prefilter: Prefilter {
+        prefilter: StorageFilter {
             storage: Storage::F32,
             filter: blur,
         },
@@ -774,7 +774,7 @@ fn plans_hold_exactly_what_each_light_needs() {
         min_variance: 1e-5,
     };
     let msm = Technique::Msm {
-        prefilter: Prefilter {
+        prefilter: StorageFilter {
             storage: Storage::F16,
             filter: Filter::Mips {
                 width: 2.0,
@@ -786,7 +786,7 @@ fn plans_hold_exactly_what_each_light_needs() {
         bleed: 0.0,
     };
     let csm = Technique::Csm {
-        prefilter: Prefilter {
+        prefilter: StorageFilter {
             storage: Storage::F32,
             filter: blur,
         },
@@ -796,7 +796,7 @@ fn plans_hold_exactly_what_each_light_needs() {
         scale: 2.0,
     };
     let lights = [light(pcf), light(vsm), light(msm), light(csm), light(pcf)];
-    let sp = shadowgraph::render::plan_lights(&lights).expect("plan");
+    let sp = shadowgraph::low_level::render::plan_lights(&lights).expect("plan");
     let kernels = |i: usize| -> Vec<&str> {
         sp.plan
             .steps

@@ -10,7 +10,8 @@ mod procedural;
 use std::path::Path;
 
 use glam::{DVec3, Vec3};
-use shadowgraph::scene::{LightKind, Scene};
+use shadowgraph::LightKind;
+use shadowgraph::low_level::scene::Scene;
 
 fn scenes_dir() -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
@@ -38,7 +39,7 @@ fn committed_files_are_the_generators_output() {
 fn the_canopy_loads_as_its_generator_means_it() {
     use procedural::canopy::{CARDS, CLUMPS};
     let path = scenes_dir().join("meshes/canopy.gltf");
-    let loaded = shadowgraph::scene::gltf::load_gltf(&path).unwrap_or_else(|e| panic!("{e}"));
+    let loaded = shadowgraph::low_level::scene::gltf::load_gltf(&path).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(loaded.repaired_normals, 0);
     let m = &loaded.mesh;
     assert_eq!((CARDS, CLUMPS), (14, 11));
@@ -94,7 +95,7 @@ fn the_canopy_loads_as_its_generator_means_it() {
         obj += &format!("f {a}//{a} {b}//{b} {c}//{c}\n");
     }
     std::fs::write(d.join("canopy.obj"), obj).unwrap();
-    let from_obj = shadowgraph::scene::obj::load_obj(&d.join("canopy.obj"))
+    let from_obj = shadowgraph::low_level::scene::obj::load_obj(&d.join("canopy.obj"))
         .unwrap()
         .mesh;
     for (k, &i) in from_obj.indices.iter().enumerate() {
@@ -118,7 +119,7 @@ fn the_canopy_loads_as_its_generator_means_it() {
         bin: Some(bin.into()),
     };
     std::fs::write(d.join("canopy.glb"), glb.to_vec().unwrap()).unwrap();
-    let from_glb = shadowgraph::scene::gltf::load_gltf(&d.join("canopy.glb"))
+    let from_glb = shadowgraph::low_level::scene::gltf::load_gltf(&d.join("canopy.glb"))
         .unwrap()
         .mesh;
     assert_eq!(from_glb.positions, m.positions);

@@ -11,7 +11,7 @@ const END: &str = "<!-- fronts:end -->";
 #[test]
 fn fronts_table_is_the_committed_reports_summary() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let table = shadowgraph::evaluate::summary::fronts_table_of(&root.join("benches/evaluation"))
+    let table = shadowgraph::low_level::evaluate::summary::fronts_table_of(&root.join("benches/evaluation"))
         .expect("summary of the committed reports");
     assert!(
         table.lines().count() >= 2 + 9,

@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use shadowgraph::scene::Scene;
-use shadowgraph::technique::{REGISTRY, names, parameters_markdown};
+use shadowgraph::low_level::scene::Scene;
+use shadowgraph::low_level::technique::{REGISTRY, names, parameters_markdown};
 
 #[test]
 fn names_are_unique_and_examples_use_their_technique() {
@@ -254,8 +254,8 @@ fn rust_files(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
 /// config error naming the key and listing the registered names.
 #[test]
 fn configs_are_built_by_name() {
-    use shadowgraph::prefilter::PrefilterConfig;
-    use shadowgraph::technique::default_of;
+    use shadowgraph::PrefilterConfig;
+    use shadowgraph::low_level::technique::default_of;
     for def in REGISTRY {
         let config = PrefilterConfig::named(def.name, 256).expect(def.name);
         assert_eq!(config.technique, default_of(def), "{}", def.name);

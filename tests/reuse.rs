@@ -1,6 +1,6 @@
 //! Nothing is rebuilt per frame: after the first frame of a scene, frames and further
 //! `render` calls of the same scene create no buffer, texture, view, bind group, layout,
-//! shader module, pipeline, sampler or query set (`shadowgraph::created` counts every one the
+//! shader module, pipeline, sampler or query set (`shadowgraph::low_level::gpu_objects` counts every one the
 //! renderer, the executor, the timer and the plug-in stage create); the shading kernel is found
 //! by a key that determines its generated block; timestamps come back for every frame, read a
 //! frame later. Counts are exact: no tolerance.
@@ -9,10 +9,11 @@ mod common;
 
 use std::path::Path;
 
-use shadowgraph::created::{Created, created};
-use shadowgraph::render::{RenderOptions, Renderer};
-use shadowgraph::scene::{Filter, Scene};
-use shadowgraph::technique;
+use shadowgraph::Filter;
+use shadowgraph::low_level::gpu_objects::{Created, created};
+use shadowgraph::low_level::render::{RenderOptions, Renderer};
+use shadowgraph::low_level::scene::Scene;
+use shadowgraph::low_level::technique;
 
 fn scene(name: &str) -> Scene {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -46,7 +47,7 @@ fn scenes() -> Vec<(&'static str, Scene)> {
     .collect()
 }
 
-fn render(renderer: &mut Renderer, g: &shadowgraph::gpu::Gpu, s: &Scene, repeat: u32) {
+fn render(renderer: &mut Renderer, g: &shadowgraph::low_level::gpu::Gpu, s: &Scene, repeat: u32) {
     let opts = RenderOptions {
         repeat,
         ..Default::default()
@@ -182,7 +183,7 @@ fn equal_shade_keys_mean_equal_blocks() {
     for l in &lights {
         let def = technique::of(&l.shadow.technique);
         for spec in def.params.iter().flat_map(|p| p.iter()) {
-            let shadowgraph::model::ParamKind::Choice(options) = spec.kind else {
+            let shadowgraph::low_level::model::ParamKind::Choice(options) = spec.kind else {
                 continue;
             };
             for &option in options {
@@ -190,7 +191,7 @@ fn equal_shade_keys_mean_equal_blocks() {
                 if values.get(spec.key).is_none() {
                     continue;
                 }
-                values.set(spec.key, shadowgraph::model::ParamValue::Choice(option));
+                values.set(spec.key, shadowgraph::low_level::model::ParamValue::Choice(option));
                 let mut v = l.clone();
                 v.shadow.technique = (def.build)(&values);
                 choices.push(v);
@@ -212,8 +213,8 @@ fn equal_shade_keys_mean_equal_blocks() {
 }
 
 /// Gives a prefiltered technique filter `f`; false for the others.
-fn set_filter(t: &mut shadowgraph::scene::Technique, f: Filter) -> bool {
-    use shadowgraph::scene::Technique as T;
+fn set_filter(t: &mut shadowgraph::Technique, f: Filter) -> bool {
+    use shadowgraph::Technique as T;
     match t {
         T::Vsm { prefilter, .. }
         | T::Evsm { prefilter, .. }
@@ -226,7 +227,7 @@ fn set_filter(t: &mut shadowgraph::scene::Technique, f: Filter) -> bool {
 }
 
 /// The renderer, the executor, the timer and the plug-in stage create GPU objects only
-/// through `shadowgraph::created` (so that the counts above see everything): no direct
+/// through `shadowgraph::low_level::gpu_objects` (so that the counts above see everything): no direct
 /// `create_*` call in their sources.
 #[test]
 fn creation_goes_through_the_counter() {

@@ -12,16 +12,17 @@ use std::collections::HashMap;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 use rand::Rng;
-use shadowgraph::cpu::{Texels, sat as reference};
-use shadowgraph::exec::{Executor, KernelLayout};
-use shadowgraph::gpu::{Gpu, read_texture, submit_and_wait, write_texture};
-use shadowgraph::graph::{Graph, plan, texel_bytes};
-use shadowgraph::kernels;
-use shadowgraph::sat::five_pass::{SAT_BLOCK, SAT_CARRY_LINES, add_sat_five_pass};
-use shadowgraph::sat::lookups::{Lookup, lookup_means};
-use shadowgraph::sat::{
-    SAT_LINES_PER_GROUP, SAT_TILE, SatCoding, SatParams, SatVariant, add_sat, float_sum_depth,
-    format_channels, lookup_area,
+use shadowgraph::SatVariant;
+use shadowgraph::low_level::cpu::{Texels, sat as reference};
+use shadowgraph::low_level::exec::{Executor, KernelLayout};
+use shadowgraph::low_level::gpu::{Gpu, read_texture, submit_and_wait, write_texture};
+use shadowgraph::low_level::graph::{Graph, plan, texel_bytes};
+use shadowgraph::low_level::kernels;
+use shadowgraph::low_level::sat::five_pass::{SAT_BLOCK, SAT_CARRY_LINES, add_sat_five_pass};
+use shadowgraph::low_level::sat::lookups::{Lookup, lookup_means};
+use shadowgraph::low_level::sat::{
+    SAT_LINES_PER_GROUP, SAT_TILE, SatCoding, SatParams, add_sat, float_sum_depth, format_channels,
+    lookup_area,
 };
 
 /// f32's unit roundoff (round to nearest; Vulkan's f32 add, sub and mul are correctly rounded).
@@ -407,6 +408,62 @@ fn both_layouts_build_the_same_tables() {
             }
         }
     }
+}
+
+/// The redesign layout (`exec::KernelLayout::Redesign`: on a device with subgroups the tile
+/// passes by subgroup scans, a lane a column, `kernels/shared/sat_strip.wgsl`; without them the
+/// shipped passes) builds fixed-point tables bit for bit as the GPU layout does (wrapping sums
+/// in any order), and f32 tables within the same scan bound of the f64 table (its summation
+/// tree is no deeper than the shipped tile's: `sat::float_sum_depth`): one, two and four
+/// channels, ragged tiles, single lines, several tiles each way.
+#[test]
+fn redesign_layout_builds_the_same_tables() {
+    let g = common::gpu();
+    let mut shipped = Executor::new();
+    shipped.kernels.set_layout(KernelLayout::Gpu);
+    let mut redesign = Executor::new();
+    redesign.kernels.set_layout(KernelLayout::Redesign);
+    let mut rng = common::rng(78);
+    for (i, (w, h)) in [(1, 57), (61, 1), (100, 70), (33, 200), (257, 95)]
+        .into_iter()
+        .enumerate()
+    {
+        let channels = [1, 2, 4][i % 3];
+        let map = Map::random(&mut rng, w, h, channels, -0.5, 1.0);
+        let fixed = SatCoding::fixed((w * h) as u64, [-0.5; 4], [1.0; 4]).unwrap();
+        let a = build(&g, &mut shipped, &map, &fixed).bytes;
+        let table = build(&g, &mut redesign, &map, &fixed);
+        if let Some(k) = (0..a.len()).find(|&k| a[k] != table.bytes[k]) {
+            panic!("{w}×{h}, {channels} channels: byte {k} differs from the GPU layout's");
+        }
+        let what = format!("redesign fixed {w}x{h}");
+        check_fixed(&what, &mut rng, &map, &fixed, &table, None);
+        let float = SatCoding::float([-0.5; 4], [1.0; 4]).unwrap();
+        let table = build(&g, &mut redesign, &map, &float);
+        let what = format!("redesign float {w}x{h}");
+        check_float(&what, &mut rng, &map, &float, &table);
+    }
+}
+
+/// The redesign's modules replace the shipped ones only in the redesign layout and only on a
+/// device with the feature they need: elsewhere every kernel compiles as shipped.
+#[test]
+fn redesigned_sat_modules_need_the_redesign_layout_and_subgroups() {
+    let all = wgpu::Features::SUBGROUP;
+    assert!(
+        KernelLayout::Redesign
+            .module_sources(wgpu::Features::empty())
+            .is_empty()
+    );
+    assert!(KernelLayout::Gpu.module_sources(all).is_empty());
+    assert!(KernelLayout::Cpu.module_sources(all).is_empty());
+    assert_eq!(
+        KernelLayout::Redesign.module_sources(all),
+        [
+            ("shared/sat_tile_sums", "shared/sat_tile_sums_subgroup"),
+            ("shared/sat_tile_scan", "shared/sat_tile_scan_subgroup"),
+        ]
+    );
 }
 
 #[test]

@@ -4,8 +4,8 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Vec3, Vec4Swizzles};
-use shadowgraph::Error;
-use shadowgraph::scene::{LightKind, PcfKernel, Scene, Technique};
+use shadowgraph::low_level::scene::Scene;
+use shadowgraph::{Error, LightKind, PcfKernel, Technique};
 
 /// A minimal valid scene; each error case changes one thing in it.
 ///
@@ -317,7 +317,7 @@ fn point_light_loads_without_target_or_extent() {
     let text = point_scene("technique = \"pcf\"\nradius = 2\n", 256);
     let scene = parse(&text).expect("a point light needs no target");
     let light = &scene.lights[0];
-    assert_eq!(light.kind, shadowgraph::scene::LightKind::Point);
+    assert_eq!(light.kind, shadowgraph::LightKind::Point);
     // PCF radius 2 reads 3 texels around the receiver: a guard band of 4.
     let layout = light.point_layout().expect("layout");
     assert_eq!((layout.face, layout.guard), (256, 4));
@@ -977,8 +977,7 @@ fn bundled_scenes_cast_shadows_the_camera_sees() {
 
 #[test]
 fn sat_filter_keys() {
-    use shadowgraph::sat::SatVariant;
-    use shadowgraph::scene::Filter;
+    use shadowgraph::{Filter, SatVariant};
     // `sat_sums` needs the sat filter; `filter_width` needs mips or sat.
     let text = scene_with(&[(
         "technique = \"hard\"",
@@ -1014,7 +1013,8 @@ fn sat_filter_keys() {
 /// `sat_exponent_limit`, with a warning when the scene set them; defaults clamp silently.
 #[test]
 fn sat_filter_clamps_exponents() {
-    use shadowgraph::scene::{Filter, sat_exponent_limit};
+    use shadowgraph::Filter;
+    use shadowgraph::low_level::technique::sat_exponent_limit;
     let text = scene_with(&[(
         "technique = \"hard\"",
         "technique = \"evsm4\"\nfilter = \"sat\"\nfilter_width = 4.0",
@@ -1022,7 +1022,7 @@ fn sat_filter_clamps_exponents() {
     let s = parse(&text).expect("parses");
     let filter = Filter::Sat {
         width: 4.0,
-        variant: shadowgraph::sat::SatVariant::Fixed,
+        variant: shadowgraph::SatVariant::Fixed,
     };
     // (4 + 1)² = 25 texels: ½ ln(2²² / 25) = 6.0.
     let limit = sat_exponent_limit(&filter, false).expect("a limit");
@@ -1060,7 +1060,7 @@ fn sat_filter_clamps_exponents() {
 /// `max_anisotropy` belongs to the mips filter, 0–16.
 #[test]
 fn max_anisotropy_key() {
-    use shadowgraph::scene::Filter;
+    use shadowgraph::Filter;
     let text = scene_with(&[(
         "technique = \"hard\"",
         "technique = \"vsm\"\nfilter = \"blur\"\nmax_anisotropy = 4",
@@ -1091,8 +1091,7 @@ fn max_anisotropy_key() {
 
 #[test]
 fn soft_techniques_keys_defaults_and_errors() {
-    use shadowgraph::sat::SatVariant;
-    use shadowgraph::scene::{Soft, Storage};
+    use shadowgraph::{SatVariant, Soft, Storage};
     let soft = |keys: &str, size: &str| {
         scene_with(&[
             ("technique = \"hard\"", keys),
@@ -1123,10 +1122,10 @@ fn soft_techniques_keys_defaults_and_errors() {
             attenuation: 1.0,
             offset: 0.0625,
             scale: 2.0,
-            sharpen: shadowgraph::scene::DEFAULT_SHARPEN,
-            sharpen_falloff: shadowgraph::scene::DEFAULT_SHARPEN_FALLOFF,
-            search: shadowgraph::scene::CssmSearch::Moments,
-            resolve: shadowgraph::scene::CssmResolve::TwoDepth,
+            sharpen: shadowgraph::low_level::model::DEFAULT_SHARPEN,
+            sharpen_falloff: shadowgraph::low_level::model::DEFAULT_SHARPEN_FALLOFF,
+            search: shadowgraph::CssmSearch::Moments,
+            resolve: shadowgraph::CssmResolve::TwoDepth,
         }
     );
     let s = parse(&soft("technique = \"vssm\"", "size = 0.5")).expect("vssm parses");
@@ -1150,7 +1149,7 @@ fn soft_techniques_keys_defaults_and_errors() {
                 max_search: 0.05,
             },
             hausdorff: true,
-            moment_bias: shadowgraph::scene::default_soft_moment_bias(Storage::Unorm16),
+            moment_bias: shadowgraph::low_level::model::default_soft_moment_bias(Storage::Unorm16),
             bleed: 0.0,
         }
     );
@@ -1311,5 +1310,5 @@ fn cascade_keys_are_checked() {
         assert_eq!(c.count, 3, "{t}");
     }
     let c = parse(BASE).expect("base").lights[0].shadow.cascades;
-    assert_eq!(c, shadowgraph::model::Cascades::SINGLE);
+    assert_eq!(c, shadowgraph::Cascades::SINGLE);
 }

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use shadowgraph::Error;
-use shadowgraph::scene::Scene;
+use shadowgraph::low_level::scene::Scene;
 
 /// Two lights (a spot, then the light `LIGHT` puts in) over a plane.
 const BASE: &str = r#"[output]
@@ -150,8 +150,8 @@ fn duplicated_keys_and_tables_are_named() {
 /// it does not take, and no key of its own is unknown to the reader.
 #[test]
 fn every_registry_key_reaches_the_checker() {
-    use shadowgraph::model::{ParamKind, keys};
-    use shadowgraph::technique::REGISTRY;
+    use shadowgraph::low_level::model::{ParamKind, keys};
+    use shadowgraph::low_level::technique::REGISTRY;
     let all: Vec<_> = REGISTRY
         .iter()
         .flat_map(|d| d.params.iter().flat_map(|t| t.iter()))
@@ -191,8 +191,8 @@ fn every_registry_key_reaches_the_checker() {
 /// key of those tables as the registry lists them.
 #[test]
 fn every_common_and_cascade_key_changes_the_light() {
-    use shadowgraph::model::ParamKind;
-    use shadowgraph::technique::params::{CASCADES, COMMON};
+    use shadowgraph::low_level::model::ParamKind;
+    use shadowgraph::low_level::technique::params::{CASCADES, COMMON};
     let sun = "[[light]]\nkind = \"directional\"\nposition = [3.0, 6.0, 2.0]\n\
                target = [0.0, 0.0, 0.0]\nextent = 5.0\n\n[light.shadow]\ntechnique = \"pcf\"\n";
     let load = |extra: &str| {

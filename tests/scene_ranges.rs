@@ -6,7 +6,7 @@ use std::path::Path;
 use std::time::Duration;
 
 use shadowgraph::Error;
-use shadowgraph::scene::Scene;
+use shadowgraph::low_level::scene::Scene;
 
 /// A scene with most keys a scene can have, each number on a line of its own, so that the
 /// sweep below can change one at a time and know which key and line it changed.

@@ -5,10 +5,10 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use shadowgraph::Error;
-use shadowgraph::cpu::{self, Map, Texels};
-use shadowgraph::render::{DrawnLights, RenderOptions, Renderer, drawn_lights};
-use shadowgraph::scene::{PcfKernel, Scene, Technique};
+use shadowgraph::low_level::cpu::{self, Map, Texels};
+use shadowgraph::low_level::render::{DrawnLights, RenderOptions, Renderer, drawn_lights};
+use shadowgraph::low_level::scene::Scene;
+use shadowgraph::{Error, PcfKernel, Technique};
 
 fn scenes() -> Vec<PathBuf> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
@@ -37,7 +37,7 @@ fn scenes() -> Vec<PathBuf> {
 /// propagated errors could flip the blocker threshold).
 fn pixel_reference(
     scene: &Scene,
-    frame: &shadowgraph::render::Frame,
+    frame: &shadowgraph::low_level::render::Frame,
     moments: &[Texels],
     soft: Option<&common::soft::SoftInputs>,
     (drawn, k): (&DrawnLights, usize),
@@ -64,7 +64,7 @@ fn pixel_reference(
     let mut s = cpu::light::sample(&lg, p, n);
     if lg.max_anisotropy > 0 {
         // The pixel's footprint, as the shading kernel derives it from the camera's rays.
-        let rays = shadowgraph::render::CameraRays::new(&scene.camera, frame.width, frame.height);
+        let rays = shadowgraph::low_level::render::CameraRays::new(&scene.camera, frame.width, frame.height);
         let (x, y) = (px as u32 % frame.width, px as u32 / frame.width);
         let eye = scene.camera.position.as_dvec3();
         let (dx, dy) = cpu::shade::pixel_differentials(eye, &rays, x, y, p, n);
@@ -196,7 +196,7 @@ fn pixel_reference(
 /// reference may pick different faces. Either face reads real geometry there (the guard band):
 /// the two lookups differ by resampling, not by a seam; tests/point.rs checks those receivers
 /// against the ray cast.
-fn point_face_tie(lg: &shadowgraph::technique::LightGpu, p: glam::DVec3, n: glam::DVec3) -> bool {
+fn point_face_tie(lg: &shadowgraph::LightGpu, p: glam::DVec3, n: glam::DVec3) -> bool {
     let pos = glam::DVec3::new(
         lg.position[0].into(),
         lg.position[1].into(),
@@ -261,7 +261,7 @@ fn every_scene_renders_and_matches_the_references() {
             // (the chain's own accuracy is tested in tests/prefilter.rs).
             let technique = scene.lights[li].shadow.technique;
             let moments = match technique.filter() {
-                Some(shadowgraph::scene::Filter::Mips { .. }) => {
+                Some(shadowgraph::Filter::Mips { .. }) => {
                     cpu::mips::mip_chain(&level0, matches!(technique, Technique::Esm { .. }))
                 }
                 _ => vec![level0.clone()],
@@ -301,8 +301,8 @@ fn every_scene_renders_and_matches_the_references() {
 /// The filtered map the shading read equals the f64 encode and blur of the linear map the GPU
 /// produced: f32 storage 1e-6 (as in tests/prefilter.rs), widened by SPIR-V's (3 + 2|x|)-ULP
 /// `exp` for the exponential encodings; f16 storage 3 · 2⁻¹⁰ relative.
-fn check_prefilter_chain(scene: &Scene, frame: &shadowgraph::render::Frame, li: usize) {
-    use shadowgraph::scene::{Filter, Storage};
+fn check_prefilter_chain(scene: &Scene, frame: &shadowgraph::low_level::render::Frame, li: usize) {
+    use shadowgraph::{Filter, Storage};
     let (encoded, channels, filter, storage, log_space, rtol) =
         match scene.lights[li].shadow.technique {
             Technique::Vsm { prefilter, .. } => (
@@ -361,7 +361,7 @@ fn check_prefilter_chain(scene: &Scene, frame: &shadowgraph::render::Frame, li: 
             }
             Technique::Msm { prefilter, .. } => {
                 let quantized =
-                    shadowgraph::technique::msm_quantized(&scene.lights[li].shadow.technique);
+                    shadowgraph::low_level::technique::msm_quantized(&scene.lights[li].shadow.technique);
                 let f = move |t: &Texels| cpu::msm::msm(t, quantized);
                 (
                     Box::new(f) as Box<dyn Fn(&Texels) -> Texels>,
@@ -396,7 +396,7 @@ fn check_prefilter_chain(scene: &Scene, frame: &shadowgraph::render::Frame, li: 
             ),
             Technique::MsmSoft { soft, .. } => {
                 let quantized =
-                    shadowgraph::technique::msm_quantized(&scene.lights[li].shadow.technique);
+                    shadowgraph::low_level::technique::msm_quantized(&scene.lights[li].shadow.technique);
                 let f = move |t: &Texels| cpu::msm::msm(t, quantized);
                 (
                     Box::new(f) as Box<dyn Fn(&Texels) -> Texels>,
@@ -418,8 +418,8 @@ fn check_prefilter_chain(scene: &Scene, frame: &shadowgraph::render::Frame, li: 
                 let f = move |t: &Texels| {
                     let a = cpu::csm::csm(t, terms);
                     let b = match search {
-                        shadowgraph::scene::CssmSearch::Moments => cpu::msm::msm(t, true),
-                        shadowgraph::scene::CssmSearch::CsmZ => cpu::csm_z::csm_z(t, terms),
+                        shadowgraph::CssmSearch::Moments => cpu::msm::msm(t, true),
+                        shadowgraph::CssmSearch::CsmZ => cpu::csm_z::csm_z(t, terms),
                     };
                     let data = a
                         .data
@@ -434,8 +434,8 @@ fn check_prefilter_chain(scene: &Scene, frame: &shadowgraph::render::Frame, li: 
                     }
                 };
                 let search_channels = match search {
-                    shadowgraph::scene::CssmSearch::Moments => 4,
-                    shadowgraph::scene::CssmSearch::CsmZ => 2 * terms as usize + 1,
+                    shadowgraph::CssmSearch::Moments => 4,
+                    shadowgraph::CssmSearch::CsmZ => 2 * terms as usize + 1,
                 };
                 (
                     Box::new(f) as Box<dyn Fn(&Texels) -> Texels>,
@@ -504,18 +504,18 @@ fn check_prefilter_chain(scene: &Scene, frame: &shadowgraph::render::Frame, li: 
         // the quantization matrix's entries (up to 82) and their sum, 2⁻²⁴ of 82 each, before
         // the storage rounds: 4 · 82 · 2⁻²⁴ ≈ 2·10⁻⁵.
         Technique::Msm { .. } | Technique::MsmSoft { .. }
-            if shadowgraph::technique::msm_quantized(technique) && storage == Storage::F32 =>
+            if shadowgraph::low_level::technique::msm_quantized(technique) && storage == Storage::F32 =>
         {
             atol + 4.0 * 82.0 * 2f64.powi(-24)
         }
         _ => atol,
     };
     let what = format!("light {li} filtered map");
-    let coding = shadowgraph::technique::sat_coding(&scene.lights[li]).expect("valid coding");
+    let coding = shadowgraph::low_level::technique::sat_coding(&scene.lights[li]).expect("valid coding");
     match coding {
         // The table's texels decode to the representation quantized to the coding's step:
         // ½ / scale per channel, plus f32 rounding of the scaled value (2⁻²⁴ of it, twice).
-        Some(c) if c.variant == shadowgraph::sat::SatVariant::Fixed => {
+        Some(c) if c.variant == shadowgraph::SatVariant::Fixed => {
             for ch in 0..channels {
                 let pick = |v: &[f32]| -> Vec<f32> {
                     v.iter().skip(ch).step_by(channels).copied().collect()
@@ -594,7 +594,7 @@ fn shadow_map_past_the_device_limit_is_a_clear_error() {
 fn plan_contains_only_what_techniques_need() {
     let two =
         Scene::load(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/two_lights.toml")).unwrap();
-    let sp = shadowgraph::render::plan_lights(&two.lights).unwrap();
+    let sp = shadowgraph::low_level::render::plan_lights(&two.lights).unwrap();
     for (i, l) in two.lights.iter().enumerate() {
         let steps: Vec<&str> = sp
             .plan
@@ -626,7 +626,7 @@ fn plan_contains_only_what_techniques_need() {
 /// encoding of their hard counterparts and one table.
 #[test]
 fn blocker_kernels_are_planned_only_for_soft_lights() {
-    let mut lights: Vec<shadowgraph::scene::Light> = Vec::new();
+    let mut lights: Vec<shadowgraph::Light> = Vec::new();
     for path in scenes() {
         lights.extend(Scene::load(&path).expect("scene").lights);
     }
@@ -644,7 +644,7 @@ fn blocker_kernels_are_planned_only_for_soft_lights() {
         soft_scene("msm_sat.toml"),
         soft_scene("msm_soft.toml"),
     ]);
-    let sp = shadowgraph::render::plan_lights(&lights).expect("plan");
+    let sp = shadowgraph::low_level::render::plan_lights(&lights).expect("plan");
     for (i, l) in lights.iter().enumerate() {
         let mut kernels: Vec<&str> = sp
             .plan
@@ -683,25 +683,25 @@ fn blocker_kernels_are_planned_only_for_soft_lights() {
                 search,
                 ..
             } => {
-                let basis = shadowgraph::technique::csm_maps(terms) as usize;
+                let basis = shadowgraph::low_level::technique::csm_maps(terms) as usize;
                 let z = match search {
-                    shadowgraph::scene::CssmSearch::CsmZ => {
-                        shadowgraph::technique::csm_z_maps(terms) as usize
+                    shadowgraph::CssmSearch::CsmZ => {
+                        shadowgraph::low_level::technique::csm_z_maps(terms) as usize
                     }
-                    shadowgraph::scene::CssmSearch::Moments => 1,
+                    shadowgraph::CssmSearch::Moments => 1,
                 };
                 assert_eq!(blocker, z, "{what}: the blocker search's tables");
                 // One layered table (`sat::layers`): the edges of every layer from the depth,
                 // the carries, and four textures a dispatch, fixed-point tables as many a
                 // texture as fit; no basis map stored.
-                let per = shadowgraph::sat::layers::LAYERED_SAT_OUTPUTS as usize;
+                let per = shadowgraph::low_level::sat::layers::LAYERED_SAT_OUTPUTS as usize;
                 let tables = (basis + z) as u32;
                 let interleave =
-                    shadowgraph::technique::basis_interleave(l.map_dims().0, tables, soft.sums);
+                    shadowgraph::low_level::technique::basis_interleave(l.map_dims().0, tables, soft.sums);
                 let textures = (basis + z).div_ceil(interleave as usize);
                 let (sums, tiles) = match soft.sums {
-                    shadowgraph::sat::SatVariant::Fixed => ("csm_sat_tile_sums", "csm_sat_tiles"),
-                    shadowgraph::sat::SatVariant::Float => {
+                    shadowgraph::SatVariant::Fixed => ("csm_sat_tile_sums", "csm_sat_tiles"),
+                    shadowgraph::SatVariant::Float => {
                         ("csm_sat_tile_sums_f32", "csm_sat_tiles_f32")
                     }
                 };
@@ -711,18 +711,18 @@ fn blocker_kernels_are_planned_only_for_soft_lights() {
             }
             // The moments computed in the table's own tile passes (one layer, no map).
             Technique::Vssm { soft, .. } => Some(match soft.sums {
-                shadowgraph::sat::SatVariant::Fixed => {
+                shadowgraph::SatVariant::Fixed => {
                     vec!["vsm_sat_tile_sums", "sat_carries", "vsm_sat_tiles"]
                 }
-                shadowgraph::sat::SatVariant::Float => {
+                shadowgraph::SatVariant::Float => {
                     vec!["vsm_sat_tile_sums_f32", "sat_carries", "vsm_sat_tiles_f32"]
                 }
             }),
             Technique::MsmSoft { soft, .. } => Some(match soft.sums {
-                shadowgraph::sat::SatVariant::Fixed => {
+                shadowgraph::SatVariant::Fixed => {
                     vec!["msm_sat_tile_sums", "sat_carries", "msm_sat_tiles"]
                 }
-                shadowgraph::sat::SatVariant::Float => {
+                shadowgraph::SatVariant::Float => {
                     vec!["msm_sat_tile_sums_f32", "sat_carries", "msm_sat_tiles_f32"]
                 }
             }),
@@ -754,26 +754,26 @@ fn blocker_kernels_are_planned_only_for_soft_lights() {
 /// seen in 120×90 pixels casts little).
 #[test]
 fn every_technique_renders_every_bundled_scene() {
-    use shadowgraph::scene::{BlurKernel, Filter, Prefilter, Storage};
+    use shadowgraph::{BlurKernel, Filter, Storage, StorageFilter};
     let blur = Filter::Blur {
         radius: 2.0,
         sigma: 1.0,
         kernel: BlurKernel::Gaussian,
     };
-    let pre = |storage, filter| Prefilter { storage, filter };
+    let pre = |storage, filter| StorageFilter { storage, filter };
     let sat = Filter::Sat {
         width: 4.5,
-        variant: shadowgraph::sat::SatVariant::Fixed,
+        variant: shadowgraph::SatVariant::Fixed,
     };
     let sat_float = Filter::Sat {
         width: 2.0,
-        variant: shadowgraph::sat::SatVariant::Float,
+        variant: shadowgraph::SatVariant::Float,
     };
-    let sat_limit = shadowgraph::scene::sat_exponent_limit(&sat, false).expect("sat limit");
-    let soft = |storage, sums| shadowgraph::scene::Soft {
+    let sat_limit = shadowgraph::low_level::technique::sat_exponent_limit(&sat, false).expect("sat limit");
+    let soft = |storage, sums| shadowgraph::Soft {
         storage,
         sums,
-        max_search: shadowgraph::scene::DEFAULT_MAX_SEARCH,
+        max_search: shadowgraph::low_level::model::DEFAULT_MAX_SEARCH,
     };
     let techniques = [
         Technique::Hard,
@@ -878,23 +878,23 @@ fn every_technique_renders_every_bundled_scene() {
             scale: 2.0,
         },
         Technique::Cssm {
-            soft: soft(Storage::F32, shadowgraph::sat::SatVariant::Fixed),
+            soft: soft(Storage::F32, shadowgraph::SatVariant::Fixed),
             terms: 3,
             attenuation: 1.0,
             offset: 0.5 / 3.0,
             scale: 2.0,
-            sharpen: shadowgraph::scene::DEFAULT_SHARPEN,
-            sharpen_falloff: shadowgraph::scene::DEFAULT_SHARPEN_FALLOFF,
-            search: shadowgraph::scene::CssmSearch::CsmZ,
-            resolve: shadowgraph::scene::CssmResolve::TwoDepth,
+            sharpen: shadowgraph::low_level::model::DEFAULT_SHARPEN,
+            sharpen_falloff: shadowgraph::low_level::model::DEFAULT_SHARPEN_FALLOFF,
+            search: shadowgraph::CssmSearch::CsmZ,
+            resolve: shadowgraph::CssmResolve::TwoDepth,
         },
         Technique::Vssm {
-            soft: soft(Storage::F16, shadowgraph::sat::SatVariant::Float),
+            soft: soft(Storage::F16, shadowgraph::SatVariant::Float),
             bleed: 0.2,
             min_variance: 1e-5,
         },
         Technique::MsmSoft {
-            soft: soft(Storage::F16, shadowgraph::sat::SatVariant::Fixed),
+            soft: soft(Storage::F16, shadowgraph::SatVariant::Fixed),
             hausdorff: false,
             moment_bias: 5e-4,
             bleed: 0.0,
@@ -915,8 +915,8 @@ fn every_technique_renders_every_bundled_scene() {
             for l in &mut scene.lights {
                 l.shadow.technique = t;
                 // A technique that refuses cascades (`params::cascade_support`): one map.
-                if shadowgraph::technique::params::cascade_support(&t).is_err() {
-                    l.shadow.cascades = shadowgraph::model::Cascades::SINGLE;
+                if shadowgraph::low_level::technique::params::cascade_support(&t).is_err() {
+                    l.shadow.cascades = shadowgraph::Cascades::SINGLE;
                 }
                 l.shadow_map = l.shadow_map.min(512);
                 // PCSS and the soft techniques model an area light (scenes require a size).
@@ -958,11 +958,11 @@ mod cascades {
     use super::*;
 
     /// The maps a cascade's visibility reads (with the mips filter, the chain rebuilt in f64).
-    fn moments(frame: &shadowgraph::render::Frame, technique: Technique, k: usize) -> Vec<Texels> {
+    fn moments(frame: &shadowgraph::low_level::render::Frame, technique: Technique, k: usize) -> Vec<Texels> {
         let sm = &frame.shade_maps[k];
         let level0 = Texels::from_f32(sm.width as usize, sm.height as usize, sm.channels, &sm.data);
         match technique.filter() {
-            Some(shadowgraph::scene::Filter::Mips { .. }) => {
+            Some(shadowgraph::Filter::Mips { .. }) => {
                 cpu::mips::mip_chain(&level0, matches!(technique, Technique::Esm { .. }))
             }
             _ => vec![level0],
@@ -977,7 +977,7 @@ mod cascades {
     /// lie inside a blend band.
     pub fn check_light(
         scene: &Scene,
-        frame: &shadowgraph::render::Frame,
+        frame: &shadowgraph::low_level::render::Frame,
         drawn: &DrawnLights,
         li: usize,
         e_trig: f64,
@@ -1076,7 +1076,7 @@ mod cascades {
 
 /// Technique `name` with its registry defaults.
 fn registered(name: &str) -> Technique {
-    shadowgraph::technique::named(name, &[]).unwrap_or_else(|| panic!("{name} is registered"))
+    shadowgraph::low_level::technique::named(name, &[]).unwrap_or_else(|| panic!("{name} is registered"))
 }
 
 /// The cascaded street view with the other techniques that take cascades: each cascade's map
@@ -1087,7 +1087,7 @@ fn registered(name: &str) -> Technique {
 /// references (`cascades::check_light`).
 #[test]
 fn cascaded_techniques_match_the_references() {
-    use shadowgraph::scene::{BlurKernel, Filter, Prefilter, Storage};
+    use shadowgraph::{BlurKernel, Filter, Storage, StorageFilter};
     let g = common::gpu();
     let e_trig = common::soft_maps::trig_error(&g);
     let mut renderer = Renderer::new(&g.device);
@@ -1100,9 +1100,9 @@ fn cascaded_techniques_match_the_references() {
     };
     let table = Filter::Sat {
         width: 3.0,
-        variant: shadowgraph::sat::SatVariant::Float,
+        variant: shadowgraph::SatVariant::Float,
     };
-    let pre = |storage, filter| Prefilter { storage, filter };
+    let pre = |storage, filter| StorageFilter { storage, filter };
     for t in [
         Technique::Hard,
         Technique::Vsm {

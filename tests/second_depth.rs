@@ -12,14 +12,15 @@ mod common;
 use std::path::Path;
 
 use glam::{DMat4, DVec3, DVec4};
-use shadowgraph::cpu;
-use shadowgraph::render::{Frame, RenderOptions, Renderer};
-use shadowgraph::scene::{Light, LightKind, PcfKernel, Scene, Technique};
-use shadowgraph::technique::{self, SecondDepthParams};
-use shadowgraph::truth::bvh::Bvh;
-use shadowgraph::truth::peel::{PeeledTexel, peeled_depths};
-use shadowgraph::truth::raycast::{CpuTruth, ray_cast_truth};
-use shadowgraph::truth::{axis_distance, emitter};
+use shadowgraph::low_level::cpu;
+use shadowgraph::low_level::render::{Frame, RenderOptions, Renderer};
+use shadowgraph::low_level::scene::Scene;
+use shadowgraph::low_level::technique::{self, SecondDepthParams};
+use shadowgraph::low_level::truth::bvh::Bvh;
+use shadowgraph::low_level::truth::peel::{PeeledTexel, peeled_depths};
+use shadowgraph::low_level::truth::raycast::{CpuTruth, ray_cast_truth};
+use shadowgraph::low_level::truth::{axis_distance, emitter};
+use shadowgraph::{Light, LightKind, PcfKernel, Technique};
 
 fn scene(name: &str) -> Scene {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(name);
@@ -27,7 +28,7 @@ fn scene(name: &str) -> Scene {
 }
 
 /// Renders `scene` keeping every resource of its plan (imports too: both depth maps).
-fn dump(renderer: &mut Renderer, g: &shadowgraph::gpu::Gpu, scene: &Scene) -> Frame {
+fn dump(renderer: &mut Renderer, g: &shadowgraph::low_level::gpu::Gpu, scene: &Scene) -> Frame {
     let opts = RenderOptions {
         aux: false,
         repeat: 1,
@@ -249,9 +250,9 @@ fn ground_pixels(
 /// positions.
 fn render_with(
     renderer: &mut Renderer,
-    g: &shadowgraph::gpu::Gpu,
+    g: &shadowgraph::low_level::gpu::Gpu,
     base: &Scene,
-    set: impl Fn(&mut shadowgraph::scene::Shadow),
+    set: impl Fn(&mut shadowgraph::Shadow),
 ) -> Frame {
     let mut scene = base.clone();
     for l in &mut scene.lights {

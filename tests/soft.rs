@@ -14,13 +14,13 @@ use common::soft_maps::{
 };
 use glam::{DVec3, Vec3};
 use rand::Rng;
-use shadowgraph::cpu::sat::Integral;
-use shadowgraph::cpu::{self, Texels};
-use shadowgraph::gpu::Gpu;
-use shadowgraph::render::{MapData, Renderer, visibility_at};
-use shadowgraph::sat::SatVariant;
-use shadowgraph::scene::{CssmSearch, Light, Scene, Storage, Technique};
-use shadowgraph::technique::{LightGpu, sat_coding};
+use shadowgraph::low_level::cpu::sat::Integral;
+use shadowgraph::low_level::cpu::{self, Texels};
+use shadowgraph::low_level::gpu::Gpu;
+use shadowgraph::low_level::render::{MapData, Renderer, visibility_at};
+use shadowgraph::low_level::scene::Scene;
+use shadowgraph::low_level::technique::sat_coding;
+use shadowgraph::{CssmSearch, Light, LightGpu, SatVariant, Storage, Technique};
 
 /// A world point with random light-space UV and linear depth, normal facing the light.
 fn point(l: &Light, rng: &mut impl Rng) -> (Vec3, Vec3) {
@@ -213,7 +213,7 @@ fn msm_soft_matches_reference() {
         (Storage::F32, false, SatVariant::Float, 213),
     ] {
         let technique = with_sums(msm_soft(storage, hausdorff), sums);
-        let quantized = shadowgraph::technique::msm_quantized(&technique);
+        let quantized = shadowgraph::low_level::technique::msm_quantized(&technique);
         assert!(quantized, "a soft MSM table sums quantized moments");
         let seen = check_soft(
             &g,
@@ -240,7 +240,7 @@ fn cssm_matches_reference() {
     let g = common::gpu();
     let e_trig = trig_error(&g);
     eprintln!("device sin/cos error (×2 + 2⁻²⁴): {e_trig:.2e}");
-    use shadowgraph::scene::CssmResolve::{Sharpen, TwoDepth, TwoDepthSearch};
+    use shadowgraph::CssmResolve::{Sharpen, TwoDepth, TwoDepthSearch};
     for (terms, seed, kind, sums, resolve) in [
         (4, 220, CssmSearch::Moments, SatVariant::Fixed, TwoDepth),
         (7, 221, CssmSearch::Moments, SatVariant::Fixed, TwoDepth),
@@ -314,7 +314,7 @@ fn distance_to_pcss(g: &Gpu, renderer: &mut Renderer, scene: &Scene) -> Distance
             &g.device,
             &g.queue,
             scene,
-            shadowgraph::render::RenderOptions {
+            shadowgraph::low_level::render::RenderOptions {
                 aux: true,
                 repeat: 1,
                 dump: false,

@@ -1,6 +1,6 @@
-//! The numerical-stability suite (`shadowgraph::stability`, `shadowgraph stability`), one test
+//! The numerical-stability suite (`shadowgraph::low_level::stability`, `shadowgraph stability`), one test
 //! per case. Each case runs the real kernels on its hard inputs and compares every value with
-//! an independent f64 reference (`shadowgraph::cpu`) under a bound stated, with its reason, in
+//! an independent f64 reference (`shadowgraph::low_level::cpu`) under a bound stated, with its reason, in
 //! the case's module; here every row must pass (rows marked `reported` are figures shown
 //! without a bound), have compared something, and have no NaN/Inf. The table is printed
 //! (`cargo test --release --test stability -- --nocapture`).
@@ -10,8 +10,8 @@
 
 mod common;
 
-use shadowgraph::gpu::Gpu;
-use shadowgraph::stability::{self, SatTables, StabilityReport, StabilityRow, Verdict};
+use shadowgraph::low_level::gpu::Gpu;
+use shadowgraph::low_level::stability::{self, SatTables, StabilityReport, StabilityRow, Verdict};
 
 /// Runs one case, prints its table and asserts every verdict; returns the rows.
 fn run_case(

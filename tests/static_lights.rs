@@ -10,9 +10,9 @@ mod common;
 
 use std::path::Path;
 
-use shadowgraph::graph::Dispatch;
-use shadowgraph::render::{Frame, RenderOptions, Renderer, plan_lights};
-use shadowgraph::scene::Scene;
+use shadowgraph::low_level::graph::Dispatch;
+use shadowgraph::low_level::render::{Frame, RenderOptions, Renderer, plan_lights};
+use shadowgraph::low_level::scene::Scene;
 
 /// Two spot lights over a box on a plane. Light 0 is redrawn every frame (and moved by
 /// `moving_z`); light 1 is the cached one (`update`, moved by `x`, its `[light.shadow]` body
@@ -128,7 +128,7 @@ fn dispatches(scene: &Scene, l: usize) -> u64 {
 }
 
 /// Renders one frame of `scene`: the frame and the dispatches the executor recorded.
-fn frame(r: &mut Renderer, g: &shadowgraph::gpu::Gpu, scene: &Scene) -> (Frame, u64) {
+fn frame(r: &mut Renderer, g: &shadowgraph::low_level::gpu::Gpu, scene: &Scene) -> (Frame, u64) {
     let before = r.executor.dispatch_count();
     let f = r
         .render(&g.device, &g.queue, scene, RenderOptions::default())
@@ -153,7 +153,7 @@ fn passes_of(f: &Frame, k: usize, l: usize) -> Vec<String> {
 fn check(
     cached: &mut Renderer,
     fresh: &mut Renderer,
-    g: &shadowgraph::gpu::Gpu,
+    g: &shadowgraph::low_level::gpu::Gpu,
     s: &Setup,
     runs: bool,
     what: &str,

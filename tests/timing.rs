@@ -13,10 +13,10 @@ use std::path::Path;
 use std::sync::{Mutex, MutexGuard, PoisonError};
 use std::time::Instant;
 
-use shadowgraph::gpu::{Gpu, submit_and_wait};
-use shadowgraph::prefilter::{LightParams, Prefilter, PrefilterConfig};
-use shadowgraph::render::{RenderOptions, Renderer};
-use shadowgraph::scene::{Filter, Scene};
+use shadowgraph::low_level::gpu::{Gpu, submit_and_wait};
+use shadowgraph::low_level::render::{RenderOptions, Renderer};
+use shadowgraph::low_level::scene::Scene;
+use shadowgraph::{Filter, LightParams, Prefilter, PrefilterConfig};
 
 /// Held by each test while it measures: the tests of this file run one at a time, so that
 /// none times its frames on cores another one's frames are using (cargo runs a binary's tests
@@ -341,17 +341,17 @@ fn bench_times_agree_with_the_wall_clock() {
     let floor = if cpu(&g) { BENCH_FLOOR } else { 0.0 };
     let mut bad = Vec::new();
     for m in 0..BENCH_MEASUREMENTS {
-        let rows = shadowgraph::bench::measure(
+        let rows = shadowgraph::low_level::bench::measure(
             &g.device,
             &g.queue,
             &[1024],
             5,
             &["esm".into()],
-            shadowgraph::bench::Inputs::Random,
+            shadowgraph::low_level::bench::Inputs::Random,
         )
         .expect("bench");
         assert!(
-            rows.len() > shadowgraph::bench::COPY_FORMATS.len() + 1,
+            rows.len() > shadowgraph::low_level::bench::COPY_FORMATS.len() + 1,
             "copies and esm"
         );
         bad.extend(

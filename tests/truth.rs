@@ -7,12 +7,13 @@ mod common;
 use std::path::Path;
 
 use rand::Rng;
-use shadowgraph::cpu::Map;
-use shadowgraph::render::{RenderOptions, Renderer};
-use shadowgraph::scene::{Scene, Technique};
-use shadowgraph::truth::pcf::{Receiver, pcf_box};
-use shadowgraph::truth::raycast::{CpuTruth, ray_cast_truth};
-use shadowgraph::truth::{Emitter, Truth, TruthOptions, area_light_truth, emitter};
+use shadowgraph::Technique;
+use shadowgraph::low_level::cpu::Map;
+use shadowgraph::low_level::render::{RenderOptions, Renderer};
+use shadowgraph::low_level::scene::Scene;
+use shadowgraph::low_level::truth::pcf::{Receiver, pcf_box};
+use shadowgraph::low_level::truth::raycast::{CpuTruth, ray_cast_truth};
+use shadowgraph::low_level::truth::{Emitter, Truth, TruthOptions, area_light_truth, emitter};
 
 fn scene(name: &str, width: u32, height: u32) -> Scene {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -284,7 +285,7 @@ fn too_many_emitter_samples_are_a_limit() {
     let s = scene("sphere_on_plane.toml", 32, 24);
     let g = common::gpu();
     let mut renderer = Renderer::new(&g.device);
-    let most = shadowgraph::truth::MAX_EMITTER_SAMPLES;
+    let most = shadowgraph::low_level::truth::MAX_EMITTER_SAMPLES;
     for emitter in [
         Emitter::Stratified {
             k: most as u32 + 1,

@@ -10,10 +10,9 @@ mod common;
 
 use glam::{DVec3, Vec3};
 use rand::Rng;
-use shadowgraph::cpu::{self, Map};
-use shadowgraph::render::{MapData, Renderer, visibility_at};
-use shadowgraph::scene::{Light, LightKind, PcfKernel, Shadow, Technique};
-use shadowgraph::technique::LightGpu;
+use shadowgraph::low_level::cpu::{self, Map};
+use shadowgraph::low_level::render::{MapData, Renderer, visibility_at};
+use shadowgraph::{Light, LightGpu, LightKind, PcfKernel, Shadow, Technique};
 
 const MAP: usize = 61; // not a power of two
 
@@ -37,7 +36,7 @@ fn light(kind: LightKind, technique: Technique) -> Light {
             slope_bias: 0.0,
             normal_bias: 1.0,
             receiver_plane: 0.0,
-            cascades: shadowgraph::model::Cascades::SINGLE,
+            cascades: shadowgraph::Cascades::SINGLE,
         },
     }
 }
@@ -383,7 +382,7 @@ fn check_prefiltered(
         };
         let encoded = round(&encoded);
         let levels: Vec<cpu::Texels> = match technique.filter() {
-            Some(shadowgraph::scene::Filter::Mips { .. }) => {
+            Some(shadowgraph::Filter::Mips { .. }) => {
                 let log = matches!(technique, Technique::Esm { .. });
                 cpu::mips::mip_chain(&encoded, log)
                     .iter()
@@ -474,14 +473,14 @@ fn blurred(t: &cpu::Texels, log_space: bool) -> cpu::Texels {
         t,
         2.0,
         1.0,
-        shadowgraph::scene::BlurKernel::Gaussian,
+        shadowgraph::BlurKernel::Gaussian,
         log_space,
     )
 }
 
-fn prefilter() -> shadowgraph::scene::Prefilter {
-    use shadowgraph::scene::{BlurKernel, Filter, Prefilter, Storage};
-    Prefilter {
+fn prefilter() -> shadowgraph::StorageFilter {
+    use shadowgraph::{BlurKernel, Filter, Storage, StorageFilter};
+    StorageFilter {
         storage: Storage::F32,
         filter: Filter::Blur {
             radius: 2.0,
@@ -543,7 +542,7 @@ fn evsm2_and_evsm4_match_reference() {
 
 #[test]
 fn esm_matches_reference_in_log_space() {
-    use shadowgraph::scene::{BlurKernel, Filter};
+    use shadowgraph::{BlurKernel, Filter};
     let t = Technique::Esm {
         filter: Filter::Blur {
             radius: 2.0,
@@ -561,16 +560,16 @@ fn esm_matches_reference_in_log_space() {
     );
 }
 
-fn msm(storage: shadowgraph::scene::Storage, hausdorff: bool, filter: Filter) -> Technique {
+fn msm(storage: shadowgraph::Storage, hausdorff: bool, filter: Filter) -> Technique {
     Technique::Msm {
-        prefilter: shadowgraph::scene::Prefilter { storage, filter },
+        prefilter: shadowgraph::StorageFilter { storage, filter },
         hausdorff,
-        moment_bias: shadowgraph::scene::default_moment_bias(storage),
+        moment_bias: shadowgraph::low_level::model::default_moment_bias(storage),
         bleed: 0.05,
     }
 }
 
-use shadowgraph::scene::{Filter, Storage};
+use shadowgraph::{Filter, Storage};
 
 #[test]
 fn msm_hamburger_and_hausdorff_match_reference() {
@@ -601,7 +600,7 @@ fn msm_quantized_moments_match_reference() {
 
 fn csm(terms: u32, filter: Filter) -> Technique {
     Technique::Csm {
-        prefilter: shadowgraph::scene::Prefilter {
+        prefilter: shadowgraph::StorageFilter {
             storage: Storage::F32,
             filter,
         },
@@ -633,7 +632,7 @@ fn mip_filtered_lookups_match_reference_trilinearly() {
         max_anisotropy: 0,
     };
     let vsm = Technique::Vsm {
-        prefilter: shadowgraph::scene::Prefilter {
+        prefilter: shadowgraph::StorageFilter {
             storage: Storage::F32,
             filter: mips,
         },

@@ -15,14 +15,14 @@ use std::collections::{BTreeSet, HashMap};
 use std::path::Path;
 use std::sync::Arc;
 
-use shadowgraph::exec::{Executor, KernelLayout};
-use shadowgraph::gpu::{Gpu, read_texture, submit_and_wait};
-use shadowgraph::graph::{Graph, plan};
-use shadowgraph::kernels::{self, Replacements};
-use shadowgraph::render::{Frame, RenderOptions, Renderer};
-use shadowgraph::sat::five_pass::add_sat_five_pass;
-use shadowgraph::sat::{SatCoding, add_sat, lookup_area};
-use shadowgraph::scene::Scene;
+use shadowgraph::low_level::exec::{Executor, KernelLayout};
+use shadowgraph::low_level::gpu::{Gpu, read_texture, submit_and_wait};
+use shadowgraph::low_level::graph::{Graph, plan};
+use shadowgraph::low_level::kernels::{self, Replacements};
+use shadowgraph::low_level::render::{Frame, RenderOptions, Renderer};
+use shadowgraph::low_level::sat::five_pass::add_sat_five_pass;
+use shadowgraph::low_level::sat::{SatCoding, add_sat, lookup_area};
+use shadowgraph::low_level::scene::Scene;
 
 /// A bundled technique scene with its text edited (`edits`: each `from` must occur), shaded at
 /// 64 × 48 (the maps are what is checked; the frame only has to read them).

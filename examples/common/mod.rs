@@ -4,8 +4,7 @@
 
 use anyhow::{Context, Result};
 use glam::Vec3;
-use shadowgraph::prefilter::LightParams;
-use shadowgraph::timer::TIMER_FEATURES;
+use shadowgraph::{LightParams, TIMER_FEATURES};
 use wgpu::util::DeviceExt;
 
 #[repr(C)]

@@ -8,8 +8,8 @@ use super::graphs::{
     stage_graph, unfused,
 };
 use crate::model::ParamValue;
+use crate::model::{Storage, Technique};
 use crate::sat::{self, SatVariant};
-use crate::scene::{Storage, Technique};
 use crate::technique;
 use crate::technique::params::storage_name;
 

@@ -6,12 +6,12 @@
 
 use super::cases::named;
 use super::graphs::{BenchGraph, bench_light, shading_chain};
-use crate::gpu_data::{CSM_OUTPUTS, CsmParams, LinearizeParams};
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
 use crate::kernels::KernelId;
 use crate::model::{CssmSearch, ParamValue, Storage, Technique};
 use crate::sat::{SatCoding, add_sat};
 use crate::technique::{self, csm_maps, csm_z_channels, csm_z_maps, moments_format};
+use crate::wgsl_mirrors::{CSM_OUTPUTS, CsmParams, LinearizeParams};
 
 /// Terms of the CSSM chains timed.
 const TERMS: u32 = 8;

@@ -7,8 +7,8 @@ use glam::Vec3;
 use super::cases::named;
 use crate::filter::{BlurMode, add_filter};
 use crate::graph::Graph;
+use crate::model::{Light, LightKind, Shadow, Technique};
 use crate::sat::{self, SatCoding, SatVariant};
-use crate::scene::{Light, LightKind, Shadow, Technique};
 use crate::technique;
 
 /// The graph a case runs and the outputs that keep its nodes alive.

@@ -6,8 +6,8 @@ use super::harness::median;
 use super::{GPU_WARMUP_MS, WARMUP};
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
+use crate::model::{Filter, Storage, StorageFilter, Technique};
 use crate::sat::SatVariant;
-use crate::scene::{Filter, Prefilter, Storage, Technique};
 
 /// The scene the lookup-cost benchmark shades: `scenes/techniques/vsm.toml` (built-in shapes
 /// only), embedded so the benchmark runs from anywhere.
@@ -110,7 +110,7 @@ pub fn lookup_cost(
         Ok((median(&mut shade), median(&mut table)))
     };
     let vsm = |variant, width: u32| Technique::Vsm {
-        prefilter: Prefilter {
+        prefilter: StorageFilter {
             storage: Storage::F32,
             filter: Filter::Sat {
                 width: width as f32,
@@ -124,7 +124,7 @@ pub fn lookup_cost(
     for &width in widths {
         let (pcf_ms, _) = shade(Technique::Pcf {
             radius: (width - 1) / 2,
-            kernel: crate::scene::PcfKernel::Box,
+            kernel: crate::model::PcfKernel::Box,
         })?;
         let (sat_fixed_ms, sat_build_ms) = shade(vsm(SatVariant::Fixed, width))?;
         let (sat_float_ms, _) = shade(vsm(SatVariant::Float, width))?;

@@ -293,9 +293,9 @@ mod tests {
         assert!(held > own, "{held} {own}");
         executor.release_textures();
         assert_eq!(executor.texture_count(), 0);
-        let before = crate::created::created();
+        let before = crate::gpu_objects::created();
         let again = time(&mut executor, &msm);
-        let after = crate::created::created();
+        let after = crate::gpu_objects::created();
         assert_eq!(after.pipelines, before.pipelines, "kernels kept");
         assert_eq!(
             after.textures - before.textures,

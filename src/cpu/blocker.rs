@@ -6,7 +6,7 @@
 use std::f64::consts::PI;
 
 use super::light::{LightSample, linear_to_z, map_width};
-use crate::gpu_data::LightGpu;
+use crate::wgsl_mirrors::LightGpu;
 
 /// `BLOCKER_MIN_SHARE`: a search square with a smaller blocker share reads as lit.
 pub const MIN_SHARE: f64 = 0.01;

@@ -3,7 +3,7 @@
 
 use glam::DVec3;
 
-use crate::gpu_data::LightGpu;
+use crate::wgsl_mirrors::LightGpu;
 
 /// A receiver's cascade and blend (`CascadePick`), with its view distance and the band edges
 /// a test needs to tell where f32 may pick otherwise.

@@ -2,8 +2,8 @@
 
 use glam::{DMat4, DVec3, DVec4};
 
-use crate::gpu_data::LightGpu;
 use crate::model::point;
+use crate::wgsl_mirrors::LightGpu;
 
 /// Reference of `LightSample`.
 #[derive(Clone, Copy, Debug)]

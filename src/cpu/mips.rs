@@ -3,7 +3,7 @@
 
 use super::Texels;
 use super::light::LightSample;
-use crate::gpu_data::LightGpu;
+use crate::wgsl_mirrors::LightGpu;
 
 /// Weight of texel `i` of an `n_from`-texel axis in texel `j` of its `n_to`-texel reduction:
 /// the overlap of `[i/n_from, (i+1)/n_from)` and `[j/n_to, (j+1)/n_to)` over the latter's length.

@@ -1,7 +1,7 @@
 //! Reference of `kernels/second_depth.wgsl`.
 
 use super::linearize::linearize_texel;
-use crate::gpu_data::SecondDepthParams;
+use crate::wgsl_mirrors::SecondDepthParams;
 
 /// The depth a second-depth map holds at one texel, from its first and second rasterized
 /// depths `z1`, `z2` (depth-buffer values): the midpoint of their linear depths (`mode` 0) or

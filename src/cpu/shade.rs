@@ -5,9 +5,9 @@
 
 use glam::DVec3;
 
-use crate::gpu_data::FrameGpu;
-use crate::gpu_data::LightGpu;
 use crate::model::CameraRays;
+use crate::wgsl_mirrors::FrameGpu;
+use crate::wgsl_mirrors::LightGpu;
 
 /// What [`shade`] needs besides the G-buffer: the frame constants, each light and each
 /// material's albedo, as the shading kernel receives them.

@@ -4,7 +4,7 @@ use std::f64::consts::PI;
 
 use super::Texels;
 use super::light::LightSample;
-use crate::gpu_data::LightGpu;
+use crate::wgsl_mirrors::LightGpu;
 
 /// The truncated, attenuated Fourier series of the step minus ½, at receiver depth `d`,
 /// for filtered basis values `basis` (`2M` channels: sin, cos per term).

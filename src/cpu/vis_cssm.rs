@@ -6,8 +6,8 @@
 use super::blocker::{self, Blocker};
 use super::light::LightSample;
 use super::sat::Integral;
-use crate::gpu_data::LightGpu;
 use crate::model::CssmSearch;
+use crate::wgsl_mirrors::LightGpu;
 
 /// A CSSM light's representations, each per texel as its tables sum them.
 #[derive(Clone, Copy, Debug)]

@@ -2,7 +2,7 @@
 
 use super::Texels;
 use super::light::LightSample;
-use crate::gpu_data::LightGpu;
+use crate::wgsl_mirrors::LightGpu;
 
 /// `clamp(E[exp(c z)] · exp(−c d), 0, 1)` with the (bi/tri)linear mean of `exp(L)` over the
 /// log map (`levels`: the map, or its mip chain).

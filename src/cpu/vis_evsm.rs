@@ -2,7 +2,7 @@
 
 use super::Texels;
 use super::light::LightSample;
-use crate::gpu_data::LightGpu;
+use crate::wgsl_mirrors::LightGpu;
 
 /// One-tailed Chebyshev bound (`chebyshev_upper`).
 pub fn chebyshev_upper(mean: f64, mean_sq: f64, receiver: f64, floor: f64) -> f64 {

@@ -2,7 +2,7 @@
 
 use super::Map;
 use super::light::{LightSample, receiver_offset, tap_offset};
-use crate::gpu_data::LightGpu;
+use crate::wgsl_mirrors::LightGpu;
 
 /// Lit (1) when the receiver (moved along its plane to the texel's centre when the
 /// receiver-plane bias is on) is no deeper than the nearest texel plus the bias.

@@ -6,7 +6,7 @@
 
 use super::Texels;
 use super::light::LightSample;
-use crate::gpu_data::{LightGpu, MSM_HAUSDORFF, MSM_QUANTIZED};
+use crate::wgsl_mirrors::{LightGpu, MSM_HAUSDORFF, MSM_QUANTIZED};
 
 /// Moments of {0, ½, 1} with weights (3/16, 10/16, 3/16).
 pub const B0: [f64; 4] = [0.5, 0.34375, 0.265625, 0.2265625];

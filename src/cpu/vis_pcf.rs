@@ -2,7 +2,7 @@
 
 use super::Map;
 use super::light::{LightSample, linear_to_ndc, receiver_offset, tap_offset};
-use crate::gpu_data::LightGpu;
+use crate::wgsl_mirrors::LightGpu;
 
 /// Weighted mean of comparisons over the (2r + 1)² window (box or tent weights), each against
 /// the receiver plane's depth at its texel's centre when the receiver-plane bias is on.

@@ -2,7 +2,7 @@
 
 use super::light::{LightSample, linear_to_z, map_width, receiver_offset, tap_offset};
 use super::{Map, vogel_disc};
-use crate::gpu_data::LightGpu;
+use crate::wgsl_mirrors::LightGpu;
 
 /// Blocker-search radius in face UV (`pcss_search_radius`; map UV · `face_uv`).
 pub fn search_radius(l: &LightGpu, s: &LightSample) -> f64 {

@@ -4,7 +4,7 @@
 
 use super::Map;
 use super::light::LightSample;
-use crate::gpu_data::LightGpu;
+use crate::wgsl_mirrors::LightGpu;
 
 /// The `n` emitter points (units of the light's size, in `[−½, ½]²`), in the shader's order.
 pub fn emitter_points(n: u32) -> Vec<[f64; 2]> {

@@ -2,7 +2,7 @@
 
 use super::Texels;
 use super::light::LightSample;
-use crate::gpu_data::LightGpu;
+use crate::wgsl_mirrors::LightGpu;
 
 /// Chebyshev upper bound from the filtered moments (`levels`: the map, or its mip chain),
 /// with bleeding reduction.

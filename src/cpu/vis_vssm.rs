@@ -6,7 +6,7 @@
 use super::blocker::{self, Blocker};
 use super::light::LightSample;
 use super::sat::Integral;
-use crate::gpu_data::LightGpu;
+use crate::wgsl_mirrors::LightGpu;
 
 /// The blocker search's cells (`sat_search_cells_*`): each cell's mean moments and area.
 pub fn search(moments: &Integral, l: &LightGpu, s: &LightSample) -> Vec<(Vec<f64>, f64)> {

@@ -10,10 +10,13 @@ use crate::cpu::Map;
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
 use crate::render::{FloatMap, Frame, RenderOptions, Renderer, plan_lights};
-use crate::scene::{Filter, Scene, Technique};
 use crate::technique::LightGpu;
 use crate::truth::Truth;
 use crate::truth::pcf::{Receiver, pcf_box};
+use crate::{
+    model::{Filter, Technique},
+    scene::Scene,
+};
 
 /// What every configuration is measured against: the truth, its regions and its shading.
 pub struct Reference {
@@ -178,7 +181,7 @@ fn filter_name(f: Filter) -> String {
 
 /// What `shadowgraph plan` prints for the first drawn light: the graph's bytes per texel and
 /// dispatches, and the shading's fetches per pixel.
-fn plan_cost(plan: &crate::graph::Plan, lights: &[crate::scene::Light]) -> Result<PlanCost> {
+fn plan_cost(plan: &crate::graph::Plan, lights: &[crate::model::Light]) -> Result<PlanCost> {
     use crate::graph::cost;
     let nodes = cost::light_traffic(plan, 0)?;
     let texels = cost::map_texels(plan, 0).max(1.0);

@@ -5,8 +5,11 @@ use super::EvaluateOptions;
 use crate::error::{Error, Result};
 use crate::model::ParamValue;
 use crate::prefilter::PrefilterConfig;
-use crate::scene::{BlurKernel, Filter, Scene, Storage, Technique};
 use crate::technique::{self, SweepPlan, SweptStorages, SweptTerms, TechniqueDef};
+use crate::{
+    model::{BlurKernel, Filter, Storage, Technique},
+    scene::Scene,
+};
 
 /// A filter of a box `width` texels wide.
 pub type FilterOfWidth = fn(f32) -> Filter;

@@ -7,7 +7,10 @@ use super::protocol::{self, Protocol, Run, Sample, Spread, Timed};
 use crate::error::Result;
 use crate::gpu::Gpu;
 use crate::render::{RenderOptions, Renderer};
-use crate::scene::{Light, Scene, UpdateRate};
+use crate::{
+    model::Light,
+    scene::{Scene, UpdateRate},
+};
 
 /// The pass that is the same work in every configuration: the clock check.
 pub const CHECK_PASS: &str = "gbuffer";

@@ -36,7 +36,7 @@ impl Family {
 
     /// The family of a technique: whether it stores a representation, and whether it needs
     /// an area light.
-    pub fn of(technique: &crate::scene::Technique) -> Self {
+    pub fn of(technique: &crate::model::Technique) -> Self {
         let soft = crate::technique::by_name(technique.name()).is_some_and(|d| d.area_light);
         match (technique.storage().is_some(), soft) {
             (false, false) => Family::Lookup,

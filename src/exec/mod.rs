@@ -25,7 +25,7 @@ use crate::graph::{Plan, Slot};
 pub use crate::timer::GpuTimer;
 pub use pipelines::{
     ComputeKernel, GPU_LAYOUT_CONSTANT, KERNEL_LAYOUT_ENV, KernelCache, KernelLayout,
-    REDESIGN_CONSTANT, REDESIGNED_KERNELS, WorkgroupInit, specialized_source,
+    REDESIGN_CONSTANT, REDESIGNED_KERNELS, REDESIGNED_MODULES, WorkgroupInit, specialized_source,
     wgsl_storage_format,
 };
 pub use pool::{Outputs, TexturePool};

@@ -11,14 +11,14 @@ use std::sync::Arc;
 
 pub use self::layout::{
     GPU_LAYOUT_CONSTANT, KERNEL_LAYOUT_ENV, KernelLayout, REDESIGN_CONSTANT, REDESIGNED_KERNELS,
-    WorkgroupInit,
+    REDESIGNED_MODULES, WorkgroupInit,
 };
 use self::specialize::{apply, changes};
 pub use self::specialize::{specialized_source, wgsl_storage_format};
 use super::node_constants::NodeOverrides;
-use crate::created;
 use crate::error::{Error, Result};
 use crate::gpu::scoped;
+use crate::gpu_objects;
 use crate::kernels::{self, Reflection};
 
 /// A compute pipeline with the layouts reflected from its WGSL.
@@ -94,7 +94,7 @@ impl ComputeKernel {
         let (layouts, pipeline) = scoped(
             device,
             || {
-                let module = created::shader_module(
+                let module = gpu_objects::shader_module(
                     device,
                     wgpu::ShaderModuleDescriptor {
                         label: Some(&label),
@@ -103,7 +103,7 @@ impl ComputeKernel {
                 );
                 let layouts: Vec<wgpu::BindGroupLayout> = (0..reflection.group_count())
                     .map(|g| {
-                        created::bind_group_layout(
+                        gpu_objects::bind_group_layout(
                             device,
                             &wgpu::BindGroupLayoutDescriptor {
                                 label: Some(&label),
@@ -113,7 +113,7 @@ impl ComputeKernel {
                     })
                     .collect();
                 let refs: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(Some).collect();
-                let layout = created::pipeline_layout(
+                let layout = gpu_objects::pipeline_layout(
                     device,
                     &wgpu::PipelineLayoutDescriptor {
                         label: Some(&label),
@@ -121,7 +121,7 @@ impl ComputeKernel {
                         immediate_size: 0,
                     },
                 );
-                let pipeline = created::compute_pipeline(
+                let pipeline = gpu_objects::compute_pipeline(
                     device,
                     &wgpu::ComputePipelineDescriptor {
                         label: Some(&label),
@@ -229,6 +229,24 @@ impl KernelCache {
         }
     }
 
+    /// The texts kernels resolve with on `device`: [`KernelCache::set_replacements`]'s, and the
+    /// redesigned modules its layout and features take ([`KernelLayout::module_sources`]) where
+    /// those do not replace the shipped module themselves.
+    fn sources_for(&self, device: &wgpu::Device) -> Result<Option<Arc<kernels::Replacements>>> {
+        let modules = self.layout_for(device)?.module_sources(device.features());
+        if modules.is_empty() {
+            return Ok(self.replaced.clone());
+        }
+        let mut all = self.replaced.as_deref().cloned().unwrap_or_default();
+        for (shipped, redesign) in modules {
+            if !all.contains_key(shipped) {
+                let text = kernels::source_in(redesign, self.replaced.as_deref())?;
+                all.insert(shipped.to_string(), text.to_string());
+            }
+        }
+        Ok(Some(Arc::new(all)))
+    }
+
     /// The pipeline constants a node of kernel `name` named `node` with parameters `params`
     /// sets (the kernel's `// #override` declarations; none for most kernels).
     pub fn node_constants(
@@ -291,7 +309,7 @@ impl KernelCache {
             return Ok(k.clone());
         }
         // The file `base` compiled (a redesign's own in `KernelLayout::Redesign`).
-        let wgsl = apply(&base.name, &changes, self.replaced.as_deref())?;
+        let wgsl = apply(&base.name, &changes, self.sources_for(device)?.as_deref())?;
         let k = Arc::new(self.compile_with(device, &base.name, &wgsl, overrides)?);
         self.kernels.insert(key, k.clone());
         Ok(k)
@@ -312,7 +330,7 @@ impl KernelCache {
         }
         let layout = self.layout_for(device)?;
         let source = layout.kernel_source(name);
-        let wgsl = kernels::resolve_in(source, generated, self.replaced.as_deref())?;
+        let wgsl = kernels::resolve_in(source, generated, self.sources_for(device)?.as_deref())?;
         let k = Arc::new(self.compile(device, source, &wgsl)?);
         self.kernels.insert(key, k.clone());
         Ok(k)

@@ -3,9 +3,9 @@
 
 use std::collections::HashMap;
 
-use crate::created;
 use crate::error::{ExecError, Result};
 use crate::gpu::read_buffer;
+use crate::gpu_objects;
 use crate::graph::{Plan, Slot};
 
 /// Textures kept across runs, keyed by shape; a plan takes the ones it needs in order.
@@ -19,7 +19,7 @@ impl TexturePool {
         if let Some(t) = self.free.get_mut(slot).and_then(Vec::pop) {
             return t;
         }
-        created::texture(
+        gpu_objects::texture(
             device,
             &wgpu::TextureDescriptor {
                 label: Some("shadowgraph.pool"),
@@ -75,7 +75,7 @@ impl Outputs {
     ) -> Self {
         let steps = plan.steps.len().max(1) as u64;
         let counters = |label, usage| {
-            created::buffer(
+            gpu_objects::buffer(
                 device,
                 &wgpu::BufferDescriptor {
                     label: Some(label),
@@ -106,7 +106,7 @@ impl Outputs {
     pub fn view(&self, name: &str) -> Result<wgpu::TextureView> {
         self.textures
             .get(name)
-            .map(|t| created::view(t, &Default::default()))
+            .map(|t| gpu_objects::view(t, &Default::default()))
             .ok_or_else(|| ExecError::NoResource(name.to_string()).into())
     }
 

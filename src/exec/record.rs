@@ -9,9 +9,9 @@ use std::sync::Arc;
 use super::pipelines::{ComputeKernel, KernelCache, no_layout};
 use super::pool::{Outputs, STATS_STRIDE};
 use super::{ExecError, Prepared};
-use crate::created;
 use crate::error::{Error, Result};
 use crate::gpu::scoped;
+use crate::gpu_objects;
 use crate::graph::{Dispatch, Node, Plan};
 use crate::timer::GpuTimer;
 
@@ -274,7 +274,7 @@ fn bind_group(
     };
     scoped(
         device,
-        || created::bind_group(device, &descriptor),
+        || gpu_objects::bind_group(device, &descriptor),
         |message| Error::Pipeline {
             kernel: node.kernel.to_string(),
             message: format!("binding node `{}`: {message}", node.name),
@@ -298,7 +298,7 @@ fn texture_view(
         }
         .into());
     }
-    Ok(created::view(
+    Ok(gpu_objects::view(
         t,
         &wgpu::TextureViewDescriptor {
             aspect: if t.format().is_depth_stencil_format() {
@@ -365,7 +365,7 @@ pub(super) fn params_buffer(device: &wgpu::Device, plan: &Plan) -> Result<RunPar
     }
     // Room for the last binding's size rounded up to 16 bytes.
     bytes.resize(bytes.len().max(16).div_ceil(16) * 16 + 16, 0);
-    let buffer = created::buffer_init(
+    let buffer = gpu_objects::buffer_init(
         device,
         &wgpu::util::BufferInitDescriptor {
             label: Some("shadowgraph.params"),

@@ -167,7 +167,7 @@ impl Checker<'_> {
     }
 
     fn features(&self, features: wgpu::Features) -> Result<()> {
-        use crate::scene::Storage;
+        use crate::model::Storage;
         for (i, l) in self.scene.lights.iter().enumerate() {
             // Only MSM's tables accept unorm16 (`technique::params::MSM_FORMAT`).
             if l.shadow.technique.storage() == Some(Storage::Unorm16)

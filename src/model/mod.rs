@@ -23,7 +23,7 @@ use glam::{Mat4, Vec3};
 
 pub use cascades::Cascades;
 pub use sat_variant::SatVariant;
-pub use technique::{Prefilter, Soft, Technique};
+pub use technique::{Soft, StorageFilter, Technique};
 
 /// CSSM's blocker search (`blocker_search`): which table's means over the search square give
 /// the blocker share and average depth.

@@ -23,7 +23,7 @@ pub struct Soft {
 
 /// How a prefiltered technique stores and filters its representation.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Prefilter {
+pub struct StorageFilter {
     /// Storage precision.
     pub storage: Storage,
     /// Filter.
@@ -54,7 +54,7 @@ pub enum Technique {
     /// Variance shadow maps (Donnelly & Lauritzen 2006): moments (z, z²), filtered.
     Vsm {
         /// Storage and filter of the moments.
-        prefilter: Prefilter,
+        prefilter: StorageFilter,
         /// Light-bleeding reduction `linstep(bleed, 1, p_max)`.
         bleed: f32,
         /// Minimum variance.
@@ -64,7 +64,7 @@ pub enum Technique {
     /// `exp(c⁺ z')` and its square (EVSM2), plus `−exp(−c⁻ z')` and its square (EVSM4).
     Evsm {
         /// Storage and filter of the moments.
-        prefilter: Prefilter,
+        prefilter: StorageFilter,
         /// Four moments (EVSM4) rather than two (EVSM2).
         four: bool,
         /// Positive exponent c⁺ (already clamped to the storage's safe limit).
@@ -88,7 +88,7 @@ pub enum Technique {
     /// optimized 16-bit quantization; Hamburger or Hausdorff reconstruction.
     Msm {
         /// Storage (f32 raw; f16 or unorm16 quantized) and filter.
-        prefilter: Prefilter,
+        prefilter: StorageFilter,
         /// Hausdorff (support on [0, 1]) rather than Hamburger reconstruction.
         hausdorff: bool,
         /// Moment bias α toward the moments of a fixed three-point distribution.
@@ -100,7 +100,7 @@ pub enum Technique {
     /// k = 1..M, in ⌈M/2⌉ four-channel maps.
     Csm {
         /// Storage and filter of the basis images.
-        prefilter: Prefilter,
+        prefilter: StorageFilter,
         /// Number of terms M (1–16).
         terms: u32,
         /// Ringing attenuation α: term k weighted by exp(−α (k/M)²).
@@ -312,7 +312,7 @@ impl Technique {
 
     /// The storage and filter of a prefiltered technique (VSM, EVSM, MSM, CSM; ESM has a filter
     /// only).
-    pub fn prefilter(&self) -> Option<Prefilter> {
+    pub fn prefilter(&self) -> Option<StorageFilter> {
         match *self {
             Technique::Vsm { prefilter, .. }
             | Technique::Evsm { prefilter, .. }

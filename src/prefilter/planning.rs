@@ -8,7 +8,7 @@ use std::collections::HashMap;
 use super::{LightParams, LightSlot, OutputMap, PlanKey, Planned, PrefilterConfig};
 use crate::error::{Error, Result};
 use crate::graph::{Graph, plan};
-use crate::scene::Light;
+use crate::model::Light;
 use crate::technique;
 
 /// Node names are `light0.<node>`, like the resource names (`technique::depth_name`): the
@@ -75,7 +75,7 @@ pub(super) struct MapInput {
 }
 
 pub(super) fn depth_aspect_view(t: &wgpu::Texture) -> wgpu::TextureView {
-    crate::created::view(
+    crate::gpu_objects::view(
         t,
         &wgpu::TextureViewDescriptor {
             aspect: if t.format().is_depth_stencil_format() {

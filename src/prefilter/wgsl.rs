@@ -10,7 +10,7 @@ use std::fmt::Write;
 
 use crate::error::{Error, Result};
 use crate::kernels;
-use crate::scene::{Light, Technique};
+use crate::model::{Light, Technique};
 
 use super::{LightParams, PrefilterConfig};
 

@@ -15,7 +15,10 @@ use std::collections::HashMap;
 
 use crate::exec::Outputs;
 use crate::graph::{Plan, Slot};
-use crate::scene::{Light, Scene, UpdateRate};
+use crate::{
+    model::Light,
+    scene::{Scene, UpdateRate},
+};
 
 use super::cascade::DrawnLights;
 

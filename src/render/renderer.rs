@@ -7,12 +7,12 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use crate::created;
 use crate::error::{Error, Result};
 use crate::exec::{ComputeKernel, Executor, GpuTimer, Outputs};
 use crate::gpu::{scoped, submit_and_wait};
-use crate::scene::{Light, Scene};
+use crate::gpu_objects;
 use crate::technique;
+use crate::{model::Light, scene::Scene};
 
 mod raster;
 
@@ -88,7 +88,7 @@ impl Renderer {
             binding: None,
             timer: None,
             cache: LightCache::default(),
-            cmp_sampler: created::sampler(
+            cmp_sampler: gpu_objects::sampler(
                 device,
                 &wgpu::SamplerDescriptor {
                     label: Some("shadowgraph.cmp_sampler"),
@@ -98,7 +98,7 @@ impl Renderer {
                     ..Default::default()
                 },
             ),
-            sat_sampler: created::sampler(device, &crate::prefilter::SAT_SAMPLER_DESCRIPTOR),
+            sat_sampler: gpu_objects::sampler(device, &crate::prefilter::SAT_SAMPLER_DESCRIPTOR),
         }
     }
 
@@ -553,7 +553,7 @@ impl Renderer {
             scoped(
                 device,
                 || {
-                    created::bind_group(
+                    gpu_objects::bind_group(
                         device,
                         &wgpu::BindGroupDescriptor {
                             label: Some(label),

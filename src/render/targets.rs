@@ -6,8 +6,8 @@
 
 use std::collections::HashMap;
 
-use crate::created;
 use crate::gpu::read_buffer;
+use crate::gpu_objects;
 use crate::scene::{Scene, Vertex};
 use crate::technique::{self, LightGpu};
 
@@ -123,7 +123,7 @@ pub(super) fn texture(
     format: wgpu::TextureFormat,
     usage: wgpu::TextureUsages,
 ) -> wgpu::Texture {
-    created::texture(
+    gpu_objects::texture(
         device,
         &wgpu::TextureDescriptor {
             label: Some(label),
@@ -149,7 +149,7 @@ fn buffer(
     size: u64,
     usage: wgpu::BufferUsages,
 ) -> wgpu::Buffer {
-    created::buffer(
+    gpu_objects::buffer(
         device,
         &wgpu::BufferDescriptor {
             label: Some(label),
@@ -183,7 +183,7 @@ pub(super) fn uniform_group(
     layout: &wgpu::BindGroupLayout,
     buffer: &wgpu::Buffer,
 ) -> wgpu::BindGroup {
-    created::bind_group(
+    gpu_objects::bind_group(
         device,
         &wgpu::BindGroupDescriptor {
             label: Some(label),
@@ -215,7 +215,7 @@ fn peel_target(
         TARGET,
     );
     let first_view = super::renderer::depth_only_view(first);
-    let bind_group = created::bind_group(
+    let bind_group = gpu_objects::bind_group(
         device,
         &wgpu::BindGroupDescriptor {
             label: Some("shadowgraph.shadow_peel"),
@@ -232,7 +232,7 @@ fn peel_target(
             ],
         },
     );
-    let view = created::view(&second, &Default::default());
+    let view = gpu_objects::view(&second, &Default::default());
     imports.insert(technique::second_depth_name(i), second);
     PeelTarget {
         label: format!("light{i}.shadow_peel"),
@@ -296,7 +296,7 @@ impl Targets {
             imports.insert(technique::depth_name(i), depth.clone());
             lights.push(LightTarget {
                 label: format!("light{i}.shadow_raster"),
-                view: created::view(&depth, &Default::default()),
+                view: gpu_objects::view(&depth, &Default::default()),
                 bind_group: uniform_group(device, "shadowgraph.shadow_depth", layout, &view_proj),
                 view_proj,
                 viewports: Vec::new(),
@@ -316,9 +316,9 @@ impl Targets {
                 B::VERTEX | B::COPY_DST,
             ),
             vertex_count: 0,
-            gpos_view: created::view(&gpos, &Default::default()),
-            gnorm_view: created::view(&gnorm, &Default::default()),
-            depth_view: created::view(&cam_depth, &Default::default()),
+            gpos_view: gpu_objects::view(&gpos, &Default::default()),
+            gnorm_view: gpu_objects::view(&gnorm, &Default::default()),
+            depth_view: gpu_objects::view(&cam_depth, &Default::default()),
             gpos,
             gnorm,
             camera,
@@ -343,7 +343,7 @@ impl Targets {
                 frame_bytes,
                 B::UNIFORM | B::COPY_DST,
             ),
-            color_view: created::view(&color, &Default::default()),
+            color_view: gpu_objects::view(&color, &Default::default()),
             color,
             visibility: buffer(
                 device,

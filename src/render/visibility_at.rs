@@ -3,11 +3,11 @@
 use bytemuck::Zeroable;
 use glam::Vec3;
 
-use crate::created;
 use crate::error::{Error, Result};
 use crate::gpu::{read_buffer, submit_and_wait, write_texture};
+use crate::gpu_objects;
 use crate::graph::Graph;
-use crate::scene::Light;
+use crate::model::Light;
 use crate::technique;
 
 use super::FrameGpu;
@@ -128,7 +128,7 @@ pub fn visibility_at(
                 m.mips
             )));
         }
-        let t = created::texture(
+        let t = gpu_objects::texture(
             device,
             &wgpu::TextureDescriptor {
                 label: Some("shadowgraph.visibility_at.map"),
@@ -161,7 +161,7 @@ pub fn visibility_at(
             crate::gpu::write_texture_level(queue, &t, level, &bytes);
             at += count;
         }
-        views.push(created::view(&t, &Default::default()));
+        views.push(gpu_objects::view(&t, &Default::default()));
     }
     let frame = FrameGpu {
         size: [w, h],
@@ -175,7 +175,7 @@ pub fn visibility_at(
         gnorm: &gnorm,
     };
     let visibility = renderer.shade_points(device, queue, lights, &at)?;
-    let readback = created::buffer(
+    let readback = gpu_objects::buffer(
         device,
         &wgpu::BufferDescriptor {
             label: Some("shadowgraph.visibility.readback"),
@@ -261,7 +261,7 @@ impl Renderer {
         use wgpu::BufferUsages as B;
         let kernel = self.shade_kernel(device, lights)?;
         let init = |label, bytes: &[u8], usage| {
-            created::buffer_init(
+            gpu_objects::buffer_init(
                 device,
                 &wgpu::util::BufferInitDescriptor {
                     label: Some(label),
@@ -275,7 +275,7 @@ impl Renderer {
         let (w, h) = (at.frame.size[0], at.frame.size[1]);
         let color = super::targets::color_target(device, (w, h));
         let vis_bytes = (u64::from(w) * u64::from(h) * lights.len().max(1) as u64 * 4).max(4);
-        let visibility = created::buffer(
+        let visibility = gpu_objects::buffer(
             device,
             &wgpu::BufferDescriptor {
                 label: Some("shadowgraph.visibility"),
@@ -285,9 +285,9 @@ impl Renderer {
             },
         );
         let views = [
-            created::view(at.gpos, &Default::default()),
-            created::view(at.gnorm, &Default::default()),
-            created::view(&color, &Default::default()),
+            gpu_objects::view(at.gpos, &Default::default()),
+            gpu_objects::view(at.gnorm, &Default::default()),
+            gpu_objects::view(&color, &Default::default()),
         ];
         let inputs = ShadeInputs {
             gpos: &views[0],

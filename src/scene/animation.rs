@@ -7,8 +7,9 @@ use glam::Vec3;
 use super::ctx::{Ctx, fmt_num};
 use super::format::{AnimationFile, ObjectFile, TrackFile};
 use super::object::WORLD_LIMIT;
-use super::{Camera, Light, Object, Scene};
+use super::{Object, Scene};
 use crate::error::{Error, Result};
+use crate::model::{Camera, Light};
 
 /// Most frames an animation may have.
 pub const MAX_ANIMATION_FRAMES: i64 = 10_000;

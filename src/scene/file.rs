@@ -5,8 +5,9 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
-use super::{Camera, Light, Locations, Mesh, Vertex, parse};
+use super::{Locations, Mesh, Vertex, parse};
 use crate::error::{Error, Result};
+use crate::model::{Camera, Light};
 
 /// A loaded, validated scene.
 #[derive(Clone, Debug)]

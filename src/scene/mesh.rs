@@ -13,7 +13,7 @@ pub struct Mesh {
     pub indices: Vec<u32>,
 }
 
-pub use crate::gpu_data::Vertex;
+pub use crate::wgsl_mirrors::Vertex;
 
 impl Mesh {
     /// The mesh under `m`, computed in f64. Normals go through the cofactor matrix (the inverse

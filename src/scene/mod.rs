@@ -1,6 +1,6 @@
-//! Scenes: the model's types re-exported under their historical paths (they live in
-//! [`crate::model`]), and with the `cli` feature the validated `Scene`, loaded from TOML (see
-//! `format`) with errors that name the file, the key and the line.
+//! Scenes (the `cli` feature): the validated `Scene`, loaded from TOML (see `format`) with
+//! errors that name the file, the key and the line. Its lights, camera and techniques are the
+//! model's types ([`crate::model`]).
 
 #[cfg(feature = "cli")]
 mod animation;
@@ -33,12 +33,6 @@ mod update;
 #[cfg(feature = "cli")]
 mod validate;
 
-pub use crate::model::{
-    BlurKernel, Camera, CssmResolve, CssmSearch, DEFAULT_MAX_SEARCH, DEFAULT_SHARPEN,
-    DEFAULT_SHARPEN_FALLOFF, Filter, Light, LightKind, PcfKernel, Prefilter, Shadow, Soft, Storage,
-    Technique, default_moment_bias, default_soft_moment_bias, exponent_limit,
-};
-pub use crate::technique::sat_exponent_limit;
 #[cfg(feature = "cli")]
 pub use animation::{Animated, Animation, MAX_ANIMATION_FRAMES, Track};
 #[cfg(feature = "cli")]

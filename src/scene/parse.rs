@@ -10,10 +10,9 @@ use super::ctx::{Ctx, LENGTH_RANGE, fmt_num};
 use super::format::{LightFile, SceneFile, ShadowFile};
 use super::locate::{self, Locations};
 use super::search_cap;
-use super::{
-    Camera, Light, LightKind, Scene, Shadow, Technique, animation, object, update, validate,
-};
+use super::{Scene, animation, object, update, validate};
 use crate::error::Result;
+use crate::model::{Camera, Light, LightKind, Shadow, Technique};
 
 /// Largest output or shadow-map side accepted before the device is even asked.
 pub(super) const MAX_SIDE: i64 = 1 << 16;

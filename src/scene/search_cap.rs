@@ -9,8 +9,9 @@
 //! told so, with the cap that would cover it (the nearest and farthest vertices bound both).
 
 use super::ctx::Ctx;
+use super::Object;
 use super::format::LightFile;
-use super::{Light, LightKind, Object};
+use crate::model::{Light, LightKind};
 
 /// The largest `max_search` a scene may set.
 const MAX_SEARCH: f32 = 1.0;

@@ -4,11 +4,10 @@
 
 use toml::Spanned;
 
-use super::Shadow;
 use super::ctx::Ctx;
 use super::format::ShadowFile;
 use crate::error::{Error, Result};
-use crate::model::{ParamSource, ParamValue};
+use crate::model::{ParamSource, ParamValue, Shadow};
 use crate::technique::{
     self, ClampReason, REGISTRY,
     params::{CASCADES, COMMON},

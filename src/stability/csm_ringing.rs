@@ -24,8 +24,8 @@ use crate::cpu::{self, Texels};
 use crate::error::Result;
 use crate::exec::Executor;
 use crate::gpu::Gpu;
+use crate::model::{BlurKernel, Filter, Storage, StorageFilter, Technique};
 use crate::render::Renderer;
-use crate::scene::{BlurKernel, Filter, Prefilter, Storage, Technique};
 use crate::technique::{LightGpu, linear_name};
 use crate::tolerance;
 
@@ -35,7 +35,7 @@ const BIAS: f32 = 0.002;
 
 fn technique(storage: Storage) -> Technique {
     Technique::Csm {
-        prefilter: Prefilter {
+        prefilter: StorageFilter {
             storage,
             filter: Filter::Blur {
                 radius: 2.0,

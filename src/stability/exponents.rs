@@ -27,8 +27,11 @@ use crate::gpu::{Gpu, read_texture};
 use crate::graph::Graph;
 use crate::model::ParamValue;
 use crate::sat::{SatCoding, SatVariant, add_sat, float_sum_depth};
-use crate::scene::{BlurKernel, Filter, Scene, Storage, Technique, exponent_limit};
 use crate::technique::{Encoding, encoding};
+use crate::{
+    model::{BlurKernel, Filter, Storage, Technique, exponent_limit},
+    scene::Scene,
+};
 
 const MAP: u32 = 64;
 

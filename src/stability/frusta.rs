@@ -21,8 +21,11 @@ use crate::error::{Error, Result};
 use crate::exec::Executor;
 use crate::gpu::Gpu;
 use crate::render::{RenderOptions, Renderer};
-use crate::scene::{LightKind, PcfKernel, Scene, Technique};
 use crate::technique::{LightGpu, depth_name, linear_name};
+use crate::{
+    model::{LightKind, PcfKernel, Technique},
+    scene::Scene,
+};
 
 const MAP: u32 = 64;
 const BIAS: f32 = 0.002;
@@ -31,7 +34,7 @@ const BIAS: f32 = 0.002;
 const FRUSTA: [(f32, f32, &str); 2] = [(0.01, 100.0, "1e-4"), (9.99, 10.0, "0.999")];
 
 /// Depth-buffer values for `l` (see the module documentation), `MAP²` of them.
-fn depth_values(l: &crate::scene::Light, rng: &mut Rng) -> Vec<f32> {
+fn depth_values(l: &crate::model::Light, rng: &mut Rng) -> Vec<f32> {
     let g = LightGpu::new(l);
     let n = (MAP * MAP) as usize;
     let mut v: Vec<f32> = [0.0, 1.0, 1e-7, 1.0 - 1e-7]
@@ -58,7 +61,7 @@ fn compare(
     check: &mut Check,
     raw: &[f32],
     gpu: &[f64],
-    l: &crate::scene::Light,
+    l: &crate::model::Light,
     what: &str,
 ) -> f64 {
     let mut largest = 0.0f64;
@@ -84,7 +87,7 @@ fn rasterized(
     kind: &str,
     near: f32,
     far: f32,
-) -> Result<(Vec<f32>, Vec<f64>, crate::scene::Light)> {
+) -> Result<(Vec<f32>, Vec<f64>, crate::model::Light)> {
     // The light looks down from `h`; the plane sits at distance `mid` inside [near, far].
     let mid = near + 0.5 * (far - near);
     let size = if kind == "spot" { mid } else { 4.0 };

@@ -11,9 +11,9 @@ use crate::error::{Error, Result};
 use crate::exec::{Executor, Outputs};
 use crate::gpu::{Gpu, read_buffer, read_resource_texture, submit_and_wait, write_texture_level};
 use crate::graph::{Graph, Plan, plan, texel_bytes};
+use crate::model::{Light, LightKind, Shadow, Technique};
 use crate::model::{ParamValue, ParamValues};
 use crate::render::{MapData, Renderer, visibility_at};
-use crate::scene::{Light, LightKind, Shadow, Technique};
 use crate::technique::{self, LightGpu, params};
 
 /// A sampled, copyable texture holding `bytes` (tightly packed level 0).
@@ -253,8 +253,8 @@ pub(crate) fn light(kind: LightKind, technique: Technique, map: u32, bias: f32) 
 }
 
 /// The mip-chain filter at `width` texels (the one place that spells its fields).
-pub(crate) fn mips(width: f32) -> crate::scene::Filter {
-    crate::scene::Filter::Mips {
+pub(crate) fn mips(width: f32) -> crate::model::Filter {
+    crate::model::Filter::Mips {
         width,
         max_anisotropy: 0,
     }
@@ -265,8 +265,8 @@ pub(crate) fn mips(width: f32) -> crate::scene::Filter {
 /// clamps a scene applies.
 pub(crate) fn registered(
     name: &str,
-    storage: Option<crate::scene::Storage>,
-    filter: crate::scene::Filter,
+    storage: Option<crate::model::Storage>,
+    filter: crate::model::Filter,
     values: &[(&'static str, ParamValue)],
 ) -> Technique {
     let mut v = ParamValues(values.to_vec());

@@ -27,9 +27,9 @@ use super::planar::storage_name;
 use crate::error::Result;
 use crate::exec::Executor;
 use crate::gpu::Gpu;
+use crate::model::{BlurKernel, Filter, Soft, Storage, StorageFilter, Technique};
 use crate::render::Renderer;
 use crate::sat::SatVariant;
-use crate::scene::{BlurKernel, Filter, Prefilter, Soft, Storage, Technique};
 
 /// Map side and block side of the random map: 256 blocks, about half of them flat.
 const MAP: usize = 256;
@@ -159,7 +159,7 @@ fn techniques() -> Vec<(&'static str, Storage, Technique)> {
     let mut out = Vec::new();
     for storage in [Storage::F32, Storage::F16, Storage::Unorm16] {
         let msm = Technique::Msm {
-            prefilter: Prefilter {
+            prefilter: StorageFilter {
                 storage,
                 filter: Filter::Blur {
                     radius: 2.0,

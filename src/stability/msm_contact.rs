@@ -27,12 +27,12 @@ use super::planar::storage_name;
 use crate::error::Result;
 use crate::exec::Executor;
 use crate::gpu::Gpu;
-use crate::render::Renderer;
-use crate::sat::SatVariant;
-use crate::scene::{
-    BlurKernel, Filter, Prefilter, Soft, Storage, Technique, default_moment_bias,
+use crate::model::{
+    BlurKernel, Filter, Soft, Storage, StorageFilter, Technique, default_moment_bias,
     default_soft_moment_bias,
 };
+use crate::render::Renderer;
+use crate::sat::SatVariant;
 
 /// Map side of `msm` (a flat map has nothing to resolve), and of `msm_soft`, whose table
 /// is coded for squares up to `2·SOFT_MAX_SEARCH·SOFT_MAP` = 205 texels: the step the default
@@ -71,7 +71,7 @@ fn technique(storage: Storage, soft: bool) -> Technique {
         }
     } else {
         Technique::Msm {
-            prefilter: Prefilter {
+            prefilter: StorageFilter {
                 storage,
                 filter: Filter::Blur {
                     radius: 2.0,
@@ -87,7 +87,7 @@ fn technique(storage: Storage, soft: bool) -> Technique {
 }
 
 /// Receivers behind an occluder at `z` (texel-centre UVs away from the edges).
-fn receivers(l: &crate::scene::Light, z: f64) -> Vec<(Vec3, Vec3)> {
+fn receivers(l: &crate::model::Light, z: f64) -> Vec<(Vec3, Vec3)> {
     let mut out = Vec::new();
     for uv in [[0.5, 0.5], [0.3125, 0.6875]] {
         for k in 0..=STEPS {

@@ -21,8 +21,10 @@ use crate::cpu;
 use crate::error::Result;
 use crate::exec::Executor;
 use crate::gpu::Gpu;
+use crate::model::{
+    BlurKernel, Filter, Light, Storage, StorageFilter, Technique, default_moment_bias,
+};
 use crate::render::Renderer;
-use crate::scene::{BlurKernel, Filter, Light, Prefilter, Storage, Technique, default_moment_bias};
 use crate::technique::{LightGpu, linear_name};
 
 const MAP: u32 = 32;
@@ -46,7 +48,7 @@ const REFERENCE_RISE: f64 = 1e-6;
 
 fn technique(storage: Storage, hausdorff: bool) -> Technique {
     Technique::Msm {
-        prefilter: Prefilter {
+        prefilter: StorageFilter {
             storage,
             filter: Filter::Blur {
                 radius: 2.0,

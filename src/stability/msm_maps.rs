@@ -12,8 +12,8 @@ use crate::cpu::{self, Texels};
 use crate::error::{Error, Result};
 use crate::exec::Executor;
 use crate::gpu::{Gpu, read_texture};
+use crate::model::{Filter, Light, Technique};
 use crate::render::{MapData, Renderer, visibility_at};
-use crate::scene::{Filter, Light, Technique};
 use crate::technique::{LightGpu, MSM_QUANTIZED, linear_name, sat_coding};
 
 /// What the shading reads.

@@ -19,7 +19,7 @@ use crate::error::{Error, Result};
 use crate::exec::Executor;
 use crate::gpu::Gpu;
 use crate::model::ParamValue;
-use crate::scene::{BlurKernel, Filter, LightKind, Storage, Technique, exponent_limit};
+use crate::model::{BlurKernel, Filter, LightKind, Storage, Technique, exponent_limit};
 use crate::technique::linear_name;
 
 const MAP: u32 = 61;

@@ -16,8 +16,10 @@ use crate::cpu;
 use crate::error::Result;
 use crate::exec::Executor;
 use crate::gpu::Gpu;
+use crate::model::{
+    BlurKernel, Filter, LightKind, Storage, StorageFilter, Technique, exponent_limit,
+};
 use crate::render::Renderer;
-use crate::scene::{BlurKernel, Filter, LightKind, Prefilter, Storage, Technique, exponent_limit};
 use crate::technique::{Encoding, LightGpu, encoding, linear_name};
 
 /// Map side: small, a constant map has nothing to resolve.
@@ -25,8 +27,8 @@ const MAP: u32 = 32;
 /// The light's constant bias (the scene default).
 const BIAS: f32 = 0.002;
 
-fn prefilter(storage: Storage) -> Prefilter {
-    Prefilter {
+fn prefilter(storage: Storage) -> StorageFilter {
+    StorageFilter {
         storage,
         filter: Filter::Blur {
             radius: 2.0,
@@ -70,7 +72,7 @@ fn raw_depth(kind: LightKind, technique: Technique, z: f64) -> f32 {
 
 /// Receivers at `d` for each depth in `depths`, at `per` random map positions each.
 fn receivers(
-    l: &crate::scene::Light,
+    l: &crate::model::Light,
     rng: &mut Rng,
     depths: &[f64],
     per: usize,

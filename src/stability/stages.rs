@@ -21,7 +21,7 @@ use crate::cpu::{self, Texels};
 use crate::error::Result;
 use crate::exec::Executor;
 use crate::gpu::Gpu;
-use crate::scene::{Filter, Light, LightKind, Storage, Technique};
+use crate::model::{Filter, Light, LightKind, Storage, Technique};
 use crate::technique::{Encoding, encoding, linear_name};
 
 /// `(atol, rtol)`.

@@ -5,16 +5,16 @@ use super::encoding::{CSM_MAPS, Encoding};
 use super::params::{CSM, FILTER, FLOAT_FORMAT, prefilter, prefilter_values};
 use super::sweep_plan::{SweepPlan, SweptStorages, SweptTerms};
 use super::{TechniqueDef, no_clamp};
-use crate::gpu_data::TECHNIQUE_CSM;
 use crate::kernels::KernelId;
 use crate::model::{CssmSearch, ParamValue, ParamValues, Technique};
+use crate::wgsl_mirrors::TECHNIQUE_CSM;
 use std::fmt::Write;
 
 use super::nodes::{LightNodes, float_moments_format, map_type};
 use super::shade::{ShadeInput, VisibilityBody, sat_sample};
 use crate::filter::BlurMode;
-use crate::gpu_data::{CSM_OUTPUTS, CsmParams, LightGpu};
 use crate::model::{Filter, Light, Storage};
+use crate::wgsl_mirrors::{CSM_OUTPUTS, CsmParams, LightGpu};
 
 /// The [`CSM`] values.
 pub(super) fn series_values(

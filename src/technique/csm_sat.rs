@@ -8,12 +8,12 @@
 use super::csm::basis_sequence;
 use super::nodes::{LightNodes, float_moments_format, moments_format};
 use super::shade::ShadeInput;
-use crate::gpu_data::LinearizeParams;
 use crate::graph::{Graph, SizeRule};
 use crate::kernels::KernelId;
 use crate::model::{CssmSearch, Light, Storage, Technique};
 use crate::sat::layers::{LayeredSat, add_layered_sat};
 use crate::sat::{SatCoding, SatParams, SatVariant};
+use crate::wgsl_mirrors::LinearizeParams;
 
 /// Parameters of the layered CSM table kernels (mirrors `CsmSatParams` in
 /// `kernels/shared/csm_sat_params.wgsl`).

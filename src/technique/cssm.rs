@@ -12,11 +12,11 @@ use super::no_encoding;
 use super::params::{CSM, FLOAT_FORMAT, SOFT, choice, float, soft, soft_values};
 use super::sweep_plan::{SweepPlan, SweepVariant};
 use super::{TechniqueDef, no_clamp};
-use crate::gpu_data::{MSM_QUANTIZED, TECHNIQUE_CSSM};
 use crate::model::{
     CssmResolve, CssmSearch, DEFAULT_SHARPEN, DEFAULT_SHARPEN_FALLOFF, ParamSpec, ParamValue,
     ParamValues, Technique, default_soft_moment_bias,
 };
+use crate::wgsl_mirrors::{MSM_QUANTIZED, TECHNIQUE_CSSM};
 use std::fmt::Write;
 
 use super::csm::{csm_gpu, csm_maps, csm_nodes};

@@ -11,10 +11,10 @@ use super::params::{
 use super::shade::{ShadeInput, prefiltered};
 use super::sweep_plan::{SweepPlan, SweptStorages};
 use crate::filter::BlurMode;
-use crate::gpu_data::ExpParams;
-use crate::gpu_data::TECHNIQUE_ESM;
 use crate::kernels::KernelId;
 use crate::model::{ParamSpec, ParamValue, ParamValues, Storage, Technique};
+use crate::wgsl_mirrors::ExpParams;
+use crate::wgsl_mirrors::TECHNIQUE_ESM;
 
 const PARAMS: &[ParamSpec] = &[float(
     "exponent",

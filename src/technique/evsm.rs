@@ -13,10 +13,10 @@ use super::params::{
 use super::shade::{ShadeInput, prefiltered};
 use super::sweep_plan::{SweepPlan, SweptStorages};
 use crate::filter::BlurMode;
-use crate::gpu_data::TECHNIQUE_EVSM;
-use crate::gpu_data::{ExpParams, LightGpu};
 use crate::kernels::KernelId;
 use crate::model::{ParamSpec, ParamValue, ParamValues, Technique, exponent_limit};
+use crate::wgsl_mirrors::TECHNIQUE_EVSM;
+use crate::wgsl_mirrors::{ExpParams, LightGpu};
 
 /// c⁻ of EVSM2, which stores no negative moments (EVSM4's default).
 const DEFAULT_EXP_NEG: f32 = 5.0;

@@ -5,8 +5,8 @@ use super::shade::call;
 use super::sweep_plan::SweepPlan;
 use super::{TechniqueDef, no_clamp};
 use super::{no_gpu, no_variant, unit_range};
-use crate::gpu_data::TECHNIQUE_HARD;
 use crate::model::{ParamValues, Technique};
+use crate::wgsl_mirrors::TECHNIQUE_HARD;
 
 /// `hard`.
 pub(super) static DEF: TechniqueDef = TechniqueDef {

@@ -1,9 +1,9 @@
-//! A light's GPU description ([`LightGpu`], mirrored in `crate::gpu_data`) filled from its
+//! A light's GPU description ([`LightGpu`], mirrored in `crate::wgsl_mirrors`) filled from its
 //! technique, and the summed-area-table coding a technique's representation needs.
 
-use crate::gpu_data::LightGpu;
 use crate::model::{Filter, Light, LightKind, Technique, mip_levels};
 use crate::sat::{SatCoding, SatVariant, lookup_area};
+use crate::wgsl_mirrors::LightGpu;
 
 impl LightGpu {
     /// The GPU description of `light`: its matrices and biases, its technique's id and fields

@@ -30,11 +30,11 @@ mod sweep_plan;
 mod vsm;
 mod vssm;
 
-pub use crate::gpu_data::{
+pub use crate::model::mip_levels;
+pub use crate::wgsl_mirrors::{
     CSM_OUTPUTS, CsmParams, ExpParams, LightGpu, LinearizeParams, MSM_HAUSDORFF, MSM_QUANTIZED,
     MsmParams, PEEL_EPSILON, SecondDepthParams, VsmParams,
 };
-pub use crate::model::mip_levels;
 use crate::model::{Light, ParamSource, ParamSpec, ParamValues, Technique};
 pub(crate) use cascade_shade::pick_and_blend;
 pub use cascade_shade::{CascadeGroup, shade_key_cascaded};

@@ -11,13 +11,13 @@ use super::sweep_plan::{SweepPlan, SweptStorages};
 use super::{TechniqueDef, no_clamp};
 use super::{no_variant, unit_range};
 use crate::filter::BlurMode;
-use crate::gpu_data::TECHNIQUE_MSM;
-use crate::gpu_data::{LightGpu, MSM_HAUSDORFF, MSM_QUANTIZED, MsmParams};
 use crate::kernels::KernelId;
 use crate::model::{Filter, Storage};
 use crate::model::{
     ParamDefault, ParamKind, ParamSpec, ParamValue, ParamValues, Technique, default_moment_bias,
 };
+use crate::wgsl_mirrors::TECHNIQUE_MSM;
+use crate::wgsl_mirrors::{LightGpu, MSM_HAUSDORFF, MSM_QUANTIZED, MsmParams};
 
 /// Whether an MSM technique keeps its moments through the optimized quantization: every
 /// 16-bit storage does, and so does every summed-area table (`msm_soft`, `filter = "sat"`),

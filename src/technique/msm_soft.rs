@@ -10,8 +10,8 @@ use super::params::{MSM, MSM_FORMAT, SOFT, soft, soft_values, storage};
 use super::shade::soft_call;
 use super::sweep_plan::{SweepPlan, SweepVariant};
 use super::{TechniqueDef, no_clamp};
-use crate::gpu_data::TECHNIQUE_MSM_SOFT;
 use crate::model::{ParamSpec, ParamValue, ParamValues, Technique, default_soft_moment_bias};
+use crate::wgsl_mirrors::TECHNIQUE_MSM_SOFT;
 
 const BIAS: &[ParamSpec] = &[moment_bias(|v| {
     ParamValue::Float(default_soft_moment_bias(storage(v.choice("format"))))

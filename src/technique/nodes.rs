@@ -2,11 +2,11 @@
 //! encoding(s) and the filter or summed-area table over them.
 
 use crate::filter::{BlurMode, EncodeBlur, add_encode_blur, add_filter};
-use crate::gpu_data::LinearizeParams;
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
 use crate::kernels::KernelId;
 use crate::model::{Light, Storage};
 use crate::sat::{SatVariant, add_sat};
+use crate::wgsl_mirrors::LinearizeParams;
 
 use super::light_gpu::{sat_coding, sat_variant};
 use super::shade::ShadeInput;

@@ -1,11 +1,11 @@
 //! The parameter tables techniques share (every range and default is written here or in its
-//! technique's file, once), how a [`Prefilter`] or [`Soft`] is built from checked values and
+//! technique's file, once), how a [`StorageFilter`] or [`Soft`] is built from checked values and
 //! read back into them, and the clamps of exponential techniques.
 
 use crate::filter::MAX_BLUR_RADIUS;
 use crate::model::{
     BlurKernel, DEFAULT_MAX_SEARCH, Filter, Needs, ParamDefault, ParamKind, ParamSpec, ParamValue,
-    ParamValues, Prefilter, Soft, Storage,
+    ParamValues, Soft, Storage, StorageFilter,
 };
 use crate::sat::{SatVariant, lookup_area};
 
@@ -432,15 +432,15 @@ pub fn filter_values(f: &Filter, out: &mut ParamValues) {
 }
 
 /// The storage and filter of checked `format` and [`FILTER`] values.
-pub fn prefilter(v: &ParamValues) -> Prefilter {
-    Prefilter {
+pub fn prefilter(v: &ParamValues) -> StorageFilter {
+    StorageFilter {
         storage: storage(v.choice("format")),
         filter: filter(v),
     }
 }
 
 /// The values of `p` (`format` and the filter's keys).
-pub fn prefilter_values(p: &Prefilter, out: &mut ParamValues) {
+pub fn prefilter_values(p: &StorageFilter, out: &mut ParamValues) {
     out.set("format", ParamValue::Choice(storage_name(p.storage)));
     filter_values(&p.filter, out);
 }

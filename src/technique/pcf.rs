@@ -5,10 +5,10 @@ use super::shade::{ShadeInput, VisibilityBody, call, first};
 use super::sweep_plan::SweepPlan;
 use super::unit_range;
 use super::{TechniqueDef, no_clamp, no_encoding};
-use crate::gpu_data::LightGpu;
-use crate::gpu_data::TECHNIQUE_PCF;
 use crate::model::Light;
 use crate::model::{Needs, ParamSpec, ParamValue, ParamValues, PcfKernel, Technique};
+use crate::wgsl_mirrors::LightGpu;
+use crate::wgsl_mirrors::TECHNIQUE_PCF;
 
 const KERNELS: &[(&str, PcfKernel)] = &[
     ("box", PcfKernel::Box),

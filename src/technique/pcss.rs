@@ -6,8 +6,8 @@ use super::shade::call;
 use super::sweep_plan::SweepPlan;
 use super::{TechniqueDef, no_clamp};
 use super::{no_variant, unit_range};
-use crate::gpu_data::TECHNIQUE_PCSS;
 use crate::model::{DEFAULT_MAX_SEARCH, ParamSpec, ParamValue, ParamValues, Technique};
+use crate::wgsl_mirrors::TECHNIQUE_PCSS;
 
 const PARAMS: &[ParamSpec] = &[
     int("blocker_samples", 1, 256, 16, "blocker-search taps"),

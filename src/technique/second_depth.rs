@@ -12,10 +12,12 @@ use super::params::{choice, int};
 use super::shade::{VisibilityBody, call};
 use super::sweep_plan::SweepPlan;
 use super::{LightNodes, ShadeInput, TechniqueDef, no_clamp, unit_range};
-use crate::gpu_data::{LightGpu, SecondDepthParams, TECHNIQUE_MIDPOINT, TECHNIQUE_SECOND_DEPTH};
 use crate::graph::{Dispatch, Node, SizeRule};
 use crate::kernels::KernelId;
 use crate::model::{Light, ParamSpec, ParamValue, ParamValues, PcfKernel, Technique};
+use crate::wgsl_mirrors::{
+    LightGpu, SecondDepthParams, TECHNIQUE_MIDPOINT, TECHNIQUE_SECOND_DEPTH,
+};
 
 /// PCF over the comparisons with the map (`vis_pcf`'s box and tent windows; the hardware 2×2
 /// comparison reads the first depth, not this map).

@@ -8,8 +8,8 @@ use super::shade::call;
 use super::sweep_plan::{SweepPlan, SweepVariant};
 use super::{TechniqueDef, no_clamp};
 use super::{no_variant, unit_range};
-use crate::gpu_data::TECHNIQUE_SMRT;
 use crate::model::{ParamSpec, ParamValue, ParamValues, Technique};
+use crate::wgsl_mirrors::TECHNIQUE_SMRT;
 
 const PARAMS: &[ParamSpec] = &[
     int(

@@ -9,11 +9,11 @@ use super::sweep_plan::{SweepPlan, SweptStorages};
 use super::{TechniqueDef, no_clamp};
 use super::{no_variant, unit_range};
 use crate::filter::BlurMode;
-use crate::gpu_data::TECHNIQUE_VSM;
-use crate::gpu_data::{LightGpu, VsmParams};
 use crate::kernels::KernelId;
 use crate::model::Storage;
 use crate::model::{ParamSpec, ParamValue, ParamValues, Technique};
+use crate::wgsl_mirrors::TECHNIQUE_VSM;
+use crate::wgsl_mirrors::{LightGpu, VsmParams};
 
 /// The Chebyshev bound's keys (`vsm`, `vssm`).
 pub(super) const VARIANCE: &[ParamSpec] = &[

@@ -9,8 +9,8 @@ use super::vsm::{VARIANCE, variance_values};
 use super::vsm::{moments, variance_gpu};
 use super::{TechniqueDef, no_clamp};
 use super::{no_variant, unit_range};
-use crate::gpu_data::TECHNIQUE_VSSM;
 use crate::model::{ParamValue, ParamValues, Technique};
+use crate::wgsl_mirrors::TECHNIQUE_VSSM;
 
 fn values(t: &Technique) -> ParamValues {
     let mut out = ParamValues::default();

@@ -29,7 +29,7 @@
 
 use glam::{DVec3, Mat4, Vec4};
 
-use crate::scene::{Light, LightKind, Technique};
+use crate::model::{Light, LightKind, Technique};
 use crate::technique::LightGpu;
 
 /// Relative margin added to a widened frustum, so receivers at its edge stay a few texels in.

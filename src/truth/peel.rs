@@ -7,8 +7,8 @@
 use glam::{DMat4, DVec3, DVec4};
 
 use super::bvh::Bvh;
-use crate::gpu_data::PEEL_EPSILON;
-use crate::scene::{Light, Scene};
+use crate::wgsl_mirrors::PEEL_EPSILON;
+use crate::{model::Light, scene::Scene};
 
 /// Side of the jitter around a texel's centre, texels: where a ray this far off the centre
 /// hits other triangles, the texel sits on an edge, where rasterization rules decide.

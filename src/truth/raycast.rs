@@ -12,7 +12,10 @@ use glam::{DMat4, DVec3, DVec4};
 
 use super::bvh::Bvh;
 use super::{axis_distance, emitter, relevant};
-use crate::scene::{Light, LightKind, Scene};
+use crate::{
+    model::{Light, LightKind},
+    scene::Scene,
+};
 
 /// Ray-cast visibility per pixel and light.
 #[derive(Clone, Debug)]

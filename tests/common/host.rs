@@ -1,8 +1,8 @@
 //! The host's side of the plug-in tests: a depth pass of its own, into a texture it owns.
 
-use shadowgraph::gpu::{Gpu, submit_and_wait};
-use shadowgraph::prefilter::LightParams;
-use shadowgraph::scene::Vertex;
+use shadowgraph::LightParams;
+use shadowgraph::low_level::gpu::{Gpu, submit_and_wait};
+use shadowgraph::low_level::scene::Vertex;
 use wgpu::util::DeviceExt;
 
 /// The host's own depth pass: its own shader and pipeline, the light's matrices and slope

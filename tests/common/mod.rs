@@ -8,7 +8,7 @@ pub mod soft;
 pub mod soft_maps;
 
 use rand::{Rng, SeedableRng, rngs::SmallRng};
-use shadowgraph::gpu::Gpu;
+use shadowgraph::low_level::gpu::Gpu;
 
 /// The device every GPU test runs on. No adapter is a failure, never a skip.
 pub fn gpu() -> Gpu {
@@ -42,7 +42,7 @@ pub fn upload(
         usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
         view_formats: &[],
     });
-    shadowgraph::gpu::write_texture(queue, &t, data);
+    shadowgraph::low_level::gpu::write_texture(queue, &t, data);
     t
 }
 
@@ -54,7 +54,7 @@ pub fn rng(seed: u64) -> SmallRng {
 /// Asserts that two GPU read-backs of the same map (e.g. one run in each kernel layout,
 /// `exec::KernelLayout`) hold the same f32 bits everywhere, NaNs included; names the first
 /// value that differs.
-pub fn assert_same_bits(what: &str, a: &shadowgraph::cpu::Texels, b: &shadowgraph::cpu::Texels) {
+pub fn assert_same_bits(what: &str, a: &shadowgraph::low_level::cpu::Texels, b: &shadowgraph::low_level::cpu::Texels) {
     assert_eq!(a.data.len(), b.data.len(), "{what}: length");
     let bits = |v: f64| (v as f32).to_bits();
     if let Some(i) = (0..a.data.len()).find(|&i| bits(a.data[i]) != bits(b.data[i])) {
@@ -106,8 +106,8 @@ pub fn assert_within(what: &str, gpu: &[f32], reference: &[f64], tolerance: &[f6
 }
 
 /// The f32-vs-f64 error models, from the library's one tolerance module
-/// (`shadowgraph::tolerance`), which the numerical-stability suite uses too.
-pub use shadowgraph::tolerance::{
+/// (`shadowgraph::low_level::tolerance`), which the numerical-stability suite uses too.
+pub use shadowgraph::low_level::tolerance::{
     csm as csm_tolerance, esm as esm_tolerance, esm_sat as esm_sat_tolerance,
     evsm as evsm_tolerance, msm as msm_tolerance, vsm as vsm_tolerance,
 };
@@ -136,9 +136,9 @@ pub fn blocky_map(rng: &mut SmallRng, size: usize) -> Vec<f32> {
 /// where f32 and f64 may legitimately disagree). Continuous changes (bilinear weights) stay
 /// below that threshold; a single tap flipping moves every tested kernel by more.
 pub fn robust(
-    s: &shadowgraph::cpu::light::LightSample,
+    s: &shadowgraph::low_level::cpu::light::LightSample,
     map_size: usize,
-    f: impl Fn(&shadowgraph::cpu::light::LightSample) -> f64,
+    f: impl Fn(&shadowgraph::low_level::cpu::light::LightSample) -> f64,
 ) -> Option<f64> {
     let v = f(s);
     let du = 1e-4 / map_size as f64;

@@ -5,7 +5,7 @@
 //! change; one that writes before it reads gives the same bits (`tests/workgroup_memory.rs`).
 
 use naga::{AddressSpace, ArraySize, Binding, BuiltIn, ScalarKind, TypeInner};
-use shadowgraph::kernels::{self, KernelId, Replacements};
+use shadowgraph::low_level::kernels::{self, KernelId, Replacements};
 
 /// The poison's bits.
 pub const POISON: u32 = 0x7FC0_0001;

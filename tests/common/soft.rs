@@ -19,13 +19,13 @@
 //! (seen: an edge at 29.4992 read as past 29.5). Wider moves of the width, from the
 //! propagated errors, are in the tolerance: `finish` at z_avg ± δz takes the jump.
 
-use shadowgraph::cpu::blocker::Blocker;
-use shadowgraph::cpu::light::LightSample;
-use shadowgraph::cpu::sat::Integral;
-use shadowgraph::cpu::{self, Texels};
-use shadowgraph::sat::{SatCoding, SatVariant};
-use shadowgraph::scene::CssmSearch;
-use shadowgraph::technique::{LightGpu, MSM_QUANTIZED};
+use shadowgraph::low_level::cpu::blocker::Blocker;
+use shadowgraph::low_level::cpu::light::LightSample;
+use shadowgraph::low_level::cpu::sat::Integral;
+use shadowgraph::low_level::cpu::{self, Texels};
+use shadowgraph::low_level::sat::SatCoding;
+use shadowgraph::low_level::technique::MSM_QUANTIZED;
+use shadowgraph::{CssmSearch, LightGpu, SatVariant};
 
 const ULP: f64 = 1.0 / 16_777_216.0; // 2⁻²⁴
 
@@ -591,13 +591,13 @@ pub fn cssm_tolerance(
 /// each, as `Frame::shade_maps` holds them) split into the CSM basis (2M channels) and the
 /// search's representation (MSM's four quantized moments, or the CSM-Z basis's 2M + 1), padding
 /// dropped.
-pub fn split_cssm(light: &shadowgraph::scene::Light, map: &Texels) -> (Texels, Texels) {
-    let shadowgraph::scene::Technique::Cssm { terms, search, .. } = light.shadow.technique else {
+pub fn split_cssm(light: &shadowgraph::Light, map: &Texels) -> (Texels, Texels) {
+    let shadowgraph::Technique::Cssm { terms, search, .. } = light.shadow.technique else {
         panic!("not a CSSM light");
     };
-    let stored = shadowgraph::technique::map_channels(light);
-    let basis_maps = shadowgraph::technique::csm_maps(terms) as usize;
-    let logical = shadowgraph::technique::basis_sequence(terms, Some(search));
+    let stored = shadowgraph::low_level::technique::map_channels(light);
+    let basis_maps = shadowgraph::low_level::technique::csm_maps(terms) as usize;
+    let logical = shadowgraph::low_level::technique::basis_sequence(terms, Some(search));
     // (is a basis table, first stored channel, logical channels) of every table, in binding
     // order.
     let mut first = 0;
@@ -633,7 +633,7 @@ pub fn split_cssm(light: &shadowgraph::scene::Light, map: &Texels) -> (Texels, T
 /// the basis, then the search's representation), their errors and the device's sin/cos error. `None` for
 /// a light whose technique is not soft.
 pub struct SoftInputs {
-    light: shadowgraph::scene::Light,
+    light: shadowgraph::Light,
     integrals: Vec<Integral>,
     errors: Vec<TableError>,
     e_trig: f64,
@@ -641,8 +641,8 @@ pub struct SoftInputs {
 
 impl SoftInputs {
     /// The inputs of `light` (a soft technique, else `None`) from its shade map `level0`.
-    pub fn new(light: &shadowgraph::scene::Light, level0: &Texels, e_trig: f64) -> Option<Self> {
-        use shadowgraph::scene::Technique;
+    pub fn new(light: &shadowgraph::Light, level0: &Texels, e_trig: f64) -> Option<Self> {
+        use shadowgraph::Technique;
         let parts = match light.shadow.technique {
             Technique::Cssm { .. } => {
                 let (basis, z) = split_cssm(light, level0);
@@ -651,7 +651,7 @@ impl SoftInputs {
             Technique::Vssm { .. } | Technique::MsmSoft { .. } => vec![level0.clone()],
             _ => return None,
         };
-        let coding = shadowgraph::technique::sat_coding(light)
+        let coding = shadowgraph::low_level::technique::sat_coding(light)
             .expect("valid coding")
             .expect("soft techniques read tables");
         Some(Self {
@@ -666,7 +666,7 @@ impl SoftInputs {
     }
 
     fn cssm(&self) -> cpu::vis_cssm::Maps<'_> {
-        let shadowgraph::scene::Technique::Cssm { search: kind, .. } = self.light.shadow.technique
+        let shadowgraph::Technique::Cssm { search: kind, .. } = self.light.shadow.technique
         else {
             panic!("not a CSSM light");
         };
@@ -679,7 +679,7 @@ impl SoftInputs {
 
     /// The f64 visibility at `s` (1 outside the map).
     pub fn reference(&self, l: &LightGpu, s: &LightSample) -> f64 {
-        use shadowgraph::scene::Technique;
+        use shadowgraph::Technique;
         if !s.inside {
             return 1.0;
         }
@@ -692,7 +692,7 @@ impl SoftInputs {
 
     /// The tolerance at `s` for reference value `v` (see [`Chain`]; 0 outside the map).
     pub fn tolerance(&self, l: &LightGpu, s: &LightSample, v: f64) -> Option<f64> {
-        use shadowgraph::scene::Technique;
+        use shadowgraph::Technique;
         if !s.inside {
             return Some(0.0);
         }

@@ -4,11 +4,11 @@
 use std::collections::HashMap;
 
 use glam::Vec3;
-use shadowgraph::cpu::{self, Texels};
-use shadowgraph::gpu::Gpu;
-use shadowgraph::sat::{SatCoding, SatVariant};
-use shadowgraph::scene::{
-    CssmResolve, CssmSearch, Light, LightKind, Shadow, Soft, Storage, Technique,
+use shadowgraph::low_level::cpu::{self, Texels};
+use shadowgraph::low_level::gpu::Gpu;
+use shadowgraph::low_level::sat::SatCoding;
+use shadowgraph::{
+    CssmResolve, CssmSearch, Light, LightKind, SatVariant, Shadow, Soft, Storage, Technique,
 };
 
 const ULP: f64 = 1.0 / 16_777_216.0; // 2⁻²⁴
@@ -21,7 +21,7 @@ const ULP: f64 = 1.0 / 16_777_216.0; // 2⁻²⁴
 /// bound of 2⁻¹¹ on [−π, π]; returns twice the measured error (the sweep samples the
 /// functions, the factor covers depths between samples) plus 2⁻²⁴.
 pub fn trig_error(g: &Gpu) -> f64 {
-    use shadowgraph::graph::{Dispatch, Graph, Node, SizeRule, plan};
+    use shadowgraph::low_level::graph::{Dispatch, Graph, Node, SizeRule, plan};
     let (w, h) = (256u32, 256u32);
     let z: Vec<f32> = (0..w * h)
         .map(|i| -0.25 + 1.5 * i as f32 / (w * h - 1) as f32)
@@ -30,7 +30,7 @@ pub fn trig_error(g: &Gpu) -> f64 {
     let mut graph = Graph::default();
     graph.import("in", wgpu::TextureFormat::R32Float, w, h, Some(0));
     let mut outputs = Vec::new();
-    let per = shadowgraph::technique::CSM_OUTPUTS;
+    let per = shadowgraph::low_level::technique::CSM_OUTPUTS;
     for group in 0..(terms / 2).div_ceil(per) {
         let mut slots = Vec::new();
         for j in 0..per.min(terms / 2 - group * per) {
@@ -49,11 +49,11 @@ pub fn trig_error(g: &Gpu) -> f64 {
         }
         graph.node(Node {
             name: format!("basis.{group}"),
-            kernel: shadowgraph::kernels::KernelId::Csm,
+            kernel: shadowgraph::low_level::kernels::KernelId::Csm,
             inputs: vec![("src".into(), "in".into())],
             dispatch: Dispatch::Texels(slots[0].1.clone()),
-            params: bytemuck::bytes_of(&shadowgraph::technique::CsmParams {
-                depth: shadowgraph::technique::LinearizeParams::ORTHOGRAPHIC,
+            params: bytemuck::bytes_of(&shadowgraph::low_level::technique::CsmParams {
+                depth: shadowgraph::low_level::technique::LinearizeParams::ORTHOGRAPHIC,
                 first_map: group * per,
                 maps: slots.len() as u32,
                 terms,
@@ -74,8 +74,8 @@ pub fn trig_error(g: &Gpu) -> f64 {
         wgpu::TextureFormat::R32Float,
         bytemuck::cast_slice(&z),
     );
-    let mut exec = shadowgraph::exec::Executor::new();
-    let csm = shadowgraph::kernels::resolve("csm", None).expect("csm");
+    let mut exec = shadowgraph::low_level::exec::Executor::new();
+    let csm = shadowgraph::low_level::kernels::resolve("csm", None).expect("csm");
     let unclamped = csm.replace("let z = depth.z;", "let z = textureLoad(src, id.xy, 0).r;");
     assert_ne!(csm, unclamped, "csm's depth read changed");
     exec.kernels
@@ -86,11 +86,11 @@ pub fn trig_error(g: &Gpu) -> f64 {
     let out = exec
         .record(&g.device, &mut enc, &p, &imports, None)
         .expect("record");
-    shadowgraph::gpu::submit_and_wait(&g.device, &g.queue, enc, "trig").expect("submit");
+    shadowgraph::low_level::gpu::submit_and_wait(&g.device, &g.queue, enc, "trig").expect("submit");
     let mut worst: f64 = 0.0;
     for (chunk, name) in outputs.iter().enumerate() {
         let (_, data) =
-            shadowgraph::gpu::read_float_texture(&g.device, &g.queue, &out.textures[name], 0)
+            shadowgraph::low_level::gpu::read_float_texture(&g.device, &g.queue, &out.textures[name], 0)
                 .expect("readback");
         for (i, texel) in data.chunks(4).enumerate() {
             let zi = f64::from(z[i]);
@@ -149,7 +149,7 @@ pub fn light(kind: LightKind, technique: Technique) -> Light {
             slope_bias: 0.0,
             normal_bias: 1.0,
             receiver_plane: 0.0,
-            cascades: shadowgraph::model::Cascades::SINGLE,
+            cascades: shadowgraph::Cascades::SINGLE,
         },
     }
 }
@@ -195,7 +195,7 @@ pub fn tables(rep: &Texels, coding: &SatCoding) -> Tables {
                 .map(|&v| (v as f32).to_bits())
                 .collect(),
         };
-        chunks.push((n, shadowgraph::sat::decode_table(&raw, w, h, coding, n)));
+        chunks.push((n, shadowgraph::low_level::sat::decode_table(&raw, w, h, coding, n)));
         words.push(raw.into_iter().map(f32::from_bits).collect());
     }
     let data = (0..w * h)
@@ -239,7 +239,7 @@ pub fn msm_soft(storage: Storage, hausdorff: bool) -> Technique {
     Technique::MsmSoft {
         soft: soft(storage, SatVariant::Fixed),
         hausdorff,
-        moment_bias: shadowgraph::scene::default_moment_bias(storage),
+        moment_bias: shadowgraph::low_level::model::default_moment_bias(storage),
         bleed: 0.0,
     }
 }

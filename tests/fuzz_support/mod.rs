@@ -21,8 +21,8 @@ use rand::rngs::SmallRng;
 use rand::seq::IndexedRandom;
 use rand::{Rng, SeedableRng};
 use shadowgraph::Error;
-use shadowgraph::render::{RenderOptions, Renderer, plan_lights};
-use shadowgraph::scene::Scene;
+use shadowgraph::low_level::render::{RenderOptions, Renderer, plan_lights};
+use shadowgraph::low_level::scene::Scene;
 use toml::{Table, Value};
 
 /// What to run.
@@ -76,7 +76,7 @@ enum Outcome {
 struct Shared<'a> {
     opts: &'a Options,
     seeds: Vec<Table>,
-    gpu: Option<Mutex<(shadowgraph::gpu::Gpu, Renderer)>>,
+    gpu: Option<Mutex<(shadowgraph::low_level::gpu::Gpu, Renderer)>>,
     summary: Mutex<Summary>,
     done: AtomicU64,
     accepted: AtomicU64,
@@ -155,7 +155,7 @@ pub fn case(seeds: &[Table], seed: u64, i: u64) -> (String, Option<MeshFile>) {
 }
 
 /// Runs the cases on `opts.threads` threads; `gpu` renders the sample when given.
-pub fn run(opts: &Options, gpu: Option<shadowgraph::gpu::Gpu>) -> Summary {
+pub fn run(opts: &Options, gpu: Option<shadowgraph::low_level::gpu::Gpu>) -> Summary {
     let start = Instant::now();
     let shared = Shared {
         opts,
@@ -389,7 +389,7 @@ fn check_scene(s: &Scene) -> Result<(), String> {
 /// Renders an accepted scene at 16×12 with shadow maps of at most 64²: finite visibility in
 /// [0, 1] and finite normals, or a one-line device-limit error naming the file.
 fn render_check(
-    g: &Mutex<(shadowgraph::gpu::Gpu, Renderer)>,
+    g: &Mutex<(shadowgraph::low_level::gpu::Gpu, Renderer)>,
     mut scene: Scene,
     local: &mut Summary,
 ) -> Result<(), String> {

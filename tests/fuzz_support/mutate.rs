@@ -84,13 +84,13 @@ const INTEGERS: &[i64] = &[
 /// the technique registry), so a new key is fuzzed as soon as it exists.
 pub fn keys() -> &'static [(&'static str, Vec<&'static str>)] {
     static KEYS: OnceLock<Vec<(&'static str, Vec<&'static str>)>> = OnceLock::new();
-    KEYS.get_or_init(shadowgraph::scene::keys::tables)
+    KEYS.get_or_init(shadowgraph::low_level::scene::keys::tables)
 }
 
 /// The techniques' names (the registry's).
 pub fn techniques() -> &'static [&'static str] {
     static NAMES: OnceLock<Vec<&'static str>> = OnceLock::new();
-    NAMES.get_or_init(shadowgraph::technique::names)
+    NAMES.get_or_init(shadowgraph::low_level::technique::names)
 }
 
 /// Words the string keys take (the library's: techniques, every choice's options, light kinds,
@@ -98,7 +98,7 @@ pub fn techniques() -> &'static [&'static str] {
 pub fn words() -> &'static [&'static str] {
     static WORDS: OnceLock<Vec<&'static str>> = OnceLock::new();
     WORDS.get_or_init(|| {
-        let mut w = shadowgraph::scene::keys::words();
+        let mut w = shadowgraph::low_level::scene::keys::words();
         w.extend(JUNK);
         w
     })

@@ -18,6 +18,24 @@ pub use crate::kernels::{GPU_LAYOUT_CONSTANT, REDESIGN_CONSTANT};
 pub const REDESIGNED_KERNELS: &[(&str, &str)] =
     &[("mips", "mips_spd"), ("mips_log", "mips_spd_log")];
 
+/// Import-only modules whose redesign needs a device feature, `(shipped, redesign, feature)`:
+/// in [`KernelLayout::Redesign`] on a device with `feature` every kernel importing `shipped`
+/// imports `redesign` instead ([`KernelLayout::module_sources`]); on a device without it the
+/// shipped module. The summed-area tables' tile passes by subgroup scans, a lane a column:
+/// `kernels/shared/sat_strip.wgsl`.
+pub const REDESIGNED_MODULES: &[(&str, &str, wgpu::Features)] = &[
+    (
+        "shared/sat_tile_sums",
+        "shared/sat_tile_sums_subgroup",
+        wgpu::Features::SUBGROUP,
+    ),
+    (
+        "shared/sat_tile_scan",
+        "shared/sat_tile_scan_subgroup",
+        wgpu::Features::SUBGROUP,
+    ),
+];
+
 /// Which of its two variants a kernel that has two compiles (`override GPU_LAYOUT: bool`): today
 /// the summed-area tables' pass 3 (`kernels/shared/sat_tile*.wgsl`), whose second sweep over an
 /// invocation's sub-block loads and encodes its texels again on a GPU (from its texture cache:
@@ -94,6 +112,20 @@ impl KernelLayout {
                 .map_or(name, |(_, redesign)| redesign),
             Self::Gpu | Self::Cpu => name,
         }
+    }
+
+    /// The modules kernels import in place of others in this layout on a device with
+    /// `features`, `(shipped, redesign)`: those of [`REDESIGNED_MODULES`] the features allow in
+    /// [`KernelLayout::Redesign`], none elsewhere.
+    pub fn module_sources(self, features: wgpu::Features) -> Vec<(&'static str, &'static str)> {
+        if !self.is_redesign() {
+            return Vec::new();
+        }
+        REDESIGNED_MODULES
+            .iter()
+            .filter(|(_, _, needs)| features.contains(*needs))
+            .map(|(shipped, redesign, _)| (*shipped, *redesign))
+            .collect()
     }
 
     /// The name [`KernelLayout::parse`] reads.

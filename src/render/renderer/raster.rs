@@ -1,10 +1,10 @@
 //! The renderer's raster passes: the light's depth-only pass (also the truth's emitter
 //! samples, [`Renderer::shadow_raster`]) and the camera's G-buffer, with their pipelines.
 
-use crate::created;
 use crate::error::{Error, Result};
 use crate::exec::GpuTimer;
 use crate::gpu::scoped;
+use crate::gpu_objects;
 use crate::kernels;
 
 use super::super::targets::uniform_group;
@@ -35,7 +35,7 @@ pub(super) fn clear_depth(view: &wgpu::TextureView) -> wgpu::RenderPassDepthSten
 
 /// A view of all of `t` (its depth aspect for a depth texture).
 pub(in crate::render) fn depth_only_view(t: &wgpu::Texture) -> wgpu::TextureView {
-    created::view(
+    gpu_objects::view(
         t,
         &wgpu::TextureViewDescriptor {
             aspect: if t.format().is_depth_stencil_format() {
@@ -101,21 +101,21 @@ impl Renderer {
         scoped(
             device,
             || {
-                let module = created::shader_module(
+                let module = gpu_objects::shader_module(
                     device,
                     wgpu::ShaderModuleDescriptor {
                         label: Some(&label),
                         source: wgpu::ShaderSource::Wgsl(wgsl.as_str().into()),
                     },
                 );
-                let bgl = created::bind_group_layout(
+                let bgl = gpu_objects::bind_group_layout(
                     device,
                     &wgpu::BindGroupLayoutDescriptor {
                         label: Some(&label),
                         entries: &refl.layout_entries(0),
                     },
                 );
-                let layout = created::pipeline_layout(
+                let layout = gpu_objects::pipeline_layout(
                     device,
                     &wgpu::PipelineLayoutDescriptor {
                         label: Some(&label),
@@ -123,7 +123,7 @@ impl Renderer {
                         immediate_size: 0,
                     },
                 );
-                let pipeline = created::render_pipeline(
+                let pipeline = gpu_objects::render_pipeline(
                     device,
                     &wgpu::RenderPipelineDescriptor {
                         label: Some(&label),
@@ -228,7 +228,7 @@ impl Renderer {
             m.copy_from_slice(vp);
         }
         let viewports: Vec<[u32; 4]> = raster.views.iter().map(|(_, v)| *v).collect();
-        let ubuf = created::buffer_init(
+        let ubuf = gpu_objects::buffer_init(
             device,
             &wgpu::util::BufferInitDescriptor {
                 label: Some("shadowgraph.light_view"),
@@ -237,7 +237,7 @@ impl Renderer {
             },
         );
         let bg = uniform_group(device, "shadowgraph.shadow_depth", layout, &ubuf);
-        let view = created::view(depth, &Default::default());
+        let view = gpu_objects::view(depth, &Default::default());
         raster_pass(
             enc,
             raster.label,
