@@ -57,7 +57,6 @@ pub const SAT_LINES_PER_GROUP: u32 = 64;
 /// The largest `max_area` the fixed-point coding accepts: one unit per texel must fit an i32.
 pub const MAX_FIXED_AREA: u64 = (1 << 31) - 1;
 
-pub use crate::model::SatVariant;
 
 /// The sampler of f32 summed-area tables read with bilinear-filtered fetches (linear
 /// filtering, clamped to the edge, level 0; `kernels/shared/sat.wgsl`, `sat_mean_linear`): a
@@ -339,7 +338,10 @@ fn named(pairs: Vec<(&str, &str)>) -> Vec<(String, String)> {
 /// and one per tile to the left; in the last pass the sub-block's table 6, the sums left of
 /// it 12 and above it 20 (its columns' 12 plus the whole sub-blocks above-left, 19), each
 /// added to its carry, and both sides added:
-/// `32 + tiles_x + tiles_y` bounds them all.
+/// `32 + tiles_x + tiles_y` bounds them all. The redesign layout's tile passes
+/// (`kernels/shared/sat_strip.wgsl`) stay within it: a tile's own table at most 20 deep (a
+/// column's running sum in chunks of 8 rows, 8; the upper half-tile's sums, 1; the row scan, 5
+/// with 32-lane subgroups, at most 10 with narrower ones), as the shipped edges.
 pub fn float_sum_depth(width: u32, height: u32) -> u32 {
     32 + width.div_ceil(SAT_TILE) + height.div_ceil(SAT_TILE)
 }
