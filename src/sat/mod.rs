@@ -57,6 +57,7 @@ pub const SAT_LINES_PER_GROUP: u32 = 64;
 /// The largest `max_area` the fixed-point coding accepts: one unit per texel must fit an i32.
 pub const MAX_FIXED_AREA: u64 = (1 << 31) - 1;
 
+pub use crate::model::SatVariant;
 
 /// The sampler of f32 summed-area tables read with bilinear-filtered fetches (linear
 /// filtering, clamped to the edge, level 0; `kernels/shared/sat.wgsl`, `sat_mean_linear`): a
