@@ -387,14 +387,22 @@ fn fused_blurs_match_encode_then_blur() {
             );
             let map = format!("{encoded}.blur");
             let what = format!("{map} (r = {radius}, {shadow})");
-            check_blur(&c, &light, &raw, &map, radius, (atol, rtol), steps, &what);
+            let tol = (atol, rtol);
+            check_blur(&c, &light, &raw, &map, radius, tol, steps, &what, &ALL);
         }
     }
 }
 
-/// Runs `light`'s graph for `map` ([`run_in`]) in each of the kernels' layouts
-/// (`exec::KernelLayout`: a GPU's tile in workgroup memory, a CPU driver's strips; the row
-/// path's invocations all at once or CPU_LANES at a time) and compares it with
+/// Every kernel layout (`exec::KernelLayout`): a GPU's tile in workgroup memory, a CPU driver's
+/// strips, the redesign's columns walked down strips 240 outputs wide and 64 tall (a 300² map
+/// has a ragged strip and a ragged last workgroup of each); the row path's invocations all at
+/// once (the GPU's and the redesign's) or CPU_LANES at a time.
+const ALL: [KernelLayout; 3] = [KernelLayout::Gpu, KernelLayout::Cpu, KernelLayout::Redesign];
+
+/// The layouts a device may default to (where the redesign runs the GPU's kernels).
+const SHIPPED: [KernelLayout; 2] = [KernelLayout::Gpu, KernelLayout::Cpu];
+
+/// Runs `light`'s graph for `map` ([`run_in`]) in each of `layouts` and compares it with
 /// `c`'s f64 reference (encoding, then both blur passes at `radius`, σ = r/2) within the
 /// encoding's `tolerance` (atol, rtol) plus the blur's own, and its counts of non-finite
 /// texels with `steps` counting steps.
@@ -408,10 +416,11 @@ fn check_blur(
     (atol, rtol): (f64, f64),
     steps: usize,
     what: &str,
+    layouts: &[KernelLayout],
 ) {
     let (lin, replaced) = linear(light, raw);
     let want = (c.reference)(&lin, radius.into(), f64::from(radius) / 2.0);
-    for layout in [KernelLayout::Gpu, KernelLayout::Cpu] {
+    for &layout in layouts {
         let what = format!("{what}, {} layout", layout.name());
         let (maps, stats) = run_in(light, raw, &[map.to_string()], Some(layout));
         let got = &maps[0];
@@ -461,7 +470,36 @@ fn row_kernels_span_row_workgroups() {
                 .collect();
             assert_eq!(kernels, [kernel, "blur"], "{what}");
             // Two stores, f16 in the packed cases.
-            check_blur(&c, &light, &raw, &map, radius, c.tolerance(2.0), 1, &what);
+            // The redesign layout's row pass is the GPU's.
+            let tol = c.tolerance(2.0);
+            check_blur(&c, &light, &raw, &map, radius, tol, 1, &what, &SHIPPED);
+        }
+    }
+}
+
+/// The redesign layout's strips (`kernels/shared/encode_blur_columns.wgsl`) at their edges: a
+/// 129² map, whose strip's last workgroup has one output row (at radius 1 it stores it among
+/// the zeros pushed past its 3 encoded rows), and a 241² map, whose second strip is one column
+/// wide; VSM (whose columns share their depths through workgroup memory), EVSM4 and MSM at
+/// radius 1 and 7, against the f64 references within `fused_blurs_match_encode_then_blur`'s
+/// tolerances, each non-finite texel (three on the last column and row) counted once.
+#[test]
+fn redesign_strips_cover_ragged_edges() {
+    for n in [129u32, 241] {
+        let raw = raw_depth_sized(4, n);
+        for radius in [1u32, 7] {
+            let sigma = f64::from(radius) / 2.0;
+            let four = blur_cases().into_iter().take(4);
+            for c in four.filter(|c| !c.shadow.contains("evsm2")) {
+                let filter = format!("filter = \"blur\"\nfilter_radius = {radius}");
+                let shadow = format!("{}\n{filter}\nfilter_sigma = {sigma}", c.shadow);
+                let light = spot_sized(&shadow, n);
+                let map = format!("{}.blur", c.encoded);
+                let what = format!("{map} (r = {radius}, {n}², {})", c.shadow);
+                let redesign = [KernelLayout::Redesign];
+                let tol = c.tolerance(1.0);
+                check_blur(&c, &light, &raw, &map, radius, tol, 1, &what, &redesign);
+            }
         }
     }
 }

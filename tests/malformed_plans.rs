@@ -104,7 +104,7 @@ fn malformed_plans_are_typed_errors() {
         .position(|st| {
             matches!(
                 st.node.dispatch,
-                Dispatch::Blocks { .. } | Dispatch::Tiles { .. }
+                Dispatch::Blocks { .. } | Dispatch::Tiles { .. } | Dispatch::Redesigned { .. }
             )
         })
         .unwrap();

@@ -31,7 +31,9 @@
 //     under masks, this ran 2–3× faster than the GPU's layout (benches/RESULTS.md,
 //     2026-11-28); on a GPU its few invocations a tile would leave most of each SM idle.
 // The row path is the same in both; a CPU driver's CPU_LANES invocations run its WG_SIZE
-// invocations' work CPU_LANES at a time.
+// invocations' work CPU_LANES at a time. The redesign layout (`exec::KernelLayout::Redesign`,
+// the override REDESIGN, on top of the GPU's) walks a tile's blur down strips of columns
+// instead (shared/encode_blur_columns), the row path the GPU's.
 //
 // It holds the kernels' entry point, `main`. The importing kernel declares `const CHANNELS`
 // (2 or 4), `struct Params` (its encoding's fields, then `blur: BlurSpec`), the fields of them
@@ -51,8 +53,9 @@
 // 40 with two channels, 32 with four; its horizontal sums, TILE × (CPU_TILE_ROWS +
 // 2·TILE_RADIUS), fit SH_TEXELS); `const WALK_ROWS`, the
 // encoded rows a CPU driver's strip walks at once (`walk_step`): 2 where the encoding reads the
-// depths above and below (VSM), else 1; and the fallback's row,
-// `const ROW` outputs a workgroup in runs of `const ROW_RUN` an invocation (ROW = ROW_RUN ·
+// depths above and below (VSM), else 1; `const NEIGHBOURS`, whether `encode` reads the
+// depths beside its texel (VSM: the redesign's columns share them through workgroup memory);
+// and the fallback's row, `const ROW` outputs a workgroup in runs of `const ROW_RUN` an invocation (ROW = ROW_RUN ·
 // WG_SIZE): 1024 in runs of 4 for `vsm_blur_row` (see `blur_row_quads`),
 // 512 in runs of 2 for `vsm_blur` (see `blur_row_pairs`), 256 one an invocation with four
 // channels:
@@ -60,6 +63,7 @@
 // Storage: rg32float by default; the executor re-declares `dst` for the bound format.
 
 // #import shared/linear_depth
+// #import shared/encode_blur_columns
 
 // Keep in sync with `BlurParams` in src/filter.rs (the same bytes; `axis` 2 means both).
 struct BlurSpec {
@@ -79,6 +83,9 @@ struct BlurSpec {
 const WG_SIZE: u32 = 256u;
 // The layout the executor compiles (`exec::KernelLayout`): true on a GPU.
 override GPU_LAYOUT: bool = false;
+// The redesign layout (with GPU_LAYOUT): a tile's blur down strips of columns
+// (shared/encode_blur_columns), a graph node's `Dispatch::Redesigned` strips.
+override REDESIGN: bool = false;
 // A CPU driver's workgroup: one of llvmpipe's SIMD groups (8 lanes of AVX2's 256-bit vectors).
 // Strips of 32 and of 8 lanes ran alike on llvmpipe's wall clock and 8 took 1.2–1.6× less CPU
 // time (benches/RESULTS.md, 2026-11-28): each extra SIMD group is one more coroutine
@@ -138,6 +145,9 @@ fn tile_of(wg: vec2<u32>) -> Tile {
             t.outs.y = i32(CPU_TILE_ROWS);
         }
         t.r = vec2<i32>(r);
+        if REDESIGN {
+            columns_tile(&t, wg);
+        }
     } else {
         t.origin = vec2<i32>(i32(wg.x * ROW), i32(wg.y));
         // Clipped to the map: a row narrower than ROW loads and encodes only its own texels.
@@ -797,8 +807,11 @@ fn blur_row(t: Tile, li: u32) {
 // The importing kernel's `main`: workgroup `wg`, invocation `li`.
 fn encode_blur(wg: vec2<u32>, li: u32) {
     let t = tile_of(wg);
-    // GPU_LAYOUT is a constant at each pipeline: each layout compiles its own branches.
-    if GPU_LAYOUT {
+    // GPU_LAYOUT and REDESIGN are constants at each pipeline: each layout compiles its own
+    // branches.
+    if REDESIGN && params.blur.axis == 2u {
+        blur_columns(t, li);
+    } else if GPU_LAYOUT {
         encode_tile(t, li);
         if params.blur.axis == 2u {
             // A constant condition: each kernel compiles one of the two.

@@ -23,6 +23,10 @@ struct Coding {
     exp_neg: f32,
 }
 
+// Whether `encode` reads the depths beside its texel (shared/encode_blur):
+// its moments are of the texel alone.
+const NEIGHBOURS: bool = false;
+
 fn coding() -> Coding {
     return Coding(params.exp_pos, params.exp_neg);
 }

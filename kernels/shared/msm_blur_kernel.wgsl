@@ -22,6 +22,10 @@ struct Coding {
     quantized: bool,
 }
 
+// Whether `encode` reads the depths beside its texel (shared/encode_blur):
+// its moments are of the texel alone.
+const NEIGHBOURS: bool = false;
+
 fn coding() -> Coding {
     return Coding(params.quantized == 1u);
 }

@@ -41,6 +41,10 @@ struct Coding {
     none: u32,
 }
 
+// Whether `encode` reads the depths beside its texel (shared/encode_blur):
+// the derivatives of `vsm_moments`.
+const NEIGHBOURS: bool = true;
+
 fn coding() -> Coding {
     return Coding(0u);
 }

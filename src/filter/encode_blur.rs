@@ -72,6 +72,17 @@ pub fn encode_blur_row_kernel(kernel: KernelId, width: u32) -> KernelId {
     }
 }
 
+/// Output columns of a strip of the redesign layout's tile ([`KernelLayout::Redesign`]:
+/// `COLUMN_OUTS` in `kernels/shared/encode_blur_columns.wgsl`): its 256 invocations each own a
+/// column of the depth, [`ENCODE_BLUR_TILE_RADIUS`] + 1 of them each side the halo.
+///
+/// [`KernelLayout::Redesign`]: crate::exec::KernelLayout::Redesign
+pub const ENCODE_BLUR_COLUMNS: u32 = 240;
+
+/// Output rows a workgroup of the redesign layout's strip walks (`COLUMN_ROWS`): with its halo
+/// of 2r rows, 64 + 2r steps; a 4096² map is then 18 × 64 workgroups.
+pub const ENCODE_BLUR_COLUMN_ROWS: u32 = 64;
+
 /// The largest radius the one-dispatch tile takes (`TILE_RADIUS`): the tile's depths with
 /// their halo, (TILE + 2·8)² texels of workgroup memory, fit 16 KiB ([`encode_blur_tile`]).
 pub const ENCODE_BLUR_TILE_RADIUS: u32 = 7;
@@ -144,7 +155,8 @@ pub fn add_encode_blur(
 }
 
 /// The node `name` of `e`'s fused kernel with `blur`: a workgroup per `tile`² outputs (per
-/// `tile` × [`encode_blur_cpu_rows`] on a CPU driver), or per [`encode_blur_row`] texels of a
+/// `tile` × [`encode_blur_cpu_rows`] on a CPU driver, per [`ENCODE_BLUR_COLUMNS`] ×
+/// [`ENCODE_BLUR_COLUMN_ROWS`] in the redesign layout), or per [`encode_blur_row`] texels of a
 /// row when `tile` is `None`.
 fn fused_node(
     graph: &mut Graph,
@@ -169,11 +181,18 @@ fn fused_node(
             x: encode_blur_row(e.kernel),
             y: 1,
         },
-        Some(t) => Dispatch::Tiles {
-            of: out.clone(),
-            x: t,
-            y: t,
-            cpu_y: encode_blur_cpu_rows(e.kernel),
+        Some(t) => Dispatch::Redesigned {
+            shipped: Box::new(Dispatch::Tiles {
+                of: out.clone(),
+                x: t,
+                y: t,
+                cpu_y: encode_blur_cpu_rows(e.kernel),
+            }),
+            redesign: Box::new(Dispatch::Blocks {
+                of: out.clone(),
+                x: ENCODE_BLUR_COLUMNS,
+                y: ENCODE_BLUR_COLUMN_ROWS,
+            }),
         },
     };
     graph.node(Node {
