@@ -20,7 +20,7 @@
 // #import shared/csm_maps
 // #import shared/linear_depth
 
-// Keep in sync with `CsmParams` in src/gpu_data.rs.
+// Keep in sync with `CsmParams` in src/wgsl_mirrors.rs.
 struct Params {
     depth: DepthParams,
     first_map: u32,

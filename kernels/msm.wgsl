@@ -9,7 +9,7 @@
 // #import shared/msm_moments
 // #import shared/linear_depth
 
-// Keep in sync with `MsmParams` in src/gpu_data.rs.
+// Keep in sync with `MsmParams` in src/wgsl_mirrors.rs.
 struct Params {
     depth: DepthParams,
     quantized: u32,

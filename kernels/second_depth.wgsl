@@ -13,7 +13,7 @@
 
 // #import shared/linear_depth
 
-// Keep in sync with `SecondDepthParams` in src/gpu_data.rs.
+// Keep in sync with `SecondDepthParams` in src/wgsl_mirrors.rs.
 struct Params {
     depth: DepthParams,
     mode: u32, // 0 midpoint, 1 second depth

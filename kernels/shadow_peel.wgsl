@@ -12,7 +12,7 @@ struct LightView {
 
 // #import shared/vertex
 
-// Depth-buffer units (keep in sync with `PEEL_EPSILON` in src/gpu_data.rs). A fragment of the
+// Depth-buffer units (keep in sync with `PEEL_EPSILON` in src/wgsl_mirrors.rs). A fragment of the
 // first surface reaches this pass at the depth it was stored with, but a driver may interpolate
 // the fragment stage's z and the depth attachment's value differently by a few ULPs (2⁻²⁴ at
 // depth 0.5–1): 2⁻¹⁸ is 64 such ULPs and 4·10⁻⁶ of the depth range, so a first surface never

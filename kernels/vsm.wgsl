@@ -8,7 +8,7 @@
 // #import shared/linear_depth
 // #import shared/vsm_moments
 
-// Keep in sync with `VsmParams` in src/gpu_data.rs.
+// Keep in sync with `VsmParams` in src/wgsl_mirrors.rs.
 struct Params {
     depth: DepthParams,
 }

@@ -48,7 +48,7 @@ fn raster_passes(plan: &crate::graph::Plan, i: usize) -> String {
             s,
             ", light{i}.shadow_peel -> {second} (depth peeling: fragments at or in front of {} + {:e} discarded)",
             technique::depth_name(i),
-            technique::PEEL_EPSILON
+            crate::wgsl_mirrors::PEEL_EPSILON
         );
     }
     s
@@ -107,7 +107,7 @@ pub fn shading_fetches(lights: &[Light]) -> Result<Vec<f64>> {
         .iter()
         .enumerate()
         .map(|(i, l)| {
-            let gpu = technique::LightGpu::new(l);
+            let gpu = crate::wgsl_mirrors::LightGpu::new(l);
             Fetches::new("shade", &wgsl, bytemuck::bytes_of(&gpu))?
                 .count(&format!("light{i}_visibility"))
         })

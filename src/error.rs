@@ -149,7 +149,7 @@ impl From<StageError> for Error {
 }
 
 /// Why the executor (`exec`) cannot record a plan, beyond the plan's own shape
-/// ([`crate::graph::GraphError::BadPlan`]) and the device's pipeline errors ([`Error::Pipeline`]).
+/// ([`crate::error::GraphError::BadPlan`]) and the device's pipeline errors ([`Error::Pipeline`]).
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 #[non_exhaustive]
 pub enum ExecError {

@@ -42,8 +42,6 @@ pub mod evaluate {
 pub mod exec {
     //! The executor: records a plan's compute passes into the caller's encoder.
     pub use crate::exec::*;
-    #[expect(hidden_glob_reexports, unused_imports, reason = "the root holds `ExecError`")]
-    use crate::error::ExecError;
 }
 
 pub mod filter {
@@ -63,9 +61,13 @@ pub mod gpu_objects {
 
 pub mod graph {
     //! The kernel graph: nodes, resources, planning, cost and printing.
+    #[expect(
+        hidden_glob_reexports,
+        unused_imports,
+        reason = "the root holds `PACKED_F16X2`"
+    )]
+    use crate::graph::PACKED_F16X2;
     pub use crate::graph::*;
-    #[expect(hidden_glob_reexports, unused_imports, reason = "the root holds these")]
-    use crate::{error::GraphError, graph::PACKED_F16X2};
 }
 
 pub mod kernels {
@@ -91,7 +93,11 @@ pub mod model {
     pub mod cascades {
         //! The cascade slices' fitting beneath [`crate::cascades`].
         pub use crate::model::cascades::*;
-        #[expect(hidden_glob_reexports, unused_imports, reason = "`crate::cascades` holds these")]
+        #[expect(
+            hidden_glob_reexports,
+            unused_imports,
+            reason = "`crate::cascades` holds these"
+        )]
         use crate::model::cascades::{CascadeCamera, Cascades, MAX_CASCADES, split_distances};
     }
 }
@@ -104,9 +110,13 @@ pub mod render {
 
 pub mod sat {
     //! Summed-area tables: their codings, graphs and lookups.
+    #[expect(
+        hidden_glob_reexports,
+        unused_imports,
+        reason = "the root holds `SAT_SAMPLER_DESCRIPTOR`"
+    )]
+    use crate::sat::SAT_SAMPLER_DESCRIPTOR;
     pub use crate::sat::*;
-    #[expect(hidden_glob_reexports, unused_imports, reason = "the root holds these")]
-    use crate::{model::SatVariant, sat::SAT_SAMPLER_DESCRIPTOR};
 }
 
 #[cfg(feature = "cli")]
@@ -124,8 +134,6 @@ pub mod stability {
 pub mod technique {
     //! The technique registry: each technique's parameters, maps, nodes and shading.
     pub use crate::technique::*;
-    #[expect(hidden_glob_reexports, unused_imports, reason = "the root holds `LightGpu`")]
-    use crate::wgsl_mirrors::LightGpu;
 }
 
 #[cfg(feature = "cli")]
@@ -136,9 +144,13 @@ pub mod tolerance {
 
 pub mod timer {
     //! GPU timestamps around compute passes, and warm-up.
-    pub use crate::timer::*;
-    #[expect(hidden_glob_reexports, unused_imports, reason = "the root holds `TIMER_FEATURES`")]
+    #[expect(
+        hidden_glob_reexports,
+        unused_imports,
+        reason = "the root holds `TIMER_FEATURES`"
+    )]
     use crate::timer::TIMER_FEATURES;
+    pub use crate::timer::*;
 }
 
 #[cfg(feature = "cli")]
@@ -150,7 +162,11 @@ pub mod truth {
 pub mod wgsl_mirrors {
     //! The `#[repr(C)]` mirrors of the WGSL structs the Rust side fills, and the technique ids
     //! and flags the shading kernel reads.
-    pub use crate::wgsl_mirrors::*;
-    #[expect(hidden_glob_reexports, unused_imports, reason = "the root holds `LightGpu`")]
+    #[expect(
+        hidden_glob_reexports,
+        unused_imports,
+        reason = "the root holds `LightGpu`"
+    )]
     use crate::wgsl_mirrors::LightGpu;
+    pub use crate::wgsl_mirrors::*;
 }

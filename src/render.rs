@@ -17,12 +17,11 @@ use crate::error::{Error, Result};
 use crate::exec::Outputs;
 use crate::gpu::read_texture;
 use crate::graph::{Graph, Plan, plan};
-pub use crate::limits::check_features;
 use crate::technique;
 use crate::{model::Light, scene::Scene};
 
-pub use crate::model::CameraRays;
-pub use crate::wgsl_mirrors::FrameGpu;
+use crate::model::CameraRays;
+use crate::wgsl_mirrors::FrameGpu;
 
 impl FrameGpu {
     /// Frame constants for `scene` rendered at `width × height`, with the camera's rays.

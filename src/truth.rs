@@ -35,7 +35,7 @@ use wgpu::util::DeviceExt;
 use crate::error::{Error, Result};
 use crate::gpu::{read_buffer, submit_and_wait, write_texture};
 use crate::render::{RenderOptions, Renderer, ShadowRaster};
-use crate::technique::LightGpu;
+use crate::wgsl_mirrors::LightGpu;
 use crate::{
     model::{Light, LightKind, Technique},
     scene::Scene,

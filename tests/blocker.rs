@@ -26,9 +26,8 @@ fn csm_z_on_gpu(
     storage: Storage,
 ) -> Vec<(usize, Vec<f32>)> {
     use shadowgraph::low_level::graph::{Dispatch, Graph, Node, SizeRule, plan};
-    use shadowgraph::low_level::technique::{
-        CsmParams, LinearizeParams, csm_maps, csm_z_channels, csm_z_maps, moments_format,
-    };
+    use shadowgraph::low_level::technique::{csm_maps, csm_z_channels, csm_z_maps, moments_format};
+    use shadowgraph::low_level::wgsl_mirrors::{CsmParams, LinearizeParams};
     let mut graph = Graph::default();
     graph.import("in", wgpu::TextureFormat::R32Float, w, h, Some(0));
     let mut outputs = Vec::new();

@@ -566,7 +566,7 @@ fn counted_fetches_match_the_declarations() {
     let mut checked = 0;
     for name in &names {
         let mut s = scene(name);
-        if shadowgraph::low_level::render::check_features(&g.device, &s.lights).is_err() {
+        if shadowgraph::low_level::limits::check_features(&g.device, &s.lights).is_err() {
             continue;
         }
         (s.width, s.height) = (96, 72);

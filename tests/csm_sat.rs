@@ -26,9 +26,10 @@ use shadowgraph::low_level::sat::{
     SAT_TILE, SatCoding, decode_table, float_sum_depth, lookup_area,
 };
 use shadowgraph::low_level::technique::{
-    CsmBasis, LinearizeParams, MomentTable, Moments, add_csm_tables, add_moment_table,
-    basis_interleave, basis_sequence, csm_maps, csm_z_maps,
+    CsmBasis, MomentTable, Moments, add_csm_tables, add_moment_table, basis_interleave,
+    basis_sequence, csm_maps, csm_z_maps,
 };
+use shadowgraph::low_level::wgsl_mirrors::LinearizeParams;
 use shadowgraph::{CssmSearch, SatVariant, Storage};
 
 /// f32's unit roundoff.

@@ -10,7 +10,7 @@ use shadowgraph::low_level::cpu::linearize::linearize;
 use shadowgraph::low_level::exec::Executor;
 use shadowgraph::low_level::gpu::{read_texture, submit_and_wait, write_texture};
 use shadowgraph::low_level::graph::{Dispatch, Graph, Node, SizeRule, plan};
-use shadowgraph::low_level::technique::LinearizeParams;
+use shadowgraph::low_level::wgsl_mirrors::LinearizeParams;
 
 struct Run {
     out: Vec<f32>,

@@ -87,7 +87,7 @@ fn stage_maps_as_frame(
 /// Per pixel of `frame`, the surface's world-space differentials along x and y (two vec4s),
 /// as the renderer computes them for its footprints.
 fn differentials(frame: &Frame, scene: &Scene) -> Vec<f32> {
-    let rays = shadowgraph::low_level::render::CameraRays::new(&scene.camera, frame.width, frame.height);
+    let rays = shadowgraph::low_level::model::CameraRays::new(&scene.camera, frame.width, frame.height);
     let eye = scene.camera.position.as_dvec3();
     let mut diffs = Vec::with_capacity(8 * (frame.width * frame.height) as usize);
     for y in 0..frame.height {

@@ -11,8 +11,9 @@ use std::time::Instant;
 use common::host::host_depth;
 use glam::{Mat4, Vec3};
 use shadowgraph::low_level::gpu::{Gpu, read_texture, submit_and_wait, take_uncaptured};
-use shadowgraph::low_level::scene::{Scene, Vertex};
+use shadowgraph::low_level::scene::Scene;
 use shadowgraph::low_level::timer::GpuTimer;
+use shadowgraph::low_level::wgsl_mirrors::Vertex;
 use shadowgraph::{DepthLayer, LightParams, Prefilter, PrefilterConfig};
 
 const SIZE: u32 = 128;

@@ -91,8 +91,8 @@ fn vsm_graph(
     format: wgpu::TextureFormat,
     filter: Option<Filter>,
 ) -> (Graph, String) {
-    let params = shadowgraph::low_level::technique::VsmParams {
-        depth: shadowgraph::low_level::technique::LinearizeParams::ORTHOGRAPHIC,
+    let params = shadowgraph::low_level::wgsl_mirrors::VsmParams {
+        depth: shadowgraph::low_level::wgsl_mirrors::LinearizeParams::ORTHOGRAPHIC,
     };
     encode_graph(
         "vsm",
@@ -282,7 +282,7 @@ fn vsm_light_plans_one_fused_encode_and_blur_only() {
 #[test]
 fn evsm_and_esm_encodings_match_reference() {
     use shadowgraph::low_level::filter::BlurMode;
-    use shadowgraph::low_level::technique::ExpParams;
+    use shadowgraph::low_level::wgsl_mirrors::ExpParams;
     let g = common::gpu();
     let mut rng = common::rng(42);
     let (w, h) = (333u32, 45u32);
@@ -391,7 +391,7 @@ fn channels_of(t: &Texels, n: usize) -> Vec<f32> {
 #[test]
 fn msm_encoding_matches_reference_for_each_storage() {
     use shadowgraph::low_level::filter::BlurMode;
-    use shadowgraph::low_level::technique::{LinearizeParams, MsmParams};
+    use shadowgraph::low_level::wgsl_mirrors::{LinearizeParams, MsmParams};
     let g = common::gpu();
     let mut rng = common::rng(43);
     let (w, h) = (1000u32, 37u32);
@@ -477,7 +477,7 @@ fn msm_encoding_matches_reference_for_each_storage() {
 #[test]
 fn csm_basis_matches_reference() {
     use shadowgraph::low_level::filter::BlurMode;
-    use shadowgraph::low_level::technique::CsmParams;
+    use shadowgraph::low_level::wgsl_mirrors::CsmParams;
     let g = common::gpu();
     let mut rng = common::rng(44);
     let (w, h) = (257u32, 31u32);
@@ -493,7 +493,7 @@ fn csm_basis_matches_reference() {
         // One map a dispatch here (`tests/fused.rs` writes several): map m holds terms
         // 2m + 1 and 2m + 2.
         let params = bytemuck::bytes_of(&CsmParams {
-            depth: shadowgraph::low_level::technique::LinearizeParams::ORTHOGRAPHIC,
+            depth: shadowgraph::low_level::wgsl_mirrors::LinearizeParams::ORTHOGRAPHIC,
             first_map: (first_term - 1) / 2,
             maps: 1,
             terms,
@@ -532,7 +532,7 @@ fn csm_basis_matches_reference() {
     // With `moments` (CSSM's moment search) the map after the basis is MSM's quantized moments:
     // the quantization matrix's f32 products (entries up to 82: 6·82·2⁻²⁴).
     let params = bytemuck::bytes_of(&CsmParams {
-        depth: shadowgraph::low_level::technique::LinearizeParams::ORTHOGRAPHIC,
+        depth: shadowgraph::low_level::wgsl_mirrors::LinearizeParams::ORTHOGRAPHIC,
         first_map: shadowgraph::low_level::technique::csm_maps(terms),
         maps: 1,
         terms,
@@ -642,7 +642,7 @@ fn mip_chain_matches_reference_and_ends_at_the_mean() {
 #[test]
 fn mip_chain_of_16_bit_maps_matches_reference() {
     use shadowgraph::low_level::filter::BlurMode;
-    use shadowgraph::low_level::technique::{LinearizeParams, MsmParams};
+    use shadowgraph::low_level::wgsl_mirrors::{LinearizeParams, MsmParams};
     let g = common::gpu();
     let mut rng = common::rng(46);
     let (w, h) = (200u32, 75u32);

@@ -12,14 +12,14 @@ mod common;
 use std::path::Path;
 
 use glam::{DMat4, DVec3, DVec4};
-use shadowgraph::low_level::cpu;
 use shadowgraph::low_level::render::{Frame, RenderOptions, Renderer};
 use shadowgraph::low_level::scene::Scene;
-use shadowgraph::low_level::technique::{self, SecondDepthParams};
 use shadowgraph::low_level::truth::bvh::Bvh;
 use shadowgraph::low_level::truth::peel::{PeeledTexel, peeled_depths};
 use shadowgraph::low_level::truth::raycast::{CpuTruth, ray_cast_truth};
 use shadowgraph::low_level::truth::{axis_distance, emitter};
+use shadowgraph::low_level::wgsl_mirrors::SecondDepthParams;
+use shadowgraph::low_level::{cpu, technique};
 use shadowgraph::{Light, LightKind, PcfKernel, Technique};
 
 fn scene(name: &str) -> Scene {
@@ -121,7 +121,7 @@ fn check_map(name: &str, light: &Light, li: usize, frame: &Frame) {
     let z2 = resource(frame, &technique::second_depth_name(li));
     let midpoint = matches!(light.shadow.technique, Technique::Midpoint { .. });
     let params = SecondDepthParams {
-        depth: technique::LinearizeParams::new(light),
+        depth: shadowgraph::low_level::wgsl_mirrors::LinearizeParams::new(light),
         mode: u32::from(!midpoint),
         _pad: [0; 3],
     };

@@ -98,7 +98,7 @@
 //   d = (Z − near) / (far − near),  Z = distance along the light's view axis,
 // for both the orthographic (directional) and the perspective (spot) light.
 
-// Keep in sync with `LightGpu` in src/gpu_data.rs.
+// Keep in sync with `LightGpu` in src/wgsl_mirrors.rs.
 struct sg_Light {
     view_proj: mat4x4<f32>,  // world → light clip
     view: mat4x4<f32>,       // world → light view
@@ -159,7 +159,7 @@ struct sg_Light {
     capped_filter: u32,      // pcss: 1 where the filter radius is capped at max_search (a point light's faces, a cascade's guard band)
 }
 
-// `Light::technique` (keep in sync with the `TECHNIQUE_*` constants of src/gpu_data.rs; a test
+// `Light::technique` (keep in sync with the `TECHNIQUE_*` constants of src/wgsl_mirrors.rs; a test
 // compares them).
 const sg_TECHNIQUE_HARD: u32 = 0u;
 const sg_TECHNIQUE_PCF: u32 = 1u;

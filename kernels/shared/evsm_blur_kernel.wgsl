@@ -7,7 +7,7 @@
 // #import shared/encode_blur_rgba
 // #import shared/evsm_moments
 
-// Keep in sync with `ExpParams` in src/gpu_data.rs, then `BlurParams` in src/filter.rs.
+// Keep in sync with `ExpParams` in src/wgsl_mirrors.rs, then `BlurParams` in src/filter.rs.
 struct Params {
     depth: DepthParams,
     exp_pos: f32,

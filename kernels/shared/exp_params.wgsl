@@ -2,7 +2,7 @@
 
 // #import shared/linear_depth
 
-// Keep in sync with `ExpParams` in src/gpu_data.rs.
+// Keep in sync with `ExpParams` in src/wgsl_mirrors.rs.
 struct Params {
     depth: DepthParams,      // the depth buffer's linearization (shared/linear_depth)
     exp_pos: f32,            // evsm: c⁺; esm: c

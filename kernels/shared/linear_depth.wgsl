@@ -10,7 +10,7 @@
 // counts them (`DepthTexel.finite`) so the caller can report them instead of spreading them
 // through filters.
 
-// Keep in sync with `LinearizeParams` in src/gpu_data.rs.
+// Keep in sync with `LinearizeParams` in src/wgsl_mirrors.rs.
 struct DepthParams {
     perspective: u32,
     near: f32,

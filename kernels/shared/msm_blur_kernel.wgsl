@@ -7,7 +7,7 @@
 // #import shared/encode_blur_rgba
 // #import shared/msm_moments
 
-// Keep in sync with `MsmParams` in src/gpu_data.rs, then `BlurParams` in src/filter.rs.
+// Keep in sync with `MsmParams` in src/wgsl_mirrors.rs, then `BlurParams` in src/filter.rs.
 struct Params {
     depth: DepthParams,
     quantized: u32,

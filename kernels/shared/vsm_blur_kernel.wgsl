@@ -7,7 +7,7 @@
 // #import shared/encode_blur
 // #import shared/vsm_moments
 
-// Keep in sync with `VsmParams` in src/gpu_data.rs, then `BlurParams` in src/filter.rs.
+// Keep in sync with `VsmParams` in src/wgsl_mirrors.rs, then `BlurParams` in src/filter.rs.
 struct Params {
     depth: DepthParams,
     blur: BlurSpec,

@@ -9,9 +9,9 @@ use super::graphs::{
 };
 use crate::model::ParamValue;
 use crate::model::{Storage, Technique};
-use crate::sat::{self, SatVariant};
 use crate::technique;
 use crate::technique::params::storage_name;
+use crate::{model::SatVariant, sat};
 
 /// One kernel to benchmark: adding a kernel to the benchmark is one entry of [`CASES`].
 pub struct BenchCase {

@@ -7,10 +7,13 @@ use std::sync::Arc;
 use super::BenchGraph;
 use super::harness::{Timed, median_time, random_depths, timer};
 use crate::error::{Error, Result};
-use crate::exec::{ComputeKernel, GpuTimer, KernelCache, wgsl_storage_format};
 use crate::gpu::scoped;
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
 use crate::kernels::KernelId;
+use crate::{
+    exec::{ComputeKernel, KernelCache, wgsl_storage_format},
+    timer::GpuTimer,
+};
 
 /// Bytes one invocation of the buffer copy kernel copies (one `vec4<u32>`).
 const COPY_BYTES_PER_INVOCATION: u64 = 16;

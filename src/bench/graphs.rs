@@ -8,8 +8,11 @@ use super::cases::named;
 use crate::filter::{BlurMode, add_filter};
 use crate::graph::Graph;
 use crate::model::{Light, LightKind, Shadow, Technique};
-use crate::sat::{self, SatCoding, SatVariant};
 use crate::technique;
+use crate::{
+    model::SatVariant,
+    sat::{self, SatCoding},
+};
 
 /// The graph a case runs and the outputs that keep its nodes alive.
 pub struct BenchGraph {

@@ -6,9 +6,9 @@ use std::time::Instant;
 
 use super::WARMUP;
 use crate::error::{Error, Result};
-use crate::exec::{Executor, GpuTimer};
 use crate::gpu::{scoped, submit_and_wait, write_texture};
 use crate::graph::{self, Graph, Plan};
+use crate::{exec::Executor, timer::GpuTimer};
 
 /// A timer for `spans` spans, or the error saying this device cannot time.
 pub(super) fn timer(device: &wgpu::Device, queue: &wgpu::Queue, spans: u32) -> Result<GpuTimer> {

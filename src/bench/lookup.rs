@@ -6,8 +6,8 @@ use super::harness::median;
 use super::{GPU_WARMUP_MS, WARMUP};
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
+use crate::model::SatVariant;
 use crate::model::{Filter, Storage, StorageFilter, Technique};
-use crate::sat::SatVariant;
 
 /// The scene the lookup-cost benchmark shades: `scenes/techniques/vsm.toml` (built-in shapes
 /// only), embedded so the benchmark runs from anywhere.

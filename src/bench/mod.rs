@@ -8,7 +8,7 @@
 //! halos, second reads and mip levels included, not one read and one write per texel. Its
 //! ratio is its GB/s over the texture copy of its output's format, at the same size. The
 //! harness plans the graph, fills every imported texture with random values, records it with
-//! [`crate::exec::Executor::record`] under a [`crate::exec::GpuTimer`], and keeps the median over the timed
+//! [`crate::exec::Executor::record`] under a [`crate::timer::GpuTimer`], and keeps the median over the timed
 //! runs (after [`WARMUP`] untimed ones) of the summed node times.
 //!
 //! The entry is [`run`]; [`measure()`] ([`measure_variants`]) takes the rows, [`format_table`]
@@ -47,7 +47,7 @@ pub use self::variant::{KernelVariant, SHIPPED, ZEROED};
 use crate::error::{Error, Result};
 use crate::exec::KernelLayout;
 use crate::gpu::Gpu;
-pub use crate::timer::GPU_WARMUP_MS;
+use crate::timer::GPU_WARMUP_MS;
 
 /// Untimed runs before the timed ones (pipeline warm-up, lazy clears, caches).
 pub const WARMUP: u32 = 2;

@@ -110,7 +110,7 @@ fn scene_with(shadow: &str) -> Result<Scene> {
 fn shading_fetches(scene: &Scene) -> Result<f64> {
     let block = crate::technique::shading_block(&scene.lights);
     let wgsl = crate::kernels::resolve("shade", Some(&block))?;
-    let light = crate::technique::LightGpu::new(&scene.lights[0]);
+    let light = crate::wgsl_mirrors::LightGpu::new(&scene.lights[0]);
     crate::graph::cost::fetches::Fetches::new("shade", &wgsl, bytemuck::bytes_of(&light))?
         .count("light0_visibility")
 }

@@ -13,9 +13,9 @@
 
 use super::stats::ErrorStats;
 use crate::cpu::shade::{Shading, shade};
-use crate::render::FrameGpu;
 use crate::scene::Scene;
-use crate::technique::LightGpu;
+use crate::wgsl_mirrors::FrameGpu;
+use crate::wgsl_mirrors::LightGpu;
 
 /// The scene's shading inputs, made once per evaluation.
 pub struct Shader {

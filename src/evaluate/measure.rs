@@ -10,9 +10,9 @@ use crate::cpu::Map;
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
 use crate::render::{FloatMap, Frame, RenderOptions, Renderer, plan_lights};
-use crate::technique::LightGpu;
 use crate::truth::Truth;
 use crate::truth::pcf::{Receiver, pcf_box};
+use crate::wgsl_mirrors::LightGpu;
 use crate::{
     model::{Filter, Technique},
     scene::Scene,

@@ -28,7 +28,7 @@ pub const FILTERS: &[(&str, FilterOfWidth)] = &[
     }),
     ("sat", |width| Filter::Sat {
         width,
-        variant: crate::sat::SatVariant::Fixed,
+        variant: crate::model::SatVariant::Fixed,
     }),
 ];
 

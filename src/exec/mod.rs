@@ -19,14 +19,12 @@ mod record;
 use std::collections::HashMap;
 
 use self::record::{PreparedStep, RunParams, StepBuffers};
-pub use crate::error::ExecError;
-use crate::error::Result;
+use crate::error::{ExecError, Result};
 use crate::graph::{Plan, Slot};
-pub use crate::timer::GpuTimer;
+use crate::timer::GpuTimer;
 pub use pipelines::{
-    ComputeKernel, GPU_LAYOUT_CONSTANT, KERNEL_LAYOUT_ENV, KernelCache, KernelLayout,
-    REDESIGN_CONSTANT, REDESIGNED_KERNELS, REDESIGNED_MODULES, WorkgroupInit, specialized_source,
-    wgsl_storage_format,
+    ComputeKernel, KERNEL_LAYOUT_ENV, KernelCache, KernelLayout, REDESIGNED_KERNELS,
+    REDESIGNED_MODULES, WorkgroupInit, specialized_source, wgsl_storage_format,
 };
 pub use pool::{Outputs, TexturePool};
 

@@ -9,6 +9,8 @@ pub mod print;
 
 pub use plan::{Plan, PlannedResource, Slot, Step, plan};
 
+use crate::error::GraphError;
+
 /// How big a resource is.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum SizeRule {
@@ -412,8 +414,6 @@ pub fn layer_of<T: Copy>(data: &[T], per_texel: usize, layers: usize, k: usize) 
         .flat_map(|group| group[k * per_texel..(k + 1) * per_texel].iter().copied())
         .collect()
 }
-
-pub use crate::error::GraphError;
 
 /// Blocks of `block` texels covering `len` texels, rounded up, at least 1; a `block` of 0
 /// spans the whole length (one block).

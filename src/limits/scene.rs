@@ -12,7 +12,7 @@ use crate::scene::Scene;
 use crate::{kernels, technique};
 
 /// Bytes of one vertex as uploaded (`scene::Vertex`).
-const VERTEX_BYTES: u64 = std::mem::size_of::<crate::scene::Vertex>() as u64;
+const VERTEX_BYTES: u64 = std::mem::size_of::<crate::wgsl_mirrors::Vertex>() as u64;
 
 /// The estimated memory of one frame (GPU resources, staging buffers and host copies).
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -312,7 +312,7 @@ impl Checker<'_> {
                 ),
             ));
         }
-        let per_light = std::mem::size_of::<technique::LightGpu>() as u64;
+        let per_light = std::mem::size_of::<crate::wgsl_mirrors::LightGpu>() as u64;
         if lights * per_light > binding || s.objects.len() as u64 * 16 > binding {
             return Err(self.err(
                 "light[0]",

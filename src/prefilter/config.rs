@@ -4,10 +4,10 @@
 
 use super::StageError;
 use crate::model::Cascades;
+use crate::model::SatVariant;
 use crate::model::{
     BlurKernel, CssmResolve, CssmSearch, Filter, Light, ParamValue, ParamValues, Storage, Technique,
 };
-use crate::sat::SatVariant;
 use crate::technique::params::{CASCADES, COMMON, Given, GivenError, filter_values, storage_name};
 use crate::technique::{self, TechniqueDef};
 

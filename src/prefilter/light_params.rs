@@ -4,7 +4,7 @@ use glam::{Mat4, Vec3, Vec4};
 
 use super::{PrefilterConfig, StageError};
 use crate::model::{Light, LightKind, Shadow};
-use crate::technique::LightGpu;
+use crate::wgsl_mirrors::LightGpu;
 
 /// What changes per frame: the matrices the host rasterized the depth texture with, and how
 /// its depth maps to distance. The projection follows wgpu's conventions: right-handed view

@@ -20,7 +20,7 @@ use crate::error::{Error, Result};
 use crate::model::cascades::{CascadeCamera, CascadeSlice, SliceGuard, cascade_light, fit_slices};
 use crate::model::{Cascades, Light, LightKind};
 use crate::scene::Scene;
-use crate::technique::{CascadeGroup, LightGpu};
+use crate::{technique::CascadeGroup, wgsl_mirrors::LightGpu};
 
 /// The camera's near plane (`model::Camera::view_proj`): the closest a cascade range starts.
 const CAMERA_NEAR: f32 = 0.05;

@@ -8,10 +8,13 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 use crate::error::{Error, Result};
-use crate::exec::{ComputeKernel, Executor, GpuTimer, Outputs};
 use crate::gpu::{scoped, submit_and_wait};
 use crate::gpu_objects;
 use crate::technique;
+use crate::{
+    exec::{ComputeKernel, Executor, Outputs},
+    timer::GpuTimer,
+};
 use crate::{model::Light, scene::Scene};
 
 mod raster;

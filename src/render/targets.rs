@@ -8,8 +8,8 @@ use std::collections::HashMap;
 
 use crate::gpu::read_buffer;
 use crate::gpu_objects;
-use crate::scene::{Scene, Vertex};
-use crate::technique::{self, LightGpu};
+use crate::{scene::Scene, wgsl_mirrors::Vertex};
+use crate::{technique, wgsl_mirrors::LightGpu};
 
 use super::FrameGpu;
 use super::cascade::DrawnLights;

@@ -45,6 +45,7 @@ pub mod lookups;
 use crate::error::{Error, Result};
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
 use crate::kernels::KernelId;
+use crate::model::SatVariant;
 
 /// Side of the square tile one workgroup of `sat_tile_sums` and `sat_tiles` owns (`TILE` in
 /// `kernels/shared/sat_tile.wgsl`; a test checks them against each other).
@@ -56,8 +57,6 @@ pub const SAT_LINES_PER_GROUP: u32 = 64;
 
 /// The largest `max_area` the fixed-point coding accepts: one unit per texel must fit an i32.
 pub const MAX_FIXED_AREA: u64 = (1 << 31) - 1;
-
-pub use crate::model::SatVariant;
 
 /// The sampler of f32 summed-area tables read with bilinear-filtered fetches (linear
 /// filtering, clamped to the edge, level 0; `kernels/shared/sat.wgsl`, `sat_mean_linear`): a

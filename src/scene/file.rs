@@ -5,9 +5,10 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
-use super::{Locations, Mesh, Vertex, parse};
+use super::{Locations, Mesh, parse};
 use crate::error::{Error, Result};
 use crate::model::{Camera, Light};
+use crate::wgsl_mirrors::Vertex;
 
 /// A loaded, validated scene.
 #[derive(Clone, Debug)]

@@ -2,6 +2,8 @@
 
 use glam::{DMat3, DMat4, DVec3, Mat4, Vec3};
 
+use crate::wgsl_mirrors::Vertex;
+
 /// Indexed triangles with per-vertex normals.
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
@@ -12,8 +14,6 @@ pub struct Mesh {
     /// Triangle list.
     pub indices: Vec<u32>,
 }
-
-pub use crate::wgsl_mirrors::Vertex;
 
 impl Mesh {
     /// The mesh under `m`, computed in f64. Normals go through the cofactor matrix (the inverse

@@ -42,7 +42,7 @@ pub use file::{MAX_SCENE_BYTES, Object, Scene};
 #[cfg(feature = "cli")]
 pub use locate::Locations;
 #[cfg(feature = "cli")]
-pub use mesh::{Mesh, Vertex};
+pub use mesh::Mesh;
 #[cfg(feature = "cli")]
 pub use object::{MAX_TRIANGLES, WORLD_LIMIT};
 #[cfg(feature = "cli")]

@@ -244,7 +244,7 @@ fn light(ctx: &Ctx, i: usize, l: &LightFile) -> Result<Light> {
     }
     if let Some(soft) = shadow.technique.soft() {
         let area = crate::technique::soft_lookup_area(soft.max_search, shadow_map);
-        if soft.sums == crate::sat::SatVariant::Fixed && area > crate::sat::MAX_FIXED_AREA {
+        if soft.sums == crate::model::SatVariant::Fixed && area > crate::sat::MAX_FIXED_AREA {
             let span = l
                 .shadow
                 .as_ref()

@@ -26,8 +26,8 @@ use crate::exec::Executor;
 use crate::gpu::Gpu;
 use crate::model::{BlurKernel, Filter, Storage, StorageFilter, Technique};
 use crate::render::Renderer;
-use crate::technique::{LightGpu, linear_name};
 use crate::tolerance;
+use crate::{technique::linear_name, wgsl_mirrors::LightGpu};
 
 const MAP: u32 = 64;
 const TERMS: u32 = 16;

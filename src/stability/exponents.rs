@@ -26,8 +26,11 @@ use crate::exec::Executor;
 use crate::gpu::{Gpu, read_texture};
 use crate::graph::Graph;
 use crate::model::ParamValue;
-use crate::sat::{SatCoding, SatVariant, add_sat, float_sum_depth};
 use crate::technique::{Encoding, encoding};
+use crate::{
+    model::SatVariant,
+    sat::{SatCoding, add_sat, float_sum_depth},
+};
 use crate::{
     model::{BlurKernel, Filter, Storage, Technique, exponent_limit},
     scene::Scene,

@@ -21,10 +21,13 @@ use crate::error::{Error, Result};
 use crate::exec::Executor;
 use crate::gpu::Gpu;
 use crate::render::{RenderOptions, Renderer};
-use crate::technique::{LightGpu, depth_name, linear_name};
 use crate::{
     model::{LightKind, PcfKernel, Technique},
     scene::Scene,
+};
+use crate::{
+    technique::{depth_name, linear_name},
+    wgsl_mirrors::LightGpu,
 };
 
 const MAP: u32 = 64;

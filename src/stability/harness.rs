@@ -14,7 +14,10 @@ use crate::graph::{Graph, Plan, plan, texel_bytes};
 use crate::model::{Light, LightKind, Shadow, Technique};
 use crate::model::{ParamValue, ParamValues};
 use crate::render::{MapData, Renderer, visibility_at};
-use crate::technique::{self, LightGpu, params};
+use crate::{
+    technique::{self, params},
+    wgsl_mirrors::LightGpu,
+};
 
 /// A sampled, copyable texture holding `bytes` (tightly packed level 0).
 pub(crate) fn upload(

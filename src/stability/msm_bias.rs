@@ -27,9 +27,9 @@ use super::planar::storage_name;
 use crate::error::Result;
 use crate::exec::Executor;
 use crate::gpu::Gpu;
+use crate::model::SatVariant;
 use crate::model::{BlurKernel, Filter, Soft, Storage, StorageFilter, Technique};
 use crate::render::Renderer;
-use crate::sat::SatVariant;
 
 /// Map side and block side of the random map: 256 blocks, about half of them flat.
 const MAP: usize = 256;

@@ -27,12 +27,12 @@ use super::planar::storage_name;
 use crate::error::Result;
 use crate::exec::Executor;
 use crate::gpu::Gpu;
+use crate::model::SatVariant;
 use crate::model::{
     BlurKernel, Filter, Soft, Storage, StorageFilter, Technique, default_moment_bias,
     default_soft_moment_bias,
 };
 use crate::render::Renderer;
-use crate::sat::SatVariant;
 
 /// Map side of `msm` (a flat map has nothing to resolve), and of `msm_soft`, whose table
 /// is coded for squares up to `2·SOFT_MAX_SEARCH·SOFT_MAP` = 205 texels: the step the default

@@ -25,7 +25,7 @@ use crate::model::{
     BlurKernel, Filter, Light, Storage, StorageFilter, Technique, default_moment_bias,
 };
 use crate::render::Renderer;
-use crate::technique::{LightGpu, linear_name};
+use crate::{technique::linear_name, wgsl_mirrors::LightGpu};
 
 const MAP: u32 = 32;
 /// Receiver depths `i / STEPS` (0 < i < STEPS), and 2⁻²⁰ inside either end: a receiver

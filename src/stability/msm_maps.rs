@@ -14,7 +14,10 @@ use crate::exec::Executor;
 use crate::gpu::{Gpu, read_texture};
 use crate::model::{Filter, Light, Technique};
 use crate::render::{MapData, Renderer, visibility_at};
-use crate::technique::{LightGpu, MSM_QUANTIZED, linear_name, sat_coding};
+use crate::{
+    technique::{linear_name, sat_coding},
+    wgsl_mirrors::{LightGpu, MSM_QUANTIZED},
+};
 
 /// What the shading reads.
 enum Stored {

@@ -20,7 +20,10 @@ use crate::model::{
     BlurKernel, Filter, LightKind, Storage, StorageFilter, Technique, exponent_limit,
 };
 use crate::render::Renderer;
-use crate::technique::{Encoding, LightGpu, encoding, linear_name};
+use crate::{
+    technique::{Encoding, encoding, linear_name},
+    wgsl_mirrors::LightGpu,
+};
 
 /// Map side: small, a constant map has nothing to resolve.
 const MAP: u32 = 32;

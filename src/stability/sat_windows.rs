@@ -24,7 +24,10 @@ use crate::exec::Executor;
 use crate::gpu::Gpu;
 use crate::graph::Graph;
 use crate::sat::lookups::{Lookup, lookup_means};
-use crate::sat::{SatCoding, SatVariant, add_sat, float_sum_depth, lookup_area};
+use crate::{
+    model::SatVariant,
+    sat::{SatCoding, add_sat, float_sum_depth, lookup_area},
+};
 
 /// Units of the maps' values: every texel is an integer multiple of 2⁻²⁴.
 const UNIT: f64 = 1.0 / (1u64 << 24) as f64;

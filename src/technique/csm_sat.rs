@@ -12,8 +12,11 @@ use crate::graph::{Graph, SizeRule};
 use crate::kernels::KernelId;
 use crate::model::{CssmSearch, Light, Storage, Technique};
 use crate::sat::layers::{LayeredSat, add_layered_sat};
-use crate::sat::{SatCoding, SatParams, SatVariant};
 use crate::wgsl_mirrors::LinearizeParams;
+use crate::{
+    model::SatVariant,
+    sat::{SatCoding, SatParams},
+};
 
 /// Parameters of the layered CSM table kernels (mirrors `CsmSatParams` in
 /// `kernels/shared/csm_sat_params.wgsl`).

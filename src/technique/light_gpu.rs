@@ -2,8 +2,11 @@
 //! technique, and the summed-area-table coding a technique's representation needs.
 
 use crate::model::{Filter, Light, LightKind, Technique, mip_levels};
-use crate::sat::{SatCoding, SatVariant, lookup_area};
 use crate::wgsl_mirrors::LightGpu;
+use crate::{
+    model::SatVariant,
+    sat::{SatCoding, lookup_area},
+};
 
 impl LightGpu {
     /// The GPU description of `light`: its matrices and biases, its technique's id and fields

@@ -30,11 +30,7 @@ mod sweep_plan;
 mod vsm;
 mod vssm;
 
-pub use crate::model::mip_levels;
-pub use crate::wgsl_mirrors::{
-    CSM_OUTPUTS, CsmParams, ExpParams, LightGpu, LinearizeParams, MSM_HAUSDORFF, MSM_QUANTIZED,
-    MsmParams, PEEL_EPSILON, SecondDepthParams, VsmParams,
-};
+use crate::wgsl_mirrors::LightGpu;
 use crate::model::{Light, ParamSource, ParamSpec, ParamValues, Technique};
 pub(crate) use cascade_shade::pick_and_blend;
 pub use cascade_shade::{CascadeGroup, shade_key_cascaded};
@@ -69,7 +65,7 @@ pub use sweep_plan::{SweepPlan, SweepVariant, SweptStorages, SweptTerms};
 pub struct TechniqueDef {
     /// The scene name (`technique = "…"`).
     pub name: &'static str,
-    /// The id the shading kernel reads (`LightGpu::technique`, `gpu_data::TECHNIQUE_*`).
+    /// The id the shading kernel reads (`LightGpu::technique`, `wgsl_mirrors::TECHNIQUE_*`).
     pub id: u32,
     /// One line for documentation.
     pub doc: &'static str,

@@ -5,8 +5,8 @@ use crate::filter::{BlurMode, EncodeBlur, add_encode_blur, add_filter};
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
 use crate::kernels::KernelId;
 use crate::model::{Light, Storage};
-use crate::sat::{SatVariant, add_sat};
 use crate::wgsl_mirrors::LinearizeParams;
+use crate::{model::SatVariant, sat::add_sat};
 
 use super::light_gpu::{sat_coding, sat_variant};
 use super::shade::ShadeInput;

@@ -7,7 +7,7 @@ use crate::model::{
     BlurKernel, DEFAULT_MAX_SEARCH, Filter, Needs, ParamDefault, ParamKind, ParamSpec, ParamValue,
     ParamValues, Soft, Storage, StorageFilter,
 };
-use crate::sat::{SatVariant, lookup_area};
+use crate::{model::SatVariant, sat::lookup_area};
 
 pub use super::code_values::{Given, GivenError, Loose};
 

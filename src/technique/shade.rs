@@ -5,8 +5,8 @@
 use std::fmt::Write;
 
 use crate::graph::Graph;
+use crate::model::SatVariant;
 use crate::model::{Filter, Light, LightKind};
-use crate::sat::SatVariant;
 
 use super::cascade_shade::{CASCADE_MODULE, CascadeGroup, cascade_functions};
 use super::light_gpu::sat_variant;

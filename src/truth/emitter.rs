@@ -30,7 +30,7 @@
 use glam::{DVec3, Mat4, Vec4};
 
 use crate::model::{Light, LightKind, Technique};
-use crate::technique::LightGpu;
+use crate::wgsl_mirrors::LightGpu;
 
 /// Relative margin added to a widened frustum, so receivers at its edge stay a few texels in.
 const MARGIN: f64 = 0.01;

@@ -2,7 +2,7 @@
 
 use shadowgraph::LightParams;
 use shadowgraph::low_level::gpu::{Gpu, submit_and_wait};
-use shadowgraph::low_level::scene::Vertex;
+use shadowgraph::low_level::wgsl_mirrors::Vertex;
 use wgpu::util::DeviceExt;
 
 /// The host's own depth pass: its own shader and pipeline, the light's matrices and slope

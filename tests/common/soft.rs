@@ -24,7 +24,7 @@ use shadowgraph::low_level::cpu::light::LightSample;
 use shadowgraph::low_level::cpu::sat::Integral;
 use shadowgraph::low_level::cpu::{self, Texels};
 use shadowgraph::low_level::sat::SatCoding;
-use shadowgraph::low_level::technique::MSM_QUANTIZED;
+use shadowgraph::low_level::wgsl_mirrors::MSM_QUANTIZED;
 use shadowgraph::{CssmSearch, LightGpu, SatVariant};
 
 const ULP: f64 = 1.0 / 16_777_216.0; // 2⁻²⁴

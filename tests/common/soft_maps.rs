@@ -30,7 +30,7 @@ pub fn trig_error(g: &Gpu) -> f64 {
     let mut graph = Graph::default();
     graph.import("in", wgpu::TextureFormat::R32Float, w, h, Some(0));
     let mut outputs = Vec::new();
-    let per = shadowgraph::low_level::technique::CSM_OUTPUTS;
+    let per = shadowgraph::low_level::wgsl_mirrors::CSM_OUTPUTS;
     for group in 0..(terms / 2).div_ceil(per) {
         let mut slots = Vec::new();
         for j in 0..per.min(terms / 2 - group * per) {
@@ -52,8 +52,8 @@ pub fn trig_error(g: &Gpu) -> f64 {
             kernel: shadowgraph::low_level::kernels::KernelId::Csm,
             inputs: vec![("src".into(), "in".into())],
             dispatch: Dispatch::Texels(slots[0].1.clone()),
-            params: bytemuck::bytes_of(&shadowgraph::low_level::technique::CsmParams {
-                depth: shadowgraph::low_level::technique::LinearizeParams::ORTHOGRAPHIC,
+            params: bytemuck::bytes_of(&shadowgraph::low_level::wgsl_mirrors::CsmParams {
+                depth: shadowgraph::low_level::wgsl_mirrors::LinearizeParams::ORTHOGRAPHIC,
                 first_map: group * per,
                 maps: slots.len() as u32,
                 terms,

@@ -2,10 +2,10 @@
 //! samples, [`Renderer::shadow_raster`]) and the camera's G-buffer, with their pipelines.
 
 use crate::error::{Error, Result};
-use crate::exec::GpuTimer;
 use crate::gpu::scoped;
 use crate::gpu_objects;
 use crate::kernels;
+use crate::timer::GpuTimer;
 
 use super::super::targets::uniform_group;
 use super::Renderer;
@@ -15,7 +15,7 @@ const VERTEX_ATTRS: [wgpu::VertexAttribute; 3] =
 
 fn vertex_layout() -> wgpu::VertexBufferLayout<'static> {
     wgpu::VertexBufferLayout {
-        array_stride: std::mem::size_of::<crate::scene::Vertex>() as u64,
+        array_stride: std::mem::size_of::<crate::wgsl_mirrors::Vertex>() as u64,
         step_mode: wgpu::VertexStepMode::Vertex,
         attributes: &VERTEX_ATTRS,
     }
