@@ -3,9 +3,9 @@
 
 use std::collections::BTreeSet;
 
+use shadowgraph::low_level::exec::REDESIGNED_MODULES;
 use shadowgraph::low_level::kernels::{self, KernelId, SOURCES, struct_size};
-use shadowgraph::low_level::technique::shading_block;
-use shadowgraph::low_level::wgsl_mirrors::LinearizeParams;
+use shadowgraph::low_level::technique::{LinearizeParams, shading_block};
 use shadowgraph::{
     BlurKernel, Filter, Light, LightGpu, LightKind, PcfKernel, SatVariant, Shadow, Soft, Storage,
     StorageFilter, Technique,
@@ -235,7 +235,13 @@ fn every_kernel_validates() {
         // shared/encode_blur: each kernel gives its encoding and `Params`) validates inside
         // each kernel that imports it, and at least one must.
         if s.text.contains("// #completed-by-importer") {
-            let import = format!("// #import {}", s.name);
+            // A redesigned module stands in for its shipped one (validated below in the
+            // shipped one's importers).
+            let name = REDESIGNED_MODULES
+                .iter()
+                .find(|m| m.1 == s.name)
+                .map_or(s.name, |m| m.0);
+            let import = format!("// #import {name}");
             if !SOURCES.iter().any(|k| k.text.contains(&import)) {
                 failures.push(format!(
                     "{}: completed by importers, but none imports it",
@@ -250,6 +256,30 @@ fn every_kernel_validates() {
             if let Err(e) = result {
                 failures.push(e.to_string());
             }
+        }
+    }
+    // Every kernel importing a redesigned module's shipped one validates with the redesign in
+    // its place, as the redesign layout compiles it on a device with the feature it needs.
+    for (shipped, redesign, _) in REDESIGNED_MODULES {
+        let text = kernels::source(redesign)
+            .expect("redesigned module")
+            .to_string();
+        let extra = kernels::Replacements::from([(shipped.to_string(), text)]);
+        let mut importers = 0;
+        for k in SOURCES.iter().filter(|k| !k.name.starts_with("shared/")) {
+            let plain = kernels::resolve(k.name, None);
+            let Ok(wgsl) = kernels::resolve_in(k.name, None, Some(&extra)) else {
+                continue;
+            };
+            if plain.is_ok_and(|p| p != wgsl) {
+                importers += 1;
+                if let Err(e) = kernels::reflect(k.name, &wgsl) {
+                    failures.push(format!("{} with {redesign}: {e}", k.name));
+                }
+            }
+        }
+        if importers == 0 {
+            failures.push(format!("{redesign}: no kernel imports {shipped}"));
         }
     }
     assert!(
@@ -372,13 +402,12 @@ fn rust_mirrors_match_naga_layouts() {
     );
     assert_eq!(
         struct_size(&m, "Frame"),
-        Some(size_of::<shadowgraph::low_level::wgsl_mirrors::FrameGpu>() as u32),
+        Some(size_of::<shadowgraph::low_level::render::FrameGpu>() as u32),
         "FrameGpu vs struct Frame"
     );
     use shadowgraph::low_level::filter::BlurParams;
-    use shadowgraph::low_level::technique::CsmSatParams;
-    use shadowgraph::low_level::wgsl_mirrors::{
-        CsmParams, ExpParams, MsmParams, SecondDepthParams, VsmParams,
+    use shadowgraph::low_level::technique::{
+        CsmParams, CsmSatParams, ExpParams, MsmParams, SecondDepthParams, VsmParams,
     };
     for (kernel, rust) in [
         ("second_depth", size_of::<SecondDepthParams>()),
@@ -662,7 +691,7 @@ fn blur_dispatch_constants_match_the_wgsl() {
 }
 
 /// The peel pass discards by the margin the f64 reference of the second depth
-/// (`truth::peel`) peels by: `PEEL_EPSILON` in `shadow_peel.wgsl` is `wgsl_mirrors`'s.
+/// (`truth::peel`) peels by: `PEEL_EPSILON` in `shadow_peel.wgsl` is `gpu_data`'s.
 #[test]
 fn peel_epsilon_matches_the_wgsl() {
     let wgsl = kernels::resolve("shadow_peel", None).expect("resolve");
@@ -676,7 +705,7 @@ fn peel_epsilon_matches_the_wgsl() {
         naga::Expression::Literal(naga::Literal::F32(v)) => v,
         ref e => panic!("PEEL_EPSILON is {e:?}, not an f32 literal"),
     };
-    assert_eq!(value, shadowgraph::low_level::wgsl_mirrors::PEEL_EPSILON);
+    assert_eq!(value, shadowgraph::low_level::technique::PEEL_EPSILON);
 }
 
 /// `blur_log`'s span, past which only `blur_log_wide` is exact, is the planner's
