@@ -5,7 +5,8 @@ use std::collections::BTreeSet;
 
 use shadowgraph::low_level::exec::REDESIGNED_MODULES;
 use shadowgraph::low_level::kernels::{self, KernelId, SOURCES, struct_size};
-use shadowgraph::low_level::technique::{LinearizeParams, shading_block};
+use shadowgraph::low_level::technique::shading_block;
+use shadowgraph::low_level::wgsl_mirrors::LinearizeParams;
 use shadowgraph::{
     BlurKernel, Filter, Light, LightGpu, LightKind, PcfKernel, SatVariant, Shadow, Soft, Storage,
     StorageFilter, Technique,
@@ -402,12 +403,13 @@ fn rust_mirrors_match_naga_layouts() {
     );
     assert_eq!(
         struct_size(&m, "Frame"),
-        Some(size_of::<shadowgraph::low_level::render::FrameGpu>() as u32),
+        Some(size_of::<shadowgraph::low_level::wgsl_mirrors::FrameGpu>() as u32),
         "FrameGpu vs struct Frame"
     );
     use shadowgraph::low_level::filter::BlurParams;
-    use shadowgraph::low_level::technique::{
-        CsmParams, CsmSatParams, ExpParams, MsmParams, SecondDepthParams, VsmParams,
+    use shadowgraph::low_level::technique::CsmSatParams;
+    use shadowgraph::low_level::wgsl_mirrors::{
+        CsmParams, ExpParams, MsmParams, SecondDepthParams, VsmParams,
     };
     for (kernel, rust) in [
         ("second_depth", size_of::<SecondDepthParams>()),
@@ -691,7 +693,7 @@ fn blur_dispatch_constants_match_the_wgsl() {
 }
 
 /// The peel pass discards by the margin the f64 reference of the second depth
-/// (`truth::peel`) peels by: `PEEL_EPSILON` in `shadow_peel.wgsl` is `gpu_data`'s.
+/// (`truth::peel`) peels by: `PEEL_EPSILON` in `shadow_peel.wgsl` is `wgsl_mirrors`'s.
 #[test]
 fn peel_epsilon_matches_the_wgsl() {
     let wgsl = kernels::resolve("shadow_peel", None).expect("resolve");
@@ -705,7 +707,7 @@ fn peel_epsilon_matches_the_wgsl() {
         naga::Expression::Literal(naga::Literal::F32(v)) => v,
         ref e => panic!("PEEL_EPSILON is {e:?}, not an f32 literal"),
     };
-    assert_eq!(value, shadowgraph::low_level::technique::PEEL_EPSILON);
+    assert_eq!(value, shadowgraph::low_level::wgsl_mirrors::PEEL_EPSILON);
 }
 
 /// `blur_log`'s span, past which only `blur_log_wide` is exact, is the planner's
