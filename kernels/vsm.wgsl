@@ -25,12 +25,31 @@ struct Params {
 
 const WG_SIZE: u32 = 16u;
 
+// The redesign layout (`exec::KernelLayout::Redesign`, REDESIGN true) gives an invocation
+// TEXELS_X texels, WG_SIZE apart along x so that neighbouring lanes stay on neighbouring
+// texels, and issues every load (each texel's and its four neighbours') before the first
+// texel's arithmetic and store (one texel in flight an invocation left the texture copies at
+// 0.3 of the buffer copy on an H200); each texel's arithmetic is the one-texel kernel's, so
+// both give the same map bit for bit. The dispatch covers WG_SIZE · TEXELS_X columns a
+// workgroup (`kernels::TEXELS_X_CONSTANT`).
+override REDESIGN: bool = false;
+override TEXELS_X: u32 = select(1u, 4u, REDESIGN);
+const TEXELS_MAX: u32 = 4u;
+
 fn depth_at(p: vec2<i32>, size: vec2<i32>) -> f32 {
     return linear_depth(textureLoad(src, clamp(p, vec2<i32>(0), size - 1), 0).r, params.depth);
 }
 
 @compute @workgroup_size(WG_SIZE, WG_SIZE)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+fn main(
+    @builtin(global_invocation_id) id: vec3<u32>,
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(local_invocation_id) lid: vec3<u32>,
+) {
+    if REDESIGN {
+        main_texels(wg.xy, lid.xy);
+        return;
+    }
     let size = vec2<i32>(textureDimensions(src));
     let p = vec2<i32>(id.xy);
     if any(p >= size) {
@@ -49,4 +68,52 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         depth_at(p + vec2<i32>(0, 1), size)
     );
     textureStore(dst, p, vec4<f32>(m, 0.0, 0.0));
+}
+
+// The raw depth at `p`, clamped to the map.
+fn raw_at(p: vec2<i32>, size: vec2<i32>) -> f32 {
+    return textureLoad(src, clamp(p, vec2<i32>(0), size - 1), 0).r;
+}
+
+// TEXELS_X texels an invocation (the redesign layout): every texel's and its neighbours' loads
+// first, then each texel.
+fn main_texels(wg: vec2<u32>, lid: vec2<u32>) {
+    let size = vec2<i32>(textureDimensions(src));
+    let y = i32(wg.y * WG_SIZE + lid.y);
+    let x0 = i32(wg.x * TEXELS_X * WG_SIZE + lid.x);
+    // Past the edge a lane loads the last texel's cross again (cached already) and skips its
+    // store: the loads stay unconditional, so none waits on another's branch.
+    var centre: array<f32, TEXELS_MAX>;
+    var around: array<vec4<f32>, TEXELS_MAX>;
+    for (var k = 0u; k < TEXELS_X; k++) {
+        let q = min(vec2<i32>(x0 + i32(k * WG_SIZE), y), size - 1);
+        centre[k] = textureLoad(src, q, 0).r;
+        around[k] = vec4<f32>(
+            raw_at(q - vec2<i32>(1, 0), size),
+            raw_at(q + vec2<i32>(1, 0), size),
+            raw_at(q - vec2<i32>(0, 1), size),
+            raw_at(q + vec2<i32>(0, 1), size)
+        );
+    }
+    if y >= size.y {
+        return;
+    }
+    for (var k = 0u; k < TEXELS_X; k++) {
+        let p = vec2<i32>(x0 + i32(k * WG_SIZE), y);
+        if p.x >= size.x {
+            continue;
+        }
+        if !depth_is_finite(centre[k]) {
+            atomicAdd(&stats[0], 1u);
+        }
+        let a = around[k];
+        let m = vsm_moments(
+            linear_depth(centre[k], params.depth),
+            linear_depth(a.x, params.depth),
+            linear_depth(a.y, params.depth),
+            linear_depth(a.z, params.depth),
+            linear_depth(a.w, params.depth)
+        );
+        textureStore(dst, p, vec4<f32>(m, 0.0, 0.0));
+    }
 }

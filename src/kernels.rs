@@ -21,8 +21,8 @@ mod source;
 mod validate;
 
 pub use self::reflect::{
-    Binding, GPU_LAYOUT_CONSTANT, MAX_TEXELS_X, REDESIGN_CONSTANT, Reflection, TEXELS_X_CONSTANT,
-    reflect, reflect_replaced, struct_size,
+    Binding, GPU_LAYOUT_CONSTANT, MAX_TEXELS_X, OtherLayouts, REDESIGN_CONSTANT, Reflection,
+    TEXELS_X_CONSTANT, reflect, reflect_replaced, struct_size,
 };
 pub use self::source::{
     KERNEL_DIR_ENV, Replacements, read_replacements, resolve, resolve_in, resolve_source, source,

@@ -129,20 +129,55 @@ fn shading_several_pixels_an_invocation_renders_the_same() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// A graph kernel replaced by one declaring `TEXELS_X` (which only the shading kernel's
-/// dispatch reads: a graph node's would cover the wrong texels) is refused by name, in one
-/// line.
+/// A graph kernel whose node is dispatched by texels covers `TEXELS_X` texels an invocation,
+/// the dispatch following: `linearize` made to cover 3 (its redesign path, the 1024² map's
+/// last workgroup of a row ragged) renders the embedded kernel's image pixel for pixel. One
+/// whose node has a geometry of its own (the mip chain's dispatches) replaced by one declaring
+/// `TEXELS_X` would cover the wrong texels: refused by name, in one line.
 #[test]
-fn texels_x_in_a_graph_kernel_is_refused() {
+fn texels_x_in_a_graph_kernel_widens_a_texel_dispatch_and_is_refused_elsewhere() {
     let dir = temp_dir("texels-graph");
     let linearize = kernels::source("linearize").expect("embedded linearize");
+    let layout = "override TEXELS_X: u32 = select(1u, 4u, REDESIGN);";
+    assert!(
+        linearize.contains(layout),
+        "linearize.wgsl's TEXELS_X moved"
+    );
+    let three = linearize
+        .replace(layout, "const TEXELS_X: u32 = 3u;")
+        .replace("    if REDESIGN {\n", "    if true {\n");
+    std::fs::write(dir.join("linearize.wgsl"), three).unwrap();
+    let png = dir.join("embedded.png");
+    let o = render(None, &png);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let want = image::open(&png).expect("png").to_rgba8();
+    let png = dir.join("x3.png");
+    let o = render(Some(&dir), &png);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let got = image::open(&png).expect("png").to_rgba8();
+    let differ = got
+        .pixels()
+        .zip(want.pixels())
+        .filter(|(a, b)| a != b)
+        .count();
+    assert_eq!(differ, 0, "linearize, TEXELS_X = 3: {differ} pixels differ");
+    std::fs::remove_file(dir.join("linearize.wgsl")).unwrap();
+    let mips = kernels::source("mips").expect("embedded mips");
     std::fs::write(
-        dir.join("linearize.wgsl"),
-        format!("const TEXELS_X: u32 = 2u;\n{linearize}"),
+        dir.join("mips.wgsl"),
+        format!("const TEXELS_X: u32 = 2u;\n{mips}"),
     )
     .unwrap();
-    let o = render(Some(&dir), &dir.join("out.png"));
-    refused(&o, &["linearize", "TEXELS_X", "only the shading kernel"]);
+    let scene = edited_scene(&dir, "vsm_mips.toml", &[], "vsm_mips.toml");
+    let png = dir.join("out.png");
+    let args = [
+        OsStr::new("render"),
+        scene.as_os_str(),
+        OsStr::new("-o"),
+        png.as_os_str(),
+    ];
+    let o = shadowgraph(&args, &[(KERNEL_DIR_ENV, dir.as_os_str())]);
+    refused(&o, &["mips", "TEXELS_X", "dispatched by texels"]);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

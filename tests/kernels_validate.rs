@@ -375,14 +375,37 @@ fn texels_x_widens_the_dispatch() {
             assert_eq!(name, "shade");
             continue;
         };
-        let (module, r) = kernels::reflect(name, &wgsl).expect("reflect");
+        // Graph kernels covering several texels an invocation (their nodes dispatched by
+        // texels, which follow it): the four-texel copies in every layout, the encodings in the
+        // redesign layout only (an override of the layout).
+        let (_, r) = kernels::reflect(name, &wgsl).expect("reflect");
+        let want = match name {
+            "copy_texture_x4" | "copy_texture_u32_x4" => [4, 4, 4],
+            "vsm" | "esm" | "evsm" | "msm" | "csm" | "linearize" => [1, 1, 4],
+            _ => [1, 1, 1],
+        };
+        let got = [r.texels_x, r.other_texels_x.cpu, r.other_texels_x.redesign];
         assert_eq!(
-            wgsl_const(&module, "TEXELS_X"),
-            None,
-            "{name} declares TEXELS_X"
+            got, want,
+            "{name}: TEXELS_X in the gpu, cpu, redesign layouts"
         );
-        assert_eq!(r.texels_x, 1, "{name}");
     }
+    // An override of the layout, evaluated in each (the dispatch follows the layout's).
+    let layered = "override GPU_LAYOUT: bool = false;\noverride REDESIGN: bool = false;\n\
+                   override TEXELS_X: u32 = select(select(1u, 2u, GPU_LAYOUT), 4u, REDESIGN);";
+    let wgsl = kernel(layered).replace(
+        "textureStore(dst, id.xy, vec4<f32>(1.0));",
+        "textureStore(dst, id.xy * TEXELS_X, vec4<f32>(1.0));",
+    );
+    let (_, r) = kernels::reflect("t", &wgsl).expect("reflect");
+    assert_eq!((r.texels_x, r.groups_for(100, 17)), (2, [7, 5, 1]));
+    let cpu = r.clone().in_layout(false);
+    assert_eq!((cpu.texels_x, cpu.groups_for(100, 17)), (1, [13, 5, 1]));
+    let redesign = r.in_redesign();
+    assert_eq!(
+        (redesign.texels_x, redesign.groups_for(100, 17)),
+        (4, [4, 5, 1])
+    );
 }
 
 #[test]

@@ -1,5 +1,6 @@
 //! `linearize` on the GPU against `cpu::linearize` on random depth buffers, including sizes
-//! that are not multiples of the workgroup and non-finite texels.
+//! that are not multiples of the workgroup and non-finite texels, in the device's kernel layout
+//! and in the redesign (each invocation linearizing several texels: the same bits).
 
 mod common;
 
@@ -7,7 +8,7 @@ use std::collections::HashMap;
 
 use rand::Rng;
 use shadowgraph::low_level::cpu::linearize::linearize;
-use shadowgraph::low_level::exec::Executor;
+use shadowgraph::low_level::exec::{Executor, KernelLayout};
 use shadowgraph::low_level::gpu::{read_texture, submit_and_wait, write_texture};
 use shadowgraph::low_level::graph::{Dispatch, Graph, Node, SizeRule, plan};
 use shadowgraph::low_level::wgsl_mirrors::LinearizeParams;
@@ -17,12 +18,44 @@ struct Run {
     replaced: u32,
 }
 
+/// The device's layout, then the redesign.
+const LAYOUTS: [Option<KernelLayout>; 2] = [None, Some(KernelLayout::Redesign)];
+
+/// [`run_linearize_in`] in each of [`LAYOUTS`], the outputs and counts the same in each (the
+/// redesign keeps each texel's arithmetic); the first run.
 fn run_linearize(
     g: &shadowgraph::low_level::gpu::Gpu,
     raw: &[f32],
     w: u32,
     h: u32,
     p: LinearizeParams,
+) -> Run {
+    let runs = LAYOUTS.map(|layout| run_linearize_in(g, raw, (w, h), p, layout));
+    for (run, layout) in runs.iter().zip(LAYOUTS).skip(1) {
+        let bits = |r: &Run| r.out.iter().map(|v| v.to_bits()).collect::<Vec<u32>>();
+        let (a, b) = (bits(&runs[0]), bits(run));
+        if let Some(i) = (0..a.len()).find(|&i| a[i] != b[i]) {
+            panic!(
+                "{layout:?}, {w}x{h}: texel {i} differs ({} against {})",
+                runs[0].out[i], run.out[i]
+            );
+        }
+        assert_eq!(
+            run.replaced, runs[0].replaced,
+            "{layout:?}: replaced texels"
+        );
+    }
+    let [first, _] = runs;
+    first
+}
+
+/// `linearize` of `raw` (`w × h`) with the kernels in `layout` (the device's with `None`).
+fn run_linearize_in(
+    g: &shadowgraph::low_level::gpu::Gpu,
+    raw: &[f32],
+    (w, h): (u32, u32),
+    p: LinearizeParams,
+    layout: Option<KernelLayout>,
 ) -> Run {
     let (device, queue) = (&g.device, &g.queue);
     let mut graph = Graph::default();
@@ -55,6 +88,9 @@ fn run_linearize(
         bytemuck::cast_slice(raw),
     );
     let mut exec = Executor::new();
+    if let Some(layout) = layout {
+        exec.kernels.set_layout(layout);
+    }
     let mut enc = device.create_command_encoder(&Default::default());
     let imports = HashMap::from([("in".to_string(), tex)]);
     // Poison the output first so unwritten texels show.

@@ -7,7 +7,7 @@ use std::collections::HashMap;
 
 use rand::Rng;
 use shadowgraph::low_level::cpu::{self, Texels};
-use shadowgraph::low_level::exec::Executor;
+use shadowgraph::low_level::exec::{Executor, KernelLayout};
 use shadowgraph::low_level::gpu::{Gpu, read_resource_texture, submit_and_wait, write_texture};
 use shadowgraph::low_level::graph::{Graph, SizeRule, plan};
 use shadowgraph::{BlurKernel, Filter};
@@ -17,16 +17,70 @@ fn upload(g: &Gpu, w: u32, h: u32, format: wgpu::TextureFormat, data: &[f32]) ->
     common::upload(&g.device, &g.queue, "test.input", (w, h), format, data)
 }
 
+/// The layouts the encodings are checked in: the device's, and the redesign (each invocation
+/// encoding several texels), which must give the same maps bit for bit.
+const ENCODE_LAYOUTS: [Option<KernelLayout>; 2] = [None, Some(KernelLayout::Redesign)];
+
 /// Plans `graph` for `output`, runs it with `input` imported as "in" (the output poisoned with
 /// NaN first, so unwritten texels show) and reads the output back.
 fn run(g: &Gpu, graph: &Graph, output: &str, input: wgpu::Texture) -> Texels {
     run_levels(g, graph, output, input).swap_remove(0)
 }
 
+/// [`run`] with the kernels compiled in `layout` (the device's with `None`).
+fn run_in(
+    g: &Gpu,
+    graph: &Graph,
+    output: &str,
+    input: wgpu::Texture,
+    layout: Option<KernelLayout>,
+) -> Texels {
+    run_levels_in(g, graph, output, input, layout).swap_remove(0)
+}
+
+/// [`run_in`] in each of [`ENCODE_LAYOUTS`] on a fresh upload of the r32float `depth` (`w × h`);
+/// with `same`, the maps of every layout the same bit for bit (an encoding alone: the redesign
+/// keeps each texel's arithmetic), else each is checked against the reference by the caller.
+fn run_layouts(
+    g: &Gpu,
+    graph: &Graph,
+    output: &str,
+    (w, h, depth): (u32, u32, &[f32]),
+    same: bool,
+) -> Vec<Texels> {
+    let runs: Vec<Texels> = ENCODE_LAYOUTS
+        .iter()
+        .map(|&layout| {
+            let input = upload(g, w, h, wgpu::TextureFormat::R32Float, depth);
+            run_in(g, graph, output, input, layout)
+        })
+        .collect();
+    if same {
+        for (run, layout) in runs.iter().zip(ENCODE_LAYOUTS).skip(1) {
+            common::assert_same_bits(&format!("{output} {w}x{h} {layout:?}"), &runs[0], run);
+        }
+    }
+    runs
+}
+
 /// [`run`], reading back every mip level of the output.
 fn run_levels(g: &Gpu, graph: &Graph, output: &str, input: wgpu::Texture) -> Vec<Texels> {
+    run_levels_in(g, graph, output, input, None)
+}
+
+/// [`run_levels`] with the kernels compiled in `layout` (the device's with `None`).
+fn run_levels_in(
+    g: &Gpu,
+    graph: &Graph,
+    output: &str,
+    input: wgpu::Texture,
+    layout: Option<KernelLayout>,
+) -> Vec<Texels> {
     let plan = plan(graph, &[output]).expect("plan");
     let mut exec = Executor::new();
+    if let Some(layout) = layout {
+        exec.kernels.set_layout(layout);
+    }
     let imports = HashMap::from([("in".to_string(), input)]);
     let mut enc = g.device.create_command_encoder(&Default::default());
     let first = exec
@@ -164,21 +218,24 @@ fn vsm_encoding_matches_reference() {
     for (w, h) in [(1000u32, 37u32), (64, 64), (1, 1), (5, 300)] {
         let lin = random_linear(&mut rng, w as usize, h as usize);
         let (graph, out) = vsm_graph(w, h, wgpu::TextureFormat::Rg32Float, None);
-        let gpu = run(
-            &g,
-            &graph,
-            &out,
-            upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin),
-        );
         let reference = cpu::vsm::vsm(&Texels::from_f32(w as usize, h as usize, 1, &lin));
-        // f32: z exact; z² + ¼(dx² + dy²) is a handful of roundings of values ≤ 1.25.
-        common::assert_close(
-            &format!("vsm {w}x{h}"),
-            &channels(&gpu, 2),
-            &reference.data,
-            1e-6,
-            1e-6,
-        );
+        let mut first = None;
+        for layout in ENCODE_LAYOUTS {
+            let depth = upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin);
+            let gpu = run_in(&g, &graph, &out, depth, layout);
+            // f32: z exact; z² + ¼(dx² + dy²) is a handful of roundings of values ≤ 1.25.
+            common::assert_close(
+                &format!("vsm {w}x{h} {layout:?}"),
+                &channels(&gpu, 2),
+                &reference.data,
+                1e-6,
+                1e-6,
+            );
+            match &first {
+                None => first = Some(gpu),
+                Some(a) => common::assert_same_bits(&format!("vsm {w}x{h} layouts"), a, &gpu),
+            }
+        }
     }
 }
 
@@ -310,8 +367,6 @@ fn evsm_and_esm_encodings_match_reference() {
             filter,
             BlurMode::Linear,
         );
-        let depth = upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin);
-        let gpu = run(&g, &graph, &out, depth);
         let mut expected = cpu::evsm::evsm(&input, 42.0, 5.0);
         if filter.is_some() {
             expected = cpu::blur::blur(&expected, 3.0, 1.5, BlurKernel::Gaussian);
@@ -321,18 +376,20 @@ fn evsm_and_esm_encodings_match_reference() {
             .chunks(4)
             .flat_map(|c| c[..channels].to_vec())
             .collect();
-        // Moments span e^±42: the blur's own f32 roundings add ~65 ULP relative.
-        common::assert_close(
-            &format!("evsm {format:?} blur {}", filter.is_some()),
-            &channels_of(&gpu, channels),
-            &keep,
-            0.0,
-            exp_rtol + 65.0 * 2f64.powi(-24),
-        );
-        assert!(
-            gpu.data.iter().all(|v| v.is_finite()),
-            "evsm at the f32 limit overflowed"
-        );
+        for gpu in run_layouts(&g, &graph, &out, (w, h, &lin), filter.is_none()) {
+            // Moments span e^±42: the blur's own f32 roundings add ~65 ULP relative.
+            common::assert_close(
+                &format!("evsm {format:?} blur {}", filter.is_some()),
+                &channels_of(&gpu, channels),
+                &keep,
+                0.0,
+                exp_rtol + 65.0 * 2f64.powi(-24),
+            );
+            assert!(
+                gpu.data.iter().all(|v| v.is_finite()),
+                "evsm at the f32 limit overflowed"
+            );
+        }
     }
     // ESM at c = 40 (`blur_log`: every window within its span of 80, one exp per texel) and at
     // c = 200 (`blur_log_wide`: exp(200) overflows f32, and one texel in five is a blocker at
@@ -362,8 +419,6 @@ fn evsm_and_esm_encodings_match_reference() {
             Some(blur),
             BlurMode::log_sum_exp(c),
         );
-        let depth = upload(&g, w, h, wgpu::TextureFormat::R32Float, &edges);
-        let gpu = run(&g, &graph, &out, depth);
         let expected = cpu::blur::blur_mode(
             &cpu::esm::esm(&input, f64::from(c)),
             3.0,
@@ -371,17 +426,33 @@ fn evsm_and_esm_encodings_match_reference() {
             BlurKernel::Gaussian,
             true,
         );
-        // Each log-sum-exp: exp of (v − v₀) ∈ [−c, c] (v₀ the first texel an invocation
-        // reads; at c = 200, past the span, v − max ∈ [−c, 0]) at (3 + 2|x|) ULP relative, then log:
-        // the absolute error in L is ≲ 2·(3 + 2c) ULP of 1 plus the rounding of |L| ≤ c.
-        common::assert_close(
-            &format!("esm c={c} log-space blur"),
-            &channels_of(&gpu, 1),
-            &expected.data,
-            2.0 * (3.0 + 2.0 * f64::from(c)) * 2f64.powi(-23),
-            4.0 * 2f64.powi(-24),
-        );
+        for gpu in run_layouts(&g, &graph, &out, (w, h, &edges), false) {
+            // Each log-sum-exp: exp of (v − v₀) ∈ [−c, c] (v₀ the first texel an invocation
+            // reads; at c = 200, past the span, v − max ∈ [−c, 0]) at (3 + 2|x|) ULP relative,
+            // then log: the absolute error in L is ≲ 2·(3 + 2c) ULP of 1 plus the rounding of
+            // |L| ≤ c.
+            common::assert_close(
+                &format!("esm c={c} log-space blur"),
+                &channels_of(&gpu, 1),
+                &expected.data,
+                2.0 * (3.0 + 2.0 * f64::from(c)) * 2f64.powi(-23),
+                4.0 * 2f64.powi(-24),
+            );
+        }
     }
+    // ESM's encoding alone (L = c·z, one rounding of the product), the same in every layout.
+    let params = bytemuck::bytes_of(&ExpParams::new(40.0, 0.0)).to_vec();
+    let format = wgpu::TextureFormat::R32Float;
+    let (graph, out) = encode_graph("esm", params, w, h, format, None, BlurMode::Linear);
+    let gpu = run_layouts(&g, &graph, &out, (w, h, &edges), true).swap_remove(0);
+    let expected = cpu::esm::esm(&input, 40.0);
+    common::assert_close(
+        "esm c=40",
+        &channels_of(&gpu, 1),
+        &expected.data,
+        0.0,
+        2f64.powi(-24),
+    );
 }
 
 fn channels_of(t: &Texels, n: usize) -> Vec<f32> {
@@ -443,25 +514,25 @@ fn msm_encoding_matches_reference_for_each_storage() {
         })
         .to_vec();
         let (graph, out) = encode_graph("msm", params, w, h, format, filter, BlurMode::Linear);
-        let depth = upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin);
-        let gpu = run(&g, &graph, &out, depth);
         let mut expected = cpu::msm::msm(&input, quantized);
         if filter.is_some() {
             expected = cpu::blur::blur(&expected, 2.0, 1.0, BlurKernel::Gaussian);
         }
-        common::assert_close(
-            &format!("msm {format:?} blur {}", filter.is_some()),
-            &channels(&gpu, 4),
-            &expected.data,
-            atol,
-            rtol,
-        );
-        if quantized {
-            // The optimized quantization keeps every z ∈ [0, 1] inside [0, 1].
-            assert!(
-                gpu.data.iter().all(|v| (-1e-6..=1.0 + 1e-6).contains(v)),
-                "quantized moments leave [0, 1]"
+        for gpu in run_layouts(&g, &graph, &out, (w, h, &lin), filter.is_none()) {
+            common::assert_close(
+                &format!("msm {format:?} blur {}", filter.is_some()),
+                &channels(&gpu, 4),
+                &expected.data,
+                atol,
+                rtol,
             );
+            if quantized {
+                // The optimized quantization keeps every z ∈ [0, 1] inside [0, 1].
+                assert!(
+                    gpu.data.iter().all(|v| (-1e-6..=1.0 + 1e-6).contains(v)),
+                    "quantized moments leave [0, 1]"
+                );
+            }
         }
     }
     // Dequantization inverts quantization (the two published matrices).
@@ -501,12 +572,8 @@ fn csm_basis_matches_reference() {
         })
         .to_vec();
         let (graph, out) = encode_graph("csm", params, w, h, format, None, BlurMode::Linear);
-        let gpu = run(
-            &g,
-            &graph,
-            &out,
-            upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin),
-        );
+        // The same bits in every layout, so the first stands for all.
+        let gpu = run_layouts(&g, &graph, &out, (w, h, &lin), true).swap_remove(0);
         let n = (2 * (terms - first_term + 1)).min(4) as usize;
         let first = 2 * (first_term as usize - 1);
         let keep: Vec<f64> = expected
@@ -541,12 +608,7 @@ fn csm_basis_matches_reference() {
     .to_vec();
     let format = wgpu::TextureFormat::Rgba32Float;
     let (graph, out) = encode_graph("csm", params, w, h, format, None, BlurMode::Linear);
-    let gpu = run(
-        &g,
-        &graph,
-        &out,
-        upload(&g, w, h, wgpu::TextureFormat::R32Float, &lin),
-    );
+    let gpu = run_layouts(&g, &graph, &out, (w, h, &lin), true).swap_remove(0);
     let want = cpu::msm::msm(&input, true);
     common::assert_close(
         "csm moments map",
@@ -556,6 +618,12 @@ fn csm_basis_matches_reference() {
         0.0,
     );
 }
+
+/// The layouts the mip chains are checked in: the device's, and the redesign (the chain after
+/// AMD FidelityFX SPD, `kernels/shared/mips_spd.wgsl`), against the same f64 chain with the
+/// same tolerances: it computes every texel by the same sums in the same order
+/// (`tests/mips_redesign.rs`: bit for bit).
+const MIP_LAYOUTS: [Option<KernelLayout>; 2] = [None, Some(KernelLayout::Redesign)];
 
 #[test]
 fn mip_chain_matches_reference_and_ends_at_the_mean() {

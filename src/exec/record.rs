@@ -161,18 +161,22 @@ pub(super) fn bind_step(
     let formats = bound_formats(&specs, |r| textures.get(r).map(|t| t.format()));
     let overrides = kernels.node_constants(node.kernel.name(), &node.name, &node.params)?;
     let kernel = kernels.get_for_node(device, node.kernel.name(), &formats, &overrides)?;
-    // A graph node's dispatch follows its node's geometry, which does not read `TEXELS_X`:
-    // a kernel (a `SHADOWGRAPH_KERNEL_DIR` variant) declaring it would cover the wrong texels.
-    if kernel.reflection.texels_x != 1 {
+    // A node dispatched by texels covers `TEXELS_X` texels an invocation (its workgroups'
+    // footprint); any other dispatch follows the node's geometry, which does not read it: a
+    // kernel (a `SHADOWGRAPH_KERNEL_DIR` variant) declaring it there would cover the wrong texels.
+    let by_texels = matches!(node.dispatch, crate::graph::Dispatch::Texels(_));
+    if kernel.reflection.texels_x != 1 && !by_texels {
         return Err(Error::Kernel {
             kernel: node.kernel.name().to_string(),
             message: format!(
-                "declares `const {}`, which only the shading kernel's dispatch reads",
+                "declares `{}`, which only the shading kernel's dispatch and nodes dispatched \
+                 by texels read",
                 crate::kernels::TEXELS_X_CONSTANT
             ),
         });
     }
     let wg = kernel.reflection.workgroup_size.unwrap_or([1, 1, 1]);
+    let footprint = kernel.reflection.texel_footprint();
     // A line an invocation: the node counts its lines a workgroup, which must be the kernel's
     // workgroup (a variant with another would leave lines out or run past them).
     if let Some(per_group) = node.dispatch.lines_per_group()

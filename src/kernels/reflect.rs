@@ -37,15 +37,31 @@ pub struct Reflection {
     /// [`Reflection::workgroup_size`].
     pub redesign_workgroup_size: Option<[u32; 3]>,
     /// Texels an invocation of `main` covers along x ([`TEXELS_X_CONSTANT`]; 1 where the
-    /// kernel declares none): a workgroup covers `workgroup_size[0] · texels_x` columns.
+    /// kernel declares none): a workgroup covers `workgroup_size[0] · texels_x` columns. As
+    /// [`Reflection::workgroup_size`], the GPU layout's where it is an `override`; a
+    /// [`crate::exec::ComputeKernel`]'s reflection holds its own layout's.
     pub texels_x: u32,
+    /// [`Reflection::texels_x`] in the CPU driver's layout and in the redesign layout.
+    pub other_texels_x: OtherLayouts,
     /// Shader stages of the entry points.
     pub stages: wgpu::ShaderStages,
 }
 
-/// The constant (`const TEXELS_X: u32`) by which a compute kernel says that each invocation of
-/// `main` covers that many texels along x, `@workgroup_size`'s x apart (`kernels/shade.wgsl`:
-/// pixels a lane shades). The dispatch ([`Reflection::groups_for`]) follows it.
+/// A value of a kernel in the two layouts other than a GPU's ([`Reflection::other_texels_x`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OtherLayouts {
+    /// As a CPU driver compiles it ([`GPU_LAYOUT_CONSTANT`] false).
+    pub cpu: u32,
+    /// As the redesign layout compiles it ([`GPU_LAYOUT_CONSTANT`] and [`REDESIGN_CONSTANT`]
+    /// true).
+    pub redesign: u32,
+}
+
+/// The constant (`const TEXELS_X: u32`, or an `override` of the layout, e.g.
+/// `select(1u, 4u, REDESIGN)`) by which a compute kernel says that each invocation of `main`
+/// covers that many texels along x, `@workgroup_size`'s x apart (`kernels/shade.wgsl`: pixels a
+/// lane shades). The dispatch ([`Reflection::groups_for`]; a graph node dispatched
+/// [`crate::graph::Dispatch::Texels`]) follows it.
 pub const TEXELS_X_CONSTANT: &str = "TEXELS_X";
 
 /// The most texels along x a kernel may give an invocation ([`TEXELS_X_CONSTANT`]).
@@ -68,14 +84,24 @@ impl Reflection {
     pub fn in_layout(mut self, gpu: bool) -> Self {
         if !gpu {
             self.workgroup_size = self.cpu_workgroup_size;
+            self.texels_x = self.other_texels_x.cpu;
         }
         self
     }
 
-    /// This reflection as the redesign layout compiles it: its workgroup size that layout's.
+    /// This reflection as the redesign layout compiles it: its workgroup size and texels an
+    /// invocation that layout's.
     pub fn in_redesign(mut self) -> Self {
         self.workgroup_size = self.redesign_workgroup_size;
+        self.texels_x = self.other_texels_x.redesign;
         self
+    }
+
+    /// The texels a workgroup of `main` covers: `workgroup_size` with its x times
+    /// [`Reflection::texels_x`].
+    pub fn texel_footprint(&self) -> [u32; 3] {
+        let wg = self.workgroup_size.unwrap_or([1, 1, 1]);
+        [wg[0] * self.texels_x, wg[1], wg[2]]
     }
 
     /// The largest workgroup of either layout, dimension by dimension (what the device's limits
@@ -93,8 +119,8 @@ impl Reflection {
     /// Workgroups of `main` covering a `w × h` texel grid: `workgroup_size[0] · texels_x`
     /// columns and `workgroup_size[1]` rows a workgroup.
     pub fn groups_for(&self, w: u32, h: u32) -> [u32; 3] {
-        let wg = self.workgroup_size.unwrap_or([1, 1, 1]);
-        [w.div_ceil(wg[0] * self.texels_x), h.div_ceil(wg[1]), 1]
+        let wg = self.texel_footprint();
+        [w.div_ceil(wg[0]), h.div_ceil(wg[1]), 1]
     }
 
     /// The binding named `name`.
@@ -163,26 +189,35 @@ fn reflect_module(
         });
     }
     bindings.sort_by_key(|b| (b.group, b.binding));
+    // A `TEXELS_X` that is an override of the layout: evaluated in each layout.
+    let overrides_texels = module
+        .overrides
+        .iter()
+        .any(|(_, o)| o.name.as_deref() == Some(TEXELS_X_CONSTANT));
     let mut stages = wgpu::ShaderStages::NONE;
     let mut workgroup_size = None;
     let mut cpu_workgroup_size = None;
     let mut redesign_workgroup_size = None;
+    let mut texels = [1; 3];
     for ep in &module.entry_points {
         match ep.stage {
             naga::ShaderStage::Compute => {
                 stages |= wgpu::ShaderStages::COMPUTE;
                 if ep.name == "main" {
-                    let sizes = if ep.workgroup_size_overrides.is_some() {
-                        [(true, false), (false, false), (true, true)].map(|(gpu, redesign)| {
-                            layout_workgroup_size(kernel, &module, info, gpu, redesign)
+                    let layouts = [(true, false), (false, false), (true, true)];
+                    let sizes = if ep.workgroup_size_overrides.is_some() || overrides_texels {
+                        layouts.map(|(gpu, redesign)| {
+                            layout_main(kernel, &module, info, gpu, redesign)
                         })
                     } else {
-                        [(); 3].map(|()| Ok(ep.workgroup_size))
+                        [(); 3].map(|()| Ok((ep.workgroup_size, texels_x(kernel, &module)?)))
                     };
                     let [gpu, cpu, redesign] = sizes;
-                    workgroup_size = Some(gpu?);
-                    cpu_workgroup_size = Some(cpu?);
-                    redesign_workgroup_size = Some(redesign?);
+                    let ((gpu, tg), (cpu, tc), (redesign, tr)) = (gpu?, cpu?, redesign?);
+                    workgroup_size = Some(gpu);
+                    cpu_workgroup_size = Some(cpu);
+                    redesign_workgroup_size = Some(redesign);
+                    texels = [tg, tc, tr];
                 }
             }
             naga::ShaderStage::Vertex => stages |= wgpu::ShaderStages::VERTEX,
@@ -190,7 +225,10 @@ fn reflect_module(
             _ => {}
         }
     }
-    let texels_x = texels_x(kernel, &module)?;
+    let texels_x = match module.entry_points.iter().any(|e| e.name == "main") {
+        true => texels[0],
+        false => texels_x(kernel, &module)?,
+    };
     Ok((
         module,
         Reflection {
@@ -199,22 +237,26 @@ fn reflect_module(
             cpu_workgroup_size,
             redesign_workgroup_size,
             texels_x,
+            other_texels_x: OtherLayouts {
+                cpu: texels[1],
+                redesign: texels[2],
+            },
             stages,
         },
     ))
 }
 
-/// `main`'s workgroup size where it is an `override` expression: as the layout `gpu` (and
-/// `redesign`) compiles it ([`GPU_LAYOUT_CONSTANT`] and [`REDESIGN_CONSTANT`] set where the
-/// kernel declares them, every other override its default), naga's own evaluation of the
-/// pipeline constants.
-fn layout_workgroup_size(
+/// `main`'s workgroup size and [`TEXELS_X_CONSTANT`] where either is an `override`
+/// expression: as the layout `gpu` (and `redesign`) compiles them ([`GPU_LAYOUT_CONSTANT`] and
+/// [`REDESIGN_CONSTANT`] set where the kernel declares them, every other override its
+/// default), naga's own evaluation of the pipeline constants.
+fn layout_main(
     kernel: &str,
     module: &naga::Module,
     info: &naga::valid::ModuleInfo,
     gpu: bool,
     redesign: bool,
-) -> Result<[u32; 3]> {
+) -> Result<([u32; 3], u32)> {
     let mut constants = naga::back::PipelineConstants::default();
     for (name, value) in [(GPU_LAYOUT_CONSTANT, gpu), (REDESIGN_CONSTANT, redesign)] {
         if module
@@ -237,10 +279,11 @@ fn layout_workgroup_size(
         .iter()
         .find(|e| e.name == "main")
         .expect("process_overrides keeps the entry point it was given");
-    Ok(ep.workgroup_size)
+    Ok((ep.workgroup_size, texels_x(kernel, &resolved)?))
 }
 
-/// `kernel`'s [`TEXELS_X_CONSTANT`]: 1 if it declares none, else a u32 in 1..=[`MAX_TEXELS_X`].
+/// `kernel`'s [`TEXELS_X_CONSTANT`] (a constant; an override once naga has resolved it): 1 if
+/// it declares none, else a u32 in 1..=[`MAX_TEXELS_X`].
 fn texels_x(kernel: &str, module: &naga::Module) -> Result<u32> {
     let Some((_, c)) = module
         .constants
