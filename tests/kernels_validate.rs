@@ -530,6 +530,8 @@ fn storage_format_variants_validate() {
         ),
         ("mips", "rgba32float", all),
         ("mips_log", "rgba32float", &["r32float"][..]),
+        ("mips_spd", "rgba32float", all),
+        ("mips_spd_log", "rgba32float", &["r32float"][..]),
         ("sat_tile_sums", "rgba32uint", &["r32uint", "rg32uint"][..]),
         (
             "sat_tile_sums_f32",
@@ -597,6 +599,7 @@ fn packed_f16_variants_validate() {
         "evsm_blur_row",
         "blur",
         "mips",
+        "mips_spd",
         "sat_tile_sums",
         "sat_tile_sums_f32",
         "sat_tiles",
@@ -624,7 +627,7 @@ fn packed_f16_variants_validate() {
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
-    assert_eq!(rewritten, 12, "every variant packs or unpacks");
+    assert_eq!(rewritten, 13, "every variant packs or unpacks");
 }
 
 /// Every compute kernel fits WebGPU's default limits (what `wgpu::Limits::default()` asks
@@ -650,7 +653,8 @@ fn compute_kernels_fit_webgpu_default_limits() {
         checked += 1;
         let needs = shadowgraph::low_level::limits::kernel_needs(&module, &refl, &defaults).expect("needs");
         for n in needs.iter().filter(|n| n.over()) {
-            let known = matches!(id.name(), "mips" | "mips_log")
+            // (`mips_spd`, `mips_spd_log`: the chain's redesign, the same bindings.)
+            let known = matches!(id.name(), "mips" | "mips_log" | "mips_spd" | "mips_spd_log")
                 && matches!(
                     (n.limit_name, n.requested),
                     ("max_storage_textures_per_shader_stage", 7)

@@ -8,6 +8,7 @@
 mod common;
 
 use std::collections::HashMap;
+use std::sync::{Arc, OnceLock};
 
 use rand::Rng;
 use shadowgraph::Filter;
@@ -16,11 +17,13 @@ use shadowgraph::low_level::exec::{Executor, KernelLayout};
 use shadowgraph::low_level::filter::{BlurMode, add_filter};
 use shadowgraph::low_level::gpu::{Gpu, read_resource_texture, submit_and_wait};
 use shadowgraph::low_level::graph::{Graph, plan};
+use shadowgraph::low_level::kernels::Replacements;
 
-/// Every level of the mip chain of the `w × h` map `data` (of `format`), run in `layout`.
+/// Every level of the mip chain of the `w × h` map `data` (of `format`), run in `layout`; with
+/// `poisoned`, the kernels' workgroup memory filled with NaN first (`tests/common/poison.rs`).
 fn chain(
     g: &Gpu,
-    layout: KernelLayout,
+    (layout, poisoned): (KernelLayout, bool),
     (w, h): (u32, u32),
     format: wgpu::TextureFormat,
     data: &[u8],
@@ -37,6 +40,12 @@ fn chain(
     let input = common::upload(&g.device, &g.queue, "test.input", (w, h), format, data);
     let mut exec = Executor::new();
     exec.kernels.set_layout(layout);
+    if poisoned {
+        static POISONED: OnceLock<Arc<Replacements>> = OnceLock::new();
+        let kernels = POISONED.get_or_init(|| Arc::new(common::poison::poisoned_kernels()));
+        assert!(kernels.contains_key("mips_spd") && kernels.contains_key("mips_spd_log"));
+        exec.kernels.set_replacements(kernels.clone());
+    }
     let imports = HashMap::from([("in".to_string(), input)]);
     let mut enc = g.device.create_command_encoder(&Default::default());
     let outputs = exec
@@ -54,7 +63,8 @@ fn chain(
         .collect()
 }
 
-/// The redesign's chain equals the shipped one's, level by level, bit for bit.
+/// The redesign's chain equals the shipped one's, level by level, bit for bit, and its own
+/// with its workgroup memory poisoned.
 fn same_chains(g: &Gpu, size: (u32, u32), format: wgpu::TextureFormat, mode: BlurMode, seed: u64) {
     let mut rng = common::rng(seed);
     let n = (size.0 * size.1) as usize;
@@ -72,8 +82,17 @@ fn same_chains(g: &Gpu, size: (u32, u32), format: wgpu::TextureFormat, mode: Blu
             .collect(),
         other => panic!("no random texels of {other:?}"),
     };
-    let shipped = chain(g, KernelLayout::Gpu, size, format, &data, mode);
-    let redesign = chain(g, KernelLayout::Redesign, size, format, &data, mode);
+    let shipped = chain(g, (KernelLayout::Gpu, false), size, format, &data, mode);
+    let redesign = chain(
+        g,
+        (KernelLayout::Redesign, false),
+        size,
+        format,
+        &data,
+        mode,
+    );
+    // Every entry of its workgroup memory written before it is read: poisoned, the same bits.
+    let poisoned = chain(g, (KernelLayout::Redesign, true), size, format, &data, mode);
     assert_eq!(shipped.len(), redesign.len(), "{size:?}: levels");
     assert!(
         shipped[0].data.iter().any(|&v| v != 0.0),
@@ -83,6 +102,7 @@ fn same_chains(g: &Gpu, size: (u32, u32), format: wgpu::TextureFormat, mode: Blu
         let what = format!("{size:?} {format:?} {mode:?} level {level}");
         assert!(a.data.iter().all(|v| v.is_finite()), "{what}: not finite");
         common::assert_same_bits(&what, a, b);
+        common::assert_same_bits(&format!("{what}, poisoned"), b, &poisoned[level]);
     }
 }
 

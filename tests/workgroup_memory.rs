@@ -182,11 +182,13 @@ fn same_with_poison(
 fn every_kernel_writes_its_workgroup_memory_before_reading_it() {
     let g = common::gpu();
     let poisoned = common::poison::poisoned_kernels();
-    // Both layouts of the kernels that have two (`exec::KernelLayout`: the fused blurs' tile
-    // or strips, the tables' pass 3).
+    // Every layout of the kernels that have several (`exec::KernelLayout`: the fused blurs'
+    // tile or strips, the tables' pass 3, the redesigns), each kernel by the file it compiled
+    // (a redesign's own: `KernelLayout::kernel_source`).
     let mut ran = BTreeSet::new();
-    for layout in [KernelLayout::Gpu, KernelLayout::Cpu] {
-        ran.extend(same_with_poison(&g, None, &scenes(), Some(layout)));
+    for layout in [KernelLayout::Gpu, KernelLayout::Cpu, KernelLayout::Redesign] {
+        let kernels = same_with_poison(&g, None, &scenes(), Some(layout));
+        ran.extend(kernels.iter().map(|k| layout.kernel_source(k).to_string()));
     }
     // The library's tables from an imported map and the five-pass baseline: in
     // `the_library_tables_and_the_five_pass_baseline_too`.
