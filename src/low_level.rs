@@ -17,7 +17,7 @@ pub mod bench {
 
 #[cfg(feature = "cli")]
 pub mod cli {
-    //! The subcommands of the `shadowgraph` binary, one function each.
+    //! The library functions behind the CLI's subcommands; each returns the text it prints.
     pub use crate::cli::*;
 }
 
@@ -29,13 +29,14 @@ pub mod cpu {
 
 #[cfg(feature = "cli")]
 pub mod dump {
-    //! `shadowgraph dump`: every intermediate texture of a frame, written to files.
+    //! `shadowgraph dump`: every resource of the executed plan written to disk for inspection.
     pub use crate::dump::*;
 }
 
 #[cfg(feature = "cli")]
 pub mod evaluate {
-    //! `shadowgraph evaluate`: techniques against the area-light truth, reports and plots.
+    //! `shadowgraph evaluate`: a sweep over techniques and their accuracy knobs, measured against
+    //! the ground truth ([`truth`](super::truth)), with its reports and plots.
     pub use crate::evaluate::*;
 }
 
@@ -45,17 +46,19 @@ pub mod exec {
 }
 
 pub mod filter {
-    //! The filter kernels' graph builders (blurs, mip chains, summed-area tables' inputs).
+    //! Filters that work on any prefiltered representation: the separable blur and the mip chain.
     pub use crate::filter::*;
 }
 
 pub mod gpu {
-    //! The device, submission, readback and upload helpers.
+    //! GPU context: adapter selection, device creation with the adapter's own limits, submission,
+    //! upload and readback.
     pub use crate::gpu::*;
 }
 
 pub mod gpu_objects {
-    //! Counts of the GPU objects the renderer, the executor, the timer and the stage create.
+    //! Creates and counts (per thread) every GPU object of the renderer, the executor, the timer
+    //! and the stage.
     pub use crate::gpu_objects::*;
 }
 
@@ -138,12 +141,13 @@ pub mod technique {
 
 #[cfg(feature = "cli")]
 pub mod tolerance {
-    //! The tests' error bounds of the moment techniques, derived from their storage.
+    //! Error models of the shading kernel's f32 visibility functions against their f64
+    //! references: how far apart the two may be.
     pub use crate::tolerance::*;
 }
 
 pub mod timer {
-    //! GPU timestamps around compute passes, and warm-up.
+    //! GPU timing by timestamps at the boundaries between passes, and warm-up.
     #[expect(
         hidden_glob_reexports,
         unused_imports,
@@ -155,7 +159,7 @@ pub mod timer {
 
 #[cfg(feature = "cli")]
 pub mod truth {
-    //! The area-light ground truth: ray casting against the scene's triangles.
+    //! Ground truth for the shadow techniques: the area light's visibility by ray casting.
     pub use crate::truth::*;
 }
 
