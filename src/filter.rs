@@ -20,7 +20,7 @@ pub const BLUR_PER_INVOCATION: u32 = 8;
 
 /// Rows down a column one `blur` invocation writes (`COL_PER` in `kernels/blur.wgsl`; `blur_log`
 /// writes [`BLUR_PER_INVOCATION`]): the vertical pass reads its halo of 2r rows once per this
-/// many outputs.
+/// many outputs. In the redesign layout a row invocation writes as many along its row.
 pub const BLUR_COL_PER: u32 = 32;
 
 /// Invocations of a `blur` or `blur_log` workgroup (`WG_SIZE` in
