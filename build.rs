@@ -5,7 +5,7 @@
 //! kernel name is a compile error and a new file is registered by being there.
 //!
 //! Written by hand rather than with a crate: it only lists a folder and writes Rust text.
-//! WGSL validation stays in `tests/kernels_validate.rs` (naga as a build dependency would
+//! WGSL validation stays in `tests/kernels_validate/` (naga as a build dependency would
 //! compile it a second time, for the host, in every build).
 
 use std::fmt::Write as _;

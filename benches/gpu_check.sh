@@ -174,7 +174,7 @@ done
 # 8 since, which were chosen on llvmpipe): benches/variants/blur_rows_run1 (one output an
 # invocation, neighbouring invocations on neighbouring texels) and blur_rows_run2 (runs of 2)
 # against the shipped runs of 8, columns as shipped, the same blur bit for bit
-# (tests/kernel_dir.rs), alternated twice. On llvmpipe the row pass is 2.1x (run1) and
+# (tests/kernel_dir/), alternated twice. On llvmpipe the row pass is 2.1x (run1) and
 # 1.4-1.6x (run2) slower than shipped (benches/RESULTS.md, 2026-11-27).
 # One process a round (`bench --kernel-dirs`: one warm-up, one set of copies, each kernel in
 # each folder adjacent in time), the folders' order reversed in the second.
@@ -205,7 +205,7 @@ for dirs in "shipped,$TV,$TS,$TC" "$TC,$TS,$TV,shipped"; do
 done
 # The mip chain without level s + 1 in workgroup memory (benches/variants/mip_quads: 5.4 of
 # the shipped kernel's 21.3 KiB, which admits 10 workgroups of 64 an SM; the same chain bit for
-# bit, tests/kernel_dir.rs), alternated with the shipped kernel twice.
+# bit, tests/kernel_dir/), alternated with the shipped kernel twice.
 for dirs in shipped,benches/variants/mip_quads benches/variants/mip_quads,shipped; do
     step variants.txt 40 "$B" bench --sizes 2048,4096 --repeat 20 --only mips \
         --kernel-dirs "$dirs"

@@ -1,5 +1,5 @@
 //! The WGSL mirrors: every `#[repr(C)]` mirror of a WGSL struct the Rust side fills
-//! (bytemuck), each naming the struct it mirrors (`tests/kernels_validate.rs` checks their sizes
+//! (bytemuck), each naming the struct it mirrors (`tests/kernels_validate/` checks their sizes
 //! against naga's layouts), and the technique ids and flags the shading kernel reads. What fills a
 //! [`LightGpu`] from a light lives with the techniques (`crate::technique`); the parameters of
 //! the filter and table kernels live beside their graph builders (`crate::filter::MipParams`,

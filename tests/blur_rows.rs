@@ -122,7 +122,7 @@ fn check_f32(what: &str, input: &Texels, format: wgpu::TextureFormat, filter: &F
     // f32, a pass: w₀·v₀ + Σ wᵢ·(v₋ᵢ + vᵢ) summed in order, the pair i through its add, its
     // product and r − i + 1 accumulations, each weight rounded once from f64 (Σ w = 1): at most
     // (r + 4)·2⁻²⁴·max |v| from the f64 pass; the columns add their own to the rows' error,
-    // which their weights carry unchanged (the worst case of tests/prefilter.rs's 1e-6 on
+    // which their weights carry unchanged (the worst case of tests/prefilter/'s 1e-6 on
     // moments in [0, 1]).
     let max = input.data.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let pass_error = f64::from(weights.len() as u32 + 3) * 2f64.powi(-24) * max;
@@ -331,7 +331,7 @@ fn row_redesign_of_the_log_space_blur_matches_the_reference_and_the_shipped_rows
         let what = format!("esm c={c} r{radius} log-space blur");
         // Each log-sum-exp: exp of (v − v₀) ∈ [−c, c] (v₀ the first texel an invocation reads;
         // past the span, v − max ∈ [−c, 0]) at (3 + 2|x|) ULP relative, then log: the absolute
-        // error in L is ≲ 2·(3 + 2c) ULP of 1 plus the rounding of |L| ≤ c (tests/prefilter.rs's
+        // error in L is ≲ 2·(3 + 2c) ULP of 1 plus the rounding of |L| ≤ c (tests/prefilter/'s
         // tolerance of both passes, here on each).
         let atol = 2.0 * (3.0 + 2.0 * c) * 2f64.powi(-23);
         let rtol = 4.0 * 2f64.powi(-24);

@@ -279,7 +279,7 @@ fn the_stages_cascade_config_matches_the_renderers_pick() {
         }
     }
     // PCSS and the soft techniques take cascades that keep the light's plane
-    // (`fit_light_cascades`, checked against the renderer's in tests/plugin.rs); the
+    // (`fit_light_cascades`, checked against the renderer's in tests/plugin/); the
     // per-cascade depth ranges of `fit_cascades` are refused for them by name.
     let soft = PrefilterConfig::vssm(512, 0.5).with_cascades(4, 0.5, 0.1);
     assert!(soft.validated().is_ok());

@@ -2,7 +2,7 @@
 //! `redesign` kernel layout compiles for `mips` and `mips_log`) against the shipped chain
 //! (`kernels/shared/mip_chain.wgsl`, the `gpu` layout): every level bit for bit. Each texel of
 //! both is the same `quad` (or general reduction) of the same four values in the same order, so
-//! any difference is a texel read, kept or stored wrongly. `tests/prefilter.rs` checks both
+//! any difference is a texel read, kept or stored wrongly. `tests/prefilter/` checks both
 //! layouts against the f64 chain.
 
 mod common;

@@ -3,7 +3,7 @@
 //! valid until that light is recorded again, and one shader module holding several lights'
 //! WGSL blocks.
 //!
-//! The references are the single-light paths, which `tests/plugin.rs` checks against the
+//! The references are the single-light paths, which `tests/plugin/` checks against the
 //! renderer (and so against the f64 references): a layer holds the same depth values as the
 //! texture it was copied from, the kernels are the same, so the maps must be equal bit for bit
 //! (tolerance 0); the composed module calls the same functions on the same maps as a

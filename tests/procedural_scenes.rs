@@ -3,7 +3,7 @@
 //! the generator means it (glTF, GLB and OBJ alike); and each scene has the feature it is for:
 //! the forest's canopies stack several leaf layers along the light, the colonnade's light
 //! grazes and its occluders are long and thin, the city's depths span its light's range. Every
-//! one has an area light. No GPU needed (rendering them is `tests/scenes.rs`'s job).
+//! one has an area light. No GPU needed (rendering them is `tests/scenes/`'s job).
 
 mod procedural;
 

@@ -5,7 +5,7 @@
 //! exists), and on a ground plane with nothing behind it (`scenes/casters_on_plane.toml`) the
 //! visibility against the f64 ray cast, within what `hard` with its best constant bias reaches.
 //! (The visibility of the bundled scenes against `cpu::vis_hard` and `cpu::vis_pcf` on that map
-//! is in tests/scenes.rs.)
+//! is in tests/scenes/.)
 
 mod common;
 

@@ -7,7 +7,7 @@
 //! `kernels/shade.wgsl`, over the configuration's own G-buffer (the camera's, the same for
 //! every configuration), and stored as 8-bit sRGB as the renderer stores them: they differ
 //! exactly where the visibilities differ, so a technique that reproduces the truth has a FLIP
-//! of exactly 0. (The port agrees with the GPU's image within one 8-bit step: `tests/evaluate.rs`.)
+//! of exactly 0. (The port agrees with the GPU's image within one 8-bit step: `tests/evaluate/`.)
 //! FLIP is taken over the whole image at its default 67 pixels per degree (a 0.7 m wide
 //! 3840-pixel monitor seen from 0.7 m); its statistics are those of the per-pixel error map.
 

@@ -1,5 +1,5 @@
 //! Tolerances of the soft techniques (`cssm`, `vssm`, `msm_soft`) and the inputs of their f64
-//! references, shared by tests/soft.rs, tests/scenes.rs and tests/plugin.rs.
+//! references, shared by tests/soft.rs, tests/scenes/ and tests/plugin/.
 //!
 //! A soft visibility is a chain: table means over the search square → blocker estimate →
 //! filter width → table means over it → visibility. The GPU's errors enter at the means (f32

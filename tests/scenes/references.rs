@@ -54,7 +54,7 @@ fn every_scene_renders_and_matches_the_references() {
             let level0 =
                 Texels::from_f32(sm.width as usize, sm.height as usize, sm.channels, &sm.data);
             // With the mips filter the shading reads the chain: rebuild it in f64 from level 0
-            // (the chain's own accuracy is tested in tests/prefilter.rs).
+            // (the chain's own accuracy is tested in tests/prefilter/).
             let technique = scene.lights[li].shadow.technique;
             let moments = match technique.filter() {
                 Some(shadowgraph::Filter::Mips { .. }) => {
@@ -95,7 +95,7 @@ fn every_scene_renders_and_matches_the_references() {
 }
 
 /// The filtered map the shading read equals the f64 encode and blur of the linear map the GPU
-/// produced: f32 storage 1e-6 (as in tests/prefilter.rs), widened by SPIR-V's (3 + 2|x|)-ULP
+/// produced: f32 storage 1e-6 (as in tests/prefilter/), widened by SPIR-V's (3 + 2|x|)-ULP
 /// `exp` for the exponential encodings; f16 storage 3 · 2⁻¹⁰ relative.
 fn check_prefilter_chain(scene: &Scene, frame: &shadowgraph::low_level::render::Frame, li: usize) {
     use shadowgraph::{Filter, Storage};

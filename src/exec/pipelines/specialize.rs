@@ -7,7 +7,7 @@ use crate::exec::packed;
 use crate::kernels::{self, Reflection};
 
 /// The WGSL of kernel `name` as [`KernelCache::get_specialized`](super::KernelCache::get_specialized) compiles it for the texture
-/// formats `formats` bound by binding name (no GPU needed: `tests/kernels_validate.rs`
+/// formats `formats` bound by binding name (no GPU needed: `tests/kernels_validate/`
 /// validates every variant a technique can bind).
 pub fn specialized_source(name: &str, formats: &[(String, wgpu::TextureFormat)]) -> Result<String> {
     let (_, reflection) = kernels::reflect(name, &kernels::resolve(name, None)?)?;
