@@ -1,4 +1,5 @@
-// The texture yardstick of `shadowgraph bench`: copies a float texture texel by texel in the
+// The texture yardstick of `shadowgraph bench`, one texel an invocation (`copy_texture_x4`
+// copies four): copies a float texture texel by texel in the
 // 16×16 workgroups of the map kernels, one textureLoad and one textureStore per texel. The
 // source may be a depth texture (read as `texture_2d<f32>`, as `linearize` reads it).
 // Storage: rgba32float by default; the executor re-declares `dst` for the bound format.

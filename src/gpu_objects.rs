@@ -118,6 +118,28 @@ pub(crate) fn shader_module(
     device.create_shader_module(desc)
 }
 
+/// `Device::create_shader_module_trusted` with every runtime check off
+/// (`wgpu::ShaderRuntimeChecks::unchecked()`), counted: a kernel of `kernels/` compiled without
+/// naga's bounds on its indices and loops, for the A/B of `exec::ShaderChecks::Off` only (never
+/// a default).
+///
+/// Sound for the kernels of `kernels/` (not for any WGSL): every one indexes within bounds,
+/// loads textures at coordinates tested against or clamped to `textureDimensions`, indexes
+/// private and workgroup arrays by counters below their constant lengths and storage buffers
+/// below the sizes the host allocates for its dispatch (`arrayLength` in `copy`, `materials`
+/// clamped in `shade`), bounds every loop by a count, and divides integers only by constants or
+/// sizes of at least 1; the suite runs them checked, so a change that broke this would not
+/// show there, which is why the mode stays an opt-in measurement.
+pub(crate) fn shader_module_unchecked(
+    device: &wgpu::Device,
+    desc: wgpu::ShaderModuleDescriptor,
+) -> wgpu::ShaderModule {
+    count(|c| c.shader_modules += 1);
+    // SAFETY: the kernels passed here index within bounds, bound their loops and never
+    // divide an integer by zero (the function's documentation gives the reasons).
+    unsafe { device.create_shader_module_trusted(desc, wgpu::ShaderRuntimeChecks::unchecked()) }
+}
+
 /// `Device::create_compute_pipeline`, counted.
 pub(crate) fn compute_pipeline(
     device: &wgpu::Device,

@@ -114,8 +114,9 @@ enum Command {
         /// Time each kernel compiled from each of these folders of `.wgsl` replacements in
         /// turn (as SHADOWGRAPH_KERNEL_DIR reads one; `shipped`: the embedded kernels;
         /// `zeroed`: the embedded kernels with their workgroup memory zeroed first, wgpu's
-        /// default), in one process, rows named `<kernel> [<folder's name>]`: kernel variants
-        /// side by side.
+        /// default; `unchecked`: the embedded kernels' shader modules created without wgpu's
+        /// runtime checks), in one process, rows named `<kernel> [<folder's name>]`: kernel
+        /// variants side by side.
         #[arg(long, value_delimiter = ',', conflicts_with_all = ["lookup", "layouts"])]
         kernel_dirs: Vec<PathBuf>,
     },

@@ -1,6 +1,8 @@
-//! The yardsticks: `kernels/copy.wgsl` copying a storage buffer, and
-//! `kernels/copy_texture.wgsl` (`copy_texture_u32.wgsl`) copying a texture of each format a
-//! benchmarked kernel reads or writes, texel by texel in the map kernels' 16×16 workgroups.
+//! The yardsticks: `kernels/copy.wgsl` copying a storage buffer, and two copies of a texture of
+//! each format a benchmarked kernel reads or writes in the map kernels' 16×16 workgroups:
+//! `kernels/copy_texture.wgsl` (`copy_texture_u32.wgsl`) one texel an invocation, as the map
+//! kernels read, and `copy_texture_x4.wgsl` (`copy_texture_u32_x4.wgsl`) four, every load
+//! issued before the first store ([`TextureCopy`]).
 
 use std::sync::Arc;
 
@@ -44,15 +46,54 @@ pub fn format_name(format: wgpu::TextureFormat) -> String {
     }
 }
 
+/// A texture copy kernel: texels an invocation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TextureCopy {
+    /// One texel an invocation, one load in flight (`kernels/copy_texture.wgsl`): the map
+    /// kernels' shape, each kernel row's `x` yardstick.
+    X1,
+    /// Four texels an invocation, 16 apart along x, every load issued before the first store
+    /// (`kernels/copy_texture_x4.wgsl`): what a texture copy reaches with loads in flight.
+    X4,
+}
+
+impl TextureCopy {
+    /// Both, in the report's order.
+    pub const ALL: [TextureCopy; 2] = [TextureCopy::X1, TextureCopy::X4];
+
+    /// The row's kernel name: `copy texture x1`, `copy texture x4`.
+    pub fn name(self) -> &'static str {
+        match self {
+            TextureCopy::X1 => "copy texture x1",
+            TextureCopy::X4 => "copy texture x4",
+        }
+    }
+
+    /// The kernel copying textures of `format` (float or unsigned integer texels).
+    fn kernel(self, format: wgpu::TextureFormat) -> KernelId {
+        let uint = matches!(
+            format,
+            wgpu::TextureFormat::R32Uint
+                | wgpu::TextureFormat::Rg32Uint
+                | wgpu::TextureFormat::Rgba32Uint
+        );
+        match (self, uint) {
+            (TextureCopy::X1, false) => KernelId::CopyTexture,
+            (TextureCopy::X1, true) => KernelId::CopyTextureU32,
+            (TextureCopy::X4, false) => KernelId::CopyTextureX4,
+            (TextureCopy::X4, true) => KernelId::CopyTextureU32X4,
+        }
+    }
+}
+
 /// A graph of one node copying an imported `n`² texture of `format` into a texture of the same
-/// format (a depth texture into `r32float`): the texture roofline of that format.
-pub fn copy_texture_graph(n: u32, format: wgpu::TextureFormat) -> BenchGraph {
-    let (kernel, out) = match format {
-        wgpu::TextureFormat::R32Uint
-        | wgpu::TextureFormat::Rg32Uint
-        | wgpu::TextureFormat::Rgba32Uint => (KernelId::CopyTextureU32, format),
-        wgpu::TextureFormat::Depth32Float => (KernelId::CopyTexture, wgpu::TextureFormat::R32Float),
-        f => (KernelId::CopyTexture, f),
+/// format (a depth texture into `r32float`) with the kernel `copy`: the texture roofline of that
+/// format.
+pub fn copy_texture_graph(n: u32, format: wgpu::TextureFormat, copy: TextureCopy) -> BenchGraph {
+    let kernel = copy.kernel(format);
+    let out = match format {
+        wgpu::TextureFormat::Depth32Float => wgpu::TextureFormat::R32Float,
+        f => f,
     };
     let mut graph = Graph::default();
     let src = graph.import("copy.src", format, n, n, None);
@@ -62,7 +103,7 @@ pub fn copy_texture_graph(n: u32, format: wgpu::TextureFormat) -> BenchGraph {
     };
     let dst = graph.resource("copy.dst", out, size, None);
     graph.node(Node {
-        name: format!("copy texture {}", format_name(format)),
+        name: format!("{} {}", copy.name(), format_name(format)),
         kernel,
         inputs: vec![("src".into(), src)],
         outputs: vec![("dst".into(), dst.clone())],
@@ -248,6 +289,14 @@ mod tests {
     use super::*;
     use crate::gpu::{Gpu, read_buffer, submit_and_wait};
 
+    /// The format the copy of `format` writes.
+    fn built_format(format: wgpu::TextureFormat) -> wgpu::TextureFormat {
+        match format {
+            wgpu::TextureFormat::Depth32Float => wgpu::TextureFormat::R32Float,
+            f => f,
+        }
+    }
+
     fn gpu() -> Gpu {
         match Gpu::new() {
             Ok(g) => g,
@@ -300,18 +349,33 @@ mod tests {
         assert_eq!(got, bytemuck::cast_slice::<f32, u8>(&want));
     }
 
-    /// Every texture yardstick copies its format bit for bit (a depth texture, cleared to ½,
-    /// into `r32float`), at a size that is not a multiple of the workgroup.
+    /// Every texture yardstick, one texel an invocation or four, copies its format bit for bit
+    /// (a depth texture, cleared to ½, into `r32float`), at sizes that are multiples neither of
+    /// 4 nor of the workgroup (16) nor of the four-texel copy's 64 columns a workgroup: 37
+    /// (one workgroup, most lanes' texels past the edge) and 150 (two and a part); the
+    /// four-texel copy at 150² also with its module unchecked (`exec::ShaderChecks::Off`, the
+    /// A/B of wgpu's runtime checks), the same bits.
     #[test]
     fn texture_copies_copy_every_format() {
+        use crate::exec::ShaderChecks;
         let gpu = gpu();
         let (device, queue) = (&gpu.device, &gpu.queue);
-        let n = 37;
-        for &format in COPY_FORMATS {
-            let built = copy_texture_graph(n, format);
+        let mut cases = Vec::new();
+        for n in [37, 150] {
+            for copy in TextureCopy::ALL {
+                cases.extend(COPY_FORMATS.iter().map(|&f| (n, copy, f, ShaderChecks::On)));
+            }
+        }
+        let unchecked = COPY_FORMATS
+            .iter()
+            .map(|&f| (150, TextureCopy::X4, f, ShaderChecks::Off));
+        cases.extend(unchecked);
+        for (n, copy, format, checks) in cases {
+            let built = copy_texture_graph(n, format, copy);
             let outputs: Vec<&str> = built.outputs.iter().map(String::as_str).collect();
             let plan = crate::graph::plan(&built.graph, &outputs).unwrap();
             let mut executor = crate::exec::Executor::new();
+            executor.kernels.set_shader_checks(checks);
             let imports = super::super::harness::random_imports(device, queue, &plan).unwrap();
             let src = &imports["copy.src"];
             let mut enc = device.create_command_encoder(&Default::default());
@@ -327,8 +391,17 @@ mod tests {
                 }
                 _ => crate::gpu::read_texture(device, queue, src, 0).unwrap(),
             };
-            assert_eq!(got, want, "{}", format_name(format));
-            assert!(got.iter().any(|&b| b != 0), "{}", format_name(format));
+            let what = format!("{} {} at {n}² {checks:?}", copy.name(), format_name(format));
+            assert_eq!(got.len(), want.len(), "{what}");
+            if let Some(i) = (0..got.len()).find(|&i| got[i] != want[i]) {
+                let texel = i / crate::graph::texel_bytes(built_format(format)) as usize;
+                panic!(
+                    "{what}: texel ({}, {}) differs",
+                    texel % n as usize,
+                    texel / n as usize
+                );
+            }
+            assert!(got.iter().any(|&b| b != 0), "{what}");
         }
     }
 
@@ -351,7 +424,7 @@ mod tests {
             wgpu::TextureFormat::Rgba32Uint,
             wgpu::TextureFormat::Rgba16Float,
         ] {
-            let built = copy_texture_graph(n, format);
+            let built = copy_texture_graph(n, format, TextureCopy::X1);
             let outputs: Vec<&str> = built.outputs.iter().map(String::as_str).collect();
             let plan = crate::graph::plan(&built.graph, &outputs).unwrap();
             let imports = fill_imports(device, queue, &plan, Inputs::Smooth).unwrap();

@@ -4,10 +4,11 @@
 use std::collections::HashMap;
 
 use super::args::{check_args, select_cases};
-use super::copy::{self, COPY_FORMATS, format_name};
+use super::copy::{self, COPY_FORMATS, TextureCopy, format_name};
 use super::graphs::BenchGraph;
 use super::harness::{self, Inputs, Timed, gb_per_s, time_graph};
 use super::memory::{check_memory, check_yardstick_memory};
+use super::report::{minimal_bytes, roofline};
 use super::variant::{KernelVariant, check_distinct};
 use super::{BenchRow, texels};
 use crate::error::{Error, Result};
@@ -22,9 +23,18 @@ pub fn plan_bytes(plan: &Plan) -> Result<f64> {
         .sum()
 }
 
-/// A kernel or texture-copy row from a timed plan.
-fn row(name: &str, format: String, n: u32, plan: &Plan, t: Timed) -> Result<BenchRow> {
+/// A kernel or texture-copy row from a timed plan of `built`, its roofline from the buffer
+/// copy's `buffer_gbps`.
+fn row(
+    name: &str,
+    format: String,
+    n: u32,
+    (built, plan): (&BenchGraph, &Plan),
+    t: Timed,
+    buffer_gbps: f64,
+) -> Result<BenchRow> {
     let bytes = plan_bytes(plan)?;
+    let minimal = minimal_bytes(plan, &built.outputs)?;
     Ok(BenchRow {
         kernel: name.to_string(),
         format,
@@ -35,15 +45,19 @@ fn row(name: &str, format: String, n: u32, plan: &Plan, t: Timed) -> Result<Benc
         least_share: t.least_share,
         gbps: gb_per_s(bytes, t.ms),
         ratio: f64::NAN,
+        minimal_bytes: minimal,
+        roofline: roofline(minimal, buffer_gbps, t.ms),
         yardstick: String::new(),
         passes: t.passes,
     })
 }
 
 /// Times, at every size in `sizes` (`repeat` timed runs each), the buffer copy of an
-/// rgba32-sized map, the texture copy of every format of [`COPY_FORMATS`] (ratio to the
-/// buffer copy), then every case of [`CASES`](super::CASES) whose name contains one of `only` (every case
-/// when `only` is empty; ratio to the texture copy of its output's format).
+/// rgba32-sized map, the texture copies ([`TextureCopy`]: one texel an invocation, then four)
+/// of every format of [`COPY_FORMATS`] (ratio to the buffer copy), then every case of
+/// [`CASES`](super::CASES) whose name contains one of `only` (every case when `only` is empty;
+/// ratio to the one-texel texture copy of its output's format). Every row's roofline is its
+/// minimal traffic at the buffer copy's bandwidth of the same size ([`BenchRow::roofline`]).
 ///
 /// The copies are timed twice, before and after the cases, and each keeps the faster of its
 /// two medians: the yardstick is what the device's copy reaches, and a GPU's clock or a
@@ -117,11 +131,14 @@ pub fn measure_variants(
         let mut timed = Vec::new();
         for case in &cases {
             let built = (case.build)(n);
+            let time = |suffix: &str, executor: &mut Executor| {
+                bench.case_row(case.name, &built, (n, suffix), executor, buffer_gbps)
+            };
             if variants.is_empty() {
-                timed.push(bench.case_row(case.name, &built, n, "", &mut executor)?);
+                timed.push(time("", &mut executor)?);
             }
             for (suffix, executor) in &mut variants {
-                timed.push(bench.case_row(case.name, &built, n, suffix, executor)?);
+                timed.push(time(suffix, executor)?);
             }
         }
         // The copies again: each format's row keeps the faster of its two runs.
@@ -131,6 +148,7 @@ pub fn measure_variants(
                 *first = again;
             }
         }
+        // The kernels' yardstick: the one-texel copies, the first of each format.
         let by_format: HashMap<wgpu::TextureFormat, f64> = COPY_FORMATS
             .iter()
             .copied()
@@ -187,13 +205,15 @@ impl Bench<'_> {
             least_share: t.least_share,
             gbps: gb_per_s(2.0 * buffer as f64, t.ms),
             ratio: 1.0,
+            minimal_bytes: 2.0 * buffer as f64,
+            roofline: 1.0,
             yardstick: String::new(),
             passes: Vec::new(),
         })
     }
 
-    /// The rows of the texture copies of [`COPY_FORMATS`] at side `n`, in their order, each's
-    /// ratio to the buffer copy's `buffer_gbps`.
+    /// The rows of the texture copies at side `n`: each [`TextureCopy`] in its order, of every
+    /// format of [`COPY_FORMATS`] in theirs, each's ratio to the buffer copy's `buffer_gbps`.
     fn texture_copies(
         &self,
         executor: &mut Executor,
@@ -201,9 +221,14 @@ impl Bench<'_> {
         buffer_gbps: f64,
     ) -> Result<Vec<BenchRow>> {
         let mut copies = Vec::new();
-        for &format in COPY_FORMATS {
-            let (plan, t) = self.time(executor, &copy::copy_texture_graph(n, format))?;
-            let mut r = row("copy texture", format_name(format), n, &plan, t)?;
+        for (shape, &format) in TextureCopy::ALL
+            .iter()
+            .flat_map(|&c| COPY_FORMATS.iter().map(move |f| (c, f)))
+        {
+            let built = copy::copy_texture_graph(n, format, shape);
+            let (plan, t) = self.time(executor, &built)?;
+            let name = format_name(format);
+            let mut r = row(shape.name(), name, n, (&built, &plan), t, buffer_gbps)?;
             r.ratio = r.gbps / buffer_gbps;
             r.yardstick = "copy buffer".into();
             copies.push(r);
@@ -213,14 +238,15 @@ impl Bench<'_> {
     }
 
     /// The row of case `name` (graph `built`, side `n`) timed in `executor`, named
-    /// `<name><suffix>`, and the format of its output texture, whose copy is its yardstick.
+    /// `<name><suffix>`, and the format of its output texture, whose copy is its yardstick; its
+    /// roofline from the buffer copy's `buffer_gbps`.
     fn case_row(
         &self,
         name: &str,
         built: &BenchGraph,
-        n: u32,
-        suffix: &str,
+        (n, suffix): (u32, &str),
         executor: &mut Executor,
+        buffer_gbps: f64,
     ) -> Result<(wgpu::TextureFormat, BenchRow)> {
         let (plan, t) = self.time(executor, built)?;
         let output = built.outputs.first().and_then(|o| plan.resource(o));
@@ -228,7 +254,14 @@ impl Bench<'_> {
         let format = output
             .map(|r| crate::graph::texture_format(r.resource.format))
             .ok_or_else(|| Error::Invalid(format!("benchmark `{name}` plans no output")))?;
-        let r = row(&format!("{name}{suffix}"), format_name(format), n, &plan, t)?;
+        let r = row(
+            &format!("{name}{suffix}"),
+            format_name(format),
+            n,
+            (built, &plan),
+            t,
+            buffer_gbps,
+        )?;
         executor.release_textures();
         Ok((format, r))
     }
@@ -249,7 +282,7 @@ fn against_copy(
         ))
     })?;
     r.ratio = r.gbps / copy_gbps;
-    r.yardstick = format!("copy texture {}", r.format);
+    r.yardstick = format!("{} {}", TextureCopy::X1.name(), r.format);
     Ok(r)
 }
 
@@ -386,8 +419,11 @@ mod tests {
             .collect();
         assert_eq!(kernels, want);
         assert!(want.len() >= 2, "{want:?}");
-        let copies = rows.iter().filter(|r| r.kernel == "copy texture").count();
-        assert_eq!(copies, COPY_FORMATS.len());
+        let copies = rows
+            .iter()
+            .filter(|r| r.kernel.starts_with("copy texture"))
+            .count();
+        assert_eq!(copies, 2 * COPY_FORMATS.len());
         let e = measure(
             &gpu.device,
             &gpu.queue,
@@ -412,7 +448,9 @@ mod tests {
         let mut want = Vec::new();
         for n in [32, 48] {
             want.push(("copy buffer", n));
-            want.extend(COPY_FORMATS.iter().map(|_| ("copy texture", n)));
+            for copy in TextureCopy::ALL {
+                want.extend(COPY_FORMATS.iter().map(|_| (copy.name(), n)));
+            }
             want.extend(CASES.iter().map(|c| (c.name, n)));
         }
         assert_eq!(names, want);
@@ -427,13 +465,13 @@ mod tests {
             assert_eq!(r.bytes_moved, plan_bytes(&plan).unwrap(), "{r:?}");
             let copy = rows
                 .iter()
-                .find(|c| c.size == r.size && c.kernel == "copy texture" && c.format == r.format)
+                .find(|c| c.size == r.size && c.kernel == "copy texture x1" && c.format == r.format)
                 .unwrap();
-            assert_eq!(r.yardstick, format!("copy texture {}", r.format));
+            assert_eq!(r.yardstick, format!("copy texture x1 {}", r.format));
             assert!((r.ratio - r.gbps / copy.gbps).abs() < 1e-12, "{r:?}");
         }
         let text = format_table("test device", true, 2, Inputs::Random, false, &rows);
-        assert!(text.contains("only the ratios") && text.contains("copy texture rg32float"));
+        assert!(text.contains("only the ratios") && text.contains("copy texture x1 rg32float"));
     }
 
     #[test]

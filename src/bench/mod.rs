@@ -33,17 +33,17 @@ mod variant;
 pub use self::args::{check_args, select_cases};
 use self::args::{check_map, check_only, with_flags};
 pub use self::cases::{BenchCase, CASES};
-pub use self::copy::{COPY, COPY_FORMATS, copy_texture_graph, format_name};
+pub use self::copy::{COPY, COPY_FORMATS, TextureCopy, copy_texture_graph, format_name};
 pub use self::graphs::BenchGraph;
 pub use self::harness::{Inputs, Timed, fill_imports, random_imports};
 pub use self::lookup::{LOOKUP_WIDTHS, LookupRow, format_lookup_table, lookup_cost};
 pub use self::measure::{measure, measure_layouts, measure_variants, plan_bytes};
 pub use self::memory::{case_bytes, check_memory};
-pub use self::report::{CPU_CHECKED_MS, CPU_LEAST_SHARE, format_table};
+pub use self::report::{CPU_CHECKED_MS, CPU_LEAST_SHARE, format_table, minimal_bytes};
 pub use self::soft::{
     SOFT_LIGHT_SIZES, SOFT_TECHNIQUES, SoftRow, check_soft_args, format_soft_table, soft_cost,
 };
-pub use self::variant::{KernelVariant, SHIPPED, ZEROED};
+pub use self::variant::{KernelVariant, SHIPPED, UNCHECKED, ZEROED};
 use crate::error::{Error, Result};
 use crate::exec::KernelLayout;
 use crate::gpu::Gpu;
@@ -55,7 +55,7 @@ pub const WARMUP: u32 = 2;
 /// One kernel measured at one size.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BenchRow {
-    /// Kernel name ([`BenchCase::name`], `copy buffer` or `copy texture`).
+    /// Kernel name ([`BenchCase::name`], `copy buffer` or a [`TextureCopy::name`]).
     pub kernel: String,
     /// Format of the kernel's output (of a texture copy's source; `-` for the buffer copy).
     pub format: String,
@@ -76,10 +76,17 @@ pub struct BenchRow {
     pub gbps: f64,
     /// `gbps` over the yardstick's GB/s at the same size.
     pub ratio: f64,
+    /// The least a run could move ([`minimal_bytes`]: one read of each texture it imports, one
+    /// write of each output, every mip level), bytes; the buffer copy's own bytes.
+    pub minimal_bytes: f64,
+    /// The time `minimal_bytes` takes at the buffer copy's GB/s (same size) over the median
+    /// time: 1.0 at the buffer copy's speed. A fused chain counts its first input and its last
+    /// outputs only, so that fusing shows.
+    pub roofline: f64,
     /// Each dispatch's median time, ms, by node name in order ([`Timed::passes`]; empty for
     /// the buffer copy).
     pub passes: Vec<(String, f64)>,
-    /// The yardstick: `copy texture <format>` for a kernel, `copy buffer` for a texture copy
+    /// The yardstick: `copy texture x1 <format>` for a kernel, `copy buffer` for a texture copy
     /// (empty for the buffer copy itself).
     pub yardstick: String,
 }

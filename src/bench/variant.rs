@@ -14,6 +14,8 @@ pub struct KernelVariant {
     replaced: Option<std::sync::Arc<crate::kernels::Replacements>>,
     /// Workgroup memory zeroed first ([`ZEROED`]).
     zeroed: bool,
+    /// Shader modules created without runtime checks ([`UNCHECKED`]).
+    unchecked: bool,
 }
 
 /// The `--kernel-dirs` entry that stands for the embedded kernels.
@@ -23,6 +25,11 @@ pub const SHIPPED: &str = "shipped";
 /// zeroed first, as wgpu does by default (`exec::WorkgroupInit`): what opting out saves.
 pub const ZEROED: &str = "zeroed";
 
+/// The `--kernel-dirs` entry that stands for the embedded kernels with their shader modules
+/// created without wgpu's runtime checks (`exec::ShaderChecks::Off`): what the checks cost
+/// (`shipped,unchecked`).
+pub const UNCHECKED: &str = "unchecked";
+
 impl KernelVariant {
     /// The kernels in `layout` (`exec::KernelLayout`).
     pub fn layout(layout: KernelLayout) -> Self {
@@ -31,6 +38,7 @@ impl KernelVariant {
             layout: Some(layout),
             replaced: None,
             zeroed: false,
+            unchecked: false,
         }
     }
 
@@ -41,6 +49,16 @@ impl KernelVariant {
             layout: None,
             replaced: None,
             zeroed: false,
+            unchecked: false,
+        }
+    }
+
+    /// The embedded kernels with unchecked shader modules, named [`UNCHECKED`].
+    pub fn unchecked() -> Self {
+        Self {
+            name: UNCHECKED.to_string(),
+            unchecked: true,
+            ..Self::shipped()
         }
     }
 
@@ -56,7 +74,7 @@ impl KernelVariant {
     /// The kernels with the `.wgsl` files of `dir` in place of those they name (as
     /// [`crate::kernels::KERNEL_DIR_ENV`] reads a folder), named by the folder's last
     /// component; [`SHIPPED`] is [`KernelVariant::shipped`], [`ZEROED`]
-    /// [`KernelVariant::zeroed`]. A folder that cannot be read or
+    /// [`KernelVariant::zeroed`], [`UNCHECKED`] [`KernelVariant::unchecked`]. A folder that cannot be read or
     /// replaces nothing, a file naming no kernel, or a replaced kernel that does not validate
     /// is an error naming it. The plan (its dispatches' geometry, the bytes of the rows) is the shipped kernels':
     /// a variant may change a kernel's workgroup size only where its node's dispatch does not
@@ -68,6 +86,9 @@ impl KernelVariant {
         }
         if dir.as_os_str() == ZEROED {
             return Ok(Self::zeroed());
+        }
+        if dir.as_os_str() == UNCHECKED {
+            return Ok(Self::unchecked());
         }
         // Its messages name the environment variable that usually gives the folder.
         let env = format!("{}: ", crate::kernels::KERNEL_DIR_ENV);
@@ -100,6 +121,7 @@ impl KernelVariant {
             layout: None,
             replaced: Some(std::sync::Arc::new(replaced)),
             zeroed: false,
+            unchecked: false,
         })
     }
 
@@ -114,6 +136,9 @@ impl KernelVariant {
         }
         if self.zeroed {
             e.kernels.set_zeroed_workgroup_memory();
+        }
+        if self.unchecked {
+            e.kernels.set_shader_checks(crate::exec::ShaderChecks::Off);
         }
         e
     }
@@ -190,8 +215,11 @@ mod tests {
                 pair[0].kernel
             );
         }
-        let copies = rows.iter().filter(|r| r.kernel == "copy texture").count();
-        assert_eq!(copies, COPY_FORMATS.len());
+        let copies = rows
+            .iter()
+            .filter(|r| r.kernel.starts_with("copy texture"))
+            .count();
+        assert_eq!(copies, 2 * COPY_FORMATS.len());
         // The report's first line says which layout the kernels ran in.
         let only = ["linearize".to_string()];
         let both = run(&gpu, &[32], 1, &only, Inputs::Random, false, &layouts, &[]).unwrap();
@@ -207,5 +235,29 @@ mod tests {
             first.ends_with(&format!("(kernel layout {device})")),
             "{first}"
         );
+    }
+
+    /// `--kernel-dirs shipped,unchecked`: the embedded kernels with checked and with unchecked
+    /// shader modules (`exec::ShaderChecks`), each case in both side by side; `on` and `off`
+    /// are the environment variable's values, anything else an error naming the value.
+    #[test]
+    fn shader_checks_run_side_by_side() {
+        use crate::bench::measure_variants;
+        use crate::exec::ShaderChecks;
+        let gpu = gpu();
+        let dirs = [SHIPPED, UNCHECKED].map(|d| KernelVariant::folder(d.as_ref()).unwrap());
+        let only = ["linearize".to_string()];
+        let (d, q) = (&gpu.device, &gpu.queue);
+        let rows = measure_variants(d, q, &[32], 1, &only, Inputs::Random, &dirs).unwrap();
+        let names: Vec<&str> = rows
+            .iter()
+            .filter(|r| !r.kernel.starts_with("copy"))
+            .map(|r| r.kernel.as_str())
+            .collect();
+        assert_eq!(names, ["linearize [shipped]", "linearize [unchecked]"]);
+        assert_eq!(ShaderChecks::parse("off"), Ok(ShaderChecks::Off));
+        assert_eq!(ShaderChecks::parse("on"), Ok(ShaderChecks::On));
+        let e = ShaderChecks::parse("no").unwrap_err();
+        assert!(e.contains("`no`") && e.contains("`off`"), "{e}");
     }
 }

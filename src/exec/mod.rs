@@ -24,7 +24,8 @@ use crate::graph::{Plan, Slot};
 use crate::timer::GpuTimer;
 pub use pipelines::{
     ComputeKernel, KERNEL_LAYOUT_ENV, KernelCache, KernelLayout, REDESIGNED_KERNELS,
-    REDESIGNED_MODULES, WorkgroupInit, specialized_source, wgsl_storage_format,
+    REDESIGNED_MODULES, SHADER_CHECKS_ENV, ShaderChecks, WorkgroupInit, specialized_source,
+    wgsl_storage_format,
 };
 pub use pool::{Outputs, TexturePool};
 

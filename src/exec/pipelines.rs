@@ -11,7 +11,7 @@ use std::sync::Arc;
 
 pub use self::layout::{
     GPU_LAYOUT_CONSTANT, KERNEL_LAYOUT_ENV, KernelLayout, REDESIGN_CONSTANT, REDESIGNED_KERNELS,
-    REDESIGNED_MODULES, WorkgroupInit,
+    REDESIGNED_MODULES, SHADER_CHECKS_ENV, ShaderChecks, WorkgroupInit,
 };
 use self::specialize::{apply, changes};
 pub use self::specialize::{specialized_source, wgsl_storage_format};
@@ -65,13 +65,26 @@ impl ComputeKernel {
     }
 
     /// [`ComputeKernel::with_options`] with these pipeline constants set too (a node's
-    /// `// #override` values, `exec::KernelCache`).
+    /// `// #override` values, `exec::KernelCache`), its module checked ([`ShaderChecks::On`]).
     pub fn with_constants(
         device: &wgpu::Device,
         name: &str,
         wgsl: &str,
         layout: KernelLayout,
         init: WorkgroupInit,
+        overrides: &[(String, f64)],
+    ) -> Result<Self> {
+        let kernel = (name, wgsl);
+        let compile = (layout, init, ShaderChecks::On);
+        Self::with_checks(device, kernel, compile, overrides)
+    }
+
+    /// [`ComputeKernel::with_constants`] of kernel `(name, wgsl)` in `(layout, init, checks)`:
+    /// [`ShaderChecks::Off`] only for the kernels of `kernels/` (see it).
+    pub fn with_checks(
+        device: &wgpu::Device,
+        (name, wgsl): (&str, &str),
+        (layout, init, checks): (KernelLayout, WorkgroupInit, ShaderChecks),
         overrides: &[(String, f64)],
     ) -> Result<Self> {
         let (module, reflection) = kernels::reflect(name, wgsl)?;
@@ -94,13 +107,14 @@ impl ComputeKernel {
         let (layouts, pipeline) = scoped(
             device,
             || {
-                let module = gpu_objects::shader_module(
-                    device,
-                    wgpu::ShaderModuleDescriptor {
-                        label: Some(&label),
-                        source: wgpu::ShaderSource::Wgsl(wgsl.into()),
-                    },
-                );
+                let desc = wgpu::ShaderModuleDescriptor {
+                    label: Some(&label),
+                    source: wgpu::ShaderSource::Wgsl(wgsl.into()),
+                };
+                let module = match checks {
+                    ShaderChecks::On => gpu_objects::shader_module(device, desc),
+                    ShaderChecks::Off => gpu_objects::shader_module_unchecked(device, desc),
+                };
                 let layouts: Vec<wgpu::BindGroupLayout> = (0..reflection.group_count())
                     .map(|g| {
                         gpu_objects::bind_group_layout(
@@ -172,6 +186,8 @@ pub struct KernelCache {
     /// Zero every kernel's workgroup memory first ([`WorkgroupInit::Zeroed`]); `false`, the
     /// default: [`WorkgroupInit::AsLeft`].
     zeroed: bool,
+    /// How modules are created; `None`: [`ShaderChecks::from_env`].
+    checks: Option<ShaderChecks>,
     /// Each kernel's `// #override` declarations, read on first use.
     node_overrides: HashMap<String, Arc<NodeOverrides>>,
 }
@@ -201,6 +217,14 @@ impl KernelCache {
         self.kernels.clear();
     }
 
+    /// Creates every kernel's module from now on as `checks` says, whatever
+    /// [`SHADER_CHECKS_ENV`] (the pipelines made so far are dropped): the runtime checks' cost
+    /// timed on one device.
+    pub fn set_shader_checks(&mut self, checks: ShaderChecks) {
+        self.checks = Some(checks);
+        self.kernels.clear();
+    }
+
     fn compile(&self, device: &wgpu::Device, name: &str, wgsl: &str) -> Result<ComputeKernel> {
         self.compile_with(device, name, wgsl, &[])
     }
@@ -218,7 +242,11 @@ impl KernelCache {
         } else {
             WorkgroupInit::AsLeft
         };
-        ComputeKernel::with_constants(device, name, wgsl, layout, init, overrides)
+        let checks = match self.checks {
+            Some(checks) => checks,
+            None => ShaderChecks::from_env()?,
+        };
+        ComputeKernel::with_checks(device, (name, wgsl), (layout, init, checks), overrides)
     }
 
     /// The layout kernels compile in on `device`.

@@ -156,3 +156,47 @@ pub enum WorkgroupInit {
     /// Left as the device leaves it: for kernels that write before they read.
     AsLeft,
 }
+
+/// The environment variable that compiles every kernel's module without wgpu's runtime checks
+/// (`off`; `on` or unset: checked, the default): [`ShaderChecks`], an A/B on one machine.
+pub const SHADER_CHECKS_ENV: &str = "SHADOWGRAPH_SHADER_CHECKS";
+
+/// How a kernel's shader module is created. wgpu's `create_shader_module` has naga bound every
+/// index and loop of the WGSL it translates (clamping an index into a private array, counting a
+/// loop's iterations), which can keep a driver from unrolling a loop over a private array into
+/// registers. [`ShaderChecks::Off`] creates the module with `create_shader_module_trusted` and
+/// `wgpu::ShaderRuntimeChecks::unchecked()` instead, to time what the checks cost
+/// ([`SHADER_CHECKS_ENV`]` = off`, or `shadowgraph bench --kernel-dirs shipped,unchecked`);
+/// it is never a default.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ShaderChecks {
+    /// wgpu's checked modules (the default).
+    #[default]
+    On,
+    /// Unchecked modules: sound only because every kernel in `kernels/` indexes within bounds,
+    /// bounds its loops and never divides an integer by zero (`gpu_objects::
+    /// shader_module_unchecked` gives the reasons); for measurements.
+    Off,
+}
+
+impl ShaderChecks {
+    /// [`SHADER_CHECKS_ENV`]: `off` is [`ShaderChecks::Off`], `on` or unset
+    /// [`ShaderChecks::On`]; any other value an error naming the variable.
+    pub fn from_env() -> Result<Self> {
+        match std::env::var(SHADER_CHECKS_ENV) {
+            Err(_) => Ok(Self::On),
+            Ok(v) => {
+                Self::parse(&v).map_err(|e| Error::Invalid(format!("{SHADER_CHECKS_ENV}: {e}")))
+            }
+        }
+    }
+
+    /// `on` or `off`, as [`SHADER_CHECKS_ENV`] spells it; else what is wrong with `name`.
+    pub fn parse(name: &str) -> std::result::Result<Self, String> {
+        match name {
+            "on" => Ok(Self::On),
+            "off" => Ok(Self::Off),
+            _ => Err(format!("`{name}`: expected `on` or `off`")),
+        }
+    }
+}
