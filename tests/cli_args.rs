@@ -201,7 +201,7 @@ fn layouts_are_named_and_not_for_the_lookup() {
             "--layouts",
             "gpu,fast",
         ],
-        &["--layouts", "`fast`", "expected `gpu` or `cpu`"],
+        &["--layouts", "`fast`", "expected `gpu`, `cpu` or `redesign`"],
     );
     refused(
         &[

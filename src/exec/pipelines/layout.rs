@@ -3,8 +3,8 @@
 
 use crate::error::{Error, Result};
 
-/// The environment variable that picks [`KernelLayout`] for every device: `gpu` or `cpu`
-/// (unset: by the device's type). A/B of the two layouts on one machine.
+/// The environment variable that picks [`KernelLayout`] for every device: `gpu`, `cpu` or
+/// `redesign` (unset: by the device's type). A/B of the layouts on one machine.
 pub const KERNEL_LAYOUT_ENV: &str = "SHADOWGRAPH_KERNEL_LAYOUT";
 
 pub use crate::kernels::{GPU_LAYOUT_CONSTANT, REDESIGN_CONSTANT};
