@@ -76,7 +76,7 @@ pub fn trig_error(g: &Gpu) -> f64 {
     );
     let mut exec = shadowgraph::low_level::exec::Executor::new();
     let csm = shadowgraph::low_level::kernels::resolve("csm", None).expect("csm");
-    let unclamped = csm.replace("let z = depth.z;", "let z = textureLoad(src, id.xy, 0).r;");
+    let unclamped = csm.replace("let z = linear_depth(raw, params.depth);", "let z = raw;");
     assert_ne!(csm, unclamped, "csm's depth read changed");
     exec.kernels
         .insert_generated(&g.device, "csm", None, &unclamped)
@@ -89,9 +89,13 @@ pub fn trig_error(g: &Gpu) -> f64 {
     shadowgraph::low_level::gpu::submit_and_wait(&g.device, &g.queue, enc, "trig").expect("submit");
     let mut worst: f64 = 0.0;
     for (chunk, name) in outputs.iter().enumerate() {
-        let (_, data) =
-            shadowgraph::low_level::gpu::read_float_texture(&g.device, &g.queue, &out.textures[name], 0)
-                .expect("readback");
+        let (_, data) = shadowgraph::low_level::gpu::read_float_texture(
+            &g.device,
+            &g.queue,
+            &out.textures[name],
+            0,
+        )
+        .expect("readback");
         for (i, texel) in data.chunks(4).enumerate() {
             let zi = f64::from(z[i]);
             for j in 0..2 {
@@ -195,7 +199,10 @@ pub fn tables(rep: &Texels, coding: &SatCoding) -> Tables {
                 .map(|&v| (v as f32).to_bits())
                 .collect(),
         };
-        chunks.push((n, shadowgraph::low_level::sat::decode_table(&raw, w, h, coding, n)));
+        chunks.push((
+            n,
+            shadowgraph::low_level::sat::decode_table(&raw, w, h, coding, n),
+        ));
         words.push(raw.into_iter().map(f32::from_bits).collect());
     }
     let data = (0..w * h)
