@@ -406,7 +406,10 @@ const SHIPPED: [KernelLayout; 2] = [KernelLayout::Gpu, KernelLayout::Cpu];
 /// `c`'s f64 reference (encoding, then both blur passes at `radius`, σ = r/2) within the
 /// encoding's `tolerance` (atol, rtol) plus the blur's own, and its counts of non-finite
 /// texels with `steps` counting steps.
-#[allow(clippy::too_many_arguments)]
+#[expect(
+    clippy::too_many_arguments,
+    reason = "a case, its light, input, map, radius, tolerance, counting steps, name and layouts"
+)]
 fn check_blur(
     c: &BlurCase,
     light: &Light,
