@@ -96,7 +96,7 @@ pub enum Error {
         /// The device limit.
         limit: u64,
     },
-    /// What a host handed the plug-in stage is unusable (see [`crate::prefilter`]).
+    /// What a host handed the plug-in stage is unusable (see [`crate::Prefilter`]).
     #[error("plug-in stage: {0}")]
     Stage(StageError),
     /// The scene needs a device feature the adapter does not offer.

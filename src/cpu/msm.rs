@@ -1,5 +1,5 @@
 //! Reference of `kernels/msm.wgsl`; the quantization of `kernels/shared/msm_quantize.wgsl` is
-//! [`crate::msm_quantize`] (shared with the technique code), re-exported here.
+//! `crate::msm_quantize` (shared with the technique code), re-exported here.
 
 use super::Texels;
 pub use crate::msm_quantize::{dequantize, quantize};

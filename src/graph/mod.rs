@@ -143,7 +143,7 @@ pub enum Dispatch {
     /// `shipped` where the kernel compiles in a shipped layout (a GPU's or a CPU driver's) and
     /// `redesign` in [`crate::exec::KernelLayout::Redesign`], whose variant of the kernel
     /// (`override REDESIGN`) covers other blocks a workgroup: e.g. the separable blur's row pass
-    /// with its invocations on neighbouring rows ([`crate::filter`]). [`Dispatch::groups`] and
+    /// with its invocations on neighbouring rows (`crate::filter`). [`Dispatch::groups`] and
     /// the cost model read `shipped`; [`Dispatch::groups_in`] either.
     Redesigned {
         /// The dispatch in the shipped layouts (not [`Dispatch::Several`]).
@@ -153,7 +153,7 @@ pub enum Dispatch {
     },
     /// Several dispatches in the node's one compute pass, each with its own parameters, its
     /// bindings of single mip levels and its workgroups: e.g. a mip chain, a few levels per
-    /// dispatch, each reading the last level written ([`crate::filter`] builds them). Planner,
+    /// dispatch, each reading the last level written (`crate::filter` builds them). Planner,
     /// cost model and executor read them as data.
     Several(Vec<SubDispatch>),
 }
