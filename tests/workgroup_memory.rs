@@ -5,8 +5,9 @@
 //! five-pass table `shadowgraph bench` keeps as its baseline), and every resource of every plan,
 //! and the shaded frame, must be the same bit for bit as without the poison. No tolerance: a
 //! kernel either reads what it wrote or reads the poison, which every sum, mean and table
-//! carries into its output. The scenes run in both kernel layouts (`exec::KernelLayout`), so
-//! the GPU's variants are checked here too. The test fails if a kernel with workgroup memory is
+//! carries into its output. The scenes run in every kernel layout (`exec::KernelLayout`), each
+//! kernel poisoned as the layout resolves it (in `Redesign`, with the redesigned modules the
+//! device's features allow), so the GPU's variants and the redesigns are checked here too. The test fails if a kernel with workgroup memory is
 //! run by none of the plans, so a new one cannot go unchecked.
 
 mod common;
@@ -122,6 +123,31 @@ fn bits(v: &[f32]) -> Vec<u32> {
     v.iter().map(|x| x.to_bits()).collect()
 }
 
+/// The texts the kernels resolve with in `layout` on `g`'s device: `variant`'s, and the
+/// redesigned modules the layout imports in place of the shipped ones where the device has
+/// their feature (`KernelLayout::module_sources`), as the executor resolves them. Poisoned
+/// kernels are resolved texts, their imports inlined: resolved without these, a kernel would
+/// poison the shipped modules where the plain run compiles the redesign.
+fn layout_sources(
+    g: &Gpu,
+    variant: Option<&Replacements>,
+    layout: Option<KernelLayout>,
+) -> Option<Replacements> {
+    let modules = layout.map_or_else(Vec::new, |l| l.module_sources(g.device.features()));
+    if modules.is_empty() {
+        return variant.cloned();
+    }
+    let mut all = variant.cloned().unwrap_or_default();
+    for (shipped, redesign) in modules {
+        if !all.contains_key(shipped) {
+            let text =
+                kernels::source_in(redesign, variant).unwrap_or_else(|e| panic!("{redesign}: {e}"));
+            all.insert(shipped.to_string(), text.to_string());
+        }
+    }
+    Some(all)
+}
+
 /// Renders each scene of `scenes` with `variant`'s kernels (the shipped ones with `None`), once
 /// as they are and once with their workgroup memory poisoned, and requires every resource of
 /// every plan, the visibility and the frame to be the same bit for bit. Returns the kernels
@@ -141,10 +167,22 @@ fn same_with_poison(
     if let Some(v) = variant {
         plain.executor.kernels.set_replacements(Arc::new(v.clone()));
     }
-    poison
-        .executor
-        .kernels
-        .set_replacements(Arc::new(common::poison::poisoned_kernels_in(variant)));
+    let sources = layout_sources(g, variant, layout);
+    let poisoned = common::poison::poisoned_kernels_in(sources.as_ref());
+    // Each redesigned module the layout imports is inlined in some poisoned kernel (its text
+    // below its imports, as `kernels::resolve_in` copies it): the redesign is what is checked.
+    for (_, redesign) in layout.map_or_else(Vec::new, |l| l.module_sources(g.device.features())) {
+        let text = kernels::source_in(redesign, variant).unwrap_or_else(|e| panic!("{e}"));
+        let body = text
+            .rsplit_once("// #import ")
+            .map_or(text, |(_, rest)| rest);
+        let body = body.split_once('\n').map_or(body, |(_, rest)| rest);
+        assert!(
+            poisoned.values().any(|k| k.contains(body)),
+            "`{redesign}`: no poisoned kernel imports it"
+        );
+    }
+    poison.executor.kernels.set_replacements(Arc::new(poisoned));
     let mut ran = BTreeSet::new();
     for (what, s) in scenes {
         let a = render(g, &mut plain, what, s);
