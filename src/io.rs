@@ -33,7 +33,8 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<()
     })
 }
 
-/// Writes one 32-bit float OpenEXR layer with the given named channels (row-major, y down).
+/// Writes one 32-bit float OpenEXR layer with the given named channels (row-major, y down),
+/// the same bytes for the same pixels.
 pub fn write_exr(
     path: &Path,
     width: u32,
@@ -41,8 +42,8 @@ pub fn write_exr(
     channels: Vec<(String, Vec<f32>)>,
 ) -> Result<()> {
     use exr::prelude::{
-        AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, SmallVec,
-        WritableImage,
+        AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, LineOrder,
+        SmallVec, WritableImage,
     };
     let n = (width as usize) * (height as usize);
     if let Some((name, c)) = channels.iter().find(|(_, c)| c.len() != n) {
@@ -58,7 +59,12 @@ pub fn write_exr(
     let layer = Layer::new(
         (width as usize, height as usize),
         LayerAttributes::named("shadowgraph"),
-        Encoding::FAST_LOSSLESS,
+        // Blocks in increasing order (compressed in parallel all the same): the same pixels
+        // give the same file, so two dumps compare with `cmp`.
+        Encoding {
+            line_order: LineOrder::Increasing,
+            ..Encoding::FAST_LOSSLESS
+        },
         AnyChannels::sort(list),
     );
     Image::from_layer(layer)
