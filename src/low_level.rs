@@ -6,8 +6,8 @@
 //! none of it (the crate root has the plug-in stage and everything it takes).
 //!
 //! Each module here is the crate's module of that name, less what the crate root holds (a
-//! name has one public path): the root's names are imported privately in the modules they
-//! live in, which shadows them in the glob re-export.
+//! name has one public path): a whole module where the root holds none of its names, a list
+//! of its names where it does (`graph`, `model`, `sat`, `timer`, `wgsl_mirrors`).
 
 #[cfg(feature = "cli")]
 pub mod bench {
@@ -64,13 +64,11 @@ pub mod gpu_objects {
 
 pub mod graph {
     //! The kernel graph: nodes, resources, planning, cost and printing.
-    #[expect(
-        hidden_glob_reexports,
-        unused_imports,
-        reason = "the root holds `PACKED_F16X2`"
-    )]
-    use crate::graph::PACKED_F16X2;
-    pub use crate::graph::*;
+    pub use crate::graph::{
+        Dispatch, Graph, LevelView, Node, Plan, PlannedResource, Resource, SizeRule, Slot, Step,
+        SubDispatch, block_count, cost, format_label, is_packed, layer_of, plan, print,
+        texel_bytes, texture_format,
+    };
 }
 
 pub mod kernels {
@@ -86,22 +84,17 @@ pub mod limits {
 pub mod model {
     //! The model's plain data beside the root's settings: cameras, parameter tables, defaults,
     //! point-light faces and cascade slices.
-    pub use crate::model::*;
-    #[expect(hidden_glob_reexports, unused_imports, reason = "the root holds these")]
-    use crate::model::{
-        BlurKernel, Cascades, CssmResolve, CssmSearch, Filter, Light, LightKind, PcfKernel,
-        SatVariant, Shadow, Soft, Storage, StorageFilter, Technique,
+    pub use crate::model::{
+        Camera, CameraRays, DEFAULT_MAX_SEARCH, DEFAULT_SHARPEN, DEFAULT_SHARPEN_FALLOFF, Needs,
+        ParamDefault, ParamKind, ParamSource, ParamSpec, ParamValue, ParamValues, check_params,
+        default_moment_bias, default_soft_moment_bias, exponent_limit, keys, mip_levels, point,
     };
 
     pub mod cascades {
         //! The cascade slices' fitting beneath [`crate::cascades`].
-        pub use crate::model::cascades::*;
-        #[expect(
-            hidden_glob_reexports,
-            unused_imports,
-            reason = "`crate::cascades` holds these"
-        )]
-        use crate::model::cascades::{CascadeCamera, Cascades, MAX_CASCADES, split_distances};
+        pub use crate::model::cascades::{
+            CascadeSlice, MAX_VIEW_DISTANCE, SliceGuard, cascade_light, fit_slices, light_rotation,
+        };
     }
 }
 
@@ -113,13 +106,11 @@ pub mod render {
 
 pub mod sat {
     //! Summed-area tables: their codings, graphs and lookups.
-    #[expect(
-        hidden_glob_reexports,
-        unused_imports,
-        reason = "the root holds `SAT_SAMPLER_DESCRIPTOR`"
-    )]
-    use crate::sat::SAT_SAMPLER_DESCRIPTOR;
-    pub use crate::sat::*;
+    pub use crate::sat::{
+        MAX_FIXED_AREA, SAT_LINES_PER_GROUP, SAT_TILE, SatCoding, SatParams, add_sat, decode_table,
+        five_pass, fixed_scale, float_sum_depth, format_channels, layers, lookup_area, lookups,
+        sat_name,
+    };
 }
 
 #[cfg(feature = "cli")]
@@ -148,13 +139,9 @@ pub mod tolerance {
 
 pub mod timer {
     //! GPU timing by timestamps at the boundaries between passes, and warm-up.
-    #[expect(
-        hidden_glob_reexports,
-        unused_imports,
-        reason = "the root holds `TIMER_FEATURES`"
-    )]
-    use crate::timer::TIMER_FEATURES;
-    pub use crate::timer::*;
+    pub use crate::timer::{
+        GPU_WARMUP_MS, GpuTimer, MAX_WARMUP_RUNS, is_gpu, keep_warming, warm_up,
+    };
 }
 
 #[cfg(feature = "cli")]
@@ -166,11 +153,11 @@ pub mod truth {
 pub mod wgsl_mirrors {
     //! The `#[repr(C)]` mirrors of the WGSL structs the Rust side fills, and the technique ids
     //! and flags the shading kernel reads.
-    #[expect(
-        hidden_glob_reexports,
-        unused_imports,
-        reason = "the root holds `LightGpu`"
-    )]
-    use crate::wgsl_mirrors::LightGpu;
-    pub use crate::wgsl_mirrors::*;
+    pub use crate::wgsl_mirrors::{
+        CSM_OUTPUTS, CsmParams, ExpParams, FrameGpu, LinearizeParams, MSM_HAUSDORFF, MSM_QUANTIZED,
+        MsmParams, PEEL_EPSILON, SecondDepthParams, TECHNIQUE_CSM, TECHNIQUE_CSSM, TECHNIQUE_ESM,
+        TECHNIQUE_EVSM, TECHNIQUE_HARD, TECHNIQUE_IDS, TECHNIQUE_MIDPOINT, TECHNIQUE_MSM,
+        TECHNIQUE_MSM_SOFT, TECHNIQUE_PCF, TECHNIQUE_PCSS, TECHNIQUE_SECOND_DEPTH, TECHNIQUE_SMRT,
+        TECHNIQUE_VSM, TECHNIQUE_VSSM, Vertex, VsmParams,
+    };
 }
