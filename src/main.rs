@@ -171,6 +171,15 @@ enum Command {
         #[arg(long, value_parser = parse_size, value_delimiter = ',')]
         crossover_sizes: Option<Vec<(u32, u32)>>,
     },
+    /// Compare two evaluation reports of one scene: whether each Pareto front has the same
+    /// techniques and each front configuration's time lies within the other run's range; exits
+    /// non-zero when a front differs.
+    Compare {
+        /// The first run's `report.json`.
+        first: PathBuf,
+        /// The second run's `report.json`.
+        second: PathBuf,
+    },
     /// Run the numerical-stability suite: each hard input through the real kernels against its
     /// f64 reference and stated bound; exits non-zero when a check fails.
     Stability {
@@ -338,7 +347,10 @@ fn run(args: Args) -> Result<()> {
                 crossover_sizes,
             };
             let gpu = Gpu::new()?;
-            print!("{}", shadowgraph::low_level::evaluate::run(&gpu, &scene, &out, &opts)?);
+            print!(
+                "{}",
+                shadowgraph::low_level::evaluate::run(&gpu, &scene, &out, &opts)?
+            );
         }
         Command::Bench {
             sizes,
@@ -367,7 +379,9 @@ fn run(args: Args) -> Result<()> {
             let gpu = Gpu::new()?;
             match lookup {
                 Some(widths) => {
-                    let rows = shadowgraph::low_level::bench::lookup_cost(&gpu, &widths, repeat, image, map)?;
+                    let rows = shadowgraph::low_level::bench::lookup_cost(
+                        &gpu, &widths, repeat, image, map,
+                    )?;
                     let cpu = gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu;
                     print!(
                         "{}",
@@ -412,6 +426,16 @@ fn run(args: Args) -> Result<()> {
                         )?
                     )
                 }
+            }
+        }
+        Command::Compare { first, second } => {
+            use shadowgraph::low_level::evaluate::agreement;
+            let a = agreement::read_report(&first)?;
+            let b = agreement::read_report(&second)?;
+            let comparison = agreement::compare(&a, &b)?;
+            print!("{}", comparison.text());
+            if !comparison.agrees() {
+                anyhow::bail!("the two runs' fronts differ");
             }
         }
         Command::Stability { large } => {

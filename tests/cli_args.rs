@@ -490,3 +490,31 @@ fn memory_errors_name_the_flag_that_set_the_value() {
         assert!(!err.contains(".toml:"), "`{what}` names a line: {err}");
     }
 }
+
+/// `compare`: a committed report against itself agrees (status 0, every front "agree"); a
+/// missing report, a file that is not a report and two scenes' reports are one line each.
+#[test]
+fn compare_reads_two_reports_and_refuses_what_is_not_one() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let report = |scene: &str| {
+        root.join(format!("benches/evaluation/{scene}/report.json"))
+            .display()
+            .to_string()
+    };
+    let a = report("long_shadows");
+    let o = shadowgraph(&["compare", &a, &a]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(0), "{out}");
+    assert!(out.contains("penumbra mean front: agree"), "{out}");
+    assert!(!out.contains("differ."), "{out}");
+    refused(
+        &["compare", &a, "no/such/report.json"],
+        &["no/such/report.json"],
+    );
+    let toml = scene();
+    refused(
+        &["compare", &a, &toml],
+        &["sphere_on_plane.toml", "not an evaluation report"],
+    );
+    refused(&["compare", &a, &report("pole")], &["different scenes"]);
+}
