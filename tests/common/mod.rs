@@ -54,7 +54,11 @@ pub fn rng(seed: u64) -> SmallRng {
 /// Asserts that two GPU read-backs of the same map (e.g. one run in each kernel layout,
 /// `exec::KernelLayout`) hold the same f32 bits everywhere, NaNs included; names the first
 /// value that differs.
-pub fn assert_same_bits(what: &str, a: &shadowgraph::low_level::cpu::Texels, b: &shadowgraph::low_level::cpu::Texels) {
+pub fn assert_same_bits(
+    what: &str,
+    a: &shadowgraph::low_level::cpu::Texels,
+    b: &shadowgraph::low_level::cpu::Texels,
+) {
     assert_eq!(a.data.len(), b.data.len(), "{what}: length");
     let bits = |v: f64| (v as f32).to_bits();
     if let Some(i) = (0..a.data.len()).find(|&i| bits(a.data[i]) != bits(b.data[i])) {

@@ -666,8 +666,7 @@ impl SoftInputs {
     }
 
     fn cssm(&self) -> cpu::vis_cssm::Maps<'_> {
-        let shadowgraph::Technique::Cssm { search: kind, .. } = self.light.shadow.technique
-        else {
+        let shadowgraph::Technique::Cssm { search: kind, .. } = self.light.shadow.technique else {
             panic!("not a CSSM light");
         };
         cpu::vis_cssm::Maps {
