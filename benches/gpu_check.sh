@@ -11,19 +11,19 @@
 # Older steps (the soft table, shading shapes, kernel-folder variants, workgroup memory zeroed,
 # timer cross-checks, cascades, a second binary) are benches/gpu_more.sh, for a second call.
 #
-# In order, with their boxes (400 s of steps at most, env included):
+# In order, with their boxes (380 s of steps at most, env included):
 #   a. `evaluate` at 1920×1080 on three scenes (sphere_on_plane, bunny, colonnade), one map
 #      size (2048²), the techniques hard, pcss, vsm, msm, vssm, msm_soft (the fronts' main
 #      rows; the other techniques are evaluated by gpu_more.sh), 40 s a scene: 120 s.
-#   b. the kernel decisions, 240 s: every benchmark case in the `gpu` and `redesign` kernel
+#   b. the kernel decisions, 235 s: every benchmark case in the `gpu` and `redesign` kernel
 #      layouts side by side (`bench --layouts gpu,redesign --passes`: the redesigned
 #      encodings, blur row pass, mip chain, summed-area tables and fused encode+blur all run
 #      in both), each size its own process, the buffer copy and both texture copies first in
 #      each (the roofline rows): 4096² (80 s), then 8192² (125 s); then the shader modules
 #      with and without wgpu's runtime checks (`--kernel-dirs shipped,unchecked` in the
-#      redesign layout, 4096², the encodings, blurs, mips and tables: 35 s).
+#      redesign layout, 4096², the encodings, blurs, mips and tables: 30 s).
 #   c. the redesign's maps against the GPU layout's on this device, bit for bit (five
-#      technique scenes dumped in both layouts: 30 s).
+#      technique scenes dumped in both layouts: 15 s). The kernel decisions, b and c: 250 s.
 #
 # A dry run on a CPU driver (every step at small sizes, to check that each one works):
 #
@@ -118,7 +118,7 @@ step kernels.txt 80 "$B" bench --sizes "$FIRST" --repeat "$REPEAT" --passes --la
 step kernels.txt 125 "$B" bench --sizes "$SECOND" --repeat "$REPEAT" --passes --layouts gpu,redesign
 # Wgpu's runtime checks (naga bounding every index and loop) against none, in the redesign
 # layout, whose kernels loop over private arrays; each case in both, adjacent in time.
-SHADOWGRAPH_KERNEL_LAYOUT=redesign step checks.txt 35 "$B" bench --sizes "$FIRST" \
+SHADOWGRAPH_KERNEL_LAYOUT=redesign step checks.txt 30 "$B" bench --sizes "$FIRST" \
     --repeat "$REPEAT" --only 'linearize,evsm4,msm f16,chain vsm (depth,blur rg32f,vsm_blur r4,mips,sat fixed' \
     --kernel-dirs shipped,unchecked
 
@@ -152,7 +152,7 @@ redesign_maps() {
     done
     rm -rf "$d"
 }
-step checks.txt 30 bash -c "$(declare -f redesign_maps); B='$B'; redesign_maps"
+step checks.txt 15 bash -c "$(declare -f redesign_maps); B='$B'; redesign_maps"
 command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=clocks.sm --format=csv \
     >>"$OUT/env.txt" 2>&1
 exit 0
