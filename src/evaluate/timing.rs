@@ -171,8 +171,8 @@ fn median_passes(frames: &[&Sample]) -> Vec<(String, f64)> {
 }
 
 /// The commit the binary's source tree is at (`git rev-parse --short=12 HEAD` in the folder
-/// it was built from, `-dirty` when it has changes), or `unknown` where git or the tree is
-/// not there.
+/// it was built from, `-dirty` when what the binary is built from has changes: the reports a
+/// run writes into `benches/` do not count), or `unknown` where git or the tree is not there.
 pub fn commit() -> String {
     let dir = env!("CARGO_MANIFEST_DIR");
     let git = |args: &[&str]| {
@@ -187,7 +187,17 @@ pub fn commit() -> String {
     };
     match git(&["rev-parse", "--short=12", "HEAD"]) {
         Some(hash) if !hash.is_empty() => {
-            let dirty = git(&["status", "--porcelain", "--untracked-files=no"])
+            let dirty = git(&[
+                "status",
+                "--porcelain",
+                "--untracked-files=no",
+                "--",
+                "src",
+                "kernels",
+                "build.rs",
+                "Cargo.toml",
+                "Cargo.lock",
+            ])
                 .is_some_and(|s| !s.is_empty());
             if dirty { format!("{hash}-dirty") } else { hash }
         }
