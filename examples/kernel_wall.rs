@@ -68,7 +68,8 @@ fn run() -> Result<(), String> {
     }
     // The bench's own checks: a case filter that names nothing or holds an empty entry, a size
     // of 0 or past the device, `--repeat 0`, a case past the memory budget.
-    let mut cases = shadowgraph::low_level::bench::select_cases(&names).map_err(|e| e.to_string())?;
+    let mut cases =
+        shadowgraph::low_level::bench::select_cases(&names).map_err(|e| e.to_string())?;
     if exact {
         cases.retain(|c| names.iter().any(|n| n == c.name));
         if cases.is_empty() {
@@ -76,9 +77,11 @@ fn run() -> Result<(), String> {
         }
     }
     let gpu = Gpu::new().map_err(|e| e.to_string())?;
-    shadowgraph::low_level::bench::check_args(&gpu.device, &sizes, repeat).map_err(|e| e.to_string())?;
+    shadowgraph::low_level::bench::check_args(&gpu.device, &sizes, repeat)
+        .map_err(|e| e.to_string())?;
     let budget = shadowgraph::low_level::limits::memory_budget().map_err(|e| e.to_string())?;
-    shadowgraph::low_level::bench::check_memory(&cases, &sizes, budget).map_err(|e| e.to_string())?;
+    shadowgraph::low_level::bench::check_memory(&cases, &sizes, budget)
+        .map_err(|e| e.to_string())?;
     println!(
         "wall clock on {}; median of {repeat} after 2 warm-up runs",
         gpu.describe()
@@ -98,9 +101,10 @@ fn run() -> Result<(), String> {
             }
             let built = (case.build)(n);
             let outputs: Vec<&str> = built.outputs.iter().map(String::as_str).collect();
-            let plan =
-                shadowgraph::low_level::graph::plan(&built.graph, &outputs).map_err(|e| e.to_string())?;
-            let bytes = shadowgraph::low_level::bench::plan_bytes(&plan).map_err(|e| e.to_string())?
+            let plan = shadowgraph::low_level::graph::plan(&built.graph, &outputs)
+                .map_err(|e| e.to_string())?;
+            let bytes = shadowgraph::low_level::bench::plan_bytes(&plan)
+                .map_err(|e| e.to_string())?
                 / (f64::from(n) * f64::from(n));
             println!(
                 "{:>6}  {:<24} {:>10.2} {:>10.2} {:>8.2} {:>10.1}   ({format:?})",

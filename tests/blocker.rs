@@ -79,7 +79,8 @@ fn csm_z_on_gpu(
         let out = exec
             .record(&g.device, &mut enc, &p, &imports, None)
             .expect("record");
-        shadowgraph::low_level::gpu::submit_and_wait(&g.device, &g.queue, enc, "csm_z").expect("submit");
+        shadowgraph::low_level::gpu::submit_and_wait(&g.device, &g.queue, enc, "csm_z")
+            .expect("submit");
         out
     };
     let first = record(&mut exec);
@@ -100,8 +101,13 @@ fn csm_z_on_gpu(
     outputs
         .iter()
         .map(|name| {
-            shadowgraph::low_level::gpu::read_float_texture(&g.device, &g.queue, &out.textures[name], 0)
-                .expect("readback")
+            shadowgraph::low_level::gpu::read_float_texture(
+                &g.device,
+                &g.queue,
+                &out.textures[name],
+                0,
+            )
+            .expect("readback")
         })
         .collect()
 }
@@ -188,7 +194,8 @@ fn blocker_harness(
          s.view_z = 1.0;\n    s.inside = true;\n    var r = vec4<f32>(0.0);\n    {body}\n    \
          if id.x < arrayLength(&queries) {{\n        results[i] = r;\n    }}\n}}\n"
     ));
-    let wgsl = shadowgraph::low_level::kernels::resolve_source("test.blocker", &text).expect("resolve");
+    let wgsl =
+        shadowgraph::low_level::kernels::resolve_source("test.blocker", &text).expect("resolve");
     let d = &g.device;
     let kernel = shadowgraph::low_level::exec::ComputeKernel::new(d, "blocker_harness", &wgsl)
         .expect("harness compiles");
@@ -258,14 +265,15 @@ fn blocker_harness(
         pass.dispatch_workgroups((queries.len() as u32).div_ceil(64), 1, 1);
     }
     enc.copy_buffer_to_buffer(&results, 0, &readback, 0, results.size());
-    shadowgraph::low_level::gpu::submit_and_wait(d, &g.queue, enc, "blocker harness").expect("submit");
+    shadowgraph::low_level::gpu::submit_and_wait(d, &g.queue, enc, "blocker harness")
+        .expect("submit");
     let raw = shadowgraph::low_level::gpu::read_buffer(d, &readback).expect("readback");
     bytemuck::cast_slice(&raw).to_vec()
 }
 
 /// Compares the harness's `(z_avg, share)` with f64 estimates: every sign combination of the
 /// inputs' errors (`estimate(σ)` for σ of each input ∈ {−1, 1}, five scales as in
-/// tests/common/soft.rs) bounds each; the tolerance is twice the largest change plus 1e-6.
+/// tests/common/soft/) bounds each; the tolerance is twice the largest change plus 1e-6.
 /// z_avg counts only where every perturbation finds blockers. At least 10% of the queries
 /// must have shares strictly between 0.05 and 0.95.
 fn check_estimates(

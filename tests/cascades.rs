@@ -233,13 +233,8 @@ fn the_stages_cascade_config_matches_the_renderers_pick() {
         .expect("fit");
     assert_eq!(cascades.len(), 4);
     let mut first = cascades[0].light.light_gpu(&config, config.size);
-    shadowgraph::cascades::pick_fields(
-        &mut first,
-        &camera,
-        &cascades,
-        config.cascades.blend,
-    )
-    .expect("pick fields");
+    shadowgraph::cascades::pick_fields(&mut first, &camera, &cascades, config.cascades.blend)
+        .expect("pick fields");
     let drawn = shadowgraph::low_level::render::drawn_lights(&scene).expect("drawn lights");
     let r = drawn.gpu[0];
     let close = |a: f32, b: f32| (a - b).abs() <= 1e-6 * a.abs().max(1.0);
@@ -332,7 +327,8 @@ fn soft_cascades_keep_one_reach_inside_their_maps() {
         for _ in 0..8 {
             let mut scene = base.clone();
             let light = &mut scene.lights[0];
-            light.shadow.technique = shadowgraph::low_level::technique::named(name, &[]).expect("registered");
+            light.shadow.technique =
+                shadowgraph::low_level::technique::named(name, &[]).expect("registered");
             let eye = Vec3::new(
                 rng.random_range(-20.0..20.0),
                 rng.random_range(1.0..6.0),
@@ -393,7 +389,8 @@ fn the_cascaded_shading_calls_each_cascade_once() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/city_street.toml");
     let scene = shadowgraph::low_level::scene::Scene::load(&path).expect("city_street loads");
     let drawn = shadowgraph::low_level::render::drawn_lights(&scene).expect("drawn lights");
-    let block = shadowgraph::low_level::technique::shading_block_cascaded(&drawn.lights, &drawn.groups);
+    let block =
+        shadowgraph::low_level::technique::shading_block_cascaded(&drawn.lights, &drawn.groups);
     let group = drawn.groups[0];
     assert_eq!(group.count, 4);
     for c in 0..group.count {

@@ -21,8 +21,15 @@ fn render_writes_png_and_aux_exrs() {
     let g = common::gpu();
     let dir = temp_dir("aux");
     let png = dir.join("out.png");
-    let report = shadowgraph::low_level::cli::render(&g, &scene("two_lights.toml"), &png, Some(&dir), true, 2)
-        .expect("render");
+    let report = shadowgraph::low_level::cli::render(
+        &g,
+        &scene("two_lights.toml"),
+        &png,
+        Some(&dir),
+        true,
+        2,
+    )
+    .expect("render");
     assert!(report.contains("wrote"), "{report}");
     assert!(
         report.contains("shade") && report.contains("light0.linearize"),
@@ -94,8 +101,15 @@ fn bad_scene_path_is_an_error_naming_the_file() {
 #[test]
 fn soft_benchmark_reports_every_configuration() {
     let g = common::gpu();
-    let rows = shadowgraph::low_level::bench::soft_cost(&g, &[0.5, 1.0], 1, Some((48, 36)), Some(128), &[])
-        .expect("soft bench");
+    let rows = shadowgraph::low_level::bench::soft_cost(
+        &g,
+        &[0.5, 1.0],
+        1,
+        Some((48, 36)),
+        Some(128),
+        &[],
+    )
+    .expect("soft bench");
     let names: Vec<&str> = rows.iter().map(|r| r.technique.as_str()).collect();
     let want: Vec<&str> = shadowgraph::low_level::bench::SOFT_TECHNIQUES
         .iter()
@@ -139,7 +153,8 @@ fn soft_benchmark_reports_every_configuration() {
             tables(soft)
         );
     }
-    let table = shadowgraph::low_level::bench::format_soft_table("test", true, 1, &[0.5, 1.0], &rows);
+    let table =
+        shadowgraph::low_level::bench::format_soft_table("test", true, 1, &[0.5, 1.0], &rows);
     assert!(table.contains("(48×36, 128² spot map)"), "{table}");
     assert!(
         table.contains("prefilter ms") && table.contains("wall ms"),
@@ -147,8 +162,9 @@ fn soft_benchmark_reports_every_configuration() {
     );
     // `--only` keeps the named configurations, `hard` and the yardstick, whose ratios stay 1.
     let only = ["cssm".to_string()];
-    let some = shadowgraph::low_level::bench::soft_cost(&g, &[0.5], 1, Some((48, 36)), Some(128), &only)
-        .expect("soft bench, only cssm");
+    let some =
+        shadowgraph::low_level::bench::soft_cost(&g, &[0.5], 1, Some((48, 36)), Some(128), &only)
+            .expect("soft bench, only cssm");
     let names: Vec<&str> = some.iter().map(|r| r.technique.as_str()).collect();
     assert_eq!(names, ["hard", "pcss 16+32", "cssm M=8", "cssm M=8 csm_z"]);
     let table = shadowgraph::low_level::bench::format_soft_table("test", true, 1, &[0.5], &some);
@@ -163,7 +179,8 @@ fn soft_benchmark_reports_every_configuration() {
 #[test]
 fn lookup_benchmark_reports_every_width() {
     let g = common::gpu();
-    let rows = shadowgraph::low_level::bench::lookup_cost(&g, &[3, 9], 1, None, None).expect("lookup bench");
+    let rows = shadowgraph::low_level::bench::lookup_cost(&g, &[3, 9], 1, None, None)
+        .expect("lookup bench");
     assert_eq!(rows.iter().map(|r| r.width).collect::<Vec<_>>(), vec![3, 9]);
     for r in &rows {
         for v in [r.pcf_ms, r.sat_fixed_ms, r.sat_float_ms] {
@@ -177,13 +194,14 @@ fn lookup_benchmark_reports_every_width() {
     );
     assert!(rows.iter().all(|r| r.image == (400, 300)), "{rows:?}");
     // `--image` shades at the size asked for, and the table says so.
-    let small =
-        shadowgraph::low_level::bench::lookup_cost(&g, &[3], 1, Some((64, 48)), Some(256)).expect("at 64x48");
+    let small = shadowgraph::low_level::bench::lookup_cost(&g, &[3], 1, Some((64, 48)), Some(256))
+        .expect("at 64x48");
     assert_eq!((small[0].image, small[0].map), ((64, 48), 256));
     let table = shadowgraph::low_level::bench::format_lookup_table("test", true, 1, &small);
     assert!(table.contains("(64×48, 256² map)"), "{table}");
     for bad in [4, 0, 67] {
-        let e = shadowgraph::low_level::bench::lookup_cost(&g, &[bad], 1, None, None).expect_err("bad width");
+        let e = shadowgraph::low_level::bench::lookup_cost(&g, &[bad], 1, None, None)
+            .expect_err("bad width");
         assert!(e.to_string().contains(&format!("width {bad}")), "{e}");
     }
 }

@@ -310,7 +310,8 @@ fn shading_fetches_match_the_hand_counts() {
 /// `plan` prints each node's traffic, the closing total and the shading fetches.
 #[test]
 fn plan_prints_traffic_and_fetches() {
-    let text = shadowgraph::low_level::cli::plan(&scene_path("techniques/vsm.toml"), false).expect("plan");
+    let text =
+        shadowgraph::low_level::cli::plan(&scene_path("techniques/vsm.toml"), false).expect("plan");
     for needle in [
         "traffic per texel of the 512² map:",
         "reads    7.56 B, writes    8.00 B",
@@ -319,7 +320,8 @@ fn plan_prints_traffic_and_fetches() {
     ] {
         assert!(text.contains(needle), "`{needle}` missing:\n{text}");
     }
-    let text = shadowgraph::low_level::cli::plan(&scene_path("techniques/vsm_f16.toml"), false).expect("plan");
+    let text = shadowgraph::low_level::cli::plan(&scene_path("techniques/vsm_f16.toml"), false)
+        .expect("plan");
     for needle in [
         "light0.vsm.blur          R32Uint f16x2    512x512      1.0 MiB",
         "reads    7.56 B, writes    4.00 B",
@@ -351,8 +353,8 @@ fn a_point_lights_atlas_is_planned_like_one_map() {
         .expect("plan")
         .plan;
     assert_eq!(cost::map_dims(&plan, 0), (1536, 1024));
-    let text =
-        shadowgraph::low_level::cli::plan(&scene_path("techniques/point_vsm.toml"), false).expect("plan");
+    let text = shadowgraph::low_level::cli::plan(&scene_path("techniques/point_vsm.toml"), false)
+        .expect("plan");
     for needle in [
         "light 0: point, vsm shadows, six 512² faces, guard band 5 texels (90° cores of 502²)",
         "light0.depth             Depth32Float    1536x1024",

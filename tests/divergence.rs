@@ -24,7 +24,12 @@ fn value(level: u32, x: u32, y: u32) -> f32 {
 }
 
 /// Runs `body` per query (`q`: x = active/count, y, z = texel, w = level), `r` the result.
-fn run(g: &shadowgraph::low_level::gpu::Gpu, body: &str, sampler: bool, queries: &[[u32; 4]]) -> Vec<f32> {
+fn run(
+    g: &shadowgraph::low_level::gpu::Gpu,
+    body: &str,
+    sampler: bool,
+    queries: &[[u32; 4]],
+) -> Vec<f32> {
     let d = &g.device;
     let wgsl = format!(
         "@group(0) @binding(0) var map: texture_2d<f32>;\n\
@@ -40,7 +45,8 @@ fn run(g: &shadowgraph::low_level::gpu::Gpu, body: &str, sampler: bool, queries:
             ""
         }
     );
-    let kernel = shadowgraph::low_level::exec::ComputeKernel::new(d, "divergence", &wgsl).expect("compile");
+    let kernel =
+        shadowgraph::low_level::exec::ComputeKernel::new(d, "divergence", &wgsl).expect("compile");
     let t = d.create_texture(&wgpu::TextureDescriptor {
         label: None,
         size: wgpu::Extent3d {
@@ -58,7 +64,12 @@ fn run(g: &shadowgraph::low_level::gpu::Gpu, body: &str, sampler: bool, queries:
     for level in 0..LEVELS {
         let n = SIZE >> level;
         let data: Vec<f32> = (0..n * n).map(|i| value(level, i % n, i / n)).collect();
-        shadowgraph::low_level::gpu::write_texture_level(&g.queue, &t, level, bytemuck::cast_slice(&data));
+        shadowgraph::low_level::gpu::write_texture_level(
+            &g.queue,
+            &t,
+            level,
+            bytemuck::cast_slice(&data),
+        );
     }
     let view = t.create_view(&Default::default());
     let qbuf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -105,8 +116,8 @@ fn run(g: &shadowgraph::low_level::gpu::Gpu, body: &str, sampler: bool, queries:
         pass.set_bind_group(0, &bg, &[]);
         pass.dispatch_workgroups(queries.len() as u32 / 64, 1, 1);
     }
-    let raw =
-        shadowgraph::low_level::gpu::submit_and_read(d, &g.queue, enc, &out, "divergence").expect("read");
+    let raw = shadowgraph::low_level::gpu::submit_and_read(d, &g.queue, enc, &out, "divergence")
+        .expect("read");
     bytemuck::cast_slice(&raw).to_vec()
 }
 

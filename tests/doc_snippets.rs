@@ -283,7 +283,8 @@ fn every_snippet_line_is_compiled_here() {
 fn the_snippets_run() {
     let g = common::gpu();
     let (shader, out, light) = readme_stage(&g).expect("README stage");
-    shadowgraph::low_level::kernels::reflect("readme host", &shader).expect("README host shader validates");
+    shadowgraph::low_level::kernels::reflect("readme host", &shader)
+        .expect("README host shader validates");
     assert_eq!(out.maps[0].texture.width(), 1024);
     assert_eq!(light.len(), std::mem::size_of_val(&out.light));
 
@@ -294,7 +295,8 @@ fn the_snippets_run() {
     assert_eq!((faces, cascades), (6, 4));
 
     let (shader, out, _) = plugin_stage(&g).expect("PLUGIN stage");
-    shadowgraph::low_level::kernels::reflect("plugin host", &shader).expect("PLUGIN host shader validates");
+    shadowgraph::low_level::kernels::reflect("plugin host", &shader)
+        .expect("PLUGIN host shader validates");
     assert_eq!(out.maps[0].texture.width(), 1024);
 
     let (features, _) = plugin_device(&g).expect("PLUGIN device");

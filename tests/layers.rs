@@ -265,7 +265,10 @@ fn the_path_reader_sees_groups_and_skips_comments() {
         "use crate::{model::Light, technique::{self, x}};\n// crate::render\nlet s = \"crate::dump\";\nfoo::crate::bar; crate::wgsl_mirrors::LightGpu",
     );
     let paths: Vec<String> = crate_paths(&code).iter().map(|p| p.join("::")).collect();
-    assert_eq!(paths, ["model::Light", "technique", "wgsl_mirrors::LightGpu"]);
+    assert_eq!(
+        paths,
+        ["model::Light", "technique", "wgsl_mirrors::LightGpu"]
+    );
     assert_eq!(layer_of("limits/scene.rs"), 5);
     assert_eq!(layer_of("limits.rs"), 3);
     assert_eq!(layer_of("scene/validate.rs"), 5);

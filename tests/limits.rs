@@ -326,7 +326,8 @@ fn memory_estimate_counts_the_second_depth() {
             &[light(512, &format!("technique = \"{technique}\""))],
         );
         let sp = plan_lights(&s.lights).unwrap();
-        let m = shadowgraph::low_level::limits::render_memory(&s, &sp.plan, &RenderOptions::default());
+        let m =
+            shadowgraph::low_level::limits::render_memory(&s, &sp.plan, &RenderOptions::default());
         assert_eq!(m.lights, vec![3 * 512 * 512 * 4], "{technique}");
     }
 }
@@ -346,8 +347,16 @@ fn lowered_limits_and_budgets_name_the_key() {
     let sp = plan_lights(&s.lights).unwrap();
     let full = wgpu::Limits::default();
     let check = |l: &wgpu::Limits, f: wgpu::Features, budget: u64| {
-        shadowgraph::low_level::limits::check_scene(&s, &sp, l, f, &RenderOptions::default(), budget, &[])
-            .map_err(|e| e.to_string())
+        shadowgraph::low_level::limits::check_scene(
+            &s,
+            &sp,
+            l,
+            f,
+            &RenderOptions::default(),
+            budget,
+            &[],
+        )
+        .map_err(|e| e.to_string())
     };
     check(&full, wgpu::Features::empty(), 1 << 30).expect("fits");
     let cases = [

@@ -39,7 +39,8 @@ fn committed_files_are_the_generators_output() {
 fn the_canopy_loads_as_its_generator_means_it() {
     use procedural::canopy::{CARDS, CLUMPS};
     let path = scenes_dir().join("meshes/canopy.gltf");
-    let loaded = shadowgraph::low_level::scene::gltf::load_gltf(&path).unwrap_or_else(|e| panic!("{e}"));
+    let loaded =
+        shadowgraph::low_level::scene::gltf::load_gltf(&path).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(loaded.repaired_normals, 0);
     let m = &loaded.mesh;
     assert_eq!((CARDS, CLUMPS), (14, 11));

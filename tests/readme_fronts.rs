@@ -11,8 +11,10 @@ const END: &str = "<!-- fronts:end -->";
 #[test]
 fn fronts_table_is_the_committed_reports_summary() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let table = shadowgraph::low_level::evaluate::summary::fronts_table_of(&root.join("benches/evaluation"))
-        .expect("summary of the committed reports");
+    let table = shadowgraph::low_level::evaluate::summary::fronts_table_of(
+        &root.join("benches/evaluation"),
+    )
+    .expect("summary of the committed reports");
     assert!(
         table.lines().count() >= 2 + 9,
         "fewer than nine scenes' reports:\n{table}"

@@ -191,7 +191,10 @@ fn equal_shade_keys_mean_equal_blocks() {
                 if values.get(spec.key).is_none() {
                     continue;
                 }
-                values.set(spec.key, shadowgraph::low_level::model::ParamValue::Choice(option));
+                values.set(
+                    spec.key,
+                    shadowgraph::low_level::model::ParamValue::Choice(option),
+                );
                 let mut v = l.clone();
                 v.shadow.technique = (def.build)(&values);
                 choices.push(v);

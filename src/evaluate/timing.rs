@@ -198,7 +198,7 @@ pub fn commit() -> String {
                 "Cargo.toml",
                 "Cargo.lock",
             ])
-                .is_some_and(|s| !s.is_empty());
+            .is_some_and(|s| !s.is_empty());
             if dirty { format!("{hash}-dirty") } else { hash }
         }
         _ => "unknown".into(),

@@ -270,8 +270,10 @@ impl Renderer {
                 },
             )
         };
-        let gpu_lights: Vec<crate::wgsl_mirrors::LightGpu> =
-            lights.iter().map(crate::wgsl_mirrors::LightGpu::new).collect();
+        let gpu_lights: Vec<crate::wgsl_mirrors::LightGpu> = lights
+            .iter()
+            .map(crate::wgsl_mirrors::LightGpu::new)
+            .collect();
         let (w, h) = (at.frame.size[0], at.frame.size[1]);
         let color = super::targets::color_target(device, (w, h));
         let vis_bytes = (u64::from(w) * u64::from(h) * lights.len().max(1) as u64 * 4).max(4);

@@ -8,8 +8,8 @@
 //! covers, blockers past the cut are missed: shadows thin out and end early. Such a scene is
 //! told so, with the cap that would cover it (the nearest and farthest vertices bound both).
 
-use super::ctx::Ctx;
 use super::Object;
+use super::ctx::Ctx;
 use super::format::LightFile;
 use crate::model::{Light, LightKind};
 

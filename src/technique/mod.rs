@@ -30,8 +30,8 @@ mod sweep_plan;
 mod vsm;
 mod vssm;
 
-use crate::wgsl_mirrors::LightGpu;
 use crate::model::{Light, ParamSource, ParamSpec, ParamValues, Technique};
+use crate::wgsl_mirrors::LightGpu;
 pub(crate) use cascade_shade::pick_and_blend;
 pub use cascade_shade::{CascadeGroup, shade_key_cascaded};
 pub use csm::{basis_sequence, csm_maps, csm_z_channels, csm_z_maps, search_maps};

@@ -231,6 +231,9 @@ fn kernel_layout_is_the_devices_unless_forced() {
         &dir.join("out.png"),
         &[(KERNEL_LAYOUT_ENV, OsStr::new("fast"))],
     );
-    refused(&o, &[KERNEL_LAYOUT_ENV, "fast", "`gpu`, `cpu` or `redesign`"]);
+    refused(
+        &o,
+        &[KERNEL_LAYOUT_ENV, "fast", "`gpu`, `cpu` or `redesign`"],
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
