@@ -9,12 +9,12 @@ const CHANNELS: u32 = 4u;
 // `encode_blur_tile` in src/filter/encode_blur.rs.
 const TILE: u32 = 16u;
 const SH_TEXELS: u32 = 900u;
-// Outputs an invocation sums in the tile's blur passes, four channels: one output an invocation (shared/encode_blur, `run_sums`).
+// Outputs an invocation sums in the tile's blur passes, four channels: one output an invocation (shared/encode_blur_tile, `run_sums`).
 const RUN: u32 = 1u;
 // Output rows of a CPU driver's tile (shared/encode_blur, `filter::encode_blur_cpu_rows`):
 // 40 encoded rows at r = 4, five for each of the 8 walks.
 const CPU_TILE_ROWS: u32 = 32u;
-// Encoded rows a strip walks at once (shared/encode_blur, `walk_step`): one (the encodings read
+// Encoded rows a strip walks at once (shared/encode_blur_strips, `walk_step`): one (the encodings read
 // no neighbours, and a second window of four channels took llvmpipe 9% more instructions).
 const WALK_ROWS: u32 = 1u;
 alias Texel = vec4<f32>;

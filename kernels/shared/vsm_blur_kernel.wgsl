@@ -18,12 +18,12 @@ const CHANNELS: u32 = 2u;
 // `encode_blur_tile` in src/filter/encode_blur.rs.
 const TILE: u32 = 24u;
 const SH_TEXELS: u32 = 1444u;
-// Outputs an invocation sums in the tile's blur passes, two channels: runs of 4 (shared/encode_blur, `run_sums`).
+// Outputs an invocation sums in the tile's blur passes, two channels: runs of 4 (shared/encode_blur_tile, `run_sums`).
 const RUN: u32 = 4u;
 // Output rows of a CPU driver's tile (shared/encode_blur, `filter::encode_blur_cpu_rows`):
 // 48 encoded rows at r = 4, three pairs for each of the 8 walks.
 const CPU_TILE_ROWS: u32 = 40u;
-// Encoded rows a strip walks at once (shared/encode_blur, `walk_step`): two, which share their
+// Encoded rows a strip walks at once (shared/encode_blur_strips, `walk_step`): two, which share their
 // depths above and below (`vsm_moments` reads them).
 const WALK_ROWS: u32 = 2u;
 alias Texel = vec2<f32>;
