@@ -30,12 +30,12 @@
 #   radius; tests compare both layouts.
 # - variants.txt, VSM's table: tile sums + tiles of sat_vsm_texel against shipped for `chain
 #   vssm`. Faster: VSM's sub-block fill becomes `!GPU_LAYOUT` only (sat_tile.wgsl's existing
-#   override), its per-texel branch the GPU's; `tests/sat.rs` already builds both layouts.
+#   override), its per-texel branch the GPU's; `tests/sat/layouts.rs` already builds both layouts.
 # - variants.txt, sat_sub2: tile sums + tiles against shipped for `sat fixed`, `chain vssm`,
 #   `chain msm_soft` and CSSM, both rounds agreeing. Faster: the 2 x 2 sub-blocks ship for
 #   GPUs (SUB, GRID and the tile kernels' workgroup size from exec::KernelLayout, the carries
 #   kernel keeping 64; its f32 tables then differ from llvmpipe's in their last bits, within
-#   tests/sat.rs's tolerances) or everywhere if the suite's time allows.
+#   the tolerances of tests/sat/) or everywhere if the suite's time allows.
 # - variants.txt, sat_carries_serial: the `carries` pass against shipped's in `sat fixed`,
 #   `chain vssm` and `chain msm_soft`, both rounds. The batched loads stay unless the serial
 #   kernel is faster in both (then restore it from the variant, less its header).
