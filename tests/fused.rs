@@ -1,6 +1,6 @@
 //! The fused encodings: each reads the rasterized depth and linearizes it itself
 //! (`kernels/shared/linear_depth.wgsl`), `csm` writes up to four basis maps from one read
-//! (CSSM's tables, which compute the basis in their own passes, are in `tests/csm_sat.rs`), and
+//! (CSSM's tables, which compute the basis in their own passes, are in `tests/csm_sat/`), and
 //! the `*_blur` kernels encode and blur in one dispatch (two past `ENCODE_BLUR_TILE_RADIUS`).
 //! Run through the technique's own graph builder on a perspective (spot) depth buffer with
 //! NaN and ±Inf texels, every map is compared against the f64 pipeline

@@ -18,7 +18,7 @@
 // SUB sub-block straight from and to the texture: staging the tile through workgroup memory so
 // that neighbouring lanes touch neighbouring texels made the tables 1.3–2.7× slower on an H200
 // and 1.5–2.5× on llvmpipe (benches/RESULTS.md, 2026-11-27). The same sums in the same order either way: tables bit for bit the same
-// (`tests/sat/layouts.rs` and `tests/csm_sat.rs` compare both).
+// (`tests/sat/layouts.rs` and `tests/csm_sat/tables.rs` compare both).
 override GPU_LAYOUT: bool = false;
 
 // Keep in sync with `SAT_TILE` in src/sat/mod.rs.

@@ -1,6 +1,6 @@
 // A value rounded as a 16-bit storage format would hold it (import-only module of
 // shared/sat_tile_texel, whose depth-sourced tables sum the values a stored map would hold;
-// tests/csm_sat.rs checks both bit for bit against f64).
+// tests/csm_sat/storage_round.rs checks both bit for bit against f64).
 
 // `v` rounded to f16 and back (to nearest, ties to even): in f16's normal range the f32 significand rounded to 11 bits on its bits
 // (a carry moves into the exponent), below it (|v| < 2⁻¹⁴) to f16's subnormal step 2⁻²⁴. Exact

@@ -41,7 +41,7 @@ pub const REDESIGNED_MODULES: &[(&str, &str, wgpu::Features)] = &[
 /// invocation's sub-block loads and encodes its texels again on a GPU (from its texture cache:
 /// 7–13% faster on an H200 than keeping them) and reads the first sweep's encoded texels kept in
 /// private memory on a CPU driver (1.1–1.2× faster on llvmpipe); both give the same tables bit
-/// for bit (`tests/sat/`, `tests/csm_sat.rs`). And the encodings fused into the blur
+/// for bit (`tests/sat/`, `tests/csm_sat/`). And the encodings fused into the blur
 /// (`kernels/shared/encode_blur.wgsl`): a tile blurred in workgroup memory by 256 invocations on
 /// a GPU, walked in strips by 8 on a CPU driver (2–3× less CPU time on llvmpipe), the workgroup
 /// size itself an override (`kernels::Reflection::cpu_workgroup_size`); both within
