@@ -2,7 +2,7 @@
 //! visibility (search square → blocker → penumbra width → lookup) through the real shading
 //! kernel on random blocky maps, directional and spot (the blocker kernels alone:
 //! tests/blocker.rs). Tolerances are propagated
-//! through the f64 references by perturbation (tests/common/soft.rs). Last, each bundled soft
+//! through the f64 references by perturbation (tests/common/soft/). Last, each bundled soft
 //! scene's distance to an f64 PCSS on the same rasterized map.
 
 mod common;
@@ -181,7 +181,7 @@ impl std::fmt::Display for Seen {
 
 #[test]
 fn vssm_matches_reference() {
-    // Tolerance (tests/common/soft.rs): the table means' f32 weighting (and, for the float
+    // Tolerance (tests/common/soft/): the table means' f32 weighting (and, for the float
     // variant, the f32 differences of strip sums), the UV's rounding of the square's edges
     // and the receiver depth's, propagated through the Chebyshev blocker estimate, the
     // penumbra width and the final bound.

@@ -202,7 +202,7 @@ fn differences(a: &[f32], b: &[f32]) -> (usize, f32) {
 /// soft techniques' f32 chains (blocker estimate → width → lookup) amplify such changes where
 /// they are ill-conditioned (soft MSM's reconstruction, measured: |Δ| up to 1e-3 at 0.55% of
 /// pixels): there each run may stand as far from the f64 reference as its propagated tolerance
-/// (tests/common/soft.rs, which models UV and depth errors of that size), so a pixel counts as
+/// (tests/common/soft/, which models UV and depth errors of that size), so a pixel counts as
 /// off where |Δ| exceeds 1e-5 and twice that tolerance; pixels where the reference jumps or the
 /// blocker threshold could flip are not counted.
 #[test]

@@ -144,7 +144,7 @@ fn pixel_reference(
                 Technique::Esm { .. } => common::esm_tolerance(moments, &lg, &s, v),
                 Technique::Msm { .. } => common::msm_tolerance(moments, &lg, &s),
                 Technique::Csm { .. } => common::csm_tolerance(&lg),
-                // Propagated through the chain (tests/common/soft.rs).
+                // Propagated through the chain (tests/common/soft/).
                 Technique::Cssm { .. } | Technique::Vssm { .. } | Technique::MsmSoft { .. } => {
                     soft_tolerance
                 }
