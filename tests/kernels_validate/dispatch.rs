@@ -124,7 +124,7 @@ fn texels_x_widens_the_dispatch() {
 /// bindings. The known exception, the mip chain: a dispatch binds seven storage textures (level
 /// 0 and six levels, past the default four) and keeps 21840 bytes of levels in workgroup memory
 /// (past the default 16 KiB; desktop adapters offer 32–64 KiB). A device with less is refused
-/// by name before anything is created (`tests/plugin_errors.rs`); docs/PLUGIN.md says so.
+/// by name before anything is created (`tests/plugin_errors/`); docs/PLUGIN.md says so.
 #[test]
 fn compute_kernels_fit_webgpu_default_limits() {
     let defaults = wgpu::Limits::default();

@@ -274,7 +274,7 @@ fn stage_outputs_equal_the_renderers() {
             );
 
             // The second-depth techniques read a peeled second depth the stage takes no
-            // input for: refused by name (tests/plugin_errors.rs).
+            // input for: refused by name (tests/plugin_errors/creation.rs).
             if shadowgraph::low_level::technique::peels(&light.shadow.technique) {
                 continue;
             }

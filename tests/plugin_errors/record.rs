@@ -1,64 +1,8 @@
-//! Every mistake a host can make with the plug-in stage is a typed error naming what is wrong,
-//! never a panic or a wgpu validation error.
+//! Mistakes `Prefilter::record` names: unusable depth textures, inconsistent light
+//! parameters, a point light's atlas; every accepted depth format runs; wrapped errors
+//! print their cause once.
 
-mod common;
-
-use shadowgraph::low_level::gpu::Gpu;
-use shadowgraph::{Error, LightParams, Prefilter, PrefilterConfig, StageError};
-
-fn texture(
-    g: &Gpu,
-    format: wgpu::TextureFormat,
-    (w, h, layers): (u32, u32, u32),
-    samples: u32,
-    usage: wgpu::TextureUsages,
-) -> wgpu::Texture {
-    g.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("host.depth"),
-        size: wgpu::Extent3d {
-            width: w,
-            height: h,
-            depth_or_array_layers: layers,
-        },
-        mip_level_count: 1,
-        sample_count: samples,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage,
-        view_formats: &[],
-    })
-}
-
-const READABLE: wgpu::TextureUsages =
-    wgpu::TextureUsages::RENDER_ATTACHMENT.union(wgpu::TextureUsages::TEXTURE_BINDING);
-
-fn light() -> LightParams {
-    LightParams::orthographic(
-        glam::Mat4::look_at_rh(
-            glam::Vec3::new(0.0, 5.0, 1.0),
-            glam::Vec3::ZERO,
-            glam::Vec3::Y,
-        ),
-        2.0,
-        1.0,
-        10.0,
-    )
-}
-
-/// `record` over `depth`, expecting a stage error.
-fn record_err<'a>(
-    g: &Gpu,
-    depth: impl Into<shadowgraph::DepthLayer<'a>>,
-    light: &LightParams,
-) -> StageError {
-    let mut stage = Prefilter::new(&g.device, &PrefilterConfig::vsm(64)).expect("stage");
-    let mut enc = g.device.create_command_encoder(&Default::default());
-    match stage.record(&g.device, &mut enc, depth, light) {
-        Err(Error::Stage(e)) => e,
-        Err(e) => panic!("expected a stage error, got {e}"),
-        Ok(_) => panic!("expected a stage error, got maps"),
-    }
-}
+use super::*;
 
 #[test]
 fn unusable_depth_textures_are_named() {
@@ -197,9 +141,13 @@ fn every_accepted_depth_format_runs() {
             .unwrap_or_else(|e| panic!("{format:?}: {e}"));
         shadowgraph::low_level::gpu::submit_and_wait(&g.device, &g.queue, enc, "stage")
             .unwrap_or_else(|e| panic!("{format:?}: {e}"));
-        let (_, moments) =
-            shadowgraph::low_level::gpu::read_float_texture(&g.device, &g.queue, &out.maps[0].texture, 0)
-                .expect("readback");
+        let (_, moments) = shadowgraph::low_level::gpu::read_float_texture(
+            &g.device,
+            &g.queue,
+            &out.maps[0].texture,
+            0,
+        )
+        .expect("readback");
         assert!(
             moments.chunks(2).all(|m| m == [1.0, 1.0]),
             "{format:?}: moments of a cleared map are not (1, 1)"
@@ -311,52 +259,6 @@ fn inconsistent_light_params_are_named() {
     }
 }
 
-#[test]
-fn invalid_configs_are_named_by_new() {
-    let g = common::gpu();
-    let mut config = PrefilterConfig::vsm(64).with_blur(40.0);
-    match Prefilter::new(&g.device, &config) {
-        Err(Error::Stage(StageError::Config { field, message })) => {
-            assert_eq!(field, "filter_radius", "{message}");
-            assert!(message.contains("[0, 32]"), "{message}");
-        }
-        Err(e) => panic!("{e}"),
-        Ok(_) => panic!("radius 40 accepted"),
-    }
-    config = PrefilterConfig::evsm2(64);
-    if let shadowgraph::Technique::Evsm { exp_pos, .. } = &mut config.technique {
-        *exp_pos = 80.0;
-    }
-    let stage = Prefilter::new(&g.device, &config).expect("clamped, not rejected");
-    assert!(
-        stage.warnings().len() == 1 && stage.warnings()[0].contains("exponent_pos"),
-        "{:?}",
-        stage.warnings()
-    );
-}
-
-/// The second-depth techniques read a second, peeled depth map the stage has no input for:
-/// refused by name when the stage is made, not planned with a missing import.
-#[test]
-fn second_depth_techniques_are_refused_by_the_stage() {
-    let g = common::gpu();
-    for name in ["midpoint", "second_depth"] {
-        let t = shadowgraph::low_level::technique::named(name, &[]).expect(name);
-        let config = PrefilterConfig::new(t, 64);
-        match Prefilter::new(&g.device, &config) {
-            Err(Error::Stage(StageError::Config { field, message })) => {
-                assert_eq!(field, "technique", "{message}");
-                assert!(
-                    message.contains(name) && message.contains("second, peeled depth"),
-                    "{message}"
-                );
-            }
-            Err(e) => panic!("{name}: {e}"),
-            Ok(_) => panic!("{name} accepted by the plug-in stage"),
-        }
-    }
-}
-
 /// A point light's stage: an atlas of the wrong shape, `point_views` of a light that is not a
 /// point light, and a technique six faces cannot bound are each named.
 #[test]
@@ -415,166 +317,6 @@ fn point_light_mistakes_are_named() {
     }
 }
 
-/// A device (and queue) of the same adapter with `limits` and no optional features.
-fn device_with(g: &Gpu, limits: wgpu::Limits) -> (wgpu::Device, wgpu::Queue) {
-    pollster::block_on(g.adapter.request_device(&wgpu::DeviceDescriptor {
-        label: Some("limited"),
-        required_limits: limits,
-        ..Default::default()
-    }))
-    .expect("a device with lower limits")
-}
-
-fn limit_error(device: &wgpu::Device, config: &PrefilterConfig) -> String {
-    match Prefilter::new(device, config) {
-        Err(e @ Error::Limit { .. }) => e.to_string(),
-        Err(e) => panic!("expected a limit error, got {e}"),
-        Ok(_) => panic!("expected a limit error"),
-    }
-}
-
-#[test]
-fn sizes_and_kernels_past_the_device_limits_are_named() {
-    let g = common::gpu();
-    let (small, _) = device_with(
-        &g,
-        wgpu::Limits {
-            max_texture_dimension_2d: 1024,
-            ..g.adapter.limits()
-        },
-    );
-    let e = limit_error(&small, &PrefilterConfig::vsm(2048));
-    assert!(
-        e.contains("map size") && e.contains("2048") && e.contains("1024"),
-        "{e}"
-    );
-
-    let (little_memory, _) = device_with(
-        &g,
-        wgpu::Limits {
-            max_compute_workgroup_storage_size: 2048,
-            ..g.adapter.limits()
-        },
-    );
-    let table = PrefilterConfig::vsm(64).with_filter(shadowgraph::Filter::Sat {
-        width: 3.0,
-        variant: shadowgraph::SatVariant::Fixed,
-    });
-    let e = limit_error(&little_memory, &table);
-    assert!(
-        e.contains("`vsm_sat_tile_sums`") && e.contains("max_compute_workgroup_storage_size"),
-        "{e}"
-    );
-    // The encoding fused into the blur keeps its tile in WebGPU's default 16 KiB of workgroup
-    // memory: named against a device with less.
-    let e = limit_error(&little_memory, &PrefilterConfig::vsm(64));
-    assert!(
-        e.contains("`vsm_blur`") && e.contains("max_compute_workgroup_storage_size"),
-        "{e}"
-    );
-    // docs/PLUGIN.md quotes this message as its example: word for word.
-    let guide = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/PLUGIN.md"))
-        .expect("docs/PLUGIN.md")
-        .replace("\n  ", " ");
-    assert!(guide.contains(&e), "docs/PLUGIN.md's example is not `{e}`");
-
-    // A device made for WebGL 2 runs no compute shaders: one message says what to request
-    // (not the first kernel's workgroup width against a limit of 0).
-    let (no_compute, _) = device_with(&g, wgpu::Limits::downlevel_webgl2_defaults());
-    match Prefilter::new(&no_compute, &PrefilterConfig::vsm(64)) {
-        Err(e @ Error::Stage(StageError::NoCompute { .. })) => {
-            let e = e.to_string();
-            assert!(
-                e.contains("no compute shaders")
-                    && e.contains("max_compute_workgroup_size_x")
-                    && e.contains("wgpu::Limits::default()")
-                    && !e.contains('\n'),
-                "{e}"
-            );
-        }
-        Err(e) => panic!("expected NoCompute, got {e}"),
-        Ok(_) => panic!("a stage on a device without compute shaders"),
-    }
-}
-
-#[test]
-fn timing_without_timestamps_is_a_missing_feature() {
-    let g = common::gpu();
-    let (plain, queue) = device_with(&g, g.adapter.limits());
-    let mut stage = Prefilter::new(&plain, &PrefilterConfig::esm(64)).expect("stage");
-    match stage.enable_timing(&plain, &queue) {
-        Err(Error::Stage(StageError::MissingFeature {
-            feature,
-            needed_for,
-        })) => {
-            assert_eq!(feature, shadowgraph::TIMER_FEATURES);
-            assert!(needed_for.contains("timing"));
-        }
-        Err(e) => panic!("{e}"),
-        Ok(()) => panic!("timing enabled without TIMESTAMP_QUERY"),
-    }
-    // Pass timestamps alone are not enough: the timer writes between passes.
-    let (passes_only, queue) =
-        pollster::block_on(g.adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("pass timestamps only"),
-            required_features: wgpu::Features::TIMESTAMP_QUERY,
-            required_limits: g.adapter.limits(),
-            ..Default::default()
-        }))
-        .expect("a device with TIMESTAMP_QUERY (lavapipe has it)");
-    let mut stage = Prefilter::new(&passes_only, &PrefilterConfig::esm(64)).expect("stage");
-    match stage.enable_timing(&passes_only, &queue) {
-        Err(Error::Stage(StageError::MissingFeature { feature, .. })) => {
-            assert_eq!(feature, wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);
-        }
-        Err(e) => panic!("{e}"),
-        Ok(()) => panic!("timing enabled without TIMESTAMP_QUERY_INSIDE_ENCODERS"),
-    }
-}
-
-#[test]
-fn unorm16_msm_without_the_16_bit_norm_feature_is_a_missing_feature() {
-    let g = common::gpu();
-    let (plain, _) = device_with(&g, g.adapter.limits());
-    let config = PrefilterConfig::msm(64).with_storage(shadowgraph::Storage::Unorm16);
-    match Prefilter::new(&plain, &config) {
-        Err(e @ Error::MissingFeature { .. }) => {
-            let m = e.to_string();
-            assert!(
-                m.contains("unorm16") && m.contains("TEXTURE_FORMAT_16BIT_NORM"),
-                "{m}"
-            );
-        }
-        Err(e) => panic!("expected a missing feature, got {e}"),
-        Ok(_) => panic!("unorm16 MSM accepted without TEXTURE_FORMAT_16BIT_NORM"),
-    }
-    // f16 quantized moments need no feature.
-    let f16 = PrefilterConfig::msm(64).with_storage(shadowgraph::Storage::F16);
-    Prefilter::new(&plain, &f16).expect("f16 MSM on a plain device");
-}
-
-/// f32 tables are read with filtered fetches, so they need FLOAT32_FILTERABLE; fixed-point ones
-/// need nothing.
-#[test]
-fn float_tables_without_float32_filterable_are_a_missing_feature() {
-    let g = common::gpu();
-    let (plain, _) = device_with(&g, g.adapter.limits());
-    let config = PrefilterConfig::vssm(64, 0.5).with_soft(shadowgraph::SatVariant::Float, 0.2);
-    match Prefilter::new(&plain, &config) {
-        Err(e @ Error::MissingFeature { .. }) => {
-            let m = e.to_string();
-            assert!(
-                m.contains("sat_sums") && m.contains("FLOAT32_FILTERABLE"),
-                "{m}"
-            );
-        }
-        Err(e) => panic!("expected a missing feature, got {e}"),
-        Ok(_) => panic!("f32 tables accepted without FLOAT32_FILTERABLE"),
-    }
-    let fixed = PrefilterConfig::vssm(64, 0.5).with_soft(shadowgraph::SatVariant::Fixed, 0.2);
-    Prefilter::new(&plain, &fixed).expect("fixed-point tables on a plain device");
-}
-
 /// A wrapped error prints its cause once, also where causes are printed one by one (anyhow's
 /// `{:#}`, what the examples and a host's `main` print): the variant's message holds the
 /// cause, so it is not also its `source()`.
@@ -590,12 +332,13 @@ fn wrapped_errors_print_their_cause_once() {
     );
     let stage = Error::from(record_err(&g, &cleared, &light()));
     let graph = Error::from(
-        shadowgraph::low_level::graph::plan(&shadowgraph::low_level::graph::Graph::default(), &["light0.vsm"])
-            .expect_err("an undeclared output"),
+        shadowgraph::low_level::graph::plan(
+            &shadowgraph::low_level::graph::Graph::default(),
+            &["light0.vsm"],
+        )
+        .expect_err("an undeclared output"),
     );
-    let exec = Error::from(shadowgraph::ExecError::MissingImport(
-        "light0.depth".into(),
-    ));
+    let exec = Error::from(shadowgraph::ExecError::MissingImport("light0.depth".into()));
     for (e, cause) in [
         (stage, "is 64x32"),
         (graph, "`light0.vsm`"),
