@@ -7,7 +7,7 @@
 //! ```no_run
 //! # fn frame(device: &wgpu::Device, depth: &wgpu::Texture, view: glam::Mat4)
 //! #     -> shadowgraph::Result<()> {
-//! use shadowgraph::prefilter::{LightParams, Prefilter, PrefilterConfig};
+//! use shadowgraph::{LightParams, Prefilter, PrefilterConfig};
 //! let mut stage = Prefilter::new(device, &PrefilterConfig::vsm(1024))?;   // pipelines, once
 //! let host_wgsl = stage.wgsl(1, 0)?;         // prepend to the host's shader: group 1, binding 0…
 //! let mut encoder = device.create_command_encoder(&Default::default());
