@@ -6,24 +6,26 @@
 #   benches/gpu_check.sh [BINARY] [OUT]     # defaults: target/release/shadowgraph, gpu-out
 #
 # Each step runs under its own time box (`timeout`) and appends to a file of OUT (env, steps,
-# evaluate, kernels, checks: at most five, the device tool brings back eight), so a call cut
+# evaluate, kernels, buffers, checks: six, the device tool brings back eight), so a call cut
 # off by its end still returns what ran; steps.txt says how long each took and its status.
 # Older steps (the soft table, shading shapes, kernel-folder variants, workgroup memory zeroed,
 # timer cross-checks, cascades, a second binary) are benches/gpu_more.sh, for a second call.
 #
-# In order, with their boxes (380 s of steps at most, env included):
+# In order, with their boxes (381 s of steps at most, env included):
 #   a. `evaluate` at 1920×1080 on three scenes (sphere_on_plane, bunny, colonnade), one map
 #      size (2048²), the techniques hard, pcss, vsm, msm, vssm, msm_soft (the fronts' main
-#      rows; the other techniques are evaluated by gpu_more.sh), 40 s a scene: 120 s.
+#      rows; the other techniques are evaluated by gpu_more.sh), 37 s a scene: 111 s.
 #   b. the kernel decisions, 235 s: every benchmark case in the `gpu` and `redesign` kernel
 #      layouts side by side (`bench --layouts gpu,redesign --passes`: the redesigned
 #      encodings, blur row pass, mip chain, summed-area tables and fused encode+blur all run
 #      in both), each size its own process, the buffer copy and both texture copies first in
-#      each (the roofline rows): 4096² (80 s), then 8192² (125 s); then the shader modules
-#      with and without wgpu's runtime checks (`--kernel-dirs shipped,unchecked` in the
-#      redesign layout, 4096², the encodings, blurs, mips and tables: 30 s).
+#      each (the roofline rows): 4096² (80 s), then 8192² (125 s); then the intermediates in
+#      storage buffers against textures (`--layouts redesign,redesign-textures`, the blurs'
+#      two passes, 4096²: 20 s); then the shader modules with and without wgpu's runtime
+#      checks (`--kernel-dirs shipped,unchecked` in the redesign layout, 4096², the
+#      encodings, blurs, mips and tables: 20 s).
 #   c. the redesign's maps against the GPU layout's on this device, bit for bit (five
-#      technique scenes dumped in both layouts: 15 s). The kernel decisions, b and c: 250 s.
+#      technique scenes dumped in both layouts: 15 s). The kernel decisions, b and c: 260 s.
 #
 # A dry run on a CPU driver (every step at small sizes, to check that each one works):
 #
@@ -52,6 +54,12 @@
 #   the fused blurs: `…_blur …`), and its roof reaches the target where the shipped kernel's
 #   did not, or gains 0.05; slower in any of them: it stays in the redesign layout.
 #   Within 3% either way: the simpler kernel stays (the shipped one).
+# - buffers.txt, `<case> [redesign]` (the blur's row output in a row-major storage buffer)
+#   against `<case> [redesign-textures]` (in a texture), its `blur_h` and `blur_v` pass rows
+#   summed: intermediates move to storage buffers (`KernelLayout::buffers_intermediates`
+#   becomes the GPU layout's) where that sum is 3% or more faster in every blur case at
+#   4096² (the row pass's stores lane per row, the column pass's loads coalesced); slower in
+#   any: they stay textures. Within 3%: textures (one path for every resource).
 # - checks.txt, `[unchecked]` against `[shipped]` (both in the redesign layout): wgpu's runtime
 #   checks cost a kernel where its unchecked row is 5% or more faster at 4096²; that kernel's
 #   loops over private arrays are rewritten with constant indices (unrolled by hand, which
@@ -105,7 +113,7 @@ for scene in sphere_on_plane bunny colonnade; do
     else
         args=(--image 1920x1080 --sizes 2048 --repeat 5 --techniques hard,pcss,vsm,msm,vssm,msm_soft)
     fi
-    step evaluate.txt 40 "$B" evaluate "scenes/$scene.toml" "${args[@]}" --out "$EV/$scene"
+    step evaluate.txt 37 "$B" evaluate "scenes/$scene.toml" "${args[@]}" --out "$EV/$scene"
     for f in report.md report.csv; do
         [ -f "$EV/$scene/$f" ] && { echo "#### $scene/$f"; cat "$EV/$scene/$f"; } >>"$OUT/evaluate.txt"
     done
@@ -118,7 +126,11 @@ step kernels.txt 80 "$B" bench --sizes "$FIRST" --repeat "$REPEAT" --passes --la
 step kernels.txt 125 "$B" bench --sizes "$SECOND" --repeat "$REPEAT" --passes --layouts gpu,redesign
 # Wgpu's runtime checks (naga bounding every index and loop) against none, in the redesign
 # layout, whose kernels loop over private arrays; each case in both, adjacent in time.
-SHADOWGRAPH_KERNEL_LAYOUT=redesign step checks.txt 30 "$B" bench --sizes "$FIRST" \
+# The intermediates in storage buffers against textures, in the redesign's kernels: the
+# separable blurs, whose row output only their column pass reads.
+step buffers.txt 20 "$B" bench --sizes "$FIRST" --repeat "$REPEAT" --passes \
+    --only 'blur rg32f,blur log,vsm_blur r32,msm_blur r32' --layouts redesign,redesign-textures
+SHADOWGRAPH_KERNEL_LAYOUT=redesign step checks.txt 20 "$B" bench --sizes "$FIRST" \
     --repeat "$REPEAT" --only 'linearize,evsm4,msm f16,chain vsm (depth,blur rg32f,vsm_blur r4,mips,sat fixed' \
     --kernel-dirs shipped,unchecked
 

@@ -166,15 +166,16 @@ fn add_blur_pass(
         1 => (KernelId::BlurLog, BLUR_PER_INVOCATION),
         _ => (KernelId::BlurLogWide, BLUR_PER_INVOCATION),
     };
-    let out = graph.resource(
-        name.to_string(),
-        format,
-        SizeRule::Reduced {
-            of: shape.to_string(),
-            shift: 0,
-        },
-        Some(light),
-    );
+    let size = SizeRule::Reduced {
+        of: shape.to_string(),
+        shift: 0,
+    };
+    // The row pass's output is read by the column pass alone: never filtered.
+    let out = if params.axis == 0 {
+        graph.intermediate(name.to_string(), format, size, Some(light))
+    } else {
+        graph.resource(name.to_string(), format, size, Some(light))
+    };
     let axis = params.axis;
     graph.node(Node {
         name: name.to_string(),

@@ -488,7 +488,35 @@ pub fn read_float_texture(
     let channels = float_channels(format)
         .ok_or_else(|| Error::Invalid(format!("cannot read {format:?} as float")))?;
     let raw = read_texture(device, queue, texture, mip)?;
-    let values = if format == wgpu::TextureFormat::Rgba16Float {
+    Ok((channels, float_texels(format, &raw)))
+}
+
+/// A graph resource held in a storage buffer (`exec::BufferMap`: row-major texels of its
+/// texture format) as f32 values, as [`read_resource_texture`] reads the same resource's
+/// texture.
+pub fn read_resource_buffer(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    map: &crate::exec::BufferMap,
+) -> Result<(usize, Vec<f32>)> {
+    let format = crate::graph::texture_format(map.format);
+    let encoder = device.create_command_encoder(&Default::default());
+    let raw = submit_and_read(device, queue, encoder, &map.buffer, "read back")?;
+    let len = (map.width * map.height) as usize * crate::graph::texel_bytes(format) as usize;
+    let raw = raw.get(..len).unwrap_or(&raw);
+    if crate::graph::is_packed(map.format) {
+        let words: Vec<u32> = bytemuck::pod_collect_to_vec(raw);
+        return Ok((2, unpack_f16x2(&words)));
+    }
+    let channels = float_channels(format)
+        .ok_or_else(|| Error::Invalid(format!("cannot read {format:?} as float")))?;
+    Ok((channels, float_texels(format, raw)))
+}
+
+/// The texels `raw` (tightly packed, of `format`) as f32 values, as [`read_float_texture`]
+/// gives them.
+fn float_texels(format: wgpu::TextureFormat, raw: &[u8]) -> Vec<f32> {
+    if format == wgpu::TextureFormat::Rgba16Float {
         raw.chunks_exact(2)
             .map(|b| f16_to_f32(u16::from_le_bytes([b[0], b[1]])))
             .collect()
@@ -509,7 +537,6 @@ pub fn read_float_texture(
             .map(|b| i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f32)
             .collect()
     } else {
-        bytemuck::cast_slice(&raw).to_vec()
-    };
-    Ok((channels, values))
+        bytemuck::pod_collect_to_vec(raw)
+    }
 }

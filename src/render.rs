@@ -424,20 +424,14 @@ fn dump_resources(
         .iter()
         .map(|r| {
             let name = &r.resource.name;
-            let t = &outputs.textures[name];
-            let levels = (0..t.mip_level_count())
+            let levels = (0..outputs.levels(name))
                 .map(|mip| {
-                    let (channels, data) = crate::gpu::read_resource_texture(
-                        device,
-                        queue,
-                        t,
-                        mip,
-                        r.resource.format,
-                    )?;
+                    let (width, height, channels, data) =
+                        outputs.read_level(device, queue, name, mip, r.resource.format)?;
                     Ok(FloatMap {
                         resource: name.clone(),
-                        width: (t.width() >> mip).max(1),
-                        height: (t.height() >> mip).max(1),
+                        width,
+                        height,
                         channels,
                         data,
                     })

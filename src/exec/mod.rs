@@ -10,6 +10,7 @@
 //! levels included. By concern: [`pipelines`] (kernels compiled once and cached), [`pool`]
 //! (textures by shape, the run's outputs), `record` (bind groups and the passes).
 
+mod buffers;
 mod node_constants;
 mod packed;
 pub mod pipelines;
@@ -24,10 +25,11 @@ use crate::graph::{Plan, Slot};
 use crate::timer::GpuTimer;
 pub use pipelines::{
     ComputeKernel, KERNEL_LAYOUT_ENV, KernelCache, KernelLayout, REDESIGNED_KERNELS,
-    REDESIGNED_MODULES, SHADER_CHECKS_ENV, ShaderChecks, WorkgroupInit, specialized_source,
-    wgsl_storage_format,
+    REDESIGNED_MODULES, SHADER_CHECKS_ENV, ShaderChecks, WorkgroupInit, specialized_buffer_source,
+    specialized_source, wgsl_storage_format,
 };
-pub use pool::{Outputs, TexturePool};
+use pool::Held;
+pub use pool::{BufferMap, Outputs, TexturePool, slot_in_buffer};
 
 /// Runs plans: owns pipelines, pooled textures and what the last plan's run needs; borrows
 /// everything else.
@@ -36,7 +38,7 @@ pub struct Executor {
     /// Compiled kernels.
     pub kernels: KernelCache,
     pool: TexturePool,
-    in_use: Vec<(Slot, wgpu::Texture)>,
+    in_use: Vec<(Slot, Held)>,
     prepared: Option<Prepared>,
     /// Compute dispatches recorded so far.
     dispatches: u64,
@@ -77,7 +79,8 @@ impl Executor {
         self.dispatches
     }
 
-    /// Textures held by the pool (constant across runs of the same plan).
+    /// Textures (and storage buffers) held by the pool (constant across runs of the same
+    /// plan).
     pub fn texture_count(&self) -> usize {
         self.pool.texture_count() + self.in_use.len()
     }
@@ -188,22 +191,32 @@ impl Executor {
         imports: &HashMap<String, wgpu::Texture>,
         layers: &HashMap<String, u32>,
     ) -> Result<Prepared> {
-        // Textures of the previous run go back to the pool, then each slot takes one.
-        for (slot, t) in self.in_use.drain(..) {
-            self.pool.free.entry(slot).or_default().push(t);
+        // Textures of the previous run go back to the pool, then each slot takes one (or a
+        // buffer, where the layout keeps the slot's intermediates in one).
+        for (slot, held) in self.in_use.drain(..) {
+            self.pool.give_back(slot, held);
         }
-        let slot_textures: Vec<wgpu::Texture> = plan
+        let layout = self.kernels.layout_for(device)?;
+        let limits = device.limits();
+        let held: Vec<Held> = plan
             .slots
             .iter()
-            .map(|s| self.pool.take(device, s))
+            .enumerate()
+            .map(|(i, s)| {
+                if slot_in_buffer(plan, i, layout, &limits) {
+                    Held::Buffer(self.pool.take_buffer(device, s))
+                } else {
+                    Held::Texture(self.pool.take(device, s))
+                }
+            })
             .collect();
         self.in_use = plan
             .slots
             .iter()
             .cloned()
-            .zip(slot_textures.iter().cloned())
+            .zip(held.iter().cloned())
             .collect();
-        let textures = pool::plan_textures(plan, &slot_textures, imports)?;
+        let textures = pool::plan_textures(plan, &held, imports)?;
         let outputs = Outputs::new(device, plan, textures, layers.clone());
         let params = record::params_buffer(device, plan)?;
         let mut bound = Vec::new();
@@ -249,8 +262,10 @@ impl Executor {
         imports: &HashMap<String, wgpu::Texture>,
         layers: &HashMap<String, u32>,
     ) -> Result<Prepared> {
-        let slots: Vec<wgpu::Texture> = self.in_use.iter().map(|(_, t)| t.clone()).collect();
-        prepared.outputs.textures = pool::plan_textures(&prepared.plan, &slots, imports)?;
+        let held: Vec<Held> = self.in_use.iter().map(|(_, h)| h.clone()).collect();
+        let (textures, buffers) = pool::plan_textures(&prepared.plan, &held, imports)?;
+        prepared.outputs.textures = textures;
+        prepared.outputs.buffers = buffers;
         prepared.outputs.layers = layers.clone();
         prepared.layers = layers.clone();
         for (name, t) in &mut prepared.imports {

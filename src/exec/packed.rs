@@ -32,13 +32,21 @@ pub(super) fn unpack_loads(wgsl: &str, binding: &str) -> Option<String> {
     Some(with_module(wgsl))
 }
 
+/// `wgsl` with the declaration that starts with `head` (up to and including its `;`) replaced
+/// by `new`.
+pub(super) fn replace_decl(wgsl: &str, head: &str, new: &str) -> Option<String> {
+    let at = wgsl.find(head)?;
+    let end = at + wgsl[at..].find(';')? + 1;
+    Some(format!("{}{new}{}", &wgsl[..at], &wgsl[end..]))
+}
+
 fn replace_once(wgsl: &str, from: &str, to: &str) -> Option<String> {
     let at = wgsl.find(from)?;
     Some(format!("{}{to}{}", &wgsl[..at], &wgsl[at + from.len()..]))
 }
 
 /// `wgsl` with the helpers of `shared/packed` appended (once).
-fn with_module(mut wgsl: String) -> String {
+pub(super) fn with_module(mut wgsl: String) -> String {
     if !wgsl.contains("fn pack_f16x2(") {
         if let Ok(module) = crate::kernels::source("shared/packed") {
             wgsl.push('\n');
@@ -51,7 +59,7 @@ fn with_module(mut wgsl: String) -> String {
 /// Every call `f(binding, …)` in `wgsl` replaced by `call(args)` (the call's arguments,
 /// trimmed, split at top-level commas), except inside a function with a parameter of that
 /// name (it shadows the binding). `None` if a call's parentheses do not close.
-fn rewrite_calls(
+pub(super) fn rewrite_calls(
     wgsl: &str,
     f: &str,
     binding: &str,

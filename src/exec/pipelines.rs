@@ -14,7 +14,7 @@ pub use self::layout::{
     REDESIGNED_MODULES, SHADER_CHECKS_ENV, ShaderChecks, WorkgroupInit,
 };
 use self::specialize::{apply, changes};
-pub use self::specialize::{specialized_source, wgsl_storage_format};
+pub use self::specialize::{specialized_buffer_source, specialized_source, wgsl_storage_format};
 use super::node_constants::NodeOverrides;
 use crate::error::{Error, Result};
 use crate::gpu::scoped;
@@ -92,7 +92,7 @@ impl ComputeKernel {
             overrides.iter().map(|(n, v)| (n.as_str(), *v)).collect();
         for (name, value) in [
             (GPU_LAYOUT_CONSTANT, layout.is_gpu()),
-            (REDESIGN_CONSTANT, layout == KernelLayout::Redesign),
+            (REDESIGN_CONSTANT, layout.is_redesign()),
         ] {
             if module
                 .overrides
@@ -158,9 +158,10 @@ impl ComputeKernel {
         )?;
         Ok(Self {
             name: name.to_string(),
-            reflection: match layout {
-                KernelLayout::Redesign => reflection.in_redesign(),
-                _ => reflection.in_layout(layout.is_gpu()),
+            reflection: if layout.is_redesign() {
+                reflection.in_redesign()
+            } else {
+                reflection.in_layout(layout.is_gpu())
             },
             layouts,
             pipeline,
@@ -250,7 +251,7 @@ impl KernelCache {
     }
 
     /// The layout kernels compile in on `device`.
-    fn layout_for(&self, device: &wgpu::Device) -> Result<KernelLayout> {
+    pub(crate) fn layout_for(&self, device: &wgpu::Device) -> Result<KernelLayout> {
         match self.layout {
             Some(layout) => Ok(layout),
             None => KernelLayout::for_device(device),
@@ -315,20 +316,22 @@ impl KernelCache {
         name: &str,
         formats: &[(String, wgpu::TextureFormat)],
     ) -> Result<Arc<ComputeKernel>> {
-        self.get_for_node(device, name, formats, &[])
+        self.get_for_node(device, name, formats, &[], &[])
     }
 
-    /// [`KernelCache::get_specialized`] with the pipeline constants `overrides` set (a node's,
-    /// [`KernelCache::node_constants`]): one pipeline for each set of values.
+    /// [`KernelCache::get_specialized`] with the bindings of `buffers` bound to storage buffers
+    /// of maps of `[width, height]` texels (`exec::buffers`) and the pipeline constants
+    /// `overrides` set (a node's, [`KernelCache::node_constants`]): one pipeline for each set.
     pub fn get_for_node(
         &mut self,
         device: &wgpu::Device,
         name: &str,
         formats: &[(String, wgpu::TextureFormat)],
+        buffers: &[(String, [u32; 2])],
         overrides: &[(String, f64)],
     ) -> Result<Arc<ComputeKernel>> {
         let base = self.get(device, name)?;
-        let changes = changes(name, &base.reflection, formats)?;
+        let changes = changes(name, &base.reflection, formats, buffers)?;
         if changes.is_empty() && overrides.is_empty() {
             return Ok(base);
         }

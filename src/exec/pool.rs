@@ -1,5 +1,6 @@
-//! What a plan's run holds: textures pooled by shape across runs, the texture of every planned
-//! resource, and the per-step counters a kernel may increment.
+//! What a plan's run holds: textures (and the storage buffers of intermediates kept in buffers)
+//! pooled by shape across runs, the texture or buffer of every planned resource, and the
+//! per-step counters a kernel may increment.
 
 use std::collections::HashMap;
 
@@ -8,13 +9,95 @@ use crate::gpu::read_buffer;
 use crate::gpu_objects;
 use crate::graph::{Plan, Slot};
 
-/// Textures kept across runs, keyed by shape; a plan takes the ones it needs in order.
+use super::KernelLayout;
+
+/// Textures (and buffers) kept across runs, keyed by shape; a plan takes the ones it needs in
+/// order.
 #[derive(Default)]
 pub struct TexturePool {
     pub(super) free: HashMap<Slot, Vec<wgpu::Texture>>,
+    pub(super) free_buffers: HashMap<Slot, Vec<wgpu::Buffer>>,
+}
+
+/// What holds a slot's resources: a texture, or a row-major storage buffer
+/// ([`slot_in_buffer`]).
+#[derive(Clone)]
+pub(super) enum Held {
+    Texture(wgpu::Texture),
+    Buffer(wgpu::Buffer),
+}
+
+/// A resource held in a row-major storage buffer ([`crate::graph::Resource::unfiltered`]):
+/// texel `(x, y)` at element `y · width + x`, each the bytes of its texture format's texel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BufferMap {
+    /// The buffer.
+    pub buffer: wgpu::Buffer,
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    /// The resource's format ([`crate::graph::texture_format`] gives its texels' bytes).
+    pub format: wgpu::TextureFormat,
+}
+
+/// Whether `plan`'s slot `slot` is a storage buffer in `layout` on a device of `limits`: where
+/// the layout keeps intermediates in buffers, every resource of the slot is
+/// [`crate::graph::Resource::unfiltered`] and no requested output (which a shading pass or a
+/// host samples), the slot has one level, its format is held bit for bit
+/// (`exec::buffers`), and its bytes fit one storage binding (else it stays a texture).
+pub fn slot_in_buffer(
+    plan: &Plan,
+    slot: usize,
+    layout: KernelLayout,
+    limits: &wgpu::Limits,
+) -> bool {
+    let Some(s) = plan.slots.get(slot) else {
+        return false;
+    };
+    let format = crate::graph::texture_format(s.format);
+    let bytes = u64::from(s.width) * u64::from(s.height) * crate::graph::texel_bytes(format);
+    layout.buffers_intermediates()
+        && s.mips == 1
+        && super::buffers::holds(format)
+        && bytes <= limits.max_storage_buffer_binding_size.min(limits.max_buffer_size)
+        && plan
+            .resources
+            .iter()
+            .filter(|r| r.slot == Some(slot))
+            .all(|r| r.resource.unfiltered && !plan.outputs.contains(&r.resource.name))
 }
 
 impl TexturePool {
+    /// A buffer for `slot` ([`slot_in_buffer`]): a free one of its shape, or a new one.
+    pub(super) fn take_buffer(&mut self, device: &wgpu::Device, slot: &Slot) -> wgpu::Buffer {
+        if let Some(b) = self.free_buffers.get_mut(slot).and_then(Vec::pop) {
+            return b;
+        }
+        let format = crate::graph::texture_format(slot.format);
+        let bytes =
+            u64::from(slot.width) * u64::from(slot.height) * crate::graph::texel_bytes(format);
+        gpu_objects::buffer(
+            device,
+            &wgpu::BufferDescriptor {
+                label: Some("shadowgraph.pool.buffer"),
+                size: bytes.max(4),
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_SRC
+                    | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            },
+        )
+    }
+
+    /// Returns `held` of `slot` to the free lists.
+    pub(super) fn give_back(&mut self, slot: Slot, held: Held) {
+        match held {
+            Held::Texture(t) => self.free.entry(slot).or_default().push(t),
+            Held::Buffer(b) => self.free_buffers.entry(slot).or_default().push(b),
+        }
+    }
+
     pub(super) fn take(&mut self, device: &wgpu::Device, slot: &Slot) -> wgpu::Texture {
         if let Some(t) = self.free.get_mut(slot).and_then(Vec::pop) {
             return t;
@@ -41,17 +124,21 @@ impl TexturePool {
         )
     }
 
-    /// Textures held (in use by the last run or free).
+    /// Textures and buffers held (free).
     pub fn texture_count(&self) -> usize {
-        self.free.values().map(Vec::len).sum()
+        self.free.values().map(Vec::len).sum::<usize>()
+            + self.free_buffers.values().map(Vec::len).sum::<usize>()
     }
 }
 
 /// The textures a run produced, by resource name.
 #[derive(Clone)]
 pub struct Outputs {
-    /// Texture of every planned resource, imports included.
+    /// Texture of every planned resource held in a texture, imports included.
     pub textures: HashMap<String, wgpu::Texture>,
+    /// Buffer of every planned resource held in a storage buffer ([`slot_in_buffer`]; none
+    /// outside [`KernelLayout::Redesign`]).
+    pub buffers: HashMap<String, BufferMap>,
     /// The array layer each imported resource is read from, where it is one layer of an array
     /// texture (absent: the whole texture).
     pub layers: HashMap<String, u32>,
@@ -70,7 +157,7 @@ impl Outputs {
     pub(super) fn new(
         device: &wgpu::Device,
         plan: &Plan,
-        textures: HashMap<String, wgpu::Texture>,
+        (textures, buffers): (HashMap<String, wgpu::Texture>, HashMap<String, BufferMap>),
         layers: HashMap<String, u32>,
     ) -> Self {
         let steps = plan.steps.len().max(1) as u64;
@@ -98,7 +185,49 @@ impl Outputs {
             ),
             steps: plan.steps.iter().map(|s| s.node.name.clone()).collect(),
             textures,
+            buffers,
             layers,
+        }
+    }
+
+    /// Mip levels of resource `name` (1 for one held in a buffer; 0 for none).
+    pub fn levels(&self, name: &str) -> u32 {
+        match self.textures.get(name) {
+            Some(t) => t.mip_level_count(),
+            None => u32::from(self.buffers.contains_key(name)),
+        }
+    }
+
+    /// Level `level` of resource `name` (of `format`, its planned format) as f32 values,
+    /// wherever it is held: `(width, height, channels, values)`
+    /// ([`crate::gpu::read_resource_texture`], [`crate::gpu::read_resource_buffer`]).
+    pub fn read_level(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        name: &str,
+        level: u32,
+        format: wgpu::TextureFormat,
+    ) -> Result<(u32, u32, usize, Vec<f32>)> {
+        if let Some(t) = self.textures.get(name) {
+            let (c, v) = crate::gpu::read_resource_texture(device, queue, t, level, format)?;
+            let (w, h) = ((t.width() >> level).max(1), (t.height() >> level).max(1));
+            return Ok((w, h, c, v));
+        }
+        match self.buffers.get(name) {
+            Some(b) if level == 0 => {
+                let (c, v) = crate::gpu::read_resource_buffer(device, queue, b)?;
+                Ok((b.width, b.height, c, v))
+            }
+            _ => Err(ExecError::NoResource(name.to_string()).into()),
+        }
+    }
+
+    /// `(width, height)` of resource `name`, in a texture (level 0) or a buffer.
+    pub fn size(&self, name: &str) -> Option<(u32, u32)> {
+        match self.textures.get(name) {
+            Some(t) => Some((t.width(), t.height())),
+            None => self.buffers.get(name).map(|b| (b.width, b.height)),
         }
     }
 
@@ -131,18 +260,29 @@ impl Outputs {
     }
 }
 
-/// The texture of every planned resource: its slot's, or the caller's for an import; sizes
-/// checked against the plan.
+/// The texture or buffer of every planned resource: its slot's, or the caller's texture for an
+/// import; sizes checked against the plan.
 pub(super) fn plan_textures(
     plan: &Plan,
-    slot_textures: &[wgpu::Texture],
+    held: &[Held],
     imports: &HashMap<String, wgpu::Texture>,
-) -> Result<HashMap<String, wgpu::Texture>> {
+) -> Result<(HashMap<String, wgpu::Texture>, HashMap<String, BufferMap>)> {
     let mut textures = HashMap::new();
+    let mut buffers = HashMap::new();
     for r in &plan.resources {
         let name = &r.resource.name;
-        let t = match r.slot.and_then(|s| slot_textures.get(s)) {
-            Some(t) => t.clone(),
+        let t = match r.slot.and_then(|s| held.get(s)) {
+            Some(Held::Texture(t)) => t.clone(),
+            Some(Held::Buffer(b)) => {
+                let map = BufferMap {
+                    buffer: b.clone(),
+                    width: r.width,
+                    height: r.height,
+                    format: r.resource.format,
+                };
+                buffers.insert(name.clone(), map);
+                continue;
+            }
             None => imports
                 .get(name)
                 .cloned()
@@ -160,5 +300,5 @@ pub(super) fn plan_textures(
         }
         textures.insert(name.clone(), t);
     }
-    Ok(textures)
+    Ok((textures, buffers))
 }

@@ -121,7 +121,25 @@ fn bound_formats(
         .unwrap_or_default()
 }
 
-/// Compiles `node`'s pipeline for the formats `plan` binds (what [`bind_step`] will ask for).
+/// The bindings of a node's first dispatch bound to resources held in storage buffers, with
+/// their maps' `[width, height]`: what its pipeline is specialized for (`exec::buffers`).
+fn bound_buffers(
+    specs: &[Spec<'_>],
+    size: impl Fn(&str) -> Option<[u32; 2]>,
+) -> Vec<(String, [u32; 2])> {
+    specs
+        .first()
+        .map(|s| {
+            s.views
+                .iter()
+                .filter_map(|(b, r, _)| size(r).map(|wh| (b.clone(), wh)))
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// Compiles `node`'s pipeline for the formats `plan` binds, and the storage buffers it binds
+/// in `layout` (what [`bind_step`] will ask for).
 pub(super) fn compile(
     kernels: &mut KernelCache,
     device: &wgpu::Device,
@@ -134,8 +152,15 @@ pub(super) fn compile(
         plan.resource(r)
             .map(|p| crate::graph::texture_format(p.resource.format))
     });
+    let layout = kernels.layout_for(device)?;
+    let limits = device.limits();
+    let buffers = bound_buffers(&specs, |r| {
+        let p = plan.resource(r)?;
+        let slot = p.slot?;
+        super::slot_in_buffer(plan, slot, layout, &limits).then_some([p.width, p.height])
+    });
     let overrides = kernels.node_constants(node.kernel.name(), &node.name, &node.params)?;
-    kernels.get_for_node(device, node.kernel.name(), &formats, &overrides)?;
+    kernels.get_for_node(device, node.kernel.name(), &formats, &buffers, &overrides)?;
     Ok(())
 }
 
@@ -155,12 +180,27 @@ pub(super) fn bind_step(
     node: &Node,
     buffers: &StepBuffers<'_>,
 ) -> Result<PreparedStep> {
-    let textures = &buffers.outputs.textures;
+    let outputs = buffers.outputs;
     let base = kernels.get(device, node.kernel.name())?;
     let specs = specs(&base, node)?;
-    let formats = bound_formats(&specs, |r| textures.get(r).map(|t| t.format()));
+    let formats = bound_formats(&specs, |r| match outputs.textures.get(r) {
+        Some(t) => Some(t.format()),
+        None => outputs
+            .buffers
+            .get(r)
+            .map(|b| crate::graph::texture_format(b.format)),
+    });
+    let in_buffers = bound_buffers(&specs, |r| {
+        outputs.buffers.get(r).map(|b| [b.width, b.height])
+    });
     let overrides = kernels.node_constants(node.kernel.name(), &node.name, &node.params)?;
-    let kernel = kernels.get_for_node(device, node.kernel.name(), &formats, &overrides)?;
+    let kernel = kernels.get_for_node(
+        device,
+        node.kernel.name(),
+        &formats,
+        &in_buffers,
+        &overrides,
+    )?;
     // A node dispatched by texels covers `TEXELS_X` texels an invocation (its workgroups'
     // footprint); any other dispatch follows the node's geometry, which does not read it: a
     // kernel (a `SHADOWGRAPH_KERNEL_DIR` variant) declaring it there would cover the wrong texels.
@@ -191,7 +231,7 @@ pub(super) fn bind_step(
             ),
         });
     }
-    let size = |r: &str| textures.get(r).map(|t| (t.width(), t.height()));
+    let size = |r: &str| outputs.size(r);
     let mut dispatches = Vec::new();
     for (k, spec) in specs.iter().enumerate() {
         let at = buffers
@@ -232,8 +272,13 @@ fn bind_group(
     (offset, size): (u64, u64),
 ) -> Result<wgpu::BindGroup> {
     let mut views: Vec<(u32, wgpu::TextureView)> = Vec::new();
+    let mut held: Vec<(u32, &wgpu::Buffer)> = Vec::new();
     for b in kernel.reflection.bindings.iter().filter(|b| b.group == 0) {
         if let Some((_, r, level)) = spec.views.iter().find(|(n, ..)| *n == b.name) {
+            if let Some(m) = buffers.outputs.buffers.get(*r) {
+                held.push((b.binding, &m.buffer));
+                continue;
+            }
             let t = buffers
                 .outputs
                 .textures
@@ -259,6 +304,12 @@ fn bind_group(
             resource: wgpu::BindingResource::TextureView(view),
         })
         .collect();
+    for (binding, buffer) in held {
+        entries.push(wgpu::BindGroupEntry {
+            binding,
+            resource: buffer.as_entire_binding(),
+        });
+    }
     if let Some(b) = kernel.reflection.binding("params") {
         let size = size.div_ceil(16) * 16;
         entries.push(buffer_entry(b.binding, buffers.params, offset, size));

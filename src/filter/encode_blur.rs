@@ -166,15 +166,16 @@ fn fused_node(
     blur: BlurParams,
     tile: Option<u32>,
 ) {
-    let out = graph.resource(
-        name.to_string(),
-        e.format,
-        SizeRule::Reduced {
-            of: e.depth.to_string(),
-            shift: 0,
-        },
-        Some(light),
-    );
+    let size = SizeRule::Reduced {
+        of: e.depth.to_string(),
+        shift: 0,
+    };
+    // The row pass of the two-pass fallback is read by its column pass alone.
+    let out = if tile.is_none() {
+        graph.intermediate(name.to_string(), e.format, size, Some(light))
+    } else {
+        graph.resource(name.to_string(), e.format, size, Some(light))
+    };
     let dispatch = match tile {
         None => Dispatch::Blocks {
             of: out.clone(),

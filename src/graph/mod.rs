@@ -75,6 +75,12 @@ pub struct Resource {
     /// `(x·n + k, y)` is texel `(x, y)` of `layers[k]` (n = `layers.len()`). Empty for a
     /// plain resource.
     pub layers: Vec<String>,
+    /// An intermediate that is never filtered: written by `textureStore` and read only by
+    /// `textureLoad` at level 0 of graph kernels, never by the shading or a host. In a layout
+    /// that keeps such intermediates in storage buffers
+    /// ([`crate::exec::KernelLayout::buffers_intermediates`]) the executor may hold it in a
+    /// row-major buffer instead of a texture ([`Graph::intermediate`]).
+    pub unfiltered: bool,
 }
 
 /// How many workgroups a node dispatches.
@@ -328,7 +334,25 @@ impl Graph {
             imported: false,
             light,
             layers: Vec::new(),
+            unfiltered: false,
         });
+        name
+    }
+
+    /// Declares a resource produced and consumed inside the graph that is never filtered
+    /// ([`Resource::unfiltered`]): e.g. a separable blur's row pass output, which only its
+    /// column pass reads.
+    pub fn intermediate(
+        &mut self,
+        name: impl Into<String>,
+        format: wgpu::TextureFormat,
+        size: SizeRule,
+        light: Option<usize>,
+    ) -> String {
+        let name = self.resource(name, format, size, light);
+        if let Some(r) = self.resources.last_mut() {
+            r.unfiltered = true;
+        }
         name
     }
 
@@ -392,6 +416,7 @@ impl Graph {
             imported: true,
             light,
             layers: Vec::new(),
+            unfiltered: false,
         });
         name
     }

@@ -9,7 +9,7 @@ use glam::{DVec3, Vec3};
 use crate::cpu::{self, Texels};
 use crate::error::{Error, Result};
 use crate::exec::{Executor, Outputs};
-use crate::gpu::{Gpu, read_buffer, read_resource_texture, submit_and_wait, write_texture_level};
+use crate::gpu::{Gpu, read_buffer, submit_and_wait, write_texture_level};
 use crate::graph::{Graph, Plan, plan, texel_bytes};
 use crate::model::{Light, LightKind, Shadow, Technique};
 use crate::model::{ParamValue, ParamValues};
@@ -87,6 +87,11 @@ pub(crate) fn run_graph(
     match poison {
         Poison::All => {
             for r in plan.resources.iter().filter(|r| r.slot.is_some()) {
+                if let Some(b) = out.buffers.get(&r.resource.name) {
+                    gpu.queue
+                        .write_buffer(&b.buffer, 0, &vec![0xFF; b.buffer.size() as usize]);
+                    continue;
+                }
                 let t = &out.textures[&r.resource.name];
                 for level in 0..t.mip_level_count() {
                     let (w, h) = ((t.width() >> level).max(1), (t.height() >> level).max(1));
@@ -123,27 +128,20 @@ pub(crate) fn run_graph(
 impl Ran {
     /// Mip `level` of resource `name` as f64 texels.
     pub(crate) fn texels(&self, gpu: &Gpu, name: &str, level: u32) -> Result<Texels> {
-        let t = self
-            .outputs
-            .textures
-            .get(name)
-            .ok_or_else(|| Error::Invalid(format!("the plan has no resource `{name}`")))?;
         let format = self
             .plan
             .resource(name)
-            .map_or(t.format(), |r| r.resource.format);
-        let (channels, data) = read_resource_texture(&gpu.device, &gpu.queue, t, level, format)?;
-        let (w, h) = ((t.width() >> level).max(1), (t.height() >> level).max(1));
+            .map(|r| r.resource.format)
+            .ok_or_else(|| Error::Invalid(format!("the plan has no resource `{name}`")))?;
+        let (w, h, channels, data) =
+            self.outputs
+                .read_level(&gpu.device, &gpu.queue, name, level, format)?;
         Ok(Texels::from_f32(w as usize, h as usize, channels, &data))
     }
 
     /// Every level of resource `name`.
     pub(crate) fn levels(&self, gpu: &Gpu, name: &str) -> Result<Vec<Texels>> {
-        let n = self
-            .outputs
-            .textures
-            .get(name)
-            .map_or(1, wgpu::Texture::mip_level_count);
+        let n = self.outputs.levels(name).max(1);
         (0..n).map(|level| self.texels(gpu, name, level)).collect()
     }
 }

@@ -338,3 +338,101 @@ fn packed_f16_variants_validate() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
     assert_eq!(rewritten, 13, "every variant packs or unpacks");
 }
+
+/// The storage-buffer variant (`exec::buffers`) of every kernel that writes or reads an
+/// intermediate the redesign layout keeps in a buffer validates, as the executor specializes
+/// it: every technique's plan (its shading maps requested), each step bound as
+/// `exec::slot_in_buffer` says at WebGPU's default limits, on 64² and 1024² maps. At least the
+/// blur's passes and the fused blurs' row kernels (both kinds) are rewritten.
+#[test]
+fn storage_buffer_variants_validate() {
+    use shadowgraph::low_level::exec::{KernelLayout, slot_in_buffer, specialized_buffer_source};
+    use shadowgraph::low_level::graph::{Graph, plan, texture_format};
+    let limits = wgpu::Limits::default();
+    let mut failures = Vec::new();
+    let mut rewritten = BTreeSet::new();
+    let mut techniques = all_techniques();
+    // The fused blurs' two-pass fallback (past their tile's radius 7).
+    for radius in [3.0, 12.0] {
+        let filter = Filter::Blur {
+            radius,
+            sigma: radius / 2.0,
+            kernel: BlurKernel::Gaussian,
+        };
+        let prefilter = StorageFilter {
+            storage: Storage::F32,
+            filter,
+        };
+        techniques.push(Technique::Vsm {
+            prefilter,
+            bleed: 0.2,
+            min_variance: 1e-5,
+        });
+        techniques.push(Technique::Msm {
+            prefilter,
+            hausdorff: false,
+            moment_bias: 6e-5,
+            bleed: 0.0,
+        });
+    }
+    // 64²: the fused kernels' own rows; 1024²: their `*_blur_row` kernels' full rows.
+    let lights = techniques.into_iter().flat_map(|t| {
+        [64, 1024].map(|side| Light {
+            shadow_map: side,
+            ..light(t)
+        })
+    });
+    for light in lights {
+        let technique = &light.shadow.technique;
+        let mut graph = Graph::default();
+        let input = shadowgraph::low_level::technique::add_light_nodes(&mut graph, 0, &light);
+        let outputs: Vec<&str> = input.maps.iter().map(String::as_str).collect();
+        let Ok(plan) = plan(&graph, &outputs) else {
+            failures.push(format!("{technique:?}: no plan"));
+            continue;
+        };
+        let in_buffer = |r: &str| {
+            let p = plan.resource(r)?;
+            let slot = p.slot?;
+            slot_in_buffer(&plan, slot, KernelLayout::Redesign, &limits)
+                .then_some([p.width, p.height])
+        };
+        for step in &plan.steps {
+            let node = &step.node;
+            let slots = node.inputs.iter().chain(&node.outputs);
+            let buffers: Vec<(String, [u32; 2])> = slots
+                .clone()
+                .filter_map(|(b, r)| in_buffer(r).map(|wh| (b.clone(), wh)))
+                .collect();
+            if buffers.is_empty() {
+                continue;
+            }
+            let formats: Vec<(String, wgpu::TextureFormat)> = slots
+                .filter_map(|(b, r)| {
+                    let f = plan.resource(r)?.resource.format;
+                    Some((b.clone(), texture_format(f)))
+                })
+                .collect();
+            let kernel = node.kernel.name();
+            match specialized_buffer_source(kernel, &formats, &buffers) {
+                Ok(wgsl) => {
+                    rewritten.insert(kernel.to_string());
+                    if let Err(e) = kernels::reflect(kernel, &wgsl) {
+                        failures.push(format!("{technique:?} {kernel}: {e}"));
+                    }
+                }
+                Err(e) => failures.push(format!("{technique:?} {kernel}: {e}")),
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    for k in [
+        "blur",
+        "vsm_blur",
+        "msm_blur",
+        "vsm_blur_row",
+        "msm_blur_row",
+    ] {
+        assert!(rewritten.contains(k), "{k} rewritten: {rewritten:?}");
+    }
+}

@@ -14,9 +14,14 @@ pub use crate::kernels::{GPU_LAYOUT_CONSTANT, REDESIGN_CONSTANT};
 /// shipped kernel (the same bindings and dispatches; [`KernelLayout::kernel_source`]). A
 /// separate file rather than a branch on `REDESIGN`: a kernel's declared workgroup memory costs
 /// on a GPU even where the branch using it never runs (`benches/RESULTS.md`, 2026-11-27).
-/// The mip chain after AMD FidelityFX SPD: `kernels/shared/mips_spd.wgsl`.
-pub const REDESIGNED_KERNELS: &[(&str, &str)] =
-    &[("mips", "mips_spd"), ("mips_log", "mips_spd_log")];
+/// The mip chain after AMD FidelityFX SPD: `kernels/shared/mips_spd.wgsl`. The summed-area
+/// tables' carries scanned by 8 lanes a line: `kernels/sat_carries_scan.wgsl` (its nodes'
+/// dispatch is `graph::Dispatch::Redesigned`: `sat::carries_dispatch`).
+pub const REDESIGNED_KERNELS: &[(&str, &str)] = &[
+    ("mips", "mips_spd"),
+    ("mips_log", "mips_spd_log"),
+    ("sat_carries", "sat_carries_scan"),
+];
 
 /// Import-only modules whose redesign needs a device feature, `(shipped, redesign, feature)`:
 /// in [`KernelLayout::Redesign`] on a device with `feature` every kernel importing `shipped`
@@ -63,8 +68,13 @@ pub enum KernelLayout {
     /// device's default, chosen by [`KERNEL_LAYOUT_ENV`]` = redesign` or `shadowgraph bench
     /// --layouts gpu,redesign`, which times it against [`KernelLayout::Gpu`] kernel by kernel.
     /// Every redesign is tested in it on lavapipe against the same references as the shipped
-    /// kernels; one that wins on a GPU moves into [`KernelLayout::Gpu`].
+    /// kernels; one that wins on a GPU moves into [`KernelLayout::Gpu`]. Intermediates that
+    /// are never filtered ([`crate::graph::Resource::unfiltered`]) live in storage buffers here
+    /// ([`KernelLayout::buffers_intermediates`]).
     Redesign,
+    /// [`KernelLayout::Redesign`] with every intermediate in a texture (`redesign-textures`):
+    /// timed against it, it tells what the storage buffers bring alone.
+    RedesignTextures,
 }
 
 impl KernelLayout {
@@ -87,7 +97,10 @@ impl KernelLayout {
             "gpu" => Ok(Self::Gpu),
             "cpu" => Ok(Self::Cpu),
             "redesign" => Ok(Self::Redesign),
-            _ => Err(format!("`{name}`: expected `gpu`, `cpu` or `redesign`")),
+            "redesign-textures" => Ok(Self::RedesignTextures),
+            _ => Err(format!(
+                "`{name}`: expected `gpu`, `cpu`, `redesign` or `redesign-textures`"
+            )),
         }
     }
 
@@ -97,8 +110,17 @@ impl KernelLayout {
         !matches!(self, Self::Cpu)
     }
 
-    /// Whether the undecided redesigns run ([`KernelLayout::Redesign`]).
+    /// Whether the undecided redesigns run ([`KernelLayout::Redesign`],
+    /// [`KernelLayout::RedesignTextures`]).
     pub fn is_redesign(self) -> bool {
+        matches!(self, Self::Redesign | Self::RedesignTextures)
+    }
+
+    /// Whether the executor keeps intermediates that are never filtered
+    /// ([`crate::graph::Resource::unfiltered`]) in storage buffers, row-major, instead of
+    /// textures ([`KernelLayout::Redesign`]): kernels read and write them through the rewrite
+    /// of `exec::buffers`.
+    pub fn buffers_intermediates(self) -> bool {
         matches!(self, Self::Redesign)
     }
 
@@ -106,7 +128,7 @@ impl KernelLayout {
     /// a redesign with a file of its own ([`REDESIGNED_KERNELS`]), else `name` itself.
     pub fn kernel_source(self, name: &str) -> &str {
         match self {
-            Self::Redesign => REDESIGNED_KERNELS
+            Self::Redesign | Self::RedesignTextures => REDESIGNED_KERNELS
                 .iter()
                 .find(|(shipped, _)| *shipped == name)
                 .map_or(name, |(_, redesign)| redesign),
@@ -134,6 +156,7 @@ impl KernelLayout {
             Self::Gpu => "gpu",
             Self::Cpu => "cpu",
             Self::Redesign => "redesign",
+            Self::RedesignTextures => "redesign-textures",
         }
     }
 }

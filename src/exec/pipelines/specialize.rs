@@ -3,27 +3,42 @@
 //! marked `// #channels <binding>` set to the bound format's channel count.
 
 use crate::error::{Error, Result};
-use crate::exec::packed;
+use crate::exec::{buffers, packed};
 use crate::kernels::{self, Reflection};
 
 /// The WGSL of kernel `name` as [`KernelCache::get_specialized`](super::KernelCache::get_specialized) compiles it for the texture
 /// formats `formats` bound by binding name (no GPU needed: `tests/kernels_validate/`
 /// validates every variant a technique can bind).
 pub fn specialized_source(name: &str, formats: &[(String, wgpu::TextureFormat)]) -> Result<String> {
-    let (_, reflection) = kernels::reflect(name, &kernels::resolve(name, None)?)?;
-    apply(name, &changes(name, &reflection, formats)?, None)
+    specialized_buffer_source(name, formats, &[])
 }
 
-/// The changes binding `formats` to kernel `name` needs.
+/// [`specialized_source`] with the bindings in `buffers` bound to storage buffers of maps of
+/// `[width, height]` texels of their format in `formats` (`exec::buffers`).
+pub fn specialized_buffer_source(
+    name: &str,
+    formats: &[(String, wgpu::TextureFormat)],
+    buffers: &[(String, [u32; 2])],
+) -> Result<String> {
+    let (_, reflection) = kernels::reflect(name, &kernels::resolve(name, None)?)?;
+    apply(name, &changes(name, &reflection, formats, buffers)?, None)
+}
+
+/// The changes binding `formats` to kernel `name` needs, the bindings of `buffers` bound to
+/// storage buffers of maps of that size.
 pub(super) fn changes(
     name: &str,
     reflection: &Reflection,
     formats: &[(String, wgpu::TextureFormat)],
+    buffers: &[(String, [u32; 2])],
 ) -> Result<Vec<Change>> {
     let mut changes = Vec::new();
     for (binding, format) in formats {
         if let Some(b) = reflection.binding(binding) {
-            if let Some(change) = change_for(name, binding, b.ty, *format)? {
+            let buffer = buffers.iter().find(|(n, _)| n == binding);
+            if let Some(&(_, size)) = buffer {
+                changes.push(buffer_change(name, binding, b.ty, *format, size)?);
+            } else if let Some(change) = change_for(name, binding, b.ty, *format)? {
                 changes.push(change);
             }
             if let Some(change) = channels_for(binding, b.ty, *format) {
@@ -70,6 +85,18 @@ pub(super) enum Change {
     /// the kernel reads it: `const NAME: u32 = N; // #channels <binding>` (e.g. `blur`'s run
     /// length along columns).
     Channels { binding: String, count: u32 },
+    /// A storage texture bound to a storage buffer of a map of `size` texels of `format`.
+    StoreToBuffer {
+        binding: String,
+        format: wgpu::TextureFormat,
+        size: [u32; 2],
+    },
+    /// A texture bound to a storage buffer of a map of `size` texels of `format`.
+    LoadFromBuffer {
+        binding: String,
+        format: wgpu::TextureFormat,
+        size: [u32; 2],
+    },
 }
 
 impl Change {
@@ -78,7 +105,9 @@ impl Change {
             Change::Retype { binding, .. }
             | Change::PackStores { binding, .. }
             | Change::UnpackLoads { binding }
-            | Change::Channels { binding, .. } => binding,
+            | Change::Channels { binding, .. }
+            | Change::StoreToBuffer { binding, .. }
+            | Change::LoadFromBuffer { binding, .. } => binding,
         }
     }
 
@@ -88,7 +117,49 @@ impl Change {
             Change::PackStores { binding, from } => packed::pack_stores(wgsl, binding, from),
             Change::UnpackLoads { binding } => packed::unpack_loads(wgsl, binding),
             Change::Channels { binding, count } => set_channels(wgsl, binding, *count),
+            Change::StoreToBuffer {
+                binding,
+                format,
+                size,
+            } => buffers::store_to_buffer(wgsl, binding, *format, *size),
+            Change::LoadFromBuffer {
+                binding,
+                format,
+                size,
+            } => buffers::load_from_buffer(wgsl, binding, *format, *size),
         }
+    }
+}
+
+/// The change binding `binding` (of type `ty`) of kernel `name` to a storage buffer of a map of
+/// `size` texels of `format` needs: a storage texture's stores or a texture's loads.
+fn buffer_change(
+    name: &str,
+    binding: &str,
+    ty: wgpu::BindingType,
+    format: wgpu::TextureFormat,
+    size: [u32; 2],
+) -> Result<Change> {
+    let binding = binding.to_string();
+    match ty {
+        wgpu::BindingType::StorageTexture { .. } => Ok(Change::StoreToBuffer {
+            binding,
+            format,
+            size,
+        }),
+        wgpu::BindingType::Texture {
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+            ..
+        } => Ok(Change::LoadFromBuffer {
+            binding,
+            format,
+            size,
+        }),
+        _ => Err(Error::Pipeline {
+            kernel: name.to_string(),
+            message: format!("`{binding}` is no 2-D texture: a storage buffer cannot replace it"),
+        }),
     }
 }
 

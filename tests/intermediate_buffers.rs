@@ -1,0 +1,260 @@
+//! Intermediates kept in storage buffers (`exec::KernelLayout::Redesign`, which keeps every
+//! never-filtered intermediate of a plan in a row-major buffer; `RedesignTextures` runs the same
+//! kernels with textures): the separable blur's row output in every format a buffer holds bit
+//! for bit, against the f64 blur and bit for bit against the same kernels with textures; the
+//! log-space blur; and which resources the executor puts in buffers (row outputs only: never a
+//! requested output, a 16-bit format or a map past the device's binding size).
+
+mod common;
+
+use std::collections::HashMap;
+
+use rand::Rng;
+use shadowgraph::low_level::cpu::{self, Texels};
+use shadowgraph::low_level::exec::{Executor, KernelLayout, Outputs};
+use shadowgraph::low_level::filter::{BlurMode, add_filter};
+use shadowgraph::low_level::gpu::{Gpu, read_resource_texture, submit_and_wait, write_texture};
+use shadowgraph::low_level::graph::{Graph, Plan, plan, texel_bytes};
+use shadowgraph::{BlurKernel, Filter};
+
+/// f32's unit roundoff.
+const U: f64 = 1.0 / (1u64 << 24) as f64;
+
+/// Runs `plan` in `layout` over `imports`, its output and every buffer poisoned with 0xFF
+/// bytes first (NaN in every float format, so unwritten texels show); returns the outputs and
+/// the output's texels.
+fn run(
+    g: &Gpu,
+    plan: &Plan,
+    imports: &HashMap<String, wgpu::Texture>,
+    layout: KernelLayout,
+) -> (Outputs, Texels) {
+    let mut exec = Executor::new();
+    exec.kernels.set_layout(layout);
+    let mut enc = g.device.create_command_encoder(&Default::default());
+    let out = exec
+        .record(&g.device, &mut enc, plan, imports, None)
+        .expect("record");
+    let name = &plan.outputs[0];
+    let t = &out.textures[name];
+    let bytes = texel_bytes(t.format()) as usize * (t.width() * t.height()) as usize;
+    write_texture(&g.queue, t, &vec![0xFF; bytes]);
+    for b in out.buffers.values() {
+        g.queue
+            .write_buffer(&b.buffer, 0, &vec![0xFF; b.buffer.size() as usize]);
+    }
+    submit_and_wait(&g.device, &g.queue, enc, "intermediate buffers").expect("submit");
+    let format = plan.resource(name).expect("planned").resource.format;
+    let (c, v) = read_resource_texture(&g.device, &g.queue, t, 0, format).expect("read");
+    let texels = Texels::from_f32(t.width() as usize, t.height() as usize, c, &v);
+    (out, texels)
+}
+
+/// Random texels of `channels` channels in [−1, 2), one in ten times 4 (edges in every window).
+fn random_texels(rng: &mut impl Rng, (w, h): (u32, u32), channels: usize) -> Vec<f32> {
+    (0..(w * h) as usize * channels)
+        .map(|_| {
+            let v: f32 = rng.random_range(-1.0..2.0);
+            if rng.random_bool(0.1) { v * 4.0 } else { v }
+        })
+        .collect()
+}
+
+/// The plan blurring the import `in` (`format`, `w × h`) for its blurred output only.
+fn blur_plan(
+    format: wgpu::TextureFormat,
+    (w, h): (u32, u32),
+    filter: &Filter,
+    mode: BlurMode,
+) -> Plan {
+    let mut graph = Graph::default();
+    graph.import("in", format, w, h, Some(0));
+    let out = add_filter(&mut graph, 0, "in", filter, mode);
+    plan(&graph, &[&out]).expect("plan")
+}
+
+/// Blurs `data` (`channels` f32 channels, `format`) in the redesign layout with its row output
+/// in a buffer: the blur within the f64 reference's two-pass bound, the same bits as with
+/// textures, and the row output in a buffer (in a texture with `RedesignTextures`).
+fn check(what: &str, data: &[f32], format: wgpu::TextureFormat, size: (u32, u32), filter: &Filter) {
+    let g = common::gpu();
+    let Filter::Blur {
+        radius,
+        sigma,
+        kernel,
+    } = *filter
+    else {
+        unreachable!("a blur")
+    };
+    let channels = data.len() / (size.0 * size.1) as usize;
+    let plan = blur_plan(format, size, filter, BlurMode::Linear);
+    let tex = common::upload(
+        &g.device,
+        &g.queue,
+        "in",
+        size,
+        format,
+        bytemuck::cast_slice(data),
+    );
+    let imports = HashMap::from([("in".to_string(), tex)]);
+    let (buffered, got) = run(&g, &plan, &imports, KernelLayout::Redesign);
+    let (textured, want_bits) = run(&g, &plan, &imports, KernelLayout::RedesignTextures);
+    assert_eq!(
+        buffered.buffers.keys().collect::<Vec<_>>(),
+        vec!["in.blur_h"],
+        "{what}: the row output, and only it, in a buffer"
+    );
+    assert!(textured.buffers.is_empty(), "{what}: textures only");
+    let input = Texels::from_f32(size.0 as usize, size.1 as usize, channels, data);
+    let weights = cpu::blur::weights(f64::from(radius), f64::from(sigma), kernel);
+    let both = cpu::blur::blur_pass(&cpu::blur::blur_pass(&input, &weights, 0), &weights, 1);
+    // As tests/blur_rows.rs: a pass's ordered sum of r + 1 terms with weights rounded once from
+    // f64 is within (r + 4)·u·max |v| of the f64 pass, two passes twice that.
+    let max = input.data.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let pass_error = f64::from(weights.len() as u32 + 3) * U * max;
+    let got_f32: Vec<f32> = got
+        .data
+        .chunks(got.channels)
+        .flat_map(|c| c[..channels].iter().map(|&v| v as f32))
+        .collect();
+    common::assert_close(what, &got_f32, &both.data, 2.0 * pass_error, 0.0);
+    common::assert_same_bits(&format!("{what}: buffer against texture"), &got, &want_bits);
+}
+
+#[test]
+fn row_outputs_in_buffers_blur_as_the_reference_and_as_textures() {
+    use wgpu::TextureFormat as T;
+    let mut rng = common::rng(0xB0FF);
+    // Sizes off every block (a redesign row block is 32 × 64): a buffer row's end is where a
+    // stray store or load would wrap into the next row.
+    for (size, format, channels, radius) in [
+        ((130u32, 67u32), T::R32Float, 1usize, 2.0f32),
+        ((97, 130), T::Rg32Float, 2, 32.0),
+        ((45, 33), T::Rgba32Float, 4, 4.0),
+        ((33, 1), T::Rg32Float, 2, 7.5),
+        ((1, 40), T::R32Float, 1, 3.0),
+    ] {
+        let data = random_texels(&mut rng, size, channels);
+        let filter = Filter::Blur {
+            radius,
+            sigma: radius / 2.0,
+            kernel: BlurKernel::Gaussian,
+        };
+        let what = format!("blur {}x{} r{radius} {format:?}", size.0, size.1);
+        check(&what, &data, format, size, &filter);
+    }
+}
+
+#[test]
+fn log_space_row_outputs_in_buffers_are_the_textures_bits() {
+    let g = common::gpu();
+    let mut rng = common::rng(0x10C);
+    let size = (131u32, 70u32);
+    // c·z with a blocker at 0.1 before receivers past 0.8: at c = 200 the wide kernel's
+    // per-output path, at c = 40 `blur_log`'s.
+    for c in [40.0f32, 200.0] {
+        let cz: Vec<f32> = (0..size.0 * size.1)
+            .map(|_| {
+                c * if rng.random_bool(0.2) {
+                    0.1
+                } else {
+                    rng.random_range(0.8..1.0)
+                }
+            })
+            .collect();
+        let filter = Filter::Blur {
+            radius: 5.0,
+            sigma: 2.5,
+            kernel: BlurKernel::Gaussian,
+        };
+        let format = wgpu::TextureFormat::R32Float;
+        let plan = blur_plan(format, size, &filter, BlurMode::log_sum_exp(c));
+        let tex = common::upload(
+            &g.device,
+            &g.queue,
+            "in",
+            size,
+            format,
+            bytemuck::cast_slice(&cz),
+        );
+        let imports = HashMap::from([("in".to_string(), tex)]);
+        let (buffered, got) = run(&g, &plan, &imports, KernelLayout::Redesign);
+        let (_, want) = run(&g, &plan, &imports, KernelLayout::RedesignTextures);
+        assert!(
+            buffered.buffers.contains_key("in.blur_h"),
+            "c = {c}: row output in a buffer"
+        );
+        // log Σ w·exp(v) of values within c of each other: finite, and within the window's
+        // range (a stray load of a poisoned or wrapped texel would leave it).
+        for (&v, &x) in got.data.iter().zip(&want.data) {
+            assert!(
+                v.is_finite() && (0.0..=f64::from(c)).contains(&v),
+                "c = {c}: {v}"
+            );
+            assert_eq!(v, x);
+        }
+        common::assert_same_bits(
+            &format!("log blur c = {c}: buffer against texture"),
+            &got,
+            &want,
+        );
+    }
+}
+
+#[test]
+fn only_unfiltered_intermediates_that_a_buffer_holds_go_to_buffers() {
+    use shadowgraph::low_level::exec::slot_in_buffer;
+    let filter = Filter::Blur {
+        radius: 3.0,
+        sigma: 1.5,
+        kernel: BlurKernel::Gaussian,
+    };
+    let limits = wgpu::Limits::default();
+    let in_buffers = |plan: &Plan, layout, limits: &wgpu::Limits| -> Vec<String> {
+        plan.resources
+            .iter()
+            .filter(|r| {
+                r.slot
+                    .is_some_and(|s| slot_in_buffer(plan, s, layout, limits))
+            })
+            .map(|r| r.resource.name.clone())
+            .collect()
+    };
+    let rg = blur_plan(
+        wgpu::TextureFormat::Rg32Float,
+        (64, 64),
+        &filter,
+        BlurMode::Linear,
+    );
+    assert_eq!(
+        in_buffers(&rg, KernelLayout::Redesign, &limits),
+        ["in.blur_h"]
+    );
+    for layout in [
+        KernelLayout::Gpu,
+        KernelLayout::Cpu,
+        KernelLayout::RedesignTextures,
+    ] {
+        assert!(in_buffers(&rg, layout, &limits).is_empty(), "{layout:?}");
+    }
+    // f16 channels round on a texture store: a buffer would not hold the same bits.
+    let f16 = blur_plan(
+        wgpu::TextureFormat::Rgba16Float,
+        (64, 64),
+        &filter,
+        BlurMode::Linear,
+    );
+    assert!(in_buffers(&f16, KernelLayout::Redesign, &limits).is_empty());
+    // A map past one storage binding stays a texture (64² rg32float: 32 KiB).
+    let small = wgpu::Limits {
+        max_storage_buffer_binding_size: 32 * 1024 - 8,
+        ..limits.clone()
+    };
+    assert!(in_buffers(&rg, KernelLayout::Redesign, &small).is_empty());
+    // A requested output is sampled by a shading pass or a host: never a buffer.
+    let mut graph = Graph::default();
+    graph.import("in", wgpu::TextureFormat::Rg32Float, 64, 64, Some(0));
+    let out = add_filter(&mut graph, 0, "in", &filter, BlurMode::Linear);
+    let both = plan(&graph, &["in.blur_h", &out]).expect("plan");
+    assert!(in_buffers(&both, KernelLayout::Redesign, &limits).is_empty());
+}
