@@ -30,7 +30,7 @@
 //! fixed point a table is bit-identical to the integer reference of the codes the kernel
 //! computes.
 
-use super::{SAT_LINES_PER_GROUP, SAT_TILE, SatCoding, SatParams, named, sat_name};
+use super::{SAT_TILE, SatCoding, SatParams, carries_dispatch, named, sat_name};
 use crate::graph::{Dispatch, Graph, Node, SizeRule};
 use crate::kernels::KernelId;
 use crate::model::SatVariant;
@@ -154,13 +154,7 @@ pub fn add_layered_sat(graph: &mut Graph, light: usize, sat: &LayeredSat<'_>) ->
         named(vec![("col_part", &col_part), ("row_part", &row_part)]),
         named(vec![("col_carry", &col_carry), ("row_carry", &row_carry)]),
         bytemuck::bytes_of(&sat_params).to_vec(),
-        Dispatch::Layers {
-            base: Box::new(Dispatch::Lines {
-                of: source.clone(),
-                per_group: SAT_LINES_PER_GROUP,
-            }),
-            layers,
-        },
+        carries_dispatch(&source, Some(layers)),
     );
     for (g, group) in tables.chunks(LAYERED_SAT_OUTPUTS as usize).enumerate() {
         let first = g as u32 * LAYERED_SAT_OUTPUTS * per as u32;

@@ -13,7 +13,9 @@
 //! 2. `sat_carries`: one invocation per column and one per row ([`Dispatch::Lines`]), the
 //!    exclusive prefix of those edges along the line: `.col_carry` (the map above the tile
 //!    row) and `.row_carry` (the map left of the tile column, every row above included: each
-//!    row workgroup first sums the totals of the tiles above its tile row).
+//!    row workgroup first sums the totals of the tiles above its tile row). In
+//!    [`crate::exec::KernelLayout::Redesign`] `sat_carries_scan`, a line's tiles shared among
+//!    8 lanes and scanned in workgroup memory ([`carries_dispatch`]).
 //! 3. `sat_tiles` / `sat_tiles_f32`: read and encode the tile again, scan it, add its column
 //!    and row carries, store the inclusive table.
 //!
@@ -54,6 +56,36 @@ pub const SAT_TILE: u32 = 32;
 /// Lines per `sat_carries` workgroup, one per invocation (its workgroup size, and that of the
 /// tile kernels): a row workgroup covers two tile rows.
 pub const SAT_LINES_PER_GROUP: u32 = 64;
+
+/// Lines per workgroup of the carries' redesign (`LINES` in `kernels/sat_carries_scan.wgsl`,
+/// 8 lanes a line, each holding 8 consecutive tiles of a segment; a test checks them against
+/// each other): a row workgroup covers one tile row.
+pub const SAT_SCAN_LINES: u32 = 32;
+
+/// The dispatch of a table's carries over `of` (`layers` tables stacked, or one): one
+/// invocation a column and one a row of `sat_carries` ([`SAT_LINES_PER_GROUP`] a workgroup)
+/// in the shipped layouts; in [`crate::exec::KernelLayout::Redesign`], whose `sat_carries`
+/// nodes compile `sat_carries_scan` (a line's tiles among 8 lanes, scanned in workgroup
+/// memory), [`SAT_SCAN_LINES`] lines a workgroup.
+pub fn carries_dispatch(of: &str, layers: Option<u32>) -> Dispatch {
+    let lines = |per_group| {
+        let d = Dispatch::Lines {
+            of: of.to_string(),
+            per_group,
+        };
+        match layers {
+            Some(layers) => Dispatch::Layers {
+                base: Box::new(d),
+                layers,
+            },
+            None => d,
+        }
+    };
+    Dispatch::Redesigned {
+        shipped: Box::new(lines(SAT_LINES_PER_GROUP)),
+        redesign: Box::new(lines(SAT_SCAN_LINES)),
+    }
+}
 
 /// The largest `max_area` the fixed-point coding accepts: one unit per texel must fit an i32.
 pub const MAX_FIXED_AREA: u64 = (1 << 31) - 1;
@@ -291,10 +323,7 @@ pub fn add_sat(graph: &mut Graph, light: usize, input: &str, coding: &SatCoding)
             KernelId::SatCarries,
             vec![("col_part", col_part.as_str()), ("row_part", &row_part)],
             vec![("col_carry", col_carry.as_str()), ("row_carry", &row_carry)],
-            Dispatch::Lines {
-                of: input.to_string(),
-                per_group: SAT_LINES_PER_GROUP,
-            },
+            carries_dispatch(input, None),
         ),
         (
             "",
@@ -460,6 +489,37 @@ mod tests {
         }
     }
 
+    /// A `const NAME: u32` of `kernel`'s resolved WGSL, and its workgroup's width.
+    fn wgsl_consts(kernel: &str, names: &[&str]) -> (Vec<Option<u32>>, u32) {
+        let wgsl = crate::kernels::resolve(kernel, None).unwrap();
+        let (module, r) = crate::kernels::reflect(kernel, &wgsl).unwrap();
+        let value = |name: &str| {
+            let (_, c) = module
+                .constants
+                .iter()
+                .find(|(_, c)| c.name.as_deref() == Some(name))?;
+            match module.global_expressions[c.init] {
+                naga::Expression::Literal(naga::Literal::U32(v)) => Some(v),
+                _ => None,
+            }
+        };
+        let wg = r.workgroup_size.unwrap_or_default()[0];
+        (names.iter().map(|n| value(n)).collect(), wg)
+    }
+
+    #[test]
+    fn carries_scan_constants_match_the_wgsl() {
+        let names = ["LINES", "PARTS", "BATCH", "SPAN", "QUARTERS", "TILE"];
+        let (c, wg) = wgsl_consts("sat_carries_scan", &names);
+        let [lines, parts, batch, span, quarters, tile] = [0, 1, 2, 3, 4, 5].map(|i| c[i].unwrap());
+        // A row workgroup is one tile row; its lanes cover a segment's tiles QUARTERS times.
+        assert_eq!((lines, tile), (SAT_SCAN_LINES, SAT_TILE));
+        assert_eq!(lines, tile);
+        assert_eq!(wg, lines * parts);
+        assert_eq!(span, parts * batch);
+        assert_eq!(quarters * span, wg);
+    }
+
     #[test]
     fn sat_plans_three_passes_sized_by_tiles() {
         let mut g = Graph::default();
@@ -489,6 +549,14 @@ mod tests {
             p.steps[1].node.dispatch.groups(size, [64, 1, 1]),
             Some([47, 2, 1])
         );
+        // The redesign's carries: 32 lines a workgroup; a shipped layout keeps 64.
+        for (gpu, redesign, groups) in [(true, true, 94), (true, false, 47), (false, false, 47)] {
+            let d = &p.steps[1].node.dispatch;
+            assert_eq!(
+                d.groups_in(size, [256, 1, 1], gpu, redesign),
+                Some([groups, 2, 1])
+            );
+        }
 
         for (format, channels, table) in [
             (

@@ -284,6 +284,31 @@ fn layered_csm_tables_match_the_f64_basis() {
             storage: Storage::F32,
             bad: 6,
         },
+        // Lines of more than one segment of the redesign's carries (64 tiles,
+        // `kernels/sat_carries_scan.wgsl`), layered: CSM at M = 4 (two tables), 66 tiles
+        // across, ragged, fixed point; CSM and CSM-Z at M = 2 (two tables), 66 tiles down, f32.
+        Case {
+            w: 2090,
+            h: 40,
+            terms: 4,
+            search: None,
+            moments: None,
+            exp: [0.0; 2],
+            variant: SatVariant::Fixed,
+            storage: Storage::F32,
+            bad: 5,
+        },
+        Case {
+            w: 40,
+            h: 2090,
+            terms: 2,
+            search: Some(CssmSearch::CsmZ),
+            moments: None,
+            exp: [0.0; 2],
+            variant: SatVariant::Float,
+            storage: Storage::F32,
+            bad: 5,
+        },
         // CSM at M = 1: one two-channel table, so two-channel edges and carries.
         Case {
             w: 40,

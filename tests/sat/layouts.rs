@@ -44,11 +44,13 @@ fn both_layouts_build_the_same_tables() {
 }
 
 /// The redesign layout (`exec::KernelLayout::Redesign`: on a device with subgroups the tile
-/// passes by subgroup scans, a lane a column, `kernels/shared/sat_strip.wgsl`; without them the
-/// shipped passes) builds fixed-point tables bit for bit as the GPU layout does (wrapping sums
-/// in any order), and f32 tables within the same scan bound of the f64 table (its summation
-/// tree is no deeper than the shipped tile's: `sat::float_sum_depth`): one, two and four
-/// channels, ragged tiles, single lines, several tiles each way.
+/// passes by subgroup scans, a lane a column, `kernels/shared/sat_strip.wgsl`, without them the
+/// shipped passes; everywhere the carries scanned by 8 lanes a line,
+/// `kernels/sat_carries_scan.wgsl`) builds fixed-point tables bit for bit as the GPU layout
+/// does (wrapping sums in any order), and f32 tables within the same scan bound of the f64
+/// table (its summation tree is no deeper than the shipped one's: `sat::float_sum_depth`):
+/// one, two and four channels, ragged tiles, single lines, several tiles each way, and lines
+/// of more than one segment of the carries' scan (64 tiles: 2090 wide, 2100 tall), ragged.
 #[test]
 fn redesign_layout_builds_the_same_tables() {
     let g = common::gpu();
@@ -57,10 +59,16 @@ fn redesign_layout_builds_the_same_tables() {
     let mut redesign = Executor::new();
     redesign.kernels.set_layout(KernelLayout::Redesign);
     let mut rng = common::rng(78);
-    for (i, (w, h)) in [(1, 57), (61, 1), (100, 70), (33, 200), (257, 95)]
-        .into_iter()
-        .enumerate()
-    {
+    let sizes = [
+        (1, 57),
+        (61, 1),
+        (100, 70),
+        (33, 200),
+        (257, 95),
+        (2090, 170),
+        (45, 2100),
+    ];
+    for (i, (w, h)) in sizes.into_iter().enumerate() {
         let channels = [1, 2, 4][i % 3];
         let map = Map::random(&mut rng, w, h, channels, -0.5, 1.0);
         let fixed = SatCoding::fixed((w * h) as u64, [-0.5; 4], [1.0; 4]).unwrap();
