@@ -57,7 +57,7 @@ pub const SAT_TILE: u32 = 32;
 /// tile kernels): a row workgroup covers two tile rows.
 pub const SAT_LINES_PER_GROUP: u32 = 64;
 
-/// Lines per workgroup of the carries' redesign (`LINES` in `kernels/sat_carries_scan.wgsl`,
+/// Lines per workgroup of the carries' redesign (`SCAN_LINES` in `kernels/sat_carries_scan.wgsl`,
 /// 8 lanes a line, each holding 8 consecutive tiles of a segment; a test checks them against
 /// each other): a row workgroup covers one tile row.
 pub const SAT_SCAN_LINES: u32 = 32;
@@ -509,7 +509,14 @@ mod tests {
 
     #[test]
     fn carries_scan_constants_match_the_wgsl() {
-        let names = ["LINES", "PARTS", "BATCH", "SPAN", "QUARTERS", "TILE"];
+        let names = [
+            "SCAN_LINES",
+            "SCAN_PARTS",
+            "SCAN_BATCH",
+            "SCAN_SPAN",
+            "SCAN_QUARTERS",
+            "TILE",
+        ];
         let (c, wg) = wgsl_consts("sat_carries_scan", &names);
         let [lines, parts, batch, span, quarters, tile] = [0, 1, 2, 3, 4, 5].map(|i| c[i].unwrap());
         // A row workgroup is one tile row; its lanes cover a segment's tiles QUARTERS times.
