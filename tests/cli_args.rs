@@ -201,7 +201,11 @@ fn layouts_are_named_and_not_for_the_lookup() {
             "--layouts",
             "gpu,fast",
         ],
-        &["--layouts", "`fast`", "expected `gpu`, `cpu` or `redesign`"],
+        &[
+            "--layouts",
+            "`fast`",
+            "expected `gpu`, `cpu`, `redesign` or `redesign-textures`",
+        ],
     );
     refused(
         &[

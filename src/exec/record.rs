@@ -219,7 +219,9 @@ pub(super) fn bind_step(
     let footprint = kernel.reflection.texel_footprint();
     // A line an invocation: the node counts its lines a workgroup, which must be the kernel's
     // workgroup (a variant with another would leave lines out or run past them).
-    if let Some(per_group) = node.dispatch.lines_per_group()
+    if let Some(per_group) = node
+        .dispatch
+        .lines_per_group_in(kernel.layout.is_redesign())
         && per_group != wg[0]
     {
         return Err(Error::Kernel {

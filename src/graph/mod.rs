@@ -201,12 +201,23 @@ impl Node {
 
 impl Dispatch {
     /// The lines a workgroup of a [`Dispatch::Lines`] covers (within [`Dispatch::Layers`] or
-    /// [`Dispatch::Interleaved`] too): the kernel's workgroup size it assumes. `None` for the
-    /// other kinds.
+    /// [`Dispatch::Interleaved`] too, and as the shipped dispatch of a
+    /// [`Dispatch::Redesigned`]): the kernel's workgroup size it assumes. `None` for the other
+    /// kinds.
     pub fn lines_per_group(&self) -> Option<u32> {
+        self.lines_per_group_in(false)
+    }
+
+    /// [`Dispatch::lines_per_group`] in the redesign layout too (`redesign`), where a
+    /// [`Dispatch::Redesigned`] is its redesign's dispatch, whose kernel is its own file and
+    /// may give a line several invocations: `None` there.
+    pub fn lines_per_group_in(&self, redesign: bool) -> Option<u32> {
         match self {
             Self::Lines { per_group, .. } => Some(*per_group),
-            Self::Layers { base, .. } | Self::Interleaved { base, .. } => base.lines_per_group(),
+            Self::Layers { base, .. } | Self::Interleaved { base, .. } => {
+                base.lines_per_group_in(redesign)
+            }
+            Self::Redesigned { shipped, .. } if !redesign => shipped.lines_per_group_in(false),
             _ => None,
         }
     }

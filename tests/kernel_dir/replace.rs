@@ -233,7 +233,11 @@ fn kernel_layout_is_the_devices_unless_forced() {
     );
     refused(
         &o,
-        &[KERNEL_LAYOUT_ENV, "fast", "`gpu`, `cpu` or `redesign`"],
+        &[
+            KERNEL_LAYOUT_ENV,
+            "fast",
+            "`gpu`, `cpu`, `redesign` or `redesign-textures`",
+        ],
     );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -90,8 +90,8 @@ impl KernelLayout {
         }
     }
 
-    /// `gpu`, `cpu` or `redesign`, as [`KERNEL_LAYOUT_ENV`] and `shadowgraph bench --layouts`
-    /// spell it; else what is wrong with `name`.
+    /// `gpu`, `cpu`, `redesign` or `redesign-textures`, as [`KERNEL_LAYOUT_ENV`] and
+    /// `shadowgraph bench --layouts` spell it; else what is wrong with `name`.
     pub fn parse(name: &str) -> std::result::Result<Self, String> {
         match name {
             "gpu" => Ok(Self::Gpu),
