@@ -21,9 +21,9 @@
 #      in both), each size its own process, the buffer copy and both texture copies first in
 #      each (the roofline rows): 4096² (80 s), then 8192² (125 s); then the intermediates in
 #      storage buffers against textures (`--layouts redesign,redesign-textures`, the blurs'
-#      two passes, 4096²: 20 s); then the shader modules with and without wgpu's runtime
-#      checks (`--kernel-dirs shipped,unchecked` in the redesign layout, 4096², the
-#      encodings, blurs, mips and tables: 20 s).
+#      two passes and the tables' edges and carries, 4096²: 25 s); then the shader modules
+#      with and without wgpu's runtime checks (`--kernel-dirs shipped,unchecked` in the
+#      redesign layout, 4096², the encodings, blurs, mips and tables: 15 s).
 #   c. the redesign's maps against the GPU layout's on this device, bit for bit (five
 #      technique scenes dumped in both layouts: 15 s). The kernel decisions, b and c: 260 s.
 #
@@ -54,12 +54,18 @@
 #   the fused blurs: `…_blur …`), and its roof reaches the target where the shipped kernel's
 #   did not, or gains 0.05; slower in any of them: it stays in the redesign layout.
 #   Within 3% either way: the simpler kernel stays (the shipped one).
-# - buffers.txt, `<case> [redesign]` (the blur's row output in a row-major storage buffer)
-#   against `<case> [redesign-textures]` (in a texture), its `blur_h` and `blur_v` pass rows
-#   summed: intermediates move to storage buffers (`KernelLayout::buffers_intermediates`
-#   becomes the GPU layout's) where that sum is 3% or more faster in every blur case at
-#   4096² (the row pass's stores lane per row, the column pass's loads coalesced); slower in
-#   any: they stay textures. Within 3%: textures (one path for every resource).
+# - buffers.txt, `<case> [redesign]` (intermediates in row-major storage buffers: the blur's
+#   row output, the tables' edges and carries) against `<case> [redesign-textures]` (in
+#   textures), the passes that write or read them summed (`blur_h` + `blur_v`; a table's
+#   `.tile_sums` + `.carries` + its last pass): intermediates move to storage buffers
+#   (`KernelLayout::buffers_intermediates` becomes the GPU layout's) where that sum is 3% or
+#   more faster in every case at 4096²; slower in any: they stay textures. Within 3%:
+#   textures (one path for every resource). The blurs and the tables may decide apart.
+# - kernels.txt, the tables' `.carries` pass rows (`sat fixed`, `sat float`, `chain vssm`,
+#   `chain msm_soft`, `chain cssm 8 terms`), `[redesign]` (`kernels/sat_carries_scan.wgsl`,
+#   8 lanes a line) against `[gpu]` (a line an invocation): the scan ships where its
+#   `.carries` row is 3% or more faster at 4096² and 8192² in every one of them (the table
+#   totals mix the tile passes' redesign in); slower in any: the serial carries stay.
 # - checks.txt, `[unchecked]` against `[shipped]` (both in the redesign layout): wgpu's runtime
 #   checks cost a kernel where its unchecked row is 5% or more faster at 4096²; that kernel's
 #   loops over private arrays are rewritten with constant indices (unrolled by hand, which
@@ -127,10 +133,12 @@ step kernels.txt 125 "$B" bench --sizes "$SECOND" --repeat "$REPEAT" --passes --
 # Wgpu's runtime checks (naga bounding every index and loop) against none, in the redesign
 # layout, whose kernels loop over private arrays; each case in both, adjacent in time.
 # The intermediates in storage buffers against textures, in the redesign's kernels: the
-# separable blurs, whose row output only their column pass reads.
-step buffers.txt 20 "$B" bench --sizes "$FIRST" --repeat "$REPEAT" --passes \
-    --only 'blur rg32f,blur log,vsm_blur r32,msm_blur r32' --layouts redesign,redesign-textures
-SHADOWGRAPH_KERNEL_LAYOUT=redesign step checks.txt 20 "$B" bench --sizes "$FIRST" \
+# separable blurs, whose row output only their column pass reads, and the tables' edges and
+# carries.
+step buffers.txt 25 "$B" bench --sizes "$FIRST" --repeat "$REPEAT" --passes \
+    --only 'blur rg32f,blur log,vsm_blur r32,msm_blur r32,sat fixed,sat float,chain vssm' \
+    --layouts redesign,redesign-textures
+SHADOWGRAPH_KERNEL_LAYOUT=redesign step checks.txt 15 "$B" bench --sizes "$FIRST" \
     --repeat "$REPEAT" --only 'linearize,evsm4,msm f16,chain vsm (depth,blur rg32f,vsm_blur r4,mips,sat fixed' \
     --kernel-dirs shipped,unchecked
 

@@ -2,8 +2,9 @@
 //! never-filtered intermediate of a plan in a row-major buffer; `RedesignTextures` runs the same
 //! kernels with textures): the separable blur's row output in every format a buffer holds bit
 //! for bit, against the f64 blur and bit for bit against the same kernels with textures; the
-//! log-space blur; and which resources the executor puts in buffers (row outputs only: never a
-//! requested output, a 16-bit format or a map past the device's binding size).
+//! log-space blur; the summed-area tables' edges and carries; and which resources the executor
+//! puts in buffers (intermediates only: never a requested output, a 16-bit format, a map past
+//! the device's binding size, or one a kernel passes on to a function).
 
 mod common;
 
@@ -257,4 +258,66 @@ fn only_unfiltered_intermediates_that_a_buffer_holds_go_to_buffers() {
     let out = add_filter(&mut graph, 0, "in", &filter, BlurMode::Linear);
     let both = plan(&graph, &["in.blur_h", &out]).expect("plan");
     assert!(in_buffers(&both, KernelLayout::Redesign, &limits).is_empty());
+}
+
+#[test]
+fn table_edges_and_carries_in_buffers_are_the_textures_words() {
+    use shadowgraph::low_level::gpu::read_texture;
+    use shadowgraph::low_level::sat::{SatCoding, add_sat};
+    let g = common::gpu();
+    let mut rng = common::rng(0x5A7);
+    // Ragged tiles, and rows of more than one segment of the carries' scan (64 tiles).
+    for (w, h) in [(100u32, 70u32), (2090, 40)] {
+        let values = random_texels(&mut rng, (w, h), 2);
+        let mut graph = Graph::default();
+        graph.import("in", wgpu::TextureFormat::Rg32Float, w, h, Some(0));
+        let tex = common::upload(
+            &g.device,
+            &g.queue,
+            "in",
+            (w, h),
+            wgpu::TextureFormat::Rg32Float,
+            bytemuck::cast_slice(&values),
+        );
+        let imports = HashMap::from([("in".to_string(), tex)]);
+        for coding in [
+            SatCoding::fixed(u64::from(w * h), [-4.0; 4], [8.0; 4]).expect("fixed"),
+            SatCoding::float([-4.0; 4], [8.0; 4]).expect("float"),
+        ] {
+            let mut graph = graph.clone();
+            let out = add_sat(&mut graph, 0, "in", &coding);
+            let plan = plan(&graph, &[&out]).expect("plan");
+            let words = |layout| {
+                let mut exec = Executor::new();
+                exec.kernels.set_layout(layout);
+                let mut enc = g.device.create_command_encoder(&Default::default());
+                let outputs = exec
+                    .record(&g.device, &mut enc, &plan, &imports, None)
+                    .expect("record");
+                for b in outputs.buffers.values() {
+                    g.queue
+                        .write_buffer(&b.buffer, 0, &vec![0xFF; b.buffer.size() as usize]);
+                }
+                submit_and_wait(&g.device, &g.queue, enc, "table").expect("submit");
+                let bytes = read_texture(&g.device, &g.queue, &outputs.textures[&out], 0);
+                let mut held: Vec<String> = outputs.buffers.keys().cloned().collect();
+                held.sort();
+                (bytes.expect("read"), held)
+            };
+            let (got, held) = words(KernelLayout::Redesign);
+            let (want, _) = words(KernelLayout::RedesignTextures);
+            let what = format!("{w}x{h} {:?}", coding.variant);
+            assert!(
+                got == want,
+                "{what}: the table differs from the textures' one"
+            );
+            // With subgroups the tile passes (`shared/sat_strip`) read the carries by
+            // `textureLoad` alone; the shipped passes hand them to functions (textures).
+            if g.device.features().contains(wgpu::Features::SUBGROUP) {
+                let parts = ["col_carry", "col_part", "row_carry", "row_part"];
+                let want: Vec<String> = parts.iter().map(|p| format!("in.sat.{p}")).collect();
+                assert_eq!(held, want, "{what}: the edges and carries in buffers");
+            }
+        }
+    }
 }

@@ -9,7 +9,7 @@
 //! kernels keep one source, and the bits they store and load are the texture's bit for bit
 //! (32-bit channels are stored as they are; a packed f16 pair as its `r32uint` word).
 
-use super::packed::{replace_decl, rewrite_calls, with_module};
+use super::packed::{replace_decl, rewrite_calls, shadowed, with_module};
 
 /// How a texel of a bound format lives in a buffer element.
 struct Element {
@@ -140,18 +140,11 @@ fn dimensions(wgsl: &str, binding: &str) -> Option<String> {
     })
 }
 
-/// `wgsl` with the packed f16 helpers where an element uses them; `None` where a texture
-/// builtin is still called on `binding` (a use the rewrite does not know).
+/// `wgsl` with the packed f16 helpers where an element uses them; `None` where `binding` is
+/// still used otherwise than indexed (a texture builtin the rewrite does not know, the texture
+/// passed on to a function).
 fn finish(wgsl: String, binding: &str) -> Option<String> {
-    let left = [
-        "textureLoad",
-        "textureStore",
-        "textureDimensions",
-        "textureNumLevels",
-    ]
-    .iter()
-    .any(|f| rewrite_calls(&wgsl, f, binding, |_| None).is_none());
-    if left {
+    if used_unindexed(&wgsl, binding) {
         return None;
     }
     Some(if wgsl.contains("pack_f16x2(") {
@@ -159,6 +152,34 @@ fn finish(wgsl: String, binding: &str) -> Option<String> {
     } else {
         wgsl
     })
+}
+
+/// Whether `wgsl` (comments aside) names `binding` anywhere but in its declaration
+/// (`binding:`), indexed (`binding[`) or where a function's parameter of that name shadows it.
+fn used_unindexed(wgsl: &str, binding: &str) -> bool {
+    let code: String = wgsl
+        .lines()
+        .map(|l| l.split("//").next().unwrap_or(""))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let word = |c: char| c.is_alphanumeric() || c == '_';
+    let mut from = 0;
+    while let Some(found) = code[from..].find(binding) {
+        let at = from + found;
+        let end = at + binding.len();
+        from = end;
+        let before = code[..at].chars().next_back().is_some_and(word);
+        let after = code[end..].chars().next().is_some_and(word);
+        if before || after {
+            continue;
+        }
+        let next = code[end..].trim_start().chars().next();
+        if matches!(next, Some('[' | ':')) || shadowed(&code[..at], binding) {
+            continue;
+        }
+        return true;
+    }
+    false
 }
 
 #[cfg(test)]
@@ -198,10 +219,19 @@ mod tests {
         assert_eq!(s.matches("fn pack_f16x2(").count(), 1);
         // 16-bit channels round on a texture store: not held bit for bit, not rewritten.
         assert!(store_to_buffer(KERNEL, "dst", T::Rgba16Float, [4, 4]).is_none());
-        // A texture passed on to a function is a use the rewrite does not know.
-        let passed = "@group(0) @binding(0) var src: texture_2d<f32>;\n\
+        // A builtin the rewrite does not know, or the texture passed on to a function, is a
+        // use it refuses; a parameter of the binding's name shadows it.
+        let levels = "@group(0) @binding(0) var src: texture_2d<f32>;\n\
                       fn f() -> u32 { return textureNumLevels(src); }\n";
+        assert!(load_from_buffer(levels, "src", T::R32Float, [4, 4]).is_none());
+        let passed = "@group(0) @binding(0) var src: texture_2d<f32>;\n\
+                      fn g(src: texture_2d<f32>) -> f32 { return textureLoad(src, vec2(0), 0).x; }\n\
+                      fn f() -> f32 { return g(src); } // src\n";
         assert!(load_from_buffer(passed, "src", T::R32Float, [4, 4]).is_none());
+        let shadowing = passed.replace("return g(src);", "return textureLoad(src, vec2(1), 0).x;");
+        let s = load_from_buffer(&shadowing, "src", T::R32Float, [4, 4]).unwrap();
+        assert!(s.contains("{ return textureLoad(src, vec2(0), 0).x; }"));
+        assert!(s.contains("return src_buffer_load(vec2<i32>(vec2(1))).x;"));
         assert!(load_from_buffer(KERNEL, "nothing", T::R32Float, [4, 4]).is_none());
     }
 }

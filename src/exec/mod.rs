@@ -14,6 +14,7 @@ mod buffers;
 mod node_constants;
 mod packed;
 pub mod pipelines;
+mod placement;
 pub mod pool;
 mod record;
 
@@ -28,8 +29,9 @@ pub use pipelines::{
     REDESIGNED_MODULES, SHADER_CHECKS_ENV, ShaderChecks, WorkgroupInit, specialized_buffer_source,
     specialized_source, wgsl_storage_format,
 };
+pub use placement::{buffer_slots, slot_in_buffer};
 use pool::Held;
-pub use pool::{BufferMap, Outputs, TexturePool, slot_in_buffer};
+pub use pool::{BufferMap, Outputs, TexturePool};
 
 /// Runs plans: owns pipelines, pooled textures and what the last plan's run needs; borrows
 /// everything else.
@@ -67,10 +69,19 @@ impl Executor {
 
     /// Compiles every kernel `plan` uses (also done lazily by [`Executor::record`]).
     pub fn prepare(&mut self, device: &wgpu::Device, plan: &Plan) -> Result<()> {
+        let in_buffer = self.buffer_slots(device, plan)?;
         for step in &plan.steps {
-            record::compile(&mut self.kernels, device, plan, &step.node)?;
+            record::compile(&mut self.kernels, device, plan, &in_buffer, &step.node)?;
         }
         Ok(())
+    }
+
+    /// Per slot of `plan`, whether this executor holds it in a storage buffer on `device`
+    /// ([`buffer_slots`] in its kernels' layout, with their sources).
+    fn buffer_slots(&self, device: &wgpu::Device, plan: &Plan) -> Result<Vec<bool>> {
+        let layout = self.kernels.layout_for(device)?;
+        let sources = self.kernels.sources_for(device)?;
+        buffer_slots(plan, layout, &device.limits(), sources.as_deref())
     }
 
     /// Compute dispatches this executor has recorded so far, every run together (a run's are
@@ -196,14 +207,13 @@ impl Executor {
         for (slot, held) in self.in_use.drain(..) {
             self.pool.give_back(slot, held);
         }
-        let layout = self.kernels.layout_for(device)?;
-        let limits = device.limits();
+        let in_buffer = self.buffer_slots(device, plan)?;
         let held: Vec<Held> = plan
             .slots
             .iter()
-            .enumerate()
-            .map(|(i, s)| {
-                if slot_in_buffer(plan, i, layout, &limits) {
+            .zip(&in_buffer)
+            .map(|(s, &buffer)| {
+                if buffer {
                     Held::Buffer(self.pool.take_buffer(device, s))
                 } else {
                     Held::Texture(self.pool.take(device, s))

@@ -95,7 +95,7 @@ pub(super) fn rewrite_calls(
 
 /// Whether the function that `before` ends inside (WGSL functions are module-scope, declared
 /// at the start of a line here) has a parameter named `binding`.
-fn shadowed(before: &str, binding: &str) -> bool {
+pub(super) fn shadowed(before: &str, binding: &str) -> bool {
     let Some(start) = before
         .rfind("\nfn ")
         .map(|at| at + 1)

@@ -13,6 +13,7 @@ pub use self::layout::{
     GPU_LAYOUT_CONSTANT, KERNEL_LAYOUT_ENV, KernelLayout, REDESIGN_CONSTANT, REDESIGNED_KERNELS,
     REDESIGNED_MODULES, SHADER_CHECKS_ENV, ShaderChecks, WorkgroupInit,
 };
+pub(crate) use self::specialize::rewrites_to_buffer;
 use self::specialize::{apply, changes};
 pub use self::specialize::{specialized_buffer_source, specialized_source, wgsl_storage_format};
 use super::node_constants::NodeOverrides;
@@ -261,7 +262,10 @@ impl KernelCache {
     /// The texts kernels resolve with on `device`: [`KernelCache::set_replacements`]'s, and the
     /// redesigned modules its layout and features take ([`KernelLayout::module_sources`]) where
     /// those do not replace the shipped module themselves.
-    fn sources_for(&self, device: &wgpu::Device) -> Result<Option<Arc<kernels::Replacements>>> {
+    pub(crate) fn sources_for(
+        &self,
+        device: &wgpu::Device,
+    ) -> Result<Option<Arc<kernels::Replacements>>> {
         let modules = self.layout_for(device)?.module_sources(device.features());
         if modules.is_empty() {
             return Ok(self.replaced.clone());

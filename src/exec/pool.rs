@@ -9,8 +9,6 @@ use crate::gpu::read_buffer;
 use crate::gpu_objects;
 use crate::graph::{Plan, Slot};
 
-use super::KernelLayout;
-
 /// Textures (and buffers) kept across runs, keyed by shape; a plan takes the ones it needs in
 /// order.
 #[derive(Default)]
@@ -20,7 +18,7 @@ pub struct TexturePool {
 }
 
 /// What holds a slot's resources: a texture, or a row-major storage buffer
-/// ([`slot_in_buffer`]).
+/// ([`super::buffer_slots`]).
 #[derive(Clone)]
 pub(super) enum Held {
     Texture(wgpu::Texture),
@@ -41,35 +39,8 @@ pub struct BufferMap {
     pub format: wgpu::TextureFormat,
 }
 
-/// Whether `plan`'s slot `slot` is a storage buffer in `layout` on a device of `limits`: where
-/// the layout keeps intermediates in buffers, every resource of the slot is
-/// [`crate::graph::Resource::unfiltered`] and no requested output (which a shading pass or a
-/// host samples), the slot has one level, its format is held bit for bit
-/// (`exec::buffers`), and its bytes fit one storage binding (else it stays a texture).
-pub fn slot_in_buffer(
-    plan: &Plan,
-    slot: usize,
-    layout: KernelLayout,
-    limits: &wgpu::Limits,
-) -> bool {
-    let Some(s) = plan.slots.get(slot) else {
-        return false;
-    };
-    let format = crate::graph::texture_format(s.format);
-    let bytes = u64::from(s.width) * u64::from(s.height) * crate::graph::texel_bytes(format);
-    layout.buffers_intermediates()
-        && s.mips == 1
-        && super::buffers::holds(format)
-        && bytes <= limits.max_storage_buffer_binding_size.min(limits.max_buffer_size)
-        && plan
-            .resources
-            .iter()
-            .filter(|r| r.slot == Some(slot))
-            .all(|r| r.resource.unfiltered && !plan.outputs.contains(&r.resource.name))
-}
-
 impl TexturePool {
-    /// A buffer for `slot` ([`slot_in_buffer`]): a free one of its shape, or a new one.
+    /// A buffer for `slot` ([`super::buffer_slots`]): a free one of its shape, or a new one.
     pub(super) fn take_buffer(&mut self, device: &wgpu::Device, slot: &Slot) -> wgpu::Buffer {
         if let Some(b) = self.free_buffers.get_mut(slot).and_then(Vec::pop) {
             return b;
@@ -136,8 +107,8 @@ impl TexturePool {
 pub struct Outputs {
     /// Texture of every planned resource held in a texture, imports included.
     pub textures: HashMap<String, wgpu::Texture>,
-    /// Buffer of every planned resource held in a storage buffer ([`slot_in_buffer`]; none
-    /// outside [`KernelLayout::Redesign`]).
+    /// Buffer of every planned resource held in a storage buffer ([`super::buffer_slots`];
+    /// none outside [`super::KernelLayout::Redesign`]).
     pub buffers: HashMap<String, BufferMap>,
     /// The array layer each imported resource is read from, where it is one layer of an array
     /// texture (absent: the whole texture).

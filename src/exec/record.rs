@@ -139,11 +139,12 @@ fn bound_buffers(
 }
 
 /// Compiles `node`'s pipeline for the formats `plan` binds, and the storage buffers it binds
-/// in `layout` (what [`bind_step`] will ask for).
+/// (`in_buffer`: per slot, [`super::buffer_slots`]): what [`bind_step`] will ask for.
 pub(super) fn compile(
     kernels: &mut KernelCache,
     device: &wgpu::Device,
     plan: &Plan,
+    in_buffer: &[bool],
     node: &Node,
 ) -> Result<()> {
     let base = kernels.get(device, node.kernel.name())?;
@@ -152,12 +153,14 @@ pub(super) fn compile(
         plan.resource(r)
             .map(|p| crate::graph::texture_format(p.resource.format))
     });
-    let layout = kernels.layout_for(device)?;
-    let limits = device.limits();
     let buffers = bound_buffers(&specs, |r| {
         let p = plan.resource(r)?;
         let slot = p.slot?;
-        super::slot_in_buffer(plan, slot, layout, &limits).then_some([p.width, p.height])
+        in_buffer
+            .get(slot)
+            .copied()
+            .unwrap_or(false)
+            .then_some([p.width, p.height])
     });
     let overrides = kernels.node_constants(node.kernel.name(), &node.name, &node.params)?;
     kernels.get_for_node(device, node.kernel.name(), &formats, &buffers, &overrides)?;

@@ -58,7 +58,7 @@ pub fn add_sat_five_pass(
         y,
     };
     let mut res = |suffix: &str, size: SizeRule| {
-        graph.resource(format!("{name}.{suffix}"), u32x4, size, Some(light))
+        graph.intermediate(format!("{name}.{suffix}"), u32x4, size, Some(light))
     };
     let rows = res("rows", same.clone());
     let row_sums = res("row_sums", blocks(SAT_BLOCK, 1));

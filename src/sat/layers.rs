@@ -83,7 +83,8 @@ pub fn add_layered_sat(graph: &mut Graph, light: usize, sat: &LayeredSat<'_>) ->
             across,
             down,
         };
-        graph.resource(format!("{stem}.{suffix}"), words, size, Some(light))
+        // Read by the tables' own passes alone, with `textureLoad`.
+        graph.intermediate(format!("{stem}.{suffix}"), words, size, Some(light))
     };
     let col_part = edges("col_part", 1, SAT_TILE, 1, layers);
     let row_part = edges("row_part", SAT_TILE, 1, layers, 1);

@@ -288,7 +288,8 @@ pub fn add_sat(graph: &mut Graph, light: usize, input: &str, coding: &SatCoding)
         y,
     };
     let mut res = |suffix: &str, size: SizeRule| {
-        graph.resource(format!("{name}.{suffix}"), words, size, Some(light))
+        // Read by the table's own passes alone, with `textureLoad`.
+        graph.intermediate(format!("{name}.{suffix}"), words, size, Some(light))
     };
     let col_part = res("col_part", blocks(1, SAT_TILE));
     let row_part = res("row_part", blocks(SAT_TILE, 1));

@@ -341,16 +341,29 @@ fn packed_f16_variants_validate() {
 
 /// The storage-buffer variant (`exec::buffers`) of every kernel that writes or reads an
 /// intermediate the redesign layout keeps in a buffer validates, as the executor specializes
-/// it: every technique's plan (its shading maps requested), each step bound as
-/// `exec::slot_in_buffer` says at WebGPU's default limits, on 64² and 1024² maps. At least the
-/// blur's passes and the fused blurs' row kernels (both kinds) are rewritten.
+/// it: every technique's plan (its shading maps requested, 64² and 1024² maps), its slots
+/// placed as `exec::buffer_slots` places them at WebGPU's default limits, each kernel the file
+/// that layout compiles (`KernelLayout::kernel_source`), with the shipped modules and with the
+/// redesigned ones a device with subgroups takes. The blur's passes, the fused blurs' row
+/// kernels (both kinds) and the tables' carries are rewritten; with the redesigned modules the
+/// tables' tile passes too (the shipped ones pass the carries on to functions: their slots stay
+/// textures).
 #[test]
 fn storage_buffer_variants_validate() {
-    use shadowgraph::low_level::exec::{KernelLayout, slot_in_buffer, specialized_buffer_source};
+    use shadowgraph::low_level::exec::{KernelLayout, buffer_slots, specialized_buffer_source};
     use shadowgraph::low_level::graph::{Graph, plan, texture_format};
+    let redesign = KernelLayout::Redesign;
+    let modules: kernels::Replacements = redesign
+        .module_sources(wgpu::Features::all())
+        .into_iter()
+        .map(|(shipped, module)| {
+            let text = kernels::source(module).expect("redesigned module");
+            (shipped.to_string(), text.to_string())
+        })
+        .collect();
     let limits = wgpu::Limits::default();
     let mut failures = Vec::new();
-    let mut rewritten = BTreeSet::new();
+    let mut rewritten = [BTreeSet::new(), BTreeSet::new()];
     let mut techniques = all_techniques();
     // The fused blurs' two-pass fallback (past their tile's radius 7).
     for radius in [3.0, 12.0] {
@@ -391,48 +404,70 @@ fn storage_buffer_variants_validate() {
             failures.push(format!("{technique:?}: no plan"));
             continue;
         };
-        let in_buffer = |r: &str| {
-            let p = plan.resource(r)?;
-            let slot = p.slot?;
-            slot_in_buffer(&plan, slot, KernelLayout::Redesign, &limits)
-                .then_some([p.width, p.height])
-        };
-        for step in &plan.steps {
-            let node = &step.node;
-            let slots = node.inputs.iter().chain(&node.outputs);
-            let buffers: Vec<(String, [u32; 2])> = slots
-                .clone()
-                .filter_map(|(b, r)| in_buffer(r).map(|wh| (b.clone(), wh)))
-                .collect();
-            if buffers.is_empty() {
-                continue;
-            }
-            let formats: Vec<(String, wgpu::TextureFormat)> = slots
-                .filter_map(|(b, r)| {
-                    let f = plan.resource(r)?.resource.format;
-                    Some((b.clone(), texture_format(f)))
-                })
-                .collect();
-            let kernel = node.kernel.name();
-            match specialized_buffer_source(kernel, &formats, &buffers) {
-                Ok(wgsl) => {
-                    rewritten.insert(kernel.to_string());
-                    if let Err(e) = kernels::reflect(kernel, &wgsl) {
-                        failures.push(format!("{technique:?} {kernel}: {e}"));
-                    }
+        for (k, with) in [None, Some(&modules)].into_iter().enumerate() {
+            let held = match buffer_slots(&plan, redesign, &limits, with) {
+                Ok(h) => h,
+                Err(e) => {
+                    failures.push(format!("{technique:?}: {e}"));
+                    continue;
                 }
-                Err(e) => failures.push(format!("{technique:?} {kernel}: {e}")),
+            };
+            let in_buffer = |r: &str| {
+                let p = plan.resource(r)?;
+                held[p.slot?].then_some([p.width, p.height])
+            };
+            for step in &plan.steps {
+                let node = &step.node;
+                let slots = node.inputs.iter().chain(&node.outputs);
+                let buffers: Vec<(String, [u32; 2])> = slots
+                    .clone()
+                    .filter_map(|(b, r)| in_buffer(r).map(|wh| (b.clone(), wh)))
+                    .collect();
+                if buffers.is_empty() {
+                    continue;
+                }
+                let formats: Vec<(String, wgpu::TextureFormat)> = slots
+                    .filter_map(|(b, r)| {
+                        let f = plan.resource(r)?.resource.format;
+                        Some((b.clone(), texture_format(f)))
+                    })
+                    .collect();
+                let kernel = redesign.kernel_source(node.kernel.name());
+                match specialized_buffer_source(kernel, &formats, &buffers, with) {
+                    Ok(wgsl) => {
+                        rewritten[k].insert(kernel.to_string());
+                        if let Err(e) = kernels::reflect(kernel, &wgsl) {
+                            failures.push(format!("{technique:?} {kernel}: {e}"));
+                        }
+                    }
+                    Err(e) => failures.push(format!("{technique:?} {kernel}: {e}")),
+                }
             }
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
-    for k in [
+    let both = [
         "blur",
         "vsm_blur",
         "msm_blur",
         "vsm_blur_row",
         "msm_blur_row",
-    ] {
-        assert!(rewritten.contains(k), "{k} rewritten: {rewritten:?}");
+    ];
+    for k in both.iter().chain(&["sat_carries_scan"]) {
+        assert!(
+            rewritten[0].contains(*k),
+            "{k} rewritten: {:?}",
+            rewritten[0]
+        );
+    }
+    for k in both
+        .iter()
+        .chain(&["sat_carries_scan", "vsm_sat_tile_sums", "vsm_sat_tiles"])
+    {
+        assert!(
+            rewritten[1].contains(*k),
+            "{k} rewritten: {:?}",
+            rewritten[1]
+        );
     }
 }

@@ -141,6 +141,11 @@ fn build_with(g: &Gpu, exec: &mut Executor, map: &Map, coding: &SatCoding, add: 
             write_texture(&g.queue, t, &vec![0xFF; bytes]);
         }
     }
+    // Intermediates the redesign layout keeps in storage buffers too.
+    for b in outputs.buffers.values() {
+        g.queue
+            .write_buffer(&b.buffer, 0, &vec![0xFF; b.buffer.size() as usize]);
+    }
     submit_and_wait(&g.device, &g.queue, enc, "sat").expect("run");
     let texture = outputs.textures[&out].clone();
     let bytes = read_texture(&g.device, &g.queue, &texture, 0).expect("readback");

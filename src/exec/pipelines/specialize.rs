@@ -10,18 +10,25 @@ use crate::kernels::{self, Reflection};
 /// formats `formats` bound by binding name (no GPU needed: `tests/kernels_validate/`
 /// validates every variant a technique can bind).
 pub fn specialized_source(name: &str, formats: &[(String, wgpu::TextureFormat)]) -> Result<String> {
-    specialized_buffer_source(name, formats, &[])
+    specialized_buffer_source(name, formats, &[], None)
 }
 
 /// [`specialized_source`] with the bindings in `buffers` bound to storage buffers of maps of
-/// `[width, height]` texels of their format in `formats` (`exec::buffers`).
+/// `[width, height]` texels of their format in `formats` (`exec::buffers`), its modules
+/// resolved with `modules` in place of the embedded ones where given (a layout's redesigned
+/// modules, [`super::KernelLayout::module_sources`]).
 pub fn specialized_buffer_source(
     name: &str,
     formats: &[(String, wgpu::TextureFormat)],
     buffers: &[(String, [u32; 2])],
+    modules: Option<&kernels::Replacements>,
 ) -> Result<String> {
-    let (_, reflection) = kernels::reflect(name, &kernels::resolve(name, None)?)?;
-    apply(name, &changes(name, &reflection, formats, buffers)?, None)
+    let (_, reflection) = kernels::reflect(name, &kernels::resolve_in(name, None, modules)?)?;
+    apply(
+        name,
+        &changes(name, &reflection, formats, buffers)?,
+        modules,
+    )
 }
 
 /// The changes binding `formats` to kernel `name` needs, the bindings of `buffers` bound to
@@ -161,6 +168,18 @@ fn buffer_change(
             message: format!("`{binding}` is no 2-D texture: a storage buffer cannot replace it"),
         }),
     }
+}
+
+/// Whether `wgsl` can bind `binding` (of type `ty`) to a storage buffer of a map of `size`
+/// texels of `format`: whether the kernel uses it only in ways `exec::buffers` rewrites.
+pub(crate) fn rewrites_to_buffer(
+    wgsl: &str,
+    binding: &str,
+    ty: wgpu::BindingType,
+    format: wgpu::TextureFormat,
+    size: [u32; 2],
+) -> bool {
+    buffer_change("", binding, ty, format, size).is_ok_and(|c| c.apply(wgsl).is_some())
 }
 
 /// Whether `format` is a float texel format.
