@@ -318,10 +318,22 @@ pub fn read_sat_map(
     tables: &[usize],
 ) -> Result<FloatMap> {
     let raw = crate::gpu::read_texture(device, queue, texture, 0)?;
-    let words: &[u32] = bytemuck::cast_slice(&raw);
+    let size = (texture.width(), texture.height());
+    sat_map_from_words(name, bytemuck::cast_slice(&raw), size, coding, tables)
+}
+
+/// [`read_sat_map`] of the table `name` read back as `words` (its texture's or its storage
+/// buffer's: the same row-major words) of a `full_width × height` map.
+fn sat_map_from_words(
+    name: &str,
+    words: &[u32],
+    (full_width, height): (u32, u32),
+    coding: &crate::sat::SatCoding,
+    tables: &[usize],
+) -> Result<FloatMap> {
     let n = tables.len().max(1);
-    let (width, height) = (texture.width() / n as u32, texture.height());
-    let per_texel = words.len() / (texture.width() as usize * height as usize).max(1);
+    let width = full_width / n as u32;
+    let per_texel = words.len() / (full_width as usize * height as usize).max(1);
     let maps = tables
         .iter()
         .enumerate()
@@ -340,6 +352,30 @@ pub fn read_sat_map(
         })
         .collect();
     FloatMap::concat(maps)
+}
+
+/// [`read_sat_map`] of plan output `name`, in a texture or in a storage buffer
+/// ([`crate::exec::Outputs::buffers`]).
+fn read_sat_output(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    outputs: &Outputs,
+    name: &str,
+    coding: &crate::sat::SatCoding,
+    tables: &[usize],
+) -> Result<FloatMap> {
+    if let Some(t) = outputs.textures.get(name) {
+        return read_sat_map(device, queue, name, t, coding, tables);
+    }
+    let b = outputs
+        .buffers
+        .get(name)
+        .ok_or_else(|| Error::Invalid(format!("the plan has no map `{name}`")))?;
+    let encoder = device.create_command_encoder(&Default::default());
+    let raw = crate::gpu::submit_and_read(device, queue, encoder, &b.buffer, "read back")?;
+    let words: &[u32] = bytemuck::cast_slice(&raw);
+    let size = (b.width, b.height);
+    sat_map_from_words(name, words, size, coding, tables)
 }
 
 /// Adds to `frame` what `opts` asks for besides the image: every resource of the plan
@@ -376,15 +412,12 @@ fn read_extras(
             .iter()
             .zip(tables)
             .map(|(m, n)| match &coding {
-                Some(c) => read_sat_map(device, queue, m, &outputs.textures[m], c, &n),
+                Some(c) => read_sat_output(device, queue, outputs, m, c, &n),
                 None => FloatMap::read(device, queue, m, &outputs.textures[m], format_of(m)),
             })
             .collect::<Result<Vec<_>>>()?;
         frame.shade_maps.push(FloatMap::concat(maps)?);
-        let levels = input
-            .maps
-            .first()
-            .map_or(1, |m| outputs.textures[m].mip_level_count());
+        let levels = input.maps.first().map_or(1, |m| outputs.levels(m));
         let mut mips = Vec::new();
         for level in 1..levels {
             let maps = input

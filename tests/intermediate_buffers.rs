@@ -216,7 +216,7 @@ fn only_unfiltered_intermediates_that_a_buffer_holds_go_to_buffers() {
             .iter()
             .filter(|r| {
                 r.slot
-                    .is_some_and(|s| slot_in_buffer(plan, s, layout, limits))
+                    .is_some_and(|s| slot_in_buffer(plan, s, layout, limits, false))
             })
             .map(|r| r.resource.name.clone())
             .collect()
@@ -252,12 +252,24 @@ fn only_unfiltered_intermediates_that_a_buffer_holds_go_to_buffers() {
         ..limits.clone()
     };
     assert!(in_buffers(&rg, KernelLayout::Redesign, &small).is_empty());
-    // A requested output is sampled by a shading pass or a host: never a buffer.
+    // A requested output is bound by a host as a texture: a buffer only where the caller
+    // allows it (the renderer, whose shading reads them rewritten), and never one that is
+    // filtered (the blur's output).
     let mut graph = Graph::default();
     graph.import("in", wgpu::TextureFormat::Rg32Float, 64, 64, Some(0));
     let out = add_filter(&mut graph, 0, "in", &filter, BlurMode::Linear);
     let both = plan(&graph, &["in.blur_h", &out]).expect("plan");
     assert!(in_buffers(&both, KernelLayout::Redesign, &limits).is_empty());
+    let allowed: Vec<&str> = both
+        .resources
+        .iter()
+        .filter(|r| {
+            r.slot
+                .is_some_and(|s| slot_in_buffer(&both, s, KernelLayout::Redesign, &limits, true))
+        })
+        .map(|r| r.resource.name.as_str())
+        .collect();
+    assert_eq!(allowed, ["in.blur_h"]);
 }
 
 #[test]
@@ -319,5 +331,77 @@ fn table_edges_and_carries_in_buffers_are_the_textures_words() {
                 assert_eq!(held, want, "{what}: the edges and carries in buffers");
             }
         }
+    }
+}
+
+/// Renders bundled technique scene `name` (shrunk to 160 × 120 with 128² maps) in `layout`:
+/// the image and visibility, and the plan outputs its executor held in storage buffers.
+fn render_in(name: &str, layout: KernelLayout) -> (Vec<u8>, Vec<f32>, Vec<String>) {
+    use shadowgraph::low_level::render::{RenderOptions, Renderer};
+    use shadowgraph::low_level::scene::Scene;
+    let g = common::gpu();
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes/techniques")
+        .join(format!("{name}.toml"));
+    let text = std::fs::read_to_string(&path)
+        .expect("scene")
+        .replace("width = 400", "width = 160")
+        .replace("height = 300", "height = 120")
+        .replace("shadow_map = 512", "shadow_map = 128");
+    let scene = Scene::parse(&path, &text).expect("parse");
+    let mut r = Renderer::new(&g.device);
+    r.executor.kernels.set_layout(layout);
+    let opts = RenderOptions {
+        aux: true,
+        ..RenderOptions::default()
+    };
+    let frame = r.render(&g.device, &g.queue, &scene, opts).expect("render");
+    let plan = shadowgraph::low_level::render::plan_lights_for(&scene.lights, &opts)
+        .expect("plan")
+        .plan;
+    let held = r
+        .executor
+        .buffer_slots(&g.device, &plan)
+        .expect("placement");
+    let mut names: Vec<String> = plan
+        .resources
+        .iter()
+        .filter(|p| p.slot.is_some_and(|s| held[s]))
+        .map(|p| p.resource.name.clone())
+        .collect();
+    names.sort();
+    (frame.rgba, frame.visibility, names)
+}
+
+/// The renderer's shading pass reads fixed-point tables that the redesign layout keeps in
+/// storage buffers (its lookups specialized to each table, `exec::monomorph`, then its loads
+/// rewritten): `msm_soft`'s and `vsm_sat`'s frames the same bit for bit as with the tables in
+/// textures, their visibility too, and the tables in buffers.
+#[test]
+fn the_shading_reads_tables_in_buffers_as_in_textures() {
+    for (name, table) in [
+        ("msm_soft", "light0.msm.sat"),
+        ("vsm_sat", "light0.vsm.sat"),
+    ] {
+        let (rgba, vis, held) = render_in(name, KernelLayout::Redesign);
+        let (want_rgba, want_vis, none) = render_in(name, KernelLayout::RedesignTextures);
+        assert!(held.contains(&table.to_string()), "{name}: {held:?}");
+        assert!(none.is_empty(), "{name}: textures only, {none:?}");
+        assert!(
+            vis.iter().any(|&v| v < 0.5) && vis.iter().any(|&v| v > 0.5),
+            "{name}: shadow and light"
+        );
+        assert!(
+            rgba == want_rgba,
+            "{name}: the image differs from the textures' one"
+        );
+        let same = vis
+            .iter()
+            .zip(&want_vis)
+            .all(|(a, b)| a.to_bits() == b.to_bits());
+        assert!(
+            same,
+            "{name}: the visibility differs from the textures' one"
+        );
     }
 }

@@ -11,6 +11,7 @@
 //! (textures by shape, the run's outputs), `record` (bind groups and the passes).
 
 mod buffers;
+mod monomorph;
 mod node_constants;
 mod packed;
 pub mod pipelines;
@@ -44,6 +45,8 @@ pub struct Executor {
     prepared: Option<Prepared>,
     /// Compute dispatches recorded so far.
     dispatches: u64,
+    /// Whether requested outputs may live in storage buffers ([`Executor::set_output_buffers`]).
+    output_buffers: bool,
 }
 
 /// What a plan's run needs besides its passes, made once and reused while the plan and the
@@ -78,10 +81,26 @@ impl Executor {
 
     /// Per slot of `plan`, whether this executor holds it in a storage buffer on `device`
     /// ([`buffer_slots`] in its kernels' layout, with their sources).
-    fn buffer_slots(&self, device: &wgpu::Device, plan: &Plan) -> Result<Vec<bool>> {
+    pub fn buffer_slots(&self, device: &wgpu::Device, plan: &Plan) -> Result<Vec<bool>> {
         let layout = self.kernels.layout_for(device)?;
         let sources = self.kernels.sources_for(device)?;
-        buffer_slots(plan, layout, &device.limits(), sources.as_deref())
+        let limits = device.limits();
+        buffer_slots(
+            plan,
+            layout,
+            &limits,
+            sources.as_deref(),
+            self.output_buffers,
+        )
+    }
+
+    /// Lets requested outputs that are never filtered (a fixed-point summed-area table) live
+    /// in storage buffers too, in a layout that keeps intermediates in buffers
+    /// ([`KernelLayout::buffers_intermediates`]): for a caller whose readers of them are
+    /// rewritten as the graph's kernels are (the renderer's shading pass), never for a host,
+    /// which binds the outputs as textures. Off by default.
+    pub fn set_output_buffers(&mut self, on: bool) {
+        self.output_buffers = on;
     }
 
     /// Compute dispatches this executor has recorded so far, every run together (a run's are

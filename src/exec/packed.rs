@@ -122,7 +122,7 @@ fn identifier_after(s: &str) -> &str {
 
 /// The arguments of a call whose text after `(` is `s`, split at top-level commas and
 /// trimmed, and the length of `s` up to and including the closing `)`.
-fn split_args(s: &str) -> Option<(Vec<&str>, usize)> {
+pub(super) fn split_args(s: &str) -> Option<(Vec<&str>, usize)> {
     let mut depth = 0usize;
     let mut start = 0;
     let mut args = Vec::new();

@@ -14,7 +14,7 @@ pub use self::layout::{
     REDESIGNED_MODULES, SHADER_CHECKS_ENV, ShaderChecks, WorkgroupInit,
 };
 pub(crate) use self::specialize::rewrites_to_buffer;
-use self::specialize::{apply, changes};
+use self::specialize::{apply, apply_changes, changes};
 pub use self::specialize::{specialized_buffer_source, specialized_source, wgsl_storage_format};
 use super::node_constants::NodeOverrides;
 use crate::error::{Error, Result};
@@ -367,6 +367,39 @@ impl KernelCache {
         let source = layout.kernel_source(name);
         let wgsl = kernels::resolve_in(source, generated, self.sources_for(device)?.as_deref())?;
         let k = Arc::new(self.compile(device, source, &wgsl)?);
+        self.kernels.insert(key, k.clone());
+        Ok(k)
+    }
+
+    /// [`KernelCache::get_keyed`] with the bindings of `buffers` bound to storage buffers of
+    /// maps of `[width, height]` texels of their formats in `formats` (`exec::buffers`: the
+    /// renderer's shading pass over tables held in buffers), cached under `key` and the
+    /// buffers; [`KernelCache::get_keyed`] itself where `buffers` is empty.
+    pub fn get_keyed_buffers(
+        &mut self,
+        device: &wgpu::Device,
+        (key, name): (&str, &str),
+        generated: impl FnOnce() -> String,
+        formats: &[(String, wgpu::TextureFormat)],
+        buffers: &[(String, [u32; 2])],
+    ) -> Result<Arc<ComputeKernel>> {
+        if buffers.is_empty() {
+            return self.get_keyed(device, key, name, generated);
+        }
+        let key = format!("{key}@{buffers:?}");
+        if let Some(k) = self.kernels.get(&key) {
+            return Ok(k.clone());
+        }
+        let wgsl = kernels::resolve_in(name, Some(&generated()), self.replaced.as_deref())?;
+        let (_, reflection) = kernels::reflect(name, &wgsl)?;
+        let bound: Vec<(String, wgpu::TextureFormat)> = formats
+            .iter()
+            .filter(|(b, _)| buffers.iter().any(|(n, _)| n == b))
+            .cloned()
+            .collect();
+        let changes = changes(name, &reflection, &bound, buffers)?;
+        let wgsl = apply_changes(name, wgsl, &changes)?;
+        let k = Arc::new(self.compile(device, name, &wgsl)?);
         self.kernels.insert(key, k.clone());
         Ok(k)
     }

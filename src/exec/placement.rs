@@ -11,15 +11,17 @@ use super::KernelLayout;
 
 /// Whether `plan`'s slot `slot` may be a storage buffer in `layout` on a device of `limits`:
 /// where the layout keeps intermediates in buffers, every resource of the slot is
-/// [`crate::graph::Resource::unfiltered`] and no requested output (which a shading pass or a
-/// host samples), the slot has one level, its format is held bit for bit
-/// (`exec::buffers`), and its bytes fit one storage binding (else it stays a texture).
-/// [`buffer_slots`] also asks the kernels that bind it.
+/// [`crate::graph::Resource::unfiltered`] and, unless `outputs` (a caller whose readers of the
+/// outputs take buffers: the renderer's shading pass, [`super::Executor::set_output_buffers`]),
+/// no requested output (which a host binds as a texture), the slot has one level, its format is
+/// held bit for bit (`exec::buffers`), and its bytes fit one storage binding (else it stays a
+/// texture). [`buffer_slots`] also asks the kernels that bind it.
 pub fn slot_in_buffer(
     plan: &Plan,
     slot: usize,
     layout: KernelLayout,
     limits: &wgpu::Limits,
+    outputs: bool,
 ) -> bool {
     let Some(s) = plan.slots.get(slot) else {
         return false;
@@ -37,11 +39,11 @@ pub fn slot_in_buffer(
             .resources
             .iter()
             .filter(|r| r.slot == Some(slot))
-            .all(|r| r.resource.unfiltered && !plan.outputs.contains(&r.resource.name))
+            .all(|r| r.resource.unfiltered && (outputs || !plan.outputs.contains(&r.resource.name)))
 }
 
 /// Per slot of `plan`, whether the executor holds it in a storage buffer in `layout` on a
-/// device of `limits`, each node's kernel the file the layout compiles
+/// device of `limits` (requested outputs too where `outputs`), each node's kernel the file the layout compiles
 /// ([`KernelLayout::kernel_source`]) resolved with `sources` (replaced kernels and the
 /// layout's redesigned modules): a slot of [`slot_in_buffer`] that every kernel binding it
 /// uses only through `textureLoad`, `textureStore` and `textureDimensions` (what
@@ -52,9 +54,10 @@ pub fn buffer_slots(
     layout: KernelLayout,
     limits: &wgpu::Limits,
     sources: Option<&Replacements>,
+    outputs: bool,
 ) -> Result<Vec<bool>> {
     let mut held: Vec<bool> = (0..plan.slots.len())
-        .map(|i| slot_in_buffer(plan, i, layout, limits))
+        .map(|i| slot_in_buffer(plan, i, layout, limits, outputs))
         .collect();
     if !held.contains(&true) {
         return Ok(held);

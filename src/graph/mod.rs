@@ -75,11 +75,12 @@ pub struct Resource {
     /// `(x·n + k, y)` is texel `(x, y)` of `layers[k]` (n = `layers.len()`). Empty for a
     /// plain resource.
     pub layers: Vec<String>,
-    /// An intermediate that is never filtered: written by `textureStore` and read only by
-    /// `textureLoad` at level 0 of graph kernels, never by the shading or a host. In a layout
-    /// that keeps such intermediates in storage buffers
+    /// Never filtered: written by `textureStore` and read only by `textureLoad` at level 0
+    /// (by graph kernels, or as an output by the renderer's shading, e.g. a fixed-point
+    /// summed-area table). In a layout that keeps such maps in storage buffers
     /// ([`crate::exec::KernelLayout::buffers_intermediates`]) the executor may hold it in a
-    /// row-major buffer instead of a texture ([`Graph::intermediate`]).
+    /// row-major buffer instead of a texture ([`Graph::intermediate`],
+    /// [`crate::exec::buffer_slots`]; a requested output only for a caller that allows it).
     pub unfiltered: bool,
 }
 
@@ -350,9 +351,9 @@ impl Graph {
         name
     }
 
-    /// Declares a resource produced and consumed inside the graph that is never filtered
-    /// ([`Resource::unfiltered`]): e.g. a separable blur's row pass output, which only its
-    /// column pass reads.
+    /// Declares a resource that is never filtered ([`Resource::unfiltered`]): e.g. a separable
+    /// blur's row pass output, which only its column pass reads, or a fixed-point table, which
+    /// its lookups only load.
     pub fn intermediate(
         &mut self,
         name: impl Into<String>,
@@ -365,6 +366,13 @@ impl Graph {
             r.unfiltered = true;
         }
         name
+    }
+
+    /// Marks resource `name` [`Resource::unfiltered`] (no effect on a name not declared).
+    pub fn mark_unfiltered(&mut self, name: &str) {
+        if let Some(r) = self.resources.iter_mut().find(|r| r.name == name) {
+            r.unfiltered = true;
+        }
     }
 
     /// Declares a texture holding the maps `layers` (each the size of `of`) interleaved along

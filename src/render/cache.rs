@@ -81,6 +81,8 @@ pub(super) struct LightCache {
     keys: Vec<String>,
     /// The plan's textures of the last frame, which the kept maps lie in.
     textures: Option<HashMap<String, wgpu::Texture>>,
+    /// The plan's storage buffers of the last frame (`exec::Outputs::buffers`).
+    buffers: Option<HashMap<String, crate::exec::BufferMap>>,
     /// Whether the scene caches (else every light is drawn every frame and nothing is kept).
     active: bool,
 }
@@ -177,8 +179,10 @@ impl LightCache {
         let same = self
             .textures
             .as_ref()
-            .is_none_or(|t| *t == outputs.textures);
+            .is_none_or(|t| *t == outputs.textures)
+            && self.buffers.as_ref().is_none_or(|b| *b == outputs.buffers);
         self.textures = Some(outputs.textures.clone());
+        self.buffers = Some(outputs.buffers.clone());
         same
     }
 

@@ -17,8 +17,10 @@ use crate::{
 };
 use crate::{model::Light, scene::Scene};
 
+mod maps;
 mod raster;
 
+pub(super) use maps::ShadeMap;
 pub use raster::ShadowRaster;
 pub(super) use raster::VIEW_BYTES;
 pub(super) use raster::depth_only_view;
@@ -54,7 +56,7 @@ pub struct Renderer {
 /// targets they were made with.
 struct ShadeBinding {
     kernel: Arc<ComputeKernel>,
-    maps: Vec<wgpu::Texture>,
+    maps: Vec<ShadeMap>,
     groups: [wgpu::BindGroup; 2],
 }
 
@@ -82,8 +84,11 @@ pub(super) struct ShadeInputs<'a> {
 impl Renderer {
     /// A renderer for `device`.
     pub fn new(device: &wgpu::Device) -> Self {
+        // The shading kernel reads the tables that the layout keeps in buffers from them.
+        let mut executor = Executor::new();
+        executor.set_output_buffers(true);
         Self {
-            executor: Executor::new(),
+            executor,
             shadow: HashMap::new(),
             peel: HashMap::new(),
             gbuffer: None,
@@ -290,7 +295,7 @@ impl Renderer {
         drawn: &DrawnLights,
         repeat: u32,
     ) -> Result<(Vec<Vec<(String, f64)>>, Vec<f64>, Vec<Vec<String>>, Outputs)> {
-        let kernel = self.shade_kernel_cascaded(device, &drawn.lights, &drawn.groups)?;
+        let kernel = self.frame_shade_kernel(device, drawn, sp)?;
         let peels = targets.lights.iter().filter(|t| t.peel.is_some()).count();
         let spans = (drawn.lights.len() + peels) as u32 + sp.plan.steps.len() as u32 + 2;
         let mut timer = match self.timer.take() {
@@ -378,12 +383,12 @@ impl Renderer {
         let steps = sp.plan.steps.iter().zip(&run).filter(|(_, r)| **r);
         passes.extend(steps.map(|(s, _)| s.node.name.clone()));
         self.gbuffer_pass(device, enc, frame.targets, timer.as_deref_mut())?;
-        let maps: Vec<wgpu::Texture> = sp
+        let maps = sp
             .shade_inputs
             .iter()
             .flat_map(|s| &s.maps)
-            .map(|m| outputs.textures[m].clone())
-            .collect();
+            .map(|m| ShadeMap::of(&outputs, m))
+            .collect::<Result<Vec<_>>>()?;
         let groups = self.shade_groups(device, frame.kernel, frame.targets, maps)?;
         record_shade(enc, frame.kernel, groups, frame.targets.key.size, timer);
         passes.extend(["gbuffer".to_string(), "shade".to_string()]);
@@ -471,50 +476,13 @@ impl Renderer {
         Ok(())
     }
 
-    /// The shading pass's bind groups for `kernel` over `maps` (light by light, in binding
-    /// order), made when either changed since the last frame.
-    fn shade_groups(
-        &mut self,
-        device: &wgpu::Device,
-        kernel: &Arc<ComputeKernel>,
-        targets: &Targets,
-        maps: Vec<wgpu::Texture>,
-    ) -> Result<&[wgpu::BindGroup; 2]> {
-        let current = self
-            .binding
-            .as_ref()
-            .is_some_and(|b| Arc::ptr_eq(&b.kernel, kernel) && b.maps == maps);
-        if !current {
-            let views: Vec<wgpu::TextureView> = maps.iter().map(depth_only_view).collect();
-            let inputs = ShadeInputs {
-                gpos: &targets.gpos_view,
-                gnorm: &targets.gnorm_view,
-                materials: &targets.materials,
-                lights: &targets.light_data,
-                frame: &targets.frame,
-                color: &targets.color_view,
-                visibility: &targets.visibility,
-            };
-            let groups = self.shade_bind_groups(device, kernel, &inputs, &views)?;
-            self.binding = Some(ShadeBinding {
-                kernel: kernel.clone(),
-                maps,
-                groups,
-            });
-        }
-        self.binding
-            .as_ref()
-            .map(|b| &b.groups)
-            .ok_or_else(|| Error::Invalid("the shading pass is not bound".into()))
-    }
-
     /// The shading pass's bind groups: group 0 from `inputs`, group 1 the maps.
     pub(super) fn shade_bind_groups(
         &self,
         device: &wgpu::Device,
         kernel: &ComputeKernel,
         inputs: &ShadeInputs,
-        maps: &[wgpu::TextureView],
+        maps: &[wgpu::BindingResource<'_>],
     ) -> Result<[wgpu::BindGroup; 2]> {
         let err = |message: String| Error::Pipeline {
             kernel: "shade".into(),
@@ -550,7 +518,10 @@ impl Renderer {
         let map_entries: Vec<wgpu::BindGroupEntry> = maps
             .iter()
             .enumerate()
-            .map(|(i, v)| view(i as u32, v))
+            .map(|(i, r)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource: r.clone(),
+            })
             .collect();
         let group = |label, layout, entries: &[wgpu::BindGroupEntry]| {
             scoped(

@@ -312,7 +312,12 @@ impl Renderer {
             color: &views[2],
             visibility: &visibility,
         };
-        let groups = self.shade_bind_groups(device, &kernel, &inputs, at.maps)?;
+        let maps: Vec<wgpu::BindingResource> = at
+            .maps
+            .iter()
+            .map(wgpu::BindingResource::TextureView)
+            .collect();
+        let groups = self.shade_bind_groups(device, &kernel, &inputs, &maps)?;
         let mut enc = device.create_command_encoder(&Default::default());
         record_shade(&mut enc, &kernel, &groups, (w, h), None);
         submit_and_wait(device, queue, enc, "visibility_at")?;

@@ -102,7 +102,7 @@ pub fn add_layered_sat(graph: &mut Graph, light: usize, sat: &LayeredSat<'_>) ->
                 let format = sat.coding.variant.format(*channels);
                 graph.resource(sat_name(name), format, same, Some(light))
             })
-            .collect()
+            .collect::<Vec<_>>()
     } else {
         // A texture's format holds its widest table; narrower ones leave channels unused.
         sat.tables
@@ -122,6 +122,12 @@ pub fn add_layered_sat(graph: &mut Graph, light: usize, sat: &LayeredSat<'_>) ->
             })
             .collect()
     };
+    // Fixed-point tables are only loaded, never filtered (their lookups' `textureLoad`).
+    if sat.coding.variant == crate::model::SatVariant::Fixed {
+        for t in &tables {
+            graph.mark_unfiltered(t);
+        }
+    }
     let tiles = |count: u32| Dispatch::Layers {
         base: Box::new(Dispatch::Blocks {
             of: source.clone(),

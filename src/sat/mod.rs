@@ -299,12 +299,22 @@ pub fn add_sat(graph: &mut Graph, light: usize, input: &str, coding: &SatCoding)
         of: input.to_string(),
         shift: 0,
     };
-    let out = graph.resource(
-        name.clone(),
-        coding.variant.format(channels),
-        same,
-        Some(light),
-    );
+    // A fixed-point table is only loaded, never filtered (its lookups' `textureLoad`).
+    let out = if coding.variant == SatVariant::Fixed {
+        graph.intermediate(
+            name.clone(),
+            coding.variant.format(channels),
+            same,
+            Some(light),
+        )
+    } else {
+        graph.resource(
+            name.clone(),
+            coding.variant.format(channels),
+            same,
+            Some(light),
+        )
+    };
     let tiles = Dispatch::Blocks {
         of: input.to_string(),
         x: SAT_TILE,

@@ -54,8 +54,8 @@ pub use params::{Clamp, ClampReason, sat_exponent_limit};
 pub use reach::{cascade_guard, reach, texels_past_radius};
 pub use second_depth::{peels, second_depth_name};
 pub use shade::{
-    SAT_SAMPLER, ShadeInput, VisibilityBody, shade_key, shading_block, shading_block_cascaded,
-    visibility_body,
+    SAT_SAMPLER, ShadeInput, VisibilityBody, map_binding, shade_key, shading_block,
+    shading_block_cascaded, visibility_body,
 };
 pub use sweep_plan::{SweepPlan, SweepVariant, SweptStorages, SweptTerms};
 

@@ -199,6 +199,11 @@ pub fn shade_key(lights: &[Light]) -> String {
     key
 }
 
+/// The name of light `light`'s map `map` in the shading kernel's group 1 ([`shading_block`]).
+pub fn map_binding(light: usize, map: usize) -> String {
+    format!("light{light}_map{map}")
+}
+
 /// The `// #generated` block of `kernels/shade.wgsl` for these lights: imports of the
 /// techniques used, one group-1 binding per map (light by light, in [`ShadeInput::maps`]
 /// order), one visibility function per light and `light_visibility`, which dispatches on the
@@ -222,9 +227,7 @@ pub fn shading_block_cascaded(lights: &[Light], groups: &[CascadeGroup]) -> Stri
     let mut binding = 0;
     for (i, light) in lights.iter().enumerate() {
         let input = add_light_nodes(&mut Graph::default(), i, light);
-        let maps: Vec<String> = (0..input.maps.len())
-            .map(|k| format!("light{i}_map{k}"))
-            .collect();
+        let maps: Vec<String> = (0..input.maps.len()).map(|k| map_binding(i, k)).collect();
         let vis = visibility_body(light, &maps);
         for module in vis.modules {
             if !imports.contains(&module) {

@@ -405,7 +405,7 @@ fn storage_buffer_variants_validate() {
             continue;
         };
         for (k, with) in [None, Some(&modules)].into_iter().enumerate() {
-            let held = match buffer_slots(&plan, redesign, &limits, with) {
+            let held = match buffer_slots(&plan, redesign, &limits, with, true) {
                 Ok(h) => h,
                 Err(e) => {
                     failures.push(format!("{technique:?}: {e}"));

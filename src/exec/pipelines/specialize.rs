@@ -62,7 +62,11 @@ pub(super) fn apply(
     changes: &[Change],
     extra: Option<&kernels::Replacements>,
 ) -> Result<String> {
-    let mut wgsl = kernels::resolve_in(name, None, extra)?;
+    apply_changes(name, kernels::resolve_in(name, None, extra)?, changes)
+}
+
+/// Kernel `name`'s text `wgsl` with `changes` applied.
+pub(super) fn apply_changes(name: &str, mut wgsl: String, changes: &[Change]) -> Result<String> {
     for change in changes {
         wgsl = change.apply(&wgsl).ok_or_else(|| Error::Kernel {
             kernel: name.to_string(),
