@@ -9,11 +9,11 @@
 #   benches/gpu_more.sh [BINARY] [OUT]     # defaults: target/release/shadowgraph, gpu-more
 #
 # The steps run in order, each under its own time box, appending to files of OUT (env, steps,
-# soft, shade, variants, kernels_2048), so a call stopped by its time box still returns what
-# ran: soft table about 66 s, four shading shapes about 80 s, the blur rows' variants 35 s,
-# the tables' 30 s, the mip chain's 20 s, every kernel at 2048² 20 s, the fused ablation 10 s,
-# the layouts 70 s, workgroup memory 30 s, the bunny frame and six cascaded frames 20 s (about
-# 400 s; BASE about 60 s more). A second binary to compare against goes in as
+# soft, tables, shade, variants, kernels_2048), so a call stopped by its time box still returns
+# what ran: soft table about 66 s, the shading over tables in buffers 50 s, four shading
+# shapes about 80 s, the blur rows' variants 35 s, the tables' 30 s, the mip chain's 20 s,
+# every kernel at 2048² 20 s, the fused ablation 10 s, the layouts 70 s, workgroup memory
+# 30 s, the bunny frame and six cascaded frames 20 s (about 450 s; BASE about 60 s more). A second binary to compare against goes in as
 # BASE=path/to/other/shadowgraph: its 2048² blur and table rows are then timed alternately with
 # BINARY's (compare timings only within one call). Record the results in benches/RESULTS.md
 # (device, date, commit, command, table).
@@ -46,6 +46,11 @@
 #   and EVSM4 alike: GPU_LAYOUT's branches in shared/encode_blur.wgsl go, LANES becomes the
 #   constant CPU_LANES (then rename it).
 # - variants.txt, zeroed: informational (exec::WorkgroupInit::AsLeft ships either way).
+# - tables.txt: `vssm` and `msm_soft` (fixed-point tables) shaded over tables in storage
+#   buffers (the first block, `redesign`) against textures (`redesign-textures`), at every
+#   light size. Together with gpu_check.sh's buffers.txt: the renderer's tables move to
+#   buffers where the shade pass and the table build are both 3% or more faster; a plug-in
+#   output in a buffer (a host-visible change) only then.
 set -u
 B=${1:-target/release/shadowgraph}
 OUT=${2:-gpu-more}
@@ -93,6 +98,12 @@ if command -v nvidia-smi >/dev/null; then
 fi
 step soft.txt 150 "$B" bench --lookup 3 --repeat 20 --image 1920x1080 --map 2048
 [ -n "$SAMPLER" ] && kill "$SAMPLER" 2>/dev/null
+# The shading over fixed-point tables in storage buffers (the redesign layout) against the
+# same kernels over textures, one process each, back to back.
+for layout in redesign redesign-textures; do
+    SHADOWGRAPH_KERNEL_LAYOUT=$layout step tables.txt 25 "$B" bench --lookup 3 --repeat 20 \
+        --image 1920x1080 --map 2048 --only vssm,msm_soft
+done
 # The shading pass's floor: `hard` with parts of kernels/shade.wgsl taken out
 # (SHADOWGRAPH_KERNEL_DIR), from the constant store alone up to the shipped kernel. A variant
 # that no longer uses a binding is bound without it (bindings follow the kernel's reflection).
