@@ -36,6 +36,11 @@
 # times, each box BOX_SCALE (default 4) times longer, for a CPU driver's speed.
 #
 # Reading the results (decided before the run, so that a lent GPU's time goes to the change):
+# - evaluate.txt, the soft target: per scene, `vssm`'s prefilter passes (its 2048² table
+#   build, redone every frame for a moving light) plus its `shade` pass against `pcss 16+32`'s
+#   `shade` pass, at 1920×1080: met where the sum is the smaller in all three scenes (the
+#   reports' per-pass medians; a configuration the clock check flags is read from its
+#   second measurement).
 # - Roofline (kernels.txt, every row's `roof`: its minimal traffic, one read of its inputs and
 #   one write of its outputs, at the buffer copy's GB/s over its time; 1.00 = the buffer
 #   copy's speed). The targets: every encode, blur pass, fused chain and mip chain ≥ 0.70 at

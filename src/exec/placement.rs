@@ -43,12 +43,13 @@ pub fn slot_in_buffer(
 }
 
 /// Per slot of `plan`, whether the executor holds it in a storage buffer in `layout` on a
-/// device of `limits` (requested outputs too where `outputs`), each node's kernel the file the layout compiles
-/// ([`KernelLayout::kernel_source`]) resolved with `sources` (replaced kernels and the
-/// layout's redesigned modules): a slot of [`slot_in_buffer`] that every kernel binding it
-/// uses only through `textureLoad`, `textureStore` and `textureDimensions` (what
-/// `exec::buffers` rewrites; a kernel that passes the texture on to a function of its own
-/// keeps the slot a texture) and that no node binds by mip level ([`Dispatch::Several`]).
+/// device of `limits` (requested outputs too where `outputs`), each node's kernel the file
+/// the layout compiles ([`KernelLayout::kernel_source`]) resolved with `sources` (replaced
+/// kernels and the layout's redesigned modules): a slot of [`slot_in_buffer`] that every
+/// kernel binding it uses only through `textureLoad`, `textureStore` and
+/// `textureDimensions`, directly or in functions it passes the texture to (what
+/// `exec::monomorph` and `exec::buffers` rewrite), and that no node binds by mip level
+/// ([`Dispatch::Several`]).
 pub fn buffer_slots(
     plan: &Plan,
     layout: KernelLayout,
