@@ -33,25 +33,27 @@ impl ShadeMap {
         }
     }
 
-    /// The view a texture is bound through; none for a buffer.
-    pub(super) fn view(&self) -> Option<wgpu::TextureView> {
+    /// What the shading pass binds for this map: a texture's (depth-only) view, or the
+    /// buffer.
+    fn bound(&self) -> Bound {
         match self {
-            Self::Texture(t) => Some(super::depth_only_view(t)),
-            Self::Buffer(_) => None,
+            Self::Texture(t) => Bound::View(super::depth_only_view(t)),
+            Self::Buffer(b) => Bound::Buffer(b.clone()),
         }
     }
+}
 
-    /// The binding of this map, `view` its [`ShadeMap::view`].
-    pub(super) fn resource<'a>(
-        &'a self,
-        view: &'a Option<wgpu::TextureView>,
-    ) -> wgpu::BindingResource<'a> {
-        match (self, view) {
-            (Self::Buffer(b), _) => b.as_entire_binding(),
-            (Self::Texture(_), Some(v)) => wgpu::BindingResource::TextureView(v),
-            (Self::Texture(t), None) => {
-                unreachable!("a texture's view is made with it ({:?})", t.format())
-            }
+/// A map as bound: the view made of its texture, or its buffer.
+enum Bound {
+    View(wgpu::TextureView),
+    Buffer(wgpu::Buffer),
+}
+
+impl Bound {
+    fn resource(&self) -> wgpu::BindingResource<'_> {
+        match self {
+            Self::View(v) => wgpu::BindingResource::TextureView(v),
+            Self::Buffer(b) => b.as_entire_binding(),
         }
     }
 }
@@ -112,12 +114,8 @@ impl Renderer {
             .as_ref()
             .is_some_and(|b| Arc::ptr_eq(&b.kernel, kernel) && b.maps == maps);
         if !current {
-            let views: Vec<Option<wgpu::TextureView>> = maps.iter().map(ShadeMap::view).collect();
-            let resources: Vec<wgpu::BindingResource> = maps
-                .iter()
-                .zip(&views)
-                .map(|(m, v)| m.resource(v))
-                .collect();
+            let bound: Vec<Bound> = maps.iter().map(ShadeMap::bound).collect();
+            let resources: Vec<wgpu::BindingResource> = bound.iter().map(Bound::resource).collect();
             let inputs = ShadeInputs {
                 gpos: &targets.gpos_view,
                 gnorm: &targets.gnorm_view,
